@@ -1,0 +1,1 @@
+//! hindsight's specification language: Past-MTL formulas over typed atoms, compiled to monitors.

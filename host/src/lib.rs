@@ -1,0 +1,1 @@
+//! hindsight's host side: models, simulation, SMC and the CLI.

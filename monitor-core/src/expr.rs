@@ -1,0 +1,154 @@
+//! The atom stack machine: type-checked once on load, then evaluated with a fixed stack.
+
+use crate::error::StepError;
+use crate::program::{CmpOp, Instr, NumTy, Ty, Value, Var};
+
+/// Deepest stack an atom may use; deeper expressions are rejected by the compiler.
+pub const MAX_STACK: usize = 32;
+
+/// Type-checks one atom's bytecode against the variable types; `true` when it
+/// never underflows, never exceeds [`MAX_STACK`], types every operand and leaves
+/// exactly one boolean.
+pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> bool {
+    let mut stack = [Ty::Bool; MAX_STACK];
+    let mut sp = 0usize;
+    if code.is_empty() {
+        return false;
+    }
+    for ins in code {
+        let (pops, push): (&[Ty], Ty) = match *ins {
+            Instr::Push(v) => (&[], v.ty()),
+            Instr::Load(n) => match vars.get(n as usize) {
+                Some(v) => (&[], v.ty),
+                None => return false,
+            },
+            Instr::Not => (&[Ty::Bool], Ty::Bool),
+            Instr::And | Instr::Or => (&[Ty::Bool, Ty::Bool], Ty::Bool),
+            Instr::Neg(NumTy::Int) => (&[Ty::Int], Ty::Int),
+            Instr::Neg(NumTy::Float) => (&[Ty::Float], Ty::Float),
+            Instr::Add(n) | Instr::Sub(n) | Instr::Mul(n) | Instr::Div(n) | Instr::Rem(n) => {
+                match n {
+                    NumTy::Int => (&[Ty::Int, Ty::Int], Ty::Int),
+                    NumTy::Float => (&[Ty::Float, Ty::Float], Ty::Float),
+                }
+            }
+            Instr::Cmp(op, ty) => {
+                let ordered = matches!(op, CmpOp::Lt | CmpOp::Le | CmpOp::Gt | CmpOp::Ge);
+                if ordered && matches!(ty, Ty::Bool | Ty::Str) {
+                    return false;
+                }
+                match ty {
+                    Ty::Bool => (&[Ty::Bool, Ty::Bool], Ty::Bool),
+                    Ty::Int => (&[Ty::Int, Ty::Int], Ty::Bool),
+                    Ty::Float => (&[Ty::Float, Ty::Float], Ty::Bool),
+                    Ty::Str => (&[Ty::Str, Ty::Str], Ty::Bool),
+                }
+            }
+            Instr::ToFloat => (&[Ty::Int], Ty::Float),
+        };
+        if sp < pops.len() {
+            return false;
+        }
+        for (k, want) in pops.iter().enumerate() {
+            if stack[sp - pops.len() + k] != *want {
+                return false;
+            }
+        }
+        sp -= pops.len();
+        if sp >= MAX_STACK {
+            return false;
+        }
+        stack[sp] = push;
+        sp += 1;
+    }
+    sp == 1 && stack[0] == Ty::Bool
+}
+
+/// Evaluates a checked atom over `vals`. Errors on a value of the wrong type
+/// (the caller's input) or on integer overflow / division by zero.
+pub(crate) fn eval(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, StepError> {
+    let mut stack = [Value::Bool(false); MAX_STACK];
+    let mut sp = 0usize;
+    let arith = StepError::Arithmetic { atom };
+    for ins in code {
+        // Checked programs never underflow or overflow; the guards only keep this panic-free.
+        let v = match *ins {
+            Instr::Push(v) => v,
+            Instr::Load(n) => match vals.get(n as usize) {
+                Some(v) => *v,
+                None => return Err(StepError::VarType { var: n }),
+            },
+            Instr::Not | Instr::Neg(_) | Instr::ToFloat => {
+                let Some(a) = sp.checked_sub(1).map(|i| stack[i]) else {
+                    return Err(arith);
+                };
+                sp -= 1;
+                match (*ins, a) {
+                    (Instr::Not, Value::Bool(a)) => Value::Bool(!a),
+                    (Instr::Neg(_), Value::Int(a)) => Value::Int(a.checked_neg().ok_or(arith)?),
+                    (Instr::Neg(_), Value::Float(a)) => Value::Float(-a),
+                    (Instr::ToFloat, Value::Int(a)) => Value::Float(a as f64),
+                    _ => return Err(arith),
+                }
+            }
+            _ => {
+                if sp < 2 {
+                    return Err(arith);
+                }
+                let (a, b) = (stack[sp - 2], stack[sp - 1]);
+                sp -= 2;
+                binary(*ins, a, b).ok_or(arith)?
+            }
+        };
+        let Some(slot) = stack.get_mut(sp) else {
+            return Err(arith);
+        };
+        *slot = v;
+        sp += 1;
+    }
+    match (sp, stack[0]) {
+        (1, Value::Bool(b)) => Ok(b),
+        _ => Err(arith),
+    }
+}
+
+fn binary(ins: Instr, a: Value, b: Value) -> Option<Value> {
+    use Value::{Bool, Float, Int, Str};
+    Some(match (ins, a, b) {
+        (Instr::And, Bool(a), Bool(b)) => Bool(a && b),
+        (Instr::Or, Bool(a), Bool(b)) => Bool(a || b),
+        (Instr::Add(_), Int(a), Int(b)) => Int(a.checked_add(b)?),
+        (Instr::Sub(_), Int(a), Int(b)) => Int(a.checked_sub(b)?),
+        (Instr::Mul(_), Int(a), Int(b)) => Int(a.checked_mul(b)?),
+        (Instr::Div(_), Int(a), Int(b)) => Int(a.checked_div(b)?),
+        (Instr::Rem(_), Int(a), Int(b)) => Int(a.checked_rem(b)?),
+        (Instr::Add(_), Float(a), Float(b)) => Float(a + b),
+        (Instr::Sub(_), Float(a), Float(b)) => Float(a - b),
+        (Instr::Mul(_), Float(a), Float(b)) => Float(a * b),
+        (Instr::Div(_), Float(a), Float(b)) => Float(a / b),
+        (Instr::Rem(_), Float(a), Float(b)) => Float(a % b),
+        (Instr::Cmp(op, _), a, b) => Bool(match (a, b) {
+            (Int(a), Int(b)) => cmp(op, a.partial_cmp(&b)),
+            (Float(a), Float(b)) => cmp(op, a.partial_cmp(&b)),
+            (Bool(a), Bool(b)) => cmp(op, Some(a.cmp(&b))),
+            (Str(a), Str(b)) => cmp(op, Some(a.cmp(&b))),
+            _ => return None,
+        }),
+        _ => return None,
+    })
+}
+
+fn cmp(op: CmpOp, ord: Option<core::cmp::Ordering>) -> bool {
+    use core::cmp::Ordering::{Equal, Greater, Less};
+    match (op, ord) {
+        // NaN: every comparison false except `!=`.
+        (CmpOp::Ne, None) => true,
+        (_, None) => false,
+        (CmpOp::Eq, Some(o)) => o == Equal,
+        (CmpOp::Ne, Some(o)) => o != Equal,
+        (CmpOp::Lt, Some(o)) => o == Less,
+        (CmpOp::Le, Some(o)) => o != Greater,
+        (CmpOp::Gt, Some(o)) => o == Greater,
+        (CmpOp::Ge, Some(o)) => o != Less,
+    }
+}

@@ -1,0 +1,51 @@
+//! The run-time half of hindsight's Past-MTL monitors: `no_std`, no `alloc`, fixed memory.
+//!
+//! # Pipeline
+//!
+//! A specification (variables, atoms, Past-MTL formulas) is parsed, checked
+//! and compiled on the host by `hindsight-codegen` into a [`Program`]: atom
+//! bytecode plus one *sequential network* per formula, nodes in topological
+//! order. This crate only runs programs:
+//!
+//! 1. **Get a program**: generated Rust source builds one from `static` arrays,
+//!    or [`table::Table::from_bytes`] (feature `postcard`) decodes one from bytes.
+//! 2. **Validate**: [`Monitor::try_new`] checks every index, type, bound and
+//!    state slot once, so that stepping cannot panic or misbehave.
+//! 3. **Allocate state**: [`Monitor::state_words`] `u64` words, owned by the
+//!    caller (a `static`, the stack, a `Vec` on the host); [`Monitor::reset`].
+//! 4. **Step**: [`Monitor::try_step`] once per trace point with the variables'
+//!    values ([`valuation`] keeps event/state semantics), or
+//!    [`Monitor::try_step_atoms`] with precomputed atom bits. Each call writes
+//!    one verdict per property; a timestamp that goes backwards is an
+//!    [`StepError`], never a wrong verdict.
+//!
+//! Work per point is constant (amortised for windowed `S[a:b]`, whose runs are
+//! each pushed and expired once) and memory is fixed by the formula's bounds
+//! ([`layout`]).
+//!
+//! # Crate features
+//!
+//! - `serde`: `Serialize`/`Deserialize` for every program type.
+//! - `postcard`: [`table::Table`], a validated postcard loader (implies `serde`).
+//! - `defmt`: `defmt::Format` for the error types.
+#![no_std]
+#![forbid(unsafe_code)]
+
+pub mod error;
+mod expr;
+pub mod layout;
+mod monitor;
+pub mod program;
+#[cfg(feature = "postcard")]
+pub mod table;
+pub mod valuation;
+
+#[cfg(feature = "defmt")]
+mod defmt_impls;
+
+pub use error::{StepError, TableError};
+pub use expr::MAX_STACK;
+pub use monitor::{Monitor, MAX_IDS};
+pub use program::{
+    Atom, CmpOp, Instr, Node, NodeId, NumTy, Op, Program, Property, Ty, Value, Var, VarKind,
+};

@@ -1,0 +1,1 @@
+//! Shared helpers for hindsight's workspace-level tests.
