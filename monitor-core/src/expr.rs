@@ -79,7 +79,7 @@ pub(crate) fn eval(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, St
                 None => return Err(StepError::VarType { var: n }),
             },
             Instr::Not | Instr::Neg(_) | Instr::ToFloat => {
-                let Some(a) = sp.checked_sub(1).map(|i| stack[i]) else {
+                let Some(&a) = sp.checked_sub(1).and_then(|i| stack.get(i)) else {
                     return Err(arith);
                 };
                 sp -= 1;
@@ -92,10 +92,12 @@ pub(crate) fn eval(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, St
                 }
             }
             _ => {
-                if sp < 2 {
+                let (Some(&a), Some(&b)) = (
+                    sp.checked_sub(2).and_then(|i| stack.get(i)),
+                    sp.checked_sub(1).and_then(|i| stack.get(i)),
+                ) else {
                     return Err(arith);
-                }
-                let (a, b) = (stack[sp - 2], stack[sp - 1]);
+                };
                 sp -= 2;
                 binary(*ins, a, b).ok_or(arith)?
             }
@@ -106,8 +108,8 @@ pub(crate) fn eval(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, St
         *slot = v;
         sp += 1;
     }
-    match (sp, stack[0]) {
-        (1, Value::Bool(b)) => Ok(b),
+    match (sp, stack.first()) {
+        (1, Some(Value::Bool(b))) => Ok(*b),
         _ => Err(arith),
     }
 }

@@ -33,8 +33,8 @@ impl<'a> Monitor<'a> {
             return Err(TableError::TooLarge);
         }
         for (i, v) in p.vars.iter().enumerate() {
-            let ok = v.init.ty() == v.ty
-                && (v.kind == VarKind::State || v.init == Value::Bool(false));
+            let ok =
+                v.init.ty() == v.ty && (v.kind == VarKind::State || v.init == Value::Bool(false));
             if !ok {
                 return Err(TableError::Var { var: i as u16 });
             }
@@ -52,7 +52,11 @@ impl<'a> Monitor<'a> {
         let mut first = 0usize;
         for (i, n) in p.nodes.iter().enumerate() {
             // The property owning node i: the first whose root is >= i.
-            while p.props.get(prop_of_next).is_some_and(|pr| (pr.root as usize) < i) {
+            while p
+                .props
+                .get(prop_of_next)
+                .is_some_and(|pr| (pr.root as usize) < i)
+            {
                 prop_of_next += 1;
                 first = i;
             }
@@ -173,13 +177,14 @@ impl<'a> Monitor<'a> {
                 let Some(a) = p.atoms.get(atoms_done) else {
                     break;
                 };
-                let code = &p.instrs[a.start as usize..a.start as usize + a.len as usize];
+                let range = a.start as usize..a.start as usize + a.len as usize;
+                let code = p.instrs.get(range).unwrap_or(&[]);
                 if expr::eval(code, vars, atoms_done as u16)? {
                     bits |= 1 << b;
                 }
                 atoms_done += 1;
             }
-            state[layout::HEADER_WORDS + w] = bits;
+            wr(state, layout::HEADER_WORDS + w, bits);
         }
         self.advance(state, time, verdicts);
         Ok(())
@@ -202,7 +207,9 @@ impl<'a> Monitor<'a> {
                 found: atoms.len(),
             });
         }
-        state[layout::HEADER_WORDS..self.values_at].copy_from_slice(atoms);
+        for (k, a) in atoms.iter().enumerate() {
+            wr(state, layout::HEADER_WORDS + k, *a);
+        }
         self.advance(state, time, verdicts);
         Ok(())
     }
@@ -218,9 +225,10 @@ impl<'a> Monitor<'a> {
         if time == u64::MAX {
             return Err(StepError::TimeOutOfRange);
         }
-        if state[0] != 0 && time < state[0] - 1 {
+        let last = rd(state, 0);
+        if last != 0 && time < last - 1 {
             return Err(StepError::TimeWentBackwards {
-                last: state[0] - 1,
+                last: last - 1,
                 now: time,
             });
         }
@@ -235,76 +243,95 @@ impl<'a> Monitor<'a> {
     }
 
     /// Updates every node; the state length and the time were checked by the caller.
+    ///
+    /// Every access goes through `get`/`get_mut` (the slots were validated, so the
+    /// fallbacks never run): the step links no panic path into firmware.
     fn advance(&self, state: &mut [u64], t: u64, verdicts: &mut [bool]) {
-        let first_point = state[0] == 0;
+        let first_point = rd(state, 0) == 0;
         let vals = self.values_at;
-        let get = |state: &[u64], base: usize, i: u16| -> bool {
+        let bit = |state: &[u64], base: usize, i: u16| -> bool {
             let i = i as usize;
-            state[base + i / 64] >> (i % 64) & 1 == 1
+            rd(state, base + i / 64) >> (i % 64) & 1 == 1
         };
         for (i, node) in self.program.nodes.iter().enumerate() {
             let slot = node.slot as usize;
             let v = match node.op {
                 Op::Const(c) => c,
-                Op::Atom(a) => get(state, layout::HEADER_WORDS, a),
-                Op::Not(a) => !get(state, vals, a),
-                Op::And(a, b) => get(state, vals, a) && get(state, vals, b),
-                Op::Or(a, b) => get(state, vals, a) || get(state, vals, b),
-                Op::Implies(a, b) => !get(state, vals, a) || get(state, vals, b),
-                Op::Iff(a, b) => get(state, vals, a) == get(state, vals, b),
+                Op::Atom(a) => bit(state, layout::HEADER_WORDS, a),
+                Op::Not(a) => !bit(state, vals, a),
+                Op::And(a, b) => bit(state, vals, a) && bit(state, vals, b),
+                Op::Or(a, b) => bit(state, vals, a) || bit(state, vals, b),
+                Op::Implies(a, b) => !bit(state, vals, a) || bit(state, vals, b),
+                Op::Iff(a, b) => bit(state, vals, a) == bit(state, vals, b),
                 Op::Yesterday(a) => {
-                    let out = !first_point && state[slot] != 0;
-                    state[slot] = get(state, vals, a) as u64;
+                    let out = !first_point && rd(state, slot) != 0;
+                    wr(state, slot, bit(state, vals, a) as u64);
                     out
                 }
                 Op::WeakYesterday(a) => {
-                    let out = first_point || state[slot] != 0;
-                    state[slot] = get(state, vals, a) as u64;
+                    let out = first_point || rd(state, slot) != 0;
+                    wr(state, slot, bit(state, vals, a) as u64);
                     out
                 }
                 Op::Since { lhs, rhs, lo, hi } => {
-                    let f = get(state, vals, lhs);
-                    let g = get(state, vals, rhs);
+                    let f = bit(state, vals, lhs);
+                    let g = bit(state, vals, rhs);
                     match layout::since_kind(lo, hi) {
                         Some(SinceKind::Unbounded) => {
-                            let prev = !first_point && get(state, vals, i as u16);
+                            let prev = !first_point && bit(state, vals, i as u16);
                             g || (f && prev)
                         }
                         Some(SinceKind::UpTo(b)) => {
-                            let w = &mut state[slot];
+                            let mut w = rd(state, slot);
                             if !f {
-                                *w = 0;
+                                w = 0;
                             }
                             if g {
-                                *w = t + 1;
+                                w = t + 1;
                             }
-                            *w != 0 && t - (*w - 1) <= b
+                            wr(state, slot, w);
+                            w != 0 && t.wrapping_sub(w - 1) <= b
                         }
                         Some(SinceKind::AtLeast(a)) => {
-                            let w = &mut state[slot];
+                            let mut w = rd(state, slot);
                             if !f {
-                                *w = 0;
+                                w = 0;
                             }
-                            if g && *w == 0 {
-                                *w = t + 1;
+                            if g && w == 0 {
+                                w = t + 1;
                             }
-                            *w != 0 && t - (*w - 1) >= a
+                            wr(state, slot, w);
+                            w != 0 && t.wrapping_sub(w - 1) >= a
                         }
-                        Some(SinceKind::Window { lo, hi, cap }) => {
-                            window_step(&mut state[slot..], cap as usize, lo, hi, t, f, g)
-                        }
+                        Some(SinceKind::Window { lo, hi, cap }) => match state.get_mut(slot..) {
+                            Some(w) => window_step(w, cap as usize, lo, hi, t, f, g),
+                            None => false,
+                        },
                         // Rejected by `try_new`.
                         None => false,
                     }
                 }
             };
-            let w = &mut state[vals + i / 64];
-            *w = (*w & !(1 << (i % 64))) | ((v as u64) << (i % 64));
+            let k = vals + i / 64;
+            let w = rd(state, k);
+            wr(state, k, (w & !(1 << (i % 64))) | ((v as u64) << (i % 64)));
         }
-        state[0] = t + 1;
+        wr(state, 0, t + 1);
         for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
-            *out = get(state, vals, pr.root);
+            *out = bit(state, vals, pr.root);
         }
+    }
+}
+
+#[inline(always)]
+fn rd(w: &[u64], i: usize) -> u64 {
+    w.get(i).copied().unwrap_or(0)
+}
+
+#[inline(always)]
+fn wr(w: &mut [u64], i: usize, v: u64) {
+    if let Some(x) = w.get_mut(i) {
+        *x = v;
     }
 }
 
@@ -315,30 +342,36 @@ impl<'a> Monitor<'a> {
 /// oldest run decides the verdict (it has the smallest `first`, and every live
 /// run still has `last + hi >= t`).
 fn window_step(w: &mut [u64], cap: usize, lo: u64, hi: u64, t: u64, f: bool, g: bool) -> bool {
-    let mut head = (w[0] & 0xffff_ffff) as usize;
-    let mut len = (w[0] >> 32) as usize;
+    let next = |k: usize| if k + 1 >= cap { 0 } else { k + 1 };
+    let header = rd(w, 0);
+    let mut head = (header & 0xffff_ffff) as usize;
+    let mut len = (header >> 32) as usize;
     if !f {
         len = 0;
     }
-    while len > 0 && w[2 + 2 * head].saturating_add(hi) < t {
-        head = if head + 1 == cap { 0 } else { head + 1 };
+    while len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
+        head = next(head);
         len -= 1;
     }
     if len == 0 {
         head = 0;
     }
     if g {
-        let newest = (head + len + cap - 1) % cap;
-        if len > 0 && t - w[2 + 2 * newest] <= hi - lo {
-            w[2 + 2 * newest] = t;
+        // Index of the newest run and of the slot after it, without `%` (cap >= 1).
+        let mut tail = head + len;
+        if tail >= cap {
+            tail -= cap;
+        }
+        let newest = if tail == 0 { cap - 1 } else { tail - 1 };
+        if len > 0 && t.wrapping_sub(rd(w, 2 + 2 * newest)) <= hi - lo {
+            wr(w, 2 + 2 * newest, t);
         } else if len < cap {
-            let k = (head + len) % cap;
-            w[1 + 2 * k] = t;
-            w[2 + 2 * k] = t;
+            wr(w, 1 + 2 * tail, t);
+            wr(w, 2 + 2 * tail, t);
             len += 1;
         }
         // len == cap cannot happen: at most floor(hi / (hi - lo + 1)) + 1 runs are live.
     }
-    w[0] = head as u64 | (len as u64) << 32;
-    len > 0 && w[1 + 2 * head].saturating_add(lo) <= t
+    wr(w, 0, head as u64 | (len as u64) << 32);
+    len > 0 && rd(w, 1 + 2 * head).saturating_add(lo) <= t
 }
