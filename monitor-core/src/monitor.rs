@@ -237,9 +237,24 @@ impl<'a> Monitor<'a> {
 
     /// The verdict of property `prop` at the last point (false before any point).
     pub fn verdict(&self, state: &[u64], prop: usize) -> Option<bool> {
-        let root = self.program.props.get(prop)?.root as usize;
-        let w = state.get(self.values_at + root / 64)?;
-        Some(w >> (root % 64) & 1 == 1)
+        self.node_value(state, self.program.props.get(prop)?.root)
+    }
+
+    /// The value of node `node` at the last point (false before any point).
+    ///
+    /// Lets a host-side analysis (for example "this verdict can no longer change")
+    /// read the network without knowing the state layout.
+    pub fn node_value(&self, state: &[u64], node: u16) -> Option<bool> {
+        if node as usize >= self.program.nodes.len() {
+            return None;
+        }
+        let w = state.get(self.values_at + node as usize / 64)?;
+        Some(w >> (node % 64) & 1 == 1)
+    }
+
+    /// The timestamp of the last point, `None` before the first point.
+    pub fn last_time(&self, state: &[u64]) -> Option<u64> {
+        state.first().and_then(|t| t.checked_sub(1))
     }
 
     /// Updates every node; the state length and the time were checked by the caller.
