@@ -6,3 +6,4 @@
 
 pub mod gen;
 pub mod oracle;
+pub mod trace;
