@@ -526,6 +526,73 @@ pub fn valuations(decls: &Decls, trace: &[TracePoint]) -> Vec<Vec<Val>> {
         .collect()
 }
 
+/// One conformance case, as written in `tests/conformance/*.toml` (`[[case]]` tables).
+#[derive(Clone, Debug, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// Unique name across the corpus.
+    pub name: String,
+    /// One line: why these verdicts.
+    pub rationale: String,
+    /// Declarations in the spec syntax ([`parse_decls`]).
+    pub decls: String,
+    /// The formula in Rye syntax.
+    pub formula: String,
+    /// The points, in the point syntax ([`parse_point`]).
+    pub trace: Vec<String>,
+    /// One verdict per point: `T` or `F`.
+    pub expect: String,
+}
+
+impl Case {
+    /// The expected verdicts, or `None` if `expect` holds anything but `T`/`F`.
+    pub fn expected(&self) -> Option<Vec<bool>> {
+        self.expect
+            .chars()
+            .map(|c| match c {
+                'T' => Some(true),
+                'F' => Some(false),
+                _ => None,
+            })
+            .collect()
+    }
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CaseFile {
+    case: Vec<Case>,
+}
+
+/// Every case of every `*.toml` file in `dir`, files in name order, as
+/// `(file name, case)`. An unreadable or malformed file is an error naming it.
+pub fn load_corpus(dir: &std::path::Path) -> Result<Vec<(String, Case)>, String> {
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .map_err(|e| format!("{}: {e}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    files.sort();
+    let mut out = Vec::new();
+    for path in files {
+        let text =
+            std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let file: CaseFile =
+            toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        out.extend(file.case.into_iter().map(|c| (name.clone(), c)));
+    }
+    Ok(out)
+}
+
+/// The corpus directory of this repository (`tests/conformance`).
+pub fn corpus_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("conformance")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
