@@ -50,7 +50,8 @@ pub enum Kind {
 pub enum Type {
     /// `bool`.
     Bool,
-    /// `int`, `i8` .. `i64`, `u8` .. `u64`: values in `min..=max`.
+    /// `int`, `i8` .. `i64`, `u8` .. `u64`: values in `min..=max` (`u64` up to
+    /// `i64::MAX`, as every integer runs as `i64`).
     Int {
         /// Smallest value.
         min: i128,
@@ -88,7 +89,8 @@ impl Type {
             "u8" => int(8, false),
             "u16" => int(16, false),
             "u32" => int(32, false),
-            "u64" => int(64, false),
+            // Every integer runs as i64, so u64 values stop at i64::MAX.
+            "u64" => int(63, false),
             "float" | "f32" | "f64" => Type::Float,
             "string" => Type::Str,
             _ => return None,
@@ -330,12 +332,22 @@ fn typed(lit: Lit, ty: Type) -> Result<Val, String> {
     }
 }
 
-/// Parses a declaration block: `unit D;`, `event NAME;`, `state NAME: TYPE = INIT;`,
-/// one or more per line, with `//` comments.
+/// The initial value of a state declared without `= INIT`: `false`, `0`, `0.0` or `""`.
+fn default_value(ty: Type) -> Val {
+    match ty {
+        Type::Bool => Val::Bool(false),
+        Type::Int { .. } => Val::Int(0),
+        Type::Float => Val::Float(0.0),
+        Type::Str => Val::Str(String::new()),
+    }
+}
+
+/// Parses a declaration block: `unit D;`, `event NAME;`, `state NAME: TYPE [= INIT];`,
+/// one or more per line, with `//` and `#` comments.
 pub fn parse_decls(text: &str) -> Result<Decls, Error> {
     let mut decls = Decls::default();
     for (n, raw) in text.lines().enumerate() {
-        let s = raw.split("//").next().unwrap_or("");
+        let s = strip_comment(raw);
         let mut c = Cur {
             s,
             pos: 0,
@@ -383,16 +395,17 @@ pub fn parse_decls(text: &str) -> Result<Decls, Error> {
                             c.err(format!("unknown type `{ty_name}`"))
                         })?;
                         c.skip_ws();
-                        if !c.eat('=') {
-                            return Err(c.err("expected `=` and an initial value"));
-                        }
-                        c.skip_ws();
-                        let lit_at = c.pos;
-                        let lit = c.literal(&[';'])?;
-                        let init = typed(lit, ty).map_err(|m| {
-                            c.pos = lit_at;
-                            c.err(m)
-                        })?;
+                        let init = if c.eat('=') {
+                            c.skip_ws();
+                            let lit_at = c.pos;
+                            let lit = c.literal(&[';'])?;
+                            typed(lit, ty).map_err(|m| {
+                                c.pos = lit_at;
+                                c.err(m)
+                            })?
+                        } else {
+                            default_value(ty)
+                        };
                         (Kind::State, ty, init)
                     };
                     decls.vars.push(VarDecl {
@@ -414,6 +427,23 @@ pub fn parse_decls(text: &str) -> Result<Decls, Error> {
         }
     }
     Ok(decls)
+}
+
+/// `line` up to a `//` or `#` that is not inside a string.
+fn strip_comment(line: &str) -> &str {
+    let mut in_str = false;
+    let mut escaped = false;
+    for (i, c) in line.char_indices() {
+        match c {
+            _ if escaped => escaped = false,
+            '\\' if in_str => escaped = true,
+            '"' => in_str = !in_str,
+            '#' if !in_str => return &line[..i],
+            '/' if !in_str && line[i..].starts_with("//") => return &line[..i],
+            _ => {}
+        }
+    }
+    line
 }
 
 /// Parses point number `number` (from 1, used in errors): `<time>: item item ...`.
@@ -598,6 +628,7 @@ mod tests {
     use super::*;
 
     const DECLS: &str = "unit 100ms; // ten points a second\n\
+                         # a comment; state no: int = 1;\n\
                          event p;\n\
                          state b: bool = true; state x: u8 = 3;\n\
                          state f: float = 0;\n\
@@ -613,6 +644,18 @@ mod tests {
         assert_eq!(d.vars[2].ty, Type::Int { min: 0, max: 255 });
         assert_eq!(d.vars[3].init, Val::Float(0.0));
         assert_eq!(d.vars[4].init, Val::Str("idle".into()));
+        let d = parse_decls("state s: string; state k: i8; state u: f32; state c: bool; state h: string = \"a#b//c\";").unwrap();
+        let inits: Vec<_> = d.vars.iter().map(|v| v.init.clone()).collect();
+        assert_eq!(
+            inits,
+            [
+                Val::Str(String::new()),
+                Val::Int(0),
+                Val::Float(0.0),
+                Val::Bool(false),
+                Val::Str("a#b//c".into())
+            ]
+        );
     }
 
     #[test]
@@ -658,6 +701,12 @@ mod tests {
         assert_eq!(parse_decls("event p").unwrap_err().column, 8);
         assert_eq!(parse_decls("event p; event p;").unwrap_err().column, 16);
         assert_eq!(parse_decls("unit 3;").unwrap_err().column, 6);
+        assert_eq!(
+            parse_decls("state n: u64 = 9223372036854775808;")
+                .unwrap_err()
+                .column,
+            16
+        );
     }
 
     #[test]
