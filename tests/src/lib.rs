@@ -1,1 +1,9 @@
 //! Shared helpers for hindsight's workspace-level tests.
+//!
+//! - [`oracle`]: the reference Past-MTL evaluator, straight from the semantics.
+//! - [`gen`]: seeded random formulas and traces for differential tests.
+//! - [`trace`]: the corpus's declaration and trace-point syntax, and event/state valuation.
+
+pub mod gen;
+pub mod oracle;
+pub mod trace;
