@@ -1,1 +1,4 @@
 //! hindsight's host side: models, simulation, SMC and the CLI.
+
+pub mod cli;
+pub mod tracefile;

@@ -1,0 +1,50 @@
+//! The `hindsight` subcommands, one module each; `main.rs` only parses arguments and dispatches.
+
+pub mod compile;
+pub mod replay;
+
+use std::fmt;
+
+/// How a subcommand failed, mapped to the documented exit codes.
+#[derive(Debug)]
+pub enum CliError {
+    /// Bad input (a file that does not parse, a bad argument): exit code 2.
+    Input(String),
+    /// Anything else that stopped the command (I/O on output): exit code 1.
+    Failed(String),
+}
+
+impl CliError {
+    /// The process exit code for this error.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Input(_) => 2,
+            CliError::Failed(_) => 1,
+        }
+    }
+}
+
+impl fmt::Display for CliError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CliError::Input(m) | CliError::Failed(m) => f.write_str(m.trim_end()),
+        }
+    }
+}
+
+/// Reads a whole file, naming it in the error.
+pub fn read_file(path: &std::path::Path) -> Result<String, CliError> {
+    std::fs::read_to_string(path)
+        .map_err(|e| CliError::Input(format!("{}: cannot read: {e}", path.display())))
+}
+
+/// Compiles a `.hspec` file, printing warnings to stderr.
+pub fn compile_spec_file(path: &std::path::Path) -> Result<codegen::Compiled, CliError> {
+    let src = read_file(path)?;
+    let compiled = codegen::compile_spec(&src, &path.display().to_string())
+        .map_err(|d| CliError::Input(d.to_string()))?;
+    if !compiled.warnings().is_empty() {
+        eprint!("{}", compiled.warnings());
+    }
+    Ok(compiled)
+}

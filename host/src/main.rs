@@ -1,0 +1,52 @@
+//! The `hindsight` command line: parses arguments, dispatches to `hindsight::cli`, maps errors to exit codes.
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use hindsight::cli;
+
+/// Check Past-MTL properties of robot models off-line (statistical model checking)
+/// and on-line (runtime monitors), with the same compiled monitors.
+///
+/// Exit codes: 0 done; 1 failed for another reason (I/O); 2 bad input (a model,
+/// property, spec or trace that does not parse or check, or a bad argument).
+#[derive(Debug, Parser)]
+#[command(name = "hindsight", version, about, long_about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Compile a spec (.hspec) into a monitor table or print its networks.
+    ///
+    /// Example: `hindsight compile examples/specs/museum.hspec --emit table -o museum.bin`
+    Compile(cli::compile::CompileArgs),
+    /// Run a spec's monitors over a CSV trace and print the verdict at every point.
+    ///
+    /// Example: `hindsight replay examples/specs/museum.hspec trace.csv --changes`
+    Replay(cli::replay::ReplayArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    let result = match &cli.command {
+        Command::Compile(a) => cli::compile::run(a),
+        Command::Replay(a) => cli::replay::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("{e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}
