@@ -17,7 +17,7 @@ fn main() {
     println!("cargo:rerun-if-changed=../codegen/tests/golden/programs.rs");
     let out_dir = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     let mut out = String::new();
-    for (name, program) in programs::all() {
+    for (name, program) in programs::all().into_iter().chain(programs::random_all()) {
         let opts = EmitOptions::new(name, "hindsight-tests build.rs");
         let src = emit_rust(&program, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
         out.push_str(&src);

@@ -601,7 +601,10 @@ fn render(code: &[Instr], p: &Program<'_>, names: &Names, mode: Mode) -> Option<
                 let a = stack.pop()?;
                 Ex::new(format!("{} as f64", a.wrapped(a.prec < P_CAST)), P_CAST)
             }
-            Instr::ToFloat => stack.pop()?,
+            Instr::ToFloat => {
+                let a = stack.pop()?;
+                Ex::new(format!("float({})", a.text), P_ATOM)
+            }
             Instr::And | Instr::Or => {
                 let b = stack.pop()?;
                 let a = stack.pop()?;
@@ -634,10 +637,12 @@ fn render(code: &[Instr], p: &Program<'_>, names: &Names, mode: Mode) -> Option<
                     let t = format!("{}.{method}({})?", a.wrapped(a.prec < P_ATOM), b.text);
                     Ex::new(t, P_ATOM)
                 } else {
+                    // A cast on the right could end up before a `<` (`a - x as f64 < b`
+                    // reads `f64<` as generics): wrap it; on the left an operator follows.
                     let t = format!(
                         "{} {sym} {}",
                         a.wrapped(a.prec < prec),
-                        b.wrapped(b.prec <= prec)
+                        b.wrapped(b.prec <= prec || b.prec == P_CAST)
                     );
                     Ex::new(t, prec)
                 }

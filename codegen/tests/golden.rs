@@ -119,7 +119,7 @@ fn every_snapshot_has_a_program() {
 
 #[test]
 fn emitting_is_deterministic() {
-    for (name, program) in programs::all() {
+    for (name, program) in programs::all().into_iter().chain(programs::random_all()) {
         let opts = EmitOptions::new(name, COMMAND);
         assert_eq!(emit_rust(&program, &opts), emit_rust(&program, &opts));
     }

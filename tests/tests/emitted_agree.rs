@@ -84,12 +84,13 @@ const FLOATS: &[f64] = &[
     3.0,
 ];
 
-fn random_value(rng: &mut Rng, ty: Ty, strings: usize) -> Value {
+/// A random value of type `ty`; extreme numbers with probability `extremes` percent.
+fn random_value(rng: &mut Rng, ty: Ty, strings: usize, extremes: u64) -> Value {
     match ty {
         Ty::Bool => Value::Bool(rng.chance(50)),
-        Ty::Int if rng.chance(50) => Value::Int(rng.pick(INTS)),
+        Ty::Int if rng.chance(extremes) => Value::Int(rng.pick(INTS)),
         Ty::Int => Value::Int(rng.below(101) as i64 - 50),
-        Ty::Float if rng.chance(50) => Value::Float(rng.pick(FLOATS)),
+        Ty::Float if rng.chance(extremes) => Value::Float(rng.pick(FLOATS)),
         Ty::Float => Value::Float((rng.below(401) as f64 - 200.0) / 4.0),
         Ty::Str => Value::Str(rng.below(strings as u64 + 3) as u32),
     }
@@ -155,6 +156,12 @@ generated!(ints, ints_io);
 generated!(floats, floats_io);
 generated!(strings, strings_io);
 generated!(windows, windows_io);
+generated!(random_1, random_1_io);
+generated!(random_2, random_2_io);
+generated!(random_3, random_3_io);
+generated!(random_4, random_4_io);
+generated!(random_5, random_5_io);
+generated!(random_6, random_6_io);
 
 /// How a trace is drawn.
 #[derive(Clone, Copy, Debug)]
@@ -167,6 +174,8 @@ struct Shape {
     events: u64,
     /// Timestamps advance by exactly one unit (fills wide windows).
     dense: bool,
+    /// Percent chance that a new number is an extreme one (overflow, NaN, infinities).
+    extremes: u64,
 }
 
 /// What one run covered, so that a test can insist the interesting cases happened.
@@ -205,7 +214,7 @@ fn agree<M: Generated>(program: &Program<'_>, seed: u64, points: usize, shape: S
             let value = match var.kind {
                 VarKind::Event if rng.chance(shape.events) => Value::Bool(true),
                 VarKind::State if rng.chance(shape.change) => {
-                    random_value(&mut rng, var.ty, program.strings.len())
+                    random_value(&mut rng, var.ty, program.strings.len(), shape.extremes)
                 }
                 _ => continue,
             };
@@ -271,6 +280,11 @@ fn agree<M: Generated>(program: &Program<'_>, seed: u64, points: usize, shape: S
 
 /// Runs a program under several trace shapes and seeds; returns the combined coverage.
 fn agree_all<M: Generated>(program: &Program<'_>) -> Seen {
+    agree_all_with::<M>(program, 50)
+}
+
+/// [`agree_all`] with extreme numbers drawn `extremes` percent of the time.
+fn agree_all_with<M: Generated>(program: &Program<'_>, extremes: u64) -> Seen {
     let mut total = Seen::default();
     for seed in 1..=12u64 {
         let shape = Shape {
@@ -282,6 +296,7 @@ fn agree_all<M: Generated>(program: &Program<'_>) -> Seen {
             change: [10, 30, 70][seed as usize % 3],
             events: [20, 50, 95][seed as usize % 3],
             dense: seed % 3 == 0,
+            extremes,
         };
         let s = agree::<M>(program, seed, 3000, shape);
         total.points += s.points;
@@ -327,6 +342,27 @@ fn strings_agree() {
 #[test]
 fn windows_agree() {
     agree_all::<windows::Monitor>(&programs::windows());
+}
+
+/// Random atoms: every operator nested in every position, errors included.
+#[test]
+fn random_atoms_agree() {
+    let runs = [
+        agree_all_with::<random_1::Monitor>(&programs::random(1), 5),
+        agree_all_with::<random_2::Monitor>(&programs::random(2), 5),
+        agree_all_with::<random_3::Monitor>(&programs::random(3), 5),
+        agree_all_with::<random_4::Monitor>(&programs::random(4), 5),
+        agree_all_with::<random_5::Monitor>(&programs::random(5), 5),
+        agree_all_with::<random_6::Monitor>(&programs::random(6), 5),
+    ];
+    let arithmetic: usize = runs.iter().map(|s| s.arithmetic).sum();
+    assert!(arithmetic > 0, "no overflow was exercised: {runs:?}");
+    for s in &runs {
+        assert!(s.arithmetic * 4 < s.points, "too few points judged: {s:?}");
+    }
+    for (name, p) in programs::random_all() {
+        assert!(p.instrs.len() > 6 * 3, "{name}: expressions too small");
+    }
 }
 
 /// `true S[1000:1000] req` with `req` at every unit fills all 1001 runs.

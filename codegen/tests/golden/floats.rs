@@ -4,7 +4,7 @@
 #[rustfmt::skip]
 #[allow(clippy::all, invalid_nan_comparisons)]
 pub mod floats {
-    //! Generated monitor `floats`: 3 variables, 8 atoms, 3 properties.
+    //! Generated monitor `floats`: 3 variables, 9 atoms, 4 properties.
     //!
     //! Feed one [`Input`] per point to [`Monitor::step`]; it returns one verdict per
     //! property, in the order of [`PROPERTY_NAMES`]. Depends on `core` only.
@@ -12,17 +12,19 @@ pub mod floats {
     /// Length of one time unit in nanoseconds; timestamps are counted in units.
     pub const TICK_NS: u64 = 1000000;
     /// Number of atoms, the length of the array [`eval_atoms`] returns.
-    pub const ATOMS: usize = 8;
+    pub const ATOMS: usize = 9;
     /// Number of properties, the length of every verdict array.
-    pub const PROPERTIES: usize = 3;
+    pub const PROPERTIES: usize = 4;
     /// Property names, in verdict order.
-    pub const PROPERTY_NAMES: [&str; 3] = ["below_limit", "mixed", "fast_then_slow"];
+    pub const PROPERTY_NAMES: [&str; 4] = ["below_limit", "cast_before_less", "mixed", "fast_then_slow"];
     /// Index of property `below_limit` in a verdict array.
     pub const PROP_BELOW_LIMIT: usize = 0;
+    /// Index of property `cast_before_less` in a verdict array.
+    pub const PROP_CAST_BEFORE_LESS: usize = 1;
     /// Index of property `mixed` in a verdict array.
-    pub const PROP_MIXED: usize = 1;
+    pub const PROP_MIXED: usize = 2;
     /// Index of property `fast_then_slow` in a verdict array.
-    pub const PROP_FAST_THEN_SLOW: usize = 2;
+    pub const PROP_FAST_THEN_SLOW: usize = 3;
     /// Size of a [`Monitor`] in bytes: all the state it keeps between points.
     pub const STATE_BYTES: usize = core::mem::size_of::<Monitor>();
     /// String constants, indexed by interned id; other ids equal no constant.
@@ -105,16 +107,17 @@ pub mod floats {
     ///
     /// Properties:
     /// - [`PROP_BELOW_LIMIT`] `below_limit`: `{speed < limit}`
-    /// - [`PROP_MIXED`] `mixed`: `Z (((n10 <-> {count - speed != NaN}) <-> {1.0 / count == -inf}) <-> {-(-0.5) > count * 2 / -speed})`
+    /// - [`PROP_CAST_BEFORE_LESS`] `cast_before_less`: `{speed - float(count) < 2.0}`
+    /// - [`PROP_MIXED`] `mixed`: `Z n14`
     /// - [`PROP_FAST_THEN_SLOW`] `fast_then_slow`: `{-speed >= limit / 3.0} S[0:3] {speed <= -0.0}`
     #[derive(Clone, Debug)]
     pub struct Monitor {
         /// `1 +` the last point's timestamp, 0 before the first point.
         last: u64,
-        /// Node 14 `Z (((n10 <-> {count - speed != NaN}) <-> {1.0 / count == -inf}) <-> {-(-0.5) > count * 2 / -speed})`: child's value at the last point.
-        n14: bool,
-        /// Node 17 `{-speed >= limit / 3.0} S[0:3] {speed <= -0.0}`: `1 +` newest live witness, 0: none.
-        n17: u64,
+        /// Node 15 `Z n14`: child's value at the last point.
+        n15: bool,
+        /// Node 18 `{-speed >= limit / 3.0} S[0:3] {speed <= -0.0}`: `1 +` newest live witness, 0: none.
+        n18: u64,
     }
 
     impl Monitor {
@@ -122,16 +125,16 @@ pub mod floats {
         pub const fn new() -> Self {
             Monitor {
                 last: 0,
-                n14: true,
-                n17: 0,
+                n15: true,
+                n18: 0,
             }
         }
 
         /// Puts the monitor back before the first point, in place.
         pub fn reset(&mut self) {
             self.last = 0;
-            self.n14 = true;
-            self.n17 = 0;
+            self.n15 = true;
+            self.n18 = 0;
         }
 
         /// The timestamp of the last point judged, `None` before the first.
@@ -143,7 +146,7 @@ pub mod floats {
         /// returns each property's verdict at this point. Timestamps may repeat but not
         /// decrease; on error the monitor is unchanged.
         #[inline]
-        pub fn step(&mut self, time: u64, input: &Input) -> Result<[bool; 3], StepError> {
+        pub fn step(&mut self, time: u64, input: &Input) -> Result<[bool; 4], StepError> {
             self.check_time(time)?;
             let atoms = eval_atoms(input)?;
             Ok(self.advance(time, atoms))
@@ -151,7 +154,7 @@ pub mod floats {
 
         /// Like [`Monitor::step`] with atoms computed by the caller (see [`eval_atoms`]).
         #[inline]
-        pub fn step_atoms(&mut self, time: u64, atoms: [bool; 8]) -> Result<[bool; 3], StepError> {
+        pub fn step_atoms(&mut self, time: u64, atoms: [bool; 9]) -> Result<[bool; 4], StepError> {
             self.check_time(time)?;
             Ok(self.advance(time, atoms))
         }
@@ -169,34 +172,35 @@ pub mod floats {
 
         /// Updates every node in order at time `t` (checked: not `u64::MAX`, not backwards).
         #[inline(always)]
-        fn advance(&mut self, t: u64, atoms: [bool; 8]) -> [bool; 3] {
+        fn advance(&mut self, t: u64, atoms: [bool; 9]) -> [bool; 4] {
             let t1 = t.wrapping_add(1);
-            let [a0, a1, a2, a3, a4, a5, a6, a7] = atoms;
+            let [a0, a1, a2, a3, a4, a5, a6, a7, a8] = atoms;
             let n0 = a0;
-            let n1 = a1;
-            let n2 = a2;
-            let n3 = a3;
-            let n4 = a4;
-            let n5 = a5;
-            let n6 = a6;
-            let n7 = a7;
-            let n8 = n1 || n2;
-            let n9 = n8 == n3;
+            let n1 = a8;
+            let n2 = a1;
+            let n3 = a2;
+            let n4 = a3;
+            let n5 = a4;
+            let n6 = a5;
+            let n7 = a6;
+            let n8 = a7;
+            let n9 = n2 || n3;
             let n10 = n9 == n4;
             let n11 = n10 == n5;
             let n12 = n11 == n6;
             let n13 = n12 == n7;
-            // Node 14: `Z (((n10 <-> {count - speed != NaN}) <-> {1.0 / count == -inf}) <-> {-(-0.5) > count * 2 / -speed})`
-            let n14 = self.n14;
-            self.n14 = n13;
-            let n15 = a3;
-            let n16 = a1;
-            // Node 17: `{-speed >= limit / 3.0} S[0:3] {speed <= -0.0}`
-            let w = if n16 { t1 } else if n15 { self.n17 } else { 0 };
-            self.n17 = w;
-            let n17 = w != 0 && t1.wrapping_sub(w) <= 3;
+            let n14 = n13 == n8;
+            // Node 15: `Z n14`
+            let n15 = self.n15;
+            self.n15 = n14;
+            let n16 = a3;
+            let n17 = a1;
+            // Node 18: `{-speed >= limit / 3.0} S[0:3] {speed <= -0.0}`
+            let w = if n17 { t1 } else if n16 { self.n18 } else { 0 };
+            self.n18 = w;
+            let n18 = w != 0 && t1.wrapping_sub(w) <= 3;
             self.last = t1;
-            [n0, n14, n17]
+            [n0, n1, n15, n18]
         }
     }
 
@@ -206,7 +210,7 @@ pub mod floats {
         }
     }
 
-    /// Atom 7 `{-(-0.5) > count * 2 / -speed}`; `None` on overflow or division by zero.
+    /// Atom 7 `{-(-0.5) > float(count * 2) / -speed}`; `None` on overflow or division by zero.
     #[inline(always)]
     fn atom_7(input: &Input) -> Option<bool> {
         Some(-(-0.5f64) > input.count.checked_mul(2i64)? as f64 / -input.speed)
@@ -215,7 +219,7 @@ pub mod floats {
     /// Computes every atom from `input`, in order; the first atom whose integer
     /// arithmetic overflows or divides by zero is the error.
     #[inline(always)]
-    pub fn eval_atoms(input: &Input) -> Result<[bool; 8], StepError> {
+    pub fn eval_atoms(input: &Input) -> Result<[bool; 9], StepError> {
         // {speed < limit}
         let a0 = input.speed < input.limit;
         // {speed <= -0.0}
@@ -226,13 +230,15 @@ pub mod floats {
         let a3 = -input.speed >= input.limit / 3.0f64;
         // {speed % -1.5 == speed}
         let a4 = input.speed % -1.5f64 == input.speed;
-        // {count - speed != NaN}
+        // {float(count) - speed != NaN}
         let a5 = input.count as f64 - input.speed != f64::NAN;
-        // {1.0 / count == -inf}
-        let a6 = 1.0f64 / input.count as f64 == f64::NEG_INFINITY;
+        // {1.0 / float(count) == -inf}
+        let a6 = 1.0f64 / (input.count as f64) == f64::NEG_INFINITY;
         let Some(a7) = atom_7(input) else {
             return Err(StepError::Arithmetic { atom: 7 });
         };
-        Ok([a0, a1, a2, a3, a4, a5, a6, a7])
+        // {speed - float(count) < 2.0}
+        let a8 = input.speed - (input.count as f64) < 2.0f64;
+        Ok([a0, a1, a2, a3, a4, a5, a6, a7, a8])
     }
 }

@@ -391,9 +391,19 @@ pub fn floats() -> Program<'static> {
                 I::Div(NumTy::Float),
                 I::Cmp(CmpOp::Gt, Ty::Float),
             ],
+            // speed - float(count) < 2.0 (a cast before `<` must not read as generics)
+            vec![
+                I::Load(0),
+                I::Load(2),
+                I::ToFloat,
+                I::Sub(NumTy::Float),
+                float(2.0),
+                I::Cmp(CmpOp::Lt, Ty::Float),
+            ],
         ],
         vec![
             ("below_limit", vec![Atom(0)]),
+            ("cast_before_less", vec![Atom(8)]),
             (
                 "mixed",
                 vec![
@@ -546,6 +556,185 @@ pub fn windows() -> Program<'static> {
             ),
         ],
     )
+}
+
+/// A deterministic xorshift generator for [`random`] programs.
+struct Gen(u64);
+
+impl Gen {
+    fn below(&mut self, n: u64) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0 % n
+    }
+}
+
+const BOOL_VARS: [u16; 2] = [0, 1];
+const INT_VARS: [u16; 2] = [2, 3];
+const FLOAT_VARS: [u16; 2] = [4, 5];
+const STR_VAR: u16 = 6;
+
+/// Appends the code of a random expression of type `ty`, at most `depth` deep.
+fn random_expr(g: &mut Gen, ty: Ty, depth: u32, out: &mut Vec<I>) {
+    let leaf = depth == 0 || g.below(4) == 0;
+    let pick = |g: &mut Gen, vars: [u16; 2]| vars[g.below(2) as usize];
+    let num = |g: &mut Gen| {
+        if g.below(2) == 0 {
+            NumTy::Int
+        } else {
+            NumTy::Float
+        }
+    };
+    match ty {
+        Ty::Bool if leaf => match g.below(3) {
+            0 | 1 => out.push(I::Load(pick(g, BOOL_VARS))),
+            _ => out.push(I::Push(Value::Bool(g.below(2) == 0))),
+        },
+        Ty::Bool => match g.below(5) {
+            0 => {
+                random_expr(g, Ty::Bool, depth - 1, out);
+                out.push(I::Not);
+            }
+            1 => {
+                random_expr(g, Ty::Bool, depth - 1, out);
+                random_expr(g, Ty::Bool, depth - 1, out);
+                out.push(if g.below(2) == 0 { I::And } else { I::Or });
+            }
+            2 | 3 => {
+                let ty = if num(g) == NumTy::Int {
+                    Ty::Int
+                } else {
+                    Ty::Float
+                };
+                random_expr(g, ty, depth - 1, out);
+                random_expr(g, ty, depth - 1, out);
+                let ops = [
+                    CmpOp::Eq,
+                    CmpOp::Ne,
+                    CmpOp::Lt,
+                    CmpOp::Le,
+                    CmpOp::Gt,
+                    CmpOp::Ge,
+                ];
+                out.push(I::Cmp(ops[g.below(6) as usize], ty));
+            }
+            _ => {
+                let ty = if g.below(2) == 0 { Ty::Bool } else { Ty::Str };
+                random_expr(g, ty, depth - 1, out);
+                random_expr(g, ty, depth - 1, out);
+                let op = if g.below(2) == 0 {
+                    CmpOp::Eq
+                } else {
+                    CmpOp::Ne
+                };
+                out.push(I::Cmp(op, ty));
+            }
+        },
+        Ty::Str => match g.below(2) {
+            0 => out.push(I::Load(STR_VAR)),
+            _ => out.push(I::Push(Value::Str(g.below(4) as u32))),
+        },
+        Ty::Int | Ty::Float if leaf => {
+            let int = ty == Ty::Int;
+            match (g.below(3), int) {
+                (0 | 1, true) => out.push(I::Load(pick(g, INT_VARS))),
+                (0 | 1, false) => out.push(I::Load(pick(g, FLOAT_VARS))),
+                (_, true) => {
+                    // Extremes are rare: any overflow in any atom rejects the whole point.
+                    let ints = [0, 1, -1, 2, -7, 1000, 3, 5, -2, 10, 100, i64::MAX, i64::MIN];
+                    out.push(I::Push(Value::Int(ints[g.below(13) as usize])));
+                }
+                (_, false) => {
+                    let floats = [0.0, -0.0, 1.5, -2.25, 1e300, f64::NAN, f64::INFINITY];
+                    out.push(I::Push(Value::Float(floats[g.below(7) as usize])));
+                }
+            }
+        }
+        Ty::Int | Ty::Float => {
+            let n = if ty == Ty::Int {
+                NumTy::Int
+            } else {
+                NumTy::Float
+            };
+            match g.below(4) {
+                0 => {
+                    random_expr(g, ty, depth - 1, out);
+                    out.push(I::Neg(n));
+                }
+                1 if ty == Ty::Float => {
+                    random_expr(g, Ty::Int, depth - 1, out);
+                    out.push(I::ToFloat);
+                }
+                _ => {
+                    let op = [I::Add(n), I::Sub(n), I::Mul(n), I::Div(n), I::Rem(n)]
+                        [g.below(5) as usize];
+                    random_expr(g, ty, depth - 1, out);
+                    if n == NumTy::Int && matches!(op, I::Div(_) | I::Rem(_)) {
+                        // A variable or a non-zero constant: `x / 0` would fail at every point.
+                        match g.below(2) {
+                            0 => out.push(I::Load(pick(g, INT_VARS))),
+                            _ => out.push(I::Push(Value::Int([3, -2, 7][g.below(3) as usize]))),
+                        }
+                    } else {
+                        random_expr(g, ty, depth - 1, out);
+                    }
+                    out.push(op);
+                }
+            }
+        }
+    }
+}
+
+/// Random well-typed atoms over every variable type, combined by one property
+/// per atom (`Y`-delayed and `S[1:4]`-windowed in turn): exercises how every
+/// operator nests, which the hand-built programs cannot cover.
+pub fn random(seed: u64) -> Program<'static> {
+    use Op::*;
+    let mut g = Gen(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1);
+    let atoms: Vec<Vec<I>> = (0..6)
+        .map(|_| {
+            let mut code = Vec::new();
+            random_expr(&mut g, Ty::Bool, 4, &mut code);
+            code
+        })
+        .collect();
+    let props = (0..atoms.len() as u16)
+        .map(|a| {
+            let ops = match a % 3 {
+                0 => vec![Atom(a)],
+                1 => vec![Atom(a), Yesterday(0), Iff(0, 1)],
+                _ => vec![Const(true), Atom(a), since(0, 1, 1, Some(4))],
+            };
+            ("p", ops)
+        })
+        .collect();
+    build(
+        vec![
+            event("b0"),
+            state("b1", Value::Bool(true)),
+            state("i0", Value::Int(0)),
+            state("i1", Value::Int(-3)),
+            state("x0", Value::Float(0.5)),
+            state("x1", Value::Float(-0.0)),
+            state("s", Value::Str(1)),
+        ],
+        vec!["idle", "busy", "x"],
+        atoms,
+        props,
+    )
+}
+
+/// Random programs for the compile-and-run test (not snapshotted).
+pub fn random_all() -> Vec<(&'static str, Program<'static>)> {
+    vec![
+        ("random_1", random(1)),
+        ("random_2", random(2)),
+        ("random_3", random(3)),
+        ("random_4", random(4)),
+        ("random_5", random(5)),
+        ("random_6", random(6)),
+    ]
 }
 
 /// Every program, with the module name it is emitted under.
