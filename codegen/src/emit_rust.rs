@@ -38,7 +38,7 @@
 //!     }
 //!     pub enum StepError { TimeWentBackwards { last: u64, now: u64 }, TimeOutOfRange,
 //!                          Arithmetic { atom: u16 } }
-//!     pub struct Monitor { last: u64, n5: u64, .. }  // one plain field per stateful node
+//!     pub struct Monitor { last: u64, n6: u64 }  // one plain field per stateful node
 //!     impl Monitor {
 //!         pub const fn new() -> Self { .. }
 //!         pub fn reset(&mut self) { .. }
@@ -57,14 +57,15 @@
 //!             let n1 = a1;
 //!             let n2 = !n1;
 //!             let n3 = !n0 || n2;
-//!             let n4 = !n3;
-//!             // Node 5: `true S[0:5] n4`
-//!             let w = if n4 { t1 } else { self.n5 };
-//!             self.n5 = w;
-//!             let n5 = w != 0 && t1.wrapping_sub(w) <= 5;
-//!             let n6 = !n5;
+//!             let n4 = true;
+//!             let n5 = !n3;
+//!             // Node 6: `true S[0:5] !({mode == "idle"} -> !{opened})`
+//!             let w = if n5 { t1 } else if n4 { self.n6 } else { 0 };
+//!             self.n6 = w;
+//!             let n6 = w != 0 && t1.wrapping_sub(w) <= 5;
+//!             let n7 = !n6;
 //!             self.last = t1;
-//!             [n6]
+//!             [n7]
 //!         }
 //!     }
 //!     pub fn eval_atoms(input: &Input) -> Result<[bool; 2], StepError> {
