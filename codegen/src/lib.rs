@@ -47,6 +47,7 @@ pub mod ast;
 mod check;
 mod compile;
 pub mod diag;
+pub mod emit_rust;
 mod lower;
 pub mod parse;
 pub mod print;
