@@ -1,0 +1,3 @@
+//! Statistical model checking glue: properties observed on simulated runs, judged by monitors.
+
+pub mod settle;
