@@ -261,10 +261,18 @@ property q = {b + true} || {9223372036854775808 > b};
         "{e:#?}"
     );
     assert!(e[0].2.contains("does not fit in u8"));
-    assert!(e[1].2.contains("declared twice"));
+    assert!(
+        e[1].2.contains("declared twice (first at e.hspec:1:1)"),
+        "{}",
+        e[1].2
+    );
     assert!(e[2].2.contains("unknown variable `c`"));
     assert!(e[3].2.contains("orders numbers only"));
-    assert!(e[4].2.contains("defined twice"));
+    assert!(
+        e[4].2.contains("defined twice (first at e.hspec:5:10)"),
+        "{}",
+        e[4].2
+    );
     assert!(e[5].2.contains("must be a boolean"));
     assert!(e[6].2.contains("needs two numbers"));
     assert!(e[7].2.contains("larger than the largest int"));
