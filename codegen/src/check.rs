@@ -7,7 +7,7 @@ use monitor_core::{CmpOp, Ty, Value, VarKind, MAX_IDS};
 use crate::ast::{
     self, BinaryOp, CheckedSpec, ExprKind, FormulaKind, Interval, PropertyDef, UnaryOp, VarDecl,
 };
-use crate::diag::{Sink, Span};
+use crate::diag::{Sink, SourceMap, Span};
 use crate::syntax::{self, Bound, InfixOp, PrefixOp, SpecSyntax, TimeLit, TimeUnit};
 
 /// Nanoseconds in the default time unit (one second).
@@ -140,6 +140,7 @@ fn resolve_type(name: &str) -> Option<(Ty, Option<(i128, i128)>)> {
 
 struct Checker<'a> {
     sink: &'a mut Sink,
+    sources: &'a SourceMap,
     tick_ns: u64,
     vars: Vec<VarDecl>,
     var_ids: HashMap<String, u16>,
@@ -149,9 +150,10 @@ struct Checker<'a> {
 
 /// Checks a parsed spec; errors and warnings go to `sink`. The result is only
 /// meaningful when `sink` has no errors.
-pub(crate) fn check(syn: &SpecSyntax, sink: &mut Sink) -> CheckedSpec {
+pub(crate) fn check(syn: &SpecSyntax, sources: &SourceMap, sink: &mut Sink) -> CheckedSpec {
     let mut ck = Checker {
         sink,
+        sources,
         tick_ns: DEFAULT_TICK_NS,
         vars: Vec::new(),
         var_ids: HashMap::new(),
@@ -174,10 +176,11 @@ pub(crate) fn check(syn: &SpecSyntax, sink: &mut Sink) -> CheckedSpec {
     let mut props = Vec::new();
     let mut prop_ids: HashMap<&str, Span> = HashMap::new();
     for p in &syn.props {
-        if prop_ids.contains_key(p.name.name.as_str()) {
+        if let Some(first) = prop_ids.get(p.name.name.as_str()) {
+            let at = ck.at(*first);
             ck.sink.error(
                 p.name.span,
-                format!("property `{}` is defined twice", p.name.name),
+                format!("property `{}` is defined twice (first {at})", p.name.name),
             );
         } else {
             prop_ids.insert(&p.name.name, p.name.span);
@@ -199,6 +202,12 @@ pub(crate) fn check(syn: &SpecSyntax, sink: &mut Sink) -> CheckedSpec {
 }
 
 impl Checker<'_> {
+    /// `at FILE:LINE:COL` for messages that point at a second place.
+    fn at(&self, span: Span) -> String {
+        let l = self.sources.locate(span);
+        format!("at {}:{}:{}", l.file, l.line, l.col)
+    }
+
     fn intern(&mut self, s: &str) -> u32 {
         if let Some(&i) = self.string_ids.get(s) {
             return i;
@@ -218,9 +227,12 @@ impl Checker<'_> {
             );
             return;
         }
-        if self.var_ids.contains_key(name) {
-            self.sink
-                .error(d.name.span, format!("variable `{name}` is declared twice"));
+        if let Some(&first) = self.var_ids.get(name) {
+            let at = self.at(self.vars[first as usize].span);
+            self.sink.error(
+                d.name.span,
+                format!("variable `{name}` is declared twice (first {at})"),
+            );
             return;
         }
         if self.vars.len() >= MAX_IDS {

@@ -45,6 +45,10 @@ pub struct PropertyInfo {
 /// Invariant: [`Compiled::program`] passes [`Monitor::try_new`] (checked when
 /// it is built), and [`Compiled::to_table_bytes`] loads with
 /// `monitor_core::table::Table::from_bytes`.
+///
+/// The names and string constants that `program()` lends out are interned
+/// for the life of the process (each distinct text once), since a
+/// [`Program`] borrows them as `&str`.
 #[derive(Clone, Debug)]
 pub struct Compiled {
     checked: CheckedSpec,
@@ -138,6 +142,7 @@ impl Compiled {
 
     /// The postcard table: `(TABLE_VERSION, program)`, for `monitor_core::table::Table::from_bytes`.
     pub fn to_table_bytes(&self) -> Vec<u8> {
+        // Serialising plain data into a Vec cannot fail; an empty table would fail to load.
         postcard::to_allocvec(&(TABLE_VERSION, self.program())).unwrap_or_default()
     }
 

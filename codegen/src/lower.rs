@@ -112,7 +112,7 @@ pub(crate) fn lower(spec: &CheckedSpec, limits: &Limits, sink: &mut Sink) -> Net
     let limit_words = limits.max_state_bytes / 8;
     for (i, op) in lw.ops.iter().enumerate() {
         let span = lw.spans[i];
-        let words = match layout::node_words(op) {
+        let words = match safe_node_words(op) {
             Some(w) if w <= limit_words => w,
             w => {
                 let (lo, hi) = match op {
@@ -167,6 +167,19 @@ pub(crate) fn lower(spec: &CheckedSpec, limits: &Limits, sink: &mut Sink) -> Net
         node_words,
         props,
         state_words: next,
+    }
+}
+
+/// [`layout::node_words`], except for `S[b:b]` with `b == u64::MAX`, whose
+/// capacity `b + 1` overflows inside `layout::window_capacity`: too large either way.
+fn safe_node_words(op: &Op) -> Option<u64> {
+    match op {
+        Op::Since {
+            lo,
+            hi: Some(u64::MAX),
+            ..
+        } if *lo == u64::MAX => None,
+        op => layout::node_words(op),
     }
 }
 

@@ -103,7 +103,10 @@ impl<S> Spec<S> {
     }
 
     /// Ends a pass: the next stage when `sink` holds no errors, else every diagnostic.
-    fn finish<T>(self, sink: Sink, next: impl FnOnce(S) -> T) -> Result<Spec<T>, Diagnostics> {
+    fn finish<T>(self, mut sink: Sink, next: impl FnOnce(S) -> T) -> Result<Spec<T>, Diagnostics> {
+        // Within one pass, report in source order.
+        sink.items
+            .sort_by_key(|r| (r.span.source, r.span.lo, r.span.hi));
         let mut all = self.warnings;
         all.items.extend(sink.items);
         if all.has_errors() {
@@ -191,7 +194,7 @@ impl Spec<Parsed> {
     /// Resolves names and types and converts bounds to ticks.
     pub fn check(self) -> Result<Spec<Checked>, Diagnostics> {
         let mut sink = Sink::default();
-        let ast = check::check(&self.stage.syntax, &mut sink);
+        let ast = check::check(&self.stage.syntax, &self.sources, &mut sink);
         self.finish(sink, |_| Checked { ast })
     }
 }

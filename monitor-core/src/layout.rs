@@ -52,7 +52,10 @@ pub const fn window_capacity(lo: u64, hi: u64) -> Option<u32> {
     let cap = if width == u64::MAX {
         1
     } else {
-        hi / (width + 1) + 1
+        match (hi / (width + 1)).checked_add(1) {
+            Some(c) => c,
+            None => return None,
+        }
     };
     if cap > u32::MAX as u64 {
         None

@@ -3,20 +3,27 @@
 mod common;
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 use common::{program, since_nodes, Rng};
 use monitor_core::{Monitor, Value};
 
 struct Counting;
 
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    // Per thread, so the test harness's own threads cannot disturb the count.
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|a| a.get())
+}
 
 // SAFETY-free wrapper: forwards to the system allocator and counts calls.
 #[allow(unsafe_code)]
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        ALLOCATIONS.with(|a| a.set(a.get() + 1));
         // SAFETY: same contract as the caller's.
         unsafe { System.alloc(layout) }
     }
@@ -44,7 +51,7 @@ fn a_million_steps_allocate_nothing() {
         let mut state = vec![0u64; m.state_words()];
         let mut out = [false];
         let mut rng = Rng(99);
-        let before = ALLOCATIONS.load(Ordering::SeqCst);
+        let before = allocations();
         let mut t = 0;
         let mut trues = 0u64;
         for _ in 0..1_000_000 {
@@ -56,11 +63,7 @@ fn a_million_steps_allocate_nothing() {
             m.try_step(&mut state, t, &vals, &mut out).unwrap();
             trues += out[0] as u64;
         }
-        assert_eq!(
-            ALLOCATIONS.load(Ordering::SeqCst),
-            before,
-            "S[{lo}:{hi:?}] allocated"
-        );
+        assert_eq!(allocations(), before, "S[{lo}:{hi:?}] allocated");
         // The formula did real work: some points true, some false.
         assert!(
             trues > 0 && trues < 1_000_000,

@@ -127,3 +127,32 @@ fn window_state_is_sized_by_the_bounds_alone() {
         assert_eq!(m.state_words(), base + 1 + 2 * cap as usize, "[{lo}:{hi}]");
     }
 }
+
+#[test]
+fn capacities_that_do_not_fit_are_rejected_not_wrapped() {
+    assert_eq!(
+        monitor_core::layout::window_capacity(u64::MAX, u64::MAX),
+        None
+    );
+    assert_eq!(monitor_core::layout::window_capacity(1, u64::MAX), Some(2));
+    let nodes = [
+        monitor_core::Node {
+            op: monitor_core::Op::Atom(0),
+            slot: 0,
+        },
+        monitor_core::Node {
+            op: monitor_core::Op::Atom(1),
+            slot: 0,
+        },
+        monitor_core::Node {
+            op: monitor_core::Op::Since {
+                lhs: 0,
+                rhs: 1,
+                lo: u64::MAX,
+                hi: Some(u64::MAX),
+            },
+            slot: monitor_core::layout::first_node_word(2, 3) as u32,
+        },
+    ];
+    assert!(Monitor::try_new(program(&nodes)).is_err());
+}
