@@ -7,7 +7,7 @@
 //! with `Monitor::try_new`, then for every point of a replay trace calls
 //! [`step_point`] and hands the verdicts to [`VerdictLog`], which logs every
 //! change. At the end [`finish`] logs the point count and the stack high-water
-//! mark and exits QEMU with status 0; any error goes to [`fail`] (status 1),
+//! marks and exits QEMU with status 0; any error goes to [`fail`] (status 1),
 //! and so does a panic.
 //!
 //! # Log lines (the contract with `host-check`)
@@ -17,7 +17,10 @@
 //! - `verdict prop=<p> point=<i> time=<t> value=<bool>`: property `p`'s
 //!   verdict at point `i` (0-based) differs from its verdict at point `i-1`,
 //!   or `i` is the first point
-//! - `done points=<N> stack=<bytes>`
+//! - `done points=<N> stack=<bytes> setup_stack=<bytes> replay_stack=<bytes>`:
+//!   stack high-water marks of the whole run, of the set-up (decoding and
+//!   validating the program) and of the replay (from [`end_of_setup`] on,
+//!   frames live at that point included)
 //! - `error ...` before a failing exit
 #![no_std]
 
@@ -44,12 +47,24 @@ pub fn fail(what: &str) -> ! {
     exit(false)
 }
 
-/// Logs the end of the replay (point count and stack high-water mark) and exits with status 0.
-pub fn finish(points: u32) -> ! {
+/// Ends the set-up phase: returns its stack high-water mark in bytes and
+/// repaints the free stack so that [`finish`] measures the replay on its own.
+pub fn end_of_setup() -> usize {
+    let setup = stack::high_water();
+    stack::repaint();
+    setup
+}
+
+/// Logs the end of the replay (point count; stack high-water marks of the
+/// whole run, of the set-up and of the replay) and exits with status 0.
+pub fn finish(points: u32, setup_stack: usize) -> ! {
+    let replay = stack::high_water();
     defmt::info!(
-        "done points={=u32} stack={=u32}",
+        "done points={=u32} stack={=u32} setup_stack={=u32} replay_stack={=u32}",
         points,
-        stack::high_water() as u32
+        setup_stack.max(replay) as u32,
+        setup_stack as u32,
+        replay as u32
     );
     exit(true)
 }

@@ -57,8 +57,14 @@ pub fn state_breakdown(program: &monitor_core::Program<'_>) -> Option<StateBreak
     Some(StateBreakdown { shared, props })
 }
 
-/// Names of the firmware images, as built by `firmware-examples`.
-pub const IMAGES: [&str; 3] = ["monitor-static", "monitor-table", "baseline"];
+/// The images that replay the museum trace, as built by `firmware-examples`,
+/// each with the baseline that replays the same trace without a monitor.
+pub const IMAGES: [(&str, &str); 4] = [
+    ("monitor-static", "baseline"),
+    ("monitor-table", "baseline-bytes"),
+    ("baseline", "baseline"),
+    ("baseline-bytes", "baseline-bytes"),
+];
 
 /// Where the images are: `$FIRMWARE_DIR`, else the firmware project's release output.
 pub fn image_dir() -> PathBuf {

@@ -58,8 +58,12 @@ pub struct Change {
 pub struct Done {
     /// Points replayed.
     pub points: u32,
-    /// Stack high-water mark in bytes.
+    /// Stack high-water mark of the whole run, in bytes.
     pub stack: u32,
+    /// Of which the set-up (decoding, validating) used this much.
+    pub setup_stack: u32,
+    /// And the replay this much (frames live at its start included).
+    pub replay_stack: u32,
 }
 
 /// Everything a firmware logged.
@@ -125,6 +129,8 @@ impl Log {
                     log.done = Some(Done {
                         points: field(line, "points")?,
                         stack: field(line, "stack")?,
+                        setup_stack: field(line, "setup_stack")?,
+                        replay_stack: field(line, "replay_stack")?,
                     })
                 }
                 Some("error") => log.errors.push(line.clone()),
@@ -149,7 +155,7 @@ mod tests {
             "verdict prop=0 point=0 time=0 value=true",
             "verdict prop=1 point=2 time=7 value=false",
             "replayed events=1 level_sum=3",
-            "done points=3 stack=412",
+            "done points=3 stack=412 setup_stack=412 replay_stack=300",
         ];
         let log = Log::parse(lines.iter().map(|s| s.to_string()).collect()).unwrap();
         assert_eq!(
@@ -175,7 +181,9 @@ mod tests {
             log.done,
             Some(Done {
                 points: 3,
-                stack: 412
+                stack: 412,
+                setup_stack: 412,
+                replay_stack: 300
             })
         );
         assert!(log.errors.is_empty());

@@ -187,7 +187,12 @@ mod tests {
                     value,
                 })
                 .collect(),
-            done: Some(Done { points, stack: 0 }),
+            done: Some(Done {
+                points,
+                stack: 0,
+                setup_stack: 0,
+                replay_stack: 0,
+            }),
             ..Log::default()
         }
     }

@@ -32,7 +32,8 @@ fn check(name: &str, expected: &Expected) {
     }
     assert_eq!(log.start.as_ref().map(|s| s.name.as_str()), Some(name));
     let done = log.done.unwrap();
-    assert!(done.stack > 0, "{name}: no stack use measured");
+    assert!(done.replay_stack > 0, "{name}: no stack use measured");
+    assert_eq!(done.stack, done.setup_stack.max(done.replay_stack));
 }
 
 #[test]
@@ -47,10 +48,40 @@ fn monitor_table_verdicts_equal_the_host_interpreter() {
 }
 
 #[test]
-fn baseline_replays_the_whole_trace() {
-    let log = run("baseline");
-    assert!(log.errors.is_empty(), "{:?}", log.errors);
-    assert!(log.changes.is_empty());
-    let done = log.done.expect("no `done` line");
-    assert_eq!(done.points as usize, museum_spec::TRACE_LEN);
+fn baselines_replay_the_whole_trace() {
+    for name in ["baseline", "baseline-bytes"] {
+        let log = run(name);
+        assert!(log.errors.is_empty(), "{name}: {:?}", log.errors);
+        assert!(log.changes.is_empty());
+        let done = log.done.expect("no `done` line");
+        assert_eq!(done.points as usize, museum_spec::TRACE_LEN, "{name}");
+        // Both read every value of the trace: count its events.
+        let events = museum_spec::TRACE
+            .iter()
+            .flat_map(|p| p.values)
+            .filter(|v| *v == monitor_core::Value::Bool(true))
+            .count();
+        let line = format!("replayed events={events} ");
+        assert!(
+            log.messages.iter().any(|m| m.starts_with(&line)),
+            "{name}: {:?}",
+            log.messages
+        );
+    }
+}
+
+#[test]
+fn a_panic_fails_the_run() {
+    let (path, elf) = read_image("panic-check").unwrap();
+    let run = qemu::run(&path, TIMEOUT).unwrap();
+    assert_eq!(run.status.code(), Some(1), "stderr: {}", run.stderr);
+    let log = Log::parse(decode(&elf, &run.stdout).unwrap()).unwrap();
+    assert!(log.done.is_none());
+    assert!(
+        log.errors
+            .iter()
+            .any(|e| e.starts_with("error panic at ") && e.contains("panic-check.rs")),
+        "{:?}",
+        log.messages
+    );
 }

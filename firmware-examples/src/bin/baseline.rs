@@ -1,11 +1,11 @@
-//! Size baseline: the same replay of the compiled-in trace as `monitor-static`, with the same logging and exit, but no monitor.
+//! Size baseline for `monitor-static`: the same replay of the compiled-in `static` trace, with the same logging and exit, but no monitor.
 #![no_std]
 #![no_main]
 
 use core::hint::black_box;
 
 use cortex_m_rt::entry;
-use firmware::finish;
+use firmware::{end_of_setup, finish};
 use monitor_core::Value;
 use museum_spec::TRACE;
 
@@ -16,7 +16,8 @@ fn main() -> ! {
         "baseline",
         TRACE.len() as u32
     );
-    // Touch every value so that the trace is read as in the monitored images.
+    let setup_stack = end_of_setup();
+    // Read every value, as the monitored image does.
     let mut events = 0u32;
     let mut level_sum = 0i64;
     for point in black_box(&TRACE).iter() {
@@ -29,5 +30,5 @@ fn main() -> ! {
         }
     }
     defmt::info!("replayed events={=u32} level_sum={=i64}", events, level_sum);
-    finish(TRACE.len() as u32)
+    finish(TRACE.len() as u32, setup_stack)
 }

@@ -3,7 +3,7 @@
 #![no_main]
 
 use cortex_m_rt::entry;
-use firmware::{fail, finish, log_start, step_point, VerdictLog};
+use firmware::{end_of_setup, fail, finish, log_start, step_point, VerdictLog};
 use monitor_core::Monitor;
 use museum_spec::{PROGRAM, PROPS, STATE_WORDS, TRACE};
 
@@ -22,6 +22,7 @@ fn main() -> ! {
         fail("state")
     }
     log_start("monitor-static", &monitor, TRACE.len() as u32);
+    let setup_stack = end_of_setup();
     let mut log = VerdictLog::<PROPS>::new();
     let mut verdicts = [false; PROPS];
     for point in TRACE.iter() {
@@ -37,5 +38,5 @@ fn main() -> ! {
         }
         log.record(point.time, &verdicts);
     }
-    finish(log.points())
+    finish(log.points(), setup_stack)
 }

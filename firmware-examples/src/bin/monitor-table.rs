@@ -3,7 +3,7 @@
 #![no_main]
 
 use cortex_m_rt::entry;
-use firmware::{fail, finish, log_start, step_point, VerdictLog};
+use firmware::{end_of_setup, fail, finish, log_start, step_point, VerdictLog};
 use monitor_core::table::Table;
 use monitor_core::Value;
 use museum_spec::trace::Reader;
@@ -16,15 +16,34 @@ mod info {
 static TABLE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/table.postcard"));
 static TRACE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/trace.bin"));
 
-#[entry]
-fn main() -> ! {
-    let table = match Table::<{ info::CAPACITY }>::from_bytes(TABLE) {
+type MonitorTable = Table<'static, { info::CAPACITY }>;
+
+/// Decodes and validates the embedded table into a `static`. Decoding moves
+/// the table by value a few times: doing it in a frame of its own keeps that
+/// transient stack out of the replay.
+#[inline(never)]
+fn load() -> &'static MonitorTable {
+    let table = match MonitorTable::from_bytes(TABLE) {
         Ok(t) => t,
         Err(e) => {
             defmt::error!("table rejected: {}", e);
             fail("table")
         }
     };
+    match cortex_m::singleton!(: MonitorTable = table) {
+        Some(t) => t,
+        None => fail("table loaded twice"),
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    let table = load();
+    defmt::info!(
+        "table bytes={=usize} decoded_bytes={=usize}",
+        TABLE.len(),
+        core::mem::size_of::<MonitorTable>()
+    );
     let monitor = match table.monitor() {
         Ok(m) => m,
         Err(e) => {
@@ -42,6 +61,7 @@ fn main() -> ! {
         fail("state")
     }
     log_start("monitor-table", &monitor, trace.points());
+    let setup_stack = end_of_setup();
     // Variables start at their declared values; each point then gives all of them.
     let mut values = [Value::Bool(false); info::VARS];
     monitor_core::valuation::init(monitor.program().vars, &mut values);
@@ -59,5 +79,5 @@ fn main() -> ! {
         }
         log.record(time, &verdicts);
     }
-    finish(log.points())
+    finish(log.points(), setup_stack)
 }

@@ -30,7 +30,8 @@ fn main() -> ExitCode {
 fn report() -> Result<(), String> {
     let mut sizes = BTreeMap::new();
     let mut stacks = BTreeMap::new();
-    for name in IMAGES {
+    let mut tables = Vec::new();
+    for (name, _) in IMAGES {
         let (path, bytes) = read_image(name)?;
         sizes.insert(name, elf::sizes(&bytes)?);
         let run = qemu::run(&path, Duration::from_secs(30))?;
@@ -42,35 +43,39 @@ fn report() -> Result<(), String> {
             ));
         }
         let done = log.done.ok_or_else(|| format!("{name}: no `done` line"))?;
-        stacks.insert(name, (done.stack, run.elapsed));
+        stacks.insert(name, (done, run.elapsed));
+        tables.extend(log.messages.into_iter().filter(|m| m.starts_with("table ")));
     }
 
-    let base = sizes["baseline"];
     println!(
         "== Flash and RAM (bytes; RAM = static .data + .bss + .uninit, the stack comes on top)"
     );
     println!(
-        "{:<16} {:>7} {:>7} {:>7} {:>7}   {:>12} {:>10}",
-        "image", "flash", "text", "rodata", "ram", "flash - base", "ram - base"
+        "{:<16} {:>7} {:>7} {:>7} {:>7}   {:<15} {:>12} {:>10}",
+        "image", "flash", "text", "rodata", "ram", "baseline", "flash - base", "ram - base"
     );
-    for name in IMAGES {
+    for (name, baseline) in IMAGES {
         let s = sizes[name];
+        let base = sizes[baseline];
         println!(
-            "{:<16} {:>7} {:>7} {:>7} {:>7}   {:>+12} {:>+10}",
+            "{:<16} {:>7} {:>7} {:>7} {:>7}   {:<15} {:>+12} {:>+10}",
             name,
             s.flash,
             s.text,
             s.rodata,
             s.ram,
+            baseline,
             s.flash as i64 - base.flash as i64,
             s.ram as i64 - base.ram as i64
         );
     }
     println!(
-        "(every image embeds the {}-point replay trace; baseline replays it without a monitor)",
+        "(each image embeds the {}-point replay trace: as a static array in monitor-static and \
+         baseline, as bytes in monitor-table and baseline-bytes; a baseline replays it without a monitor)",
         museum_spec::TRACE_LEN
     );
-    largest_additions()?;
+    largest_additions("monitor-static", "baseline")?;
+    largest_additions("monitor-table", "baseline-bytes")?;
 
     println!();
     println!(
@@ -105,15 +110,24 @@ fn report() -> Result<(), String> {
             .map_err(|_| "table thread panicked".to_string())?
     })?;
     println!(
-        "monitor-table: state {} bytes, postcard table {} bytes in flash",
-        table_state.0, table_state.1
+        "monitor-table: state {} bytes, postcard table {} bytes in flash; firmware log: {}",
+        table_state.0,
+        table_state.1,
+        tables.join("; ")
     );
 
     println!();
-    println!("== Stack high-water mark (QEMU mps2-an386, cortex-m-rt paint-stack)");
-    for name in IMAGES {
-        let (stack, elapsed) = stacks[name];
-        println!("{name:<16} {stack:>6} bytes   (QEMU run {elapsed:.2?})");
+    println!("== Stack high-water mark (bytes; QEMU mps2-an386, cortex-m-rt paint-stack)");
+    println!(
+        "{:<16} {:>6} {:>7} {:>7}   (set-up: decode and validate the program; replay: from then on, live frames included)",
+        "image", "peak", "set-up", "replay"
+    );
+    for (name, _) in IMAGES {
+        let (done, elapsed) = stacks[name];
+        println!(
+            "{name:<16} {:>6} {:>7} {:>7}   (QEMU run {elapsed:.2?})",
+            done.stack, done.setup_stack, done.replay_stack
+        );
     }
 
     println!();
@@ -175,8 +189,8 @@ fn short_path(file: &str) -> String {
     file.to_string()
 }
 
-/// The largest symbols of monitor-static that baseline does not have: where the monitor's flash goes.
-fn largest_additions() -> Result<(), String> {
+/// The largest symbols of `image` that `baseline` does not have: where the monitor's flash goes.
+fn largest_additions(image: &str, baseline: &str) -> Result<(), String> {
     let nm = callgraph::llvm_tool("llvm-nm")?;
     let symbols = |image: &Path| -> Result<BTreeMap<String, u64>, String> {
         let out = Command::new(&nm)
@@ -203,8 +217,8 @@ fn largest_additions() -> Result<(), String> {
             })
             .collect())
     };
-    let (monitor, _) = read_image("monitor-static")?;
-    let (base, _) = read_image("baseline")?;
+    let (monitor, _) = read_image(image)?;
+    let (base, _) = read_image(baseline)?;
     let base = symbols(&base)?;
     let mut added: Vec<(String, u64)> = symbols(&monitor)?
         .into_iter()
@@ -213,7 +227,7 @@ fn largest_additions() -> Result<(), String> {
     added.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
     let total: u64 = added.iter().map(|(_, s)| s).sum();
     println!(
-        "largest symbols monitor-static adds to baseline ({total} bytes in {} symbols):",
+        "largest symbols {image} adds to {baseline} ({total} bytes in {} symbols):",
         added.len()
     );
     for (name, size) in added.iter().take(12) {
