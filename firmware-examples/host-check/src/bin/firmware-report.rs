@@ -1,0 +1,237 @@
+//! Prints the firmware size report: flash and RAM with and without the monitor, state bytes per property, stack high-water mark in QEMU, panic paths below the monitor step.
+//!
+//! Usage: `firmware-report` (images from `$FIRMWARE_DIR` or the firmware
+//! project's release output). Exits non-zero when an image is missing, fails
+//! in QEMU, or a measurement cannot be made.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::{Command, ExitCode};
+use std::time::Duration;
+
+use host_check::callgraph::{self, Location};
+use host_check::log::{decode, Log};
+use host_check::{elf, qemu, read_image, state_breakdown, table_inputs, IMAGES};
+use monitor_core::table::Table;
+
+/// The function every monitor step goes through (`firmware::step_point`, never inlined).
+const STEP: &str = "firmware::step_point";
+
+fn main() -> ExitCode {
+    match report() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("firmware-report: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn report() -> Result<(), String> {
+    let mut sizes = BTreeMap::new();
+    let mut stacks = BTreeMap::new();
+    let mut tables = Vec::new();
+    for (name, _) in IMAGES {
+        let (path, bytes) = read_image(name)?;
+        sizes.insert(name, elf::sizes(&bytes)?);
+        let run = qemu::run(&path, Duration::from_secs(30))?;
+        let log = Log::parse(decode(&bytes, &run.stdout)?)?;
+        if !run.status.success() || !log.errors.is_empty() {
+            return Err(format!(
+                "{name} failed in QEMU ({:?}): {:?}",
+                run.status, log.errors
+            ));
+        }
+        let done = log.done.ok_or_else(|| format!("{name}: no `done` line"))?;
+        stacks.insert(name, (done, run.elapsed));
+        tables.extend(log.messages.into_iter().filter(|m| m.starts_with("table ")));
+    }
+
+    println!(
+        "== Flash and RAM (bytes; RAM = static .data + .bss + .uninit, the stack comes on top)"
+    );
+    println!(
+        "{:<16} {:>7} {:>7} {:>7} {:>7}   {:<15} {:>12} {:>10}",
+        "image", "flash", "text", "rodata", "ram", "baseline", "flash - base", "ram - base"
+    );
+    for (name, baseline) in IMAGES {
+        let s = sizes[name];
+        let base = sizes[baseline];
+        println!(
+            "{:<16} {:>7} {:>7} {:>7} {:>7}   {:<15} {:>+12} {:>+10}",
+            name,
+            s.flash,
+            s.text,
+            s.rodata,
+            s.ram,
+            baseline,
+            s.flash as i64 - base.flash as i64,
+            s.ram as i64 - base.ram as i64
+        );
+    }
+    println!(
+        "(each image embeds the {}-point replay trace: as a static array in monitor-static and \
+         baseline, as bytes in monitor-table and baseline-bytes; a baseline replays it without a monitor)",
+        museum_spec::TRACE_LEN
+    );
+    largest_additions("monitor-static", "baseline")?;
+    largest_additions("monitor-table", "baseline-bytes")?;
+
+    println!();
+    println!(
+        "== Monitor state (bytes, fixed at compile time; the firmware allocates exactly this)"
+    );
+    let breakdown = state_breakdown(&museum_spec::PROGRAM).ok_or("museum program has no layout")?;
+    println!(
+        "shared by all properties (timestamp, atom bits, node value bits): {}",
+        breakdown.shared
+    );
+    for (i, (name, bytes)) in breakdown.props.iter().enumerate() {
+        println!(
+            "property {i} {name:<28} {bytes:>4}   {}",
+            museum_spec::FORMULAS.get(i).copied().unwrap_or("")
+        );
+    }
+    println!(
+        "total (Monitor::state_bytes, monitor-static): {}",
+        breakdown.total()
+    );
+    let (table, _) = table_inputs()?;
+    let table_state = std::thread::scope(|s| {
+        std::thread::Builder::new()
+            .stack_size(64 << 20)
+            .spawn_scoped(s, || {
+                let t = Table::<4096>::from_bytes(&table).map_err(|e| e.to_string())?;
+                let m = t.monitor().map_err(|e| e.to_string())?;
+                Ok::<_, String>((m.state_bytes(), table.len()))
+            })
+            .map_err(|e| e.to_string())?
+            .join()
+            .map_err(|_| "table thread panicked".to_string())?
+    })?;
+    println!(
+        "monitor-table: state {} bytes, postcard table {} bytes in flash; firmware log: {}",
+        table_state.0,
+        table_state.1,
+        tables.join("; ")
+    );
+
+    println!();
+    println!("== Stack high-water mark (bytes; QEMU mps2-an386, cortex-m-rt paint-stack)");
+    println!(
+        "{:<16} {:>6} {:>7} {:>7}   (set-up: decode and validate the program; replay: from then on, live frames included)",
+        "image", "peak", "set-up", "replay"
+    );
+    for (name, _) in IMAGES {
+        let (done, elapsed) = stacks[name];
+        println!(
+            "{name:<16} {:>6} {:>7} {:>7}   (QEMU run {elapsed:.2?})",
+            done.stack, done.setup_stack, done.replay_stack
+        );
+    }
+
+    println!();
+    println!("== Panic paths below `{STEP}` (direct calls into core's panic entry points)");
+    for name in ["monitor-static", "monitor-table"] {
+        let (path, _) = read_image(name)?;
+        let r = callgraph::analyse(&path, STEP)?;
+        let (builtins, own): (Vec<&String>, Vec<&String>) = r.reachable.iter().partition(|f| {
+            f.starts_with("__") || f.starts_with("compiler_builtins::") || f.as_str() == "fmod"
+        });
+        let own: Vec<&str> = own.iter().map(|s| s.as_str()).collect();
+        println!(
+            "{name}: the step reaches {} and {} compiler-builtins routines (soft f64, fmod, 64-bit division)",
+            own.join(", "),
+            builtins.len()
+        );
+        if r.panic_calls.is_empty() {
+            println!("  no panic entry point is reachable");
+        }
+        for (caller, callee, n) in &r.panic_calls {
+            println!("  {caller} -> {callee}  ({n} call sites)");
+        }
+        print_locations("  panic locations", &r.locations);
+    }
+    for name in ["monitor-static", "monitor-table"] {
+        let (path, _) = read_image(name)?;
+        let step = callgraph::analyse(&path, STEP)?;
+        let all = callgraph::analyse(&path, "main")?;
+        let outside: Vec<Location> = all
+            .locations
+            .into_iter()
+            .filter(|l| !step.locations.contains(l))
+            .collect();
+        print_locations(
+            &format!("{name}: further panic locations reachable from `main` (start-up, logging)"),
+            &outside,
+        );
+    }
+    Ok(())
+}
+
+fn print_locations(title: &str, locations: &[Location]) {
+    println!("{title}: {}", locations.len());
+    for l in locations {
+        println!("    {}:{}:{}", short_path(&l.file), l.line, l.col);
+    }
+}
+
+/// `monitor-core/src/..` for the workspace crate, `crate-x.y.z/src/..` for a registry crate.
+fn short_path(file: &str) -> String {
+    if let Some((_, rest)) = file.split_once("/monitor-core/") {
+        return format!("monitor-core/{rest}");
+    }
+    if let Some((_, rest)) = file.split_once("/registry/src/") {
+        if let Some((_, krate)) = rest.split_once('/') {
+            return krate.to_string();
+        }
+    }
+    file.to_string()
+}
+
+/// The largest symbols of `image` that `baseline` does not have: where the monitor's flash goes.
+fn largest_additions(image: &str, baseline: &str) -> Result<(), String> {
+    let nm = callgraph::llvm_tool("llvm-nm")?;
+    let symbols = |image: &Path| -> Result<BTreeMap<String, u64>, String> {
+        let out = Command::new(&nm)
+            .args(["-C", "--print-size", "--size-sort"])
+            .arg(image)
+            .output()
+            .map_err(|e| format!("{}: {e}", nm.display()))?;
+        let text = String::from_utf8_lossy(&out.stdout);
+        Ok(text
+            .lines()
+            .filter_map(|l| {
+                // "000011cc 00000e52 T firmware::step_point::h3ab4713ba77f7c1b"
+                let mut f = l.splitn(4, ' ');
+                let (_, size, kind, name) = (f.next()?, f.next()?, f.next()?, f.next()?);
+                if !matches!(kind, "T" | "t" | "R" | "r" | "D" | "d") {
+                    return None;
+                }
+                let size = u64::from_str_radix(size, 16).ok()?;
+                let name = match name.rsplit_once("::h") {
+                    Some((head, hash)) if hash.len() == 16 => head,
+                    _ => name,
+                };
+                Some((name.to_string(), size))
+            })
+            .collect())
+    };
+    let (monitor, _) = read_image(image)?;
+    let (base, _) = read_image(baseline)?;
+    let base = symbols(&base)?;
+    let mut added: Vec<(String, u64)> = symbols(&monitor)?
+        .into_iter()
+        .filter(|(n, _)| !base.contains_key(n))
+        .collect();
+    added.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
+    let total: u64 = added.iter().map(|(_, s)| s).sum();
+    println!(
+        "largest symbols {image} adds to {baseline} ({total} bytes in {} symbols):",
+        added.len()
+    );
+    for (name, size) in added.iter().take(12) {
+        println!("  {size:>6}  {name}");
+    }
+    Ok(())
+}

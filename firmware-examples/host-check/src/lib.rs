@@ -1,0 +1,103 @@
+//! Host side of the firmware examples: run an image under QEMU, decode its defmt log, check its verdicts against the host interpreter, measure it.
+//!
+//! # Pipeline
+//!
+//! 1. [`qemu::run`] boots an image on `qemu-system-arm` (machine
+//!    `mps2-an386`, Cortex-M4F) with semihosting, under a time limit, and
+//!    returns the raw defmt stream and the exit status.
+//! 2. [`log::decode`] turns the stream into messages with the image's defmt
+//!    table (`defmt-decoder`); [`log::Log::parse`] reads the firmware's log
+//!    lines (see the firmware crate's docs for the format).
+//! 3. [`verdicts`] runs `monitor_core::Monitor` on this machine over the same
+//!    program and trace, and [`verdicts::compare`] checks the firmware's
+//!    verdict changes against it point for point.
+//! 4. [`elf::sizes`] and [`callgraph`] measure the image: flash and RAM, and
+//!    the `core::panicking` functions reachable from the monitor step.
+//!
+//! `tests/qemu.rs` runs steps 1-3 for each image; the `firmware-report`
+//! binary prints the size, state, stack and panic-path report.
+
+pub mod callgraph;
+pub mod elf;
+pub mod log;
+pub mod qemu;
+pub mod verdicts;
+
+use std::path::{Path, PathBuf};
+
+/// A program's state size split up: the words every property shares, and each property's own.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StateBreakdown {
+    /// Bytes shared by all properties: last timestamp, atom bits, node value bits.
+    pub shared: usize,
+    /// Each property's name and the bytes its nodes own.
+    pub props: Vec<(String, usize)>,
+}
+
+impl StateBreakdown {
+    /// Every byte: what `Monitor::state_bytes` reports.
+    pub fn total(&self) -> usize {
+        self.shared + self.props.iter().map(|(_, b)| b).sum::<usize>()
+    }
+}
+
+/// Splits `program`'s state by [`monitor_core::layout`]; `None` when a node has no layout.
+pub fn state_breakdown(program: &monitor_core::Program<'_>) -> Option<StateBreakdown> {
+    use monitor_core::layout;
+    let shared = 8 * layout::first_node_word(program.atoms.len(), program.nodes.len());
+    let mut props = Vec::new();
+    for p in program.props {
+        let nodes = program.nodes.get(p.first as usize..=p.root as usize)?;
+        let words = nodes
+            .iter()
+            .map(|n| layout::node_words(&n.op))
+            .sum::<Option<u64>>()?;
+        props.push((p.name.to_string(), 8 * usize::try_from(words).ok()?));
+    }
+    Some(StateBreakdown { shared, props })
+}
+
+/// The images that replay the museum trace, as built by `firmware-examples`,
+/// each with the baseline that replays the same trace without a monitor.
+pub const IMAGES: [(&str, &str); 4] = [
+    ("monitor-static", "baseline"),
+    ("monitor-table", "baseline-bytes"),
+    ("baseline", "baseline"),
+    ("baseline-bytes", "baseline-bytes"),
+];
+
+/// Where the images are: `$FIRMWARE_DIR`, else the firmware project's release output.
+pub fn image_dir() -> PathBuf {
+    match std::env::var_os("FIRMWARE_DIR") {
+        Some(d) => PathBuf::from(d),
+        None => {
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/thumbv7em-none-eabihf/release")
+        }
+    }
+}
+
+/// Reads image `name` from [`image_dir`], with a hint when it has not been built.
+pub fn read_image(name: &str) -> Result<(PathBuf, Vec<u8>), String> {
+    let path = image_dir().join(name);
+    match std::fs::read(&path) {
+        Ok(bytes) => Ok((path, bytes)),
+        Err(e) => Err(format!(
+            "{}: {e} (build the firmware first: scripts/firmware, or `cargo build --release` in firmware-examples/)",
+            path.display()
+        )),
+    }
+}
+
+/// The table and trace bytes `monitor-table` embeds: the files named by
+/// `HINDSIGHT_TABLE` / `HINDSIGHT_TRACE` when set (as for its build script),
+/// else museum-spec's.
+pub fn table_inputs() -> Result<(Vec<u8>, Vec<u8>), String> {
+    let read = |var: &str, default: fn() -> Vec<u8>| match std::env::var_os(var) {
+        Some(p) => std::fs::read(&p).map_err(|e| format!("{var}={}: {e}", Path::new(&p).display())),
+        None => Ok(default()),
+    };
+    Ok((
+        read("HINDSIGHT_TABLE", museum_spec::table_bytes)?,
+        read("HINDSIGHT_TRACE", museum_spec::trace_bytes)?,
+    ))
+}

@@ -1,0 +1,272 @@
+//! The host interpreter's verdicts over a trace, and the point-for-point comparison with a firmware's verdict changes.
+
+use monitor_core::table::Table;
+use monitor_core::{Monitor, Program, Value};
+use museum_spec::trace::Reader;
+
+use crate::log::Log;
+
+/// Verdicts of every property at every point of a trace.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Expected {
+    /// Timestamp of each point.
+    pub times: Vec<u64>,
+    /// `verdicts[i][p]`: property `p` at point `i`.
+    pub verdicts: Vec<Vec<bool>>,
+    /// Number of properties.
+    pub props: usize,
+    /// Monitor state size in bytes.
+    pub state_bytes: usize,
+}
+
+/// Runs `monitor_core::Monitor` on this machine over `points`.
+pub fn host_run<'v>(
+    program: Program<'_>,
+    points: impl IntoIterator<Item = (u64, &'v [Value])>,
+) -> Result<Expected, String> {
+    let monitor = Monitor::try_new(program).map_err(|e| format!("program rejected: {e}"))?;
+    let mut state = vec![0u64; monitor.state_words()];
+    monitor.reset(&mut state).map_err(|e| e.to_string())?;
+    let mut expected = Expected {
+        times: Vec::new(),
+        verdicts: Vec::new(),
+        props: monitor.properties(),
+        state_bytes: monitor.state_bytes(),
+    };
+    for (time, values) in points {
+        let mut verdicts = vec![false; monitor.properties()];
+        monitor
+            .try_step(&mut state, time, values, &mut verdicts)
+            .map_err(|e| format!("point {}: {e}", expected.times.len()))?;
+        expected.times.push(time);
+        expected.verdicts.push(verdicts);
+    }
+    Ok(expected)
+}
+
+/// What `monitor-static` must log: museum-spec's `PROGRAM` over its `TRACE`.
+pub fn static_expected() -> Result<Expected, String> {
+    host_run(
+        museum_spec::PROGRAM,
+        museum_spec::TRACE.iter().map(|p| (p.time, &p.values[..])),
+    )
+}
+
+/// The largest table [`table_expected`] decodes (entries per vector).
+pub const HOST_CAPACITY: usize = 4096;
+
+/// What `monitor-table` must log: the table decoded from `table` over the trace
+/// decoded from `trace`, read exactly as the firmware reads them.
+pub fn table_expected(table: &[u8], trace: &[u8]) -> Result<Expected, String> {
+    // A decoded `Table<HOST_CAPACITY>` is about 600 KiB and moves by value.
+    std::thread::scope(|s| {
+        std::thread::Builder::new()
+            .stack_size(64 << 20)
+            .spawn_scoped(s, || table_expected_on_this_thread(table, trace))
+            .map_err(|e| format!("spawning the decoder thread: {e}"))?
+            .join()
+            .map_err(|_| "the decoder thread panicked".to_string())?
+    })
+}
+
+fn table_expected_on_this_thread(table: &[u8], trace: &[u8]) -> Result<Expected, String> {
+    let table = Table::<HOST_CAPACITY>::from_bytes(table).map_err(|e| format!("table: {e}"))?;
+    let program = table.program();
+    let mut reader = Reader::new(trace, program.vars.len()).map_err(|e| format!("trace: {e}"))?;
+    let mut values: Vec<Value> = program.vars.iter().map(|v| v.init).collect();
+    let mut points = Vec::new();
+    while let Some(time) = reader
+        .next_point(&mut values)
+        .map_err(|e| format!("trace: {e}"))?
+    {
+        points.push((time, values.clone()));
+    }
+    host_run(program, points.iter().map(|(t, v)| (*t, &v[..])))
+}
+
+/// Rebuilds every point's verdicts from a log of changes, for `props` properties over `points` points.
+pub fn replay_changes(log: &Log, props: usize, points: usize) -> Result<Vec<Vec<bool>>, String> {
+    let mut current: Vec<Option<bool>> = vec![None; props];
+    let mut rows = Vec::with_capacity(points);
+    let mut changes = log.changes.iter().peekable();
+    for point in 0..points {
+        while let Some(c) = changes.next_if(|c| c.point as usize == point) {
+            let slot = current
+                .get_mut(c.prop)
+                .ok_or_else(|| format!("verdict for property {} of {props}", c.prop))?;
+            *slot = Some(c.value);
+        }
+        if let Some(c) = changes.peek() {
+            if (c.point as usize) < point {
+                return Err(format!("verdict changes out of order at {c:?}"));
+            }
+        }
+        let row = current
+            .iter()
+            .enumerate()
+            .map(|(p, v)| v.ok_or_else(|| format!("no verdict for property {p} at point {point}")))
+            .collect::<Result<Vec<bool>, String>>()?;
+        rows.push(row);
+    }
+    if let Some(c) = changes.next() {
+        return Err(format!(
+            "verdict change past the last point {}: {c:?}",
+            points - 1
+        ));
+    }
+    Ok(rows)
+}
+
+/// Checks a firmware log against the host's verdicts: the same number of
+/// properties and points, every change at the right timestamp, and the same
+/// verdict for every property at every point.
+pub fn compare(expected: &Expected, log: &Log) -> Result<(), String> {
+    if !log.errors.is_empty() {
+        return Err(format!("the firmware logged errors: {:?}", log.errors));
+    }
+    let start = log.start.as_ref().ok_or("no `start` line")?;
+    let done = log
+        .done
+        .ok_or("no `done` line: the replay did not finish")?;
+    let n = expected.times.len();
+    if start.props != expected.props {
+        return Err(format!(
+            "{} properties, the host has {}",
+            start.props, expected.props
+        ));
+    }
+    if start.state_bytes != expected.state_bytes {
+        return Err(format!(
+            "state of {} bytes, the host has {}",
+            start.state_bytes, expected.state_bytes
+        ));
+    }
+    if start.points as usize != n || done.points as usize != n {
+        return Err(format!(
+            "announced {} and replayed {} points, the trace has {n}",
+            start.points, done.points
+        ));
+    }
+    for c in &log.changes {
+        let want = expected.times.get(c.point as usize);
+        if want != Some(&c.time) {
+            return Err(format!("{c:?}: the trace's point has time {want:?}"));
+        }
+    }
+    let got = replay_changes(log, expected.props, n)?;
+    for (i, (g, e)) in got.iter().zip(&expected.verdicts).enumerate() {
+        if let Some(p) = (0..expected.props).find(|&p| g[p] != e[p]) {
+            return Err(format!(
+                "point {i} (time {}), property {p}: firmware says {}, host says {}",
+                expected.times[i], g[p], e[p]
+            ));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::log::{Change, Done, Start};
+
+    fn log_of(changes: &[(usize, u32, u64, bool)], points: u32) -> Log {
+        Log {
+            start: Some(Start {
+                name: "t".into(),
+                props: 2,
+                points,
+                state_bytes: 8,
+            }),
+            changes: changes
+                .iter()
+                .map(|&(prop, point, time, value)| Change {
+                    prop,
+                    point,
+                    time,
+                    value,
+                })
+                .collect(),
+            done: Some(Done {
+                points,
+                stack: 0,
+                setup_stack: 0,
+                replay_stack: 0,
+            }),
+            ..Log::default()
+        }
+    }
+
+    fn expected(verdicts: &[[bool; 2]]) -> Expected {
+        Expected {
+            times: (0..verdicts.len() as u64).map(|i| i * 10).collect(),
+            verdicts: verdicts.iter().map(|v| v.to_vec()).collect(),
+            props: 2,
+            state_bytes: 8,
+        }
+    }
+
+    #[test]
+    fn changes_rebuild_every_point() {
+        let log = log_of(
+            &[
+                (0, 0, 0, true),
+                (1, 0, 0, false),
+                (1, 2, 20, true),
+                (0, 3, 30, false),
+            ],
+            4,
+        );
+        let rows = replay_changes(&log, 2, 4).unwrap();
+        assert_eq!(
+            rows,
+            [[true, false], [true, false], [true, true], [false, true]]
+        );
+        let e = expected(&[[true, false], [true, false], [true, true], [false, true]]);
+        assert_eq!(compare(&e, &log), Ok(()));
+    }
+
+    #[test]
+    fn a_missing_change_is_a_mismatch_at_its_point() {
+        let log = log_of(&[(0, 0, 0, true), (1, 0, 0, false)], 3);
+        let e = expected(&[[true, false], [true, true], [true, true]]);
+        let err = compare(&e, &log).unwrap_err();
+        assert!(err.starts_with("point 1 (time 10), property 1"), "{err}");
+    }
+
+    #[test]
+    fn a_wrong_timestamp_or_count_is_rejected() {
+        let log = log_of(&[(0, 0, 0, true), (1, 0, 5, false)], 1);
+        assert!(compare(&expected(&[[true, false]]), &log).is_err());
+        let log = log_of(&[(0, 0, 0, true), (1, 0, 0, false)], 2);
+        assert!(compare(&expected(&[[true, false]]), &log).is_err());
+    }
+
+    #[test]
+    fn a_property_without_a_first_verdict_is_rejected() {
+        let log = log_of(&[(0, 0, 0, true)], 1);
+        assert!(replay_changes(&log, 2, 1).is_err());
+    }
+
+    #[test]
+    fn static_program_and_table_agree_on_the_museum_trace() {
+        let a = static_expected().unwrap();
+        let b = table_expected(&museum_spec::table_bytes(), &museum_spec::trace_bytes()).unwrap();
+        assert_eq!(a, b);
+        assert_eq!(a.state_bytes, museum_spec::STATE_WORDS * 8);
+        assert_eq!(a.times.len(), museum_spec::TRACE_LEN);
+    }
+
+    #[test]
+    fn the_museum_trace_changes_every_property_verdict() {
+        // The trace is meant to show each property change its verdict at least once.
+        let e = static_expected().unwrap();
+        for p in 0..e.props {
+            let first = e.verdicts[0][p];
+            assert!(
+                e.verdicts.iter().any(|v| v[p] != first),
+                "property {p} never changes"
+            );
+        }
+    }
+}

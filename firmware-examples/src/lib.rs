@@ -1,0 +1,150 @@
+//! Shared run-time of the example firmware: defmt over semihosting, exit status, panic handler, stack high-water mark, verdict log.
+//!
+//! # Pipeline
+//!
+//! Each binary gets a [`monitor_core::Program`] (from `static` arrays in
+//! `monitor-static`, from a postcard table in `monitor-table`), validates it
+//! with `Monitor::try_new`, then for every point of a replay trace calls
+//! [`step_point`] and hands the verdicts to [`VerdictLog`], which logs every
+//! change. At the end [`finish`] logs the point count and the stack high-water
+//! marks and exits QEMU with status 0; any error goes to [`fail`] (status 1),
+//! and so does a panic.
+//!
+//! # Log lines (the contract with `host-check`)
+//!
+//! - `start <name> props=<P> points=<N> state_bytes=<S>`
+//! - `property <index> <name>` for each property
+//! - `verdict prop=<p> point=<i> time=<t> value=<bool>`: property `p`'s
+//!   verdict at point `i` (0-based) differs from its verdict at point `i-1`,
+//!   or `i` is the first point
+//! - `done points=<N> stack=<bytes> setup_stack=<bytes> replay_stack=<bytes>`:
+//!   stack high-water marks of the whole run, of the set-up (decoding and
+//!   validating the program) and of the replay (from [`end_of_setup`] on,
+//!   frames live at that point included)
+//! - `error ...` before a failing exit
+#![no_std]
+
+use core::panic::PanicInfo;
+
+use cortex_m_rt as _;
+use defmt_semihosting as _;
+use monitor_core::{Monitor, StepError, Value};
+
+// Provides the single-core critical section that defmt-semihosting needs.
+use cortex_m as _;
+
+/// The stack high-water mark in bytes, from cortex-m-rt's `paint-stack`.
+pub mod stack;
+
+/// Exits QEMU through semihosting: status 0 when `success`, else 1.
+pub fn exit(success: bool) -> ! {
+    semihosting::process::exit(if success { 0 } else { 1 })
+}
+
+/// Logs `error <what>` and exits with status 1.
+pub fn fail(what: &str) -> ! {
+    defmt::error!("error {=str}", what);
+    exit(false)
+}
+
+/// Ends the set-up phase: returns its stack high-water mark in bytes and
+/// repaints the free stack so that [`finish`] measures the replay on its own.
+pub fn end_of_setup() -> usize {
+    let setup = stack::high_water();
+    stack::repaint();
+    setup
+}
+
+/// Logs the end of the replay (point count; stack high-water marks of the
+/// whole run, of the set-up and of the replay) and exits with status 0.
+pub fn finish(points: u32, setup_stack: usize) -> ! {
+    let replay = stack::high_water();
+    defmt::info!(
+        "done points={=u32} stack={=u32} setup_stack={=u32} replay_stack={=u32}",
+        points,
+        setup_stack.max(replay) as u32,
+        setup_stack as u32,
+        replay as u32
+    );
+    exit(true)
+}
+
+/// Logs the program's shape before the replay starts.
+pub fn log_start(name: &str, monitor: &Monitor<'_>, points: u32) {
+    defmt::info!(
+        "start {=str} props={=usize} points={=u32} state_bytes={=usize}",
+        name,
+        monitor.properties(),
+        points,
+        monitor.state_bytes()
+    );
+    for (i, p) in monitor.program().props.iter().enumerate() {
+        defmt::info!("property {=usize} {=str}", i, p.name);
+    }
+}
+
+/// One monitor step; never inlined so that the image has a symbol to start the panic-path analysis from.
+#[inline(never)]
+pub fn step_point(
+    monitor: &Monitor<'_>,
+    state: &mut [u64],
+    time: u64,
+    vars: &[Value],
+    verdicts: &mut [bool],
+) -> Result<(), StepError> {
+    monitor.try_step(state, time, vars, verdicts)
+}
+
+/// Remembers the last verdict of each of `P` properties and logs every change.
+pub struct VerdictLog<const P: usize> {
+    last: [bool; P],
+    points: u32,
+}
+
+impl<const P: usize> Default for VerdictLog<P> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const P: usize> VerdictLog<P> {
+    /// A log before the first point.
+    pub const fn new() -> Self {
+        VerdictLog {
+            last: [false; P],
+            points: 0,
+        }
+    }
+
+    /// Logs each verdict of the point at `time` that differs from the previous point's (all of them at the first point).
+    pub fn record(&mut self, time: u64, verdicts: &[bool; P]) {
+        let point = self.points;
+        for (prop, (last, &now)) in self.last.iter_mut().zip(verdicts).enumerate() {
+            if point == 0 || *last != now {
+                defmt::info!(
+                    "verdict prop={=usize} point={=u32} time={=u64} value={=bool}",
+                    prop,
+                    point,
+                    time,
+                    now
+                );
+            }
+            *last = now;
+        }
+        self.points = point.saturating_add(1);
+    }
+
+    /// Number of points recorded.
+    pub fn points(&self) -> u32 {
+        self.points
+    }
+}
+
+#[panic_handler]
+fn panic(info: &PanicInfo<'_>) -> ! {
+    match info.location() {
+        Some(l) => defmt::error!("error panic at {=str}:{=u32}", l.file(), l.line()),
+        None => defmt::error!("error panic"),
+    }
+    exit(false)
+}
