@@ -26,7 +26,6 @@ fn every_panic_below_the_step_comes_from_monitor_core() {
 }
 
 #[test]
-#[ignore = "monitor-core's step still indexes its state and atom stack with bounds checks and divides by `cap` (firmware-report lists the sites); enable once they are gone"]
 fn the_monitor_step_links_no_panic_path() {
     for name in ["monitor-static", "monitor-table"] {
         let (path, _) = read_image(name).unwrap();
