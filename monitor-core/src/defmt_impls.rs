@@ -16,7 +16,9 @@ impl defmt::Format for StepError {
                 defmt::write!(f, "input size {=usize}, expected {=usize}", found, expected)
             }
             StepError::VarType { var } => defmt::write!(f, "variable {=u16}: wrong type", var),
-            StepError::Arithmetic { atom } => defmt::write!(f, "atom {=u16}: arithmetic error", atom),
+            StepError::Arithmetic { atom } => {
+                defmt::write!(f, "atom {=u16}: arithmetic error", atom)
+            }
         }
     }
 }

@@ -33,8 +33,8 @@ impl<'a> Monitor<'a> {
             return Err(TableError::TooLarge);
         }
         for (i, v) in p.vars.iter().enumerate() {
-            let ok = v.init.ty() == v.ty
-                && (v.kind == VarKind::State || v.init == Value::Bool(false));
+            let ok =
+                v.init.ty() == v.ty && (v.kind == VarKind::State || v.init == Value::Bool(false));
             if !ok {
                 return Err(TableError::Var { var: i as u16 });
             }
@@ -52,7 +52,11 @@ impl<'a> Monitor<'a> {
         let mut first = 0usize;
         for (i, n) in p.nodes.iter().enumerate() {
             // The property owning node i: the first whose root is >= i.
-            while p.props.get(prop_of_next).is_some_and(|pr| (pr.root as usize) < i) {
+            while p
+                .props
+                .get(prop_of_next)
+                .is_some_and(|pr| (pr.root as usize) < i)
+            {
                 prop_of_next += 1;
                 first = i;
             }
