@@ -34,6 +34,15 @@ impl Ty {
         matches!(self, Ty::Int | Ty::Float)
     }
 
+    fn with_article(self) -> &'static str {
+        match self {
+            Ty::Bool => "a boolean",
+            Ty::Int => "an integer",
+            Ty::Float => "a float",
+            Ty::Str => "a string",
+        }
+    }
+
     fn name(self) -> &'static str {
         match self {
             Ty::Bool => "boolean",
@@ -893,7 +902,7 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
                         PropsErrorKind::BadValue {
                             attribute: "expr".to_owned(),
                             value: value.as_str().to_owned(),
-                            expected: format!("a {} constant", ty.name()),
+                            expected: format!("{} constant", ty.with_article()),
                         },
                     );
                     return None;
