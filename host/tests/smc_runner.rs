@@ -443,3 +443,30 @@ fn run_range_counts_every_run_once() {
     let share = one.properties[1].successes as f64 / 1000.0;
     assert!((share - 0.75).abs() < 0.05, "{share}");
 }
+
+#[test]
+fn few_runs_are_wasted_past_the_stopping_point() {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    for threads in [2, 4] {
+        let started = AtomicU64::new(0);
+        let run = |_: u64, _: &mut Xoshiro256PlusPlus| {
+            started.fetch_add(1, Ordering::Relaxed);
+            std::thread::sleep(Duration::from_micros(50));
+            RunOutcome {
+                verdicts: vec![Verdict::True],
+                assumptions: Verdict::True,
+                end: RunEnd::Quiescent,
+                steps: 1,
+                time: 0,
+            }
+        };
+        let rules = rules(RuleKind::Adaptive, 0.95, 0.01, 1);
+        let result = run_study(&config(0, threads), &rules, run, &mut quiet);
+        let started = started.load(Ordering::Relaxed);
+        assert!(
+            started <= result.runs.runs + 2 * threads as u64,
+            "{threads} threads: {started} started for {} used",
+            result.runs.runs
+        );
+    }
+}

@@ -9,6 +9,8 @@ use std::f64::consts::{PI, SQRT_2};
 
 /// Relative precision the series and continued fractions aim for.
 const EPS: f64 = 1e-15;
+/// Relative step size at which the root finder stops.
+const SOLVE_TOLERANCE: f64 = 1e-13;
 /// Smallest magnitude the modified Lentz algorithm lets a denominator reach.
 const TINY: f64 = 1e-300;
 
@@ -86,13 +88,18 @@ pub fn reg_inc_beta(a: f64, b: f64, x: f64) -> f64 {
     if a.is_nan() || b.is_nan() || x.is_nan() || a <= 0.0 || b <= 0.0 {
         return f64::NAN;
     }
+    reg_inc_beta_with(a, b, x, ln_beta(a, b))
+}
+
+/// [`reg_inc_beta`] for valid shapes, with `ln B(a, b)` precomputed.
+fn reg_inc_beta_with(a: f64, b: f64, x: f64, ln_b: f64) -> f64 {
     if x <= 0.0 {
         return 0.0;
     }
     if x >= 1.0 {
         return 1.0;
     }
-    let ln_front = a * x.ln() + b * (-x).ln_1p() - ln_beta(a, b);
+    let ln_front = a * x.ln() + b * (-x).ln_1p() - ln_b;
     if x < (a + 1.0) / (a + b + 2.0) {
         (ln_front.exp() * beta_continued_fraction(a, b, x) / a).clamp(0.0, 1.0)
     } else {
@@ -102,8 +109,8 @@ pub fn reg_inc_beta(a: f64, b: f64, x: f64) -> f64 {
 }
 
 /// Density of the beta distribution at `x`, the derivative of [`reg_inc_beta`] in `x`.
-fn beta_density(a: f64, b: f64, x: f64) -> f64 {
-    ((a - 1.0) * x.ln() + (b - 1.0) * (-x).ln_1p() - ln_beta(a, b)).exp()
+fn beta_density(a: f64, b: f64, x: f64, ln_b: f64) -> f64 {
+    ((a - 1.0) * x.ln() + (b - 1.0) * (-x).ln_1p() - ln_b).exp()
 }
 
 /// Solve `f(x) = target` for increasing `f` on `[lo, hi]`: Newton steps with derivative
@@ -139,14 +146,38 @@ fn solve_increasing(
         } else {
             0.5 * (lo + hi)
         };
+        // The functions inverted here are accurate to about 1e-14 (relative), so a
+        // tighter tolerance would only make Newton dither at rounding noise.
         let scale = next.abs().max(x.abs()).max(f64::MIN_POSITIVE);
-        if (next - x).abs() <= 4.0 * f64::EPSILON * scale || (hi - lo) <= 4.0 * f64::EPSILON * scale
-        {
+        if (next - x).abs() <= SOLVE_TOLERANCE * scale || (hi - lo) <= SOLVE_TOLERANCE * scale {
             return next;
         }
         x = next;
     }
     x
+}
+
+/// A rough normal quantile (relative error about 1e-3), good enough for a start point.
+fn rough_normal_quantile(p: f64) -> f64 {
+    4.91 * (p.powf(0.14) - (1.0 - p).powf(0.14))
+}
+
+/// A start point for solving `I_x(a, b) = y`: the normal approximation of the beta
+/// distribution, or the small-`x` expansion `I_x ~ x^a / (a B(a, b))` where that falls
+/// outside `(0, 1)`.
+fn beta_quantile_start(a: f64, b: f64, y: f64, ln_b: f64) -> f64 {
+    let sum = a + b;
+    let mean = a / sum;
+    let sd = (a * b / (sum * sum * (sum + 1.0))).sqrt();
+    let normal = mean + rough_normal_quantile(y) * sd;
+    if normal > 0.0 && normal < 1.0 {
+        return normal;
+    }
+    if normal <= 0.0 {
+        ((y.ln() + a.ln() + ln_b) / a).exp().min(mean)
+    } else {
+        1.0 - (((1.0 - y).ln() + b.ln() + ln_b) / b).exp().min(1.0 - mean)
+    }
 }
 
 /// The inverse of [`reg_inc_beta`] in `x`: the `y`-quantile of the `Beta(a, b)`
@@ -161,13 +192,28 @@ pub fn inv_reg_inc_beta(a: f64, b: f64, y: f64) -> f64 {
     if y >= 1.0 {
         return 1.0;
     }
+    let ln_b = ln_beta(a, b);
+    let start = beta_quantile_start(a, b, y, ln_b);
+    if start > 0.5 {
+        // Solve for 1 - x, which is then small and precisely represented:
+        // I_x(a, b) = y  <=>  I_{1-x}(b, a) = 1 - y.
+        let complement = solve_increasing(
+            |x| reg_inc_beta_with(b, a, x, ln_b),
+            |x| beta_density(b, a, x, ln_b),
+            1.0 - y,
+            0.0,
+            1.0,
+            1.0 - start,
+        );
+        return 1.0 - complement;
+    }
     solve_increasing(
-        |x| reg_inc_beta(a, b, x),
-        |x| beta_density(a, b, x),
+        |x| reg_inc_beta_with(a, b, x, ln_b),
+        |x| beta_density(a, b, x, ln_b),
         y,
         0.0,
         1.0,
-        a / (a + b),
+        start,
     )
 }
 
@@ -243,8 +289,8 @@ pub fn normal_quantile(p: f64) -> f64 {
     if p >= 1.0 {
         return f64::INFINITY;
     }
-    // Start from a logistic-style approximation, then refine in the bracket.
-    let start = 4.91 * (p.powf(0.14) - (1.0 - p).powf(0.14));
+    // Start from a rough approximation, then refine in the bracket.
+    let start = rough_normal_quantile(p);
     let density = |z: f64| (-0.5 * z * z).exp() / (2.0 * PI).sqrt();
     solve_increasing(normal_cdf, density, p, -40.0, 40.0, start)
 }

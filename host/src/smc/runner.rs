@@ -335,13 +335,13 @@ fn result_of(rule: &dyn StoppingRule, tracker: &Tracker) -> PropertyResult {
     }
 }
 
-/// Time left: the largest number of runs a rule still needs, at the current rate.
-fn estimate_eta(
+/// Runs still to consume: the largest number of judged runs a rule still needs, scaled
+/// by the share of runs that are judged for it. `None` when some rule cannot say.
+fn remaining_runs(
     rules: &[Box<dyn StoppingRule>],
     trackers: &[Tracker],
     consumed: u64,
-    elapsed: Duration,
-) -> Option<Duration> {
+) -> Option<f64> {
     if consumed == 0 {
         return None;
     }
@@ -356,9 +356,24 @@ fn estimate_eta(
         let rate = judged.max(1) as f64 / consumed as f64;
         remaining_runs = remaining_runs.max(needed.saturating_sub(judged) as f64 / rate);
     }
-    let per_run = elapsed.as_secs_f64() / consumed as f64;
-    Some(Duration::from_secs_f64((remaining_runs * per_run).min(1e9)))
+    Some(remaining_runs)
 }
+
+/// Time left at the current rate.
+fn estimate_eta(
+    rules: &[Box<dyn StoppingRule>],
+    trackers: &[Tracker],
+    consumed: u64,
+    elapsed: Duration,
+) -> Option<Duration> {
+    let remaining = remaining_runs(rules, trackers, consumed)?;
+    let per_run = elapsed.as_secs_f64() / consumed as f64;
+    Some(Duration::from_secs_f64((remaining * per_run).min(1e9)))
+}
+
+/// How often (in consumed runs) the runner re-estimates the runs still needed, to keep
+/// workers from starting runs far past the likely stopping point.
+const HINT_EVERY: u64 = 8;
 
 /// Runs a sequential study: run `k` gets stream `k`, results are consumed in index order
 /// by one rule per property, and the study stops when every rule is done (or at
@@ -385,6 +400,7 @@ where
         .collect();
     let mut runs = RunCounts::default();
     let mut last_report = start;
+    let mut remaining_hint = u64::MAX;
     let all_done = |trackers: &[Tracker]| trackers.iter().all(|t| t.stopped_at.is_some());
     let end = config.max_runs;
     let mut report = |trackers: &[Tracker], consumed: u64, finished: bool| {
@@ -442,7 +458,13 @@ where
                     last_report = now;
                     report(&trackers, runs.runs, false);
                 }
-                ControlFlow::Continue(())
+                remaining_hint = if runs.runs % HINT_EVERY == 0 {
+                    remaining_runs(rules, &trackers, runs.runs)
+                        .map_or(u64::MAX, |remaining| remaining.ceil() as u64)
+                } else {
+                    remaining_hint.saturating_sub(1)
+                };
+                ControlFlow::Continue(remaining_hint)
             },
         );
     }
@@ -533,7 +555,7 @@ where
                     last_report = now;
                     report(counts.runs.runs, false);
                 }
-                ControlFlow::Continue(())
+                ControlFlow::Continue(u64::MAX)
             },
         );
     }
@@ -561,11 +583,13 @@ type Finished = (u64, thread::Result<RunOutcome>);
 
 /// Runs indices `start, start + 1, ...` (up to `end`, exclusive, if given) on `threads`
 /// threads and calls `consume` strictly in index order on the calling thread, until it
-/// breaks or the range is exhausted.
+/// breaks or the range is exhausted. `consume` continues with its estimate of the runs
+/// still needed (`u64::MAX` for "unknown"): workers start at most that many runs (plus
+/// one per thread) past the last consumed one, so few runs are wasted at the end.
 fn drive<F, C>(seed: u64, threads: usize, start: u64, end: Option<u64>, run: &F, mut consume: C)
 where
     F: Fn(u64, &mut Xoshiro256PlusPlus) -> RunOutcome + Sync,
-    C: FnMut(u64, RunOutcome) -> ControlFlow<()>,
+    C: FnMut(u64, RunOutcome) -> ControlFlow<(), u64>,
 {
     let mut rng = stream(seed, start);
     let past_end = |index: u64| end.is_some_and(|end| index >= end);
@@ -628,6 +652,7 @@ where
 
         let mut pending: BTreeMap<u64, RunOutcome> = BTreeMap::new();
         let mut expected = start;
+        let mut ahead = window;
         'consume: for (index, outcome) in receiver.iter() {
             match outcome {
                 Ok(outcome) => {
@@ -641,12 +666,18 @@ where
             while let Some(outcome) = pending.remove(&expected) {
                 let flow = consume(expected, outcome);
                 expected += 1;
-                if flow.is_break() || past_end(expected) {
+                match flow {
+                    ControlFlow::Break(()) => break 'consume,
+                    ControlFlow::Continue(remaining) => {
+                        ahead = remaining.saturating_add(threads as u64).min(window);
+                    }
+                }
+                if past_end(expected) {
                     break 'consume;
                 }
             }
             let mut guard = shared.lock().unwrap_or_else(PoisonError::into_inner);
-            guard.window_end = expected.saturating_add(window);
+            guard.window_end = expected.saturating_add(ahead);
             drop(guard);
             wake.notify_all();
         }

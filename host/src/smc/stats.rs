@@ -459,15 +459,23 @@ pub fn clopper_pearson_interval(successes: u64, runs: u64, confidence: f64) -> I
 }
 
 /// Exact Clopper-Pearson interval; stops when its half-width is at most the precision.
+///
+/// The most expensive rule to evaluate (two inverse incomplete beta functions per check,
+/// a few microseconds); [`StoppingRule::runs_needed`] uses the Wilson interval's answer,
+/// which is close.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ClopperPearson {
     accuracy: Accuracy,
+    wilson: WilsonInterval,
 }
 
 impl ClopperPearson {
     /// A rule for this confidence and precision.
     pub fn new(accuracy: Accuracy) -> ClopperPearson {
-        ClopperPearson { accuracy }
+        ClopperPearson {
+            accuracy,
+            wilson: WilsonInterval::new(accuracy),
+        }
     }
 }
 
@@ -485,15 +493,7 @@ impl StoppingRule for ClopperPearson {
     }
 
     fn runs_needed(&self, successes: u64, runs: u64) -> Option<u64> {
-        let p = if runs == 0 {
-            0.5
-        } else {
-            successes as f64 / runs as f64
-        };
-        first_n(runs, |n| {
-            let s = (p * n as f64).round() as u64;
-            self.done(s.min(n), n)
-        })
+        self.wilson.runs_needed(successes, runs)
     }
 
     fn fixed_runs(&self) -> Option<u64> {
