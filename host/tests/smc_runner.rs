@@ -387,16 +387,27 @@ fn progress_reports_end_with_a_final_one() {
         ..config(4, 2)
     };
     let mut reports = Vec::new();
+    let mut expected = Vec::new();
+    // Draws only if the test's standard error is a terminal.
+    let mut bar = hindsight::smc::progress::TerminalProgress::stderr();
     let result = run_study(
         &study,
         &rules(RuleKind::Adaptive, 0.95, 0.05, 1),
         bernoulli(&probabilities),
         &mut |progress: &Progress<'_>| {
             reports.push((progress.runs, progress.finished, progress.eta.is_some()));
+            expected.push(progress.expected_runs);
+            bar.update(progress);
         },
     );
     let last = *reports.last().expect("a report");
     assert_eq!(last, (result.runs.runs, true, true));
+    assert_eq!(expected.last(), Some(&Some(result.runs.runs)));
+    // The adaptive bound's estimate of the total is never below the runs already done.
+    assert!(reports
+        .iter()
+        .zip(&expected)
+        .all(|(report, total)| total.is_none_or(|total| total >= report.0)));
     assert!(reports.windows(2).all(|w| w[0].0 <= w[1].0));
     assert_eq!(reports.iter().filter(|r| r.1).count(), 1);
     // With progress every run, ETAs are reported once runs exist.

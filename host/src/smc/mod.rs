@@ -14,10 +14,14 @@
 //! 4. **Fixed-size study, sharded** ([`shard`]): [`run_shard`] runs slice `i/n` and
 //!    returns a [`PartialResult`] (JSON); [`merge`] checks and combines them.
 //!
+//! 5. **Progress** ([`progress`]): [`progress::TerminalProgress`] draws the reports as a
+//!    bar on a terminal and stays silent otherwise.
+//!
 //! Discarded runs (assumptions violated) and runs cut short (step limit) are counted,
 //! never silently judged: see [`runner`] for the policy.
 
 pub mod math;
+pub mod progress;
 pub mod runner;
 pub mod shard;
 pub mod stats;

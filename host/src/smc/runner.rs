@@ -297,6 +297,8 @@ pub struct Progress<'a> {
     pub elapsed: Duration,
     /// Estimated time left, when the rules can say.
     pub eta: Option<Duration>,
+    /// Estimated total runs the study will consume, when the rules can say.
+    pub expected_runs: Option<u64>,
     /// Current per-property results.
     pub properties: &'a [PropertyResult],
     /// Whether this is the last report.
@@ -359,18 +361,6 @@ fn remaining_runs(
     Some(remaining_runs)
 }
 
-/// Time left at the current rate.
-fn estimate_eta(
-    rules: &[Box<dyn StoppingRule>],
-    trackers: &[Tracker],
-    consumed: u64,
-    elapsed: Duration,
-) -> Option<Duration> {
-    let remaining = remaining_runs(rules, trackers, consumed)?;
-    let per_run = elapsed.as_secs_f64() / consumed as f64;
-    Some(Duration::from_secs_f64((remaining * per_run).min(1e9)))
-}
-
 /// How often (in consumed runs) the runner re-estimates the runs still needed, to keep
 /// workers from starting runs far past the likely stopping point.
 const HINT_EVERY: u64 = 8;
@@ -410,15 +400,20 @@ where
             .zip(trackers)
             .map(|(rule, tracker)| result_of(rule.as_ref(), tracker))
             .collect();
-        let eta = if finished {
-            Some(Duration::ZERO)
+        let remaining = if finished {
+            Some(0.0)
         } else {
-            estimate_eta(rules, trackers, consumed, elapsed)
+            remaining_runs(rules, trackers, consumed)
         };
+        let eta = remaining.map(|remaining| {
+            let per_run = elapsed.as_secs_f64() / consumed.max(1) as f64;
+            Duration::from_secs_f64((remaining * per_run).min(1e9))
+        });
         progress(&Progress {
             runs: consumed,
             elapsed,
             eta,
+            expected_runs: remaining.map(|remaining| consumed + remaining.ceil() as u64),
             properties: &properties,
             finished,
         });
@@ -526,6 +521,7 @@ where
             runs: done,
             elapsed,
             eta,
+            expected_runs: Some(total),
             properties: &[],
             finished,
         });
