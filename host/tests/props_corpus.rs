@@ -5,10 +5,18 @@ use std::path::{Path, PathBuf};
 
 use hindsight::props::{parse_file, Location, PortKind, PropertyFile};
 
-fn corpus(relative: &str) -> PathBuf {
+/// `shared/corpus`, found next to the repository or a worktree container above it (the
+/// repository may be checked out at `X/repo` or `X/wt/name`, with `X/shared`).
+fn corpus_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/corpus")
-        .join(relative)
+        .ancestors()
+        .map(|dir| dir.join("shared/corpus"))
+        .find(|dir| dir.is_dir())
+        .expect("shared/corpus next to the repository")
+}
+
+fn corpus(relative: &str) -> PathBuf {
+    corpus_root().join(relative)
 }
 
 fn read(relative: &str) -> (PropertyFile, String) {

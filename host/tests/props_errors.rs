@@ -1,7 +1,7 @@
 //! Bad property files: every error names the file, line and column, and independent
 //! problems are all reported.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use hindsight::props::{parse_file, parse_str, Location, PropsError, PropsErrorKind};
 
@@ -411,7 +411,7 @@ fn files_that_cannot_be_read() {
 #[test]
 fn damaged_corpus_files_never_panic() {
     use rand_core::{Rng, SeedableRng};
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus");
+    let root = corpus_root();
     let files = [
         root.join("uc3-plain/properties.xml"),
         root.join("museum-simpar2025/model_scxml/properties.xml"),
@@ -451,4 +451,14 @@ fn damaged_corpus_files_never_panic() {
             }
         }
     }
+}
+
+/// `shared/corpus`, found next to the repository or a worktree container above it (the
+/// repository may be checked out at `X/repo` or `X/wt/name`, with `X/shared`).
+fn corpus_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .map(|dir| dir.join("shared/corpus"))
+        .find(|dir| dir.is_dir())
+        .expect("shared/corpus next to the repository")
 }
