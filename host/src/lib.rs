@@ -3,3 +3,5 @@
 pub mod cli;
 pub mod tracefile;
 pub mod verify;
+pub mod props;
+pub mod smc;

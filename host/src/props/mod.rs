@@ -1,0 +1,183 @@
+//! SCAN property files: ports (state and event variables) and Past-MTL guarantees and
+//! assumptions, read from both formats SCAN has used.
+//!
+//! # Formats
+//!
+//! **Current** (SCAN today):
+//!
+//! ```xml
+//! <properties>
+//!   <ports>
+//!     <scxml_event_send event="E" origin="M" target="T">
+//!       <state_var id="x" param="p" type="int32" expr="0"/>
+//!       <event_var id="e"/>
+//!     </scxml_event_send>
+//!   </ports>
+//!   <guarantees><property id="P1" logic="pmtl" expr="historically({ x &lt; 3 })"/></guarantees>
+//!   <assumes>...same as guarantees...</assumes>
+//! </properties>
+//! ```
+//!
+//! `logic` is optional and must be `pmtl` when given. The formula is the unescaped `expr`
+//! (tabs and line breaks become spaces, as XML attribute normalisation says).
+//!
+//! **Tree form** (older SCAN, used by the museum case study):
+//! `<port id type>` with `<origin refid/>`, `<target refid/>` and
+//! `<message event [param_name expr]/>` (a port with `param_name` is a state variable
+//! with initial value `expr`, one without is an event variable and must be `boolean`);
+//! `<predicates>` of `<predicate id>` holding one value expression; `<guarantees>` of
+//! `<guarantee id>` (and, as an extension, `<assumes>` of `<assume id>`) holding one
+//! formula. Elements:
+//!
+//! | element | Rye text |
+//! | --- | --- |
+//! | `<true/>`, `<false/>` | `true`, `false` |
+//! | `<var refid/>` | `{x}` for a boolean variable, the predicate's body for a predicate |
+//! | `<not>`, `<and>`, `<or>`, `<implies>` | `(!f)`, `(f && g ...)`, `(f \|\| g ...)`, `(f -> g)` |
+//! | `<historically lower_bound upper_bound>` | `(historically[a:b] f)` |
+//! | `<previously ...>` (also `<once>`) | `(once[a:b] f)` |
+//! | `<since ...>` f g | `(f since[a:b] g)` (f must hold since the last g) |
+//! | `<equal>`, `<less>`, `<leq>`, `<greater>`, `<geq>` | `{a == b}` etc., one atom |
+//! | `<sum>`, `<mult>`, `<opposite>` | `a + b`, `a * b`, `-a`, inside an atom |
+//! | `<const type expr/>` | the literal (strings in single quotes) |
+//!
+//! Bounds are optional non-negative integers (`[a:]`, `[:b]`, `[a:b]`). Inside an atom
+//! (an argument of a comparison or arithmetic) boolean operators become `&&`, `||`, `!`
+//! and `!a || b`. The whole formula loses its outermost parentheses.
+//!
+//! # Output
+//!
+//! A [`PropertyFile`]: one [`Port`] per variable, and [`Property`]s whose formula is a
+//! [`SourceText`] that maps every byte offset back to a file [`Location`], so an error
+//! the formula compiler reports at an offset can name the line and column in the file
+//! (exactly for the current format, at the generating element for the tree form).
+//!
+//! # Errors
+//!
+//! Malformed XML stops reading at the first error. Otherwise every problem is collected
+//! ([`Diagnostics`]): unknown elements and attributes, missing attributes and elements,
+//! bad values and types, duplicate ids, unknown references, predicate cycles, each with
+//! file, line and column.
+
+mod error;
+mod read;
+mod source;
+mod xml;
+
+use std::path::{Path, PathBuf};
+
+pub use error::{Diagnostics, PropsError, PropsErrorKind};
+pub use source::{Location, SourceText};
+
+/// A property file, read and checked.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PropertyFile {
+    /// The file, as given.
+    pub path: PathBuf,
+    /// The variables formulas may use, in file order; ids are unique.
+    pub ports: Vec<Port>,
+    /// Properties to verify, in file order; ids are unique among all properties.
+    pub guarantees: Vec<Property>,
+    /// Properties that restrict runs (a run violating one is discarded), in file order.
+    pub assumptions: Vec<Property>,
+}
+
+/// One variable of a property file, observed on one message.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Port {
+    /// The variable's name in formulas.
+    pub id: String,
+    /// State or event variable.
+    pub kind: PortKind,
+    /// The SCXML event (message) observed.
+    pub event: String,
+    /// The machine that sends it.
+    pub origin: String,
+    /// The machine it is sent to.
+    pub target: String,
+    /// Where the variable is declared (`<state_var>`, `<event_var>` or `<port>`).
+    pub at: Location,
+}
+
+/// What a variable holds.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PortKind {
+    /// True exactly at the point where the message is sent.
+    Event,
+    /// The value of a message parameter as last sent.
+    State {
+        /// The message parameter.
+        param: String,
+        /// The declared type, as written: `bool`/`boolean`, `int`, `int8`..`int64`,
+        /// `uint8`..`uint64`, `float`, `double`, `float32`, `float64` or `string`.
+        ty: String,
+        /// The initial value expression, as written (unescaped).
+        init: SourceText,
+    },
+}
+
+/// A guarantee or assumption.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Property {
+    /// The property's id.
+    pub id: String,
+    /// The Past-MTL formula in Rye syntax.
+    pub formula: SourceText,
+    /// Where the property's element starts.
+    pub at: Location,
+    /// Whether the formula was converted from the tree form (its locations then point at
+    /// the elements that generated each piece).
+    pub converted: bool,
+}
+
+impl PropertyFile {
+    /// The port declaring variable `id`.
+    pub fn port(&self, id: &str) -> Option<&Port> {
+        self.ports.iter().find(|port| port.id == id)
+    }
+}
+
+/// Reads and checks the property file at `path`.
+pub fn parse_file(path: &Path) -> Result<PropertyFile, Diagnostics> {
+    let fail = |at, kind| {
+        Diagnostics(vec![PropsError {
+            path: path.to_path_buf(),
+            at,
+            kind,
+        }])
+    };
+    let bytes = std::fs::read(path)
+        .map_err(|error| fail(Location::new(1, 1), PropsErrorKind::Io(error.to_string())))?;
+    match String::from_utf8(bytes) {
+        Ok(text) => parse_str(&text, path),
+        Err(error) => {
+            let valid = error.utf8_error().valid_up_to();
+            let bytes = error.as_bytes();
+            let prefix = std::str::from_utf8(&bytes[..valid]).unwrap_or_default();
+            let at = source::LineIndex::new(prefix).location(valid);
+            Err(fail(at, PropsErrorKind::Encoding))
+        }
+    }
+}
+
+/// Reads and checks a property file's text; `path` is only used in errors.
+pub fn parse_str(text: &str, path: &Path) -> Result<PropertyFile, Diagnostics> {
+    let lines = source::LineIndex::new(text);
+    let root = xml::parse_document(text, &lines).map_err(|(at, kind)| {
+        Diagnostics(vec![PropsError {
+            path: path.to_path_buf(),
+            at,
+            kind,
+        }])
+    })?;
+    let mut reader = read::FileReader::new(path, &lines);
+    let file = reader.read(&root);
+    let mut errors = reader.into_errors();
+    if errors.is_empty() {
+        Ok(file)
+    } else {
+        errors.sort_by_key(|error| error.at);
+        errors.dedup();
+        Err(Diagnostics(errors))
+    }
+}

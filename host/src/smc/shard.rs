@@ -1,0 +1,391 @@
+//! Sharded fixed-size studies: `--shard i/n` runs a deterministic slice of a study of
+//! `N` runs and writes a [`PartialResult`]; [`merge`] checks that a set of partial
+//! results is one study covered exactly once and reports every property.
+//!
+//! Shard `i` of `n` covers the contiguous block of run indices
+//! `[floor(i N / n), floor((i + 1) N / n))` ([`Shard::range`]): contiguous blocks let a
+//! shard derive its streams with one jump per run (a round-robin slice would need `n`),
+//! and the blocks of `0/n .. (n-1)/n` tile `[0, N)` exactly. Run `k` uses stream `k`
+//! whatever the shard, so merged counts equal those of the same study run on one
+//! machine ([`run_fixed_study`]), for any thread count.
+//!
+//! A fixed-size study does not stop early: every property sees all `N` runs, and the
+//! rule only provides the interval (and, for Wald's test, the answer on those counts).
+
+use std::collections::BTreeMap;
+use std::fmt;
+use std::ops::Range;
+use std::str::FromStr;
+
+use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::{Deserialize, Serialize};
+
+use super::runner::{
+    run_range, widened_interval, Progress, PropertyCounts, RunCounts, RunOutcome, StudyConfig,
+};
+use super::stats::{Estimate, Interval, RuleConfig, StatsError};
+
+/// The `format` tag of partial result files.
+pub const PARTIAL_FORMAT: &str = "hindsight-partial-1";
+
+/// Slice `index` of `count` (`--shard index/count`, `index < count`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct Shard {
+    /// Which slice, from 0.
+    pub index: u64,
+    /// How many slices.
+    pub count: u64,
+}
+
+impl Shard {
+    /// The whole study as one shard (`0/1`).
+    pub const WHOLE: Shard = Shard { index: 0, count: 1 };
+
+    /// Checks `index < count`.
+    pub fn new(index: u64, count: u64) -> Result<Shard, ShardError> {
+        if count == 0 || index >= count {
+            return Err(ShardError::Invalid(format!("{index}/{count}")));
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// The run indices this shard covers in a study of `study_runs` runs.
+    pub fn range(&self, study_runs: u64) -> Range<u64> {
+        let at = |i: u64| ((i as u128 * study_runs as u128) / self.count as u128) as u64;
+        at(self.index)..at(self.index + 1)
+    }
+}
+
+impl fmt::Display for Shard {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl FromStr for Shard {
+    type Err = ShardError;
+
+    /// Parses `i/n`.
+    fn from_str(text: &str) -> Result<Shard, ShardError> {
+        let invalid = || ShardError::Invalid(text.to_owned());
+        let (index, count) = text.trim().split_once('/').ok_or_else(invalid)?;
+        let index = index.trim().parse().map_err(|_| invalid())?;
+        let count = count.trim().parse().map_err(|_| invalid())?;
+        Shard::new(index, count).map_err(|_| invalid())
+    }
+}
+
+/// Errors of sharding and merging.
+#[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum ShardError {
+    /// A shard that is not `i/n` with `i < n`.
+    Invalid(String),
+    /// A partial result file that does not parse.
+    Json(String),
+    /// A partial result of another format version.
+    Format(String),
+    /// No partial results to merge.
+    Empty,
+    /// Two partial results disagree on a field that identifies the study.
+    Mismatch {
+        /// Which field.
+        field: &'static str,
+        /// The shard whose value differs from the first one's.
+        shard: Shard,
+    },
+    /// The same shard given twice.
+    Duplicate(Shard),
+    /// A shard of the study is missing.
+    Missing(Shard),
+    /// A partial result whose run range is not its shard's.
+    Range(Shard),
+    /// A property's rule is invalid.
+    Rule(StatsError),
+}
+
+impl fmt::Display for ShardError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ShardError::Invalid(text) => {
+                write!(f, "invalid shard `{text}`: expected i/n with 0 <= i < n")
+            }
+            ShardError::Json(message) => write!(f, "invalid partial result: {message}"),
+            ShardError::Format(format) => write!(
+                f,
+                "partial result format `{format}` is not `{PARTIAL_FORMAT}`"
+            ),
+            ShardError::Empty => write!(f, "no partial results to merge"),
+            ShardError::Mismatch { field, shard } => write!(
+                f,
+                "shard {shard} belongs to another study: its `{field}` differs"
+            ),
+            ShardError::Duplicate(shard) => write!(f, "shard {shard} is given more than once"),
+            ShardError::Missing(shard) => write!(f, "shard {shard} is missing"),
+            ShardError::Range(shard) => {
+                write!(f, "shard {shard} does not cover its own range of runs")
+            }
+            ShardError::Rule(error) => write!(f, "{error}"),
+        }
+    }
+}
+
+impl std::error::Error for ShardError {}
+
+/// A property as the caller names it, with its rule.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PropertySpec {
+    /// The property's id.
+    pub id: String,
+    /// Its stopping rule (only the interval matters in a fixed-size study).
+    pub rule: RuleConfig,
+}
+
+/// What identifies a fixed-size study; the same for all its shards.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FixedStudy {
+    /// The study seed.
+    pub seed: u64,
+    /// Total runs of the study, `N`.
+    pub study_runs: u64,
+    /// A fingerprint of the model, supplied by the caller (e.g. a content hash).
+    pub model: String,
+    /// A fingerprint of the properties and run settings, supplied by the caller.
+    pub properties_fingerprint: String,
+    /// The properties, in verdict order.
+    pub properties: Vec<PropertySpec>,
+}
+
+/// One property's counts in a partial result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PartialProperty {
+    /// The property's id.
+    pub id: String,
+    /// Counts over the shard's runs.
+    pub counts: PropertyCounts,
+    /// Indices of the shard's first failing runs.
+    pub failing_runs: Vec<u64>,
+}
+
+/// The result of one shard, as written to a JSON file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PartialResult {
+    /// Always [`PARTIAL_FORMAT`].
+    pub format: String,
+    /// The study this shard belongs to.
+    pub study: FixedStudy,
+    /// Which shard.
+    pub shard: Shard,
+    /// The run indices covered, `shard.range(study.study_runs)`.
+    pub first_run: u64,
+    /// End of the run indices covered (exclusive).
+    pub end_run: u64,
+    /// Per-property counts, in the order of `study.properties`.
+    pub properties: Vec<PartialProperty>,
+    /// Counts over every run of the shard.
+    pub runs: RunCounts,
+}
+
+impl PartialResult {
+    /// The JSON text of this result.
+    pub fn to_json(&self) -> String {
+        // Serialising plain data with string keys cannot fail.
+        serde_json::to_string_pretty(self).unwrap_or_default()
+    }
+
+    /// Reads a partial result from JSON and checks its format tag.
+    pub fn from_json(text: &str) -> Result<PartialResult, ShardError> {
+        let result: PartialResult =
+            serde_json::from_str(text).map_err(|error| ShardError::Json(error.to_string()))?;
+        if result.format != PARTIAL_FORMAT {
+            return Err(ShardError::Format(result.format));
+        }
+        Ok(result)
+    }
+}
+
+/// Runs shard `shard` of the fixed-size study `study` (see the module doc).
+pub fn run_shard<F>(
+    config: &StudyConfig,
+    study: &FixedStudy,
+    shard: Shard,
+    run: F,
+    progress: &mut dyn FnMut(&Progress<'_>),
+) -> PartialResult
+where
+    F: Fn(u64, &mut Xoshiro256PlusPlus) -> RunOutcome + Sync,
+{
+    let range = shard.range(study.study_runs);
+    let config = StudyConfig {
+        seed: study.seed,
+        max_runs: None,
+        ..config.clone()
+    };
+    let counts = run_range(
+        &config,
+        range.clone(),
+        study.properties.len(),
+        run,
+        progress,
+    );
+    PartialResult {
+        format: PARTIAL_FORMAT.to_owned(),
+        study: study.clone(),
+        shard,
+        first_run: range.start,
+        end_run: range.end,
+        properties: study
+            .properties
+            .iter()
+            .zip(counts.properties.iter().zip(counts.failing_runs))
+            .map(|(spec, (counts, failing_runs))| PartialProperty {
+                id: spec.id.clone(),
+                counts: *counts,
+                failing_runs,
+            })
+            .collect(),
+        runs: counts.runs,
+    }
+}
+
+/// Runs a whole fixed-size study on this machine (shard `0/1`) and reports it.
+pub fn run_fixed_study<F>(
+    config: &StudyConfig,
+    study: &FixedStudy,
+    run: F,
+    progress: &mut dyn FnMut(&Progress<'_>),
+) -> Result<MergedResult, ShardError>
+where
+    F: Fn(u64, &mut Xoshiro256PlusPlus) -> RunOutcome + Sync,
+{
+    merge(
+        &[run_shard(config, study, Shard::WHOLE, run, progress)],
+        config.keep_failing,
+    )
+}
+
+/// One property of a merged study.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MergedProperty {
+    /// The property's id.
+    pub id: String,
+    /// Its rule.
+    pub rule: RuleConfig,
+    /// Counts over the whole study.
+    pub counts: PropertyCounts,
+    /// The rule's report on the judged runs.
+    pub estimate: Estimate,
+    /// The interval to report, widened over unknown runs.
+    pub interval: Interval,
+    /// Indices of the first failing runs of the study.
+    pub failing_runs: Vec<u64>,
+}
+
+/// A whole fixed-size study, merged from its shards.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MergedResult {
+    /// The study.
+    pub study: FixedStudy,
+    /// Shards merged.
+    pub shards: u64,
+    /// Per-property results.
+    pub properties: Vec<MergedProperty>,
+    /// Counts over every run.
+    pub runs: RunCounts,
+}
+
+/// Merges the partial results of one study: they must share format, seed, study size,
+/// fingerprints and properties, have the same shard count, and cover every shard exactly
+/// once, each on its own range. Failing-run lists are merged in index order and cut to
+/// `keep_failing` per property.
+pub fn merge(parts: &[PartialResult], keep_failing: usize) -> Result<MergedResult, ShardError> {
+    let first = parts.first().ok_or(ShardError::Empty)?;
+    let count = first.shard.count;
+    let mut by_index: BTreeMap<u64, &PartialResult> = BTreeMap::new();
+    for part in parts {
+        let shard = part.shard;
+        if part.format != PARTIAL_FORMAT {
+            return Err(ShardError::Format(part.format.clone()));
+        }
+        if shard.count == 0 || shard.index >= shard.count {
+            return Err(ShardError::Invalid(shard.to_string()));
+        }
+        let mismatch = |field| Err(ShardError::Mismatch { field, shard });
+        if shard.count != count {
+            return mismatch("shard count");
+        }
+        if part.study.seed != first.study.seed {
+            return mismatch("seed");
+        }
+        if part.study.study_runs != first.study.study_runs {
+            return mismatch("study_runs");
+        }
+        if part.study.model != first.study.model {
+            return mismatch("model");
+        }
+        if part.study.properties_fingerprint != first.study.properties_fingerprint {
+            return mismatch("properties_fingerprint");
+        }
+        if part.study.properties != first.study.properties {
+            return mismatch("properties");
+        }
+        let ids_match = part.properties.len() == part.study.properties.len()
+            && part
+                .properties
+                .iter()
+                .zip(&part.study.properties)
+                .all(|(counts, spec)| counts.id == spec.id);
+        if !ids_match {
+            return mismatch("properties");
+        }
+        let range = shard.range(part.study.study_runs);
+        let covered = part.runs.runs;
+        if part.first_run != range.start
+            || part.end_run != range.end
+            || covered != range.end - range.start
+        {
+            return Err(ShardError::Range(shard));
+        }
+        if by_index.insert(shard.index, part).is_some() {
+            return Err(ShardError::Duplicate(shard));
+        }
+    }
+    if let Some(missing) = (0..count).find(|i| !by_index.contains_key(i)) {
+        return Err(ShardError::Missing(Shard {
+            index: missing,
+            count,
+        }));
+    }
+
+    let study = first.study.clone();
+    let mut runs = RunCounts::default();
+    let mut counts = vec![PropertyCounts::default(); study.properties.len()];
+    let mut failing: Vec<Vec<u64>> = vec![Vec::new(); study.properties.len()];
+    for part in by_index.values() {
+        runs.add(&part.runs);
+        for (i, property) in part.properties.iter().enumerate() {
+            counts[i].add(&property.counts);
+            failing[i].extend(&property.failing_runs);
+        }
+    }
+    let mut properties = Vec::with_capacity(study.properties.len());
+    for ((spec, counts), mut failing_runs) in study.properties.iter().zip(counts).zip(failing) {
+        let rule = spec.rule.build().map_err(ShardError::Rule)?;
+        failing_runs.sort_unstable();
+        failing_runs.truncate(keep_failing);
+        properties.push(MergedProperty {
+            id: spec.id.clone(),
+            rule: spec.rule,
+            counts,
+            estimate: rule.estimate(counts.successes, counts.judged()),
+            interval: widened_interval(rule.as_ref(), &counts),
+            failing_runs,
+        });
+    }
+    Ok(MergedResult {
+        study,
+        shards: count,
+        properties,
+        runs,
+    })
+}
