@@ -1,1 +1,3 @@
 //! hindsight's host side: models, simulation, SMC and the CLI.
+
+pub mod model;
