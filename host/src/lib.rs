@@ -1,3 +1,4 @@
 //! hindsight's host side: models, simulation, SMC and the CLI.
 
+pub mod expr;
 pub mod model;
