@@ -171,6 +171,9 @@ pub(crate) struct Scope<'a> {
     pub event: EventScope<'a>,
     /// Structs and enumeration labels.
     pub types: &'a TypeTable,
+    /// Maps an offset in the expression text to the offset reported by run-time errors
+    /// (the simulator passes the file offset of the attribute character).
+    pub abs: &'a dyn Fn(u32) -> u32,
 }
 
 /// Maximum number of `[i]`/`.f` steps in one access path.
@@ -337,6 +340,10 @@ impl Compiler<'_, '_> {
         self.scope.types.name(t)
     }
 
+    fn abs(&self, at: u32) -> u32 {
+        (self.scope.abs)(at)
+    }
+
     fn expr(&mut self, e: &Expr, expect: Option<&Ty>) -> Result<Typed, CompileError> {
         let at = e.start;
         match &e.kind {
@@ -490,7 +497,7 @@ impl Compiler<'_, '_> {
                     root: Root::Var(i as u32),
                     steps: Vec::new(),
                     ty: self.scope.vars[i].1.clone(),
-                    at: e.start,
+                    at: self.abs(e.start),
                 })),
                 None => Ok(None),
             },
@@ -553,7 +560,7 @@ impl Compiler<'_, '_> {
                 if p.steps.len() >= MAX_PATH {
                     return Err(cerr(idx.start, "access path too long"));
                 }
-                p.steps.push(Step::Index(f, idx.start));
+                p.steps.push(Step::Index(f, self.abs(idx.start)));
                 p.ty = elem;
                 Ok(Some(p))
             }
@@ -574,7 +581,7 @@ impl Compiler<'_, '_> {
                             root: Root::Param(i as u32),
                             steps: Vec::new(),
                             ty: t.clone(),
-                            at,
+                            at: self.abs(at),
                         }),
                         None => Err(CompileError {
                             at,
@@ -685,16 +692,12 @@ impl Compiler<'_, '_> {
     ) -> Result<Typed, CompileError> {
         if let ExprKind::Ident(n) = &obj.kind {
             if n == "_event" && self.scope.vars.iter().all(|(v, _)| v != "_event") {
-                let event = match self.scope.event {
-                    EventScope::None => {
-                        return Err(cerr(
-                            obj.start,
-                            "`_event` is only available in a transition that has an `event`",
-                        ))
-                    }
-                    EventScope::Event { .. } => (),
-                };
-                let _ = event;
+                if let EventScope::None = self.scope.event {
+                    return Err(cerr(
+                        obj.start,
+                        "`_event` is only available in a transition that has an `event`",
+                    ));
+                }
                 return match field {
                     "name" => Ok(Typed {
                         ty: Ty::Str,
@@ -731,12 +734,14 @@ impl Compiler<'_, '_> {
                     "LN2" => std::f64::consts::LN_2,
                     "LN10" => std::f64::consts::LN_10,
                     "SQRT2" => std::f64::consts::SQRT_2,
-                    _ => return Err(cerr(
-                        fat,
-                        format!(
+                    _ => {
+                        return Err(cerr(
+                            fat,
+                            format!(
                             "`Math.{field}` is not a supported constant (call functions with `()`)"
                         ),
-                    )),
+                        ))
+                    }
                 };
                 return Ok(Typed {
                     ty: Ty::Float,
@@ -1052,7 +1057,7 @@ impl Compiler<'_, '_> {
                     let (Code::Int(x), Code::Int(y)) = (ta.code, tb.code) else {
                         return Err(cerr(at, "internal error"));
                     };
-                    let bat = b.start;
+                    let bat = self.abs(b.start);
                     let f: IntFn = match op {
                         BinOp::Add => Box::new(move |e| Ok(x(e)?.wrapping_add(y(e)?))),
                         BinOp::Sub => Box::new(move |e| Ok(x(e)?.wrapping_sub(y(e)?))),
@@ -1216,6 +1221,8 @@ pub(crate) struct Place {
     pub ty: Ty,
     /// Maximum length when the location is a bounded array.
     pub bound: Option<u32>,
+    /// `a.length = n`: the element default used when the array grows.
+    set_length: Option<Cell>,
 }
 
 enum PlaceStep {
@@ -1227,7 +1234,53 @@ enum PlaceStep {
 impl Place {
     /// True when the location is a whole variable.
     pub fn is_whole_var(&self) -> bool {
-        self.steps.is_empty()
+        self.steps.is_empty() && self.set_length.is_none()
+    }
+
+    /// Stores `value` (left unspecified afterwards: buffers are swapped, not copied).
+    pub fn store(&self, vars: &mut [Cell], idx: &[i64; MAX_PATH], value: &mut Cell) -> Res<()> {
+        let dst = self.target(vars, idx)?;
+        let Some(default) = &self.set_length else {
+            if let (Some(b), Cell::List(v)) = (self.bound, &*value) {
+                if v.len() > b as usize {
+                    return Err(EvalError {
+                        at: 0,
+                        kind: EvalErrorKind::TooLong { bound: b },
+                    });
+                }
+            }
+            std::mem::swap(dst, value);
+            return Ok(());
+        };
+        let (Cell::List(items), Cell::Int(n)) = (dst, &*value) else {
+            return Err(internal(0));
+        };
+        let len = items.len();
+        let Ok(n) = usize::try_from(*n) else {
+            return Err(EvalError {
+                at: 0,
+                kind: EvalErrorKind::Index { index: *n, len },
+            });
+        };
+        if let Some(b) = self.bound {
+            if n > b as usize {
+                return Err(EvalError {
+                    at: 0,
+                    kind: EvalErrorKind::TooLong { bound: b },
+                });
+            }
+        }
+        if n > len + 1_000_000 {
+            return Err(EvalError {
+                at: 0,
+                kind: EvalErrorKind::Index {
+                    index: n as i64,
+                    len,
+                },
+            });
+        }
+        items.resize(n, default.clone());
+        Ok(())
     }
 
     /// Evaluates the indices (before the variables are borrowed mutably).
@@ -1304,6 +1357,7 @@ pub(crate) fn compile_place(
                     steps: Vec::new(),
                     ty,
                     bound,
+                    set_length: None,
                 })
             }
             None if name == "_event" => Err(cerr(e.start, "cannot assign to `_event`")),
@@ -1311,6 +1365,9 @@ pub(crate) fn compile_place(
         },
         ExprKind::Index(arr, idx) => {
             let mut p = compile_place(arr, scope, strings)?;
+            if p.set_length.is_some() {
+                return Err(cerr(idx.start, "`length` cannot be indexed"));
+            }
             let Ty::Array(elem, bound) = p.ty.clone() else {
                 return Err(cerr(
                     idx.start,
@@ -1334,7 +1391,8 @@ pub(crate) fn compile_place(
                 return Err(cerr(idx.start, "access path too long"));
             }
             let default = scope.types.default_cell(&elem);
-            p.steps.push(PlaceStep::Index(f, default, bound, idx.start));
+            p.steps
+                .push(PlaceStep::Index(f, default, bound, (scope.abs)(idx.start)));
             p.bound = match &*elem {
                 Ty::Array(_, b) => *b,
                 _ => None,
@@ -1349,10 +1407,16 @@ pub(crate) fn compile_place(
                 return Err(cerr(e.start, "cannot assign to `_event`"));
             }
             let mut p = compile_place(obj, scope, strings)?;
+            if p.set_length.is_some() {
+                return Err(cerr(*fat, format!("`length` has no field `{field}`")));
+            }
+            if let (Ty::Array(elem, _), "length") = (&p.ty, field.as_str()) {
+                // `a.length = n` truncates or extends with default values.
+                p.set_length = Some(scope.types.default_cell(elem));
+                p.ty = Ty::Int;
+                return Ok(p);
+            }
             let Ty::Struct(s) = p.ty else {
-                if field == "length" {
-                    return Err(cerr(*fat, "cannot assign to `length`"));
-                }
                 return Err(cerr(
                     *fat,
                     format!("type {} has no field `{field}`", scope.types.name(&p.ty)),
@@ -1438,6 +1502,7 @@ mod tests {
                 params: &params,
             },
             types: &types,
+            abs: &|k| k,
         };
         let e = parse_expr(text).map_err(|e| e.to_string())?;
         let t =
@@ -1480,6 +1545,10 @@ mod tests {
     fn logic_comparisons_ternary() {
         assert_eq!(eval("i > 3 && !b || false"), Ok(Cell::Bool(false)));
         assert_eq!(eval("i == 7.0"), Ok(Cell::Bool(true)));
+        assert_eq!(eval("0.131"), Ok(Cell::Float(0.131)));
+        assert_eq!(eval("f <= 2.6"), Ok(Cell::Bool(true)));
+        assert_eq!(eval("0.0 <= f && f <= 3.0"), Ok(Cell::Bool(true)));
+        assert_eq!(eval("0.0 <= f && f <= 0.7"), Ok(Cell::Bool(false)));
         assert_eq!(eval("s == 'hi'"), Ok(Cell::Bool(true)));
         assert_eq!(eval("s != 'ho'"), Ok(Cell::Bool(true)));
         assert_eq!(eval("b ? i : f"), Ok(Cell::Float(7.0)));
@@ -1544,6 +1613,7 @@ mod tests {
             vars: &vs,
             event: EventScope::None,
             types: &types,
+            abs: &|k| k,
         };
         let mut vals = cells(&mut strings);
         let mut idx = [0i64; MAX_PATH];
@@ -1581,7 +1651,17 @@ mod tests {
         assert!(
             compile_place(&parse_expr("_event.data.p").unwrap(), &scope, &mut strings).is_err()
         );
-        assert!(compile_place(&parse_expr("a.length").unwrap(), &scope, &mut strings).is_err());
+        let len = compile_place(&parse_expr("a.length").unwrap(), &scope, &mut strings).unwrap();
+        let mut v = Cell::Int(1);
+        len.store(&mut vals, &idx, &mut v).unwrap();
+        assert_eq!(vals[4], Cell::List(vec![Cell::Int(1)]));
+        let mut v = Cell::Int(3);
+        len.store(&mut vals, &idx, &mut v).unwrap();
+        assert_eq!(
+            vals[4],
+            Cell::List(vec![Cell::Int(1), Cell::Int(0), Cell::Int(0)])
+        );
+        assert!(compile_place(&parse_expr("a.length.x").unwrap(), &scope, &mut strings).is_err());
         assert!(compile_place(&parse_expr("i + 1").unwrap(), &scope, &mut strings).is_err());
     }
 }

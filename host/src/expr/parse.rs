@@ -12,8 +12,8 @@
 use super::ast::{BinOp, Expr, ExprKind, UnOp};
 use nom::branch::alt;
 use nom::bytes::complete::{tag, take_while, take_while1};
-use nom::character::complete::{char as ch, digit0, digit1, hex_digit1, one_of};
-use nom::combinator::{opt, recognize};
+use nom::character::complete::hex_digit1;
+use nom::combinator::recognize;
 use nom::sequence::pair;
 use nom::{IResult, Parser as _};
 
@@ -84,15 +84,37 @@ fn name(i: &str) -> IResult<&str, &str> {
     recognize(pair(take_while1(ident_start), take_while(ident_char))).parse(i)
 }
 
+/// A decimal literal: `12`, `1.5`, `1.`, `.5`, with an optional exponent `e-3`.
 fn decimal(i: &str) -> IResult<&str, &str> {
-    recognize((
-        alt((
-            recognize((digit1, opt((ch('.'), digit0)))),
-            recognize((ch('.'), digit1)),
-        )),
-        opt((one_of("eE"), opt(one_of("+-")), digit1)),
-    ))
-    .parse(i)
+    let b = i.as_bytes();
+    let digits = |mut k: usize| {
+        while k < b.len() && b[k].is_ascii_digit() {
+            k += 1;
+        }
+        k
+    };
+    let int_end = digits(0);
+    let mut end = int_end;
+    if b.get(end) == Some(&b'.') {
+        end = digits(end + 1);
+    }
+    if end == 0 || (int_end == 0 && end == 1) {
+        return Err(nom::Err::Error(nom::error::Error::new(
+            i,
+            nom::error::ErrorKind::Digit,
+        )));
+    }
+    if matches!(b.get(end), Some(b'e' | b'E')) {
+        let mut k = end + 1;
+        if matches!(b.get(k), Some(b'+' | b'-')) {
+            k += 1;
+        }
+        let k2 = digits(k);
+        if k2 > k {
+            end = k2;
+        }
+    }
+    Ok((&i[end..], &i[..end]))
 }
 
 fn hex(i: &str) -> IResult<&str, &str> {
@@ -496,6 +518,10 @@ mod tests {
         assert_eq!(p("[[], [1, 2.5e1]]"), "[[],[1,25.0]]");
         assert_eq!(p("'it\\'s' == \"x\""), "('it's' == 'x')");
         assert_eq!(p(".5 + 0x10"), "(0.5 + 16)");
+        assert_eq!(
+            p("0.131 + 2.6 + 1e3 + 2.5E-1 + 7."),
+            "((((0.131 + 2.6) + 1000.0) + 0.25) + 7.0)"
+        );
         assert_eq!(p("!('' == s)"), "(Not ('' == s))");
     }
 
