@@ -88,6 +88,8 @@ pub(crate) struct TransDef {
 
 pub(crate) struct StateDef {
     pub name: String,
+    /// The state's tag.
+    pub span: Span,
     /// Start of the entry code.
     pub entry: u32,
     /// Eventless transitions, document order.
@@ -1109,6 +1111,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
             self.emit(Instr::CheckEventless, s.span);
             states.push(StateDef {
                 name: s.id.name.clone(),
+                span: s.span,
                 entry,
                 eventless: Vec::new(),
                 on_event: Vec::new(),

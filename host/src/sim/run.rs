@@ -360,7 +360,7 @@ impl<'m> Simulator<'m> {
         let span = def
             .states
             .get(s as usize)
-            .and_then(|st| def.code_spans.get(st.entry as usize).copied())
+            .map(|st| st.span)
             .unwrap_or(Span {
                 file: def.file,
                 offset: 0,
