@@ -1237,11 +1237,11 @@ impl Place {
         self.steps.is_empty() && self.set_length.is_none()
     }
 
-    /// Stores `value` (left unspecified afterwards: buffers are swapped, not copied).
-    pub fn store(&self, vars: &mut [Cell], idx: &[i64; MAX_PATH], value: &mut Cell) -> Res<()> {
+    /// Stores `value`, reusing the destination's buffers.
+    pub fn store(&self, vars: &mut [Cell], idx: &[i64; MAX_PATH], value: &Cell) -> Res<()> {
         let dst = self.target(vars, idx)?;
         let Some(default) = &self.set_length else {
-            if let (Some(b), Cell::List(v)) = (self.bound, &*value) {
+            if let (Some(b), Cell::List(v)) = (self.bound, value) {
                 if v.len() > b as usize {
                     return Err(EvalError {
                         at: 0,
@@ -1249,10 +1249,10 @@ impl Place {
                     });
                 }
             }
-            std::mem::swap(dst, value);
+            dst.clone_from(value);
             return Ok(());
         };
-        let (Cell::List(items), Cell::Int(n)) = (dst, &*value) else {
+        let (Cell::List(items), Cell::Int(n)) = (dst, value) else {
             return Err(internal(0));
         };
         let len = items.len();
@@ -1652,11 +1652,9 @@ mod tests {
             compile_place(&parse_expr("_event.data.p").unwrap(), &scope, &mut strings).is_err()
         );
         let len = compile_place(&parse_expr("a.length").unwrap(), &scope, &mut strings).unwrap();
-        let mut v = Cell::Int(1);
-        len.store(&mut vals, &idx, &mut v).unwrap();
+        len.store(&mut vals, &idx, &Cell::Int(1)).unwrap();
         assert_eq!(vals[4], Cell::List(vec![Cell::Int(1)]));
-        let mut v = Cell::Int(3);
-        len.store(&mut vals, &idx, &mut v).unwrap();
+        len.store(&mut vals, &idx, &Cell::Int(3)).unwrap();
         assert_eq!(
             vals[4],
             Cell::List(vec![Cell::Int(1), Cell::Int(0), Cell::Int(0)])

@@ -154,13 +154,34 @@ impl TypeTable {
 }
 
 /// Run-time storage of one value. Arrays and structs are lists of cells.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Debug, PartialEq)]
 pub(crate) enum Cell {
     Bool(bool),
     Int(i64),
     Float(f64),
     Str(StrId),
     List(Vec<Cell>),
+}
+
+impl Clone for Cell {
+    fn clone(&self) -> Self {
+        match self {
+            Cell::Bool(b) => Cell::Bool(*b),
+            Cell::Int(v) => Cell::Int(*v),
+            Cell::Float(v) => Cell::Float(*v),
+            Cell::Str(s) => Cell::Str(*s),
+            Cell::List(v) => Cell::List(v.clone()),
+        }
+    }
+
+    /// Reuses the destination's buffers (list into list, element by element), so copying
+    /// a value into a cell of the same shape does not allocate.
+    fn clone_from(&mut self, source: &Self) {
+        match (self, source) {
+            (Cell::List(dst), Cell::List(src)) => dst.clone_from(src),
+            (dst, src) => *dst = src.clone(),
+        }
+    }
 }
 
 /// A read-only view of a value produced by a run (a message parameter, a logged value).

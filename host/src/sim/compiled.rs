@@ -54,13 +54,16 @@ pub(crate) enum Instr {
     /// `x = e` for a whole variable; the bound of a bounded array.
     AssignVar {
         slot: u32,
-        value: CellFn,
+        value: Code,
         bound: Option<u32>,
+        /// The instruction's own scratch cell (arrays and structs are built there).
+        scratch: u32,
     },
     /// `a[i] = e`, `s.f = e`, ...
     AssignPlace {
         place: Place,
-        value: CellFn,
+        value: Code,
+        scratch: u32,
     },
     /// Jump to `else_pc` when `cond` is false.
     If {
@@ -73,6 +76,7 @@ pub(crate) enum Instr {
     Log {
         label: Box<str>,
         value: Option<CellFn>,
+        scratch: u32,
     },
     /// Enter a state: run its entry code.
     Goto(u32),
@@ -117,8 +121,10 @@ pub(crate) struct MachineDef {
     pub file: FileId,
     pub vars: Vec<(String, Ty)>,
     pub defaults: Vec<Cell>,
-    /// `(slot, initial value, bound)` in document order.
-    pub init: Vec<(u32, CellFn, Option<u32>, Span)>,
+    /// `(slot, initial value, bound, span, scratch cell)` in document order.
+    pub init: Vec<(u32, CellFn, Option<u32>, Span, u32)>,
+    /// Number of scratch cells the machine's instructions use.
+    pub n_scratch: u32,
     pub states: Vec<StateDef>,
     pub initial: u32,
     pub trans: Vec<TransDef>,
@@ -824,6 +830,7 @@ struct MachineCompiler<'b, 's> {
     events: &'b EventParams,
     code: Vec<Instr>,
     spans: Vec<Span>,
+    n_scratch: u32,
 }
 
 impl<'b, 's> MachineCompiler<'b, 's> {
@@ -834,7 +841,13 @@ impl<'b, 's> MachineCompiler<'b, 's> {
             events,
             code: Vec::new(),
             spans: Vec::new(),
+            n_scratch: 0,
         }
+    }
+
+    fn new_scratch(&mut self) -> u32 {
+        self.n_scratch += 1;
+        self.n_scratch - 1
     }
 
     fn emit(&mut self, i: Instr, span: Span) -> u32 {
@@ -948,12 +961,28 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                 let Some(value) = self.typed(expr, event, Some(&ty)) else {
                     return;
                 };
-                let value = value.into_cell_fn();
+                let value = value.code;
+                let scratch = self.new_scratch();
                 if place.is_whole_var() {
                     let (slot, bound) = (place.var, place.bound);
-                    self.emit(Instr::AssignVar { slot, value, bound }, *span);
+                    self.emit(
+                        Instr::AssignVar {
+                            slot,
+                            value,
+                            bound,
+                            scratch,
+                        },
+                        *span,
+                    );
                 } else {
-                    self.emit(Instr::AssignPlace { place, value }, *span);
+                    self.emit(
+                        Instr::AssignPlace {
+                            place,
+                            value,
+                            scratch,
+                        },
+                        *span,
+                    );
                 }
             }
             Exec::If {
@@ -999,7 +1028,15 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                     None => None,
                 };
                 let label = label.clone().unwrap_or_default().into_boxed_str();
-                self.emit(Instr::Log { label, value }, *span);
+                let scratch = self.new_scratch();
+                self.emit(
+                    Instr::Log {
+                        label,
+                        value,
+                        scratch,
+                    },
+                    *span,
+                );
             }
             Exec::Send(s) => {
                 let Some(&ev) = self.b.event_index.get(&s.event.name) else {
@@ -1209,7 +1246,8 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                     Ty::Array(_, b) => *b,
                     _ => None,
                 };
-                init.push((slot as u32, t.into_cell_fn(), bound, d.span));
+                let scratch = self.new_scratch();
+                init.push((slot as u32, t.into_cell_fn(), bound, d.span, scratch));
             }
         }
         MachineDef {
@@ -1225,6 +1263,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
             dispatch,
             code: self.code,
             code_spans: self.spans,
+            n_scratch: self.n_scratch,
         }
     }
 }

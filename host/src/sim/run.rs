@@ -3,7 +3,7 @@
 use super::compiled::{CompiledModel, DelayDef, Instr, MachineDef, SendTo};
 use super::ids::{MachineId, StateId};
 use super::observer::{Flow, Observer, SentMessage};
-use crate::expr::compile::{Entropy, Env, EvalError, MAX_PATH};
+use crate::expr::compile::{Code, Entropy, Env, EvalError, EvalErrorKind, MAX_PATH};
 use crate::expr::value::{Cell, StrId};
 use crate::expr::Value;
 use crate::model::{Diagnostic, Span};
@@ -156,7 +156,7 @@ const IDLE: u32 = u32::MAX;
 const NO_MSG: u32 = u32::MAX;
 const NOT_RUNNABLE: u32 = u32::MAX;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 struct Slot {
     event: u32,
     origin: u32,
@@ -198,7 +198,8 @@ pub struct Simulator<'m> {
     model: &'m CompiledModel,
     ms: Vec<MachineRt>,
     pool: Vec<Slot>,
-    free: Vec<u32>,
+    /// Free message slots, per event.
+    free: Vec<Vec<u32>>,
     runnable: Vec<u32>,
     rpos: Vec<u32>,
     delayed: Vec<u32>,
@@ -207,8 +208,9 @@ pub struct Simulator<'m> {
     steps: u64,
     instant_steps: u64,
     instant_moves: Vec<u32>,
-    scratch: Cell,
-    params_buf: Vec<Cell>,
+    /// Per machine, one scratch cell per instruction that builds arrays or structs,
+    /// so each keeps its buffers' shape from step to step and run to run.
+    scratch: Vec<Vec<Cell>>,
     idx: [i64; MAX_PATH],
 }
 
@@ -237,6 +239,24 @@ enum Stop {
     End(EndReason),
 }
 
+/// Evaluates `code`: a scalar is returned, an array or struct is written into `scratch`.
+fn eval_code(
+    code: &Code,
+    env: &mut Env<'_>,
+    scratch: &mut Cell,
+) -> Result<Option<Cell>, EvalError> {
+    Ok(Some(match code {
+        Code::Bool(f) => Cell::Bool(f(env)?),
+        Code::Int(f) => Cell::Int(f(env)?),
+        Code::Float(f) => Cell::Float(f(env)?),
+        Code::Str(f) => Cell::Str(f(env)?),
+        Code::Comp(f) => {
+            f(env, scratch)?;
+            return Ok(None);
+        }
+    }))
+}
+
 impl<'m> Simulator<'m> {
     /// A simulator for `model` (allocates its buffers once).
     pub fn new(model: &'m CompiledModel) -> Self {
@@ -262,7 +282,7 @@ impl<'m> Simulator<'m> {
                 })
                 .collect(),
             pool: Vec::new(),
-            free: Vec::new(),
+            free: vec![Vec::new(); model.events.len()],
             runnable: Vec::with_capacity(n),
             rpos: vec![NOT_RUNNABLE; n],
             delayed: Vec::with_capacity(n),
@@ -271,8 +291,11 @@ impl<'m> Simulator<'m> {
             steps: 0,
             instant_steps: 0,
             instant_moves: vec![0; n],
-            scratch: Cell::Int(0),
-            params_buf: Vec::new(),
+            scratch: model
+                .machines
+                .iter()
+                .map(|d| vec![Cell::Int(0); d.n_scratch as usize])
+                .collect(),
             idx: [0; MAX_PATH],
         }
     }
@@ -321,10 +344,17 @@ impl<'m> Simulator<'m> {
         }
     }
 
+    fn free_slot(&mut self, slot: u32) {
+        let ev = self.pool.get(slot as usize).map_or(0, |s| s.event as usize);
+        if let Some(f) = self.free.get_mut(ev) {
+            f.push(slot);
+        }
+    }
+
     fn release(&mut self, m: usize) {
         let cur = self.ms[m].cur;
         if cur != NO_MSG {
-            self.free.push(cur);
+            self.free_slot(cur);
             self.ms[m].cur = NO_MSG;
         }
     }
@@ -384,8 +414,15 @@ impl<'m> Simulator<'m> {
         self.steps = 0;
         self.instant_steps = 0;
         self.instant_moves.iter_mut().for_each(|c| *c = 0);
-        self.free.clear();
-        self.free.extend((0..self.pool.len() as u32).rev());
+        for f in &mut self.free {
+            f.clear();
+        }
+        for i in (0..self.pool.len()).rev() {
+            let ev = self.pool[i].event as usize;
+            if let Some(f) = self.free.get_mut(ev) {
+                f.push(i as u32);
+            }
+        }
         self.runnable.clear();
         self.rpos.iter_mut().for_each(|p| *p = NOT_RUNNABLE);
         self.delayed.clear();
@@ -406,10 +443,21 @@ impl<'m> Simulator<'m> {
             r.cur_origin = StrId(0);
             r.intq.clear();
             r.extq.clear();
-            for (v, d) in r.vars.iter_mut().zip(&def.defaults) {
-                v.clone_from(d);
+            // Variables with an initial value are overwritten below; resetting them to the
+            // default first would throw their buffers away.
+            for (i, (v, d)) in r.vars.iter_mut().zip(&def.defaults).enumerate() {
+                if !def.init.iter().any(|x| x.0 as usize == i) {
+                    v.clone_from(d);
+                }
             }
-            for (slot, f, bound, span) in &def.init {
+            for (slot, f, bound, span, sc) in &def.init {
+                let Some(scratch) = self
+                    .scratch
+                    .get_mut(m)
+                    .and_then(|v| v.get_mut(*sc as usize))
+                else {
+                    continue;
+                };
                 let res = {
                     let r = &self.ms[m];
                     let mut env = Env {
@@ -420,12 +468,13 @@ impl<'m> Simulator<'m> {
                         rng: &mut *rng,
                         strings: &model.strings,
                     };
-                    f(&mut env, &mut self.scratch)
+                    f(&mut env, scratch)
                 };
                 if let Err(e) = res {
                     return Err(self.diag_error(m, None, e));
                 }
-                if let (Some(b), Cell::List(v)) = (bound, &self.scratch) {
+                let scratch = &self.scratch[m][*sc as usize];
+                if let (Some(b), Cell::List(v)) = (bound, scratch) {
                     if v.len() > *b as usize {
                         return Err(Stop::End(EndReason::Error(RunError {
                             machine: MachineId(m as u32),
@@ -441,7 +490,7 @@ impl<'m> Simulator<'m> {
                     }
                 }
                 if let Some(dst) = self.ms[m].vars.get_mut(*slot as usize) {
-                    std::mem::swap(dst, &mut self.scratch);
+                    dst.clone_from(scratch);
                 }
             }
         }
@@ -659,12 +708,24 @@ impl<'m> Simulator<'m> {
                     None,
                     EvalError {
                         at: 0,
-                        kind: crate::expr::compile::EvalErrorKind::Internal,
+                        kind: EvalErrorKind::Internal,
                     },
                 ));
             };
             match instr {
-                Instr::AssignVar { slot, value, bound } => {
+                Instr::AssignVar {
+                    slot,
+                    value,
+                    bound,
+                    scratch: sc,
+                } => {
+                    let Some(scratch) = self
+                        .scratch
+                        .get_mut(m)
+                        .and_then(|v| v.get_mut(*sc as usize))
+                    else {
+                        return Err(self.internal(m, pc));
+                    };
                     let res = {
                         let r = &self.ms[m];
                         let params: &[Cell] = if r.cur == NO_MSG {
@@ -680,22 +741,41 @@ impl<'m> Simulator<'m> {
                             rng: &mut *rng,
                             strings: &model.strings,
                         };
-                        value(&mut env, &mut self.scratch)
+                        eval_code(value, &mut env, scratch)
                     };
-                    if let Err(e) = res {
-                        return Err(self.diag_error(m, Some(pc as usize), e));
-                    }
-                    if let (Some(b), Cell::List(v)) = (bound, &self.scratch) {
-                        if v.len() > *b as usize {
-                            return Err(self.too_long(m, pc, *b));
+                    let scratch = &self.scratch[m][*sc as usize];
+                    let scalar = match res {
+                        Ok(v) => v,
+                        Err(e) => return Err(self.diag_error(m, Some(pc as usize), e)),
+                    };
+                    let Some(dst) = self.ms[m].vars.get_mut(*slot as usize) else {
+                        return Err(self.internal(m, pc));
+                    };
+                    match scalar {
+                        Some(v) => *dst = v,
+                        None => {
+                            if let (Some(b), Cell::List(v)) = (bound, scratch) {
+                                if v.len() > *b as usize {
+                                    return Err(self.too_long(m, pc, *b));
+                                }
+                            }
+                            dst.clone_from(scratch);
                         }
-                    }
-                    if let Some(dst) = self.ms[m].vars.get_mut(*slot as usize) {
-                        std::mem::swap(dst, &mut self.scratch);
                     }
                     self.ms[m].pc = pc + 1;
                 }
-                Instr::AssignPlace { place, value } => {
+                Instr::AssignPlace {
+                    place,
+                    value,
+                    scratch: sc,
+                } => {
+                    let Some(scratch) = self
+                        .scratch
+                        .get_mut(m)
+                        .and_then(|v| v.get_mut(*sc as usize))
+                    else {
+                        return Err(self.internal(m, pc));
+                    };
                     let res = {
                         let r = &self.ms[m];
                         let params: &[Cell] = if r.cur == NO_MSG {
@@ -713,13 +793,15 @@ impl<'m> Simulator<'m> {
                         };
                         place
                             .eval_indices(&mut env, &mut self.idx)
-                            .and_then(|()| value(&mut env, &mut self.scratch))
+                            .and_then(|()| eval_code(value, &mut env, scratch))
                     };
-                    if let Err(e) = res {
-                        return Err(self.diag_error(m, Some(pc as usize), e));
-                    }
-                    if let Err(e) = place.store(&mut self.ms[m].vars, &self.idx, &mut self.scratch)
-                    {
+                    let scratch = &self.scratch[m][*sc as usize];
+                    let stored = match res {
+                        Ok(Some(v)) => place.store(&mut self.ms[m].vars, &self.idx, &v),
+                        Ok(None) => place.store(&mut self.ms[m].vars, &self.idx, scratch),
+                        Err(e) => Err(e),
+                    };
+                    if let Err(e) = stored {
                         return Err(self.diag_error(m, Some(pc as usize), e));
                     }
                     self.ms[m].pc = pc + 1;
@@ -753,7 +835,18 @@ impl<'m> Simulator<'m> {
                     self.ms[m].intq.push_back(*ev);
                     self.ms[m].pc = pc + 1;
                 }
-                Instr::Log { label, value } => {
+                Instr::Log {
+                    label,
+                    value,
+                    scratch: sc,
+                } => {
+                    let Some(scratch) = self
+                        .scratch
+                        .get_mut(m)
+                        .and_then(|v| v.get_mut(*sc as usize))
+                    else {
+                        return Err(self.internal(m, pc));
+                    };
                     let mut has = false;
                     if let Some(f) = value {
                         let res = {
@@ -771,18 +864,15 @@ impl<'m> Simulator<'m> {
                                 rng: &mut *rng,
                                 strings: &model.strings,
                             };
-                            f(&mut env, &mut self.scratch)
+                            f(&mut env, scratch)
                         };
                         if let Err(e) = res {
                             return Err(self.diag_error(m, Some(pc as usize), e));
                         }
                         has = true;
                     }
-                    let v = if has {
-                        Some(Value::of(&self.scratch))
-                    } else {
-                        None
-                    };
+                    let scratch = &self.scratch[m][*sc as usize];
+                    let v = if has { Some(Value::of(scratch)) } else { None };
                     obs.on_log(self.time, MachineId(m as u32), label, v);
                     self.ms[m].pc = pc + 1;
                 }
@@ -914,20 +1004,28 @@ impl<'m> Simulator<'m> {
                             Some(pc as usize),
                             EvalError {
                                 at: 0,
-                                kind: crate::expr::compile::EvalErrorKind::Internal,
+                                kind: EvalErrorKind::Internal,
                             },
                         ));
                     };
-                    let n = evdef.params.len();
-                    self.params_buf.truncate(n);
-                    while self.params_buf.len() < n {
-                        self.params_buf.push(Cell::Int(0));
-                    }
+                    // Slots are reused per event, so their cells keep their shapes (no allocation).
+                    let slot = match self.free.get_mut(sd.event as usize).and_then(|f| f.pop()) {
+                        Some(s) => s,
+                        None => {
+                            self.pool.push(Slot {
+                                event: sd.event,
+                                origin: 0,
+                                target: 0,
+                                params: evdef.defaults.clone(),
+                            });
+                            self.pool.len() as u32 - 1
+                        }
+                    };
+                    let mut out = std::mem::take(&mut self.pool[slot as usize].params);
                     for &i in &sd.missing {
-                        if let (Some(dst), Some(d)) = (
-                            self.params_buf.get_mut(i as usize),
-                            evdef.defaults.get(i as usize),
-                        ) {
+                        if let (Some(dst), Some(d)) =
+                            (out.get_mut(i as usize), evdef.defaults.get(i as usize))
+                        {
                             dst.clone_from(d);
                         }
                     }
@@ -948,7 +1046,7 @@ impl<'m> Simulator<'m> {
                         };
                         let mut res = Ok(());
                         for (i, f) in &sd.params {
-                            if let Some(dst) = self.params_buf.get_mut(*i as usize) {
+                            if let Some(dst) = out.get_mut(*i as usize) {
                                 res = f(&mut env, dst);
                                 if res.is_err() {
                                     break;
@@ -957,22 +1055,16 @@ impl<'m> Simulator<'m> {
                         }
                         res
                     };
-                    if let Err(e) = res {
-                        return Err(self.diag_error(m, Some(pc as usize), e));
-                    }
-                    let slot = match self.free.pop() {
-                        Some(s) => s,
-                        None => {
-                            self.pool.push(Slot::default());
-                            self.pool.len() as u32 - 1
-                        }
-                    };
                     {
                         let s = &mut self.pool[slot as usize];
-                        std::mem::swap(&mut s.params, &mut self.params_buf);
+                        s.params = out;
                         s.event = sd.event;
                         s.origin = m as u32;
                         s.target = target.unwrap_or(u32::MAX);
+                    }
+                    if let Err(e) = res {
+                        self.free_slot(slot);
+                        return Err(self.diag_error(m, Some(pc as usize), e));
                     }
                     self.steps += 1;
                     self.instant_steps += 1;
@@ -991,7 +1083,7 @@ impl<'m> Simulator<'m> {
                             self.ms[t as usize].extq.push_back(slot);
                             self.refresh(t as usize);
                         }
-                        None => self.free.push(slot),
+                        None => self.free_slot(slot),
                     }
                     let r = &mut self.ms[m];
                     if broadcast_len > 0 && (r.bcast as usize) + 1 < broadcast_len {
@@ -1007,13 +1099,24 @@ impl<'m> Simulator<'m> {
         }
     }
 
+    fn internal(&self, m: usize, pc: u32) -> Stop {
+        self.diag_error(
+            m,
+            Some(pc as usize),
+            EvalError {
+                at: 0,
+                kind: EvalErrorKind::Internal,
+            },
+        )
+    }
+
     fn too_long(&self, m: usize, pc: u32, bound: u32) -> Stop {
         self.diag_error(
             m,
             Some(pc as usize),
             EvalError {
                 at: 0,
-                kind: crate::expr::compile::EvalErrorKind::TooLong { bound },
+                kind: EvalErrorKind::TooLong { bound },
             },
         )
     }
