@@ -484,3 +484,50 @@ fn trace_csv() {
     assert_eq!(lines[2], "0,pong,Pong,Ping,n=1");
     assert_eq!(lines.last(), Some(&"0,finished,Ping,NONE,n=10"));
 }
+
+#[test]
+fn scan_main_file_lists_processes_types_and_properties() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/sim/spec");
+    let m = CompiledModel::load(&dir.join("model.xml")).unwrap();
+    assert_eq!(m.machine_count(), 2);
+    assert_eq!(m.types().labels.get("GREEN"), Some(&1));
+    assert!(m.properties_path().unwrap().ends_with("properties.xml"));
+    let (out, rec) = run(&m, 0, &RunConfig::default());
+    assert_eq!(out.end, EndReason::Quiescent);
+    assert_eq!(rec.rows.len(), 21);
+    let err = hindsight::model::load(&dir.join("bad_model.xml")).unwrap_err();
+    let msgs: Vec<String> = err
+        .iter()
+        .map(|d| format!("{}:{}: {}", d.line, d.column, d.message))
+        .collect();
+    assert_eq!(msgs.len(), 2, "{msgs:?}");
+    assert!(
+        msgs[0].starts_with("5:43: process `Wrong` names a machine called `Pong`"),
+        "{msgs:?}"
+    );
+    assert!(msgs[1].starts_with("6:45: no such file"), "{msgs:?}");
+}
+
+#[test]
+fn compiled_models_are_shared_between_threads() {
+    fn send_sync<T: Send + Sync>() {}
+    fn send<T: Send>() {}
+    send_sync::<CompiledModel>();
+    send::<Simulator<'static>>();
+    let m = model("race");
+    let traces: Vec<Vec<(u64, String, String, String)>> = std::thread::scope(|s| {
+        let hs: Vec<_> = (0..2)
+            .map(|_| {
+                s.spawn(|| {
+                    let (_, rec) = run(&m, 3, &RunConfig::default());
+                    sends(&m, &rec)
+                })
+            })
+            .collect();
+        hs.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    assert_eq!(traces[0], traces[1]);
+    assert!(m
+        .dump_machine(m.machine_id("Judge").unwrap())
+        .contains("send winner_p to NONE"));
+}

@@ -1,7 +1,7 @@
 //! Static types, run-time storage cells, interned strings, and the public [`Value`] view.
 //!
 //! Every datamodel variable and event parameter has a static [`Ty`]. At run
-//! time it is stored in a [`Cell`]; scalars are inline, arrays and structs are
+//! time it is stored in a cell; scalars are inline, arrays and structs are
 //! lists of cells whose buffers are reused between steps and runs
 //! (`clone_from`), so a run in steady state does not allocate.
 

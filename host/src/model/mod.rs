@@ -6,7 +6,7 @@
 //!    `types.xml` and `properties.xml` when present) or a SCAN main file
 //!    (`<specification><model><processList><process id moc="fsm" path/>...`,
 //!    `<types path/>`, `<properties path/>`).
-//! 2. Each file is parsed into an element tree ([`xml`], private) and then
+//! 2. Each file is parsed into an element tree (with byte spans) and then
 //!    into an [`ast::Machine`]; `<!-- TYPE name:type -->` comments type the
 //!    next `<data>` or `<param>` of that name.
 //! 3. The result is a [`ModelSource`]: machines, named types, the properties

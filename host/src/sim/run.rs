@@ -34,6 +34,10 @@ pub enum Quiescence {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RunConfig {
     /// The clock never goes past this time; the run ends when it would.
+    ///
+    /// SCAN's `--duration d` runs while the time is at most `d` and then adds one
+    /// time point at `d + 1`; to reproduce it, use `max_time = d + 1` and return
+    /// [`Flow::Stop`] from [`Observer::on_time`] at `d + 1`.
     pub max_time: u64,
     /// Maximum number of communication steps (sends plus receives).
     pub max_steps: u64,
@@ -223,16 +227,18 @@ impl std::fmt::Debug for Simulator<'_> {
     }
 }
 
-/// Unbiased uniform integer in `0..n` (`n > 0`), Lemire's multiply-and-reject.
+/// Unbiased uniform integer in `0..n` (`n > 0`), Lemire's multiply-and-reject
+/// (the division is only needed in the rare case the low half is small).
 fn below(rng: &mut dyn Entropy, n: u32) -> u32 {
     let n = n as u64;
-    let threshold = n.wrapping_neg() % n;
-    loop {
-        let m = (rng.next_u64() as u128) * (n as u128);
-        if (m as u64) >= threshold {
-            return (m >> 64) as u32;
+    let mut m = (rng.next_u64() as u128) * (n as u128);
+    if (m as u64) < n {
+        let threshold = n.wrapping_neg() % n;
+        while (m as u64) < threshold {
+            m = (rng.next_u64() as u128) * (n as u128);
         }
     }
+    (m >> 64) as u32
 }
 
 enum Stop {
