@@ -1,7 +1,10 @@
 //! hindsight's host side: models, simulation, SMC and the CLI.
 
 pub mod cli;
+pub mod expr;
+pub mod model;
+pub mod props;
+pub mod sim;
+pub mod smc;
 pub mod tracefile;
 pub mod verify;
-pub mod props;
-pub mod smc;

@@ -1,0 +1,358 @@
+//! Static types, run-time storage cells, interned strings, and the public [`Value`] view.
+//!
+//! Every datamodel variable and event parameter has a static [`Ty`]. At run
+//! time it is stored in a cell; scalars are inline, arrays and structs are
+//! lists of cells whose buffers are reused between steps and runs
+//! (`clone_from`), so a run in steady state does not allocate.
+
+use std::collections::HashMap;
+
+/// An interned string: an index into the model's string table.
+///
+/// Every string a model can produce is a literal of the model (there is no
+/// string concatenation), so the table is fixed when the model is compiled;
+/// [`StrId(0)`](StrId) is the empty string.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+pub struct StrId(pub u32);
+
+/// The string interner of a compiled model.
+#[derive(Clone, Debug)]
+pub struct Strings {
+    map: HashMap<Box<str>, u32>,
+    list: Vec<Box<str>>,
+}
+
+impl Default for Strings {
+    fn default() -> Self {
+        let mut s = Strings {
+            map: HashMap::new(),
+            list: Vec::new(),
+        };
+        s.intern("");
+        s
+    }
+}
+
+impl Strings {
+    /// The id of `s`, adding it when new.
+    pub fn intern(&mut self, s: &str) -> StrId {
+        if let Some(&i) = self.map.get(s) {
+            return StrId(i);
+        }
+        let i = self.list.len() as u32;
+        self.list.push(s.into());
+        self.map.insert(s.into(), i);
+        StrId(i)
+    }
+
+    /// The id of `s` when the model contains it.
+    pub fn lookup(&self, s: &str) -> Option<StrId> {
+        self.map.get(s).map(|&i| StrId(i))
+    }
+
+    /// The text of an id (`""` for an unknown id).
+    pub fn get(&self, id: StrId) -> &str {
+        self.list.get(id.0 as usize).map_or("", |s| s)
+    }
+
+    /// Number of strings.
+    pub fn len(&self) -> usize {
+        self.list.len()
+    }
+
+    /// Always false: the empty string is always present.
+    pub fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+}
+
+/// A static type.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Ty {
+    /// `bool`.
+    Bool,
+    /// Every integer width (and enumerations), stored as `i64`.
+    Int,
+    /// `float32` / `float64`, stored as `f64`.
+    Float,
+    /// Interned string.
+    Str,
+    /// Array with an optional maximum length.
+    Array(Box<Ty>, Option<u32>),
+    /// Struct: index into the model's struct table.
+    Struct(u32),
+    /// The element type of `[]` before it meets a declared type.
+    Unknown,
+}
+
+impl Ty {
+    /// True for `Bool`, `Int`, `Float` and `Str`.
+    pub fn is_scalar(&self) -> bool {
+        matches!(self, Ty::Bool | Ty::Int | Ty::Float | Ty::Str)
+    }
+
+    /// True for `Int` and `Float`.
+    pub fn is_numeric(&self) -> bool {
+        matches!(self, Ty::Int | Ty::Float)
+    }
+}
+
+/// A struct type from `types.xml`.
+#[derive(Clone, Debug)]
+pub struct StructDef {
+    /// Type name.
+    pub name: String,
+    /// Fields in declaration order.
+    pub fields: Vec<(String, Ty)>,
+}
+
+/// Named types available to expressions: structs and enumeration labels.
+#[derive(Clone, Debug, Default)]
+pub struct TypeTable {
+    /// Struct definitions; `Ty::Struct(i)` is `structs[i]`.
+    pub structs: Vec<StructDef>,
+    /// Enumeration labels and their integer values (globally unique, as in SCAN).
+    pub labels: HashMap<String, i64>,
+    /// Named types by name.
+    pub named: HashMap<String, Ty>,
+}
+
+impl TypeTable {
+    /// Human-readable type name.
+    pub fn name(&self, ty: &Ty) -> String {
+        match ty {
+            Ty::Bool => "bool".into(),
+            Ty::Int => "int".into(),
+            Ty::Float => "float".into(),
+            Ty::Str => "string".into(),
+            Ty::Array(t, None) => format!("{}[]", self.name(t)),
+            Ty::Array(t, Some(n)) => format!("{}[{n}]", self.name(t)),
+            Ty::Struct(i) => self
+                .structs
+                .get(*i as usize)
+                .map_or_else(|| "struct".into(), |s| s.name.clone()),
+            Ty::Unknown => "unknown".into(),
+        }
+    }
+
+    /// The default (initial) value of a type.
+    pub(crate) fn default_cell(&self, ty: &Ty) -> Cell {
+        match ty {
+            Ty::Bool => Cell::Bool(false),
+            Ty::Int | Ty::Unknown => Cell::Int(0),
+            Ty::Float => Cell::Float(0.0),
+            Ty::Str => Cell::Str(StrId(0)),
+            Ty::Array(..) => Cell::List(Vec::new()),
+            Ty::Struct(i) => Cell::List(
+                self.structs
+                    .get(*i as usize)
+                    .map(|s| s.fields.iter().map(|(_, t)| self.default_cell(t)).collect())
+                    .unwrap_or_default(),
+            ),
+        }
+    }
+}
+
+/// Run-time storage of one value. Arrays and structs are lists of cells.
+#[derive(Debug, PartialEq)]
+pub(crate) enum Cell {
+    Bool(bool),
+    Int(i64),
+    Float(f64),
+    Str(StrId),
+    List(Vec<Cell>),
+}
+
+impl Clone for Cell {
+    fn clone(&self) -> Self {
+        match self {
+            Cell::Bool(b) => Cell::Bool(*b),
+            Cell::Int(v) => Cell::Int(*v),
+            Cell::Float(v) => Cell::Float(*v),
+            Cell::Str(s) => Cell::Str(*s),
+            Cell::List(v) => Cell::List(v.clone()),
+        }
+    }
+
+    /// Reuses the destination's buffers (list into list, element by element), so copying
+    /// a value into a cell of the same shape does not allocate.
+    fn clone_from(&mut self, source: &Self) {
+        match (self, source) {
+            (Cell::List(dst), Cell::List(src)) => dst.clone_from(src),
+            (dst, src) => *dst = src.clone(),
+        }
+    }
+}
+
+/// A read-only view of a value produced by a run (a message parameter, a logged value).
+///
+/// Strings are [`StrId`]s, resolved with the compiled model's string table;
+/// arrays and structs are [`Value::List`]s (a struct lists its fields in
+/// declaration order).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Value<'a> {
+    /// A boolean.
+    Bool(bool),
+    /// An integer (every integer width and enumerations).
+    Int(i64),
+    /// A float (`float32` and `float64`).
+    Float(f64),
+    /// An interned string.
+    Str(StrId),
+    /// An array or a struct.
+    List(ListRef<'a>),
+}
+
+/// The elements of an array (or fields of a struct) in a [`Value::List`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ListRef<'a>(pub(crate) &'a [Cell]);
+
+impl<'a> ListRef<'a> {
+    /// Number of elements.
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    /// True when there is no element.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    /// Element `i`.
+    pub fn get(&self, i: usize) -> Option<Value<'a>> {
+        self.0.get(i).map(Value::of)
+    }
+
+    /// All elements in order.
+    pub fn iter(&self) -> impl Iterator<Item = Value<'a>> + 'a {
+        self.0.iter().map(Value::of)
+    }
+}
+
+impl<'a> Value<'a> {
+    pub(crate) fn of(c: &'a Cell) -> Value<'a> {
+        match c {
+            Cell::Bool(b) => Value::Bool(*b),
+            Cell::Int(v) => Value::Int(*v),
+            Cell::Float(v) => Value::Float(*v),
+            Cell::Str(s) => Value::Str(*s),
+            Cell::List(v) => Value::List(ListRef(v)),
+        }
+    }
+
+    /// The boolean, if this is one.
+    pub fn as_bool(&self) -> Option<bool> {
+        match self {
+            Value::Bool(b) => Some(*b),
+            _ => None,
+        }
+    }
+
+    /// The integer, if this is one.
+    pub fn as_i64(&self) -> Option<i64> {
+        match self {
+            Value::Int(v) => Some(*v),
+            _ => None,
+        }
+    }
+
+    /// The number as a float, if this is an integer or a float.
+    pub fn as_f64(&self) -> Option<f64> {
+        match self {
+            Value::Int(v) => Some(*v as f64),
+            Value::Float(v) => Some(*v),
+            _ => None,
+        }
+    }
+
+    /// The string id, if this is a string.
+    pub fn as_str_id(&self) -> Option<StrId> {
+        match self {
+            Value::Str(s) => Some(*s),
+            _ => None,
+        }
+    }
+
+    /// Writes the value as text (strings resolved, lists as `[a,b]`).
+    pub fn write_to(&self, strings: &Strings, out: &mut String) {
+        use std::fmt::Write;
+        match self {
+            Value::Bool(b) => {
+                let _ = write!(out, "{b}");
+            }
+            Value::Int(v) => {
+                let _ = write!(out, "{v}");
+            }
+            Value::Float(v) => {
+                let _ = write!(out, "{v}");
+            }
+            Value::Str(s) => out.push_str(strings.get(*s)),
+            Value::List(l) => {
+                out.push('[');
+                for (i, v) in l.iter().enumerate() {
+                    if i > 0 {
+                        out.push(',');
+                    }
+                    v.write_to(strings, out);
+                }
+                out.push(']');
+            }
+        }
+    }
+}
+
+/// An owned copy of a [`Value`], for traces kept after the run.
+#[derive(Clone, Debug, PartialEq)]
+pub enum OwnedValue {
+    /// A boolean.
+    Bool(bool),
+    /// An integer.
+    Int(i64),
+    /// A float.
+    Float(f64),
+    /// An interned string.
+    Str(StrId),
+    /// An array or struct.
+    List(Vec<OwnedValue>),
+}
+
+impl From<Value<'_>> for OwnedValue {
+    fn from(v: Value<'_>) -> Self {
+        match v {
+            Value::Bool(b) => OwnedValue::Bool(b),
+            Value::Int(i) => OwnedValue::Int(i),
+            Value::Float(f) => OwnedValue::Float(f),
+            Value::Str(s) => OwnedValue::Str(s),
+            Value::List(l) => OwnedValue::List(l.iter().map(OwnedValue::from).collect()),
+        }
+    }
+}
+
+impl OwnedValue {
+    /// Writes the value as text (strings resolved, lists as `[a,b]`).
+    pub fn write_to(&self, strings: &Strings, out: &mut String) {
+        use std::fmt::Write;
+        match self {
+            OwnedValue::Bool(b) => {
+                let _ = write!(out, "{b}");
+            }
+            OwnedValue::Int(v) => {
+                let _ = write!(out, "{v}");
+            }
+            OwnedValue::Float(v) => {
+                let _ = write!(out, "{v}");
+            }
+            OwnedValue::Str(s) => out.push_str(strings.get(*s)),
+            OwnedValue::List(l) => {
+                out.push('[');
+                for (i, v) in l.iter().enumerate() {
+                    if i > 0 {
+                        out.push(',');
+                    }
+                    v.write_to(strings, out);
+                }
+                out.push(']');
+            }
+        }
+    }
+}

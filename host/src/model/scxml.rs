@@ -1,0 +1,642 @@
+//! Reads one `.scxml` file (the flat subset SCAN accepts) into a [`Machine`], collecting every error.
+
+use super::ast::*;
+use super::source::{Diagnostic, FileId, SourceMap, Span};
+use super::types::{parse_type_comment, TypeAnn, TypeExpr};
+use super::xml::{self, Element, Node};
+
+/// Reads the SCXML file `file` (already in `sm`) into a machine.
+pub fn read_machine(sm: &SourceMap, file: FileId) -> Result<Machine, Vec<Diagnostic>> {
+    let root = xml::parse(sm, file).map_err(|d| vec![d])?;
+    let mut r = Reader {
+        sm,
+        errs: Vec::new(),
+    };
+    let m = r.machine(&root, file);
+    if r.errs.is_empty() {
+        Ok(m)
+    } else {
+        Err(r.errs)
+    }
+}
+
+struct Reader<'a> {
+    sm: &'a SourceMap,
+    errs: Vec<Diagnostic>,
+}
+
+/// A pending `<!-- TYPE name:type -->` annotation.
+type Pending = Option<(String, Result<TypeExpr, String>, Span)>;
+
+impl Reader<'_> {
+    fn err(&mut self, span: Span, msg: impl Into<String>) {
+        self.errs.push(self.sm.diag(span, msg));
+    }
+
+    fn ident(&self, a: &xml::Attr) -> Ident {
+        Ident {
+            name: a.value.trim().to_string(),
+            span: a.value_span,
+        }
+    }
+
+    fn src(&self, a: &xml::Attr) -> SrcExpr {
+        SrcExpr {
+            text: a.value.clone(),
+            span: a.value_span,
+        }
+    }
+
+    fn required_ident(&mut self, el: &Element, name: &str) -> Option<Ident> {
+        match el.required(self.sm, name) {
+            Ok(a) if a.value.trim().is_empty() => {
+                self.err(a.value_span, format!("attribute `{name}` is empty"));
+                None
+            }
+            Ok(a) => Some(self.ident(a)),
+            Err(d) => {
+                self.errs.push(d);
+                None
+            }
+        }
+    }
+
+    fn required_src(&mut self, el: &Element, name: &str) -> Option<SrcExpr> {
+        match el.required(self.sm, name) {
+            Ok(a) => Some(self.src(a)),
+            Err(d) => {
+                self.errs.push(d);
+                None
+            }
+        }
+    }
+
+    fn check(&mut self, el: &Element, allowed: &[&str]) {
+        el.check_attrs(self.sm, allowed, &mut self.errs);
+    }
+
+    fn text_not_allowed(&mut self, el: &Element) {
+        for n in &el.children {
+            if let Node::Text(span) = n {
+                self.err(*span, format!("unexpected text inside <{}>", el.name));
+            }
+        }
+    }
+
+    fn machine(&mut self, root: &Element, file: FileId) -> Machine {
+        if root.name != "scxml" {
+            self.err(
+                root.span,
+                format!("expected an <scxml> root element, found <{}>", root.name),
+            );
+        }
+        self.check(
+            root,
+            &[
+                "name",
+                "initial",
+                "version",
+                "datamodel",
+                "binding",
+                "model_src",
+            ],
+        );
+        if let Some(dm) = root.attr("datamodel") {
+            if dm.value != "ecmascript" {
+                self.err(
+                    dm.value_span,
+                    format!("unsupported datamodel `{}` (only ecmascript)", dm.value),
+                );
+            }
+        }
+        let name = match root.attr("name") {
+            Some(a) => self.ident(a),
+            None => {
+                let stem = self
+                    .sm
+                    .file(file)
+                    .and_then(|f| f.path().file_stem())
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                Ident {
+                    name: stem,
+                    span: root.span,
+                }
+            }
+        };
+        let initial = root.attr("initial").map(|a| self.ident(a));
+        let mut m = Machine {
+            name,
+            initial,
+            datamodel: Vec::new(),
+            states: Vec::new(),
+            span: root.span,
+        };
+        self.text_not_allowed(root);
+        for el in root.elements() {
+            match el.name.as_str() {
+                "datamodel" => self.datamodel(el, &mut m.datamodel),
+                "state" | "final" => {
+                    if let Some(s) = self.state(el) {
+                        m.states.push(s);
+                    }
+                }
+                "parallel" | "history" | "initial" | "invoke" => self.err(
+                    el.span,
+                    format!("<{}> is not supported: machines must be flat", el.name),
+                ),
+                "script" => self.err(el.span, "<script> is not supported"),
+                other => self.err(el.span, format!("unexpected <{other}> in <scxml>")),
+            }
+        }
+        if m.states.is_empty() {
+            self.err(root.span, "the machine has no state");
+        }
+        m
+    }
+
+    fn datamodel(&mut self, el: &Element, out: &mut Vec<Data>) {
+        self.check(el, &[]);
+        self.text_not_allowed(el);
+        let mut pending: Pending = None;
+        for node in &el.children {
+            match node {
+                Node::Comment(text, span) => {
+                    if let Some((n, t)) = parse_type_comment(text) {
+                        pending = Some((n, t, *span));
+                    }
+                }
+                Node::Text(_) => {}
+                Node::Element(d) if d.name == "data" => {
+                    self.check(d, &["id", "expr", "type", "src"]);
+                    if let Some(src) = d.attr("src") {
+                        self.err(src.name_span, "<data src> is not supported");
+                    }
+                    let Some(id) = self.required_ident(d, "id") else {
+                        continue;
+                    };
+                    let mut ty = self.type_attr(d);
+                    if let Some((n, t, span)) = pending.take() {
+                        if n == id.name && ty.is_none() {
+                            ty = self.type_ann(t, span);
+                        }
+                    }
+                    if d.children.iter().any(|c| !matches!(c, Node::Comment(..))) {
+                        self.err(d.span, "<data> content is not supported; use `expr`");
+                    }
+                    out.push(Data {
+                        id,
+                        ty,
+                        expr: d.attr("expr").map(|a| self.src(a)),
+                        span: d.span,
+                    });
+                }
+                Node::Element(other) => self.err(
+                    other.span,
+                    format!("unexpected <{}> in <datamodel>", other.name),
+                ),
+            }
+        }
+    }
+
+    fn type_ann(&mut self, t: Result<TypeExpr, String>, span: Span) -> Option<TypeAnn> {
+        match t {
+            Ok(ty) => Some(TypeAnn { ty, span }),
+            Err(m) => {
+                self.err(span, m);
+                None
+            }
+        }
+    }
+
+    fn type_attr(&mut self, el: &Element) -> Option<TypeAnn> {
+        let a = el.attr("type")?;
+        let t = TypeExpr::parse(&a.value);
+        self.type_ann(t, a.value_span)
+    }
+
+    fn state(&mut self, el: &Element) -> Option<State> {
+        self.check(el, &["id"]);
+        self.text_not_allowed(el);
+        let id = self.required_ident(el, "id")?;
+        let mut s = State {
+            id,
+            onentry: Vec::new(),
+            onexit: Vec::new(),
+            transitions: Vec::new(),
+            is_final: el.name == "final",
+            span: el.span,
+        };
+        for c in el.elements() {
+            match c.name.as_str() {
+                "onentry" => {
+                    self.check(c, &[]);
+                    let mut v = self.block(c, 0);
+                    s.onentry.append(&mut v);
+                }
+                "onexit" => {
+                    self.check(c, &[]);
+                    let mut v = self.block(c, 0);
+                    s.onexit.append(&mut v);
+                }
+                "transition" => {
+                    if s.is_final {
+                        self.err(c.span, "a <final> state cannot have transitions");
+                    }
+                    if let Some(t) = self.transition(c) {
+                        s.transitions.push(t);
+                    }
+                }
+                "state" | "parallel" | "final" | "history" | "initial" => self.err(
+                    c.span,
+                    format!(
+                        "nested <{}> is not supported: machines must be flat",
+                        c.name
+                    ),
+                ),
+                "datamodel" => self.err(c.span, "a <datamodel> must be a child of <scxml>"),
+                "invoke" => self.err(c.span, "<invoke> is not supported"),
+                "donedata" => self.err(c.span, "<donedata> is not supported"),
+                other => self.err(c.span, format!("unexpected <{other}> in <{}>", el.name)),
+            }
+        }
+        Some(s)
+    }
+
+    fn transition(&mut self, el: &Element) -> Option<Transition> {
+        self.check(el, &["event", "cond", "target"]);
+        let events = match el.attr("event") {
+            Some(a) => {
+                let mut v = Vec::new();
+                let mut off = 0u32;
+                for part in a.value.split(' ') {
+                    if !part.trim().is_empty() {
+                        v.push(Ident {
+                            name: part.trim().to_string(),
+                            span: self.sm.unescaped_offset(a.value_span, off),
+                        });
+                    }
+                    off += part.len() as u32 + 1;
+                }
+                if v.is_empty() {
+                    self.err(a.value_span, "empty `event` attribute");
+                }
+                if v.iter().any(|e| e.name.contains('*')) {
+                    self.err(a.value_span, "wildcard events are not supported");
+                }
+                v
+            }
+            None => Vec::new(),
+        };
+        let target = match el.attr("target") {
+            Some(a) if a.value.split_whitespace().count() > 1 => {
+                self.err(a.value_span, "a transition may have only one target");
+                None
+            }
+            Some(a) => Some(self.ident(a)),
+            None => None,
+        };
+        Some(Transition {
+            events,
+            cond: el.attr("cond").map(|a| self.src(a)),
+            target,
+            body: self.block(el, 0),
+            span: el.span,
+        })
+    }
+
+    /// Executable content of `el`'s children.
+    fn block(&mut self, el: &Element, depth: usize) -> Vec<Exec> {
+        self.text_not_allowed(el);
+        let mut out = Vec::new();
+        let mut pending: Pending = None;
+        for node in &el.children {
+            match node {
+                Node::Comment(text, span) => {
+                    if let Some((n, t)) = parse_type_comment(text) {
+                        pending = Some((n, t, *span));
+                    }
+                }
+                Node::Text(_) => {}
+                Node::Element(c) => {
+                    if let Some(e) = self.exec(c, depth, &mut pending) {
+                        out.push(e);
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    fn exec(&mut self, el: &Element, depth: usize, pending: &mut Pending) -> Option<Exec> {
+        if depth > 64 {
+            self.err(el.span, "executable content nested too deeply");
+            return None;
+        }
+        match el.name.as_str() {
+            "assign" => {
+                self.check(el, &["location", "expr"]);
+                self.text_not_allowed(el);
+                let location = self.required_src(el, "location")?;
+                let expr = self.required_src(el, "expr")?;
+                Some(Exec::Assign {
+                    location,
+                    expr,
+                    span: el.span,
+                })
+            }
+            "raise" => {
+                self.check(el, &["event"]);
+                let event = self.required_ident(el, "event")?;
+                Some(Exec::Raise {
+                    event,
+                    span: el.span,
+                })
+            }
+            "log" => {
+                self.check(el, &["label", "expr"]);
+                Some(Exec::Log {
+                    label: el.attr("label").map(|a| a.value.clone()),
+                    expr: el.attr("expr").map(|a| self.src(a)),
+                    span: el.span,
+                })
+            }
+            "send" => self.send(el, pending),
+            "if" => {
+                self.check(el, &["cond"]);
+                self.text_not_allowed(el);
+                let cond = self.required_src(el, "cond")?;
+                let mut branches = vec![(cond, Vec::new())];
+                let mut otherwise = Vec::new();
+                let mut in_else = false;
+                let mut inner: Pending = None;
+                for node in &el.children {
+                    let c = match node {
+                        Node::Element(c) => c,
+                        Node::Comment(text, span) => {
+                            if let Some((n, t)) = parse_type_comment(text) {
+                                inner = Some((n, t, *span));
+                            }
+                            continue;
+                        }
+                        Node::Text(_) => continue,
+                    };
+                    match c.name.as_str() {
+                        "elseif" => {
+                            self.check(c, &["cond"]);
+                            if in_else {
+                                self.err(c.span, "<elseif> after <else>");
+                            }
+                            if let Some(cond) = self.required_src(c, "cond") {
+                                branches.push((cond, Vec::new()));
+                            }
+                            if c.elements().next().is_some() {
+                                self.err(
+                                    c.span,
+                                    "<elseif> must be empty (`<elseif cond=\"..\"/>`)",
+                                );
+                            }
+                        }
+                        "else" => {
+                            self.check(c, &[]);
+                            if in_else {
+                                self.err(c.span, "more than one <else>");
+                            }
+                            in_else = true;
+                            if c.elements().next().is_some() {
+                                self.err(c.span, "<else> must be empty (`<else/>`)");
+                            }
+                        }
+                        _ => {
+                            if let Some(e) = self.exec(c, depth + 1, &mut inner) {
+                                if in_else {
+                                    otherwise.push(e);
+                                } else if let Some(last) = branches.last_mut() {
+                                    last.1.push(e);
+                                }
+                            }
+                        }
+                    }
+                }
+                Some(Exec::If {
+                    branches,
+                    otherwise,
+                    span: el.span,
+                })
+            }
+            "elseif" | "else" => {
+                self.err(el.span, format!("<{}> outside <if>", el.name));
+                None
+            }
+            "script" => {
+                self.err(el.span, "<script> is not supported");
+                None
+            }
+            "cancel" | "foreach" => {
+                self.err(el.span, format!("<{}> is not supported", el.name));
+                None
+            }
+            other => {
+                self.err(
+                    el.span,
+                    format!("unexpected <{other}> in executable content"),
+                );
+                None
+            }
+        }
+    }
+
+    fn send(&mut self, el: &Element, pending: &mut Pending) -> Option<Exec> {
+        self.check(
+            el,
+            &[
+                "event",
+                "target",
+                "targetexpr",
+                "delay",
+                "delayexpr",
+                "type",
+            ],
+        );
+        self.text_not_allowed(el);
+        if let Some(t) = el.attr("type") {
+            let v = t.value.trim();
+            if !(v == "scxml" || v.ends_with("SCXMLEventProcessor")) {
+                self.err(t.value_span, format!("unsupported send type `{v}`"));
+            }
+        }
+        let event = self.required_ident(el, "event");
+        let target = match (el.attr("target"), el.attr("targetexpr")) {
+            (Some(a), None) => Some(SendTarget::Id(self.ident(a))),
+            (None, Some(a)) => Some(SendTarget::Expr(self.src(a))),
+            (None, None) => None,
+            (Some(_), Some(b)) => {
+                self.err(b.name_span, "<send> has both `target` and `targetexpr`");
+                None
+            }
+        };
+        let delay = match (el.attr("delay"), el.attr("delayexpr")) {
+            (Some(a), None) => match a.value.trim().parse::<u64>() {
+                Ok(n) => Some(Delay::Const(n, a.value_span)),
+                Err(_) => {
+                    self.err(
+                        a.value_span,
+                        format!("delay `{}` is not a whole number of time units", a.value),
+                    );
+                    None
+                }
+            },
+            (None, Some(a)) => Some(Delay::Expr(self.src(a))),
+            (None, None) => None,
+            (Some(_), Some(b)) => {
+                self.err(b.name_span, "<send> has both `delay` and `delayexpr`");
+                None
+            }
+        };
+        let mut params = Vec::new();
+        // An annotation right before the <send> is for its first param (AS2FM writes them inside).
+        let mut local: Pending = pending.take();
+        for node in &el.children {
+            match node {
+                Node::Comment(text, span) => {
+                    if let Some((n, t)) = parse_type_comment(text) {
+                        local = Some((n, t, *span));
+                    }
+                }
+                Node::Text(_) => {}
+                Node::Element(p) if p.name == "param" => {
+                    self.check(p, &["name", "expr", "location", "type"]);
+                    let Some(name) = self.required_ident(p, "name") else {
+                        continue;
+                    };
+                    let expr = match (p.attr("expr"), p.attr("location")) {
+                        (Some(a), None) | (None, Some(a)) => self.src(a),
+                        (Some(_), Some(b)) => {
+                            self.err(b.name_span, "<param> has both `expr` and `location`");
+                            continue;
+                        }
+                        (None, None) => {
+                            self.err(p.span, "<param> needs `expr` or `location`");
+                            continue;
+                        }
+                    };
+                    let mut ty = self.type_attr(p);
+                    if let Some((n, t, span)) = local.take() {
+                        if n == name.name && ty.is_none() {
+                            ty = self.type_ann(t, span);
+                        }
+                    }
+                    if params.iter().any(|q: &Param| q.name.name == name.name) {
+                        self.err(name.span, format!("param `{}` is given twice", name.name));
+                        continue;
+                    }
+                    params.push(Param {
+                        name,
+                        expr,
+                        ty,
+                        span: p.span,
+                    });
+                }
+                Node::Element(c) if c.name == "content" => {
+                    self.err(c.span, "<content> is not supported; use <param>");
+                }
+                Node::Element(c) => {
+                    self.err(c.span, format!("unexpected <{}> in <send>", c.name));
+                }
+            }
+        }
+        Some(Exec::Send(Send {
+            event: event?,
+            target,
+            delay,
+            params,
+            span: el.span,
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read(text: &str) -> Result<Machine, Vec<Diagnostic>> {
+        let mut sm = SourceMap::new();
+        let f = sm.add("m.scxml", text.to_string());
+        read_machine(&sm, f)
+    }
+
+    #[test]
+    fn reads_the_subset() {
+        let m = read(
+            r#"<scxml name="M" initial="a" xmlns="http://www.w3.org/2005/07/scxml">
+  <datamodel>
+    <!-- TYPE x:int32 -->
+    <data id="x" expr="0"/>
+    <data id="y" type="float64"/>
+  </datamodel>
+  <state id="a">
+    <onentry><raise event="go"/></onentry>
+    <transition event="go tick" cond="x &lt; 3" target="b">
+      <assign location="x" expr="x + 1"/>
+      <if cond="x == 1"><log label="one"/><elseif cond="x == 2"/><log expr="x"/><else/><raise event="z"/></if>
+      <send event="e" target="M" delay="2">
+        <!-- TYPE p:float32 -->
+        <param name="p" expr="x"/>
+        <param name="q" location="y"/>
+      </send>
+    </transition>
+  </state>
+  <final id="b"/>
+</scxml>"#,
+        )
+        .unwrap();
+        assert_eq!(m.name.name, "M");
+        assert_eq!(m.datamodel.len(), 2);
+        assert!(m.datamodel[0].ty.is_some() && m.datamodel[1].ty.is_some());
+        assert_eq!(m.states.len(), 2);
+        let t = &m.states[0].transitions[0];
+        assert_eq!(t.events.len(), 2);
+        assert_eq!(t.events[1].name, "tick");
+        assert_eq!(t.cond.as_ref().unwrap().text, "x < 3");
+        match &t.body[1] {
+            Exec::If {
+                branches,
+                otherwise,
+                ..
+            } => {
+                assert_eq!(branches.len(), 2);
+                assert_eq!(branches[1].1.len(), 1);
+                assert_eq!(otherwise.len(), 1);
+            }
+            e => panic!("{e:?}"),
+        }
+        match &t.body[2] {
+            Exec::Send(s) => {
+                assert!(matches!(s.delay, Some(Delay::Const(2, _))));
+                assert!(s.params[0].ty.is_some());
+                assert!(s.params[1].ty.is_none());
+            }
+            e => panic!("{e:?}"),
+        }
+        assert!(m.states[1].is_final);
+    }
+
+    #[test]
+    fn errors_have_positions() {
+        let text = "<scxml name=\"M\">\n  <state id=\"a\" bogus=\"1\">\n    <parallel/>\n  </state>\n</scxml>";
+        let errs = read(text).unwrap_err();
+        assert_eq!(errs.len(), 2, "{errs:?}");
+        assert_eq!((errs[0].line, errs[0].column), (2, 17));
+        assert!(errs[0].message.contains("bogus"));
+        assert_eq!((errs[1].line, errs[1].column), (3, 5));
+    }
+
+    #[test]
+    fn bad_delay_and_missing_attrs() {
+        let errs = read(
+            r#"<scxml name="M"><state id="a"><onentry><send target="M" delay="1s"/><assign location="x"/></onentry></state></scxml>"#,
+        )
+        .unwrap_err();
+        assert_eq!(errs.len(), 3, "{errs:?}");
+    }
+}

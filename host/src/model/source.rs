@@ -1,0 +1,349 @@
+//! Source files, byte spans and diagnostics: every error about a model points at a file, line and column.
+//!
+//! The model reader keeps the text of every file it read in a [`SourceMap`];
+//! parsed items carry a [`Span`] (file + byte offset). Line and column are
+//! computed only when a [`Diagnostic`] is made, so spans cost 8 bytes.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Index of a file in a [`SourceMap`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct FileId(pub u32);
+
+/// A position in a source file: the file and a byte offset into its text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Span {
+    /// The file.
+    pub file: FileId,
+    /// Byte offset from the start of the file's text.
+    pub offset: u32,
+}
+
+impl Span {
+    /// The span `delta` bytes further in the same file.
+    pub fn shifted(self, delta: u32) -> Span {
+        Span {
+            file: self.file,
+            offset: self.offset.saturating_add(delta),
+        }
+    }
+}
+
+/// One source file: its path, text and the byte offsets where lines start.
+#[derive(Clone, Debug)]
+pub struct SourceFile {
+    path: PathBuf,
+    text: String,
+    line_starts: Vec<u32>,
+}
+
+impl SourceFile {
+    /// The file's path as given to the reader.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The file's full text.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// 1-based line and column (in characters) of a byte offset.
+    pub fn line_col(&self, offset: u32) -> (u32, u32) {
+        let offset = offset.min(self.text.len() as u32);
+        let line = match self.line_starts.binary_search(&offset) {
+            Ok(i) => i,
+            Err(i) => i.saturating_sub(1),
+        };
+        let start = self.line_starts.get(line).copied().unwrap_or(0) as usize;
+        let mut end = offset as usize;
+        while end > start && !self.text.is_char_boundary(end) {
+            end -= 1;
+        }
+        let column = self.text.get(start..end).map_or(0, |s| s.chars().count());
+        (line as u32 + 1, column as u32 + 1)
+    }
+}
+
+/// Every file read for a model, so that spans can be turned into line and column.
+#[derive(Clone, Debug, Default)]
+pub struct SourceMap {
+    files: Vec<SourceFile>,
+}
+
+impl SourceMap {
+    /// An empty map.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a file's text and returns its id.
+    pub fn add(&mut self, path: impl Into<PathBuf>, text: String) -> FileId {
+        let mut line_starts = vec![0u32];
+        for (i, b) in text.bytes().enumerate() {
+            if b == b'\n' {
+                line_starts.push(i as u32 + 1);
+            }
+        }
+        self.files.push(SourceFile {
+            path: path.into(),
+            text,
+            line_starts,
+        });
+        FileId(self.files.len() as u32 - 1)
+    }
+
+    /// The file with this id.
+    pub fn file(&self, id: FileId) -> Option<&SourceFile> {
+        self.files.get(id.0 as usize)
+    }
+
+    /// All files, in the order they were added.
+    pub fn files(&self) -> &[SourceFile] {
+        &self.files
+    }
+
+    /// A diagnostic at `span` with `message`.
+    pub fn diag(&self, span: Span, message: impl Into<String>) -> Diagnostic {
+        match self.file(span.file) {
+            Some(f) => {
+                let (line, column) = f.line_col(span.offset);
+                Diagnostic {
+                    path: f.path.clone(),
+                    line,
+                    column,
+                    message: message.into(),
+                }
+            }
+            None => Diagnostic {
+                path: PathBuf::from("<unknown>"),
+                line: 0,
+                column: 0,
+                message: message.into(),
+            },
+        }
+    }
+
+    /// The span of byte `k` of an attribute value whose raw (escaped) text starts at `span`.
+    ///
+    /// Expressions are parsed from the unescaped value; this maps an offset in
+    /// the unescaped text back to the file (`&amp;` counts as one character).
+    pub fn unescaped_offset(&self, span: Span, k: u32) -> Span {
+        let Some(f) = self.file(span.file) else {
+            return span;
+        };
+        let raw = f.text.as_bytes();
+        let mut raw_pos = span.offset as usize;
+        let mut out = 0u32;
+        while out < k && raw_pos < raw.len() {
+            if raw[raw_pos] == b'&' {
+                if let Some(len) = raw[raw_pos..].iter().take(12).position(|&b| b == b';') {
+                    let entity = &raw[raw_pos..raw_pos + len + 1];
+                    let produced = entity_len(entity).unwrap_or(1);
+                    out += produced;
+                    raw_pos += len + 1;
+                    continue;
+                }
+            }
+            raw_pos += 1;
+            out += 1;
+        }
+        Span {
+            file: span.file,
+            offset: raw_pos as u32,
+        }
+    }
+}
+
+/// UTF-8 length of the character an entity such as `&amp;` or `&#x41;` stands for.
+fn entity_len(entity: &[u8]) -> Option<u32> {
+    let name = std::str::from_utf8(entity.get(1..entity.len() - 1)?).ok()?;
+    Some(resolve_entity(name)?.len_utf8() as u32)
+}
+
+/// The character an XML entity name (without `&` and `;`) stands for.
+pub(crate) fn resolve_entity(name: &str) -> Option<char> {
+    match name {
+        "lt" => Some('<'),
+        "gt" => Some('>'),
+        "amp" => Some('&'),
+        "apos" => Some('\''),
+        "quot" => Some('"'),
+        _ => {
+            let num = name.strip_prefix('#')?;
+            let code = match num.strip_prefix('x') {
+                Some(hex) => u32::from_str_radix(hex, 16).ok()?,
+                None => num.parse::<u32>().ok()?,
+            };
+            char::from_u32(code)
+        }
+    }
+}
+
+/// Unescapes an XML attribute value; `Err(offset)` gives the byte offset of a bad entity.
+pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, usize> {
+    if !raw.contains('&') {
+        return Ok(std::borrow::Cow::Borrowed(raw));
+    }
+    let mut out = String::with_capacity(raw.len());
+    let mut rest = raw;
+    let mut pos = 0usize;
+    while let Some(i) = rest.find('&') {
+        out.push_str(&rest[..i]);
+        let after = &rest[i + 1..];
+        let Some(end) = after.find(';') else {
+            return Err(pos + i);
+        };
+        let Some(c) = resolve_entity(&after[..end]) else {
+            return Err(pos + i);
+        };
+        out.push(c);
+        pos += i + end + 2;
+        rest = &after[end + 1..];
+    }
+    out.push_str(rest);
+    Ok(std::borrow::Cow::Owned(out))
+}
+
+/// An error (or warning) about a model, at a file, line and column.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Diagnostic {
+    /// The file.
+    pub path: PathBuf,
+    /// 1-based line (0 when there is no position, e.g. a missing file).
+    pub line: u32,
+    /// 1-based column in characters (0 when there is no position).
+    pub column: u32,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl Diagnostic {
+    /// A diagnostic about a whole file (no line or column).
+    pub fn file(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
+        Diagnostic {
+            path: path.into(),
+            line: 0,
+            column: 0,
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.line == 0 {
+            write!(f, "{}: {}", self.path.display(), self.message)
+        } else {
+            write!(
+                f,
+                "{}:{}:{}: {}",
+                self.path.display(),
+                self.line,
+                self.column,
+                self.message
+            )
+        }
+    }
+}
+
+impl std::error::Error for Diagnostic {}
+
+/// One or more [`Diagnostic`]s: the error type of loading and compiling a model.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Diagnostics(pub Vec<Diagnostic>);
+
+impl Diagnostics {
+    /// True when there is no diagnostic.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+
+    /// The diagnostics in the order they were found.
+    pub fn iter(&self) -> std::slice::Iter<'_, Diagnostic> {
+        self.0.iter()
+    }
+
+    /// Adds one diagnostic.
+    pub fn push(&mut self, d: Diagnostic) {
+        self.0.push(d);
+    }
+
+    /// `Ok(v)` when empty, `Err(self)` otherwise.
+    pub fn into_result<T>(self, v: T) -> Result<T, Diagnostics> {
+        if self.0.is_empty() {
+            Ok(v)
+        } else {
+            Err(self)
+        }
+    }
+}
+
+impl From<Diagnostic> for Diagnostics {
+    fn from(d: Diagnostic) -> Self {
+        Diagnostics(vec![d])
+    }
+}
+
+impl fmt::Display for Diagnostics {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        for (i, d) in self.0.iter().enumerate() {
+            if i > 0 {
+                writeln!(f)?;
+            }
+            write!(f, "{d}")?;
+        }
+        Ok(())
+    }
+}
+
+impl std::error::Error for Diagnostics {}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_and_column() {
+        let mut sm = SourceMap::new();
+        let f = sm.add("a.scxml", "ab\ncdé\nx".to_string());
+        let d = sm.diag(Span { file: f, offset: 0 }, "m");
+        assert_eq!((d.line, d.column), (1, 1));
+        let d = sm.diag(Span { file: f, offset: 4 }, "m");
+        assert_eq!((d.line, d.column), (2, 2));
+        let d = sm.diag(Span { file: f, offset: 7 }, "m");
+        assert_eq!((d.line, d.column), (2, 4));
+        let d = sm.diag(Span { file: f, offset: 8 }, "m");
+        assert_eq!((d.line, d.column), (3, 1));
+        assert_eq!(d.to_string(), "a.scxml:3:1: m");
+    }
+
+    #[test]
+    fn unescaped_offsets_map_back() {
+        let mut sm = SourceMap::new();
+        let text = r#"<if cond="a &amp;&amp; b.c"/>"#;
+        let f = sm.add("x", text.to_string());
+        let start = text.find("a &").unwrap() as u32;
+        let span = Span {
+            file: f,
+            offset: start,
+        };
+        let raw = &text[start as usize..text.rfind('"').unwrap()];
+        let un = unescape(raw).unwrap();
+        assert_eq!(un, "a && b.c");
+        let k = un.find('b').unwrap() as u32;
+        let mapped = sm.unescaped_offset(span, k);
+        assert_eq!(
+            &text[mapped.offset as usize..mapped.offset as usize + 1],
+            "b"
+        );
+    }
+
+    #[test]
+    fn bad_entity_is_an_error() {
+        assert_eq!(unescape("a &bogus; b"), Err(2));
+        assert_eq!(unescape("a & b"), Err(2));
+        assert_eq!(unescape("&#x41;&lt;").unwrap(), "A<");
+    }
+}

@@ -1,0 +1,295 @@
+//! A small XML element tree with byte spans, built with quick-xml, that the model readers walk.
+//!
+//! Reading into a tree first (with an explicit stack, so nesting depth cannot
+//! overflow the call stack) keeps the SCXML, types and model-list readers
+//! simple: each one walks elements and reports errors at exact positions.
+
+use super::source::{unescape, Diagnostic, FileId, SourceMap, Span};
+use quick_xml::events::Event;
+use quick_xml::Reader;
+
+/// Deepest element nesting accepted (real models nest fewer than 20 levels).
+pub(crate) const MAX_DEPTH: usize = 256;
+
+/// An attribute: its name and its unescaped value, with spans of both.
+#[derive(Clone, Debug)]
+pub(crate) struct Attr {
+    pub name: String,
+    pub name_span: Span,
+    /// The unescaped value.
+    pub value: String,
+    /// Span of the first byte of the raw (escaped) value in the file.
+    pub value_span: Span,
+}
+
+/// A child of an element.
+#[derive(Clone, Debug)]
+pub(crate) enum Node {
+    Element(Element),
+    /// A comment's text (between `<!--` and `-->`).
+    Comment(String, Span),
+    /// Non-blank character data.
+    Text(Span),
+}
+
+/// An element with its attributes and children.
+#[derive(Clone, Debug)]
+pub(crate) struct Element {
+    pub name: String,
+    /// Span of the `<` that opens the element.
+    pub span: Span,
+    pub attrs: Vec<Attr>,
+    pub children: Vec<Node>,
+}
+
+impl Element {
+    /// The attribute called `name`, if present.
+    pub fn attr(&self, name: &str) -> Option<&Attr> {
+        self.attrs.iter().find(|a| a.name == name)
+    }
+
+    /// Child elements, skipping comments and text.
+    pub fn elements(&self) -> impl Iterator<Item = &Element> {
+        self.children.iter().filter_map(|n| match n {
+            Node::Element(e) => Some(e),
+            _ => None,
+        })
+    }
+
+    /// Errors for attributes not in `allowed` (names starting with `xmlns` are always allowed).
+    pub fn check_attrs(&self, sm: &SourceMap, allowed: &[&str], out: &mut Vec<Diagnostic>) {
+        for a in &self.attrs {
+            if !allowed.contains(&a.name.as_str()) && !a.name.starts_with("xmlns") {
+                out.push(sm.diag(
+                    a.name_span,
+                    format!(
+                        "unknown attribute `{}` on <{}> (expected one of: {})",
+                        a.name,
+                        self.name,
+                        allowed.join(", ")
+                    ),
+                ));
+            }
+        }
+    }
+
+    /// The attribute called `name`, or an error at the element when it is missing.
+    pub fn required(&self, sm: &SourceMap, name: &str) -> Result<&Attr, Diagnostic> {
+        self.attr(name).ok_or_else(|| {
+            sm.diag(
+                self.span,
+                format!(
+                    "<{}> is missing the required attribute `{}`",
+                    self.name, name
+                ),
+            )
+        })
+    }
+}
+
+fn offset_in(src: &str, part: &[u8]) -> Option<u32> {
+    let s = src.as_ptr() as usize;
+    let p = part.as_ptr() as usize;
+    if p >= s && p + part.len() <= s + src.len() {
+        Some((p - s) as u32)
+    } else {
+        None
+    }
+}
+
+/// Parses the text of file `file` into its root element.
+pub(crate) fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
+    let Some(f) = sm.file(file) else {
+        return Err(Diagnostic::file(
+            "<unknown>",
+            "internal error: file not in source map",
+        ));
+    };
+    let src = f.text();
+    let at = |offset: u64| Span {
+        file,
+        offset: offset.min(u32::MAX as u64) as u32,
+    };
+    let mut reader = Reader::from_str(src);
+    let mut stack: Vec<Element> = Vec::new();
+    let mut root: Option<Element> = None;
+    loop {
+        let start = reader.buffer_position();
+        let ev = match reader.read_event() {
+            Ok(ev) => ev,
+            Err(e) => {
+                return Err(sm.diag(at(reader.error_position()), format!("malformed XML: {e}")));
+            }
+        };
+        match ev {
+            ev @ (Event::Start(_) | Event::Empty(_)) => {
+                let (e, is_empty) = match ev {
+                    Event::Start(e) => (e, false),
+                    Event::Empty(e) => (e, true),
+                    _ => continue,
+                };
+                let name = e.name().as_ref().to_string();
+                let mut attrs = Vec::new();
+                for a in e.attributes() {
+                    let a = match a {
+                        Ok(a) => a,
+                        Err(err) => {
+                            return Err(sm.diag(at(start), format!("malformed attribute: {err}")));
+                        }
+                    };
+                    let key = a.key.as_ref();
+                    let key_off = offset_in(src, key.as_bytes()).unwrap_or(start as u32);
+                    let raw: &str = &a.value;
+                    let val_off = offset_in(src, raw.as_bytes()).unwrap_or(key_off);
+                    let value = match unescape(raw) {
+                        Ok(v) => v.into_owned(),
+                        Err(k) => {
+                            return Err(sm.diag(
+                                Span {
+                                    file,
+                                    offset: val_off + k as u32,
+                                },
+                                "unknown or malformed entity reference in attribute value",
+                            ));
+                        }
+                    };
+                    attrs.push(Attr {
+                        name: key.to_string(),
+                        name_span: Span {
+                            file,
+                            offset: key_off,
+                        },
+                        value,
+                        value_span: Span {
+                            file,
+                            offset: val_off,
+                        },
+                    });
+                }
+                let el = Element {
+                    name,
+                    span: at(start),
+                    attrs,
+                    children: Vec::new(),
+                };
+                if is_empty {
+                    attach(&mut stack, &mut root, el, sm)?;
+                } else {
+                    if stack.len() >= MAX_DEPTH {
+                        return Err(sm.diag(at(start), "elements nested too deeply"));
+                    }
+                    stack.push(el);
+                }
+            }
+            Event::End(_) => {
+                let Some(el) = stack.pop() else {
+                    return Err(sm.diag(at(start), "unexpected closing tag"));
+                };
+                attach(&mut stack, &mut root, el, sm)?;
+            }
+            Event::Comment(c) => {
+                if let Some(top) = stack.last_mut() {
+                    let text = c.as_ref().to_string();
+                    top.children.push(Node::Comment(text, at(start)));
+                }
+            }
+            Event::Text(t) => {
+                let raw: &str = t.as_ref();
+                let blank = raw.bytes().all(|b| b.is_ascii_whitespace());
+                if !blank {
+                    let off = raw
+                        .bytes()
+                        .position(|b| !b.is_ascii_whitespace())
+                        .unwrap_or(0) as u64;
+                    match stack.last_mut() {
+                        Some(top) => top.children.push(Node::Text(at(start + off))),
+                        None => {
+                            return Err(sm.diag(at(start + off), "text outside the root element"))
+                        }
+                    }
+                }
+            }
+            Event::CData(_) | Event::GeneralRef(_) => match stack.last_mut() {
+                Some(top) => top.children.push(Node::Text(at(start))),
+                None => return Err(sm.diag(at(start), "text outside the root element")),
+            },
+            Event::Decl(_) | Event::PI(_) | Event::DocType(_) => {}
+            Event::Eof => break,
+        }
+    }
+    if let Some(open) = stack.last() {
+        return Err(sm.diag(open.span, format!("<{}> is never closed", open.name)));
+    }
+    root.ok_or_else(|| sm.diag(at(0), "the file contains no XML element"))
+}
+
+fn attach(
+    stack: &mut [Element],
+    root: &mut Option<Element>,
+    el: Element,
+    sm: &SourceMap,
+) -> Result<(), Diagnostic> {
+    match stack.last_mut() {
+        Some(parent) => {
+            parent.children.push(Node::Element(el));
+            Ok(())
+        }
+        None => {
+            if root.is_some() {
+                return Err(sm.diag(el.span, "more than one root element"));
+            }
+            *root = Some(el);
+            Ok(())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn doc(text: &str) -> Result<Element, Diagnostic> {
+        let mut sm = SourceMap::new();
+        let f = sm.add("t.xml", text.to_string());
+        parse(&sm, f)
+    }
+
+    #[test]
+    fn tree_with_spans() {
+        let text = "<a x=\"1 &lt; 2\">\n  <!-- TYPE v:int32 -->\n  <b/>\n  <c y='q'></c>\n</a>";
+        let root = doc(text).unwrap();
+        assert_eq!(root.name, "a");
+        let x = root.attr("x").unwrap();
+        assert_eq!(x.value, "1 < 2");
+        assert_eq!(x.value_span.offset as usize, text.find("1 &lt;").unwrap());
+        let kids: Vec<_> = root.elements().map(|e| e.name.as_str()).collect();
+        assert_eq!(kids, ["b", "c"]);
+        assert!(matches!(&root.children[0], Node::Comment(c, _) if c.contains("TYPE v:int32")));
+        let b = root.elements().next().unwrap();
+        assert_eq!(b.span.offset as usize, text.find("<b/>").unwrap());
+    }
+
+    #[test]
+    fn malformed_is_an_error_not_a_panic() {
+        for bad in [
+            "<a>",
+            "<a></b>",
+            "</a>",
+            "<a x=1/>",
+            "<a x='&nope;'/>",
+            "",
+            "<a/><b/>",
+            "text",
+            "<a x='1' x='2'/>",
+        ] {
+            assert!(doc(bad).is_err(), "{bad:?} should be rejected");
+        }
+    }
+
+    #[test]
+    fn deep_nesting_is_an_error() {
+        let text = "<a>".repeat(MAX_DEPTH + 5) + &"</a>".repeat(MAX_DEPTH + 5);
+        let err = doc(&text).unwrap_err();
+        assert!(err.message.contains("nested too deeply"));
+    }
+}

@@ -1,0 +1,1129 @@
+//! The simulator: runs a [`CompiledModel`] as a channel system, step by step, without allocating.
+
+use super::compiled::{CompiledModel, DelayDef, Instr, MachineDef, SendTo};
+use super::ids::{MachineId, StateId};
+use super::observer::{Flow, Observer, SentMessage};
+use crate::expr::compile::{Code, Entropy, Env, EvalError, EvalErrorKind, MAX_PATH};
+use crate::expr::value::{Cell, StrId};
+use crate::expr::Value;
+use crate::model::{Diagnostic, Span};
+use std::collections::VecDeque;
+
+/// How a machine picks among several enabled transitions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TransitionChoice {
+    /// The first enabled transition in document order (SCXML and SCAN).
+    #[default]
+    DocumentOrder,
+    /// Uniformly at random among the enabled transitions.
+    Random,
+}
+
+/// What happens when nothing can move and no delayed send is pending.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Quiescence {
+    /// End the run ([`EndReason::Quiescent`]).
+    #[default]
+    Stop,
+    /// Keep advancing time (one [`Observer::on_time`] per unit) until `max_time`,
+    /// as SCAN does; the run then ends with [`EndReason::MaxTime`].
+    AdvanceTime,
+}
+
+/// Limits and choices for one run.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RunConfig {
+    /// The clock never goes past this time; the run ends when it would.
+    ///
+    /// SCAN's `--duration d` runs while the time is at most `d` and then adds one
+    /// time point at `d + 1`; to reproduce it, use `max_time = d + 1` and return
+    /// [`Flow::Stop`] from [`Observer::on_time`] at `d + 1`.
+    pub max_time: u64,
+    /// Maximum number of communication steps (sends plus receives).
+    pub max_steps: u64,
+    /// Eventless transitions (and raised events) one machine may take in a row
+    /// without communicating before the run ends as an eventless loop.
+    pub max_eventless: u32,
+    /// Steps allowed at one instant before the run ends as a loop that never
+    /// lets time advance.
+    pub max_steps_per_instant: u64,
+    /// How enabled transitions are chosen.
+    pub transitions: TransitionChoice,
+    /// What quiescence does.
+    pub quiescence: Quiescence,
+}
+
+impl Default for RunConfig {
+    fn default() -> Self {
+        RunConfig {
+            max_time: 10_000,
+            max_steps: 100_000_000,
+            max_eventless: 100_000,
+            max_steps_per_instant: 1_000_000,
+            transitions: TransitionChoice::DocumentOrder,
+            quiescence: Quiescence::Stop,
+        }
+    }
+}
+
+/// Which kind of endless loop was detected.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SpinKind {
+    /// A machine kept taking eventless transitions without communicating.
+    EventlessLoop,
+    /// Machines kept exchanging messages without ever letting time advance.
+    NoTimeProgress,
+}
+
+/// An endless loop: the machine and state that spin.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SpinReport {
+    /// The kind of loop.
+    pub kind: SpinKind,
+    /// The machine that spins (for [`SpinKind::NoTimeProgress`]: the one that moved most).
+    pub machine: MachineId,
+    /// Its state when the loop was detected.
+    pub state: StateId,
+    /// The machine's name.
+    pub machine_name: String,
+    /// The state's id.
+    pub state_name: String,
+    /// Where the state is declared.
+    pub location: Diagnostic,
+}
+
+impl std::fmt::Display for SpinReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let what = match self.kind {
+            SpinKind::EventlessLoop => "loops through eventless transitions without communicating",
+            SpinKind::NoTimeProgress => "keeps the model busy without letting time advance",
+        };
+        write!(
+            f,
+            "{}:{}:{}: machine `{}` in state `{}` {what}",
+            self.location.path.display(),
+            self.location.line,
+            self.location.column,
+            self.machine_name,
+            self.state_name
+        )
+    }
+}
+
+/// A run-time error (index out of bounds, remainder by zero, unknown `targetexpr`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RunError {
+    /// The machine executing.
+    pub machine: MachineId,
+    /// Model time of the error.
+    pub time: u64,
+    /// File, line, column and message.
+    pub diagnostic: Diagnostic,
+}
+
+impl std::fmt::Display for RunError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} (at time {})", self.diagnostic, self.time)
+    }
+}
+
+/// Why a run ended.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum EndReason {
+    /// Nothing can ever happen again: every machine waits for an event that no
+    /// one will send and no delayed send is pending.
+    Quiescent,
+    /// The clock reached [`RunConfig::max_time`] and everything due then was done.
+    MaxTime,
+    /// [`RunConfig::max_steps`] steps were taken.
+    MaxSteps,
+    /// An observer returned [`Flow::Stop`].
+    Stopped,
+    /// An endless loop was detected.
+    Spin(SpinReport),
+    /// The model failed at run time.
+    Error(RunError),
+}
+
+/// The result of one run.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RunOutcome {
+    /// Why the run ended.
+    pub end: EndReason,
+    /// Model time at the end.
+    pub time: u64,
+    /// Communication steps taken (sends plus receives).
+    pub steps: u64,
+}
+
+const IDLE: u32 = u32::MAX;
+const NO_MSG: u32 = u32::MAX;
+const NOT_RUNNABLE: u32 = u32::MAX;
+
+#[derive(Clone, Debug)]
+struct Slot {
+    event: u32,
+    origin: u32,
+    /// `u32::MAX`: the `NONE` sink.
+    target: u32,
+    params: Vec<Cell>,
+}
+
+#[derive(Debug)]
+struct MachineRt {
+    state: u32,
+    pc: u32,
+    /// Blocked by a delayed send until `wake`.
+    waiting: bool,
+    wake: u64,
+    /// Index of the next target of a send without target.
+    bcast: u32,
+    /// The current send's delay has elapsed.
+    delay_done: bool,
+    /// Message being processed (`_event`), a pool slot.
+    cur: u32,
+    cur_event: StrId,
+    cur_origin: StrId,
+    intq: VecDeque<u32>,
+    extq: VecDeque<u32>,
+    vars: Vec<Cell>,
+}
+
+/// Runs a compiled model; reuse one simulator for many runs (buffers are kept).
+///
+/// Scheduling (SCAN's channel-system semantics): at each step one machine is
+/// chosen uniformly at random among those that can move; it runs until it
+/// completes one communication (a send, or taking a message from its external
+/// queue) or until it has nothing left to do. Assignments, conditions,
+/// eventless transitions and raised events are internal to that step.
+/// When no machine can move, time advances by one unit (waking machines whose
+/// delayed send is due).
+pub struct Simulator<'m> {
+    model: &'m CompiledModel,
+    ms: Vec<MachineRt>,
+    pool: Vec<Slot>,
+    /// Free message slots, per event.
+    free: Vec<Vec<u32>>,
+    runnable: Vec<u32>,
+    rpos: Vec<u32>,
+    delayed: Vec<u32>,
+    enabled: Vec<u32>,
+    time: u64,
+    steps: u64,
+    instant_steps: u64,
+    instant_moves: Vec<u32>,
+    /// Per machine, one scratch cell per instruction that builds arrays or structs,
+    /// so each keeps its buffers' shape from step to step and run to run.
+    scratch: Vec<Vec<Cell>>,
+    idx: [i64; MAX_PATH],
+}
+
+impl std::fmt::Debug for Simulator<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Simulator")
+            .field("time", &self.time)
+            .field("steps", &self.steps)
+            .finish()
+    }
+}
+
+/// Unbiased uniform integer in `0..n` (`n > 0`), Lemire's multiply-and-reject
+/// (the division is only needed in the rare case the low half is small).
+fn below(rng: &mut dyn Entropy, n: u32) -> u32 {
+    let n = n as u64;
+    let mut m = (rng.next_u64() as u128) * (n as u128);
+    if (m as u64) < n {
+        let threshold = n.wrapping_neg() % n;
+        while (m as u64) < threshold {
+            m = (rng.next_u64() as u128) * (n as u128);
+        }
+    }
+    (m >> 64) as u32
+}
+
+enum Stop {
+    End(EndReason),
+}
+
+/// Evaluates `code`: a scalar is returned, an array or struct is written into `scratch`.
+fn eval_code(
+    code: &Code,
+    env: &mut Env<'_>,
+    scratch: &mut Cell,
+) -> Result<Option<Cell>, EvalError> {
+    Ok(Some(match code {
+        Code::Bool(f) => Cell::Bool(f(env)?),
+        Code::Int(f) => Cell::Int(f(env)?),
+        Code::Float(f) => Cell::Float(f(env)?),
+        Code::Str(f) => Cell::Str(f(env)?),
+        Code::Comp(f) => {
+            f(env, scratch)?;
+            return Ok(None);
+        }
+    }))
+}
+
+impl<'m> Simulator<'m> {
+    /// A simulator for `model` (allocates its buffers once).
+    pub fn new(model: &'m CompiledModel) -> Self {
+        let n = model.machines.len();
+        Simulator {
+            model,
+            ms: model
+                .machines
+                .iter()
+                .map(|d| MachineRt {
+                    state: d.initial,
+                    pc: IDLE,
+                    waiting: false,
+                    wake: 0,
+                    bcast: 0,
+                    delay_done: false,
+                    cur: NO_MSG,
+                    cur_event: StrId(0),
+                    cur_origin: StrId(0),
+                    intq: VecDeque::new(),
+                    extq: VecDeque::new(),
+                    vars: d.defaults.clone(),
+                })
+                .collect(),
+            pool: Vec::new(),
+            free: vec![Vec::new(); model.events.len()],
+            runnable: Vec::with_capacity(n),
+            rpos: vec![NOT_RUNNABLE; n],
+            delayed: Vec::with_capacity(n),
+            enabled: Vec::new(),
+            time: 0,
+            steps: 0,
+            instant_steps: 0,
+            instant_moves: vec![0; n],
+            scratch: model
+                .machines
+                .iter()
+                .map(|d| vec![Cell::Int(0); d.n_scratch as usize])
+                .collect(),
+            idx: [0; MAX_PATH],
+        }
+    }
+
+    /// The model being run.
+    pub fn model(&self) -> &'m CompiledModel {
+        self.model
+    }
+
+    /// Current model time.
+    pub fn time(&self) -> u64 {
+        self.time
+    }
+
+    /// Communication steps taken so far in the current (or last) run.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// The current state of a machine.
+    pub fn state_of(&self, m: MachineId) -> StateId {
+        StateId(self.ms.get(m.0 as usize).map_or(0, |r| r.state))
+    }
+
+    /// The current value of a machine's variable.
+    pub fn var(&self, m: MachineId, name: &str) -> Option<Value<'_>> {
+        let def = self.model.machines.get(m.0 as usize)?;
+        let slot = def.vars.iter().position(|(n, _)| n == name)?;
+        self.ms.get(m.0 as usize)?.vars.get(slot).map(Value::of)
+    }
+
+    fn refresh(&mut self, m: usize) {
+        let r = &self.ms[m];
+        let can = !r.waiting && (r.pc != IDLE || !r.intq.is_empty() || !r.extq.is_empty());
+        let pos = self.rpos[m];
+        if can && pos == NOT_RUNNABLE {
+            self.rpos[m] = self.runnable.len() as u32;
+            self.runnable.push(m as u32);
+        } else if !can && pos != NOT_RUNNABLE {
+            let last = self.runnable.len() - 1;
+            self.runnable.swap(pos as usize, last);
+            let moved = self.runnable[pos as usize] as usize;
+            self.rpos[moved] = pos;
+            self.runnable.pop();
+            self.rpos[m] = NOT_RUNNABLE;
+        }
+    }
+
+    fn free_slot(&mut self, slot: u32) {
+        let ev = self.pool.get(slot as usize).map_or(0, |s| s.event as usize);
+        if let Some(f) = self.free.get_mut(ev) {
+            f.push(slot);
+        }
+    }
+
+    fn release(&mut self, m: usize) {
+        let cur = self.ms[m].cur;
+        if cur != NO_MSG {
+            self.free_slot(cur);
+            self.ms[m].cur = NO_MSG;
+        }
+    }
+
+    fn diag_error(&self, m: usize, pc: Option<usize>, e: EvalError) -> Stop {
+        let def = &self.model.machines[m];
+        let span = if e.at != 0 {
+            Span {
+                file: def.file,
+                offset: e.at,
+            }
+        } else {
+            pc.and_then(|p| def.code_spans.get(p).copied())
+                .unwrap_or(Span {
+                    file: def.file,
+                    offset: 0,
+                })
+        };
+        Stop::End(EndReason::Error(RunError {
+            machine: MachineId(m as u32),
+            time: self.time,
+            diagnostic: self.model.sources.diag(span, e.message()),
+        }))
+    }
+
+    fn spin(&self, m: usize, kind: SpinKind) -> Stop {
+        let def = &self.model.machines[m];
+        let s = self.ms[m].state;
+        let state_name = def
+            .states
+            .get(s as usize)
+            .map_or(String::new(), |st| st.name.clone());
+        let span = def
+            .states
+            .get(s as usize)
+            .map(|st| st.span)
+            .unwrap_or(Span {
+                file: def.file,
+                offset: 0,
+            });
+        Stop::End(EndReason::Spin(SpinReport {
+            kind,
+            machine: MachineId(m as u32),
+            state: StateId(s),
+            machine_name: def.name.clone(),
+            state_name: state_name.clone(),
+            location: self
+                .model
+                .sources
+                .diag(span, format!("state `{state_name}`")),
+        }))
+    }
+
+    /// Resets every machine to its initial state and evaluates the datamodel.
+    fn reset(&mut self, rng: &mut dyn Entropy) -> Result<(), Stop> {
+        self.time = 0;
+        self.steps = 0;
+        self.instant_steps = 0;
+        self.instant_moves.iter_mut().for_each(|c| *c = 0);
+        for f in &mut self.free {
+            f.clear();
+        }
+        for i in (0..self.pool.len()).rev() {
+            let ev = self.pool[i].event as usize;
+            if let Some(f) = self.free.get_mut(ev) {
+                f.push(i as u32);
+            }
+        }
+        self.runnable.clear();
+        self.rpos.iter_mut().for_each(|p| *p = NOT_RUNNABLE);
+        self.delayed.clear();
+        let model = self.model;
+        for (m, def) in model.machines.iter().enumerate() {
+            let r = &mut self.ms[m];
+            r.state = def.initial;
+            r.pc = def
+                .states
+                .get(def.initial as usize)
+                .map_or(IDLE, |s| s.entry);
+            r.waiting = false;
+            r.wake = 0;
+            r.bcast = 0;
+            r.delay_done = false;
+            r.cur = NO_MSG;
+            r.cur_event = StrId(0);
+            r.cur_origin = StrId(0);
+            r.intq.clear();
+            r.extq.clear();
+            // Variables with an initial value are overwritten below; resetting them to the
+            // default first would throw their buffers away.
+            for (i, (v, d)) in r.vars.iter_mut().zip(&def.defaults).enumerate() {
+                if !def.init.iter().any(|x| x.0 as usize == i) {
+                    v.clone_from(d);
+                }
+            }
+            for (slot, f, bound, span, sc) in &def.init {
+                let Some(scratch) = self
+                    .scratch
+                    .get_mut(m)
+                    .and_then(|v| v.get_mut(*sc as usize))
+                else {
+                    continue;
+                };
+                let res = {
+                    let r = &self.ms[m];
+                    let mut env = Env {
+                        vars: &r.vars,
+                        params: &[],
+                        event: StrId(0),
+                        origin: StrId(0),
+                        rng: &mut *rng,
+                        strings: &model.strings,
+                    };
+                    f(&mut env, scratch)
+                };
+                if let Err(e) = res {
+                    return Err(self.diag_error(m, None, e));
+                }
+                let scratch = &self.scratch[m][*sc as usize];
+                if let (Some(b), Cell::List(v)) = (bound, scratch) {
+                    if v.len() > *b as usize {
+                        return Err(Stop::End(EndReason::Error(RunError {
+                            machine: MachineId(m as u32),
+                            time: 0,
+                            diagnostic: model.sources.diag(
+                                *span,
+                                format!(
+                                    "initial value has {} elements, more than the declared {b}",
+                                    v.len()
+                                ),
+                            ),
+                        })));
+                    }
+                }
+                if let Some(dst) = self.ms[m].vars.get_mut(*slot as usize) {
+                    dst.clone_from(scratch);
+                }
+            }
+        }
+        for m in 0..self.ms.len() {
+            self.refresh(m);
+        }
+        Ok(())
+    }
+
+    /// Runs the model once from its initial state, calling `obs` at every trace point.
+    ///
+    /// The same model, configuration and random stream give the same run.
+    pub fn run<R: rand_core::Rng, O: Observer + ?Sized>(
+        &mut self,
+        rng: &mut R,
+        cfg: &RunConfig,
+        obs: &mut O,
+    ) -> RunOutcome {
+        let rng: &mut dyn Entropy = rng;
+        let end = match self.run_inner(rng, cfg, obs) {
+            Ok(e) | Err(Stop::End(e)) => e,
+        };
+        RunOutcome {
+            end,
+            time: self.time,
+            steps: self.steps,
+        }
+    }
+
+    fn run_inner<O: Observer + ?Sized>(
+        &mut self,
+        rng: &mut dyn Entropy,
+        cfg: &RunConfig,
+        obs: &mut O,
+    ) -> Result<EndReason, Stop> {
+        self.reset(rng)?;
+        loop {
+            if self.runnable.is_empty() {
+                if self.delayed.is_empty() && cfg.quiescence == Quiescence::Stop {
+                    return Ok(EndReason::Quiescent);
+                }
+                if self.time >= cfg.max_time {
+                    return Ok(EndReason::MaxTime);
+                }
+                self.time += 1;
+                self.instant_steps = 0;
+                self.instant_moves.iter_mut().for_each(|c| *c = 0);
+                let flow = obs.on_time(self.time);
+                let mut i = 0;
+                while i < self.delayed.len() {
+                    let m = self.delayed[i] as usize;
+                    if self.ms[m].wake <= self.time {
+                        self.ms[m].waiting = false;
+                        self.delayed.swap_remove(i);
+                        self.refresh(m);
+                    } else {
+                        i += 1;
+                    }
+                }
+                if flow == Flow::Stop {
+                    return Ok(EndReason::Stopped);
+                }
+                continue;
+            }
+            if self.steps >= cfg.max_steps {
+                return Ok(EndReason::MaxSteps);
+            }
+            if self.instant_steps >= cfg.max_steps_per_instant {
+                let busiest = (0..self.ms.len())
+                    .max_by_key(|&m| self.instant_moves[m])
+                    .unwrap_or(0);
+                return Err(self.spin(busiest, SpinKind::NoTimeProgress));
+            }
+            let k = below(rng, self.runnable.len() as u32) as usize;
+            let m = self.runnable[k] as usize;
+            self.instant_moves[m] = self.instant_moves[m].saturating_add(1);
+            if self.step(m, rng, cfg, obs)? == Flow::Stop {
+                return Ok(EndReason::Stopped);
+            }
+        }
+    }
+
+    /// Evaluates the guards of `list` and picks a transition.
+    fn select(
+        &mut self,
+        m: usize,
+        def: &MachineDef,
+        event: Option<u32>,
+        rng: &mut dyn Entropy,
+        cfg: &RunConfig,
+    ) -> Result<Option<u32>, Stop> {
+        let st = match def.states.get(self.ms[m].state as usize) {
+            Some(s) => s,
+            None => return Ok(None),
+        };
+        let list: &[u32] = match event {
+            Some(e) => st.transitions(e, &def.dispatch),
+            None => &st.eventless,
+        };
+        if list.is_empty() {
+            return Ok(None);
+        }
+        self.enabled.clear();
+        for &t in list {
+            let Some(td) = def.trans.get(t as usize) else {
+                continue;
+            };
+            let ok = match &td.cond {
+                None => true,
+                Some(c) => {
+                    let r = &self.ms[m];
+                    let params: &[Cell] = if r.cur == NO_MSG {
+                        &[]
+                    } else {
+                        &self.pool[r.cur as usize].params
+                    };
+                    let mut env = Env {
+                        vars: &r.vars,
+                        params,
+                        event: r.cur_event,
+                        origin: r.cur_origin,
+                        rng: &mut *rng,
+                        strings: &self.model.strings,
+                    };
+                    match c(&mut env) {
+                        Ok(b) => b,
+                        Err(e) => return Err(self.diag_error(m, Some(td.pc as usize), e)),
+                    }
+                }
+            };
+            if ok {
+                if cfg.transitions == TransitionChoice::DocumentOrder {
+                    return Ok(Some(t));
+                }
+                self.enabled.push(t);
+            }
+        }
+        match self.enabled.len() {
+            0 => Ok(None),
+            1 => Ok(Some(self.enabled[0])),
+            n => Ok(Some(self.enabled[below(rng, n as u32) as usize])),
+        }
+    }
+
+    /// One step of machine `m`: runs until it communicates once or has nothing to do.
+    fn step<O: Observer + ?Sized>(
+        &mut self,
+        m: usize,
+        rng: &mut dyn Entropy,
+        cfg: &RunConfig,
+        obs: &mut O,
+    ) -> Result<Flow, Stop> {
+        let model = self.model;
+        let def = &model.machines[m];
+        let mut internal = 0u32;
+        loop {
+            let pc = self.ms[m].pc;
+            if pc == IDLE {
+                if let Some(ev) = self.ms[m].intq.pop_front() {
+                    self.release(m);
+                    self.ms[m].cur_event = model
+                        .events
+                        .get(ev as usize)
+                        .map_or(StrId(0), |e| e.name_str);
+                    self.ms[m].cur_origin = def.name_str;
+                    if let Some(t) = self.select(m, def, Some(ev), rng, cfg)? {
+                        self.ms[m].pc = def.trans[t as usize].pc;
+                    }
+                    internal += 1;
+                    if internal > cfg.max_eventless {
+                        return Err(self.spin(m, SpinKind::EventlessLoop));
+                    }
+                    continue;
+                }
+                if let Some(slot) = self.ms[m].extq.pop_front() {
+                    self.release(m);
+                    let (event, origin, target) = {
+                        let s = &self.pool[slot as usize];
+                        (s.event, s.origin, s.target)
+                    };
+                    let r = &mut self.ms[m];
+                    r.cur = slot;
+                    r.cur_event = model
+                        .events
+                        .get(event as usize)
+                        .map_or(StrId(0), |e| e.name_str);
+                    r.cur_origin = model
+                        .machines
+                        .get(origin as usize)
+                        .map_or(StrId(0), |d| d.name_str);
+                    self.steps += 1;
+                    self.instant_steps += 1;
+                    let flow = obs.on_receive(
+                        self.time,
+                        &SentMessage {
+                            model,
+                            event: super::ids::EventId(event),
+                            origin: MachineId(origin),
+                            target: (target != u32::MAX).then_some(MachineId(target)),
+                            params: &self.pool[slot as usize].params,
+                        },
+                    );
+                    if let Some(t) = self.select(m, def, Some(event), rng, cfg)? {
+                        self.ms[m].pc = def.trans[t as usize].pc;
+                    }
+                    self.refresh(m);
+                    return Ok(flow);
+                }
+                self.refresh(m);
+                return Ok(Flow::Continue);
+            }
+            let Some(instr) = def.code.get(pc as usize) else {
+                return Err(self.diag_error(
+                    m,
+                    None,
+                    EvalError {
+                        at: 0,
+                        kind: EvalErrorKind::Internal,
+                    },
+                ));
+            };
+            match instr {
+                Instr::AssignVar {
+                    slot,
+                    value,
+                    bound,
+                    scratch: sc,
+                } => {
+                    let Some(scratch) = self
+                        .scratch
+                        .get_mut(m)
+                        .and_then(|v| v.get_mut(*sc as usize))
+                    else {
+                        return Err(self.internal(m, pc));
+                    };
+                    let res = {
+                        let r = &self.ms[m];
+                        let params: &[Cell] = if r.cur == NO_MSG {
+                            &[]
+                        } else {
+                            &self.pool[r.cur as usize].params
+                        };
+                        let mut env = Env {
+                            vars: &r.vars,
+                            params,
+                            event: r.cur_event,
+                            origin: r.cur_origin,
+                            rng: &mut *rng,
+                            strings: &model.strings,
+                        };
+                        eval_code(value, &mut env, scratch)
+                    };
+                    let scratch = &self.scratch[m][*sc as usize];
+                    let scalar = match res {
+                        Ok(v) => v,
+                        Err(e) => return Err(self.diag_error(m, Some(pc as usize), e)),
+                    };
+                    let Some(dst) = self.ms[m].vars.get_mut(*slot as usize) else {
+                        return Err(self.internal(m, pc));
+                    };
+                    match scalar {
+                        Some(v) => *dst = v,
+                        None => {
+                            if let (Some(b), Cell::List(v)) = (bound, scratch) {
+                                if v.len() > *b as usize {
+                                    return Err(self.too_long(m, pc, *b));
+                                }
+                            }
+                            dst.clone_from(scratch);
+                        }
+                    }
+                    self.ms[m].pc = pc + 1;
+                }
+                Instr::AssignPlace {
+                    place,
+                    value,
+                    scratch: sc,
+                } => {
+                    let Some(scratch) = self
+                        .scratch
+                        .get_mut(m)
+                        .and_then(|v| v.get_mut(*sc as usize))
+                    else {
+                        return Err(self.internal(m, pc));
+                    };
+                    let res = {
+                        let r = &self.ms[m];
+                        let params: &[Cell] = if r.cur == NO_MSG {
+                            &[]
+                        } else {
+                            &self.pool[r.cur as usize].params
+                        };
+                        let mut env = Env {
+                            vars: &r.vars,
+                            params,
+                            event: r.cur_event,
+                            origin: r.cur_origin,
+                            rng: &mut *rng,
+                            strings: &model.strings,
+                        };
+                        place
+                            .eval_indices(&mut env, &mut self.idx)
+                            .and_then(|()| eval_code(value, &mut env, scratch))
+                    };
+                    let scratch = &self.scratch[m][*sc as usize];
+                    let stored = match res {
+                        Ok(Some(v)) => place.store(&mut self.ms[m].vars, &self.idx, &v),
+                        Ok(None) => place.store(&mut self.ms[m].vars, &self.idx, scratch),
+                        Err(e) => Err(e),
+                    };
+                    if let Err(e) = stored {
+                        return Err(self.diag_error(m, Some(pc as usize), e));
+                    }
+                    self.ms[m].pc = pc + 1;
+                }
+                Instr::If { cond, else_pc } => {
+                    let res = {
+                        let r = &self.ms[m];
+                        let params: &[Cell] = if r.cur == NO_MSG {
+                            &[]
+                        } else {
+                            &self.pool[r.cur as usize].params
+                        };
+                        let mut env = Env {
+                            vars: &r.vars,
+                            params,
+                            event: r.cur_event,
+                            origin: r.cur_origin,
+                            rng: &mut *rng,
+                            strings: &model.strings,
+                        };
+                        cond(&mut env)
+                    };
+                    match res {
+                        Ok(true) => self.ms[m].pc = pc + 1,
+                        Ok(false) => self.ms[m].pc = *else_pc,
+                        Err(e) => return Err(self.diag_error(m, Some(pc as usize), e)),
+                    }
+                }
+                Instr::Jump(t) => self.ms[m].pc = *t,
+                Instr::Raise(ev) => {
+                    self.ms[m].intq.push_back(*ev);
+                    self.ms[m].pc = pc + 1;
+                }
+                Instr::Log {
+                    label,
+                    value,
+                    scratch: sc,
+                } => {
+                    let Some(scratch) = self
+                        .scratch
+                        .get_mut(m)
+                        .and_then(|v| v.get_mut(*sc as usize))
+                    else {
+                        return Err(self.internal(m, pc));
+                    };
+                    let mut has = false;
+                    if let Some(f) = value {
+                        let res = {
+                            let r = &self.ms[m];
+                            let params: &[Cell] = if r.cur == NO_MSG {
+                                &[]
+                            } else {
+                                &self.pool[r.cur as usize].params
+                            };
+                            let mut env = Env {
+                                vars: &r.vars,
+                                params,
+                                event: r.cur_event,
+                                origin: r.cur_origin,
+                                rng: &mut *rng,
+                                strings: &model.strings,
+                            };
+                            f(&mut env, scratch)
+                        };
+                        if let Err(e) = res {
+                            return Err(self.diag_error(m, Some(pc as usize), e));
+                        }
+                        has = true;
+                    }
+                    let scratch = &self.scratch[m][*sc as usize];
+                    let v = if has { Some(Value::of(scratch)) } else { None };
+                    obs.on_log(self.time, MachineId(m as u32), label, v);
+                    self.ms[m].pc = pc + 1;
+                }
+                Instr::Goto(s) => {
+                    let r = &mut self.ms[m];
+                    r.state = *s;
+                    r.pc = def.states.get(*s as usize).map_or(IDLE, |st| st.entry);
+                }
+                Instr::CheckEventless => match self.select(m, def, None, rng, cfg)? {
+                    Some(t) => {
+                        internal += 1;
+                        if internal > cfg.max_eventless {
+                            return Err(self.spin(m, SpinKind::EventlessLoop));
+                        }
+                        self.ms[m].pc = def.trans[t as usize].pc;
+                    }
+                    None => self.ms[m].pc = IDLE,
+                },
+                Instr::Send(sd) => {
+                    // A delayed send blocks its machine for the delay (as in SCAN), then sends.
+                    if let Some(d) = &sd.delay {
+                        if !self.ms[m].delay_done {
+                            let n = match d {
+                                DelayDef::Const(n) => *n,
+                                DelayDef::Expr(f) => {
+                                    let res = {
+                                        let r = &self.ms[m];
+                                        let params: &[Cell] = if r.cur == NO_MSG {
+                                            &[]
+                                        } else {
+                                            &self.pool[r.cur as usize].params
+                                        };
+                                        let mut env = Env {
+                                            vars: &r.vars,
+                                            params,
+                                            event: r.cur_event,
+                                            origin: r.cur_origin,
+                                            rng: &mut *rng,
+                                            strings: &model.strings,
+                                        };
+                                        f(&mut env)
+                                    };
+                                    match res {
+                                        Ok(v) => v.max(0) as u64,
+                                        Err(e) => {
+                                            return Err(self.diag_error(m, Some(pc as usize), e))
+                                        }
+                                    }
+                                }
+                            };
+                            if n > 0 {
+                                let r = &mut self.ms[m];
+                                r.delay_done = true;
+                                r.waiting = true;
+                                r.wake = self.time.saturating_add(n);
+                                self.delayed.push(m as u32);
+                                self.refresh(m);
+                                return Ok(Flow::Continue);
+                            }
+                        }
+                    }
+                    let mut broadcast_len = 0usize;
+                    let target: Option<u32> = match &sd.to {
+                        SendTo::Machine(t) => Some(*t),
+                        SendTo::Sink => None,
+                        SendTo::Broadcast(list) => {
+                            broadcast_len = list.len();
+                            match list.get(self.ms[m].bcast as usize) {
+                                Some(&t) => Some(t),
+                                None => {
+                                    // Nobody receives this event: nothing is sent.
+                                    let r = &mut self.ms[m];
+                                    r.bcast = 0;
+                                    r.delay_done = false;
+                                    r.pc = pc + 1;
+                                    continue;
+                                }
+                            }
+                        }
+                        SendTo::Expr(f) => {
+                            let res = {
+                                let r = &self.ms[m];
+                                let params: &[Cell] = if r.cur == NO_MSG {
+                                    &[]
+                                } else {
+                                    &self.pool[r.cur as usize].params
+                                };
+                                let mut env = Env {
+                                    vars: &r.vars,
+                                    params,
+                                    event: r.cur_event,
+                                    origin: r.cur_origin,
+                                    rng: &mut *rng,
+                                    strings: &model.strings,
+                                };
+                                f(&mut env)
+                            };
+                            let s = match res {
+                                Ok(s) => s,
+                                Err(e) => return Err(self.diag_error(m, Some(pc as usize), e)),
+                            };
+                            match model.machine_of_str.get(s.0 as usize) {
+                                Some(&t) if t != u32::MAX => Some(t),
+                                _ if s == model.none_str => None,
+                                _ => {
+                                    let span =
+                                        def.code_spans.get(pc as usize).copied().unwrap_or(Span {
+                                            file: def.file,
+                                            offset: 0,
+                                        });
+                                    return Err(Stop::End(EndReason::Error(RunError {
+                                        machine: MachineId(m as u32),
+                                        time: self.time,
+                                        diagnostic: model.sources.diag(
+                                            span,
+                                            format!(
+                                                "targetexpr evaluated to `{}`, which is not a machine",
+                                                model.strings.get(s)
+                                            ),
+                                        ),
+                                    })));
+                                }
+                            }
+                        }
+                    };
+                    let Some(evdef) = model.events.get(sd.event as usize) else {
+                        return Err(self.diag_error(
+                            m,
+                            Some(pc as usize),
+                            EvalError {
+                                at: 0,
+                                kind: EvalErrorKind::Internal,
+                            },
+                        ));
+                    };
+                    // Slots are reused per event, so their cells keep their shapes (no allocation).
+                    let slot = match self.free.get_mut(sd.event as usize).and_then(|f| f.pop()) {
+                        Some(s) => s,
+                        None => {
+                            self.pool.push(Slot {
+                                event: sd.event,
+                                origin: 0,
+                                target: 0,
+                                params: evdef.defaults.clone(),
+                            });
+                            self.pool.len() as u32 - 1
+                        }
+                    };
+                    let mut out = std::mem::take(&mut self.pool[slot as usize].params);
+                    for &i in &sd.missing {
+                        if let (Some(dst), Some(d)) =
+                            (out.get_mut(i as usize), evdef.defaults.get(i as usize))
+                        {
+                            dst.clone_from(d);
+                        }
+                    }
+                    let res = {
+                        let r = &self.ms[m];
+                        let params: &[Cell] = if r.cur == NO_MSG {
+                            &[]
+                        } else {
+                            &self.pool[r.cur as usize].params
+                        };
+                        let mut env = Env {
+                            vars: &r.vars,
+                            params,
+                            event: r.cur_event,
+                            origin: r.cur_origin,
+                            rng: &mut *rng,
+                            strings: &model.strings,
+                        };
+                        let mut res = Ok(());
+                        for (i, f) in &sd.params {
+                            if let Some(dst) = out.get_mut(*i as usize) {
+                                res = f(&mut env, dst);
+                                if res.is_err() {
+                                    break;
+                                }
+                            }
+                        }
+                        res
+                    };
+                    {
+                        let s = &mut self.pool[slot as usize];
+                        s.params = out;
+                        s.event = sd.event;
+                        s.origin = m as u32;
+                        s.target = target.unwrap_or(u32::MAX);
+                    }
+                    if let Err(e) = res {
+                        self.free_slot(slot);
+                        return Err(self.diag_error(m, Some(pc as usize), e));
+                    }
+                    self.steps += 1;
+                    self.instant_steps += 1;
+                    let flow = obs.on_send(
+                        self.time,
+                        &SentMessage {
+                            model,
+                            event: super::ids::EventId(sd.event),
+                            origin: MachineId(m as u32),
+                            target: target.map(MachineId),
+                            params: &self.pool[slot as usize].params,
+                        },
+                    );
+                    match target {
+                        Some(t) => {
+                            self.ms[t as usize].extq.push_back(slot);
+                            self.refresh(t as usize);
+                        }
+                        None => self.free_slot(slot),
+                    }
+                    let r = &mut self.ms[m];
+                    if broadcast_len > 0 && (r.bcast as usize) + 1 < broadcast_len {
+                        r.bcast += 1;
+                    } else {
+                        r.bcast = 0;
+                        r.delay_done = false;
+                        r.pc = pc + 1;
+                    }
+                    return Ok(flow);
+                }
+            }
+        }
+    }
+
+    fn internal(&self, m: usize, pc: u32) -> Stop {
+        self.diag_error(
+            m,
+            Some(pc as usize),
+            EvalError {
+                at: 0,
+                kind: EvalErrorKind::Internal,
+            },
+        )
+    }
+
+    fn too_long(&self, m: usize, pc: u32, bound: u32) -> Stop {
+        self.diag_error(
+            m,
+            Some(pc as usize),
+            EvalError {
+                at: 0,
+                kind: EvalErrorKind::TooLong { bound },
+            },
+        )
+    }
+}

@@ -1,0 +1,124 @@
+//! Proves, with a counting allocator, that a run in steady state allocates nothing.
+//!
+//! The first runs grow the simulator's buffers (queues, message slots, arrays);
+//! after that, whole runs - every step, every reset - must not allocate.
+
+use hindsight::model::ModelSource;
+use hindsight::sim::{CompiledModel, EndReason, RunConfig, Simulator};
+use rand_core::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::path::{Path, PathBuf};
+
+struct Counting;
+
+thread_local! {
+    /// Allocations made by this thread (tests run on several threads).
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+// Forwards to the system allocator and counts calls.
+#[allow(unsafe_code)]
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations() -> u64 {
+    ALLOCATIONS.with(|n| n.get())
+}
+
+fn corpus() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus")
+}
+
+/// Warms up with `warm` runs, then checks that `runs` more runs allocate nothing.
+fn assert_steady_state_allocation_free(m: &CompiledModel, cfg: &RunConfig, warm: u64, runs: u64) {
+    let mut sim = Simulator::new(m);
+    for seed in 0..warm {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        sim.run(&mut rng, cfg, &mut ());
+    }
+    let mut steps = 0;
+    for seed in 0..runs {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let before = allocations();
+        let out = sim.run(&mut rng, cfg, &mut ());
+        let n = allocations() - before;
+        assert!(
+            !matches!(out.end, EndReason::Error(_) | EndReason::Spin(_)),
+            "{out:?}"
+        );
+        assert_eq!(
+            n, 0,
+            "run {seed} allocated {n} times in {} steps",
+            out.steps
+        );
+        steps += out.steps;
+    }
+    assert!(steps > 0);
+}
+
+#[test]
+fn museum_runs_allocate_nothing() {
+    let dir = corpus().join("museum-simpar2025/model_scxml");
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "scxml"))
+        .collect();
+    paths.sort();
+    let files: Vec<(String, String)> = paths
+        .iter()
+        .map(|p| {
+            let t = std::fs::read_to_string(p).unwrap();
+            (
+                p.display().to_string(),
+                t.replace("_event.thread_id", "_event.data.thread_id"),
+            )
+        })
+        .collect();
+    let src = ModelSource::from_texts(files.iter().map(|(a, b)| (a.as_str(), b.as_str()))).unwrap();
+    let m = CompiledModel::compile(src).unwrap();
+    assert_steady_state_allocation_free(&m, &RunConfig::default(), 3, 3);
+}
+
+#[test]
+fn uc3_runs_with_array_messages_allocate_nothing() {
+    let m = CompiledModel::load(&corpus().join("uc3-plain/model.xml")).unwrap();
+    let cfg = RunConfig {
+        max_time: 300,
+        ..RunConfig::default()
+    };
+    assert_steady_state_allocation_free(&m, &cfg, 3, 2);
+}
+
+/// Arrays of scalars grow and shrink inside their buffers. (An array of arrays or structs
+/// that a run empties and regrows allocates its new elements' buffers: the `structs` model
+/// does that with `shape.corners`, so it is not in this list.)
+#[test]
+fn array_models_allocate_nothing_once_warm() {
+    for name in ["arrays", "targetexpr", "delay", "internal", "ping_pong"] {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/sim")
+            .join(name);
+        let m = CompiledModel::load(&dir).unwrap();
+        assert_steady_state_allocation_free(&m, &RunConfig::default(), 3, 5);
+    }
+}
