@@ -123,6 +123,20 @@ fn bad_module_name_is_bad_input() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("\"Door\""), "{err}");
     assert!(out.stdout.is_empty());
+    // --module names a Rust module: with another output it is a mistake, not ignored.
+    let out = hindsight(
+        &dir,
+        &[
+            "compile",
+            "door.hspec",
+            "--emit",
+            "table",
+            "--module",
+            "door",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--module"));
 }
 
 #[test]
