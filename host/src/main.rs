@@ -19,9 +19,9 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// Compile a spec (.hspec) into a monitor table or print its networks.
+    /// Compile a spec (.hspec) into a monitor table, Rust source, or print its networks.
     ///
-    /// Example: `hindsight compile examples/specs/museum.hspec --emit table -o museum.bin`
+    /// Example: `hindsight compile examples/specs/museum.hspec --emit rust -o museum.rs`
     Compile(cli::compile::CompileArgs),
     /// Run a spec's monitors over a CSV trace and print the verdict at every point.
     ///

@@ -1,7 +1,9 @@
 //! `hindsight compile`: a spec file to a monitor table, Rust source or the printed IR.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use codegen::emit_rust::{emit_rust, EmitOptions};
 
 use super::{compile_spec_file, CliError};
 
@@ -12,6 +14,19 @@ pub enum Emit {
     Table,
     /// The compiled networks, one line per node, with state sizes.
     Ir,
+    /// A `core`-only Rust module (straight-line monitor code) to `include!`.
+    Rust,
+}
+
+impl Emit {
+    /// The value as written on the command line.
+    fn flag(self) -> &'static str {
+        match self {
+            Emit::Table => "table",
+            Emit::Ir => "ir",
+            Emit::Rust => "rust",
+        }
+    }
 }
 
 /// Arguments of `hindsight compile`.
@@ -22,6 +37,10 @@ pub struct CompileArgs {
     /// What to produce.
     #[arg(long, value_enum, default_value_t = Emit::Ir)]
     pub emit: Emit,
+    /// Name of the generated Rust module (`--emit rust`); default: the spec
+    /// file's stem as a lower-case identifier (`museum.hspec` -> `museum`).
+    #[arg(long, value_name = "NAME")]
+    pub module: Option<String>,
     /// Output file; standard output when absent.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -29,10 +48,25 @@ pub struct CompileArgs {
 
 /// Runs `hindsight compile`.
 pub fn run(args: &CompileArgs) -> Result<(), CliError> {
+    if args.module.is_some() && args.emit != Emit::Rust {
+        return Err(CliError::Input(
+            "--module only applies to --emit rust".into(),
+        ));
+    }
     let compiled = compile_spec_file(&args.spec)?;
     let bytes = match args.emit {
         Emit::Table => compiled.to_table_bytes(),
         Emit::Ir => compiled.ir().into_bytes(),
+        Emit::Rust => {
+            let module = match &args.module {
+                Some(m) => m.clone(),
+                None => module_name(&args.spec),
+            };
+            let opts = EmitOptions::new(module, command_line(args));
+            emit_rust(&compiled.program(), &opts)
+                .map_err(|e| CliError::Input(format!("{}: {e}", args.spec.display())))?
+                .into_bytes()
+        }
     };
     match &args.output {
         Some(path) => std::fs::write(path, &bytes)
@@ -42,4 +76,107 @@ pub fn run(args: &CompileArgs) -> Result<(), CliError> {
             .map_err(|e| CliError::Failed(format!("standard output: {e}")))?,
     }
     Ok(())
+}
+
+/// The command that reproduces this output, for the generated file's header.
+///
+/// Built from the parsed arguments rather than the raw process arguments so
+/// that the header (and so the file) does not depend on how the binary was
+/// invoked.
+fn command_line(args: &CompileArgs) -> String {
+    let mut cmd = format!(
+        "hindsight compile {} --emit {}",
+        shell_word(&args.spec.display().to_string()),
+        args.emit.flag()
+    );
+    if let Some(m) = &args.module {
+        cmd.push_str(" --module ");
+        cmd.push_str(&shell_word(m));
+    }
+    if let Some(o) = &args.output {
+        cmd.push_str(" -o ");
+        cmd.push_str(&shell_word(&o.display().to_string()));
+    }
+    cmd
+}
+
+/// `s` quoted for a POSIX shell when it holds anything but plain path characters.
+fn shell_word(s: &str) -> String {
+    let plain = !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./:=+,@%".contains(c));
+    if plain {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// A module name from a spec path: the file stem's ASCII letters and digits,
+/// lower-cased, words joined by single `_`; a leading digit gets `m_` before
+/// it, a Rust keyword gets `_monitor` after it, nothing left gives `monitor`.
+pub fn module_name(spec: &Path) -> String {
+    let stem = spec
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut name = String::new();
+    for word in stem
+        .split(|c: char| !c.is_ascii_alphanumeric())
+        .filter(|w| !w.is_empty())
+    {
+        if !name.is_empty() {
+            name.push('_');
+        }
+        name.push_str(&word.to_ascii_lowercase());
+    }
+    if name.is_empty() {
+        return "monitor".into();
+    }
+    if name.starts_with(|c: char| c.is_ascii_digit()) {
+        name.insert_str(0, "m_");
+    }
+    if is_keyword(&name) {
+        name.push_str("_monitor");
+    }
+    name
+}
+
+/// Whether `s` is a Rust keyword (strict, reserved or weak enough to break `pub mod s`).
+fn is_keyword(s: &str) -> bool {
+    const KEYWORDS: &[&str] = &[
+        "abstract", "as", "async", "await", "become", "box", "break", "const", "continue", "crate",
+        "do", "dyn", "else", "enum", "extern", "false", "final", "fn", "for", "gen", "if", "impl",
+        "in", "let", "loop", "macro", "match", "mod", "move", "mut", "override", "priv", "pub",
+        "ref", "return", "self", "static", "struct", "super", "trait", "true", "try", "type",
+        "typeof", "unsafe", "unsized", "use", "virtual", "where", "while", "yield",
+    ];
+    KEYWORDS.contains(&s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn module_names_are_identifiers() {
+        let cases = [
+            ("specs/museum.hspec", "museum"),
+            ("Museum-Guide v2.hspec", "museum_guide_v2"),
+            ("2024_run.hspec", "m_2024_run"),
+            ("type.hspec", "type_monitor"),
+            ("__.hspec", "monitor"),
+            ("a__b.hspec", "a_b"),
+        ];
+        for (path, want) in cases {
+            assert_eq!(module_name(Path::new(path)), want, "{path}");
+        }
+    }
+
+    #[test]
+    fn shell_words_quote_only_when_needed() {
+        assert_eq!(shell_word("specs/a.hspec"), "specs/a.hspec");
+        assert_eq!(shell_word("my spec.hspec"), "'my spec.hspec'");
+        assert_eq!(shell_word("it's"), r"'it'\''s'");
+    }
 }
