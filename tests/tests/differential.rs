@@ -55,21 +55,27 @@ fn env_count(name: &str, default: usize) -> usize {
     }
 }
 
-/// A random trace shape, then a trace: lengths 1..=60, sparse to dense atoms,
-/// few to many repeated timestamps, gaps past the largest bound, and now and
-/// then a start near the top of the timestamp range.
+/// A random trace shape, then a trace: mostly 1..=60 points, sometimes up to
+/// 300 with unit gaps (which fill windows to their capacity), sparse to dense
+/// atoms, few to many repeated timestamps, gaps past the largest bound, and
+/// now and then a start near the top of the timestamp range.
 fn random_trace(rng: &mut Gen) -> Vec<Point> {
+    let long = gen::range(rng, 0, 9) == 0;
     let start = match gen::range(rng, 0, 9) {
         0 => u64::MAX - 200_000 + gen::range(rng, 0, 1000),
         1 => gen::range(rng, 1, 1 << 40),
         _ => gen::range(rng, 0, 3),
     };
     let cfg = TraceConfig {
-        len: gen::range(rng, 1, 60) as usize,
+        len: if long {
+            gen::range(rng, 100, 300)
+        } else {
+            gen::range(rng, 1, 60)
+        } as usize,
         atoms: gen::DIFF_ATOMS,
         p_true: [0.15, 0.5, 0.85][gen::range(rng, 0, 2) as usize],
         p_repeat: [0.1, 0.35, 0.7][gen::range(rng, 0, 2) as usize],
-        max_gap: gen::range(rng, 1, 4),
+        max_gap: if long { 1 } else { gen::range(rng, 1, 4) },
         p_jump: 0.05,
         big_gap: 1500,
         start,
