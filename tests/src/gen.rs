@@ -192,6 +192,33 @@ pub fn decls(atoms: usize) -> String {
         .collect()
 }
 
+/// The spec of formula `f` over atoms `a0 .. a(atoms-1)`: [`decls`] and one
+/// property `p` whose formula is `f` printed by [`crate::oracle::print`].
+pub fn spec(f: &F, atoms: usize) -> String {
+    format!(
+        "{}property p = {};\n",
+        decls(atoms),
+        crate::oracle::print(f)
+    )
+}
+
+/// Seed of the differential test's fixed formula set (see [`diff_formula`]).
+pub const DIFF_SEED: u64 = 0x6869_6e64_7369_6768;
+
+/// Atoms of the differential test's formulas.
+pub const DIFF_ATOMS: usize = 3;
+
+/// Formula `k` of the differential test's fixed set: `tests/build.rs` emits
+/// code for formulas `0..count`, and the test draws them again to judge them.
+/// Depth up to 6, every operator and every interval shape ([`FormulaConfig::default`]).
+pub fn diff_formula(k: usize) -> F {
+    let cfg = FormulaConfig {
+        atoms: DIFF_ATOMS,
+        ..FormulaConfig::default()
+    };
+    formula(&mut rng(DIFF_SEED.wrapping_add(k as u64)), &cfg)
+}
+
 /// A trace in the corpus point syntax over the variables of [`decls`]: every
 /// point sets every atom, `a0` for true and `!a0` for false.
 pub fn trace_lines(trace: &[Point]) -> Vec<String> {

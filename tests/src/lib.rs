@@ -3,7 +3,11 @@
 //! - [`oracle`]: the reference Past-MTL evaluator, straight from the semantics.
 //! - [`gen`]: seeded random formulas and traces for differential tests.
 //! - [`trace`]: the corpus's declaration and trace-point syntax, and event/state valuation.
+//! - [`checked`]: codegen's checked AST as an oracle formula, with a tree-walking atom evaluator.
+//! - [`engines`]: compiled specs run through the interpreter and postcard tables.
 
+pub mod checked;
+pub mod engines;
 pub mod gen;
 pub mod oracle;
 pub mod trace;
