@@ -45,7 +45,11 @@ fn allocations() -> u64 {
 }
 
 fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/corpus")
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .map(|dir| dir.join("shared/corpus"))
+        .find(|dir| dir.is_dir())
+        .expect("shared/corpus next to the repository")
 }
 
 /// Warms up with `warm` runs, then checks that `runs` more runs allocate nothing.
