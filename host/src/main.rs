@@ -27,6 +27,20 @@ enum Command {
     ///
     /// Example: `hindsight replay examples/specs/museum.hspec trace.csv --changes`
     Replay(cli::replay::ReplayArgs),
+    /// Estimate each guarantee's probability on a plain SCXML model (statistical model checking).
+    ///
+    /// The model is a folder of .scxml machines (what AS2FM emits, what SCAN reads) or a
+    /// SCAN model.xml; properties are a SCAN properties.xml (current or tree form).
+    /// Runs are seeded (run k uses xoshiro256++ stream k) and consumed in run order, so the
+    /// same --seed gives the same numbers on any number of threads. A run stops early only
+    /// when every verdict can no longer change.
+    ///
+    /// Example: `hindsight verify examples/museum-scxml --seed 7`
+    Verify(cli::verify::VerifyArgs),
+    /// Check that a model and its properties load and compile, without simulating.
+    ///
+    /// Example: `hindsight validate examples/museum-scxml`
+    Validate(cli::verify::ValidateArgs),
 }
 
 fn main() -> ExitCode {
@@ -41,6 +55,8 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Compile(a) => cli::compile::run(a),
         Command::Replay(a) => cli::replay::run(a),
+        Command::Verify(a) => cli::verify::run(a),
+        Command::Validate(a) => cli::verify::validate(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -2,6 +2,7 @@
 
 pub mod compile;
 pub mod replay;
+pub mod verify;
 
 use std::fmt;
 

@@ -1,0 +1,378 @@
+//! `hindsight verify`: estimate each guarantee's probability on a plain SCXML model.
+
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Duration;
+
+use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::Serialize;
+
+use super::CliError;
+use crate::props;
+use crate::sim::{CompiledModel, EndReason, RunConfig, Simulator};
+use crate::smc::progress::TerminalProgress;
+use crate::smc::stats::{RuleConfig, RuleKind};
+use crate::smc::{run_study, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
+use crate::verify::observe::{Judge, PropertySet};
+
+/// The stopping rule, as named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Rule {
+    /// SCAN's adaptive bound: Okamoto's count scaled by how far the estimate is from 1/2.
+    Adaptive,
+    /// The fixed Okamoto (Chernoff-Hoeffding) bound: ln(2/(1-c)) / (2 e^2) runs.
+    Okamoto,
+    /// Stop when the Wilson score interval is narrower than ±precision.
+    Wilson,
+    /// Stop when the exact Clopper-Pearson interval is narrower than ±precision.
+    ClopperPearson,
+}
+
+/// Arguments of `hindsight verify`.
+#[derive(Debug, clap::Args)]
+pub struct VerifyArgs {
+    /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
+    pub model: PathBuf,
+    /// The SCAN property file; default: the one model.xml names, else MODEL/properties.xml.
+    pub props: Option<PathBuf>,
+    /// Confidence of the reported intervals.
+    #[arg(long, default_value_t = 0.95)]
+    pub confidence: f64,
+    /// Half-width of the intervals the study aims for.
+    #[arg(long, default_value_t = 0.01)]
+    pub precision: f64,
+    /// Stopping rule (ignored with --threshold, which runs Wald's sequential test).
+    #[arg(long, value_enum, default_value_t = Rule::Adaptive)]
+    pub rule: Rule,
+    /// Ask "is P >= THETA?" with Wald's SPRT (indifference region ±precision).
+    #[arg(long, value_name = "THETA")]
+    pub threshold: Option<f64>,
+    /// Study seed: run k uses stream k of xoshiro256++, so results do not depend on --threads.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Worker threads (0: all cores).
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+    /// A run ends when model time reaches this (in the model's time unit).
+    #[arg(long, default_value_t = 10_000)]
+    pub max_time: u64,
+    /// A run reaching this many steps is cut short: its open verdicts are unknown.
+    #[arg(long, default_value_t = 100_000_000)]
+    pub max_steps: u64,
+    /// Stop the study after this many runs even if the rule wants more.
+    #[arg(long)]
+    pub max_runs: Option<u64>,
+    /// Print JSON (one object) instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// One property's line of the report.
+#[derive(Debug, Serialize)]
+pub struct PropertyReport {
+    /// The guarantee's id.
+    pub property: String,
+    /// Estimated probability that a run satisfies it (`null` with no judged run).
+    pub probability: Option<f64>,
+    /// Lower end of the interval (widened over unknown runs).
+    pub lower: f64,
+    /// Upper end of the interval.
+    pub upper: f64,
+    /// Runs judged.
+    pub runs: u64,
+    /// Runs that satisfied it.
+    pub successes: u64,
+    /// Runs cut short before its verdict was final (not judged).
+    pub cut_short: u64,
+    /// With --threshold: `accept` (P >= theta) or `reject`.
+    pub decision: Option<String>,
+}
+
+/// The whole report.
+#[derive(Debug, Serialize)]
+pub struct Report {
+    /// The model path.
+    pub model: String,
+    /// The property file.
+    pub properties_file: String,
+    /// Study seed.
+    pub seed: u64,
+    /// Confidence of the intervals.
+    pub confidence: f64,
+    /// Target precision.
+    pub precision: f64,
+    /// Runs started and consumed.
+    pub runs: u64,
+    /// Runs discarded because an assumption was violated.
+    pub discarded: u64,
+    /// Runs that ended at the time horizon.
+    pub time_horizon: u64,
+    /// Runs that reached the step limit.
+    pub step_limit: u64,
+    /// Runs stopped early because every verdict was final.
+    pub decided: u64,
+    /// Runs that ended because nothing could move.
+    pub quiescent: u64,
+    /// Wall-clock seconds.
+    pub seconds: f64,
+    /// Per guarantee.
+    pub properties: Vec<PropertyReport>,
+}
+
+/// Finds the property file for a model when none is given.
+fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, CliError> {
+    if let Some(p) = compiled.properties_path() {
+        return Ok(p.to_path_buf());
+    }
+    let dir = if model.is_dir() {
+        model.to_path_buf()
+    } else {
+        model.parent().map(Path::to_path_buf).unwrap_or_default()
+    };
+    let p = dir.join("properties.xml");
+    if p.is_file() {
+        Ok(p)
+    } else {
+        Err(CliError::Input(format!(
+            "{}: no property file given and none found (looked for {})",
+            model.display(),
+            p.display()
+        )))
+    }
+}
+
+/// Loads the model and its properties: everything `validate` checks.
+pub fn load(
+    model: &Path,
+    props_path: Option<&Path>,
+) -> Result<(CompiledModel, PropertySet, PathBuf), CliError> {
+    let compiled = CompiledModel::load(model).map_err(|d| CliError::Input(d.to_string()))?;
+    for w in compiled.warnings() {
+        eprintln!("warning: {w}");
+    }
+    let props_path = match props_path {
+        Some(p) => p.to_path_buf(),
+        None => default_props(model, &compiled)?,
+    };
+    let file = props::parse_file(&props_path).map_err(|d| CliError::Input(d.to_string()))?;
+    let set = PropertySet::new(&file, &compiled).map_err(CliError::Input)?;
+    Ok((compiled, set, props_path))
+}
+
+/// Runs a study of `set` on `model`: the function `verify` and `sweep` share.
+pub fn study(
+    model: &CompiledModel,
+    set: &PropertySet,
+    run_cfg: &RunConfig,
+    study_cfg: &StudyConfig,
+    rule: &RuleConfig,
+    show_progress: bool,
+) -> Result<StudyResult, CliError> {
+    let rules = set
+        .guarantee_names()
+        .iter()
+        .map(|_| rule.build())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| CliError::Input(format!("statistics: {e}")))?;
+    // Simulators and judges are reused across runs (no allocation per step).
+    let pool: Mutex<Vec<(Simulator<'_>, Judge<'_>)>> = Mutex::new(Vec::new());
+    let failure: Mutex<Option<String>> = Mutex::new(None);
+    let run = |k: u64, rng: &mut Xoshiro256PlusPlus| -> RunOutcome {
+        let popped = pool.lock().ok().and_then(|mut p| p.pop());
+        let (mut sim, mut judge) = match popped {
+            Some(pair) => pair,
+            None => (
+                Simulator::new(model),
+                Judge::new(set).expect("validated program"),
+            ),
+        };
+        let unknown = |end| RunOutcome {
+            verdicts: Vec::new(),
+            assumptions: Verdict::Unknown,
+            end,
+            steps: 0,
+            time: 0,
+        };
+        let outcome = if judge.start() == crate::sim::Flow::Stop && judge.error.is_some() {
+            unknown(RunEnd::StepLimit)
+        } else {
+            let out = sim.run(rng, run_cfg, &mut judge);
+            let end = match &out.end {
+                EndReason::Quiescent => Some(RunEnd::Quiescent),
+                EndReason::MaxTime => Some(RunEnd::TimeHorizon),
+                EndReason::MaxSteps => Some(RunEnd::StepLimit),
+                EndReason::Stopped => Some(RunEnd::Decided),
+                EndReason::Spin(s) => {
+                    record(&failure, format!("run {k}: {s}"));
+                    None
+                }
+                EndReason::Error(e) => {
+                    record(&failure, format!("run {k}: {e}"));
+                    None
+                }
+            };
+            if let Some(err) = &judge.error {
+                record(&failure, format!("run {k}: {err}"));
+            }
+            match end {
+                Some(end) if judge.error.is_none() => judge.outcome(end, out.steps, out.time),
+                _ => unknown(RunEnd::StepLimit),
+            }
+        };
+        if let Ok(mut p) = pool.lock() {
+            p.push((sim, judge));
+        }
+        outcome
+    };
+    let mut bar = if show_progress {
+        TerminalProgress::stderr()
+    } else {
+        TerminalProgress::hidden()
+    };
+    let result = run_study(study_cfg, &rules, run, &mut |p| bar.update(p));
+    if let Some(msg) = failure.into_inner().ok().flatten() {
+        return Err(CliError::Input(format!(
+            "the model failed during simulation: {msg}"
+        )));
+    }
+    Ok(result)
+}
+
+fn record(slot: &Mutex<Option<String>>, msg: String) {
+    if let Ok(mut s) = slot.lock() {
+        s.get_or_insert(msg);
+    }
+}
+
+/// Runs `hindsight verify`.
+pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
+    let (model, set, props_path) = load(&args.model, args.props.as_deref())?;
+    let rule = RuleConfig {
+        kind: match (args.threshold, args.rule) {
+            (Some(threshold), _) => RuleKind::Sprt { threshold },
+            (None, Rule::Adaptive) => RuleKind::Adaptive,
+            (None, Rule::Okamoto) => RuleKind::Okamoto,
+            (None, Rule::Wilson) => RuleKind::Wilson,
+            (None, Rule::ClopperPearson) => RuleKind::ClopperPearson,
+        },
+        confidence: args.confidence,
+        precision: args.precision,
+    };
+    let run_cfg = RunConfig {
+        max_time: args.max_time,
+        max_steps: args.max_steps,
+        ..RunConfig::default()
+    };
+    let study_cfg = StudyConfig {
+        seed: args.seed,
+        threads: args.threads,
+        max_runs: args.max_runs,
+        keep_failing: 0,
+        progress_every: Duration::from_millis(200),
+    };
+    let result = study(&model, &set, &run_cfg, &study_cfg, &rule, !args.json)?;
+    let report = report(args, &props_path, &set, &result);
+    if args.json {
+        let text = serde_json::to_string_pretty(&report)
+            .map_err(|e| CliError::Failed(format!("json: {e}")))?;
+        println!("{text}");
+    } else {
+        print_table(&report);
+    }
+    Ok(())
+}
+
+fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -> Report {
+    Report {
+        model: args.model.display().to_string(),
+        properties_file: props.display().to_string(),
+        seed: args.seed,
+        confidence: args.confidence,
+        precision: args.precision,
+        runs: r.runs.runs,
+        discarded: r.runs.discarded,
+        time_horizon: r.runs.time_horizon,
+        step_limit: r.runs.step_limit,
+        decided: r.runs.decided,
+        quiescent: r.runs.quiescent,
+        seconds: r.elapsed.as_secs_f64(),
+        properties: set
+            .guarantee_names()
+            .iter()
+            .zip(&r.properties)
+            .map(|(name, p)| PropertyReport {
+                property: name.clone(),
+                probability: p.estimate.estimate,
+                lower: p.interval.lower,
+                upper: p.interval.upper,
+                runs: p.counts.judged(),
+                successes: p.counts.successes,
+                cut_short: p.counts.unknown,
+                decision: p.estimate.decision.map(|d| format!("{d:?}").to_lowercase()),
+            })
+            .collect(),
+    }
+}
+
+fn print_table(r: &Report) {
+    let w = r
+        .properties
+        .iter()
+        .map(|p| p.property.len())
+        .max()
+        .unwrap_or(8)
+        .max(8);
+    println!(
+        "{:<w$}  {:>11}  {:>17}  {:>7}  {:>9}  decision",
+        "property", "probability", "interval", "runs", "cut short"
+    );
+    for p in &r.properties {
+        let prob = p.probability.map_or("-".to_string(), |x| format!("{x:.4}"));
+        let interval = format!("[{:.4}, {:.4}]", p.lower, p.upper);
+        println!(
+            "{:<w$}  {prob:>11}  {interval:>17}  {:>7}  {:>9}  {}",
+            p.property,
+            p.runs,
+            p.cut_short,
+            p.decision.as_deref().unwrap_or("")
+        );
+    }
+    println!(
+        "{} runs in {:.2} s ({:.0} runs/s; seed {}, confidence {}, precision {}): {} discarded by assumptions, {} stopped early (verdicts final), {} at the time horizon, {} quiescent, {} cut at the step limit",
+        r.runs,
+        r.seconds,
+        r.runs as f64 / r.seconds.max(1e-9),
+        r.seed,
+        r.confidence,
+        r.precision,
+        r.discarded,
+        r.decided,
+        r.time_horizon,
+        r.quiescent,
+        r.step_limit
+    );
+}
+
+/// Arguments of `hindsight validate`.
+#[derive(Debug, clap::Args)]
+pub struct ValidateArgs {
+    /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
+    pub model: PathBuf,
+    /// The SCAN property file; default as for `verify`.
+    pub props: Option<PathBuf>,
+}
+
+/// Runs `hindsight validate`: loads and compiles, prints a one-line summary.
+pub fn validate(args: &ValidateArgs) -> Result<(), CliError> {
+    let (model, set, props_path) = load(&args.model, args.props.as_deref())?;
+    println!(
+        "{}: {} machines, {} events; {}: {} guarantees, monitor state {} bytes: ok",
+        args.model.display(),
+        model.machine_count(),
+        model.event_count(),
+        props_path.display(),
+        set.guarantee_names().len(),
+        set.compiled().state_bytes()
+    );
+    Ok(())
+}

@@ -1,0 +1,363 @@
+//! The property layer: SCAN ports resolved against a compiled model, and an observer that
+//! turns every simulation point into a monitor step.
+//!
+//! [`PropertySet::new`] compiles a property file's guarantees and assumptions into one
+//! monitor program (its ports become the spec's event and state variables) and resolves
+//! each port's message, origin, target and parameter to the model's ids once. A
+//! [`Judge`] then observes one run: at every point DESIGN.md section 2 defines (the
+//! initial state, every send, every receive, every time advance) it clears the event
+//! variables, applies the ports of a sent message, and steps the monitors. When every
+//! verdict is final ([`super::settle`]) it stops the run.
+
+use codegen::{Compiled, DeclInput, FormulaInput, Origin, SpecInput};
+use monitor_core::{valuation, Monitor, Ty, Value, VarKind};
+
+use super::settle::Settler;
+use crate::expr::Value as SimValue;
+use crate::props::{PortKind, PropertyFile};
+use crate::sim::{CompiledModel, Flow, MachineId, Observer, SentMessage};
+use crate::smc::{RunEnd, RunOutcome, Verdict};
+
+/// One port resolved to model ids.
+#[derive(Clone, Debug)]
+struct Port {
+    origin: MachineId,
+    /// `None`: the `NONE` sink.
+    target: Option<MachineId>,
+    /// The spec variable it sets.
+    var: usize,
+    /// The message parameter (state variables only).
+    param: Option<usize>,
+}
+
+/// Guarantees and assumptions compiled to one program, with their ports resolved.
+#[derive(Debug)]
+pub struct PropertySet {
+    compiled: Compiled,
+    guarantees: Vec<String>,
+    assumptions: usize,
+    /// Ports by event id.
+    by_event: Vec<Vec<Port>>,
+    /// Model string id -> spec string id (`u32::MAX`: equal to no constant).
+    strings: Vec<u32>,
+}
+
+/// Maps a SCAN port type to a spec type name.
+fn spec_type(scan: &str) -> Option<&'static str> {
+    Some(match scan {
+        "bool" | "boolean" => "bool",
+        "int" | "int32" => "i32",
+        "int8" => "i8",
+        "int16" => "i16",
+        "int64" => "i64",
+        "uint8" => "u8",
+        "uint16" => "u16",
+        "uint32" => "u32",
+        "uint64" => "u64",
+        "float" | "float32" => "f32",
+        "double" | "float64" => "f64",
+        "string" => "string",
+        _ => return None,
+    })
+}
+
+impl PropertySet {
+    /// Compiles `props` and resolves its ports against `model`. Every error names the
+    /// property file's line and column.
+    pub fn new(props: &PropertyFile, model: &CompiledModel) -> Result<PropertySet, String> {
+        let file = props.path.display().to_string();
+        let origin = |line: u32, col: u32| Origin {
+            file: file.clone(),
+            line,
+            col,
+        };
+        let mut errors = Vec::new();
+        let mut decls = Vec::new();
+        for p in &props.ports {
+            let at = origin(p.at.line, p.at.column);
+            let (kind, type_name, init) = match &p.kind {
+                PortKind::Event => (VarKind::Event, "bool".to_string(), None),
+                PortKind::State { ty, init, .. } => match spec_type(ty) {
+                    Some(t) => (
+                        VarKind::State,
+                        t.to_string(),
+                        Some(init.as_str().to_string()),
+                    ),
+                    None => {
+                        errors.push(format!(
+                            "{file}:{}:{}: port `{}`: unsupported type `{ty}`",
+                            p.at.line, p.at.column, p.id
+                        ));
+                        continue;
+                    }
+                },
+            };
+            decls.push(DeclInput {
+                kind,
+                name: p.id.clone(),
+                type_name,
+                init,
+                origin: at,
+            });
+        }
+        let formula = |p: &crate::props::Property, name: String| {
+            let at = p.formula.location(0);
+            FormulaInput {
+                name,
+                text: p.formula.as_str().to_string(),
+                origin: origin(at.line, at.column),
+            }
+        };
+        let mut formulas: Vec<FormulaInput> = props
+            .guarantees
+            .iter()
+            .map(|p| formula(p, p.id.clone()))
+            .collect();
+        // Assumption names cannot clash with guarantees: property ids are unique.
+        formulas.extend(props.assumptions.iter().map(|p| formula(p, p.id.clone())));
+        if !errors.is_empty() {
+            return Err(errors.join("\n"));
+        }
+        let compiled = codegen::compile_input(&SpecInput {
+            unit: None,
+            decls,
+            formulas,
+        })
+        .map_err(|d| d.to_string())?;
+        if !compiled.warnings().is_empty() {
+            eprint!("{}", compiled.warnings());
+        }
+
+        let mut by_event = vec![Vec::new(); model.event_count()];
+        for p in &props.ports {
+            let here = format!("{file}:{}:{}: port `{}`", p.at.line, p.at.column, p.id);
+            let Some(event) = model.event_id(&p.event) else {
+                errors.push(format!("{here}: the model sends no event `{}`", p.event));
+                continue;
+            };
+            let Some(origin) = model.machine_id(&p.origin) else {
+                errors.push(format!("{here}: no machine `{}` in the model", p.origin));
+                continue;
+            };
+            let target = match model.machine_id(&p.target) {
+                Some(m) => Some(m),
+                None if p.target == "NONE" => None,
+                None => {
+                    errors.push(format!("{here}: no machine `{}` in the model", p.target));
+                    continue;
+                }
+            };
+            let param = match &p.kind {
+                PortKind::Event => None,
+                PortKind::State { param, .. } => match model.param_index(event, param) {
+                    Some(i) => Some(i),
+                    None => {
+                        errors.push(format!(
+                            "{here}: event `{}` has no parameter `{param}`",
+                            p.event
+                        ));
+                        continue;
+                    }
+                },
+            };
+            let var = compiled
+                .var_index(&p.id)
+                .ok_or_else(|| format!("{here}: not compiled"))?;
+            by_event[event.0 as usize].push(Port {
+                origin,
+                target,
+                var,
+                param,
+            });
+        }
+        if !errors.is_empty() {
+            return Err(errors.join("\n"));
+        }
+        let table = model.strings();
+        let strings = (0..table.len() as u32)
+            .map(|i| {
+                let s = table.get(crate::expr::StrId(i));
+                // Model strings quoted like SCXML literals may carry their quotes.
+                let bare = s.trim_matches(|c| c == '\'' || c == '"');
+                compiled
+                    .string_id(s)
+                    .or_else(|| compiled.string_id(bare))
+                    .unwrap_or(u32::MAX)
+            })
+            .collect();
+        Ok(PropertySet {
+            guarantees: props.guarantees.iter().map(|p| p.id.clone()).collect(),
+            assumptions: props.assumptions.len(),
+            compiled,
+            by_event,
+            strings,
+        })
+    }
+
+    /// The guarantees' ids, in file order (one verdict each).
+    pub fn guarantee_names(&self) -> &[String] {
+        &self.guarantees
+    }
+
+    /// The compiled monitors (guarantees first, then assumptions).
+    pub fn compiled(&self) -> &Compiled {
+        &self.compiled
+    }
+}
+
+/// Judges one run: an [`Observer`] stepping the monitors at every point.
+pub struct Judge<'a> {
+    set: &'a PropertySet,
+    monitor: Monitor<'a>,
+    state: Vec<u64>,
+    vals: Vec<Value>,
+    verdicts: Vec<bool>,
+    settler: Settler,
+    /// The first error (a payload of the wrong type, a timestamp going back).
+    pub error: Option<String>,
+    decided: bool,
+}
+
+impl<'a> Judge<'a> {
+    /// A judge for `set`, before the run's initial point.
+    pub fn new(set: &'a PropertySet) -> Result<Judge<'a>, String> {
+        let monitor = Monitor::try_new(set.compiled.program())
+            .map_err(|e| format!("internal: compiled program rejected: {e}"))?;
+        let vars = monitor.program().vars;
+        let mut vals = vec![Value::Bool(false); vars.len()];
+        valuation::init(vars, &mut vals);
+        Ok(Judge {
+            set,
+            settler: Settler::new(&monitor),
+            state: vec![0; monitor.state_words()],
+            verdicts: vec![false; monitor.properties()],
+            monitor,
+            vals,
+            error: None,
+            decided: false,
+        })
+    }
+
+    /// Puts the judge back before a run's initial point and judges that point (time 0).
+    pub fn start(&mut self) -> Flow {
+        let vars = self.monitor.program().vars;
+        valuation::init(vars, &mut self.vals);
+        self.state.fill(0);
+        self.error = None;
+        self.decided = false;
+        self.step(0)
+    }
+
+    fn step(&mut self, time: u64) -> Flow {
+        if let Err(e) = self
+            .monitor
+            .try_step(&mut self.state, time, &self.vals, &mut self.verdicts)
+        {
+            self.error = Some(format!("monitor step at time {time}: {e}"));
+            return Flow::Stop;
+        }
+        self.settler.update(&self.monitor, &self.state);
+        let all =
+            (0..self.verdicts.len()).all(|p| self.settler.property(&self.monitor, p).is_some());
+        if all {
+            self.decided = true;
+            return Flow::Stop;
+        }
+        Flow::Continue
+    }
+
+    fn begin(&mut self) {
+        valuation::begin_point(self.monitor.program().vars, &mut self.vals);
+    }
+
+    fn convert(&self, v: SimValue<'_>, ty: Ty) -> Option<Value> {
+        Some(match (v, ty) {
+            (SimValue::Bool(b), Ty::Bool) => Value::Bool(b),
+            (SimValue::Int(i), Ty::Int) => Value::Int(i),
+            (SimValue::Int(i), Ty::Float) => Value::Float(i as f64),
+            (SimValue::Float(f), Ty::Float) => Value::Float(f),
+            (SimValue::Str(s), Ty::Str) => Value::Str(
+                self.set
+                    .strings
+                    .get(s.0 as usize)
+                    .copied()
+                    .unwrap_or(u32::MAX),
+            ),
+            _ => return None,
+        })
+    }
+
+    /// The run's outcome from the verdicts at its last point and why it ended.
+    pub fn outcome(&self, end: RunEnd, steps: u64, time: u64) -> RunOutcome {
+        let g = self.set.guarantees.len();
+        let judged = |p: usize| -> Verdict {
+            match self.settler.property(&self.monitor, p) {
+                Some(v) => v.into(),
+                // A run cut short is judged only where the verdict was already final.
+                None if end == RunEnd::StepLimit => Verdict::Unknown,
+                None => self.verdicts[p].into(),
+            }
+        };
+        let verdicts = (0..g).map(judged).collect();
+        let mut assumptions = Verdict::True;
+        for a in g..g + self.set.assumptions {
+            match judged(a) {
+                Verdict::False => {
+                    assumptions = Verdict::False;
+                    break;
+                }
+                Verdict::Unknown => assumptions = Verdict::Unknown,
+                Verdict::True => {}
+            }
+        }
+        RunOutcome {
+            verdicts,
+            assumptions,
+            end: if self.decided { RunEnd::Decided } else { end },
+            steps,
+            time,
+        }
+    }
+}
+
+impl Observer for Judge<'_> {
+    fn on_send(&mut self, time: u64, msg: &SentMessage<'_>) -> Flow {
+        self.begin();
+        let ports = self.set.by_event.get(msg.event().0 as usize);
+        for port in ports.into_iter().flatten() {
+            if port.origin != msg.origin() || port.target != msg.target() {
+                continue;
+            }
+            let decl = &self.monitor.program().vars[port.var];
+            let value = match port.param {
+                None => Some(Value::Bool(true)),
+                Some(i) => msg.param(i).and_then(|v| self.convert(v, decl.ty)),
+            };
+            match value {
+                Some(v) => self.vals[port.var] = v,
+                None => {
+                    self.error = Some(format!(
+                        "time {time}: `{}` from {} to {}: parameter for `{}` is not a {:?}",
+                        msg.event_name(),
+                        msg.origin_name(),
+                        msg.target_name(),
+                        decl.name,
+                        decl.ty
+                    ));
+                    return Flow::Stop;
+                }
+            }
+        }
+        self.step(time)
+    }
+
+    fn on_receive(&mut self, time: u64, _msg: &SentMessage<'_>) -> Flow {
+        self.begin();
+        self.step(time)
+    }
+
+    fn on_time(&mut self, time: u64) -> Flow {
+        self.begin();
+        self.step(time)
+    }
+}

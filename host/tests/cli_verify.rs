@@ -1,0 +1,182 @@
+//! `hindsight verify` / `validate` end to end: analytic probabilities, assumptions, determinism
+//! across threads, the museum's thresholds, and bad models reported with a position.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn hindsight(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_hindsight"))
+        .args(args)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .output()
+        .expect("run hindsight");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn json(args: &[&str]) -> serde_json::Value {
+    let mut all = args.to_vec();
+    all.push("--json");
+    let (code, out, err) = hindsight(&all);
+    assert_eq!(code, 0, "{args:?}: {err}");
+    serde_json::from_str(&out).expect("json report")
+}
+
+fn prop<'a>(report: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    report["properties"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["property"] == name)
+        .unwrap_or_else(|| panic!("no property {name}"))
+}
+
+const COIN: &str = "host/tests/data/verify/coin";
+
+#[test]
+fn a_biased_coin_is_estimated_inside_the_reported_interval() {
+    // heads with probability 0.3 (Math.random() < 0.3), across seeds and rules.
+    for (seed, rule) in [("1", "wilson"), ("2", "clopper-pearson"), ("3", "adaptive")] {
+        let r = json(&[
+            "verify",
+            COIN,
+            "--seed",
+            seed,
+            "--rule",
+            rule,
+            "--precision",
+            "0.03",
+        ]);
+        for (name, p) in [("heads", 0.3), ("tails", 0.7)] {
+            let pr = prop(&r, name);
+            let (lo, hi) = (pr["lower"].as_f64().unwrap(), pr["upper"].as_f64().unwrap());
+            assert!(
+                lo <= p && p <= hi,
+                "seed {seed} {rule} {name}: [{lo}, {hi}]"
+            );
+            assert!(hi - lo <= 0.061, "{rule}: interval too wide: [{lo}, {hi}]");
+        }
+    }
+}
+
+#[test]
+fn the_same_seed_gives_the_same_numbers_on_one_and_two_threads() {
+    let strip = |mut v: serde_json::Value| {
+        v["seconds"] = serde_json::Value::Null;
+        v
+    };
+    let a = strip(json(&["verify", COIN, "--seed", "9", "--threads", "1"]));
+    let b = strip(json(&["verify", COIN, "--seed", "9", "--threads", "2"]));
+    assert_eq!(a, b);
+    let c = strip(json(&["verify", COIN, "--seed", "10", "--threads", "2"]));
+    assert_ne!(
+        prop(&a, "heads")["successes"],
+        prop(&c, "heads")["successes"]
+    );
+}
+
+#[test]
+fn runs_violating_an_assumption_are_discarded_and_counted() {
+    let props = format!("{COIN}/assume-tails.xml");
+    let r = json(&["verify", COIN, &props, "--seed", "4"]);
+    let p = prop(&r, "no_heads");
+    // Given tails, heads never happened: every judged run satisfies it.
+    assert_eq!(p["successes"], p["runs"]);
+    let (runs, discarded) = (
+        r["runs"].as_u64().unwrap(),
+        r["discarded"].as_u64().unwrap(),
+    );
+    // About 30 % of runs throw heads and are discarded.
+    let share = discarded as f64 / runs as f64;
+    assert!((0.22..0.38).contains(&share), "{discarded}/{runs}");
+    assert_eq!(p["runs"].as_u64().unwrap() + discarded, runs);
+}
+
+fn museum() -> PathBuf {
+    PathBuf::from("examples/museum-scxml")
+}
+
+#[test]
+fn the_museum_requirements_hold_at_the_papers_bounds_and_fail_one_step_below() {
+    let m = museum();
+    let m = m.to_str().unwrap();
+    let r = json(&["verify", m, "--seed", "5", "--max-runs", "12"]);
+    for p in r["properties"].as_array().unwrap() {
+        assert_eq!(p["successes"], p["runs"], "{p}");
+        assert_eq!(p["runs"], 12);
+    }
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-scxml/properties.xml"),
+    )
+    .unwrap();
+    let below = text
+        .replace("since[62:]", "since[61:]")
+        .replace("since[2:]", "since[1:]")
+        .replace("once[10:] true) -> once[:10]", "once[9:] true) -> once[:9]");
+    let dir = std::env::temp_dir().join(format!("hindsight-below-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("properties.xml");
+    std::fs::write(&file, below).unwrap();
+    let r = json(&[
+        "verify",
+        m,
+        file.to_str().unwrap(),
+        "--seed",
+        "5",
+        "--max-runs",
+        "12",
+    ]);
+    for name in [
+        "alarm_response",
+        "battery_recurrence",
+        "poi_response",
+        "visitors_recurrence",
+    ] {
+        assert_eq!(
+            prop(&r, name)["successes"],
+            0,
+            "{name} should fail one step below"
+        );
+    }
+    assert_eq!(prop(&r, "absence")["successes"], 12);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn the_museum_typo_is_reported_with_file_line_and_column() {
+    let corpus = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .map(|d| d.join("shared/corpus/museum-simpar2025/model_scxml"))
+        .find(|d| d.is_dir())
+        .expect("shared/corpus next to the repository");
+    let (code, _, err) = hindsight(&["validate", corpus.to_str().unwrap()]);
+    assert_eq!(code, 2);
+    assert!(err.contains("NavigationComponent.scxml:20:30"), "{err}");
+    assert!(err.contains("_event.data.thread_id"), "{err}");
+    let (code, out, err) = hindsight(&["validate", "examples/museum-scxml"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("5 guarantees"), "{out}");
+}
+
+#[test]
+fn bad_properties_and_arguments_exit_2() {
+    let dir = std::env::temp_dir().join(format!("hindsight-badprops-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("p.xml");
+    std::fs::write(
+        &bad,
+        "<properties>\n<ports>\n<scxml_event_send event=\"heads\" origin=\"coin\" target=\"sink\"><event_var id=\"h\"/></scxml_event_send>\n</ports>\n<guarantees>\n<property id=\"x\" logic=\"pmtl\" expr=\"once {h} &amp;&amp;\"/>\n</guarantees>\n</properties>\n",
+    )
+    .unwrap();
+    let (code, _, err) = hindsight(&["verify", COIN, bad.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("p.xml:6:"), "{err}");
+    let (code, _, _) = hindsight(&["verify", COIN, "--confidence", "2"]);
+    assert_eq!(code, 2);
+    let (code, _, _) = hindsight(&["verify", "no/such/model"]);
+    assert_eq!(code, 2);
+    let _ = std::fs::remove_dir_all(dir);
+}
