@@ -41,6 +41,13 @@ enum Command {
     ///
     /// Example: `hindsight validate examples/museum-scxml`
     Validate(cli::verify::ValidateArgs),
+    /// Success rate of one guarantee as its time bounds sweep a range (CSV).
+    ///
+    /// Every integer bound in the guarantee's formula takes the swept value, which finds
+    /// the threshold of a response or recurrence requirement.
+    ///
+    /// Example: `hindsight sweep examples/museum-scxml --property alarm_response --from 58 --to 64 --max-runs 50`
+    Sweep(cli::sweep::SweepArgs),
 }
 
 fn main() -> ExitCode {
@@ -57,6 +64,7 @@ fn main() -> ExitCode {
         Command::Replay(a) => cli::replay::run(a),
         Command::Verify(a) => cli::verify::run(a),
         Command::Validate(a) => cli::verify::validate(a),
+        Command::Sweep(a) => cli::sweep::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

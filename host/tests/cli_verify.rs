@@ -180,3 +180,41 @@ fn bad_properties_and_arguments_exit_2() {
     assert_eq!(code, 2);
     let _ = std::fs::remove_dir_all(dir);
 }
+
+#[test]
+fn sweep_shows_the_step_at_the_recurrence_threshold() {
+    let (code, out, err) = hindsight(&[
+        "sweep",
+        "examples/museum-scxml",
+        "--property",
+        "visitors_recurrence",
+        "--from",
+        "9",
+        "--to",
+        "10",
+        "--max-runs",
+        "10",
+        "--seed",
+        "2",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let rows: Vec<Vec<&str>> = out
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), 2, "{out}");
+    assert_eq!((rows[0][0], rows[0][1]), ("9", "0.0000"), "{out}");
+    assert_eq!((rows[1][0], rows[1][1]), ("10", "1.0000"), "{out}");
+    let (code, _, err) = hindsight(&[
+        "sweep",
+        "examples/museum-scxml",
+        "--property",
+        "absence",
+        "--from",
+        "1",
+        "--to",
+        "2",
+    ]);
+    assert_eq!(code, 2, "absence has no bound: {err}");
+}

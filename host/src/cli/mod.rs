@@ -2,6 +2,7 @@
 
 pub mod compile;
 pub mod replay;
+pub mod sweep;
 pub mod verify;
 
 use std::fmt;
