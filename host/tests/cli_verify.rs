@@ -218,3 +218,49 @@ fn sweep_shows_the_step_at_the_recurrence_threshold() {
     ]);
     assert_eq!(code, 2, "absence has no bound: {err}");
 }
+
+#[test]
+fn failing_runs_are_replayed_to_csv_with_their_verdicts() {
+    let dir = std::env::temp_dir().join(format!("hindsight-failing-{}", std::process::id()));
+    let (code, _, err) = hindsight(&[
+        "verify",
+        COIN,
+        "--seed",
+        "6",
+        "--max-runs",
+        "50",
+        "--save-failing",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    // Two failing runs kept for each of heads and tails.
+    assert_eq!(files.len(), 4, "{files:?}");
+    for f in files {
+        let text = std::fs::read_to_string(&f).unwrap();
+        let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+        let last: Vec<&str> = text.lines().last().unwrap().split(',').collect();
+        // The last two columns are the verdicts of `heads` and `tails`.
+        let verdict = |name: &str| last[header.len() - if name == "heads" { 2 } else { 1 }];
+        let name = f.file_name().unwrap().to_str().unwrap();
+        let (failed, other) = if name.starts_with("heads") {
+            ("heads", "tails")
+        } else {
+            ("tails", "heads")
+        };
+        // The replayed run (stream k of the seed) fails the property it was kept for.
+        assert_eq!(verdict(failed), "false", "{name}: {text}");
+        assert_eq!(verdict(other), "true", "{name}: {text}");
+        assert!(
+            text.contains(&format!(",send,{other},coin,sink")),
+            "{name}: {text}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -65,6 +65,13 @@ pub struct VerifyArgs {
     /// Print JSON (one object) instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// Replay up to N failing runs per property and write each as CSV (time, step, event,
+    /// origin, target, parameters, every property variable and verdict) into --out.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub save_failing: usize,
+    /// Folder for --save-failing files (created if missing).
+    #[arg(long, default_value = "failing-runs")]
+    pub out: PathBuf,
 }
 
 /// One property's line of the report.
@@ -238,6 +245,31 @@ pub fn study(
     Ok(result)
 }
 
+/// Replays each kept failing run (run k is stream k of the seed) and writes its CSV.
+fn save_failing(
+    args: &VerifyArgs,
+    model: &CompiledModel,
+    set: &PropertySet,
+    run_cfg: &RunConfig,
+    result: &StudyResult,
+) -> Result<(), CliError> {
+    let io = |e: std::io::Error| CliError::Failed(format!("{}: {e}", args.out.display()));
+    std::fs::create_dir_all(&args.out).map_err(io)?;
+    for (name, p) in set.guarantee_names().iter().zip(&result.properties) {
+        for &k in &p.failing_runs {
+            let mut judge = Judge::new(set).map_err(CliError::Failed)?;
+            let mut rec = crate::verify::record::Recorder::new(&mut judge, model);
+            rec.start();
+            let mut rng = crate::smc::runner::stream(args.seed, k);
+            Simulator::new(model).run(&mut rng, run_cfg, &mut rec);
+            let path = args.out.join(format!("{name}-run{k}.csv"));
+            std::fs::write(&path, &rec.csv).map_err(io)?;
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    Ok(())
+}
+
 fn record(slot: &Mutex<Option<String>>, msg: String) {
     if let Ok(mut s) = slot.lock() {
         s.get_or_insert(msg);
@@ -267,10 +299,13 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         seed: args.seed,
         threads: args.threads,
         max_runs: args.max_runs,
-        keep_failing: 0,
+        keep_failing: args.save_failing,
         progress_every: Duration::from_millis(200),
     };
     let result = study(&model, &set, &run_cfg, &study_cfg, &rule, !args.json)?;
+    if args.save_failing > 0 {
+        save_failing(args, &model, &set, &run_cfg, &result)?;
+    }
     let report = report(args, &props_path, &set, &result);
     if args.json {
         let text = serde_json::to_string_pretty(&report)

@@ -1,4 +1,5 @@
 //! Statistical model checking glue: properties observed on simulated runs, judged by monitors.
 
 pub mod observe;
+pub mod record;
 pub mod settle;

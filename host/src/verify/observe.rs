@@ -248,6 +248,21 @@ impl<'a> Judge<'a> {
         self.step(0)
     }
 
+    /// The property variables' values at the last point.
+    pub fn values(&self) -> &[Value] {
+        &self.vals
+    }
+
+    /// Every property's verdict at the last point (guarantees, then assumptions).
+    pub fn verdicts(&self) -> &[bool] {
+        &self.verdicts
+    }
+
+    /// The property set this judge works for.
+    pub fn set(&self) -> &'a PropertySet {
+        self.set
+    }
+
     fn step(&mut self, time: u64) -> Flow {
         if let Err(e) = self
             .monitor
