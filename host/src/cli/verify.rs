@@ -181,16 +181,51 @@ pub fn study(
         .map(|_| rule.build())
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| CliError::Input(format!("statistics: {e}")))?;
-    // Simulators and judges are reused across runs (no allocation per step).
-    let pool: Mutex<Vec<(Simulator<'_>, Judge<'_>)>> = Mutex::new(Vec::new());
-    let failure: Mutex<Option<String>> = Mutex::new(None);
-    let run = |k: u64, rng: &mut Xoshiro256PlusPlus| -> RunOutcome {
-        let popped = pool.lock().ok().and_then(|mut p| p.pop());
+    let runner = Runner::new(model, set, run_cfg);
+    let mut bar = if show_progress {
+        TerminalProgress::stderr()
+    } else {
+        TerminalProgress::hidden()
+    };
+    let result = run_study(study_cfg, &rules, |k, rng| runner.run(k, rng), &mut |p| {
+        bar.update(p)
+    });
+    runner.finish()?;
+    Ok(result)
+}
+
+/// Runs one simulation with its judge: the run function every study shares.
+///
+/// Simulators and judges are pooled and reused across runs (no allocation per step);
+/// the first model failure (a spin, a run-time error) is kept and ends the study.
+pub struct Runner<'m> {
+    model: &'m CompiledModel,
+    set: &'m PropertySet,
+    run_cfg: &'m RunConfig,
+    pool: Mutex<Vec<(Simulator<'m>, Judge<'m>)>>,
+    failure: Mutex<Option<String>>,
+}
+
+impl<'m> Runner<'m> {
+    /// A runner for `model` judged by `set`.
+    pub fn new(model: &'m CompiledModel, set: &'m PropertySet, run_cfg: &'m RunConfig) -> Self {
+        Runner {
+            model,
+            set,
+            run_cfg,
+            pool: Mutex::new(Vec::new()),
+            failure: Mutex::new(None),
+        }
+    }
+
+    /// Run `k` with its stream.
+    pub fn run(&self, k: u64, rng: &mut Xoshiro256PlusPlus) -> RunOutcome {
+        let popped = self.pool.lock().ok().and_then(|mut p| p.pop());
         let (mut sim, mut judge) = match popped {
             Some(pair) => pair,
             None => (
-                Simulator::new(model),
-                Judge::new(set).expect("validated program"),
+                Simulator::new(self.model),
+                Judge::new(self.set).expect("validated program"),
             ),
         };
         let unknown = |end| RunOutcome {
@@ -203,46 +238,44 @@ pub fn study(
         let outcome = if judge.start() == crate::sim::Flow::Stop && judge.error.is_some() {
             unknown(RunEnd::StepLimit)
         } else {
-            let out = sim.run(rng, run_cfg, &mut judge);
+            let out = sim.run(rng, self.run_cfg, &mut judge);
             let end = match &out.end {
                 EndReason::Quiescent => Some(RunEnd::Quiescent),
                 EndReason::MaxTime => Some(RunEnd::TimeHorizon),
                 EndReason::MaxSteps => Some(RunEnd::StepLimit),
                 EndReason::Stopped => Some(RunEnd::Decided),
                 EndReason::Spin(s) => {
-                    record(&failure, format!("run {k}: {s}"));
+                    record(&self.failure, format!("run {k}: {s}"));
                     None
                 }
                 EndReason::Error(e) => {
-                    record(&failure, format!("run {k}: {e}"));
+                    record(&self.failure, format!("run {k}: {e}"));
                     None
                 }
             };
             if let Some(err) = &judge.error {
-                record(&failure, format!("run {k}: {err}"));
+                record(&self.failure, format!("run {k}: {err}"));
             }
             match end {
                 Some(end) if judge.error.is_none() => judge.outcome(end, out.steps, out.time),
                 _ => unknown(RunEnd::StepLimit),
             }
         };
-        if let Ok(mut p) = pool.lock() {
+        if let Ok(mut p) = self.pool.lock() {
             p.push((sim, judge));
         }
         outcome
-    };
-    let mut bar = if show_progress {
-        TerminalProgress::stderr()
-    } else {
-        TerminalProgress::hidden()
-    };
-    let result = run_study(study_cfg, &rules, run, &mut |p| bar.update(p));
-    if let Some(msg) = failure.into_inner().ok().flatten() {
-        return Err(CliError::Input(format!(
-            "the model failed during simulation: {msg}"
-        )));
     }
-    Ok(result)
+
+    /// The first model failure any run met, as a bad-input error.
+    pub fn finish(self) -> Result<(), CliError> {
+        match self.failure.into_inner().ok().flatten() {
+            Some(msg) => Err(CliError::Input(format!(
+                "the model failed during simulation: {msg}"
+            ))),
+            None => Ok(()),
+        }
+    }
 }
 
 /// Replays each kept failing run (run k is stream k of the seed) and writes its CSV.
