@@ -48,6 +48,10 @@ enum Command {
     ///
     /// Example: `hindsight sweep examples/museum-scxml --property alarm_response --from 58 --to 64 --max-runs 50`
     Sweep(cli::sweep::SweepArgs),
+    /// Combine the partial results of `verify --shard I/N --runs R` into one report.
+    ///
+    /// Example: `hindsight merge part-0.json part-1.json`
+    Merge(cli::verify::MergeArgs),
 }
 
 fn main() -> ExitCode {
@@ -65,6 +69,7 @@ fn main() -> ExitCode {
         Command::Verify(a) => cli::verify::run(a),
         Command::Validate(a) => cli::verify::validate(a),
         Command::Sweep(a) => cli::sweep::run(a),
+        Command::Merge(a) => cli::verify::merge(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -264,3 +264,42 @@ fn failing_runs_are_replayed_to_csv_with_their_verdicts() {
     }
     let _ = std::fs::remove_dir_all(dir);
 }
+
+#[test]
+fn shards_merged_equal_the_whole_study_and_gaps_are_refused() {
+    let dir = std::env::temp_dir().join(format!("hindsight-shards-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let part = |shard: &str, name: &str| {
+        let file = dir.join(name);
+        let (code, _, err) = hindsight(&[
+            "verify",
+            COIN,
+            "--seed",
+            "5",
+            "--runs",
+            "300",
+            "--shard",
+            shard,
+            "--partial",
+            file.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        file.to_str().unwrap().to_string()
+    };
+    let (a, b, c) = (
+        part("0/3", "a.json"),
+        part("1/3", "b.json"),
+        part("2/3", "c.json"),
+    );
+    let whole = part("0/1", "w.json");
+    let merged = json(&["merge", &a, &b, &c]);
+    let single = json(&["merge", &whole]);
+    assert_eq!(merged["properties"], single["properties"]);
+    assert_eq!(merged["runs"], 300);
+    let (code, _, err) = hindsight(&["merge", &a, &c]);
+    assert_eq!(code, 2);
+    assert!(err.contains("missing"), "{err}");
+    let (code, _, _) = hindsight(&["merge", &a, &a, &b, &c]);
+    assert_eq!(code, 2);
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -72,6 +72,18 @@ pub struct VerifyArgs {
     /// Folder for --save-failing files (created if missing).
     #[arg(long, default_value = "failing-runs")]
     pub out: PathBuf,
+    /// Run only slice I of N of a fixed-size study (needs --runs) and write a partial
+    /// result as JSON (to --partial or standard output); combine them with `hindsight merge`.
+    /// Slices are contiguous run ranges, so any batch scheduler (Slurm arrays,
+    /// Kubernetes indexed jobs) can run them anywhere.
+    #[arg(long, value_name = "I/N", requires = "runs")]
+    pub shard: Option<crate::smc::shard::Shard>,
+    /// Size of the fixed study that --shard slices.
+    #[arg(long, value_name = "N")]
+    pub runs: Option<u64>,
+    /// File for the partial result of --shard.
+    #[arg(long, value_name = "FILE")]
+    pub partial: Option<PathBuf>,
 }
 
 /// One property's line of the report.
@@ -93,6 +105,26 @@ pub struct PropertyReport {
     pub cut_short: u64,
     /// With --threshold: `accept` (P >= theta) or `reject`.
     pub decision: Option<String>,
+}
+
+impl PropertyReport {
+    fn new(
+        name: &str,
+        estimate: &crate::smc::stats::Estimate,
+        interval: &crate::smc::stats::Interval,
+        counts: &crate::smc::runner::PropertyCounts,
+    ) -> Self {
+        PropertyReport {
+            property: name.to_string(),
+            probability: estimate.estimate,
+            lower: interval.lower,
+            upper: interval.upper,
+            runs: counts.judged(),
+            successes: counts.successes,
+            cut_short: counts.unknown,
+            decision: estimate.decision.map(|d| format!("{d:?}").to_lowercase()),
+        }
+    }
 }
 
 /// The whole report.
@@ -278,6 +310,124 @@ impl<'m> Runner<'m> {
     }
 }
 
+/// FNV-1a over bytes: a stable fingerprint so `merge` can refuse mixed studies.
+fn fingerprint(parts: &[&[u8]]) -> String {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for p in parts {
+        for b in p.iter().chain(&[0xff]) {
+            h ^= *b as u64;
+            h = h.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    format!("{h:016x}")
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_shard_cli(
+    args: &VerifyArgs,
+    model: &CompiledModel,
+    set: &PropertySet,
+    props_path: &Path,
+    run_cfg: &RunConfig,
+    study_cfg: &StudyConfig,
+    rule: &RuleConfig,
+    shard: crate::smc::shard::Shard,
+    runs: u64,
+) -> Result<(), CliError> {
+    use crate::smc::shard::{run_shard, FixedStudy, PropertySpec};
+    let props_text = std::fs::read(props_path).unwrap_or_default();
+    let model_desc = format!(
+        "{} machines, {} events, max_time {}, max_steps {}",
+        model.machine_count(),
+        model.event_count(),
+        run_cfg.max_time,
+        run_cfg.max_steps
+    );
+    let fixed = FixedStudy {
+        seed: args.seed,
+        study_runs: runs,
+        model: format!("{} ({model_desc})", fingerprint(&[model_desc.as_bytes()])),
+        properties_fingerprint: fingerprint(&[&props_text]),
+        properties: set
+            .guarantee_names()
+            .iter()
+            .map(|id| PropertySpec {
+                id: id.clone(),
+                rule: *rule,
+            })
+            .collect(),
+    };
+    let runner = Runner::new(model, set, run_cfg);
+    let mut bar = TerminalProgress::stderr();
+    let part = run_shard(
+        study_cfg,
+        &fixed,
+        shard,
+        |k, rng| runner.run(k, rng),
+        &mut |p| bar.update(p),
+    );
+    runner.finish()?;
+    let json = part.to_json();
+    match &args.partial {
+        Some(p) => std::fs::write(p, json)
+            .map_err(|e| CliError::Failed(format!("{}: {e}", p.display())))?,
+        None => println!("{json}"),
+    }
+    Ok(())
+}
+
+/// Arguments of `hindsight merge`.
+#[derive(Debug, clap::Args)]
+pub struct MergeArgs {
+    /// Partial results written by `verify --shard I/N --runs R`, one per shard.
+    #[arg(required = true)]
+    pub parts: Vec<PathBuf>,
+    /// Print JSON instead of the table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `hindsight merge`: checks the parts cover one study exactly once, then reports it.
+pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
+    use crate::smc::shard::{merge, PartialResult};
+    let mut parts = Vec::new();
+    for p in &args.parts {
+        let text = super::read_file(p)?;
+        parts.push(
+            PartialResult::from_json(&text)
+                .map_err(|e| CliError::Input(format!("{}: {e}", p.display())))?,
+        );
+    }
+    let m = merge(&parts, 0).map_err(|e| CliError::Input(format!("merge: {e}")))?;
+    let report = Report {
+        model: m.study.model.clone(),
+        properties_file: m.study.properties_fingerprint.clone(),
+        seed: m.study.seed,
+        confidence: m.properties.first().map_or(0.0, |p| p.rule.confidence),
+        precision: m.properties.first().map_or(0.0, |p| p.rule.precision),
+        runs: m.runs.runs,
+        discarded: m.runs.discarded,
+        time_horizon: m.runs.time_horizon,
+        step_limit: m.runs.step_limit,
+        decided: m.runs.decided,
+        quiescent: m.runs.quiescent,
+        seconds: 0.0,
+        properties: m
+            .properties
+            .iter()
+            .map(|p| PropertyReport::new(&p.id, &p.estimate, &p.interval, &p.counts))
+            .collect(),
+    };
+    if args.json {
+        let text = serde_json::to_string_pretty(&report)
+            .map_err(|e| CliError::Failed(format!("json: {e}")))?;
+        println!("{text}");
+    } else {
+        print_table(&report);
+    }
+    Ok(())
+}
+
 /// Replays each kept failing run (run k is stream k of the seed) and writes its CSV.
 fn save_failing(
     args: &VerifyArgs,
@@ -335,6 +485,19 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         keep_failing: args.save_failing,
         progress_every: Duration::from_millis(200),
     };
+    if let (Some(shard), Some(runs)) = (args.shard, args.runs) {
+        return run_shard_cli(
+            args,
+            &model,
+            &set,
+            &props_path,
+            &run_cfg,
+            &study_cfg,
+            &rule,
+            shard,
+            runs,
+        );
+    }
     let result = study(&model, &set, &run_cfg, &study_cfg, &rule, !args.json)?;
     if args.save_failing > 0 {
         save_failing(args, &model, &set, &run_cfg, &result)?;
@@ -368,16 +531,7 @@ fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -
             .guarantee_names()
             .iter()
             .zip(&r.properties)
-            .map(|(name, p)| PropertyReport {
-                property: name.clone(),
-                probability: p.estimate.estimate,
-                lower: p.interval.lower,
-                upper: p.interval.upper,
-                runs: p.counts.judged(),
-                successes: p.counts.successes,
-                cut_short: p.counts.unknown,
-                decision: p.estimate.decision.map(|d| format!("{d:?}").to_lowercase()),
-            })
+            .map(|(name, p)| PropertyReport::new(name, &p.estimate, &p.interval, &p.counts))
             .collect(),
     }
 }
@@ -405,11 +559,18 @@ fn print_table(r: &Report) {
             p.decision.as_deref().unwrap_or("")
         );
     }
+    let speed = if r.seconds > 0.0 {
+        format!(
+            " in {:.2} s ({:.0} runs/s)",
+            r.seconds,
+            r.runs as f64 / r.seconds
+        )
+    } else {
+        String::new()
+    };
     println!(
-        "{} runs in {:.2} s ({:.0} runs/s; seed {}, confidence {}, precision {}): {} discarded by assumptions, {} stopped early (verdicts final), {} at the time horizon, {} quiescent, {} cut at the step limit",
+        "{} runs{speed}; seed {}, confidence {}, precision {}: {} discarded by assumptions, {} stopped early (verdicts final), {} at the time horizon, {} quiescent, {} cut at the step limit",
         r.runs,
-        r.seconds,
-        r.runs as f64 / r.seconds.max(1e-9),
         r.seed,
         r.confidence,
         r.precision,
