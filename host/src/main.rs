@@ -52,6 +52,11 @@ enum Command {
     ///
     /// Example: `hindsight merge part-0.json part-1.json`
     Merge(cli::verify::MergeArgs),
+    /// Replay one run of a study (run k of --seed) and print every point as CSV: time,
+    /// step, event, origin, target, parameters, every property variable and verdict.
+    ///
+    /// Example: `hindsight trace examples/museum-scxml --run 3 --seed 1 -o run3.csv`
+    Trace(cli::verify::TraceArgs),
 }
 
 fn main() -> ExitCode {
@@ -70,6 +75,7 @@ fn main() -> ExitCode {
         Command::Validate(a) => cli::verify::validate(a),
         Command::Sweep(a) => cli::sweep::run(a),
         Command::Merge(a) => cli::verify::merge(a),
+        Command::Trace(a) => cli::verify::trace(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -303,3 +303,60 @@ fn shards_merged_equal_the_whole_study_and_gaps_are_refused() {
     assert_eq!(code, 2);
     let _ = std::fs::remove_dir_all(dir);
 }
+
+#[test]
+fn racing_timers_split_fairly_and_timing_is_exact() {
+    // a and b fire together after 2 units: which sends first is a fair choice (p = 1/2);
+    // c fires after 3 units, always last; a is sent exactly at time 2.
+    for seed in ["1", "2"] {
+        let r = json(&[
+            "verify",
+            "host/tests/data/verify/race",
+            "--rule",
+            "wilson",
+            "--precision",
+            "0.03",
+            "--seed",
+            seed,
+        ]);
+        let p = prop(&r, "a_before_b");
+        let (lo, hi) = (p["lower"].as_f64().unwrap(), p["upper"].as_f64().unwrap());
+        assert!(lo <= 0.5 && 0.5 <= hi, "seed {seed}: [{lo}, {hi}]");
+        for name in ["c_last", "a_at_2"] {
+            let p = prop(&r, name);
+            assert_eq!(p["successes"], p["runs"], "{name}");
+        }
+    }
+}
+
+#[test]
+fn trace_replays_one_run_as_csv() {
+    let (code, out, err) = hindsight(&[
+        "trace",
+        "host/tests/data/verify/race",
+        "--run",
+        "3",
+        "--seed",
+        "1",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let header = out.lines().next().unwrap();
+    assert!(
+        header.starts_with("time,step,event,origin,target,params,a,b,c,verdict_a_before_b"),
+        "{header}"
+    );
+    // Every send of the race appears, at its time.
+    assert!(out.contains("\n2,send,a_done,a,judge,"), "{out}");
+    assert!(out.contains("\n2,send,b_done,b,judge,"), "{out}");
+    assert!(out.contains("\n3,send,c_done,c,judge,"), "{out}");
+    // The same run twice gives the same text.
+    let (_, again, _) = hindsight(&[
+        "trace",
+        "host/tests/data/verify/race",
+        "--run",
+        "3",
+        "--seed",
+        "1",
+    ]);
+    assert_eq!(out, again);
+}

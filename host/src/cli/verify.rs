@@ -428,6 +428,64 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// Arguments of `hindsight trace`.
+#[derive(Debug, clap::Args)]
+pub struct TraceArgs {
+    /// The model, as for `verify`.
+    pub model: PathBuf,
+    /// The SCAN property file; default as for `verify`.
+    pub props: Option<PathBuf>,
+    /// The run to replay (its index in the study: run k uses stream k of the seed).
+    #[arg(long, default_value_t = 0)]
+    pub run: u64,
+    /// The study seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// A run ends when model time reaches this.
+    #[arg(long, default_value_t = 10_000)]
+    pub max_time: u64,
+    /// A run is cut at this many steps.
+    #[arg(long, default_value_t = 100_000_000)]
+    pub max_steps: u64,
+    /// Output CSV file; standard output when absent.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+}
+
+/// Runs `hindsight trace`: one run of the study, every point as CSV.
+pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
+    let (model, set, _) = load(&args.model, args.props.as_deref())?;
+    let run_cfg = RunConfig {
+        max_time: args.max_time,
+        max_steps: args.max_steps,
+        ..RunConfig::default()
+    };
+    let csv = replay_csv(&model, &set, &run_cfg, args.seed, args.run)?;
+    match &args.output {
+        Some(p) => {
+            std::fs::write(p, csv).map_err(|e| CliError::Failed(format!("{}: {e}", p.display())))?
+        }
+        None => print!("{csv}"),
+    }
+    Ok(())
+}
+
+/// Replays run `k` of a study with `seed` and returns its CSV (see `verify::record`).
+fn replay_csv(
+    model: &CompiledModel,
+    set: &PropertySet,
+    run_cfg: &RunConfig,
+    seed: u64,
+    k: u64,
+) -> Result<String, CliError> {
+    let mut judge = Judge::new(set).map_err(CliError::Failed)?;
+    let mut rec = crate::verify::record::Recorder::new(&mut judge, model);
+    rec.start();
+    let mut rng = crate::smc::runner::stream(seed, k);
+    Simulator::new(model).run(&mut rng, run_cfg, &mut rec);
+    Ok(rec.csv)
+}
+
 /// Replays each kept failing run (run k is stream k of the seed) and writes its CSV.
 fn save_failing(
     args: &VerifyArgs,
@@ -440,13 +498,9 @@ fn save_failing(
     std::fs::create_dir_all(&args.out).map_err(io)?;
     for (name, p) in set.guarantee_names().iter().zip(&result.properties) {
         for &k in &p.failing_runs {
-            let mut judge = Judge::new(set).map_err(CliError::Failed)?;
-            let mut rec = crate::verify::record::Recorder::new(&mut judge, model);
-            rec.start();
-            let mut rng = crate::smc::runner::stream(args.seed, k);
-            Simulator::new(model).run(&mut rng, run_cfg, &mut rec);
+            let csv = replay_csv(model, set, run_cfg, args.seed, k)?;
             let path = args.out.join(format!("{name}-run{k}.csv"));
-            std::fs::write(&path, &rec.csv).map_err(io)?;
+            std::fs::write(&path, csv).map_err(io)?;
             eprintln!("wrote {}", path.display());
         }
     }

@@ -2,7 +2,8 @@
 //!
 //! Columns: `time`, `step` (`init`, `send`, `receive`, `time`), `event`, `origin`,
 //! `target`, `params` (`name=value` separated by `;`), then one column per property
-//! variable (its value after the point) and one per property (its verdict at the point).
+//! variable (its value after the point) and one `verdict_NAME` per property (its verdict at
+//! the point).
 
 use std::fmt::Write;
 
@@ -29,7 +30,7 @@ impl<'j, 'a> Recorder<'j, 'a> {
             csv.push_str(&v.name);
         }
         for p in compiled.property_names() {
-            csv.push(',');
+            csv.push_str(",verdict_");
             csv.push_str(p);
         }
         csv.push('\n');
