@@ -360,3 +360,30 @@ fn trace_replays_one_run_as_csv() {
     ]);
     assert_eq!(out, again);
 }
+
+#[test]
+fn the_sequential_test_answers_threshold_questions() {
+    // P(heads) = 0.3: at least 0.2 is accepted, at least 0.5 rejected.
+    let r = json(&[
+        "verify",
+        COIN,
+        "--threshold",
+        "0.2",
+        "--precision",
+        "0.05",
+        "--seed",
+        "8",
+    ]);
+    assert_eq!(prop(&r, "heads")["decision"], "accept");
+    let r = json(&[
+        "verify",
+        COIN,
+        "--threshold",
+        "0.5",
+        "--precision",
+        "0.05",
+        "--seed",
+        "8",
+    ]);
+    assert_eq!(prop(&r, "heads")["decision"], "reject");
+}
