@@ -418,14 +418,7 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
             .map(|p| PropertyReport::new(&p.id, &p.estimate, &p.interval, &p.counts))
             .collect(),
     };
-    if args.json {
-        let text = serde_json::to_string_pretty(&report)
-            .map_err(|e| CliError::Failed(format!("json: {e}")))?;
-        println!("{text}");
-    } else {
-        print_table(&report);
-    }
-    Ok(())
+    print_report(&report, args.json)
 }
 
 /// Arguments of `hindsight trace`.
@@ -557,14 +550,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         save_failing(args, &model, &set, &run_cfg, &result)?;
     }
     let report = report(args, &props_path, &set, &result);
-    if args.json {
-        let text = serde_json::to_string_pretty(&report)
-            .map_err(|e| CliError::Failed(format!("json: {e}")))?;
-        println!("{text}");
-    } else {
-        print_table(&report);
-    }
-    Ok(())
+    print_report(&report, args.json)
 }
 
 fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -> Report {
@@ -588,6 +574,18 @@ fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -
             .map(|(name, p)| PropertyReport::new(name, &p.estimate, &p.interval, &p.counts))
             .collect(),
     }
+}
+
+/// Prints a report as JSON or as the table.
+fn print_report(report: &Report, json: bool) -> Result<(), CliError> {
+    if json {
+        let text = serde_json::to_string_pretty(report)
+            .map_err(|e| CliError::Failed(format!("json: {e}")))?;
+        println!("{text}");
+    } else {
+        print_table(report);
+    }
+    Ok(())
 }
 
 fn print_table(r: &Report) {
