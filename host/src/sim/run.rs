@@ -4,7 +4,7 @@ use super::compiled::{CompiledModel, DelayDef, Instr, MachineDef, SendTo};
 use super::ids::{MachineId, StateId};
 use super::observer::{Flow, Observer, SentMessage};
 use crate::expr::compile::{Code, Entropy, Env, EvalError, EvalErrorKind, MAX_PATH};
-use crate::expr::value::{Cell, StrId};
+use crate::expr::value::{Cell, StrId, Strings};
 use crate::expr::Value;
 use crate::model::{Diagnostic, Span};
 use std::collections::VecDeque;
@@ -229,6 +229,31 @@ impl std::fmt::Debug for Simulator<'_> {
 
 /// Unbiased uniform integer in `0..n` (`n > 0`), Lemire's multiply-and-reject
 /// (the division is only needed in the rare case the low half is small).
+/// The expression environment of machine `m`: its variables and its current event.
+/// A function over the two fields (not a method) so callers may hold other fields mutably.
+fn env<'s>(
+    ms: &'s [MachineRt],
+    pool: &'s [Slot],
+    m: usize,
+    rng: &'s mut dyn Entropy,
+    strings: &'s Strings,
+) -> Env<'s> {
+    let r = &ms[m];
+    let params: &[Cell] = if r.cur == NO_MSG {
+        &[]
+    } else {
+        &pool[r.cur as usize].params
+    };
+    Env {
+        vars: &r.vars,
+        params,
+        event: r.cur_event,
+        origin: r.cur_origin,
+        rng,
+        strings,
+    }
+}
+
 fn below(rng: &mut dyn Entropy, n: u32) -> u32 {
     let n = n as u64;
     let mut m = (rng.next_u64() as u128) * (n as u128);
@@ -733,20 +758,7 @@ impl<'m> Simulator<'m> {
                         return Err(self.internal(m, pc));
                     };
                     let res = {
-                        let r = &self.ms[m];
-                        let params: &[Cell] = if r.cur == NO_MSG {
-                            &[]
-                        } else {
-                            &self.pool[r.cur as usize].params
-                        };
-                        let mut env = Env {
-                            vars: &r.vars,
-                            params,
-                            event: r.cur_event,
-                            origin: r.cur_origin,
-                            rng: &mut *rng,
-                            strings: &model.strings,
-                        };
+                        let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
                         eval_code(value, &mut env, scratch)
                     };
                     let scratch = &self.scratch[m][*sc as usize];
@@ -783,20 +795,7 @@ impl<'m> Simulator<'m> {
                         return Err(self.internal(m, pc));
                     };
                     let res = {
-                        let r = &self.ms[m];
-                        let params: &[Cell] = if r.cur == NO_MSG {
-                            &[]
-                        } else {
-                            &self.pool[r.cur as usize].params
-                        };
-                        let mut env = Env {
-                            vars: &r.vars,
-                            params,
-                            event: r.cur_event,
-                            origin: r.cur_origin,
-                            rng: &mut *rng,
-                            strings: &model.strings,
-                        };
+                        let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
                         place
                             .eval_indices(&mut env, &mut self.idx)
                             .and_then(|()| eval_code(value, &mut env, scratch))
@@ -814,20 +813,7 @@ impl<'m> Simulator<'m> {
                 }
                 Instr::If { cond, else_pc } => {
                     let res = {
-                        let r = &self.ms[m];
-                        let params: &[Cell] = if r.cur == NO_MSG {
-                            &[]
-                        } else {
-                            &self.pool[r.cur as usize].params
-                        };
-                        let mut env = Env {
-                            vars: &r.vars,
-                            params,
-                            event: r.cur_event,
-                            origin: r.cur_origin,
-                            rng: &mut *rng,
-                            strings: &model.strings,
-                        };
+                        let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
                         cond(&mut env)
                     };
                     match res {
@@ -856,20 +842,7 @@ impl<'m> Simulator<'m> {
                     let mut has = false;
                     if let Some(f) = value {
                         let res = {
-                            let r = &self.ms[m];
-                            let params: &[Cell] = if r.cur == NO_MSG {
-                                &[]
-                            } else {
-                                &self.pool[r.cur as usize].params
-                            };
-                            let mut env = Env {
-                                vars: &r.vars,
-                                params,
-                                event: r.cur_event,
-                                origin: r.cur_origin,
-                                rng: &mut *rng,
-                                strings: &model.strings,
-                            };
+                            let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
                             f(&mut env, scratch)
                         };
                         if let Err(e) = res {
@@ -905,20 +878,8 @@ impl<'m> Simulator<'m> {
                                 DelayDef::Const(n) => *n,
                                 DelayDef::Expr(f) => {
                                     let res = {
-                                        let r = &self.ms[m];
-                                        let params: &[Cell] = if r.cur == NO_MSG {
-                                            &[]
-                                        } else {
-                                            &self.pool[r.cur as usize].params
-                                        };
-                                        let mut env = Env {
-                                            vars: &r.vars,
-                                            params,
-                                            event: r.cur_event,
-                                            origin: r.cur_origin,
-                                            rng: &mut *rng,
-                                            strings: &model.strings,
-                                        };
+                                        let mut env =
+                                            env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
                                         f(&mut env)
                                     };
                                     match res {
@@ -960,20 +921,8 @@ impl<'m> Simulator<'m> {
                         }
                         SendTo::Expr(f) => {
                             let res = {
-                                let r = &self.ms[m];
-                                let params: &[Cell] = if r.cur == NO_MSG {
-                                    &[]
-                                } else {
-                                    &self.pool[r.cur as usize].params
-                                };
-                                let mut env = Env {
-                                    vars: &r.vars,
-                                    params,
-                                    event: r.cur_event,
-                                    origin: r.cur_origin,
-                                    rng: &mut *rng,
-                                    strings: &model.strings,
-                                };
+                                let mut env =
+                                    env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
                                 f(&mut env)
                             };
                             let s = match res {
@@ -1036,20 +985,7 @@ impl<'m> Simulator<'m> {
                         }
                     }
                     let res = {
-                        let r = &self.ms[m];
-                        let params: &[Cell] = if r.cur == NO_MSG {
-                            &[]
-                        } else {
-                            &self.pool[r.cur as usize].params
-                        };
-                        let mut env = Env {
-                            vars: &r.vars,
-                            params,
-                            event: r.cur_event,
-                            origin: r.cur_origin,
-                            rng: &mut *rng,
-                            strings: &model.strings,
-                        };
+                        let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
                         let mut res = Ok(());
                         for (i, f) in &sd.params {
                             if let Some(dst) = out.get_mut(*i as usize) {
