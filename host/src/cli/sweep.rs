@@ -51,16 +51,20 @@ pub struct SweepArgs {
     pub max_time: u64,
 }
 
-/// Replaces every number inside `[...]` bounds of `formula` with `value`.
+/// Replaces every number inside `[...]` bounds of `formula` with `value` (text inside
+/// `{...}` atoms is left alone).
 pub fn set_bounds(formula: &str, value: u64) -> (String, usize) {
     let mut out = String::with_capacity(formula.len());
     let mut replaced = 0;
     let mut in_bound = false;
+    let mut atom_depth = 0usize;
     let mut chars = formula.chars().peekable();
     while let Some(c) = chars.next() {
         match c {
-            '[' => in_bound = true,
-            ']' => in_bound = false,
+            '{' => atom_depth += 1,
+            '}' => atom_depth = atom_depth.saturating_sub(1),
+            '[' if atom_depth == 0 => in_bound = true,
+            ']' if atom_depth == 0 => in_bound = false,
             d if in_bound && d.is_ascii_digit() => {
                 while chars.peek().is_some_and(|c| c.is_ascii_digit()) {
                     chars.next();
@@ -173,5 +177,9 @@ mod tests {
         );
         assert_eq!(set_bounds("{a} since[2:40] {b}", 5).0, "{a} since[5:5] {b}");
         assert_eq!(set_bounds("once {a}", 5).1, 0);
+        assert_eq!(
+            set_bounds("once[3:] {a[2] == 1}", 5).0,
+            "once[5:] {a[2] == 1}"
+        );
     }
 }
