@@ -4,6 +4,7 @@ pub mod cli;
 pub mod expr;
 pub mod model;
 pub mod props;
+pub mod robot;
 pub mod sim;
 pub mod smc;
 pub mod tracefile;

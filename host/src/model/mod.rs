@@ -20,7 +20,7 @@ pub mod ast;
 mod scxml;
 pub mod source;
 pub mod types;
-mod xml;
+pub mod xml;
 
 pub use ast::Machine;
 pub use source::{Diagnostic, Diagnostics, FileId, SourceMap, Span};
@@ -63,7 +63,16 @@ impl ModelSource {
         }
     }
 
-    fn check_names(&self, errs: &mut Diagnostics) {
+    /// Adds a machine given as an element tree (a lowered robot model); errors go to `errs`.
+    pub fn add_machine_tree(&mut self, root: &xml::Element, file: FileId, errs: &mut Diagnostics) {
+        match scxml::read_machine_tree(&self.sources, root, file) {
+            Ok(machine) => self.machines.push(machine),
+            Err(ds) => errs.0.extend(ds),
+        }
+    }
+
+    /// Errors for machine names used twice.
+    pub(crate) fn check_names(&self, errs: &mut Diagnostics) {
         for (i, m) in self.machines.iter().enumerate() {
             if let Some(first) = self.machines[..i]
                 .iter()

@@ -8,11 +8,23 @@ use super::xml::{self, Element, Node};
 /// Reads the SCXML file `file` (already in `sm`) into a machine.
 pub fn read_machine(sm: &SourceMap, file: FileId) -> Result<Machine, Vec<Diagnostic>> {
     let root = xml::parse(sm, file).map_err(|d| vec![d])?;
+    read_machine_tree(sm, &root, file)
+}
+
+/// Reads a machine from an element tree already in memory (a lowered robot model).
+///
+/// `file` names the machine when the root has no `name`; spans in `root` may point into
+/// any file of `sm` (a generated element carries the span of what it was made from).
+pub fn read_machine_tree(
+    sm: &SourceMap,
+    root: &Element,
+    file: FileId,
+) -> Result<Machine, Vec<Diagnostic>> {
     let mut r = Reader {
         sm,
         errs: Vec::new(),
     };
-    let m = r.machine(&root, file);
+    let m = r.machine(root, file);
     if r.errs.is_empty() {
         Ok(m)
     } else {

@@ -13,8 +13,10 @@ pub(crate) const MAX_DEPTH: usize = 256;
 
 /// An attribute: its name and its unescaped value, with spans of both.
 #[derive(Clone, Debug)]
-pub(crate) struct Attr {
+pub struct Attr {
+    /// The attribute's name.
     pub name: String,
+    /// Span of the name's first byte.
     pub name_span: Span,
     /// The unescaped value.
     pub value: String,
@@ -24,7 +26,8 @@ pub(crate) struct Attr {
 
 /// A child of an element.
 #[derive(Clone, Debug)]
-pub(crate) enum Node {
+pub enum Node {
+    /// A child element.
     Element(Element),
     /// A comment's text (between `<!--` and `-->`).
     Comment(String, Span),
@@ -34,15 +37,93 @@ pub(crate) enum Node {
 
 /// An element with its attributes and children.
 #[derive(Clone, Debug)]
-pub(crate) struct Element {
+pub struct Element {
+    /// The tag name.
     pub name: String,
     /// Span of the `<` that opens the element.
     pub span: Span,
+    /// Attributes in document order.
     pub attrs: Vec<Attr>,
+    /// Children in document order.
     pub children: Vec<Node>,
 }
 
 impl Element {
+    /// A new element with no attributes or children; `span` is where it comes from
+    /// (for a generated element, the source element that produced it).
+    pub fn new(name: impl Into<String>, span: Span) -> Element {
+        Element {
+            name: name.into(),
+            span,
+            attrs: Vec::new(),
+            children: Vec::new(),
+        }
+    }
+
+    /// Sets attribute `name` to `value` (replacing it if present); its spans are the element's.
+    pub fn set_attr(&mut self, name: &str, value: impl Into<String>) {
+        self.set_attr_at(name, value, self.span);
+    }
+
+    /// Sets attribute `name` to `value` with `span` as the value's position (errors about the
+    /// value point there, for example at the source attribute it was rewritten from).
+    pub fn set_attr_at(&mut self, name: &str, value: impl Into<String>, span: Span) {
+        let value = value.into();
+        match self.attrs.iter_mut().find(|a| a.name == name) {
+            Some(a) => {
+                a.value = value;
+                a.value_span = span;
+            }
+            None => self.attrs.push(Attr {
+                name: name.to_string(),
+                name_span: span,
+                value,
+                value_span: span,
+            }),
+        }
+    }
+
+    /// The element with attribute `name` set to `value`.
+    pub fn with_attr(mut self, name: &str, value: impl Into<String>) -> Element {
+        self.set_attr(name, value);
+        self
+    }
+
+    /// Removes attribute `name`; returns it if it was present.
+    pub fn remove_attr(&mut self, name: &str) -> Option<Attr> {
+        let i = self.attrs.iter().position(|a| a.name == name)?;
+        Some(self.attrs.remove(i))
+    }
+
+    /// The value of attribute `name`, if present.
+    pub fn attr_value(&self, name: &str) -> Option<&str> {
+        self.attr(name).map(|a| a.value.as_str())
+    }
+
+    /// Appends a child element.
+    pub fn push(&mut self, child: Element) {
+        self.children.push(Node::Element(child));
+    }
+
+    /// The element with `child` appended.
+    pub fn with_child(mut self, child: Element) -> Element {
+        self.push(child);
+        self
+    }
+
+    /// Appends a comment (for example `TYPE x:int32`, which types the next `<data>`/`<param>`).
+    pub fn push_comment(&mut self, text: impl Into<String>) {
+        self.children.push(Node::Comment(text.into(), self.span));
+    }
+
+    /// Child elements, mutably, skipping comments and text.
+    pub fn elements_mut(&mut self) -> impl Iterator<Item = &mut Element> {
+        self.children.iter_mut().filter_map(|n| match n {
+            Node::Element(e) => Some(e),
+            _ => None,
+        })
+    }
+
     /// The attribute called `name`, if present.
     pub fn attr(&self, name: &str) -> Option<&Attr> {
         self.attrs.iter().find(|a| a.name == name)
@@ -98,7 +179,7 @@ fn offset_in(src: &str, part: &[u8]) -> Option<u32> {
 }
 
 /// Parses the text of file `file` into its root element.
-pub(crate) fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
+pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
     let Some(f) = sm.file(file) else {
         return Err(Diagnostic::file(
             "<unknown>",
