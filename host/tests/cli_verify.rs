@@ -192,7 +192,7 @@ fn sweep_shows_the_step_at_the_recurrence_threshold() {
         "9",
         "--to",
         "10",
-        "--max-runs",
+        "--runs",
         "10",
         "--seed",
         "2",
@@ -204,8 +204,21 @@ fn sweep_shows_the_step_at_the_recurrence_threshold() {
         .map(|l| l.split(',').collect())
         .collect();
     assert_eq!(rows.len(), 2, "{out}");
-    assert_eq!((rows[0][0], rows[0][1]), ("9", "0.0000"), "{out}");
-    assert_eq!((rows[1][0], rows[1][1]), ("10", "1.0000"), "{out}");
+    // property,bound,successes,failures,unknown,probability,...
+    assert_eq!(
+        (rows[0][1], rows[0][2], rows[0][3]),
+        ("9", "0", "10"),
+        "{out}"
+    );
+    assert_eq!(
+        (rows[1][1], rows[1][2], rows[1][3]),
+        ("10", "10", "0"),
+        "{out}"
+    );
+    assert!(
+        err.contains("visitors_recurrence: every run succeeds from bound 10 on"),
+        "{err}"
+    );
     let (code, _, err) = hindsight(&[
         "sweep",
         "examples/museum-scxml",
@@ -217,6 +230,68 @@ fn sweep_shows_the_step_at_the_recurrence_threshold() {
         "2",
     ]);
     assert_eq!(code, 2, "absence has no bound: {err}");
+    let (code, _, err) = hindsight(&[
+        "sweep",
+        "examples/museum-scxml",
+        "--from",
+        "1",
+        "--to",
+        "2s",
+    ]);
+    assert_eq!(code, 2, "mixed units: {err}");
+}
+
+#[test]
+fn sweep_finds_every_threshold_of_the_paper_and_draws_them() {
+    let dir = std::env::temp_dir().join(format!("hindsight-sweep-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("sweep.svg");
+    // Every bounded requirement of the museum model around the paper's steps
+    // (62, 10, 2, 10): each bound's variants are judged on the same runs.
+    let (code, out, err) = hindsight(&[
+        "sweep",
+        "examples/museum-scxml",
+        "--from",
+        "1",
+        "--to",
+        "64",
+        "--runs",
+        "4",
+        "--seed",
+        "5",
+        "--json",
+        "--svg",
+        svg.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let doc: serde_json::Value = serde_json::from_str(&out).expect("one JSON object");
+    let thresholds: Vec<(String, String)> = doc["properties"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            (
+                p["property"].as_str().unwrap().to_string(),
+                p["threshold"].as_str().unwrap_or("none").to_string(),
+            )
+        })
+        .collect();
+    let want = [
+        ("alarm_response", "62"),
+        ("battery_recurrence", "10"),
+        ("poi_response", "2"),
+        ("visitors_recurrence", "10"),
+    ];
+    let want: Vec<(String, String)> = want
+        .iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect();
+    assert_eq!(thresholds, want);
+    let picture = std::fs::read_to_string(&svg).unwrap();
+    assert!(picture.starts_with("<svg"));
+    assert_eq!(picture.matches("<polyline").count(), 4);
+    assert!(picture.contains("threshold 62"));
+    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]

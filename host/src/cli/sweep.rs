@@ -1,59 +1,223 @@
 //! `hindsight sweep`: one property's success rate as every time bound in it takes each value of a range.
 
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Duration;
 
 use super::verify::{load, study};
-use super::CliError;
+use super::{plot, CliError};
 use crate::props::{self, SourceText};
-use crate::sim::{CompiledModel, RunConfig};
-use crate::smc::stats::RuleConfig;
+use crate::sim::RunConfig;
+use crate::smc::stats::{RuleConfig, RuleKind};
 use crate::smc::StudyConfig;
 use crate::verify::observe::PropertySet;
 
 /// Arguments of `hindsight sweep`.
 #[derive(Debug, clap::Args)]
+#[command(after_help = "\
+Every time bound in a property's formula ([a:], [:b], [a:b]) takes each value from
+--from to --to in steps of --step. Bounds are model time units (integers), or durations
+with a unit (100ms, 2.5s) when the model has a time unit (robot models do).
+
+Each property's variants are judged on the same runs (one study per property, --runs
+runs, Clopper-Pearson intervals). The threshold is the smallest bound from which every
+run satisfied the property at every larger bound of the range.
+
+Output: CSV `property,bound,successes,failures,unknown,probability,lower,upper` on stdout,
+the thresholds on stderr (or everything as one JSON object with --json), and with --svg
+a chart of success rate against the bound.
+
+Example:
+  hindsight sweep examples/museum-scxml --property battery_recurrence --from 5 --to 15 --svg sweep.svg")]
 pub struct SweepArgs {
     /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
     pub model: PathBuf,
     /// The SCAN property file; default as for `verify`.
     pub props: Option<PathBuf>,
-    /// The guarantee to sweep; every integer bound in its formula (`[a:]`, `[:b]`,
-    /// `[a:b]`) takes the swept value.
+    /// A guarantee to sweep (repeat for several); default: every guarantee with a time bound.
+    #[arg(long = "property")]
+    pub properties: Vec<String>,
+    /// First bound value (`62`, or `6.2s` with a unit).
     #[arg(long)]
-    pub property: String,
-    /// First bound value.
+    pub from: String,
+    /// Last bound value, inclusive.
     #[arg(long)]
-    pub from: u64,
-    /// Last bound value (inclusive).
+    pub to: String,
+    /// Step between values; default: one unit of `--from`'s last digit (`1`, `0.1s`).
     #[arg(long)]
-    pub to: u64,
-    /// Step between values.
-    #[arg(long, default_value_t = 1)]
-    pub step: u64,
+    pub step: Option<String>,
+    /// Runs per property (every bound of a property is judged on the same runs).
+    #[arg(long, default_value_t = 200)]
+    pub runs: u64,
     /// Confidence of the intervals.
     #[arg(long, default_value_t = 0.95)]
     pub confidence: f64,
-    /// Half-width of the intervals (SCAN's adaptive rule).
-    #[arg(long, default_value_t = 0.01)]
-    pub precision: f64,
-    /// Study seed (the same for every bound).
+    /// Study seed (the same for every property).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// Worker threads (0: all cores).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// Runs per bound at most.
-    #[arg(long)]
-    pub max_runs: Option<u64>,
     /// A run ends when model time reaches this.
     #[arg(long, default_value_t = 10_000)]
     pub max_time: u64,
+    /// Also write an SVG chart of success rate against the bound to this file.
+    #[arg(long)]
+    pub svg: Option<PathBuf>,
+    /// Print one JSON object instead of CSV and the threshold summary.
+    #[arg(long)]
+    pub json: bool,
 }
 
-/// Replaces every number inside `[...]` bounds of `formula` with `value` (text inside
-/// `{...}` atoms is left alone).
-pub fn set_bounds(formula: &str, value: u64) -> (String, usize) {
+/// A bound value as written: model time units, or an exact duration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum BoundValue {
+    /// A plain integer: model time units.
+    Units(u64),
+    /// A duration with a unit, in nanoseconds.
+    Nanos(u64),
+}
+
+impl BoundValue {
+    /// Parses `62`, `6.2s`, `100ms`, `1.5min`, `250us`, `10ns`.
+    pub fn parse(text: &str) -> Result<BoundValue, String> {
+        let t = text.trim();
+        let split = t
+            .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .unwrap_or(t.len());
+        let (num, unit) = t.split_at(split);
+        let bad = || format!("bad bound `{text}` (expected e.g. `62`, `6.2s`, `100ms`)");
+        if num.is_empty() || num.starts_with('.') || num.ends_with('.') {
+            return Err(bad());
+        }
+        let (int, frac) = num.split_once('.').unwrap_or((num, ""));
+        if frac.contains('.') {
+            return Err(bad());
+        }
+        let scale: u64 = match unit {
+            "" if frac.is_empty() => return int.parse().map(BoundValue::Units).map_err(|_| bad()),
+            "" => return Err(format!("bound `{text}` has a fraction but no unit")),
+            "ns" => 1,
+            "us" => 1_000,
+            "ms" => 1_000_000,
+            "s" => 1_000_000_000,
+            "min" => 60_000_000_000,
+            _ => return Err(bad()),
+        };
+        let int: u128 = int.parse().map_err(|_| bad())?;
+        let mut ns = int * scale as u128;
+        let mut place = scale as u128;
+        for d in frac.bytes() {
+            if place % 10 != 0 {
+                return Err(format!("bound `{text}` is finer than a nanosecond"));
+            }
+            place /= 10;
+            ns += (d - b'0') as u128 * place;
+        }
+        u64::try_from(ns)
+            .map(BoundValue::Nanos)
+            .map_err(|_| format!("bound `{text}` is too large"))
+    }
+
+    /// The default step for a range starting at `text`: one unit of its last digit.
+    fn default_step(text: &str) -> Result<BoundValue, String> {
+        let t = text.trim();
+        match t.split_once('.') {
+            None => match BoundValue::parse(t)? {
+                BoundValue::Units(_) => Ok(BoundValue::Units(1)),
+                BoundValue::Nanos(_) => {
+                    let unit = t.trim_start_matches(|c: char| c.is_ascii_digit());
+                    BoundValue::parse(&format!("1{unit}"))
+                }
+            },
+            Some((_, rest)) => {
+                let digits = rest.chars().take_while(char::is_ascii_digit).count();
+                let unit = &rest[digits..];
+                BoundValue::parse(&format!(
+                    "0.{}1{unit}",
+                    "0".repeat(digits.saturating_sub(1))
+                ))
+            }
+        }
+    }
+
+    fn raw(self) -> u64 {
+        match self {
+            BoundValue::Units(v) | BoundValue::Nanos(v) => v,
+        }
+    }
+
+    fn with_raw(self, v: u64) -> BoundValue {
+        match self {
+            BoundValue::Units(_) => BoundValue::Units(v),
+            BoundValue::Nanos(_) => BoundValue::Nanos(v),
+        }
+    }
+
+    /// The text put into the formula (exact: nanoseconds for durations).
+    fn formula_text(self) -> String {
+        match self {
+            BoundValue::Units(v) => v.to_string(),
+            BoundValue::Nanos(v) => format!("{v}ns"),
+        }
+    }
+
+    /// The value on the chart's x axis: units, or seconds.
+    fn axis(self) -> f64 {
+        match self {
+            BoundValue::Units(v) => v as f64,
+            BoundValue::Nanos(v) => v as f64 / 1e9,
+        }
+    }
+
+    /// The value as people read it: `62`, `6.2s`.
+    fn display(self) -> String {
+        match self {
+            BoundValue::Units(v) => v.to_string(),
+            BoundValue::Nanos(v) => {
+                let s = format!("{}.{:09}", v / 1_000_000_000, v % 1_000_000_000);
+                format!("{}s", s.trim_end_matches('0').trim_end_matches('.'))
+            }
+        }
+    }
+}
+
+/// The values from `from` to `to` (inclusive) in steps of `step`; all three of one kind.
+pub fn grid(from: &str, to: &str, step: Option<&str>) -> Result<Vec<BoundValue>, String> {
+    let a = BoundValue::parse(from)?;
+    let b = BoundValue::parse(to)?;
+    let s = match step {
+        Some(s) => BoundValue::parse(s)?,
+        None => BoundValue::default_step(from)?,
+    };
+    let same = |x: BoundValue, y: BoundValue| {
+        matches!(
+            (x, y),
+            (BoundValue::Units(_), BoundValue::Units(_))
+                | (BoundValue::Nanos(_), BoundValue::Nanos(_))
+        )
+    };
+    if !same(a, b) || !same(a, s) {
+        return Err("--from, --to and --step must all be plain numbers or all durations".into());
+    }
+    if s.raw() == 0 || a.raw() > b.raw() {
+        return Err("need --from <= --to and a step above zero".into());
+    }
+    let count = (b.raw() - a.raw()) / s.raw() + 1;
+    if count > 1000 {
+        return Err(format!(
+            "{count} bound values: at most 1000 (use a larger --step)"
+        ));
+    }
+    Ok((0..count)
+        .map(|i| a.with_raw(a.raw() + i * s.raw()))
+        .collect())
+}
+
+/// Replaces every number inside `[...]` bounds of `formula` (with its unit, if any: `62`,
+/// `2.5s`) by `value`; text inside `{...}` atoms is left alone. Returns the new formula and
+/// how many numbers were replaced.
+pub fn set_bounds(formula: &str, value: &str) -> (String, usize) {
     let mut out = String::with_capacity(formula.len());
     let mut replaced = 0;
     let mut in_bound = false;
@@ -66,10 +230,13 @@ pub fn set_bounds(formula: &str, value: u64) -> (String, usize) {
             '[' if atom_depth == 0 => in_bound = true,
             ']' if atom_depth == 0 => in_bound = false,
             d if in_bound && d.is_ascii_digit() => {
-                while chars.peek().is_some_and(|c| c.is_ascii_digit()) {
+                while chars
+                    .peek()
+                    .is_some_and(|c| c.is_ascii_alphanumeric() || *c == '.' || *c == '_')
+                {
                     chars.next();
                 }
-                out.push_str(&value.to_string());
+                out.push_str(value);
                 replaced += 1;
                 continue;
             }
@@ -80,38 +247,85 @@ pub fn set_bounds(formula: &str, value: u64) -> (String, usize) {
     (out, replaced)
 }
 
-/// Runs `hindsight sweep`: prints `bound,probability,lower,upper,runs` as CSV.
+/// One bound's counts for one property.
+#[derive(Clone, Debug, serde::Serialize)]
+struct SweepPoint {
+    bound: String,
+    successes: u64,
+    failures: u64,
+    unknown: u64,
+    probability: Option<f64>,
+    lower: f64,
+    upper: f64,
+}
+
+/// One property's sweep.
+#[derive(Clone, Debug, serde::Serialize)]
+struct SweepCurve {
+    property: String,
+    /// The smallest bound from which every run succeeded at every larger bound.
+    threshold: Option<String>,
+    points: Vec<SweepPoint>,
+}
+
+/// The smallest index from which every point has only successes (and at least one).
+fn threshold_index(points: &[SweepPoint]) -> Option<usize> {
+    let all_ok = |p: &SweepPoint| p.failures == 0 && p.unknown == 0 && p.successes > 0;
+    let first_bad_from_end = points.iter().rposition(|p| !all_ok(p));
+    match first_bad_from_end {
+        None if points.is_empty() => None,
+        None => Some(0),
+        Some(i) if i + 1 < points.len() => Some(i + 1),
+        Some(_) => None,
+    }
+}
+
+/// Runs `hindsight sweep`.
 pub fn run(args: &SweepArgs) -> Result<(), CliError> {
-    if args.step == 0 || args.from > args.to {
-        return Err(CliError::Input(
-            "sweep: need --from <= --to and --step > 0".into(),
-        ));
+    let values = grid(&args.from, &args.to, args.step.as_deref()).map_err(CliError::Input)?;
+    if args.runs == 0 {
+        return Err(CliError::Input("sweep: --runs must be at least 1".into()));
     }
     let (model, _, props_path) = load(&args.model, args.props.as_deref())?;
     let file = props::parse_file(&props_path).map_err(|d| CliError::Input(d.to_string()))?;
-    let Some(target) = file
-        .guarantees
-        .iter()
-        .find(|g| g.id == args.property)
-        .cloned()
-    else {
-        return Err(CliError::Input(format!(
-            "{}: no guarantee `{}`",
-            props_path.display(),
-            args.property
-        )));
+    let targets: Vec<props::Property> = if args.properties.is_empty() {
+        file.guarantees
+            .iter()
+            .filter(|g| set_bounds(g.formula.as_str(), "0").1 > 0)
+            .cloned()
+            .collect()
+    } else {
+        let mut out = Vec::new();
+        for id in &args.properties {
+            let Some(g) = file.guarantees.iter().find(|g| &g.id == id) else {
+                let known: Vec<&str> = file.guarantees.iter().map(|g| g.id.as_str()).collect();
+                return Err(CliError::Input(format!(
+                    "{}: no guarantee `{id}` (there are: {})",
+                    props_path.display(),
+                    known.join(", ")
+                )));
+            };
+            if set_bounds(g.formula.as_str(), "0").1 == 0 {
+                return Err(CliError::Input(format!(
+                    "{}: guarantee `{id}` has no time bound to sweep",
+                    props_path.display()
+                )));
+            }
+            out.push(g.clone());
+        }
+        out
     };
-    if set_bounds(target.formula.as_str(), 0).1 == 0 {
+    if targets.is_empty() {
         return Err(CliError::Input(format!(
-            "{}: guarantee `{}` has no time bound to sweep",
-            props_path.display(),
-            args.property
+            "{}: no guarantee has a time bound to sweep",
+            props_path.display()
         )));
     }
     let rule = RuleConfig {
+        kind: RuleKind::ClopperPearson,
         confidence: args.confidence,
-        precision: args.precision,
-        ..RuleConfig::default()
+        // Never done before `--runs`: every bound gets the same runs.
+        precision: 1e-9,
     };
     let run_cfg = RunConfig {
         max_time: args.max_time,
@@ -120,66 +334,225 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     let study_cfg = StudyConfig {
         seed: args.seed,
         threads: args.threads,
-        max_runs: args.max_runs,
+        max_runs: Some(args.runs),
         keep_failing: 0,
         progress_every: Duration::from_millis(200),
     };
-    println!("bound,probability,lower,upper,runs");
-    let mut t = args.from;
-    while t <= args.to {
-        let rate = one_bound(&model, &file, &target, t, &run_cfg, &study_cfg, &rule)?;
-        println!("{t},{:.4},{:.4},{:.4},{}", rate.0, rate.1, rate.2, rate.3);
-        t = match t.checked_add(args.step) {
-            Some(n) => n,
-            None => break,
-        };
+    let show_progress = !args.json && std::io::stderr().is_terminal();
+    if !args.json {
+        println!("property,bound,successes,failures,unknown,probability,lower,upper");
+    }
+    let mut curves = Vec::new();
+    for target in &targets {
+        let mut one = file.clone();
+        one.guarantees = values
+            .iter()
+            .map(|v| {
+                let mut g = target.clone();
+                g.id = format!("{}@{}", target.id, v.display());
+                g.formula = SourceText::generated(
+                    set_bounds(target.formula.as_str(), &v.formula_text()).0,
+                    target.at,
+                );
+                g
+            })
+            .collect();
+        let set = PropertySet::new(&one, &model).map_err(CliError::Input)?;
+        let r = study(&model, &set, &run_cfg, &study_cfg, &rule, show_progress)?;
+        let points: Vec<SweepPoint> = values
+            .iter()
+            .zip(&r.properties)
+            .map(|(v, p)| SweepPoint {
+                bound: v.display(),
+                successes: p.counts.successes,
+                failures: p.counts.failures,
+                unknown: p.counts.unknown,
+                probability: p.estimate.estimate,
+                lower: p.interval.lower,
+                upper: p.interval.upper,
+            })
+            .collect();
+        if !args.json {
+            for p in &points {
+                println!(
+                    "{},{},{},{},{},{},{:.4},{:.4}",
+                    target.id,
+                    p.bound,
+                    p.successes,
+                    p.failures,
+                    p.unknown,
+                    p.probability.map_or("".into(), |x| format!("{x:.4}")),
+                    p.lower,
+                    p.upper
+                );
+            }
+        }
+        let threshold = threshold_index(&points).map(|i| points[i].bound.clone());
+        curves.push(SweepCurve {
+            property: target.id.clone(),
+            threshold,
+            points,
+        });
+    }
+    finish(args, &values, curves)
+}
+
+/// Prints the thresholds (or the JSON object) and writes the chart.
+fn finish(
+    args: &SweepArgs,
+    values: &[BoundValue],
+    curves: Vec<SweepCurve>,
+) -> Result<(), CliError> {
+    let unit_label = match values.first() {
+        Some(BoundValue::Nanos(_)) => "bound (s)",
+        _ => "bound (model time units)",
+    };
+    if args.json {
+        let doc = serde_json::json!({
+            "runs": args.runs,
+            "seed": args.seed,
+            "confidence": args.confidence,
+            "properties": curves,
+        });
+        println!("{doc}");
+    } else {
+        for c in &curves {
+            match &c.threshold {
+                Some(t) => eprintln!("{}: every run succeeds from bound {t} on", c.property),
+                None => eprintln!(
+                    "{}: no bound in the range makes every run succeed",
+                    c.property
+                ),
+            }
+        }
+    }
+    if let Some(path) = &args.svg {
+        let plot_curves: Vec<plot::Curve> = curves
+            .iter()
+            .map(|c| {
+                let points: Vec<plot::Point> = values
+                    .iter()
+                    .zip(&c.points)
+                    .map(|(v, p)| plot::Point {
+                        x: v.axis(),
+                        rate: p.probability.unwrap_or(f64::NAN),
+                        lower: p.lower,
+                        upper: p.upper,
+                    })
+                    .filter(|p| p.rate.is_finite())
+                    .collect();
+                let threshold = threshold_index(&c.points).map(|i| values[i].axis());
+                plot::Curve {
+                    name: c.property.clone(),
+                    points,
+                    threshold,
+                }
+            })
+            .collect();
+        let title = format!(
+            "{}: success rate against the bound ({} runs each)",
+            args.model.display(),
+            args.runs
+        );
+        std::fs::write(path, plot::svg(&title, unit_label, &plot_curves))
+            .map_err(|e| CliError::Failed(format!("{}: cannot write: {e}", path.display())))?;
+        if !args.json {
+            eprintln!("wrote {}", path.display());
+        }
     }
     Ok(())
 }
 
-fn one_bound(
-    model: &CompiledModel,
-    file: &props::PropertyFile,
-    target: &props::Property,
-    t: u64,
-    run_cfg: &RunConfig,
-    study_cfg: &StudyConfig,
-    rule: &RuleConfig,
-) -> Result<(f64, f64, f64, u64), CliError> {
-    let mut one = file.clone();
-    let mut g = target.clone();
-    g.formula = SourceText::generated(set_bounds(target.formula.as_str(), t).0, target.at);
-    one.guarantees = vec![g];
-    let set = PropertySet::new(&one, model).map_err(CliError::Input)?;
-    let r = study(model, &set, run_cfg, study_cfg, rule, false)?;
-    let p = &r.properties[0];
-    Ok((
-        p.estimate.estimate.unwrap_or(f64::NAN),
-        p.interval.lower,
-        p.interval.upper,
-        p.counts.judged(),
-    ))
-}
-
 #[cfg(test)]
 mod tests {
-    use super::set_bounds;
+    use super::*;
 
     #[test]
     fn every_bound_is_replaced_and_nothing_else() {
         let f = "historically((once[10:] true) -> once[:10] {x == 10})";
         assert_eq!(
-            set_bounds(f, 7),
+            set_bounds(f, "7"),
             (
                 "historically((once[7:] true) -> once[:7] {x == 10})".to_string(),
                 2
             )
         );
-        assert_eq!(set_bounds("{a} since[2:40] {b}", 5).0, "{a} since[5:5] {b}");
-        assert_eq!(set_bounds("once {a}", 5).1, 0);
         assert_eq!(
-            set_bounds("once[3:] {a[2] == 1}", 5).0,
+            set_bounds("{a} since[2:40] {b}", "5").0,
+            "{a} since[5:5] {b}"
+        );
+        assert_eq!(set_bounds("once {a}", "5").1, 0);
+        assert_eq!(
+            set_bounds("once[3:] {a[2] == 1}", "5").0,
             "once[5:] {a[2] == 1}"
         );
+        assert_eq!(
+            set_bounds("once[2.5s:] {a}", "100ns"),
+            ("once[100ns:] {a}".to_string(), 1)
+        );
+    }
+
+    #[test]
+    fn bound_values_parse_exactly() {
+        assert_eq!(BoundValue::parse("62"), Ok(BoundValue::Units(62)));
+        assert_eq!(
+            BoundValue::parse("6.2s"),
+            Ok(BoundValue::Nanos(6_200_000_000))
+        );
+        assert_eq!(
+            BoundValue::parse("100ms"),
+            Ok(BoundValue::Nanos(100_000_000))
+        );
+        assert_eq!(
+            BoundValue::parse("1.5min"),
+            Ok(BoundValue::Nanos(90_000_000_000))
+        );
+        assert!(BoundValue::parse("0.5ns").is_err());
+        assert!(BoundValue::parse("2.5").is_err());
+        assert!(BoundValue::parse("s").is_err());
+        assert!(BoundValue::parse("1.2.3s").is_err());
+        assert!(BoundValue::parse("3parsecs").is_err());
+        assert!(BoundValue::parse("99999999999999999999s").is_err());
+        assert_eq!(BoundValue::Nanos(6_200_000_000).display(), "6.2s");
+        assert_eq!(BoundValue::Nanos(2_000_000_000).display(), "2s");
+    }
+
+    #[test]
+    fn grids_step_exactly_and_default_to_the_last_digit() {
+        let g = grid("0.1s", "0.5s", None).unwrap();
+        assert_eq!(g.len(), 5);
+        assert_eq!(g[4], BoundValue::Nanos(500_000_000));
+        let g = grid("58", "66", Some("2")).unwrap();
+        assert_eq!(g, [58, 60, 62, 64, 66].map(BoundValue::Units).to_vec());
+        assert!(grid("1", "2s", None).is_err());
+        assert!(grid("5", "1", None).is_err());
+        assert!(grid("0", "100000", None).is_err());
+    }
+
+    fn point(successes: u64, failures: u64) -> SweepPoint {
+        SweepPoint {
+            bound: String::new(),
+            successes,
+            failures,
+            unknown: 0,
+            probability: None,
+            lower: 0.0,
+            upper: 1.0,
+        }
+    }
+
+    #[test]
+    fn threshold_is_where_failures_stop_for_good() {
+        let ps = [
+            point(0, 5),
+            point(5, 0),
+            point(4, 1),
+            point(5, 0),
+            point(5, 0),
+        ];
+        assert_eq!(threshold_index(&ps), Some(3));
+        assert_eq!(threshold_index(&[point(5, 0)]), Some(0));
+        assert_eq!(threshold_index(&[point(5, 0), point(0, 5)]), None);
+        assert_eq!(threshold_index(&[]), None);
     }
 }
