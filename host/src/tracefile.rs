@@ -7,6 +7,10 @@
 //! event variable false. Values: `true`/`false` (or `1`/`0`) for booleans,
 //! integers, floats, and strings (optionally in double quotes, `""` for a quote).
 //! Lines starting with `#` and blank lines are skipped.
+//!
+//! The columns that `hindsight trace` and `verify --save-failing` add around the
+//! variables (`step`, `event`, `origin`, `target`, `params`, `verdict_NAME`) are skipped
+//! unless the spec declares a variable of that name, so a recorded run replays as is.
 
 use codegen::Compiled;
 use monitor_core::{Ty, Value};
@@ -38,17 +42,19 @@ pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoi
             hline + 1
         ));
     }
-    let mut vars = Vec::new();
+    // `None` marks a recorder column that is skipped.
+    let mut vars: Vec<Option<usize>> = Vec::new();
     for (col, name) in &cols[1..] {
         let name = name.trim();
         match spec.var_index(name) {
-            Some(i) if !vars.contains(&i) => vars.push(i),
+            Some(i) if !vars.contains(&Some(i)) => vars.push(Some(i)),
             Some(_) => {
                 return Err(format!(
                     "{file}:{}:{col}: column `{name}` repeated",
                     hline + 1
                 ))
             }
+            None if is_recorder_column(name) => vars.push(None),
             None => {
                 return Err(format!(
                     "{file}:{}:{col}: `{name}` is not a variable of the spec",
@@ -87,6 +93,7 @@ pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoi
         last = time;
         let mut sets = Vec::new();
         for ((col, cell), &var) in cells[1..].iter().zip(&vars) {
+            let Some(var) = var else { continue };
             if cell.trim().is_empty() {
                 continue;
             }
@@ -96,6 +103,12 @@ pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoi
         points.push(TracePoint { time, sets });
     }
     Ok(points)
+}
+
+/// A column that `hindsight trace` writes beside the variables.
+fn is_recorder_column(name: &str) -> bool {
+    matches!(name, "step" | "event" | "origin" | "target" | "params")
+        || name.starts_with("verdict_")
 }
 
 fn parse_value(cell: &str, spec: &Compiled, var: usize) -> Result<Value, String> {

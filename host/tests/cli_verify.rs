@@ -462,3 +462,48 @@ fn the_sequential_test_answers_threshold_questions() {
     ]);
     assert_eq!(prop(&r, "heads")["decision"], "reject");
 }
+
+#[test]
+fn a_traced_run_replays_with_the_recorded_verdicts() {
+    let (code, csv, err) = hindsight(&[
+        "trace",
+        "host/tests/data/verify/race",
+        "--run",
+        "3",
+        "--seed",
+        "1",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let dir = std::env::temp_dir().join(format!("hindsight-replay-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let trace = dir.join("race.csv");
+    std::fs::write(&trace, &csv).unwrap();
+    let spec = dir.join("race.hspec");
+    std::fs::write(
+        &spec,
+        "unit 1s;\nevent a;\nevent b;\nevent c;\n\
+         property a_before_b = P({b} && P {a});\n\
+         property c_last = P({c} && P {a} && P {b});\n",
+    )
+    .unwrap();
+    let (code, out, err) = hindsight(&["replay", spec.to_str().unwrap(), trace.to_str().unwrap()]);
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(code, 0, "{err}");
+    // The replay's verdicts are the recorded `verdict_` columns, row for row.
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (ab, cl) = (col("verdict_a_before_b"), col("verdict_c_last"));
+    let recorded: Vec<String> = csv
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let cells: Vec<&str> = l.split(',').collect();
+            format!("{},{},{}", cells[0], cells[ab], cells[cl])
+        })
+        .collect();
+    let replayed: Vec<&str> = out.lines().skip(1).collect();
+    assert_eq!(out.lines().next(), Some("time,a_before_b,c_last"));
+    assert_eq!(replayed, recorded);
+    // Run 3 sends b first: c_last turns true, a_before_b never does.
+    assert!(recorded.last().unwrap().ends_with(",false,true"), "{csv}");
+}
