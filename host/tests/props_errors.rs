@@ -100,7 +100,7 @@ fn character_references_and_line_breaks_in_formulas() {
 #[test]
 fn unknown_elements_and_attributes() {
     let text = current(
-        "  <ros_topic topic=\"/battery\" type=\"std_msgs/Int32\"/>",
+        "  <ros_parameter name=\"/battery\" type=\"std_msgs/Int32\"/>",
         "  <property id=\"p\" expr=\"true\"/>",
     );
     let (at, kind) = single(&text);
@@ -108,23 +108,23 @@ fn unknown_elements_and_attributes() {
     assert_eq!(
         kind,
         PropsErrorKind::UnknownElement {
-            name: "ros_topic".to_owned(),
+            name: "ros_parameter".to_owned(),
             parent: "ports".to_owned(),
-            expected: "<scxml_event_send> or <port>",
+            expected: "<scxml_event_send>, <ros_topic>, <ros_service> or <port>",
         }
     );
 
     let text = current(
         PORT,
-        "  <property id=\"p\" pattern=\"absence\" expr=\"true\"/>",
+        "  <property id=\"p\" pattern=\"absence\" event=\"x\" expr=\"true\"/>",
     );
     let (at, kind) = single(&text);
-    assert_eq!(at, Location::new(6, 20));
+    assert_eq!(at, Location::new(6, 48));
     assert_eq!(
         kind,
         PropsErrorKind::UnknownAttribute {
             element: "property".to_owned(),
-            name: "pattern".to_owned(),
+            name: "expr".to_owned(),
         }
     );
 

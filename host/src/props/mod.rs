@@ -61,6 +61,7 @@
 
 mod error;
 mod read;
+pub mod ros;
 mod source;
 mod xml;
 
@@ -68,6 +69,10 @@ use std::path::{Path, PathBuf};
 
 pub use error::{Diagnostics, PropsError, PropsErrorKind};
 pub use source::{Location, SourceText};
+
+/// The `origin` / `target` of a port that matches any machine (ROS ports: whoever
+/// publishes or serves).
+pub const ANY_MACHINE: &str = "*";
 
 /// A property file, read and checked.
 #[derive(Clone, Debug, PartialEq, Eq)]

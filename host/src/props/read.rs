@@ -11,7 +11,7 @@ use super::{Port, PortKind, Property, PropertyFile};
 
 /// Value types of state variables, predicates and constants.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Ty {
+pub(super) enum Ty {
     Bool,
     Int,
     Float,
@@ -111,7 +111,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
         self.errors
     }
 
-    fn error(&mut self, at: Location, kind: PropsErrorKind) {
+    pub(super) fn error(&mut self, at: Location, kind: PropsErrorKind) {
         self.errors.push(PropsError {
             path: self.path.to_path_buf(),
             at,
@@ -120,7 +120,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
     }
 
     /// Reports unknown attributes and text content; returns nothing.
-    fn check_attrs(&mut self, element: &Element<'a>, allowed: &[&str]) {
+    pub(super) fn check_attrs(&mut self, element: &Element<'a>, allowed: &[&str]) {
         for attr in &element.attrs {
             if !allowed.contains(&attr.name) {
                 self.error(
@@ -142,7 +142,38 @@ impl<'p, 'a> FileReader<'p, 'a> {
         }
     }
 
-    fn attr<'e>(element: &'e Element<'a>, name: &str) -> Option<&'e Attr<'a>> {
+    /// Like [`FileReader::check_attrs`], for an element whose text is its content.
+    pub(super) fn check_attrs_allow_text(&mut self, element: &Element<'a>, allowed: &[&str]) {
+        let plain = Element {
+            text: None,
+            ..element.clone()
+        };
+        self.check_attrs(&plain, allowed);
+    }
+
+    /// The unescaped text content of an element (`None`, with an error, if it has none).
+    pub(super) fn element_text(&mut self, element: &Element<'a>) -> Option<SourceText> {
+        let Some((raw, offset)) = element.raw_text else {
+            self.error(
+                element.at,
+                PropsErrorKind::BadValue {
+                    attribute: format!("<{}> text", element.name),
+                    value: String::new(),
+                    expected: "an expression".to_owned(),
+                },
+            );
+            return None;
+        };
+        let attr = Attr {
+            name: element.name,
+            at: element.at,
+            raw,
+            offset,
+        };
+        self.value(&attr)
+    }
+
+    pub(super) fn attr<'e>(element: &'e Element<'a>, name: &str) -> Option<&'e Attr<'a>> {
         element.attrs.iter().find(|attr| attr.name == name)
     }
 
@@ -158,13 +189,17 @@ impl<'p, 'a> FileReader<'p, 'a> {
         }
     }
 
-    fn optional(&mut self, element: &Element<'a>, name: &str) -> Option<(SourceText, Location)> {
+    pub(super) fn optional(
+        &mut self,
+        element: &Element<'a>,
+        name: &str,
+    ) -> Option<(SourceText, Location)> {
         let attr = Self::attr(element, name)?;
         let at = attr.at;
         self.value(attr).map(|value| (value, at))
     }
 
-    fn required(
+    pub(super) fn required(
         &mut self,
         element: &Element<'a>,
         name: &'static str,
@@ -183,7 +218,11 @@ impl<'p, 'a> FileReader<'p, 'a> {
     }
 
     /// A required attribute that names something: non-empty, no surrounding blanks.
-    fn required_name(&mut self, element: &Element<'a>, name: &'static str) -> Option<String> {
+    pub(super) fn required_name(
+        &mut self,
+        element: &Element<'a>,
+        name: &'static str,
+    ) -> Option<String> {
         let (value, at) = self.required(element, name)?;
         let text = value.as_str();
         if text.is_empty() || text.trim() != text {
@@ -200,7 +239,12 @@ impl<'p, 'a> FileReader<'p, 'a> {
         Some(text.to_owned())
     }
 
-    fn unknown_child(&mut self, child: &Element<'a>, parent: &Element<'a>, expected: &'static str) {
+    pub(super) fn unknown_child(
+        &mut self,
+        child: &Element<'a>,
+        parent: &Element<'a>,
+        expected: &'static str,
+    ) {
         self.error(
             child.at,
             PropsErrorKind::UnknownElement {
@@ -211,7 +255,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
         );
     }
 
-    fn declared_type(&mut self, element: &Element<'a>) -> Option<(String, Ty)> {
+    pub(super) fn declared_type(&mut self, element: &Element<'a>) -> Option<(String, Ty)> {
         let (value, at) = self.required(element, "type")?;
         match Ty::of(value.as_str()) {
             Some(ty) => Some((value.as_str().to_owned(), ty)),
@@ -260,7 +304,13 @@ impl<'p, 'a> FileReader<'p, 'a> {
                         match port.name {
                             "scxml_event_send" => self.event_send(port, &mut file.ports),
                             "port" => self.tree_port(port, &mut file.ports),
-                            _ => self.unknown_child(port, section, "<scxml_event_send> or <port>"),
+                            "ros_topic" => self.ros_topic(port, &mut file.ports),
+                            "ros_service" => self.ros_service(port, &mut file.ports),
+                            _ => self.unknown_child(
+                                port,
+                                section,
+                                "<scxml_event_send>, <ros_topic>, <ros_service> or <port>",
+                            ),
                         }
                     }
                 }
@@ -278,7 +328,12 @@ impl<'p, 'a> FileReader<'p, 'a> {
                     let tree_name = if guarantees { "guarantee" } else { "assume" };
                     for property in &section.children {
                         if property.name == "property" {
-                            if let Some(property) = self.text_property(property) {
+                            let read = if Self::attr(property, "pattern").is_some() {
+                                self.pattern_property(property)
+                            } else {
+                                self.text_property(property)
+                            };
+                            if let Some(property) = read {
                                 if guarantees {
                                     file.guarantees.push(property);
                                 } else {

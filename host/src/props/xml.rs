@@ -29,6 +29,9 @@ pub(crate) struct Element<'a> {
     pub(crate) children: Vec<Element<'a>>,
     /// Location of the first non-blank text (or CDATA, or reference) directly inside.
     pub(crate) text: Option<Location>,
+    /// The raw (still escaped) text directly inside, from the first non-blank chunk to
+    /// the end of the last one, with its byte offset in the file.
+    pub(crate) raw_text: Option<(&'a str, usize)>,
 }
 
 type XmlError = (Location, PropsErrorKind);
@@ -78,6 +81,7 @@ fn element<'a>(
         attrs,
         children: Vec::new(),
         text: None,
+        raw_text: None,
     })
 }
 
@@ -118,9 +122,14 @@ pub(crate) fn parse_document<'a>(
                 .get(before..)
                 .map_or(0, |rest| rest.len() - rest.trim_start().len());
             let at = lines.location(before + skip);
+            let after = usize::try_from(reader.buffer_position()).unwrap_or(usize::MAX);
             match stack.last_mut() {
                 Some(parent) => {
                     parent.text.get_or_insert(at);
+                    let start = parent.raw_text.map_or(before + skip, |(_, o)| o);
+                    if let Some(raw) = text.get(start..after) {
+                        parent.raw_text = Some((raw.trim_end(), start));
+                    }
                 }
                 None => {
                     return Err((

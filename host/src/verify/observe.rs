@@ -14,16 +14,17 @@ use monitor_core::{valuation, Monitor, Ty, Value, VarKind};
 
 use super::settle::Settler;
 use crate::expr::Value as SimValue;
-use crate::props::{PortKind, PropertyFile};
+use crate::props::{PortKind, PropertyFile, ANY_MACHINE};
 use crate::sim::{CompiledModel, Flow, MachineId, Observer, SentMessage};
 use crate::smc::{RunEnd, RunOutcome, Verdict};
 
 /// One port resolved to model ids.
 #[derive(Clone, Debug)]
 struct Port {
-    origin: MachineId,
-    /// `None`: the `NONE` sink.
-    target: Option<MachineId>,
+    /// `None`: any machine ([`ANY_MACHINE`]).
+    origin: Option<MachineId>,
+    /// `None`: any target ([`ANY_MACHINE`]); `Some(None)`: the `NONE` sink.
+    target: Option<Option<MachineId>>,
     /// The spec variable it sets.
     var: usize,
     /// The message parameter (state variables only).
@@ -61,10 +62,31 @@ fn spec_type(scan: &str) -> Option<&'static str> {
     })
 }
 
+/// A time unit of `ns` nanoseconds as the spec language writes it: `100ms`, `1s`, `7ns`.
+fn unit_text(ns: u64) -> String {
+    for (unit, size) in [("s", 1_000_000_000), ("ms", 1_000_000), ("us", 1_000)] {
+        if ns % size == 0 {
+            return format!("{}{unit}", ns / size);
+        }
+    }
+    format!("{ns}ns")
+}
+
 impl PropertySet {
     /// Compiles `props` and resolves its ports against `model`. Every error names the
     /// property file's line and column.
     pub fn new(props: &PropertyFile, model: &CompiledModel) -> Result<PropertySet, String> {
+        Self::with_unit(props, model, None)
+    }
+
+    /// Like [`PropertySet::new`] for a model whose time unit is `unit_ns` nanoseconds:
+    /// bounds with a unit (`6.2s`, `200ms`) are converted exactly to model steps, and a
+    /// bound that is not a whole number of steps is an error.
+    pub fn with_unit(
+        props: &PropertyFile,
+        model: &CompiledModel,
+        unit_ns: Option<u64>,
+    ) -> Result<PropertySet, String> {
         let file = props.path.display().to_string();
         let origin = |line: u32, col: u32| Origin {
             file: file.clone(),
@@ -119,7 +141,7 @@ impl PropertySet {
             return Err(errors.join("\n"));
         }
         let compiled = codegen::compile_input(&SpecInput {
-            unit: None,
+            unit: unit_ns.map(|ns| (unit_text(ns), origin(1, 1))),
             decls,
             formulas,
         })
@@ -135,13 +157,18 @@ impl PropertySet {
                 errors.push(format!("{here}: the model sends no event `{}`", p.event));
                 continue;
             };
-            let Some(origin) = model.machine_id(&p.origin) else {
-                errors.push(format!("{here}: no machine `{}` in the model", p.origin));
-                continue;
+            let origin = match model.machine_id(&p.origin) {
+                Some(m) => Some(m),
+                None if p.origin == ANY_MACHINE => None,
+                None => {
+                    errors.push(format!("{here}: no machine `{}` in the model", p.origin));
+                    continue;
+                }
             };
             let target = match model.machine_id(&p.target) {
-                Some(m) => Some(m),
-                None if p.target == "NONE" => None,
+                Some(m) => Some(Some(m)),
+                None if p.target == ANY_MACHINE => None,
+                None if p.target == "NONE" => Some(None),
                 None => {
                     errors.push(format!("{here}: no machine `{}` in the model", p.target));
                     continue;
@@ -340,7 +367,9 @@ impl Observer for Judge<'_> {
         self.begin();
         let ports = self.set.by_event.get(msg.event().0 as usize);
         for port in ports.into_iter().flatten() {
-            if port.origin != msg.origin() || port.target != msg.target() {
+            if port.origin.is_some_and(|o| o != msg.origin())
+                || port.target.is_some_and(|t| t != msg.target())
+            {
                 continue;
             }
             let decl = &self.monitor.program().vars[port.var];
