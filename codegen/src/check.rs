@@ -142,6 +142,7 @@ struct Checker<'a> {
     sink: &'a mut Sink,
     sources: &'a SourceMap,
     tick_ns: u64,
+    untimed: bool,
     vars: Vec<VarDecl>,
     var_ids: HashMap<String, u16>,
     strings: Vec<String>,
@@ -155,6 +156,7 @@ pub(crate) fn check(syn: &SpecSyntax, sources: &SourceMap, sink: &mut Sink) -> C
         sink,
         sources,
         tick_ns: DEFAULT_TICK_NS,
+        untimed: syn.untimed,
         vars: Vec::new(),
         var_ids: HashMap::new(),
         strings: Vec::new(),
@@ -329,6 +331,17 @@ impl Checker<'_> {
         let mut end = |t: &Option<TimeLit>| -> Option<Option<u64>> {
             match t {
                 None => Some(None),
+                Some(t) if self.untimed && t.unit.is_some() => {
+                    self.sink.error(
+                        t.span,
+                        format!(
+                            "`{}` has a unit, but the model's time steps have no known \
+                             duration: write the bound in steps or give the model a time unit",
+                            lit_text(t)
+                        ),
+                    );
+                    None
+                }
                 Some(t) => match lit_ticks(t, self.tick_ns) {
                     Ok(v) => Some(Some(v)),
                     Err(m) => {

@@ -58,6 +58,10 @@ pub struct FormulaInput {
 pub struct SpecInput {
     /// The time unit literal (`1s`, `100ms`) and where it was written; `None` for 1s.
     pub unit: Option<(String, Origin)>,
+    /// The ticks have no known duration (a model whose steps are not tied to a clock):
+    /// bounds must be tick counts, and a bound with a unit (`2s`) is an error instead of
+    /// being read against the default unit.
+    pub untimed: bool,
     /// Variable declarations.
     pub decls: Vec<DeclInput>,
     /// Named formulas.
@@ -148,7 +152,10 @@ impl Spec<Parsed> {
     pub fn from_input(input: &SpecInput) -> Result<Spec<Parsed>, Diagnostics> {
         let mut sources = SourceMap::default();
         let mut sink = Sink::default();
-        let mut syntax = SpecSyntax::default();
+        let mut syntax = SpecSyntax {
+            untimed: input.untimed && input.unit.is_none(),
+            ..SpecSyntax::default()
+        };
         if let Some((text, o)) = &input.unit {
             let id = sources.add(&o.file, text, o.line, o.col, true);
             if let Some(t) = parse::parse_time(text, id, &mut sink) {

@@ -166,6 +166,8 @@ pub(crate) struct Prop {
 pub(crate) struct SpecSyntax {
     /// Every `unit` statement (more than one is an error, reported by the checker).
     pub units: Vec<TimeLit>,
+    /// Ticks have no duration: bounds with a unit are errors.
+    pub untimed: bool,
     pub decls: Vec<Decl>,
     pub props: Vec<Prop>,
 }

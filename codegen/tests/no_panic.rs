@@ -194,6 +194,7 @@ proptest! {
     fn structured_input_soup(name in soup(), ty in soup(), init in soup(), f in soup(), unit in soup()) {
         let o = Origin { file: "x.xml".into(), line: 3, col: 4 };
         let input = SpecInput {
+            untimed: false,
             unit: Some((unit, o.clone())),
             decls: vec![DeclInput {
                 kind: VarKind::State,

@@ -361,6 +361,7 @@ fn origin(line: u32, col: u32) -> Origin {
 #[test]
 fn structured_input_reports_at_origins() {
     let input = SpecInput {
+        untimed: false,
         unit: Some(("100ms".into(), origin(2, 11))),
         decls: vec![
             DeclInput {
@@ -457,4 +458,30 @@ fn deep_nesting_is_an_error_not_a_crash() {
             "{d}"
         );
     }
+}
+
+#[test]
+fn untimed_input_takes_tick_counts_and_rejects_units() {
+    let input = |formula: &str| SpecInput {
+        untimed: true,
+        unit: None,
+        decls: vec![DeclInput {
+            kind: VarKind::Event,
+            name: "a".into(),
+            type_name: String::new(),
+            init: None,
+            origin: origin(1, 1),
+        }],
+        formulas: vec![FormulaInput {
+            name: "p".into(),
+            text: formula.into(),
+            origin: origin(7, 3),
+        }],
+    };
+    assert!(codegen::compile_input(&input("H(P[:10] {a})")).is_ok());
+    let err = codegen::compile_input(&input("H(P[:1s] {a})"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("props.xml:7:8"), "{err}");
+    assert!(err.contains("no known duration"), "{err}");
 }

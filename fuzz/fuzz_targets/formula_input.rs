@@ -22,6 +22,7 @@ fuzz_target!(|data: &[u8]| {
         origin: origin.clone(),
     };
     let input = SpecInput {
+        untimed: false,
         unit: Some(("100ms".into(), origin.clone())),
         decls: vec![
             decl(VarKind::Event, "a", "bool", None),

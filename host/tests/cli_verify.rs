@@ -507,3 +507,67 @@ fn a_traced_run_replays_with_the_recorded_verdicts() {
     // Run 3 sends b first: c_last turns true, a_before_b never does.
     assert!(recorded.last().unwrap().ends_with(",false,true"), "{csv}");
 }
+
+#[test]
+fn with_a_time_unit_bounds_and_sweeps_are_in_seconds() {
+    // The museum translation steps 100 ms; its requirements written over ROS names with
+    // bounds in seconds hold, and the sweep's thresholds come out in seconds.
+    let props = "examples/museum-guide/properties.xml";
+    let r = json(&[
+        "verify",
+        "examples/museum-scxml",
+        props,
+        "--time-unit",
+        "100ms",
+        "--max-time",
+        "400s",
+        "--max-runs",
+        "6",
+        "--seed",
+        "2",
+    ]);
+    for p in r["properties"].as_array().unwrap() {
+        assert_eq!(p["successes"], 6, "{p}");
+    }
+    let (code, out, err) = hindsight(&[
+        "sweep",
+        "examples/museum-scxml",
+        props,
+        "--time-unit",
+        "100ms",
+        "--from",
+        "0.1s",
+        "--to",
+        "1.2s",
+        "--property",
+        "poi_response",
+        "--property",
+        "battery_recurrence",
+        "--runs",
+        "4",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let thresholds: Vec<&str> = doc["properties"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["threshold"].as_str().unwrap_or("none"))
+        .collect();
+    assert_eq!(thresholds, ["0.2s", "1s"]);
+    // Durations that are not whole steps, or without a unit to convert them, are input errors.
+    let (code, _, err) = hindsight(&["verify", "examples/museum-scxml", props]);
+    assert_eq!(code, 2);
+    assert!(err.contains("properties.xml"), "{err}");
+    let (code, _, err) = hindsight(&[
+        "verify",
+        "examples/museum-scxml",
+        "--time-unit",
+        "100ms",
+        "--max-time",
+        "150ms",
+    ]);
+    assert_eq!(code, 2);
+    assert!(err.contains("150ms"), "{err}");
+}

@@ -30,10 +30,9 @@ a chart of success rate against the bound.
 Example:
   hindsight sweep examples/museum-scxml --property battery_recurrence --from 5 --to 15 --svg sweep.svg")]
 pub struct SweepArgs {
-    /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
-    pub model: PathBuf,
-    /// The SCAN property file; default as for `verify`.
-    pub props: Option<PathBuf>,
+    /// The model and its properties, as for `verify`.
+    #[command(flatten)]
+    pub input: super::verify::ModelArgs,
     /// A guarantee to sweep (repeat for several); default: every guarantee with a time bound.
     #[arg(long = "property")]
     pub properties: Vec<String>,
@@ -58,9 +57,9 @@ pub struct SweepArgs {
     /// Worker threads (0: all cores).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// A run ends when model time reaches this.
-    #[arg(long, default_value_t = 10_000)]
-    pub max_time: u64,
+    /// A run ends when model time reaches this, as for `verify`.
+    #[arg(long, value_name = "T")]
+    pub max_time: Option<String>,
     /// Also write an SVG chart of success rate against the bound to this file.
     #[arg(long)]
     pub svg: Option<PathBuf>,
@@ -286,8 +285,8 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     if args.runs == 0 {
         return Err(CliError::Input("sweep: --runs must be at least 1".into()));
     }
-    let (model, _, props_path) = load(&args.model, args.props.as_deref())?;
-    let file = props::parse_file(&props_path).map_err(|d| CliError::Input(d.to_string()))?;
+    let loaded = load(&args.input)?;
+    let (model, file, props_path) = (&loaded.model, &loaded.file, &loaded.props_path);
     let targets: Vec<props::Property> = if args.properties.is_empty() {
         file.guarantees
             .iter()
@@ -328,7 +327,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         precision: 1e-9,
     };
     let run_cfg = RunConfig {
-        max_time: args.max_time,
+        max_time: loaded.max_time(args.max_time.as_deref())?,
         ..RunConfig::default()
     };
     let study_cfg = StudyConfig {
@@ -357,8 +356,8 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
                 g
             })
             .collect();
-        let set = PropertySet::new(&one, &model).map_err(CliError::Input)?;
-        let r = study(&model, &set, &run_cfg, &study_cfg, &rule, show_progress)?;
+        let set = PropertySet::with_unit(&one, model, loaded.unit_ns).map_err(CliError::Input)?;
+        let r = study(model, &set, &run_cfg, &study_cfg, &rule, show_progress)?;
         let points: Vec<SweepPoint> = values
             .iter()
             .zip(&r.properties)
@@ -451,7 +450,7 @@ fn finish(
             .collect();
         let title = format!(
             "{}: success rate against the bound ({} runs each)",
-            args.model.display(),
+            args.input.model.display(),
             args.runs
         );
         std::fs::write(path, plot::svg(&title, unit_label, &plot_curves))

@@ -31,10 +31,9 @@ pub enum Rule {
 /// Arguments of `hindsight verify`.
 #[derive(Debug, clap::Args)]
 pub struct VerifyArgs {
-    /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
-    pub model: PathBuf,
-    /// The SCAN property file; default: the one model.xml names, else MODEL/properties.xml.
-    pub props: Option<PathBuf>,
+    /// The model and its properties.
+    #[command(flatten)]
+    pub input: ModelArgs,
     /// Confidence of the reported intervals.
     #[arg(long, default_value_t = 0.95)]
     pub confidence: f64,
@@ -53,9 +52,10 @@ pub struct VerifyArgs {
     /// Worker threads (0: all cores).
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
-    /// A run ends when model time reaches this (in the model's time unit).
-    #[arg(long, default_value_t = 10_000)]
-    pub max_time: u64,
+    /// A run ends when model time reaches this: model steps, or a duration (`100s`) when
+    /// the model has a time unit [default: 10000 steps].
+    #[arg(long, value_name = "T")]
+    pub max_time: Option<String>,
     /// A run reaching this many steps is cut short: its open verdicts are unknown.
     #[arg(long, default_value_t = 100_000_000)]
     pub max_steps: u64,
@@ -180,22 +180,94 @@ fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, CliE
     }
 }
 
-/// Loads the model and its properties: everything `validate` checks.
-pub fn load(
-    model: &Path,
-    props_path: Option<&Path>,
-) -> Result<(CompiledModel, PropertySet, PathBuf), CliError> {
+/// The model and property arguments every command that loads a model takes.
+#[derive(Debug, clap::Args)]
+pub struct ModelArgs {
+    /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
+    pub model: PathBuf,
+    /// The property file; default: the one model.xml names, else MODEL/properties.xml.
+    pub props: Option<PathBuf>,
+    /// The length of one model time step (`100ms`), so that bounds with a unit (`6.2s`)
+    /// and durations given to --max-time mean wall-clock time on a plain SCXML model.
+    #[arg(long, value_name = "DURATION")]
+    pub time_unit: Option<String>,
+}
+
+/// A model with its properties, compiled: everything `validate` checks.
+pub struct Loaded {
+    /// The simulator's model.
+    pub model: CompiledModel,
+    /// The property file as read.
+    pub file: props::PropertyFile,
+    /// Its guarantees and assumptions, compiled and resolved against the model.
+    pub set: PropertySet,
+    /// Where the properties came from.
+    pub props_path: PathBuf,
+    /// The length of one model time step in nanoseconds, when known.
+    pub unit_ns: Option<u64>,
+}
+
+impl Loaded {
+    /// `--max-time`: model steps, or a duration when the model has a time unit; by
+    /// default 10,000 steps.
+    pub fn max_time(&self, arg: Option<&str>) -> Result<u64, CliError> {
+        let Some(text) = arg else { return Ok(10_000) };
+        match super::sweep::BoundValue::parse(text).map_err(CliError::Input)? {
+            super::sweep::BoundValue::Units(v) => Ok(v),
+            super::sweep::BoundValue::Nanos(ns) => match self.unit_ns {
+                Some(unit) if ns % unit == 0 => Ok(ns / unit),
+                Some(unit) => Err(CliError::Input(format!(
+                    "--max-time {text} is not a whole number of model steps of {unit} ns"
+                ))),
+                None => Err(CliError::Input(format!(
+                    "--max-time {text}: the model has no time unit (give --time-unit, or \
+                     --max-time in steps)"
+                ))),
+            },
+        }
+    }
+}
+
+/// Parses `--time-unit`: a positive duration with a unit (`100ms`, `1s`).
+fn parse_time_unit(text: &str) -> Result<u64, CliError> {
+    match super::sweep::BoundValue::parse(text) {
+        Ok(super::sweep::BoundValue::Nanos(ns)) if ns > 0 => Ok(ns),
+        _ => Err(CliError::Input(format!(
+            "--time-unit {text}: expected a positive duration with a unit (100ms, 1s, 50us)"
+        ))),
+    }
+}
+
+/// Loads the model and its properties.
+pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
+    let model = &args.model;
+    let unit_ns = args.time_unit.as_deref().map(parse_time_unit).transpose()?;
     let compiled = CompiledModel::load(model).map_err(|d| CliError::Input(d.to_string()))?;
     for w in compiled.warnings() {
         eprintln!("warning: {w}");
     }
-    let props_path = match props_path {
+    let props_path = match &args.props {
         Some(p) => p.to_path_buf(),
         None => default_props(model, &compiled)?,
     };
     let file = props::parse_file(&props_path).map_err(|d| CliError::Input(d.to_string()))?;
-    let set = PropertySet::new(&file, &compiled).map_err(CliError::Input)?;
-    Ok((compiled, set, props_path))
+    let set = PropertySet::with_unit(&file, &compiled, unit_ns).map_err(|e| {
+        if unit_ns.is_none() && e.contains("no known duration") {
+            CliError::Input(format!(
+                "{e}\nhint: give the length of one model step with --time-unit (for example \
+                 --time-unit 100ms)"
+            ))
+        } else {
+            CliError::Input(e)
+        }
+    })?;
+    Ok(Loaded {
+        model: compiled,
+        file,
+        set,
+        props_path,
+        unit_ns,
+    })
 }
 
 /// Runs a study of `set` on `model`: the function `verify` and `sweep` share.
@@ -424,19 +496,18 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
 /// Arguments of `hindsight trace`.
 #[derive(Debug, clap::Args)]
 pub struct TraceArgs {
-    /// The model, as for `verify`.
-    pub model: PathBuf,
-    /// The SCAN property file; default as for `verify`.
-    pub props: Option<PathBuf>,
+    /// The model and its properties, as for `verify`.
+    #[command(flatten)]
+    pub input: ModelArgs,
     /// The run to replay (its index in the study: run k uses stream k of the seed).
     #[arg(long, default_value_t = 0)]
     pub run: u64,
     /// The study seed.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// A run ends when model time reaches this.
-    #[arg(long, default_value_t = 10_000)]
-    pub max_time: u64,
+    /// A run ends when model time reaches this, as for `verify`.
+    #[arg(long, value_name = "T")]
+    pub max_time: Option<String>,
     /// A run is cut at this many steps.
     #[arg(long, default_value_t = 100_000_000)]
     pub max_steps: u64,
@@ -447,13 +518,14 @@ pub struct TraceArgs {
 
 /// Runs `hindsight trace`: one run of the study, every point as CSV.
 pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
-    let (model, set, _) = load(&args.model, args.props.as_deref())?;
+    let loaded = load(&args.input)?;
+    let (model, set) = (&loaded.model, &loaded.set);
     let run_cfg = RunConfig {
-        max_time: args.max_time,
+        max_time: loaded.max_time(args.max_time.as_deref())?,
         max_steps: args.max_steps,
         ..RunConfig::default()
     };
-    let csv = replay_csv(&model, &set, &run_cfg, args.seed, args.run)?;
+    let csv = replay_csv(model, set, &run_cfg, args.seed, args.run)?;
     match &args.output {
         Some(p) => {
             std::fs::write(p, csv).map_err(|e| CliError::Failed(format!("{}: {e}", p.display())))?
@@ -508,7 +580,8 @@ fn record(slot: &Mutex<Option<String>>, msg: String) {
 
 /// Runs `hindsight verify`.
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
-    let (model, set, props_path) = load(&args.model, args.props.as_deref())?;
+    let loaded = load(&args.input)?;
+    let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
     let rule = RuleConfig {
         kind: match (args.threshold, args.rule) {
             (Some(threshold), _) => RuleKind::Sprt { threshold },
@@ -521,7 +594,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         precision: args.precision,
     };
     let run_cfg = RunConfig {
-        max_time: args.max_time,
+        max_time: loaded.max_time(args.max_time.as_deref())?,
         max_steps: args.max_steps,
         ..RunConfig::default()
     };
@@ -534,28 +607,20 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     };
     if let (Some(shard), Some(runs)) = (args.shard, args.runs) {
         return run_shard_cli(
-            args,
-            &model,
-            &set,
-            &props_path,
-            &run_cfg,
-            &study_cfg,
-            &rule,
-            shard,
-            runs,
+            args, model, set, props_path, &run_cfg, &study_cfg, &rule, shard, runs,
         );
     }
-    let result = study(&model, &set, &run_cfg, &study_cfg, &rule, !args.json)?;
+    let result = study(model, set, &run_cfg, &study_cfg, &rule, !args.json)?;
     if args.save_failing > 0 {
-        save_failing(args, &model, &set, &run_cfg, &result)?;
+        save_failing(args, model, set, &run_cfg, &result)?;
     }
-    let report = report(args, &props_path, &set, &result);
+    let report = report(args, props_path, set, &result);
     print_report(&report, args.json)
 }
 
 fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -> Report {
     Report {
-        model: args.model.display().to_string(),
+        model: args.input.model.display().to_string(),
         properties_file: props.display().to_string(),
         seed: args.seed,
         confidence: args.confidence,
@@ -637,18 +702,18 @@ fn print_table(r: &Report) {
 /// Arguments of `hindsight validate`.
 #[derive(Debug, clap::Args)]
 pub struct ValidateArgs {
-    /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
-    pub model: PathBuf,
-    /// The SCAN property file; default as for `verify`.
-    pub props: Option<PathBuf>,
+    /// The model and its properties, as for `verify`.
+    #[command(flatten)]
+    pub input: ModelArgs,
 }
 
 /// Runs `hindsight validate`: loads and compiles, prints a one-line summary.
 pub fn validate(args: &ValidateArgs) -> Result<(), CliError> {
-    let (model, set, props_path) = load(&args.model, args.props.as_deref())?;
+    let loaded = load(&args.input)?;
+    let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
     println!(
         "{}: {} machines, {} events; {}: {} guarantees, monitor state {} bytes: ok",
-        args.model.display(),
+        args.input.model.display(),
         model.machine_count(),
         model.event_count(),
         props_path.display(),

@@ -142,6 +142,7 @@ impl PropertySet {
         }
         let compiled = codegen::compile_input(&SpecInput {
             unit: unit_ns.map(|ns| (unit_text(ns), origin(1, 1))),
+            untimed: unit_ns.is_none(),
             decls,
             formulas,
         })
