@@ -227,10 +227,29 @@ fn largest_additions(image: &str, baseline: &str) -> Result<(), String> {
     let (monitor, _) = read_image(image)?;
     let (base, _) = read_image(baseline)?;
     let base = symbols(&base)?;
+    // Anonymous constants (`.Lanon.<hash>.<n>`) are named per image: one of
+    // the baseline's with the same size (the embedded trace) is the same data.
+    let mut base_anon: Vec<u64> = base
+        .iter()
+        .filter(|(n, _)| n.starts_with(".Lanon."))
+        .map(|(_, s)| *s)
+        .collect();
     let mut added: Vec<(String, u64)> = symbols(&monitor)?
         .into_iter()
         .filter(|(n, _)| !base.contains_key(n))
         .collect();
+    added.retain(|(n, size)| {
+        if !n.starts_with(".Lanon.") {
+            return true;
+        }
+        match base_anon.iter().position(|s| s == size) {
+            Some(i) => {
+                base_anon.swap_remove(i);
+                false
+            }
+            None => true,
+        }
+    });
     added.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
     let total: u64 = added.iter().map(|(_, s)| s).sum();
     println!(
