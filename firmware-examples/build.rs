@@ -2,10 +2,12 @@
 //!
 //! Writes into `OUT_DIR`:
 //! - `table.postcard`: the postcard table (`Table::from_bytes` format). The
-//!   file named by `HINDSIGHT_TABLE` when set (later: `hindsight compile --emit
-//!   table`), else museum-spec's hand-lowered program.
+//!   file named by `HINDSIGHT_TABLE` when set (`hindsight compile SPEC --emit
+//!   table -o FILE` writes one), else museum-spec's table, which its build
+//!   script compiles from `museum.hspec` with hindsight-codegen.
 //! - `trace.bin`: the replay trace in museum-spec's `trace` format; the file
-//!   named by `HINDSIGHT_TRACE` when set, else museum-spec's trace.
+//!   named by `HINDSIGHT_TRACE` when set, else museum-spec's recorded run of
+//!   the museum model.
 //! - `table_info.rs`: constants sized from the table (capacity, state words,
 //!   properties, variables), so the firmware allocates exactly what it needs.
 //!

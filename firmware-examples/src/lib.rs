@@ -2,11 +2,12 @@
 //!
 //! # Pipeline
 //!
-//! Each binary gets a [`monitor_core::Program`] (from `static` arrays in
-//! `monitor-static`, from a postcard table in `monitor-table`), validates it
-//! with `Monitor::try_new`, then for every point of a replay trace calls
-//! [`step_point`] and hands the verdicts to [`VerdictLog`], which logs every
-//! change. At the end [`finish`] logs the point count and the stack high-water
+//! Each binary steps a monitor over every point of a replay trace:
+//! `monitor-static` the straight-line monitor that codegen generated from
+//! museum-spec's `museum.hspec` at build time (through `museum_spec::step`),
+//! `monitor-table` a [`monitor_core::Program`] decoded from a postcard table
+//! and validated with `Monitor::try_new` (through [`step_point`]). Each hands
+//! the verdicts to [`VerdictLog`], which logs every change. At the end [`finish`] logs the point count and the stack high-water
 //! marks and exits QEMU with status 0; any error goes to [`fail`] (status 1),
 //! and so does a panic.
 //!

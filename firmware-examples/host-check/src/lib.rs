@@ -66,6 +66,13 @@ pub const IMAGES: [(&str, &str); 4] = [
     ("baseline-bytes", "baseline-bytes"),
 ];
 
+/// Each monitored image and the function every monitor step goes through
+/// (never inlined): where the panic-path analysis starts.
+pub const STEPS: [(&str, &str); 2] = [
+    ("monitor-static", "museum_spec::step"),
+    ("monitor-table", "firmware::step_point"),
+];
+
 /// Where the images are: `$FIRMWARE_DIR`, else the firmware project's release output.
 pub fn image_dir() -> PathBuf {
     match std::env::var_os("FIRMWARE_DIR") {

@@ -1,17 +1,15 @@
-//! What can panic below the monitor step in the linked firmware (`firmware::step_point`).
+//! What can panic below the monitor step in the linked firmware (`museum_spec::step` for the generated monitor, `firmware::step_point` for the table).
 
 use host_check::callgraph::analyse;
-use host_check::read_image;
-
-const STEP: &str = "firmware::step_point";
+use host_check::{read_image, STEPS};
 
 #[test]
 fn every_panic_below_the_step_comes_from_monitor_core() {
-    for name in ["monitor-static", "monitor-table"] {
+    for (name, step) in STEPS {
         let (path, _) = read_image(name).unwrap();
-        let report = analyse(&path, STEP).unwrap();
-        assert_eq!(report.reachable.first().map(String::as_str), Some(STEP));
-        // The firmware glue and the trace reader add no panic of their own.
+        let report = analyse(&path, step).unwrap();
+        assert_eq!(report.reachable.first().map(String::as_str), Some(step));
+        // The firmware glue, the trace reader and the generated code add no panic of their own.
         for l in &report.locations {
             assert!(
                 l.file.contains("monitor-core/src/"),
@@ -27,9 +25,9 @@ fn every_panic_below_the_step_comes_from_monitor_core() {
 
 #[test]
 fn the_monitor_step_links_no_panic_path() {
-    for name in ["monitor-static", "monitor-table"] {
+    for (name, step) in STEPS {
         let (path, _) = read_image(name).unwrap();
-        let report = analyse(&path, STEP).unwrap();
+        let report = analyse(&path, step).unwrap();
         assert!(
             report.panic_calls.is_empty(),
             "{name}: {:#?}\n{:#?}",

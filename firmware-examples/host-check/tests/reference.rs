@@ -1,17 +1,57 @@
-//! The hand-lowered museum program means what its formulas say: a naive evaluator over the whole trace agrees with the monitor at every point.
+//! The monitors compiled from `museum.hspec` mean what the spec says: the requirements agree with the verdicts `hindsight trace` recorded for the run, and a naive evaluator of each observer's definition agrees at every point.
 
-use host_check::verdicts::static_expected;
+use host_check::verdicts::{static_expected, REQUIREMENTS};
 use monitor_core::Value;
-use museum_spec::{Point, FORMULAS, TRACE};
+use museum_spec::{museum, Point, TRACE, VAR_NAMES};
 
-fn flag(p: &Point, var: usize) -> bool {
-    p.values[var] == Value::Bool(true)
+const CSV: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/../museum-spec/museum-run0.csv"
+));
+
+/// The data rows of the committed run, split into cells, and its header.
+fn csv() -> (Vec<&'static str>, Vec<Vec<&'static str>>) {
+    let mut lines = CSV.lines().filter(|l| !l.starts_with('#'));
+    let header = lines.next().unwrap().split(',').collect();
+    (header, lines.map(|l| l.split(',').collect()).collect())
 }
 
-fn level(p: &Point) -> i64 {
-    match p.values[1] {
+#[test]
+fn requirements_equal_the_verdicts_hindsight_recorded() {
+    let (header, rows) = csv();
+    let monitor = static_expected().unwrap();
+    assert_eq!(rows.len(), monitor.verdicts.len());
+    let mut checked = 0;
+    for (p, name) in museum::PROPERTY_NAMES.iter().enumerate() {
+        let Some(col) = header.iter().position(|h| *h == format!("verdict_{name}")) else {
+            continue;
+        };
+        assert!(p < REQUIREMENTS, "observer {name} has a recorded verdict");
+        for (i, row) in rows.iter().enumerate() {
+            let recorded: bool = row[col].parse().unwrap();
+            assert_eq!(
+                monitor.verdicts[i][p], recorded,
+                "{name} at row {i} (time {})",
+                row[0]
+            );
+        }
+        checked += 1;
+    }
+    assert_eq!(checked, REQUIREMENTS);
+}
+
+fn var(name: &str) -> usize {
+    VAR_NAMES.iter().position(|v| *v == name).unwrap()
+}
+
+fn flag(p: &Point, name: &str) -> bool {
+    p.values[var(name)] == Value::Bool(true)
+}
+
+fn int(p: &Point, name: &str) -> i64 {
+    match p.values[var(name)] {
         Value::Int(l) => l,
-        other => panic!("battery_level is {other:?}"),
+        other => panic!("{name} is {other:?}"),
     }
 }
 
@@ -23,48 +63,49 @@ fn once(k: usize, lo: u64, hi: u64, f: impl Fn(&Point) -> bool) -> bool {
         .any(|p| (lo..=hi).contains(&(now - p.time)) && f(p))
 }
 
-/// Each formula of `FORMULAS`, evaluated from its definition at point `i`.
-fn reference(i: usize) -> [bool; 3] {
-    let published = |p: &Point| flag(p, 0);
-    let every_10 = (0..=i).all(|k| !once(k, 10, u64::MAX, |_| true) || once(k, 0, 10, published));
-    let dock_after_low = (0..=i).all(|k| !flag(&TRACE[k], 2) || once(k, 1, 20, |p| level(p) <= 30));
-    let fresh = once(i, 0, 10, published);
-    [every_10, dock_after_low, fresh]
+/// `lhs S[0:hi] rhs` at point `k`, from the definition.
+fn since(k: usize, hi: u64, lhs: impl Fn(&Point) -> bool, rhs: impl Fn(&Point) -> bool) -> bool {
+    let now = TRACE[k].time;
+    (0..=k)
+        .any(|j| now - TRACE[j].time <= hi && rhs(&TRACE[j]) && TRACE[j + 1..=k].iter().all(&lhs))
 }
 
+/// An observer's verdict at point `i`, from its definition.
+type Reference = fn(usize) -> bool;
+
 #[test]
-fn monitor_matches_the_formulas_at_every_point() {
+fn observers_match_their_definitions_at_every_point() {
     let monitor = static_expected().unwrap();
-    for (i, got) in monitor.verdicts.iter().enumerate() {
-        let want = reference(i);
-        for p in 0..3 {
+    let observers: [(&str, Reference); 4] = [
+        ("battery_fresh", |i| {
+            once(i, 0, 5, |p| flag(p, "battery_published"))
+        }),
+        ("alarm_echo", |i| once(i, 3, 8, |p| flag(p, "alarm"))),
+        ("low_since_alarm", |i| {
+            since(
+                i,
+                20,
+                |p| int(p, "battery_level") <= 30,
+                |p| flag(p, "alarm"),
+            )
+        }),
+        ("poi1_pending", |i| {
+            let p = &TRACE[i];
+            int(p, "current_poi") == 1
+                && !(int(p, "poi_done_name") == 1 && int(p, "poi_done_value") == 1)
+        }),
+    ];
+    assert_eq!(REQUIREMENTS + observers.len(), museum::PROPERTIES);
+    for (k, (name, reference)) in observers.iter().enumerate() {
+        let p = REQUIREMENTS + k;
+        assert_eq!(museum::PROPERTY_NAMES[p], *name);
+        for (i, got) in monitor.verdicts.iter().enumerate() {
             assert_eq!(
-                got[p], want[p],
-                "{} at point {i} (time {})",
-                FORMULAS[p], TRACE[i].time
+                got[p],
+                reference(i),
+                "{name} at point {i} (time {})",
+                TRACE[i].time
             );
         }
     }
-}
-
-#[test]
-fn the_trace_tells_the_intended_story() {
-    let false_at = |p: usize| -> Vec<u64> {
-        (0..TRACE.len())
-            .filter(|&i| !reference(i)[p])
-            .map(|i| TRACE[i].time)
-            .collect()
-    };
-    // The publisher is silent after time 40: 11 units later nothing was
-    // published within 10, and the invariant stays broken.
-    assert_eq!(false_at(0).first(), Some(&51));
-    assert_eq!(false_at(0).last(), Some(&120));
-    // Freshness fails at the very first point (the message comes one micro-step
-    // later) and from 51 until the publisher's return at 56.
-    let fresh = false_at(2);
-    assert_eq!(fresh[0], 0);
-    assert_eq!(fresh[1..].first(), Some(&51));
-    assert_eq!(fresh.last(), Some(&56));
-    // The second dock request (time 118) comes 39 units after the last low reading.
-    assert_eq!(false_at(1).first(), Some(&118));
 }

@@ -1,16 +1,22 @@
-//! The per-property state breakdown adds up to what the monitor allocates.
+//! The per-property state breakdown of the compiled museum table adds up to what the monitor allocates and equals what the compiler reported.
 
 use host_check::state_breakdown;
-use monitor_core::Monitor;
+use host_check::verdicts::{on_big_stack, HOST_CAPACITY};
+use monitor_core::table::Table;
 
 #[test]
-fn breakdown_adds_up_to_the_monitor_state() {
-    let b = state_breakdown(&museum_spec::PROGRAM).unwrap();
-    let m = Monitor::try_new(museum_spec::PROGRAM).unwrap();
-    assert_eq!(b.total(), m.state_bytes());
-    // Shared: timestamp, one word of atom bits, one word of node bits (19 nodes).
-    assert_eq!(b.shared, 3 * 8);
-    // P[10:] and P[:10] one word each; P[1:20] a header and two runs; P[:10] one word.
-    let bytes: Vec<usize> = b.props.iter().map(|(_, n)| *n).collect();
-    assert_eq!(bytes, [16, 40, 8]);
+fn breakdown_adds_up_to_the_monitor_state_and_matches_the_compiler() {
+    on_big_stack(|| {
+        let table = Table::<HOST_CAPACITY>::from_bytes(museum_spec::TABLE).unwrap();
+        let m = table.monitor().unwrap();
+        let b = state_breakdown(&table.program()).unwrap();
+        assert_eq!(b.total(), m.state_bytes());
+        assert_eq!(m.state_bytes(), museum_spec::STATE_BYTES);
+        let bytes: Vec<usize> = b.props.iter().map(|(_, n)| *n).collect();
+        assert_eq!(bytes, museum_spec::PROPERTY_STATE_BYTES);
+        let names: Vec<&str> = b.props.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, museum_spec::museum::PROPERTY_NAMES);
+        Ok(())
+    })
+    .unwrap();
 }

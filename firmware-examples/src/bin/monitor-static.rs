@@ -1,42 +1,34 @@
-//! Firmware A: museum-spec's hand-lowered `static` program replays the compiled-in trace, logging every verdict change.
+//! Firmware A: the monitor that hindsight-codegen generated from museum-spec's `museum.hspec` at build time replays the compiled-in run, logging every verdict change.
 #![no_std]
 #![no_main]
 
 use cortex_m_rt::entry;
-use firmware::{end_of_setup, fail, finish, log_start, step_point, VerdictLog};
-use monitor_core::Monitor;
-use museum_spec::{PROGRAM, PROPS, STATE_WORDS, TRACE};
+use firmware::{end_of_setup, fail, finish, VerdictLog};
+use museum_spec::{museum, step, PROPS, TRACE};
 
 #[entry]
 fn main() -> ! {
-    let monitor = match Monitor::try_new(PROGRAM) {
-        Ok(m) => m,
-        Err(e) => {
-            defmt::error!("program rejected: {}", e);
-            fail("program")
-        }
-    };
-    let mut state = [0u64; STATE_WORDS];
-    if let Err(e) = monitor.reset(&mut state) {
-        defmt::error!("state: {}", e);
-        fail("state")
+    let mut monitor = museum::Monitor::new();
+    defmt::info!(
+        "start {=str} props={=usize} points={=u32} state_bytes={=usize}",
+        "monitor-static",
+        museum::PROPERTIES,
+        TRACE.len() as u32,
+        museum::STATE_BYTES
+    );
+    for (i, name) in museum::PROPERTY_NAMES.iter().enumerate() {
+        defmt::info!("property {=usize} {=str}", i, *name);
     }
-    log_start("monitor-static", &monitor, TRACE.len() as u32);
     let setup_stack = end_of_setup();
     let mut log = VerdictLog::<PROPS>::new();
-    let mut verdicts = [false; PROPS];
     for point in TRACE.iter() {
-        if let Err(e) = step_point(
-            &monitor,
-            &mut state,
-            point.time,
-            &point.values,
-            &mut verdicts,
-        ) {
-            defmt::error!("step at time {=u64}: {}", point.time, e);
-            fail("step")
+        match step(&mut monitor, point) {
+            Ok(verdicts) => log.record(point.time, &verdicts),
+            Err(_) => {
+                defmt::error!("step at time {=u64}", point.time);
+                fail("step")
+            }
         }
-        log.record(point.time, &verdicts);
     }
     finish(log.points(), setup_stack)
 }

@@ -11,11 +11,10 @@ use std::time::Duration;
 
 use host_check::callgraph::{self, Location};
 use host_check::log::{decode, Log};
-use host_check::{elf, qemu, read_image, state_breakdown, table_inputs, IMAGES};
+use host_check::verdicts::on_big_stack;
+use host_check::{elf, qemu, read_image, state_breakdown, table_inputs, IMAGES, STEPS};
 use monitor_core::table::Table;
-
-/// The function every monitor step goes through (`firmware::step_point`, never inlined).
-const STEP: &str = "firmware::step_point";
+use museum_spec::museum;
 
 fn main() -> ExitCode {
     match report() {
@@ -81,38 +80,46 @@ fn report() -> Result<(), String> {
     println!(
         "== Monitor state (bytes, fixed at compile time; the firmware allocates exactly this)"
     );
-    let breakdown = state_breakdown(&museum_spec::PROGRAM).ok_or("museum program has no layout")?;
+    let (museum_table, _) = table_inputs()?;
+    let (breakdown, table_state, table_len) = on_big_stack(|| {
+        let t = Table::<4096>::from_bytes(museum_spec::TABLE).map_err(|e| e.to_string())?;
+        let b = state_breakdown(&t.program()).ok_or("museum program has no layout")?;
+        let t2 = Table::<4096>::from_bytes(&museum_table).map_err(|e| e.to_string())?;
+        let m = t2.monitor().map_err(|e| e.to_string())?;
+        Ok((b, m.state_bytes(), museum_table.len()))
+    })?;
+    println!(
+        "compiled from museum-spec/museum.hspec by hindsight-codegen; the compiler's layout \
+         (interpreter state words), per property:"
+    );
     println!(
         "shared by all properties (timestamp, atom bits, node value bits): {}",
         breakdown.shared
     );
     for (i, (name, bytes)) in breakdown.props.iter().enumerate() {
+        let reported = museum_spec::PROPERTY_STATE_BYTES.get(i).copied();
+        if reported != Some(*bytes) {
+            return Err(format!(
+                "property {name}: layout says {bytes} bytes, the compiler reported {reported:?}"
+            ));
+        }
         println!(
-            "property {i} {name:<28} {bytes:>4}   {}",
+            "property {i} {name:<20} {bytes:>4}   {}",
             museum_spec::FORMULAS.get(i).copied().unwrap_or("")
         );
     }
     println!(
-        "total (Monitor::state_bytes, monitor-static): {}",
+        "total (Monitor::state_bytes, monitor-table with the default table): {}",
         breakdown.total()
     );
-    let (table, _) = table_inputs()?;
-    let table_state = std::thread::scope(|s| {
-        std::thread::Builder::new()
-            .stack_size(64 << 20)
-            .spawn_scoped(s, || {
-                let t = Table::<4096>::from_bytes(&table).map_err(|e| e.to_string())?;
-                let m = t.monitor().map_err(|e| e.to_string())?;
-                Ok::<_, String>((m.state_bytes(), table.len()))
-            })
-            .map_err(|e| e.to_string())?
-            .join()
-            .map_err(|_| "table thread panicked".to_string())?
-    })?;
+    println!(
+        "generated monitor (museum::STATE_BYTES, size_of its Monitor struct, monitor-static): {}",
+        museum::STATE_BYTES
+    );
     println!(
         "monitor-table: state {} bytes, postcard table {} bytes in flash; firmware log: {}",
-        table_state.0,
-        table_state.1,
+        table_state,
+        table_len,
         tables.join("; ")
     );
 
@@ -131,10 +138,10 @@ fn report() -> Result<(), String> {
     }
 
     println!();
-    println!("== Panic paths below `{STEP}` (direct calls into core's panic entry points)");
-    for name in ["monitor-static", "monitor-table"] {
+    println!("== Panic paths below the monitor step (direct calls into core's panic entry points)");
+    for (name, step) in STEPS {
         let (path, _) = read_image(name)?;
-        let r = callgraph::analyse(&path, STEP)?;
+        let r = callgraph::analyse(&path, step)?;
         let (builtins, own): (Vec<&String>, Vec<&String>) = r.reachable.iter().partition(|f| {
             f.starts_with("__") || f.starts_with("compiler_builtins::") || f.as_str() == "fmod"
         });
@@ -152,9 +159,9 @@ fn report() -> Result<(), String> {
         }
         print_locations("  panic locations", &r.locations);
     }
-    for name in ["monitor-static", "monitor-table"] {
+    for (name, step) in STEPS {
         let (path, _) = read_image(name)?;
-        let step = callgraph::analyse(&path, STEP)?;
+        let step = callgraph::analyse(&path, step)?;
         let all = callgraph::analyse(&path, "main")?;
         let outside: Vec<Location> = all
             .locations
@@ -220,10 +227,29 @@ fn largest_additions(image: &str, baseline: &str) -> Result<(), String> {
     let (monitor, _) = read_image(image)?;
     let (base, _) = read_image(baseline)?;
     let base = symbols(&base)?;
+    // Anonymous constants (`.Lanon.<hash>.<n>`) are named per image: one of
+    // the baseline's with the same size (the embedded trace) is the same data.
+    let mut base_anon: Vec<u64> = base
+        .iter()
+        .filter(|(n, _)| n.starts_with(".Lanon."))
+        .map(|(_, s)| *s)
+        .collect();
     let mut added: Vec<(String, u64)> = symbols(&monitor)?
         .into_iter()
         .filter(|(n, _)| !base.contains_key(n))
         .collect();
+    added.retain(|(n, size)| {
+        if !n.starts_with(".Lanon.") {
+            return true;
+        }
+        match base_anon.iter().position(|s| s == size) {
+            Some(i) => {
+                base_anon.swap_remove(i);
+                false
+            }
+            None => true,
+        }
+    });
     added.sort_by(|a, b| b.1.cmp(&a.1).then_with(|| a.0.cmp(&b.0)));
     let total: u64 = added.iter().map(|(_, s)| s).sum();
     println!(
