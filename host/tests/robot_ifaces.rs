@@ -368,3 +368,206 @@ fn interface_errors_point_at_the_file() {
     assert!(errs[0].to_string().contains("does not exist"), "{errs:?}");
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn every_main_file_reads() {
+    use hindsight::robot::main_file::{InputKind, MainFile, MainForm};
+    let mains = main_files();
+    let mut inputs = 0;
+    for main in &mains {
+        let mut sm = SourceMap::new();
+        let museum = main.to_string_lossy().contains("museum-simpar2025");
+        let m = if museum {
+            // The case study's main files name a properties.jani that its repository lacks.
+            let m = MainFile::parse(&mut sm, main).unwrap();
+            let missing = m.missing_files(&sm);
+            assert_eq!(missing.len(), 1, "{missing:?}");
+            assert!(
+                missing[0]
+                    .message
+                    .ends_with("Main/../Properties/properties.jani` not found"),
+                "{missing:?}"
+            );
+            let line = if main.ends_with("main.xml") { 35 } else { 22 };
+            assert_eq!((missing[0].line, missing[0].column), (line, 33));
+            assert_eq!(MainFile::read(&mut sm, main).unwrap_err(), missing);
+            m
+        } else {
+            MainFile::read(&mut sm, main).unwrap_or_else(|e| panic!("{}: {e:?}", main.display()))
+        };
+        assert_eq!(m.form == MainForm::ConvinceMcTc, museum);
+        assert!(m.params.max_time_ns.is_some(), "{}", main.display());
+        inputs += m.inputs().count();
+        if let Some(bt) = &m.behavior_tree {
+            assert_eq!(bt.tree.kind, InputKind::BtCppXml);
+            assert!(bt.plugins.iter().all(|p| p.kind.is_bt_plugin()));
+        }
+    }
+    assert!(inputs > 150, "{inputs} inputs");
+
+    let c = corpus();
+    let mut sm = SourceMap::new();
+    let uc3 = MainFile::read(
+        &mut sm,
+        &c.join("as2fm/test_data/uc3_museum_guide/Main/main.xml"),
+    )
+    .unwrap();
+    assert_eq!(
+        uc3.params.max_time_ns.as_ref().unwrap().value,
+        100_000_000_000
+    );
+    let rate = uc3.params.bt_tick_rate.as_ref().unwrap().value;
+    assert_eq!(
+        (rate.hz, rate.period_ns, rate.exact),
+        (10.0, 100_000_000, true)
+    );
+    assert!(uc3.params.tick_if_not_running());
+    assert!(uc3.params.max_array_size.is_none(), "commented out");
+    let bt = uc3.behavior_tree.as_ref().unwrap();
+    assert_eq!(bt.plugins.len(), 2);
+    assert_eq!(bt.plugins[0].src, "../Plugins/ROS2Condition.ascxml");
+    assert!(bt.plugins[0]
+        .path
+        .ends_with("Main/../Plugins/ROS2Condition.ascxml"));
+    assert_eq!(uc3.node_models.len(), 17);
+    assert_eq!(uc3.properties[0].kind, InputKind::Jani);
+    let d = sm.diag(uc3.properties[0].span, "here");
+    assert_eq!((d.line, d.column), (38, 33));
+
+    let uc2 = MainFile::read(
+        &mut sm,
+        &c.join("as2fm/test_data/uc2_assembly/Main/main.xml"),
+    )
+    .unwrap();
+    let rate = uc2.params.bt_tick_rate.as_ref().unwrap().value;
+    assert_eq!(rate.period_ns, 2_000_000_000);
+    assert_eq!(uc2.params.max_array_size.as_ref().unwrap().value, 10);
+    assert!(!uc2.params.tick_if_not_running(), "the default");
+
+    let ds = MainFile::read(
+        &mut sm,
+        &c.join("as2fm/test_data/data_structs/main_json_def.xml"),
+    )
+    .unwrap();
+    assert_eq!(ds.data_declarations[0].kind, InputKind::DataJson);
+    assert!(ds.behavior_tree.is_none());
+}
+
+/// Writes `text` as a main file in a fresh folder and reads it; the errors as text.
+fn main_errors(name: &str, text: &str) -> (PathBuf, Vec<String>) {
+    use hindsight::robot::main_file::MainFile;
+    let d = temp_dir(name);
+    let p = d.join("main.xml");
+    write(&p, text);
+    write(&d.join("bt.xml"), "<root/>");
+    let mut sm = SourceMap::new();
+    let errs = match MainFile::read(&mut sm, &p) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.iter().map(|d| d.to_string()).collect(),
+    };
+    (p, errs)
+}
+
+#[test]
+fn main_file_errors_point_at_the_input() {
+    let cases: &[(&str, &str, &str)] = &[
+        (
+            "unit",
+            "<roaml>\n  <parameters>\n    <max_time value=\"10\" unit=\"days\"/>\n  </parameters>\n</roaml>",
+            ":3:32: unknown time unit `days`",
+        ),
+        (
+            "inexact",
+            "<roaml><parameters>\n<max_time value=\"1.5\" unit=\"ns\"/></parameters></roaml>",
+            ":2:18: `1.5` is not a whole number of nanoseconds",
+        ),
+        (
+            "nounit",
+            "<roaml><parameters>\n  <max_time value=\"1\"/></parameters></roaml>",
+            ":2:3: <max_time> needs a `unit`",
+        ),
+        (
+            "missing",
+            "<roaml>\n<node_models>\n  <input type=\"node-ascxml\" src=\"./nope.ascxml\" />\n</node_models>\n</roaml>",
+            ":3:34: node-ascxml file `",
+        ),
+        (
+            "element",
+            "<roaml>\n  <parameter/>\n</roaml>",
+            ":2:3: unknown element <parameter> in <roaml>",
+        ),
+        (
+            "param",
+            "<roaml><parameters>\n <max_tme value=\"1\"/></parameters></roaml>",
+            ":2:2: unknown parameter <max_tme>",
+        ),
+        (
+            "attr",
+            "<roaml><node_models>\n <input type=\"node-ascxml\" scr=\"a\"/></node_models></roaml>",
+            ":2:28: unknown attribute `scr` on <input>",
+        ),
+        (
+            "kind",
+            "<roaml><node_models>\n <input type=\"jani\" src=\"a\"/></node_models></roaml>",
+            ":2:15: unknown input type `jani` in <node_models>",
+        ),
+        (
+            "twotrees",
+            "<roaml><behavior_tree>\n <input type=\"bt.cpp-xml\" src=\"bt.xml\"/>\n <input type=\"bt.cpp-xml\" src=\"bt.xml\"/>\n</behavior_tree></roaml>",
+            ":3:2: a behavior tree has exactly one bt.cpp-xml input",
+        ),
+        (
+            "notree",
+            "<roaml>\n<behavior_tree>\n</behavior_tree></roaml>",
+            ":2:1: <behavior_tree> needs one",
+        ),
+        (
+            "rate",
+            "<roaml><parameters>\n<bt_tick_rate value=\"0\"/></parameters></roaml>",
+            ":2:22: bt_tick_rate must be a positive number",
+        ),
+        (
+            "bool",
+            "<roaml><parameters>\n<bt_tick_if_not_running value=\"yes\"/></parameters></roaml>",
+            ":2:32: bt_tick_if_not_running must be true or false",
+        ),
+        (
+            "size",
+            "<roaml><parameters>\n<max_array_size value=\"-3\"/></parameters></roaml>",
+            ":2:24: max_array_size must be a positive whole number",
+        ),
+        (
+            "twice",
+            "<roaml>\n<properties/>\n<properties/>\n</roaml>",
+            ":3:1: <properties> is given twice (first on line 2)",
+        ),
+        (
+            "root",
+            "<scxml/>",
+            ":1:1: expected a main file",
+        ),
+        (
+            "xml",
+            "<roaml>\n<properties>\n</roaml>",
+            "main.xml:3:",
+        ),
+    ];
+    for (name, text, want) in cases {
+        let (p, errs) = main_errors(name, text);
+        // A misspelt `src` is also a missing `src`: two errors, the first the spelling.
+        let n = if *name == "attr" { 2 } else { 1 };
+        assert_eq!(errs.len(), n, "{name}: {errs:?}");
+        assert!(
+            errs[0].starts_with(&p.display().to_string()) && errs[0].contains(want),
+            "{name}: want `{want}`, got {errs:?}"
+        );
+        let _ = std::fs::remove_dir_all(p.parent().unwrap());
+    }
+    // Errors are collected, not stopped at the first.
+    let (p, errs) = main_errors(
+        "many",
+        "<roaml><parameters>\n<max_time value=\"x\" unit=\"s\"/>\n<bt_tick_rate value=\"y\"/>\n</parameters></roaml>",
+    );
+    assert_eq!(errs.len(), 2, "{errs:?}");
+    let _ = std::fs::remove_dir_all(p.parent().unwrap());
+}

@@ -614,25 +614,26 @@ fn parse_type(text: &str, base: usize, package: &str) -> Result<FieldType, LineE
         });
     }
     let parts: Vec<&str> = elem_name.split('/').collect();
-    let (pkg, name) =
-        match parts.as_slice() {
-            [name] => {
-                // ROS 2 reads a bare `Header` as std_msgs's.
-                if *name == "Header" && package != "std_msgs" {
-                    ("std_msgs", *name)
-                } else {
-                    (package, *name)
-                }
+    let (pkg, name) = match parts.as_slice() {
+        [name] => {
+            // ROS 2 reads a bare `Header` as std_msgs's.
+            if *name == "Header" && package != "std_msgs" {
+                ("std_msgs", *name)
+            } else {
+                (package, *name)
             }
-            [pkg, name] => (*pkg, *name),
-            [pkg, "msg", name] => (*pkg, *name),
-            _ => return Err((
+        }
+        [pkg, name] => (*pkg, *name),
+        [pkg, "msg", name] => (*pkg, *name),
+        _ => {
+            return Err((
                 base,
                 format!(
                     "`{elem_name}` is not a type (expected a primitive, `Type` or `package/Type`)"
                 ),
-            )),
-        };
+            ))
+        }
+    };
     if !valid_type_name(name) || !valid_package_name(pkg) {
         return Err((
             base,

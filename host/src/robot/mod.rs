@@ -19,5 +19,6 @@
 //! span of the source it was made from, so errors found late name the user's file.
 
 pub mod interfaces;
+pub mod main_file;
 pub mod types;
 pub mod write;
