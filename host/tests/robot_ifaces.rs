@@ -571,3 +571,112 @@ fn main_file_errors_point_at_the_input() {
     assert_eq!(errs.len(), 2, "{errs:?}");
     let _ = std::fs::remove_dir_all(p.parent().unwrap());
 }
+
+/// Every data declaration a corpus main file names reads; the JSON and XML forms of the
+/// data_structs case declare the same types.
+#[test]
+fn data_declarations_read() {
+    use hindsight::model::types::{TypeDef, TypeDefs};
+    use hindsight::robot::datatypes::{read_data_declarations, DataFormat};
+    use hindsight::robot::main_file::{InputKind, MainFile};
+    let mut read = 0;
+    for main in main_files() {
+        let mut sm = SourceMap::new();
+        let m = MainFile::parse(&mut sm, &main).unwrap();
+        let files: Vec<(&Path, DataFormat)> = m
+            .data_declarations
+            .iter()
+            .map(|i| {
+                let f = if i.kind == InputKind::DataJson {
+                    DataFormat::Json
+                } else {
+                    DataFormat::Xml
+                };
+                (i.path.as_path(), f)
+            })
+            .collect();
+        if files.is_empty() {
+            continue;
+        }
+        read_data_declarations(&mut sm, &files)
+            .unwrap_or_else(|e| panic!("{}: {e:?}", main.display()));
+        read += 1;
+    }
+    assert_eq!(read, 4);
+    let shape = |defs: &TypeDefs| -> Vec<(String, Vec<(String, String)>)> {
+        let mut v: Vec<_> = defs
+            .defs
+            .iter()
+            .map(|(n, d, _)| match d {
+                TypeDef::Struct { fields } => (
+                    n.clone(),
+                    fields
+                        .iter()
+                        .map(|(f, t)| (f.clone(), t.to_string()))
+                        .collect(),
+                ),
+                TypeDef::Enumeration { .. } => (n.clone(), Vec::new()),
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    let dir = corpus().join("as2fm/test_data/data_structs");
+    let mut sm = SourceMap::new();
+    let x =
+        read_data_declarations(&mut sm, &[(&dir.join("my_types.xml"), DataFormat::Xml)]).unwrap();
+    let j =
+        read_data_declarations(&mut sm, &[(&dir.join("my_types.json"), DataFormat::Json)]).unwrap();
+    assert_eq!(shape(&x), shape(&j));
+    assert_eq!(
+        shape(&j)[1],
+        (
+            "Polygon".to_string(),
+            vec![("points".to_string(), "Point2D[]".to_string())]
+        )
+    );
+    assert_eq!(
+        shape(&j)[0]
+            .1
+            .iter()
+            .map(|(f, _)| f.as_str())
+            .collect::<Vec<_>>(),
+        ["frame", "x", "y"],
+        "written order"
+    );
+}
+
+#[test]
+fn data_declaration_errors_point_at_the_type() {
+    use hindsight::robot::datatypes::{read_data_declarations, DataFormat};
+    let d = temp_dir("data");
+    let x = d.join("t.xml");
+    write(
+        &x,
+        "<types>\n  <struct id=\"A\">\n    <member id=\"b\" type=\"B[]\"/>\n  </struct>\n</types>\n",
+    );
+    let mut sm = SourceMap::new();
+    let e = read_data_declarations(&mut sm, &[(&x, DataFormat::Xml)]).unwrap_err();
+    assert_eq!(e.len(), 1);
+    assert!(
+        e[0].to_string()
+            .starts_with(&format!("{}:3:26: type `B` is not declared", x.display())),
+        "{e:?}"
+    );
+    let j = d.join("t.json");
+    write(&j, "{\"title\": \"A\", \"type\": \"object\",\n \"properties\": {\"b\": {\"type\": \"float\"}}}");
+    let e = read_data_declarations(&mut sm, &[(&j, DataFormat::Json)]).unwrap_err();
+    assert!(
+        e[0].to_string()
+            .starts_with(&format!("{}:2:31: unsupported type `float`", j.display())),
+        "{e:?}"
+    );
+    write(&j, "{\"title\": \"A\",\n \"type\": \"object\" \"x\"}");
+    let e = read_data_declarations(&mut sm, &[(&j, DataFormat::Json)]).unwrap_err();
+    assert!(
+        e[0].to_string()
+            .starts_with(&format!("{}:2:19: expected `,` or `}}`", j.display())),
+        "{e:?}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
