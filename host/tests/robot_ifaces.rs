@@ -680,3 +680,30 @@ fn data_declaration_errors_point_at_the_type() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// A main file given by a relative path finds the interfaces folder above it, and the
+/// interface files keep relative paths in diagnostics.
+#[test]
+fn discovery_from_a_relative_path() {
+    let here = std::env::current_dir().unwrap();
+    let up = here
+        .ancestors()
+        .position(|d| d.join("shared/corpus").is_dir())
+        .expect("corpus above the working folder");
+    let rel = PathBuf::from("../".repeat(up))
+        .join("shared/corpus/as2fm/test_data/uc3_museum_guide/Main/main.xml");
+    let mut sm = SourceMap::new();
+    let ifs = Interfaces::discover(&mut sm, &rel, &[]).unwrap();
+    assert_eq!(
+        all(&ifs
+            .service("bt_interfaces_dummy/srv/TickAction")
+            .unwrap()
+            .response),
+        vec![
+            ("ros_fields__status".to_string(), "int8".to_string()),
+            ("ros_fields__is_ok".to_string(), "bool".to_string())
+        ]
+    );
+    assert!(sm.files().iter().all(|f| f.path().is_relative()));
+    assert_eq!(sm.files().len(), 44, "every file of ros_support_interfaces");
+}

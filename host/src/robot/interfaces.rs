@@ -881,7 +881,7 @@ impl Interfaces {
     /// The built-ins plus every interface package found beside `main_file` and in `extra`.
     ///
     /// Looked for, nearest first: packages directly in the main file's folder; then, in that
-    /// folder and up to three folders above it, the folders called `ros_support_interfaces`,
+    /// folder and up to four folders above it, the folders called `ros_support_interfaces`,
     /// `Interfaces` or `interfaces` and every package below them (up to three levels deep,
     /// so `ros_support_interfaces/uc3_interfaces/<pkg>/srv/X.srv` is found). Each `extra`
     /// path is a package or a folder searched the same way. A package is a folder with a
@@ -917,13 +917,16 @@ impl Interfaces {
                 packages.push((dir_name(&child), child));
             }
         }
-        for anc in dir.ancestors().take(4) {
-            let anc = if anc.as_os_str().is_empty() {
-                Path::new(".")
-            } else {
-                anc
-            };
-            for child in sorted_dirs(anc) {
+        // Folders above the main file, written relative to it (`dir/..`) when `dir` runs
+        // out of components, so relative paths keep working above the current folder.
+        let mut anc = dir.to_path_buf();
+        let mut last: Option<PathBuf> = None;
+        for _ in 0..5 {
+            let canon = anc.canonicalize().ok();
+            if canon.is_some() && canon == last {
+                break; // the file system's root
+            }
+            for child in sorted_dirs(&anc) {
                 let n = dir_name(&child);
                 if matches!(
                     n.as_str(),
@@ -932,9 +935,8 @@ impl Interfaces {
                     find_packages(&child, 3, &mut packages);
                 }
             }
-            if anc == Path::new(".") || anc == Path::new("/") {
-                break;
-            }
+            last = canon;
+            anc = up(&anc);
         }
         let mut seen = BTreeSet::new();
         for (name, path) in packages {
@@ -1320,6 +1322,18 @@ fn sorted_dirs(dir: &Path) -> Vec<PathBuf> {
     v
 }
 
+/// The folder above `p`: its lexical parent while it has one, `p/..` after that.
+fn up(p: &Path) -> PathBuf {
+    match p.components().next_back() {
+        Some(std::path::Component::Normal(_)) => match p.parent() {
+            Some(q) if q.as_os_str().is_empty() => PathBuf::from("."),
+            Some(q) => q.to_path_buf(),
+            None => p.join(".."),
+        },
+        _ => p.join(".."),
+    }
+}
+
 fn dir_name(p: &Path) -> String {
     p.file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -1659,6 +1673,15 @@ mod tests {
             };
             assert_eq!(r, Ok(()), "{name}");
         }
+    }
+
+    #[test]
+    fn folders_above() {
+        assert_eq!(up(Path::new("a/b")), Path::new("a"));
+        assert_eq!(up(Path::new("a")), Path::new("."));
+        assert_eq!(up(Path::new(".")), Path::new("./.."));
+        assert_eq!(up(Path::new("./..")), Path::new("./../.."));
+        assert_eq!(up(Path::new("/")), Path::new("/.."));
     }
 
     #[test]
