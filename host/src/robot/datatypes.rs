@@ -534,6 +534,55 @@ mod tests {
     }
 
     #[test]
+    fn no_input_panics() {
+        let tokens = [
+            "{",
+            "}",
+            "[",
+            "]",
+            ":",
+            ",",
+            "\"",
+            "\\",
+            "u",
+            "12",
+            "-",
+            "e",
+            "true",
+            "nul",
+            "é",
+            "\"$ref\"",
+            "\"#/$defs/\"",
+            "\"type\"",
+            "\"array\"",
+            "\"items\"",
+            " ",
+        ];
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let (mut oks, mut errs) = (0, 0);
+        for _ in 0..20_000 {
+            let mut next = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                state
+            };
+            let mut text = String::new();
+            for _ in 0..(next() % 12) {
+                text.push_str(tokens[(next() % tokens.len() as u64) as usize]);
+            }
+            match parse(&text) {
+                Ok(v) => {
+                    oks += 1;
+                    let _ = json_type(&v, 0);
+                }
+                Err(_) => errs += 1,
+            }
+        }
+        assert!(oks > 500 && errs > 10_000, "{oks} parsed, {errs} rejected");
+    }
+
+    #[test]
     fn json_values() {
         assert_eq!(parse(" [1, -2.5e1, true, null] ").unwrap(), {
             Json::Arr(vec![

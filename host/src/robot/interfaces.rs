@@ -330,8 +330,9 @@ pub fn parse_interface(
     };
     let mut errs = Vec::new();
     let mut parts = vec![MessageDef::default()];
-    let mut line_start = 0usize;
-    for raw_line in text.split_inclusive('\n') {
+    // A byte-order mark is not part of the first line.
+    let mut line_start = if text.starts_with('\u{feff}') { 3 } else { 0 };
+    for raw_line in text[line_start..].split_inclusive('\n') {
         let start = line_start;
         line_start += raw_line.len();
         let line = strip_comment(raw_line.trim_end_matches(['\n', '\r']));
@@ -1673,6 +1674,53 @@ mod tests {
             };
             assert_eq!(r, Ok(()), "{name}");
         }
+    }
+
+    #[test]
+    fn no_input_panics() {
+        let tokens = [
+            "int32", "x", "X", "=", "[", "]", "[<=", "<=", "'", "\"", "é", "#", "---", " ", "\n",
+            "3", "-1", "string", "p/T", "\\", ",", "\u{feff}", "1e999", "\r\n", "[]", "T",
+        ];
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let (mut oks, mut errs) = (0, 0);
+        for _ in 0..20_000 {
+            let mut next = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                state
+            };
+            let mut text = String::new();
+            for _ in 0..(next() % 9) {
+                text.push_str(tokens[(next() % tokens.len() as u64) as usize]);
+            }
+            for kind in [
+                InterfaceKind::Message,
+                InterfaceKind::Service,
+                InterfaceKind::Action,
+            ] {
+                match parse(&text, kind) {
+                    Ok(_) => oks += 1,
+                    Err(_) => errs += 1,
+                }
+            }
+        }
+        assert!(
+            oks > 1_000 && errs > 10_000,
+            "{oks} parsed, {errs} rejected"
+        );
+        assert_eq!(
+            parse(
+                "\u{feff}int32 x\r\nstring<=3 s 'é'\r\n",
+                InterfaceKind::Message
+            )
+            .unwrap()
+            .parts[0]
+                .fields
+                .len(),
+            2
+        );
     }
 
     #[test]
