@@ -707,3 +707,34 @@ fn discovery_from_a_relative_path() {
     assert!(sm.files().iter().all(|f| f.path().is_relative()));
     assert_eq!(sm.files().len(), 44, "every file of ros_support_interfaces");
 }
+
+/// A deep diamond of messages (2^20 leaves) is refused quickly, not expanded; one nested
+/// deeper than 32 levels too.
+#[test]
+fn huge_messages_are_refused() {
+    let d = temp_dir("huge");
+    write(&d.join("main.xml"), "<roaml/>");
+    for k in 0..20 {
+        write(
+            &d.join(format!("interfaces/big_msgs/msg/M{k}.msg")),
+            &format!("M{n} a\nM{n} b\n", n = k + 1),
+        );
+    }
+    write(&d.join("interfaces/big_msgs/msg/M20.msg"), "int32 x\n");
+    for k in 0..40 {
+        write(
+            &d.join(format!("interfaces/deep_msgs/msg/D{k}.msg")),
+            &format!("D{} a\n", k + 1),
+        );
+    }
+    write(&d.join("interfaces/deep_msgs/msg/D40.msg"), "int32 x\n");
+    let mut sm = SourceMap::new();
+    let ifs = Interfaces::discover(&mut sm, &d.join("main.xml"), &[]).unwrap();
+    let e = ifs.message("big_msgs/M0").unwrap_err();
+    assert!(e.contains("more than 10000 leaf fields"), "{e}");
+    assert_eq!(ifs.message("big_msgs/M17").unwrap().len(), 8);
+    let e = ifs.message("deep_msgs/D0").unwrap_err();
+    assert!(e.contains("nest deeper than 32 levels"), "{e}");
+    assert_eq!(ifs.message("deep_msgs/D10").unwrap()[0].path.len(), 31);
+    let _ = std::fs::remove_dir_all(&d);
+}

@@ -48,6 +48,9 @@ use crate::model::source::{Diagnostic, FileId, SourceMap, Span};
 /// Deepest nesting of messages followed when flattening (a deeper chain is a cycle).
 const MAX_NESTING: usize = 32;
 
+/// Most leaf fields one flattened message may have.
+const MAX_LEAVES: usize = 10_000;
+
 /// Largest fixed array length accepted (its default literal is written out in full).
 const MAX_FIXED_LEN: u32 = 4096;
 
@@ -1078,11 +1081,13 @@ impl Interfaces {
         }
     }
 
+    /// True when message `start` can reach itself through its fields.
     fn contains_cycle(&self, start: &(String, InterfaceKind, String)) -> bool {
-        let mut stack = vec![(start.clone(), 0usize)];
-        while let Some((key, depth)) = stack.pop() {
-            if depth > MAX_NESTING {
-                return true;
+        let mut seen = BTreeSet::new();
+        let mut stack = vec![start.clone()];
+        while let Some(key) = stack.pop() {
+            if !seen.insert(key.clone()) {
+                continue;
             }
             let Some(def) = self.defs.get(&key) else {
                 continue;
@@ -1093,7 +1098,7 @@ impl Interfaces {
                     if k == *start {
                         return true;
                     }
-                    stack.push((k, depth + 1));
+                    stack.push(k);
                 }
             }
         }
@@ -1232,6 +1237,12 @@ impl Interfaces {
             ));
         }
         for f in &part.fields {
+            if out.len() >= MAX_LEAVES {
+                return Err(format!(
+                    "the message has more than {MAX_LEAVES} leaf fields (at `{}`)",
+                    path.join(".")
+                ));
+            }
             path.push(f.name.clone());
             match &f.ty.base {
                 BaseType::Primitive { prim, .. } => {
