@@ -18,5 +18,8 @@
 //! Element trees are [`crate::model::xml::Element`]: every element and attribute keeps the
 //! span of the source it was made from, so errors found late name the user's file.
 
+pub mod datatypes;
+pub mod interfaces;
+pub mod main_file;
 pub mod types;
 pub mod write;

@@ -1,0 +1,720 @@
+//! The main file of a robot model: AS2FM's `<roaml>` (and the older `<convince_mc_tc>`), which
+//! names the behavior tree, its plugins, the node models, data types and properties, and the
+//! run parameters.
+//!
+//! ```xml
+//! <roaml>
+//!     <parameters>
+//!         <max_time value="100" unit="s" />          <!-- ns, us, ms, s, min, h -->
+//!         <max_array_size value="10" />
+//!         <bt_tick_rate value="5.0" />               <!-- Hz -->
+//!         <bt_tick_if_not_running value="true" />
+//!     </parameters>
+//!     <data_declarations> <input type="xml" src="./types.xml" /> </data_declarations>
+//!     <behavior_tree>
+//!         <input type="bt.cpp-xml" src="./bt.xml" />
+//!         <input type="bt-plugin-ascxml" src="./plugin.ascxml" />
+//!     </behavior_tree>
+//!     <node_models> <input type="node-ascxml" src="./node.ascxml" /> </node_models>
+//!     <properties> <input type="jani" src="./properties.jani" /> </properties>
+//! </roaml>
+//! ```
+//!
+//! The older form is `<convince_mc_tc>` with `<mc_parameters>`, plugins of type
+//! `bt-plugin-ros-scxml` and node models of type `ros-scxml` (`.scxml` files with ROS tags).
+//! Either parameter element is accepted in either form. Paths are relative to the main file.
+//! Every element and attribute is checked: an unknown one is an error at its position.
+
+use std::path::{Path, PathBuf};
+
+use crate::model::source::{Diagnostic, FileId, SourceMap, Span};
+use crate::model::xml::{self, Element, Node};
+
+/// The BT tick rate AS2FM uses when `bt_tick_rate` is absent, in Hz.
+pub const DEFAULT_BT_TICK_RATE_HZ: f64 = 1.0;
+
+/// Whether AS2FM ticks a finished tree again when `bt_tick_if_not_running` is absent.
+pub const DEFAULT_BT_TICK_IF_NOT_RUNNING: bool = false;
+
+/// Which of the two main file formats a file is written in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MainForm {
+    /// `<roaml>`.
+    Roaml,
+    /// The older `<convince_mc_tc>`.
+    ConvinceMcTc,
+}
+
+/// What an `<input>` is, from its `type` attribute.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InputKind {
+    /// `bt.cpp-xml`: a BehaviorTree.cpp XML tree (in `<behavior_tree>`).
+    BtCppXml,
+    /// `bt-plugin-ascxml`: a BT leaf plugin as `.ascxml` (in `<behavior_tree>`).
+    BtPluginAscxml,
+    /// `bt-plugin-ros-scxml`: a BT leaf plugin as `.scxml` with ROS tags, older form.
+    BtPluginRosScxml,
+    /// `node-ascxml`: a node model as `.ascxml` (in `<node_models>`).
+    NodeAscxml,
+    /// `ros-scxml`: a node model as `.scxml` with ROS tags, older form.
+    RosScxml,
+    /// `jani`: JANI properties (in `<properties>`).
+    Jani,
+    /// `xml` in `<properties>`: SCAN-format XML properties over ROS names.
+    PropertiesXml,
+    /// `hspec`: hindsight's own property file (in `<properties>`).
+    Hspec,
+    /// `xml` in `<data_declarations>`: `<types>` of `<struct>`s.
+    DataXml,
+    /// `json` in `<data_declarations>`: a JSON schema.
+    DataJson,
+}
+
+impl InputKind {
+    /// The `type` attribute value this kind is written as.
+    pub fn type_name(self) -> &'static str {
+        match self {
+            InputKind::BtCppXml => "bt.cpp-xml",
+            InputKind::BtPluginAscxml => "bt-plugin-ascxml",
+            InputKind::BtPluginRosScxml => "bt-plugin-ros-scxml",
+            InputKind::NodeAscxml => "node-ascxml",
+            InputKind::RosScxml => "ros-scxml",
+            InputKind::Jani => "jani",
+            InputKind::PropertiesXml | InputKind::DataXml => "xml",
+            InputKind::Hspec => "hspec",
+            InputKind::DataJson => "json",
+        }
+    }
+
+    /// True for the BT plugin kinds.
+    pub fn is_bt_plugin(self) -> bool {
+        matches!(
+            self,
+            InputKind::BtPluginAscxml | InputKind::BtPluginRosScxml
+        )
+    }
+}
+
+/// One `<input type src>`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Input {
+    /// What the file is.
+    pub kind: InputKind,
+    /// The `src` attribute as written.
+    pub src: String,
+    /// `src` resolved against the main file's folder.
+    pub path: PathBuf,
+    /// Where the `src` value is written (errors about the file point here).
+    pub span: Span,
+    /// Where the `<input>` element starts.
+    pub element: Span,
+}
+
+/// A parameter's value and where it is written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Param<T> {
+    /// The value.
+    pub value: T,
+    /// Where the `value` attribute's value is written.
+    pub span: Span,
+}
+
+/// The BT tick rate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TickRate {
+    /// Ticks per second, as written.
+    pub hz: f64,
+    /// The tick period in nanoseconds, rounded to the nearest nanosecond.
+    pub period_ns: u64,
+    /// True when `period_ns` is exactly `1e9 / hz` (the rate is written as a decimal whose
+    /// period is a whole number of nanoseconds, as `0.5`, `10.0` or `3e0` are not all).
+    pub exact: bool,
+}
+
+/// The run parameters; `None` where the file does not set one.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Parameters {
+    /// `max_time`, converted exactly to nanoseconds.
+    pub max_time_ns: Option<Param<u64>>,
+    /// `max_array_size`: the length bound of unbounded arrays.
+    pub max_array_size: Option<Param<u32>>,
+    /// `bt_tick_rate` (default [`DEFAULT_BT_TICK_RATE_HZ`]).
+    pub bt_tick_rate: Option<Param<TickRate>>,
+    /// `bt_tick_if_not_running` (default [`DEFAULT_BT_TICK_IF_NOT_RUNNING`]).
+    pub bt_tick_if_not_running: Option<Param<bool>>,
+}
+
+impl Parameters {
+    /// The tick rate in Hz, or the default.
+    pub fn bt_tick_rate_hz(&self) -> f64 {
+        self.bt_tick_rate
+            .as_ref()
+            .map_or(DEFAULT_BT_TICK_RATE_HZ, |p| p.value.hz)
+    }
+
+    /// Whether a finished tree is ticked again, or the default.
+    pub fn tick_if_not_running(&self) -> bool {
+        self.bt_tick_if_not_running
+            .as_ref()
+            .map_or(DEFAULT_BT_TICK_IF_NOT_RUNNING, |p| p.value)
+    }
+}
+
+/// The `<behavior_tree>` section.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BehaviorTree {
+    /// The one `bt.cpp-xml` tree.
+    pub tree: Input,
+    /// The plugins, in the order written.
+    pub plugins: Vec<Input>,
+    /// Where `<behavior_tree>` starts.
+    pub span: Span,
+}
+
+/// A main file, read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MainFile {
+    /// The main file's path as given.
+    pub path: PathBuf,
+    /// The main file in the source map.
+    pub file: FileId,
+    /// Which format it is written in.
+    pub form: MainForm,
+    /// The run parameters.
+    pub params: Parameters,
+    /// `<data_declarations>` inputs.
+    pub data_declarations: Vec<Input>,
+    /// The behavior tree and its plugins, if any.
+    pub behavior_tree: Option<BehaviorTree>,
+    /// `<node_models>` inputs.
+    pub node_models: Vec<Input>,
+    /// `<properties>` inputs.
+    pub properties: Vec<Input>,
+}
+
+impl MainFile {
+    /// Reads the main file at `path` and checks that every file it names exists
+    /// ([`MainFile::parse`] then [`MainFile::missing_files`]).
+    pub fn read(sm: &mut SourceMap, path: &Path) -> Result<MainFile, Vec<Diagnostic>> {
+        let m = MainFile::parse(sm, path)?;
+        let missing = m.missing_files(sm);
+        if missing.is_empty() {
+            Ok(m)
+        } else {
+            Err(missing)
+        }
+    }
+
+    /// Reads the main file at `path` without looking at the files it names (for a caller
+    /// that replaces some of them, such as the properties).
+    pub fn parse(sm: &mut SourceMap, path: &Path) -> Result<MainFile, Vec<Diagnostic>> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| vec![Diagnostic::file(path, format!("cannot read: {e}"))])?;
+        let file = sm.add(path, text);
+        MainFile::parse_file(sm, file, path)
+    }
+
+    /// Reads a main file already added to `sm` as `file`; `path` is where it lives (inputs
+    /// are resolved against its folder).
+    pub fn parse_file(
+        sm: &SourceMap,
+        file: FileId,
+        path: &Path,
+    ) -> Result<MainFile, Vec<Diagnostic>> {
+        let root = xml::parse(sm, file).map_err(|d| vec![d])?;
+        let form = match root.name.as_str() {
+            "roaml" => MainForm::Roaml,
+            "convince_mc_tc" => MainForm::ConvinceMcTc,
+            other => {
+                return Err(vec![sm.diag(
+                    root.span,
+                    format!("expected a main file (<roaml> or <convince_mc_tc>), found <{other}>"),
+                )])
+            }
+        };
+        let base = path.parent().unwrap_or(Path::new("")).to_path_buf();
+        let mut r = Reader {
+            sm,
+            base,
+            errs: Vec::new(),
+        };
+        root.check_attrs(sm, &[], &mut r.errs);
+        let mut params = Parameters::default();
+        let mut seen: Vec<(String, Span)> = Vec::new();
+        let mut data_declarations = Vec::new();
+        let mut behavior_tree = None;
+        let mut node_models = Vec::new();
+        let mut properties = Vec::new();
+        for el in r.children(&root) {
+            let section = match el.name.as_str() {
+                "parameters" | "mc_parameters" => "parameters",
+                other => other,
+            };
+            if let Some((_, first)) = seen.iter().find(|(n, _)| n == section) {
+                let (line, _) = sm
+                    .file(first.file)
+                    .map_or((0, 0), |f| f.line_col(first.offset));
+                r.errs.push(sm.diag(
+                    el.span,
+                    format!("<{}> is given twice (first on line {line})", el.name),
+                ));
+                continue;
+            }
+            seen.push((section.to_string(), el.span));
+            el.check_attrs(sm, &[], &mut r.errs);
+            match section {
+                "parameters" => params = r.parameters(el),
+                "data_declarations" => {
+                    data_declarations = r.inputs(
+                        el,
+                        &[("xml", InputKind::DataXml), ("json", InputKind::DataJson)],
+                    )
+                }
+                "behavior_tree" => {
+                    let inputs = r.inputs(
+                        el,
+                        &[
+                            ("bt.cpp-xml", InputKind::BtCppXml),
+                            ("bt-plugin-ascxml", InputKind::BtPluginAscxml),
+                            ("bt-plugin-ros-scxml", InputKind::BtPluginRosScxml),
+                        ],
+                    );
+                    behavior_tree = r.behavior_tree(el, inputs);
+                }
+                "node_models" => {
+                    node_models = r.inputs(
+                        el,
+                        &[
+                            ("node-ascxml", InputKind::NodeAscxml),
+                            ("ros-scxml", InputKind::RosScxml),
+                        ],
+                    )
+                }
+                "properties" => {
+                    properties = r.inputs(
+                        el,
+                        &[
+                            ("jani", InputKind::Jani),
+                            ("xml", InputKind::PropertiesXml),
+                            ("hspec", InputKind::Hspec),
+                        ],
+                    )
+                }
+                other => r.errs.push(sm.diag(
+                    el.span,
+                    format!(
+                        "unknown element <{other}> in <{}> (expected <parameters>, <data_declarations>, <behavior_tree>, <node_models> or <properties>)",
+                        root.name
+                    ),
+                )),
+            }
+        }
+        if r.errs.is_empty() {
+            Ok(MainFile {
+                path: path.to_path_buf(),
+                file,
+                form,
+                params,
+                data_declarations,
+                behavior_tree,
+                node_models,
+                properties,
+            })
+        } else {
+            Err(r.errs)
+        }
+    }
+
+    /// Every input, in file order of sections: data declarations, tree, plugins, node
+    /// models, properties.
+    pub fn inputs(&self) -> impl Iterator<Item = &Input> {
+        let bt = self
+            .behavior_tree
+            .iter()
+            .flat_map(|b| std::iter::once(&b.tree).chain(b.plugins.iter()));
+        self.data_declarations
+            .iter()
+            .chain(bt)
+            .chain(self.node_models.iter())
+            .chain(self.properties.iter())
+    }
+
+    /// An error at each `src` whose file does not exist.
+    pub fn missing_files(&self, sm: &SourceMap) -> Vec<Diagnostic> {
+        self.inputs()
+            .filter(|i| !i.path.is_file())
+            .map(|i| {
+                sm.diag(
+                    i.span,
+                    format!(
+                        "{} file `{}` not found",
+                        i.kind.type_name(),
+                        i.path.display()
+                    ),
+                )
+            })
+            .collect()
+    }
+}
+
+struct Reader<'a> {
+    sm: &'a SourceMap,
+    base: PathBuf,
+    errs: Vec<Diagnostic>,
+}
+
+impl<'a> Reader<'a> {
+    /// Child elements; text is an error.
+    fn children<'e>(&mut self, el: &'e Element) -> Vec<&'e Element> {
+        let mut out = Vec::new();
+        for n in &el.children {
+            match n {
+                Node::Element(e) => out.push(e),
+                Node::Text(span) => self.errs.push(
+                    self.sm
+                        .diag(*span, format!("unexpected text in <{}>", el.name)),
+                ),
+                Node::Comment(..) => {}
+            }
+        }
+        out
+    }
+
+    fn parameters(&mut self, el: &Element) -> Parameters {
+        let sm = self.sm;
+        let mut p = Parameters::default();
+        for c in self.children(el) {
+            let allowed: &[&str] = if c.name == "max_time" {
+                &["value", "unit"]
+            } else {
+                &["value"]
+            };
+            if !matches!(
+                c.name.as_str(),
+                "max_time" | "max_array_size" | "bt_tick_rate" | "bt_tick_if_not_running"
+            ) {
+                self.errs.push(sm.diag(
+                    c.span,
+                    format!(
+                        "unknown parameter <{}> (expected <max_time>, <max_array_size>, <bt_tick_rate> or <bt_tick_if_not_running>)",
+                        c.name
+                    ),
+                ));
+                continue;
+            }
+            c.check_attrs(sm, allowed, &mut self.errs);
+            for n in &c.children {
+                if let Node::Element(e) = n {
+                    self.errs
+                        .push(sm.diag(e.span, format!("unexpected <{}> in <{}>", e.name, c.name)));
+                }
+            }
+            let value = match c.required(sm, "value") {
+                Ok(a) => a,
+                Err(d) => {
+                    self.errs.push(d);
+                    continue;
+                }
+            };
+            let v = value.value.trim();
+            let span = value.value_span;
+            match c.name.as_str() {
+                "max_time" => {
+                    let unit = match c.required(sm, "unit") {
+                        Ok(u) => u,
+                        Err(_) => {
+                            self.errs.push(sm.diag(
+                                c.span,
+                                "<max_time> needs a `unit` (ns, us, ms, s, min or h)",
+                            ));
+                            continue;
+                        }
+                    };
+                    if p.max_time_ns.is_some() {
+                        self.errs.push(sm.diag(c.span, "<max_time> is given twice"));
+                        continue;
+                    }
+                    match unit_ns(unit.value.trim()) {
+                        None => self.errs.push(sm.diag(
+                            unit.value_span,
+                            format!(
+                                "unknown time unit `{}` (expected ns, us, ms, s, min or h)",
+                                unit.value
+                            ),
+                        )),
+                        Some(scale) => match decimal_times(v, scale) {
+                            Ok(ns) => p.max_time_ns = Some(Param { value: ns, span }),
+                            Err(m) => self.errs.push(sm.diag(span, m)),
+                        },
+                    }
+                }
+                "max_array_size" => {
+                    if p.max_array_size.is_some() {
+                        self.errs
+                            .push(sm.diag(c.span, "<max_array_size> is given twice"));
+                        continue;
+                    }
+                    match v.parse::<u32>() {
+                        Ok(n) if n > 0 => p.max_array_size = Some(Param { value: n, span }),
+                        _ => self.errs.push(sm.diag(
+                            span,
+                            format!("max_array_size must be a positive whole number, not `{v}`"),
+                        )),
+                    }
+                }
+                "bt_tick_rate" => {
+                    if p.bt_tick_rate.is_some() {
+                        self.errs
+                            .push(sm.diag(c.span, "<bt_tick_rate> is given twice"));
+                        continue;
+                    }
+                    match tick_rate(v) {
+                        Ok(t) => p.bt_tick_rate = Some(Param { value: t, span }),
+                        Err(m) => self.errs.push(sm.diag(span, m)),
+                    }
+                }
+                _ => {
+                    if p.bt_tick_if_not_running.is_some() {
+                        self.errs
+                            .push(sm.diag(c.span, "<bt_tick_if_not_running> is given twice"));
+                        continue;
+                    }
+                    let b = match v.to_ascii_lowercase().as_str() {
+                        "true" | "1" => Some(true),
+                        "false" | "0" => Some(false),
+                        _ => None,
+                    };
+                    match b {
+                        Some(b) => p.bt_tick_if_not_running = Some(Param { value: b, span }),
+                        None => self.errs.push(sm.diag(
+                            span,
+                            format!("bt_tick_if_not_running must be true or false, not `{v}`"),
+                        )),
+                    }
+                }
+            }
+        }
+        p
+    }
+
+    fn inputs(&mut self, el: &Element, kinds: &[(&str, InputKind)]) -> Vec<Input> {
+        let sm = self.sm;
+        let mut out = Vec::new();
+        let expected = || kinds.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ");
+        for c in self.children(el) {
+            if c.name != "input" {
+                self.errs.push(sm.diag(
+                    c.span,
+                    format!(
+                        "unexpected <{}> in <{}> (expected <input type src>)",
+                        c.name, el.name
+                    ),
+                ));
+                continue;
+            }
+            c.check_attrs(sm, &["type", "src"], &mut self.errs);
+            if let Some(e) = c.elements().next() {
+                self.errs
+                    .push(sm.diag(e.span, format!("unexpected <{}> in <input>", e.name)));
+            }
+            let (ty, src) = match (c.required(sm, "type"), c.required(sm, "src")) {
+                (Ok(t), Ok(s)) => (t, s),
+                (Err(d), _) | (_, Err(d)) => {
+                    self.errs.push(d);
+                    continue;
+                }
+            };
+            let Some((_, kind)) = kinds.iter().find(|(n, _)| *n == ty.value.trim()) else {
+                self.errs.push(sm.diag(
+                    ty.value_span,
+                    format!(
+                        "unknown input type `{}` in <{}> (expected {})",
+                        ty.value,
+                        el.name,
+                        expected()
+                    ),
+                ));
+                continue;
+            };
+            let s = src.value.trim();
+            if s.is_empty() {
+                self.errs.push(sm.diag(src.value_span, "empty `src`"));
+                continue;
+            }
+            out.push(Input {
+                kind: *kind,
+                src: src.value.clone(),
+                path: self.base.join(s),
+                span: src.value_span,
+                element: c.span,
+            });
+        }
+        out
+    }
+
+    fn behavior_tree(&mut self, el: &Element, inputs: Vec<Input>) -> Option<BehaviorTree> {
+        let sm = self.sm;
+        let mut tree: Option<Input> = None;
+        let mut plugins = Vec::new();
+        for i in inputs {
+            if i.kind == InputKind::BtCppXml {
+                if tree.is_some() {
+                    self.errs.push(sm.diag(
+                        i.element,
+                        "a behavior tree has exactly one bt.cpp-xml input (SubTrees go in the same file)",
+                    ));
+                } else {
+                    tree = Some(i);
+                }
+            } else {
+                plugins.push(i);
+            }
+        }
+        match tree {
+            Some(tree) => Some(BehaviorTree {
+                tree,
+                plugins,
+                span: el.span,
+            }),
+            None => {
+                self.errs.push(sm.diag(
+                    el.span,
+                    "<behavior_tree> needs one <input type=\"bt.cpp-xml\" src=...>",
+                ));
+                None
+            }
+        }
+    }
+}
+
+/// Nanoseconds in one `unit`.
+fn unit_ns(unit: &str) -> Option<u64> {
+    Some(match unit {
+        "ns" => 1,
+        "us" | "µs" => 1_000,
+        "ms" => 1_000_000,
+        "s" | "sec" => 1_000_000_000,
+        "min" => 60_000_000_000,
+        "h" => 3_600_000_000_000,
+        _ => return None,
+    })
+}
+
+/// The decimal `text` (`100`, `2.5`) times `scale`, exactly; an error when it is negative,
+/// not a plain decimal, not a whole number of nanoseconds or too large.
+fn decimal_times(text: &str, scale: u64) -> Result<u64, String> {
+    let (int, frac) = text.split_once('.').unwrap_or((text, ""));
+    let digits = |s: &str| s.bytes().all(|b| b.is_ascii_digit());
+    if (int.is_empty() && frac.is_empty()) || !digits(int) || !digits(frac) {
+        return Err(format!(
+            "`{text}` is not a non-negative decimal number (write `100` or `2.5`)"
+        ));
+    }
+    let frac = frac.trim_end_matches('0');
+    if frac.len() > 19 {
+        return Err(format!("`{text}` has too many decimals"));
+    }
+    let too_big = || format!("`{text}` is too large");
+    let int_v: u128 = if int.is_empty() {
+        0
+    } else {
+        int.parse().map_err(|_| too_big())?
+    };
+    let pow = 10u128.pow(frac.len() as u32);
+    let frac_v: u128 = if frac.is_empty() {
+        0
+    } else {
+        frac.parse().map_err(|_| too_big())?
+    };
+    let num = int_v
+        .checked_mul(pow)
+        .and_then(|v| v.checked_add(frac_v))
+        .and_then(|v| v.checked_mul(scale as u128))
+        .ok_or_else(too_big)?;
+    if num % pow != 0 {
+        return Err(format!(
+            "`{text}` is not a whole number of nanoseconds in this unit"
+        ));
+    }
+    u64::try_from(num / pow).map_err(|_| too_big())
+}
+
+fn tick_rate(text: &str) -> Result<TickRate, String> {
+    let bad =
+        || format!("bt_tick_rate must be a positive number of ticks per second, not `{text}`");
+    let hz: f64 = text.parse().map_err(|_| bad())?;
+    if !(hz.is_finite() && hz > 0.0) {
+        return Err(bad());
+    }
+    // Exact period when the rate is a plain decimal m / 10^k: 1e9 * 10^k / m.
+    let (int, frac) = text.split_once('.').unwrap_or((text, ""));
+    let frac = frac.trim_end_matches('0');
+    let exact_ns = if int.bytes().all(|b| b.is_ascii_digit())
+        && frac.bytes().all(|b| b.is_ascii_digit())
+        && frac.len() <= 18
+    {
+        format!("{int}{frac}")
+            .parse::<u128>()
+            .ok()
+            .filter(|m| *m > 0)
+            .and_then(|m| {
+                let n = 1_000_000_000u128 * 10u128.pow(frac.len() as u32);
+                (n % m == 0).then(|| n / m)
+            })
+    } else {
+        None
+    };
+    let period = (1e9 / hz).round();
+    if period < 1.0 {
+        return Err(format!(
+            "bt_tick_rate `{text}` is faster than one tick per nanosecond"
+        ));
+    }
+    Ok(match exact_ns.and_then(|n| u64::try_from(n).ok()) {
+        Some(ns) => TickRate {
+            hz,
+            period_ns: ns,
+            exact: true,
+        },
+        None => TickRate {
+            hz,
+            period_ns: period.min(u64::MAX as f64) as u64,
+            exact: false,
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_durations() {
+        let s = 1_000_000_000;
+        assert_eq!(decimal_times("100", s), Ok(100 * s));
+        assert_eq!(decimal_times("2.5", s), Ok(2_500_000_000));
+        assert_eq!(decimal_times("0.000000001", s), Ok(1));
+        assert_eq!(decimal_times(".5", 1_000), Ok(500));
+        assert!(decimal_times("1.5", 1).is_err());
+        assert!(decimal_times("-1", s).is_err());
+        assert!(decimal_times("1e3", s).is_err());
+        assert!(decimal_times("", s).is_err());
+        assert!(decimal_times(".", s).is_err());
+        assert!(decimal_times("99999999999999999999999", s).is_err());
+        assert_eq!(decimal_times("2", 3_600_000_000_000), Ok(7_200_000_000_000));
+    }
+
+    #[test]
+    fn tick_rates() {
+        let t = tick_rate("10.0").unwrap();
+        assert_eq!((t.period_ns, t.exact), (100_000_000, true));
+        let t = tick_rate("0.5").unwrap();
+        assert_eq!((t.period_ns, t.exact), (2_000_000_000, true));
+        let t = tick_rate("3").unwrap();
+        assert_eq!((t.period_ns, t.exact), (333_333_333, false));
+        assert!(tick_rate("0").is_err());
+        assert!(tick_rate("-1").is_err());
+        assert!(tick_rate("fast").is_err());
+        assert!(tick_rate("inf").is_err());
+    }
+}
