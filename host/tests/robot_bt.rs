@@ -732,3 +732,277 @@ fn blackboard_cases_reach_tree_success_in_every_run() {
         );
     }
 }
+
+// ---------------------------------------------------------------------------------------
+// Small trees written here: SubTrees, defaults, and errors with positions.
+
+const COUNT: &str = r#"<ascxml name="Count" initial="s">
+  <bt_declare_port_in key="n" type="int8"/>
+  <bt_declare_port_out key="out" type="int32"/>
+  <datamodel><data id="k" type="int8"><expr><bt_get_input key="n"/></expr></data></datamodel>
+  <state id="s">
+    <bt_tick target="s"><bt_return_status status="SUCCESS"/></bt_tick>
+    <bt_halt target="s"><bt_return_halted/></bt_halt>
+  </state>
+</ascxml>"#;
+
+/// Lowers `tree` (named `t.xml`) with plugins `p0.ascxml`, `p1.ascxml`, ...
+fn lower_texts(
+    tree: &str,
+    plugins: &[&str],
+) -> Result<Vec<Element>, Vec<hindsight::model::Diagnostic>> {
+    let mut sm = SourceMap::new();
+    let t = sm.add("t.xml", tree.to_string());
+    let plugins = plugins
+        .iter()
+        .enumerate()
+        .map(|(i, p)| sm.add(format!("p{i}.ascxml"), p.to_string()))
+        .collect();
+    bt::lower(
+        &sm,
+        &BtInput {
+            tree: t,
+            plugins,
+            tick_rate_hz: 2.0,
+            tick_if_not_running: true,
+        },
+    )
+}
+
+/// 1-based line and column of the first `needle` in `text`.
+fn pos(text: &str, needle: &str) -> (u32, u32) {
+    let at = text
+        .find(needle)
+        .unwrap_or_else(|| panic!("{needle} not in text"));
+    let line = text[..at].matches('\n').count() as u32 + 1;
+    let col = (at - text[..at].rfind('\n').map_or(0, |i| i + 1)) as u32 + 1;
+    (line, col)
+}
+
+/// The single error of lowering, checked to be in `file` at the position of `needle`
+/// in `text`, with `words` in its message.
+fn one_error(tree: &str, plugins: &[&str], file: &str, text: &str, needle: &str, words: &str) {
+    let errs = lower_texts(tree, plugins).expect_err("an error");
+    assert_eq!(errs.len(), 1, "{errs:?}");
+    let e = &errs[0];
+    assert_eq!(e.path, Path::new(file), "{e:?}");
+    assert_eq!((e.line, e.column), pos(text, needle), "{e:?}");
+    assert!(e.message.contains(words), "{}", e.message);
+}
+
+fn wrap(body: &str) -> String {
+    format!(
+        "<root BTCPP_format=\"4\">\n<BehaviorTree ID=\"Main\">\n{body}\n</BehaviorTree>\n</root>"
+    )
+}
+
+fn names(ms: &[Element]) -> Vec<String> {
+    ms.iter()
+        .map(|m| m.attr_value("name").unwrap().to_string())
+        .collect()
+}
+
+#[test]
+fn subtrees_are_inlined_in_pre_order_with_remapped_blackboard_entries() {
+    let tree = r#"<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <Sequence>
+      <SubTree ID="Twice" out="{total}"/>
+      <Action ID="Count" name="last" n="1" out="{total}"/>
+    </Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Twice">
+    <Sequence name="twice">
+      <Count n="2" out="{out}"/>
+      <Count n="3" out="{scratch}"/>
+    </Sequence>
+  </BehaviorTree>
+</root>"#;
+    let ms = lower_texts(tree, &[COUNT]).unwrap();
+    assert_eq!(
+        names(&ms),
+        [
+            "bt_root_fsm_t",
+            "BT_plugin_1000_Sequence",
+            "BT_plugin_1001_twice",
+            "BT_plugin_1002_Count",
+            "BT_plugin_1003_Count",
+            "BT_plugin_1004_last",
+            "bt_blackboard_fsm",
+        ]
+    );
+    // `out` is remapped to the caller's `total`; `scratch` stays private to the instance.
+    let bb = shape(ms.last().unwrap());
+    let vars: Vec<&str> = bb.vars.iter().map(|(v, _)| v.as_str()).collect();
+    assert_eq!(vars, ["Twice_1_scratch", "total"]);
+    // The port constant became the data's initial value.
+    let count = shape(&ms[3]);
+    assert!(count.vars.contains(&("k".to_string(), "2".to_string())));
+    // Every machine reads back as plain SCXML except the root (its ROS timer).
+    let mut src = ModelSource::default();
+    let mut errs = Diagnostics::default();
+    for m in &ms[1..] {
+        src.add_machine_tree(m, FileId(0), &mut errs);
+    }
+    assert!(errs.is_empty(), "{errs}");
+}
+
+#[test]
+fn a_subtree_that_includes_itself_is_an_error() {
+    let tree = "<root main_tree_to_execute=\"A\">\n<BehaviorTree ID=\"A\">\n<SubTree ID=\"A\"/>\n</BehaviorTree>\n</root>";
+    let errs = lower_texts(tree, &[]).unwrap_err();
+    assert!(errs[0].message.contains("include itself"), "{errs:?}");
+}
+
+#[test]
+fn the_root_machine_ticks_on_a_ros_timer_and_stops_unless_told_otherwise() {
+    let tree = wrap("<AlwaysSuccess/>");
+    let mut sm = SourceMap::new();
+    let t = sm.add("my_tree.xml", tree);
+    for (again, states) in [(true, 1), (false, 2)] {
+        let ms = bt::lower(
+            &sm,
+            &BtInput {
+                tree: t,
+                plugins: vec![],
+                tick_rate_hz: 10.0,
+                tick_if_not_running: again,
+            },
+        )
+        .unwrap();
+        let root = &ms[0];
+        assert_eq!(root.attr_value("name"), Some("bt_root_fsm_my_tree"));
+        let timer = root.elements().find(|e| e.name == "ros_time_rate").unwrap();
+        assert_eq!(timer.attr_value("name"), Some("my_tree_tick"));
+        assert_eq!(timer.attr_value("rate_hz"), Some("10.0"));
+        let wait = &shape(root).states["wait_tick_res"].0;
+        assert_eq!(wait.len(), states, "{wait:?}");
+    }
+}
+
+#[test]
+fn plugins_without_halt_answer_halts_in_every_state() {
+    // The older format (the museum's plugins) has no <bt_halt>.
+    let old = r#"<scxml name="Old" initial="a">
+  <state id="a"><bt_tick target="b"/></state>
+  <state id="b"><transition target="a"><bt_return_status status="FAILURE"/></transition></state>
+</scxml>"#;
+    let ms = lower_texts(&wrap("<Inverter><Old/></Inverter>"), &[old]).unwrap();
+    let s = shape(&ms[2]);
+    for st in ["a", "b"] {
+        let (ts, sends) = &s.states[st];
+        assert!(ts.contains(&("bt_1001_halt".into(), String::new(), String::new())));
+        assert!(sends.contains(&"bt_1001_halt_response->BT_plugin_1000_Inverter()".to_string()));
+    }
+}
+
+#[test]
+fn unknown_nodes_and_plugins_are_errors_at_their_position() {
+    let t = wrap("<Sequence>\n  <Frobnicate/>\n</Sequence>");
+    one_error(
+        &t,
+        &[COUNT],
+        "t.xml",
+        &t,
+        "<Frobnicate",
+        "unknown node `Frobnicate`",
+    );
+    let t = wrap("<Action ID=\"Nope\" n=\"1\"/>");
+    one_error(&t, &[COUNT], "t.xml", &t, "Nope", "plugins: Count");
+}
+
+#[test]
+fn ports_are_checked_against_the_plugin() {
+    let t = wrap("<Count n=\"300\"/>");
+    one_error(&t, &[COUNT], "t.xml", &t, "300", "not a valid int8");
+    let t = wrap("<Count n=\"x\"/>");
+    one_error(&t, &[COUNT], "t.xml", &t, "x\"", "not a valid int8");
+    let t = wrap("<Count n=\"1\" speed=\"2\"/>");
+    one_error(&t, &[COUNT], "t.xml", &t, "2\"", "no port `speed`");
+    let t = wrap("<Count n=\"1\" out=\"5\"/>");
+    one_error(&t, &[COUNT], "t.xml", &t, "5\"", "output port");
+    // A port the plugin reads but the tree does not set: at the tree node.
+    let t = wrap("<Count/>");
+    one_error(&t, &[COUNT], "t.xml", &t, "<Count", "needs port `n`");
+    // One blackboard entry used with two types.
+    let other = COUNT
+        .replace("name=\"Count\"", "name=\"Str\"")
+        .replace("\"int32\"", "\"string\"");
+    let t =
+        wrap("<Sequence>\n<Count n=\"1\" out=\"{v}\"/>\n<Str n=\"1\" out=\"{v}\"/>\n</Sequence>");
+    let errs = lower_texts(&t, &[COUNT, &other]).unwrap_err();
+    assert_eq!(errs.len(), 1, "{errs:?}");
+    assert!(
+        errs[0].message.contains("used as string here but as int32"),
+        "{errs:?}"
+    );
+}
+
+#[test]
+fn bad_plugin_tags_are_errors_in_the_plugin_file() {
+    let bad = COUNT.replace("<bt_return_halted/>", "<bt_frob/>");
+    let t = wrap("<Count n=\"1\"/>");
+    one_error(
+        &t,
+        &[&bad],
+        "p0.ascxml",
+        &bad,
+        "<bt_frob",
+        "unknown BT tag <bt_frob>",
+    );
+    let bad = COUNT.replace("status=\"SUCCESS\"", "status=\"DONE\"");
+    one_error(
+        &t,
+        &[&bad],
+        "p0.ascxml",
+        &bad,
+        "DONE",
+        "unknown status `DONE`",
+    );
+    let bad = COUNT.replace("<bt_get_input key=\"n\"/>", "<bt_get_input key=\"m\"/>");
+    one_error(
+        &t,
+        &[&bad],
+        "p0.ascxml",
+        &bad,
+        "<bt_get_input",
+        "port `m` is not declared",
+    );
+    let bad = COUNT.replace("type=\"int8\"/>", "type=\"int7\"/>");
+    let errs = lower_texts(&t, &[&bad]).unwrap_err();
+    assert_eq!(
+        (errs[0].line, errs[0].column),
+        pos(&bad, "int7"),
+        "{errs:?}"
+    );
+}
+
+#[test]
+fn bad_control_node_attributes_are_errors() {
+    let t = wrap("<Repeat>\n<AlwaysSuccess/>\n</Repeat>");
+    one_error(&t, &[], "t.xml", &t, "<Repeat", "needs `num_cycles`");
+    let t = wrap("<Repeat num_cycles=\"many\">\n<AlwaysSuccess/>\n</Repeat>");
+    one_error(&t, &[], "t.xml", &t, "many", "whole number");
+    let t = wrap("<Parallel success_count=\"3\">\n<AlwaysSuccess/>\n<AlwaysSuccess/>\n</Parallel>");
+    one_error(
+        &t,
+        &[],
+        "t.xml",
+        &t,
+        "3\"",
+        "between 1 and the number of children (2)",
+    );
+    let t = wrap("<Inverter>\n<AlwaysSuccess/>\n<AlwaysFailure/>\n</Inverter>");
+    one_error(
+        &t,
+        &[],
+        "t.xml",
+        &t,
+        "<Inverter",
+        "needs 1 children, found 2",
+    );
+    let t = wrap("<Sequence colour=\"red\">\n<AlwaysSuccess/>\n</Sequence>");
+    one_error(&t, &[], "t.xml", &t, "colour", "unknown attribute `colour`");
+    let t = wrap("<Sequence _skipIf=\"x\">\n<AlwaysSuccess/>\n</Sequence>");
+    one_error(&t, &[], "t.xml", &t, "_skipIf", "not supported");
+}

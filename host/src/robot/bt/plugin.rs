@@ -69,6 +69,34 @@ impl Plugin {
     }
 }
 
+/// Whether `ty` is a type a port can have: a ROS primitive, or an array of them.
+fn port_type_ok(ty: &str) -> bool {
+    let t = ty.trim();
+    let base = t.split('[').next().unwrap_or("").trim();
+    let dims_ok = t[base.len()..].split(']').all(|d| {
+        let d = d.trim().trim_start_matches('[').trim_start_matches("<=");
+        d.is_empty() || d.parse::<u32>().is_ok()
+    });
+    dims_ok
+        && matches!(
+            base,
+            "bool"
+                | "byte"
+                | "char"
+                | "int8"
+                | "int16"
+                | "int32"
+                | "int64"
+                | "uint8"
+                | "uint16"
+                | "uint32"
+                | "uint64"
+                | "float32"
+                | "float64"
+                | "string"
+        )
+}
+
 fn contains_tag(el: &Element, tag: &str) -> bool {
     el.elements().any(|c| c.name == tag || contains_tag(c, tag))
 }
@@ -111,8 +139,14 @@ pub(crate) fn read(sm: &SourceMap, file: FileId) -> Result<Plugin, Vec<Diagnosti
                 continue;
             }
         };
-        if let Err(m) = TypeExpr::parse(&ty.value) {
-            errs.push(sm.diag(ty.value_span, format!("port `{}`: {m}", key.value)));
+        if !port_type_ok(&ty.value) {
+            errs.push(sm.diag(
+                ty.value_span,
+                format!(
+                    "port `{}` has type `{}`; a port is bool, intN, uintN, float32, float64 or string (or an array of them)",
+                    key.value, ty.value
+                ),
+            ));
         }
         if let Some(p) = ports.iter().find(|p| p.key == key.value.trim()) {
             let at = sm.diag(p.span, "");

@@ -461,7 +461,8 @@ impl Reader<'_> {
         for k in &kids {
             self.node(k, Some(idx), depth);
         }
-        let n = self.nodes[idx].children.len();
+        // Children that failed to read still count, so one error is not reported twice.
+        let n = kids.len();
         let (lo, hi) = match kind {
             Kind::Control(c) => c.arity(),
             Kind::Plugin(_) => (0, usize::MAX),
