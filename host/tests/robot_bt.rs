@@ -145,10 +145,6 @@ fn has_ros_tag(el: &Element) -> bool {
     el.name.starts_with("ros_") || el.elements().any(has_ros_tag)
 }
 
-fn has_tag(el: &Element, tag: &str) -> bool {
-    el.name == tag || el.elements().any(|c| has_tag(c, tag))
-}
-
 fn is_bt_machine(name: &str) -> bool {
     name.starts_with("BT_plugin_")
         || name.starts_with("bt_root_fsm_")
@@ -400,12 +396,30 @@ fn sends(e: &Element, out: &mut Vec<String>) {
     }
 }
 
+/// AS2FM's `lo<__RAND__&&__RAND__<=hi` as `prob:<hi - lo>`.
+fn prob_share(cond: &str) -> String {
+    let Some(at) = cond.find("<__RAND__&&__RAND__<=") else {
+        return cond.to_string();
+    };
+    let head = &cond[..at];
+    let (prefix, lo) = match head.rfind("&&") {
+        Some(i) => (&head[..i + 2], &head[i + 2..]),
+        None => ("", head),
+    };
+    let hi = &cond[at + "<__RAND__&&__RAND__<=".len()..];
+    let (lo, hi): (f64, f64) = (lo.parse().unwrap(), hi.parse().unwrap());
+    format!("{prefix}prob:{:.6}", hi - lo)
+}
+
 fn shape(m: &Element) -> Shape {
     let mut vars = BTreeSet::new();
     let mut states = BTreeMap::new();
     for c in m.elements() {
         if c.name == "datamodel" {
             for d in c.elements() {
+                if d.attr_value("id") == Some("__RAND__") {
+                    continue; // AS2FM's lowering of <target prob>; ours is the reader's
+                }
                 vars.insert((
                     d.attr_value("id").unwrap().to_string(),
                     norm(d.attr_value("expr").unwrap_or("")),
@@ -417,11 +431,27 @@ fn shape(m: &Element) -> Shape {
             let mut ss = Vec::new();
             for t in c.elements() {
                 if t.name == "transition" {
-                    ts.push((
-                        t.attr_value("event").unwrap_or("").to_string(),
-                        norm(t.attr_value("cond").unwrap_or("")),
-                        t.attr_value("target").unwrap_or("").to_string(),
-                    ));
+                    let event = t.attr_value("event").unwrap_or("").to_string();
+                    let cond = norm(t.attr_value("cond").unwrap_or(""));
+                    let targets: Vec<&Element> =
+                        t.elements().filter(|e| e.name == "target").collect();
+                    if targets.is_empty() {
+                        ts.push((
+                            event.clone(),
+                            prob_share(&cond),
+                            t.attr_value("target").unwrap_or("").to_string(),
+                        ));
+                    }
+                    for g in targets {
+                        let p: f64 = g.attr_value("prob").unwrap().parse().unwrap();
+                        let share = format!("prob:{p:.6}");
+                        let cond = if cond.is_empty() {
+                            share
+                        } else {
+                            format!("{cond}&&{share}")
+                        };
+                        ts.push((event.clone(), cond, g.attr_value("id").unwrap().to_string()));
+                    }
                 }
                 sends(t, &mut ss);
             }
@@ -445,9 +475,8 @@ fn bt_test_cases_match_as2fm_machine_by_machine() {
             if !is_bt_machine(name) {
                 continue;
             }
-            // ROS tags other than topics are the ROS lowering's; probabilistic targets are
-            // not lowered yet (AS2FM turns them into `__RAND__` conditions).
-            if has_ros_tag(m) || has_tag(m, "target") {
+            // ROS tags other than topics are the ROS lowering's.
+            if has_ros_tag(m) {
                 continue;
             }
             let path = plain.join(format!("{name}.scxml"));
@@ -1005,4 +1034,54 @@ fn bad_control_node_attributes_are_errors() {
     one_error(&t, &[], "t.xml", &t, "colour", "unknown attribute `colour`");
     let t = wrap("<Sequence _skipIf=\"x\">\n<AlwaysSuccess/>\n</Sequence>");
     one_error(&t, &[], "t.xml", &t, "_skipIf", "not supported");
+}
+
+#[test]
+fn probabilistic_targets_in_a_plugin_split_the_runs_by_their_shares() {
+    // Like uc1's BackUp: fails with probability 0.25. Ticked once (the root stops after
+    // the first answer), so the tree succeeds in about 75% of the runs.
+    let coin = r#"<ascxml name="Coin" initial="s">
+  <state id="s">
+    <bt_tick>
+      <target id="s" prob="0.25"><bt_return_status status="FAILURE"/></target>
+      <target id="s" prob="0.75"><bt_return_status status="SUCCESS"/></target>
+    </bt_tick>
+    <bt_halt target="s"><bt_return_halted/></bt_halt>
+  </state>
+</ascxml>"#;
+    let tree = wrap("<Coin/>");
+    let mut sm = SourceMap::new();
+    let t = sm.add("coin_tree.xml", tree);
+    let p = sm.add("coin.ascxml", coin.to_string());
+    let mut ms = bt::lower(
+        &sm,
+        &BtInput {
+            tree: t,
+            plugins: vec![p],
+            tick_rate_hz: 1.0,
+            tick_if_not_running: false,
+        },
+    )
+    .unwrap();
+    let mut timers = Vec::new();
+    for m in &mut ms {
+        shim(m, &mut timers);
+    }
+    let id = sm.add("timer.scxml", timer_machine(&timers, 5));
+    ms.push(xml::parse(&sm, id).unwrap());
+    let model = compile(sm, &ms);
+    let props: [Check; 2] = [
+        ("success", |v| root_is(v, 1), true),
+        ("failure", |v| root_is(v, 2), true),
+    ];
+    let cfg = RunConfig {
+        max_time: 6 * MS_PER_S,
+        ..RunConfig::default()
+    };
+    let n = 4000;
+    let counts = count_runs(&model, &cfg, Path::new("coin"), &props, n);
+    assert_eq!(counts[0] + counts[1], n, "every run answers exactly once");
+    let p = counts[0] as f64 / n as f64;
+    // 4000 runs: the standard error is under 0.007.
+    assert!((p - 0.75).abs() < 0.03, "success rate {p}");
 }
