@@ -23,6 +23,7 @@ pub fn read_machine_tree(
     let mut r = Reader {
         sm,
         errs: Vec::new(),
+        uses_rand: false,
     };
     let m = r.machine(root, file);
     if r.errs.is_empty() {
@@ -35,7 +36,12 @@ pub fn read_machine_tree(
 struct Reader<'a> {
     sm: &'a SourceMap,
     errs: Vec<Diagnostic>,
+    /// Whether a state has probabilistic targets, so the machine needs [`RAND`].
+    uses_rand: bool,
 }
+
+/// The variable holding a state's random draw for its `<target prob>` transitions.
+const RAND: &str = "__RAND__";
 
 /// A pending `<!-- TYPE name:type -->` annotation.
 type Pending = Option<(String, Result<TypeExpr, String>, Span)>;
@@ -164,6 +170,23 @@ impl Reader<'_> {
         if m.states.is_empty() {
             self.err(root.span, "the machine has no state");
         }
+        if self.uses_rand {
+            m.datamodel.push(Data {
+                id: Ident {
+                    name: RAND.into(),
+                    span: root.span,
+                },
+                ty: Some(TypeAnn {
+                    ty: TypeExpr::Base(super::types::BaseType::Float),
+                    span: root.span,
+                }),
+                expr: Some(SrcExpr {
+                    text: "0.0".into(),
+                    span: root.span,
+                }),
+                span: root.span,
+            });
+        }
         m
     }
 
@@ -239,6 +262,7 @@ impl Reader<'_> {
             is_final: el.name == "final",
             span: el.span,
         };
+        let mut prob = false;
         for c in el.elements() {
             match c.name.as_str() {
                 "onentry" => {
@@ -255,7 +279,13 @@ impl Reader<'_> {
                     if s.is_final {
                         self.err(c.span, "a <final> state cannot have transitions");
                     }
-                    if let Some(t) = self.transition(c) {
+                    if c.elements().any(|t| t.name == "target") {
+                        let mut ts = self.probabilistic(c);
+                        if !ts.is_empty() {
+                            prob = true;
+                        }
+                        s.transitions.append(&mut ts);
+                    } else if let Some(t) = self.transition(c) {
                         s.transitions.push(t);
                     }
                 }
@@ -272,11 +302,114 @@ impl Reader<'_> {
                 other => self.err(c.span, format!("unexpected <{other}> in <{}>", el.name)),
             }
         }
+        if prob {
+            // One draw per entry decides every probabilistic transition of the state.
+            s.onentry.insert(
+                0,
+                Exec::Assign {
+                    location: SrcExpr {
+                        text: RAND.into(),
+                        span: el.span,
+                    },
+                    expr: SrcExpr {
+                        text: "Math.random()".into(),
+                        span: el.span,
+                    },
+                    span: el.span,
+                },
+            );
+            self.uses_rand = true;
+        }
         Some(s)
+    }
+
+    /// A transition whose content is `<target id prob>` children: one transition per
+    /// target, taken when the state's draw `__RAND__` (uniform in [0, 1), made on entry)
+    /// falls in the target's share, as AS2FM translates them. When the shares add up to
+    /// less than 1, the rest takes no transition.
+    fn probabilistic(&mut self, el: &Element) -> Vec<Transition> {
+        self.check(el, &["event", "cond"]);
+        let Some(base) = self.transition_head(el) else {
+            return Vec::new();
+        };
+        let mut out = Vec::new();
+        let mut lo = 0.0f64;
+        for c in el.elements() {
+            if c.name != "target" {
+                self.err(
+                    c.span,
+                    format!(
+                        "<{}> beside <target> children: put it inside each <target>",
+                        c.name
+                    ),
+                );
+                continue;
+            }
+            self.check(c, &["id", "prob"]);
+            let Some(id) = self.required_ident(c, "id") else {
+                continue;
+            };
+            let Some(pa) = c.attr("prob") else {
+                self.err(c.span, "<target> is missing the required attribute `prob`");
+                continue;
+            };
+            let p = match pa.value.trim().parse::<f64>() {
+                Ok(p) if (0.0..=1.0).contains(&p) => p,
+                _ => {
+                    self.err(
+                        pa.value_span,
+                        format!(
+                            "`prob` must be a number between 0 and 1, not `{}`",
+                            pa.value
+                        ),
+                    );
+                    continue;
+                }
+            };
+            let hi = lo + p;
+            if hi > 1.0 + 1e-9 {
+                self.err(
+                    pa.value_span,
+                    format!("the targets' probabilities add up to {hi}, more than 1"),
+                );
+            }
+            let range = format!("{RAND} >= {lo:?} && {RAND} < {hi:?}");
+            let text = match &base.cond {
+                Some(c) => format!("({}) && ({range})", c.text),
+                None => range,
+            };
+            out.push(Transition {
+                events: base.events.clone(),
+                cond: Some(SrcExpr {
+                    text,
+                    span: pa.value_span,
+                }),
+                target: Some(id),
+                body: self.block(c, 0),
+                span: c.span,
+            });
+            lo = hi;
+        }
+        out
     }
 
     fn transition(&mut self, el: &Element) -> Option<Transition> {
         self.check(el, &["event", "cond", "target"]);
+        let mut t = self.transition_head(el)?;
+        t.target = match el.attr("target") {
+            Some(a) if a.value.split_whitespace().count() > 1 => {
+                self.err(a.value_span, "a transition may have only one target");
+                None
+            }
+            Some(a) => Some(self.ident(a)),
+            None => None,
+        };
+        t.body = self.block(el, 0);
+        Some(t)
+    }
+
+    /// A transition's events and condition (no target, no content yet).
+    fn transition_head(&mut self, el: &Element) -> Option<Transition> {
         let events = match el.attr("event") {
             Some(a) => {
                 let mut v = Vec::new();
@@ -300,19 +433,11 @@ impl Reader<'_> {
             }
             None => Vec::new(),
         };
-        let target = match el.attr("target") {
-            Some(a) if a.value.split_whitespace().count() > 1 => {
-                self.err(a.value_span, "a transition may have only one target");
-                None
-            }
-            Some(a) => Some(self.ident(a)),
-            None => None,
-        };
         Some(Transition {
             events,
             cond: el.attr("cond").map(|a| self.src(a)),
-            target,
-            body: self.block(el, 0),
+            target: None,
+            body: Vec::new(),
             span: el.span,
         })
     }
@@ -641,6 +766,52 @@ mod tests {
         assert_eq!((errs[0].line, errs[0].column), (2, 17));
         assert!(errs[0].message.contains("bogus"));
         assert_eq!((errs[1].line, errs[1].column), (3, 5));
+    }
+
+    #[test]
+    fn probabilistic_targets_become_ranges_of_one_draw_per_entry() {
+        let m = read(
+            r#"<scxml name="M" initial="a"><state id="a">
+  <transition event="go" cond="x > 0"><target id="a" prob="0.25"><raise event="p"/></target><target id="b" prob="0.75"/></transition>
+</state><state id="b"/></scxml>"#,
+        )
+        .unwrap();
+        let a = &m.states[0];
+        assert_eq!(a.transitions.len(), 2);
+        let conds: Vec<&str> = a
+            .transitions
+            .iter()
+            .map(|t| t.cond.as_ref().unwrap().text.as_str())
+            .collect();
+        assert_eq!(
+            conds,
+            [
+                "(x > 0) && (__RAND__ >= 0.0 && __RAND__ < 0.25)",
+                "(x > 0) && (__RAND__ >= 0.25 && __RAND__ < 1.0)"
+            ]
+        );
+        assert_eq!(a.transitions[0].target.as_ref().unwrap().name, "a");
+        assert_eq!(a.transitions[0].body.len(), 1);
+        assert_eq!(a.transitions[1].events[0].name, "go");
+        assert!(
+            matches!(&a.onentry[0], Exec::Assign { location, .. } if location.text == "__RAND__")
+        );
+        assert_eq!(m.datamodel.last().unwrap().id.name, "__RAND__");
+        assert!(m.states[1].onentry.is_empty());
+    }
+
+    #[test]
+    fn bad_probabilistic_targets_are_errors() {
+        let errs = read(
+            r#"<scxml name="M"><state id="a"><transition target="a"><target id="a" prob="0.7"/><target id="a" prob="0.7"/><target id="a" prob="x"/><assign location="y" expr="1"/></transition></state></scxml>"#,
+        )
+        .unwrap_err();
+        let msgs: Vec<&str> = errs.iter().map(|e| e.message.as_str()).collect();
+        assert_eq!(errs.len(), 4, "{msgs:?}");
+        assert!(msgs[0].contains("unknown attribute `target`"), "{msgs:?}");
+        assert!(msgs[1].contains("more than 1"), "{msgs:?}");
+        assert!(msgs[2].contains("between 0 and 1"), "{msgs:?}");
+        assert!(msgs[3].contains("beside <target>"), "{msgs:?}");
     }
 
     #[test]

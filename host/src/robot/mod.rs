@@ -18,6 +18,7 @@
 //! Element trees are [`crate::model::xml::Element`]: every element and attribute keeps the
 //! span of the source it was made from, so errors found late name the user's file.
 
+pub mod bt;
 pub mod datatypes;
 pub mod interfaces;
 pub mod main_file;

@@ -1,0 +1,348 @@
+//! Behavior trees: a BehaviorTree.cpp (v4) XML tree and its SCXML leaf plugins lowered to
+//! one machine per tree node, plus the machine that ticks the root and the blackboard.
+//!
+//! # What comes out
+//!
+//! The machines of AS2FM's translation, with its names, so probabilities and traces can
+//! be compared one to one:
+//! - `bt_root_fsm_<tree file stem>` ticks node 1000 (`bt_1000_tick`) at every event of
+//!   the ROS timer `<stem>_tick` (a `<ros_time_rate>` / `<ros_rate_callback>` pair the
+//!   ROS lowering turns into time) and waits for `bt_1000_response`. Without
+//!   `tick_if_not_running` it stops ticking after the first answer that is not RUNNING.
+//! - `BT_plugin_<id>_<name>` for every node, numbered 1000, 1001, ... in depth-first
+//!   pre-order, named after the node's `name` attribute or else its type. Built-in nodes
+//!   (Sequence, ReactiveSequence, SequenceWithMemory, Fallback, ReactiveFallback,
+//!   Parallel, IfThenElse, Inverter, ForceSuccess, ForceFailure, Repeat,
+//!   RetryUntilSuccessful, AlwaysSuccess, AlwaysFailure, SetBlackboard,
+//!   BlackboardCheckInt) are generated ([`control`], [`blackboard`]); leaves are instances
+//!   of their plugin ([`plugin`]) and keep their ROS tags for the ROS lowering.
+//! - `bt_blackboard_fsm` when the tree names `{entries}`.
+//!
+//! A parent ticks a child with `bt_<id>_tick`; the child answers `bt_<id>_response` with
+//! `status` 1 (SUCCESS), 2 (FAILURE) or 3 (RUNNING). Halting is `bt_<id>_halt`, answered
+//! by `bt_<id>_halt_response`. SubTrees (which AS2FM rejects) are inlined; their
+//! blackboard entries are private unless remapped or `_autoremap="true"`.
+//!
+//! Every generated element carries the span of the tree node or plugin tag it comes from.
+
+mod blackboard;
+mod build;
+mod control;
+mod plugin;
+mod tree;
+
+use crate::model::source::{Diagnostic, FileId, SourceMap};
+use crate::model::xml::{self, Element};
+use build::B;
+use control::Ctx;
+use tree::{Control, Kind, PortValue};
+
+/// What the main file says about the behavior tree.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BtInput {
+    /// The BehaviorTree.cpp XML file.
+    pub tree: FileId,
+    /// The plugin files (`.ascxml`, or `.scxml` with BT tags), one node type each.
+    pub plugins: Vec<FileId>,
+    /// How often the root is ticked, in ticks per second (`bt_tick_rate`).
+    pub tick_rate_hz: f64,
+    /// Whether the root is ticked again after it answered SUCCESS or FAILURE
+    /// (`bt_tick_if_not_running`).
+    pub tick_if_not_running: bool,
+}
+
+/// The name of the machine that ticks the tree read from `tree`: `bt_root_fsm_<stem>`.
+pub fn root_machine_name(sm: &SourceMap, tree: FileId) -> String {
+    format!("bt_root_fsm_{}", stem(sm, tree))
+}
+
+fn stem(sm: &SourceMap, tree: FileId) -> String {
+    let s = sm
+        .file(tree)
+        .and_then(|f| f.path().file_stem())
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "bt".into());
+    s.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// Lowers the tree and its plugins to SCXML element trees: the root machine first, then
+/// one machine per node in id order, then the blackboard machine if any. Plugins keep
+/// their ROS tags; the root machine's timer is a ROS timer tag. Every error is returned,
+/// each with the file, line and column it is about.
+pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagnostic>> {
+    let mut errs = Vec::new();
+    let mut plugins: Vec<plugin::Plugin> = Vec::new();
+    for &f in &input.plugins {
+        match plugin::read(sm, f) {
+            Ok(p) => {
+                if let Some(q) = plugins.iter().find(|q| q.name == p.name) {
+                    let at = sm.diag(q.root.span, "");
+                    errs.push(sm.diag(
+                        p.root.span,
+                        format!(
+                            "two plugins are called `{}` (the other is {}:{}:{})",
+                            p.name,
+                            at.path.display(),
+                            at.line,
+                            at.column
+                        ),
+                    ));
+                }
+                plugins.push(p);
+            }
+            Err(ds) => errs.extend(ds),
+        }
+    }
+    let root_el = xml::parse(sm, input.tree).map_err(|d| vec![d])?;
+    if !(input.tick_rate_hz.is_finite() && input.tick_rate_hz > 0.0) {
+        errs.push(sm.diag(
+            root_el.span,
+            format!(
+                "the tree's tick rate must be a positive number of ticks per second, not {}",
+                input.tick_rate_hz
+            ),
+        ));
+    }
+    let tree = match tree::read(sm, &root_el, &plugins) {
+        Ok(t) => t,
+        Err(ds) => {
+            errs.extend(ds);
+            return Err(errs);
+        }
+    };
+    let root_name = root_machine_name(sm, input.tree);
+    let mut bb = blackboard::Blackboard::default();
+    for n in &tree.nodes {
+        if let Kind::Plugin(i) = n.kind {
+            plugin::check_ports(sm, &plugins[i], n, &mut bb, &mut errs);
+        }
+    }
+    let mut out = Vec::with_capacity(tree.nodes.len() + 2);
+    let root_b = B {
+        at: tree.nodes[0].span,
+    };
+    out.push(control::root_machine(
+        root_b,
+        &root_name,
+        &format!("{}_tick", stem(sm, input.tree)),
+        input.tick_rate_hz,
+        (tree.nodes[0].id, &tree.nodes[0].machine),
+        input.tick_if_not_running,
+    ));
+    for n in &tree.nodes {
+        let (parent, halt_target) = match n.parent {
+            Some(p) => (tree.nodes[p].machine.clone(), tree.nodes[p].machine.clone()),
+            None => (root_name.clone(), "NONE".to_string()),
+        };
+        let ctx = Ctx {
+            b: B { at: n.span },
+            id: n.id,
+            machine: n.machine.clone(),
+            parent,
+            halt_target,
+            children: n
+                .children
+                .iter()
+                .map(|&c| (tree.nodes[c].id, tree.nodes[c].machine.clone()))
+                .collect(),
+        };
+        let m = match n.kind {
+            Kind::Plugin(i) => Some(plugin::instance(
+                sm,
+                &plugins[i],
+                n,
+                &ctx,
+                &mut bb,
+                &mut errs,
+            )),
+            Kind::Control(c) => builtin(sm, c, n, &ctx, &mut bb, &mut errs),
+        };
+        if let Some(m) = m {
+            out.push(m);
+        }
+    }
+    if let Some(m) = bb.machine(root_b) {
+        out.push(m);
+    }
+    if errs.is_empty() {
+        Ok(out)
+    } else {
+        Err(errs)
+    }
+}
+
+/// An integer attribute of a built-in node.
+fn int_param(
+    sm: &SourceMap,
+    n: &tree::TreeNode,
+    keys: &[&str],
+    errs: &mut Vec<Diagnostic>,
+) -> Option<(i64, crate::model::source::Span)> {
+    let p = keys.iter().find_map(|k| n.port(k))?;
+    match &p.value {
+        PortValue::Literal(v) => match v.trim().parse::<i64>() {
+            Ok(x) => Some((x, p.span)),
+            Err(_) => {
+                errs.push(sm.diag(
+                    p.span,
+                    format!("`{}` must be a whole number, not `{v}`", p.key),
+                ));
+                None
+            }
+        },
+        PortValue::Blackboard(b) => {
+            errs.push(sm.diag(
+                p.span,
+                format!("`{}` must be a constant; blackboard entries (`{{{b}}}`) are not supported here", p.key),
+            ));
+            None
+        }
+    }
+}
+
+fn builtin(
+    sm: &SourceMap,
+    c: Control,
+    n: &tree::TreeNode,
+    ctx: &Ctx,
+    bb: &mut blackboard::Blackboard,
+    errs: &mut Vec<Diagnostic>,
+) -> Option<Element> {
+    let count = n.children.len() as i64;
+    match c {
+        Control::Parallel => {
+            let ok_before = errs.len();
+            let mut th = |keys: &[&str], default: i64, what: &str| -> i64 {
+                let (v, span) = int_param(sm, n, keys, errs).unwrap_or((default, n.span));
+                let v = if v < 0 { count + v + 1 } else { v };
+                if v < 1 || v > count {
+                    errs.push(sm.diag(
+                        span,
+                        format!("the {what} threshold must be between 1 and the number of children ({count})"),
+                    ));
+                }
+                v
+            };
+            let s = th(&["success_count", "success_threshold"], -1, "success");
+            let f = th(&["failure_count", "failure_threshold"], 1, "failure");
+            (errs.len() == ok_before).then(|| control::machine(c, ctx, &[s, f]))
+        }
+        Control::Repeat | Control::RetryUntilSuccessful => {
+            let key = if c == Control::Repeat {
+                "num_cycles"
+            } else {
+                "num_attempts"
+            };
+            match int_param(sm, n, &[key], errs) {
+                Some((v, span)) if v < -1 || v > i8::MAX as i64 => {
+                    errs.push(sm.diag(
+                        span,
+                        format!("`{key}` must be -1 (forever) or between 0 and 127"),
+                    ));
+                    None
+                }
+                Some((v, _)) => Some(control::machine(c, ctx, &[v])),
+                None => {
+                    if n.port(key).is_none() {
+                        errs.push(sm.diag(n.span, format!("this node needs `{key}`")));
+                    }
+                    None
+                }
+            }
+        }
+        Control::SetBlackboard => {
+            let (Some(key), Some(value)) = (n.port("output_key"), n.port("value")) else {
+                errs.push(sm.diag(n.span, "SetBlackboard needs `output_key` and `value`"));
+                return None;
+            };
+            let entry = match &key.value {
+                PortValue::Literal(v) => v.trim().to_string(),
+                PortValue::Blackboard(b) => b.clone(),
+            };
+            let Some(ty) = bb.entry(&entry).map(|e| e.ty.clone()) else {
+                errs.push(sm.diag(
+                    key.span,
+                    format!("blackboard entry `{{{entry}}}` has no type: no plugin port uses it"),
+                ));
+                return None;
+            };
+            match &value.value {
+                PortValue::Literal(v) => match plugin::check_literal(v, &ty) {
+                    Ok(()) => Some(blackboard::set_blackboard(
+                        ctx,
+                        &entry,
+                        &plugin::literal_expr(v, &ty),
+                    )),
+                    Err(m) => {
+                        errs.push(sm.diag(value.span, format!("SetBlackboard `{{{entry}}}`: {m}")));
+                        None
+                    }
+                },
+                PortValue::Blackboard(_) => {
+                    errs.push(sm.diag(
+                        value.span,
+                        "SetBlackboard copying one entry to another is not supported",
+                    ));
+                    None
+                }
+            }
+        }
+        Control::BlackboardCheckInt => {
+            let mut reads = false;
+            let mut side = |key: &str,
+                            errs: &mut Vec<Diagnostic>,
+                            bb: &mut blackboard::Blackboard|
+             -> Option<String> {
+                let Some(p) = n.port(key) else {
+                    errs.push(sm.diag(n.span, format!("BlackboardCheckInt needs `{key}`")));
+                    return None;
+                };
+                match &p.value {
+                    PortValue::Literal(v) => match v.trim().parse::<i64>() {
+                        Ok(x) => Some(x.to_string()),
+                        Err(_) => {
+                            errs.push(sm.diag(p.span, format!("`{key}` must be a whole number or a blackboard entry, not `{v}`")));
+                            None
+                        }
+                    },
+                    PortValue::Blackboard(b) => {
+                        plugin::register(sm, bb, b, "int32", p.span, errs);
+                        reads = true;
+                        Some(format!("_event.data.{b}"))
+                    }
+                }
+            };
+            let a = side("value_A", errs, bb);
+            let bv = side("value_B", errs, bb);
+            let mismatch = match n.port("return_on_mismatch").map(|p| &p.value) {
+                None => "FAILURE".to_string(),
+                Some(PortValue::Literal(v)) if control::status_code(v).is_some() => v.clone(),
+                Some(_) => {
+                    let span = n
+                        .port("return_on_mismatch")
+                        .map(|p| p.span)
+                        .unwrap_or(n.span);
+                    errs.push(sm.diag(
+                        span,
+                        "`return_on_mismatch` must be SUCCESS, FAILURE or RUNNING",
+                    ));
+                    return None;
+                }
+            };
+            let (a, bv) = (a?, bv?);
+            if reads {
+                bb.add_reader(&ctx.machine);
+            }
+            Some(blackboard::check_int(ctx, &a, &bv, reads, &mismatch))
+        }
+        _ => Some(control::machine(c, ctx, &[])),
+    }
+}
