@@ -18,5 +18,6 @@
 //! Element trees are [`crate::model::xml::Element`]: every element and attribute keeps the
 //! span of the source it was made from, so errors found late name the user's file.
 
+pub mod ros;
 pub mod types;
 pub mod write;
