@@ -41,9 +41,9 @@ impl Cx<'_> {
         }
         for a in &src.attrs {
             match a.name.as_str() {
-                "initial" | "version" | "model_src" | "datamodel" | "binding" => {
-                    root.attrs.push(a.clone())
-                }
+                "initial" | "version" | "model_src" | "binding" => root.attrs.push(a.clone()),
+                // AS2FM drops it; ecmascript is the only data model anyway.
+                "datamodel" => {}
                 n if n.starts_with("xmlns") => {}
                 // `<ros_action_thread name n_threads>` and unknown attributes of the root.
                 "name" | "n_threads" => {}
@@ -404,15 +404,17 @@ impl Cx<'_> {
                     .collect()
             }
             "ros_topic_callback" => {
-                let Some(key) = find(&d.subscribers, &alias).map(String::from) else {
+                let Some(a) = d.subscribers.iter().find(|a| a.alias == alias) else {
                     return self.unknown_alias(el, "a topic subscriber");
                 };
-                let Some(t) = self.topics.iter().find(|t| t.key == key).cloned() else {
+                let key = a.key.clone();
+                let Some((ty, fields)) = &a.msg else {
                     return Vec::new();
                 };
-                let what = format!("topic `{}` ({})", t.key, t.ty);
+                // `_msg` has the fields of the type this subscriber declared.
+                let what = format!("topic `{key}` ({ty})");
                 let sc = Scope {
-                    fields: vec![("_msg", &t.fields, what)],
+                    fields: vec![("_msg", fields, what)],
                     ..Scope::default()
                 };
                 self.callback(el, u, &sc, &format!("topic_{key}_msg"), None)

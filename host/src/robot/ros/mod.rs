@@ -180,6 +180,8 @@ fn type_key(t: &str) -> String {
 struct Alias {
     alias: String,
     key: String,
+    /// For topics: the type this declaration names and its fields.
+    msg: Option<(String, Vec<FlatField>)>,
 }
 
 /// The ROS declarations at the top of one node model.
@@ -322,8 +324,14 @@ impl Cx<'_> {
                         };
                         let key = sanitize(&topic);
                         let alias = el.attr_value("name").unwrap_or(&topic).trim().to_string();
-                        self.declare_topic(&key, &ty, ty_span, publisher);
-                        let a = Alias { alias, key };
+                        let Some(fields) = self.declare_topic(&key, &ty, ty_span, publisher) else {
+                            continue;
+                        };
+                        let a = Alias {
+                            alias,
+                            key,
+                            msg: Some((ty.trim().to_string(), fields)),
+                        };
                         if publisher {
                             d.publishers.push(a);
                         } else {
@@ -384,7 +392,11 @@ impl Cx<'_> {
                                 self.services[i].server_span = el.span;
                             }
                         }
-                        let a = Alias { alias, key };
+                        let a = Alias {
+                            alias,
+                            key,
+                            msg: None,
+                        };
                         if server {
                             d.srv_servers.push(a);
                         } else {
@@ -413,7 +425,11 @@ impl Cx<'_> {
                                 self.actions[i].server_span = el.span;
                             }
                         }
-                        let a = Alias { alias, key };
+                        let a = Alias {
+                            alias,
+                            key,
+                            msg: None,
+                        };
                         if server {
                             d.act_servers.push(a);
                         } else {
@@ -466,21 +482,32 @@ impl Cx<'_> {
         }
     }
 
-    fn declare_topic(&mut self, key: &str, ty: &str, ty_span: Span, publisher: bool) {
-        if let Some(t) = self.topics.iter_mut().find(|t| t.key == key) {
-            t.decls.push((ty.to_string(), ty_span, publisher));
-            return;
-        }
-        match self.interfaces.message(ty.trim()) {
-            Ok(fields) => self.topics.push(Topic {
+    /// Records a declaration of topic `key`; its message's fields, or `None` after an error.
+    fn declare_topic(
+        &mut self,
+        key: &str,
+        ty: &str,
+        ty_span: Span,
+        publisher: bool,
+    ) -> Option<Vec<FlatField>> {
+        let fields = match self.interfaces.message(ty.trim()) {
+            Ok(f) => f,
+            Err(m) => {
+                self.err(ty_span, m);
+                return None;
+            }
+        };
+        match self.topics.iter_mut().find(|t| t.key == key) {
+            Some(t) => t.decls.push((ty.to_string(), ty_span, publisher)),
+            None => self.topics.push(Topic {
                 key: key.to_string(),
                 ty: ty.trim().to_string(),
-                fields,
+                fields: fields.clone(),
                 decls: vec![(ty.to_string(), ty_span, publisher)],
                 subscribers: Vec::new(),
             }),
-            Err(m) => self.err(ty_span, m),
         }
+        Some(fields)
     }
 
     fn declare_service(&mut self, key: &str, ty: &str, ty_span: Span) -> Option<usize> {
