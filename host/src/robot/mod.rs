@@ -22,5 +22,6 @@ pub mod bt;
 pub mod datatypes;
 pub mod interfaces;
 pub mod main_file;
+pub mod ros;
 pub mod types;
 pub mod write;
