@@ -21,6 +21,7 @@
 pub mod bt;
 pub mod datatypes;
 pub mod interfaces;
+pub mod load;
 pub mod main_file;
 pub mod ros;
 pub mod types;
