@@ -1085,3 +1085,78 @@ fn probabilistic_targets_in_a_plugin_split_the_runs_by_their_shares() {
     // 4000 runs: the standard error is under 0.007.
     assert!((p - 0.75).abs() < 0.03, "success rate {p}");
 }
+
+#[test]
+fn custom_control_plugins_tick_and_hear_their_children() {
+    // A two-child fallback written as a plugin, choosing its child with an expression.
+    let try_each = r#"<ascxml name="TryEach" initial="idle">
+  <datamodel><data id="i" type="int8" expr="0"/></datamodel>
+  <state id="idle">
+    <bt_tick target="wait"><assign location="i" expr="0"/><bt_tick_child id="i"/></bt_tick>
+    <bt_halt target="halting"><bt_halt_child id="0"/></bt_halt>
+  </state>
+  <state id="halting">
+    <bt_child_halted id="0" target="idle"><bt_return_halted/></bt_child_halted>
+  </state>
+  <state id="wait">
+    <bt_child_status id="i" cond="_bt.status == SUCCESS" target="idle"><bt_return_status status="SUCCESS"/></bt_child_status>
+    <bt_child_status id="i" cond="_bt.status == FAILURE &amp;&amp; i == 0" target="wait"><assign location="i" expr="1"/><bt_tick_child id="i"/></bt_child_status>
+    <bt_child_status id="i" cond="_bt.status != SUCCESS &amp;&amp; i == 1" target="idle"><bt_return_status status="FAILURE"/></bt_child_status>
+  </state>
+</ascxml>"#;
+    for (children, expect) in [
+        ("<AlwaysFailure/><AlwaysSuccess/>", 1),
+        ("<AlwaysFailure/><AlwaysFailure/>", 2),
+        ("<AlwaysSuccess/><AlwaysFailure/>", 1),
+    ] {
+        let mut sm = SourceMap::new();
+        let t = sm.add(
+            "custom.xml",
+            wrap(&format!("<TryEach>{children}</TryEach>")),
+        );
+        let p = sm.add("try_each.ascxml", try_each.to_string());
+        let mut ms = bt::lower(
+            &sm,
+            &BtInput {
+                tree: t,
+                plugins: vec![p],
+                tick_rate_hz: 1.0,
+                tick_if_not_running: false,
+            },
+        )
+        .unwrap_or_else(|e| panic!("{}", Diagnostics(e)));
+        let wait = &shape(&ms[1]).states["wait"].0;
+        assert_eq!(wait.len(), 6, "one transition per child and tag: {wait:?}");
+        let mut timers = Vec::new();
+        for m in &mut ms {
+            shim(m, &mut timers);
+        }
+        let id = sm.add("timer.scxml", timer_machine(&timers, 3));
+        ms.push(xml::parse(&sm, id).unwrap());
+        let model = compile(sm, &ms);
+        let props: [Check; 1] = [(
+            "answer",
+            |v| v.ints.contains_key("bt_1000_response__status"),
+            true,
+        )];
+        let cfg = RunConfig {
+            max_time: 4 * MS_PER_S,
+            ..RunConfig::default()
+        };
+        let mut sim = Simulator::new(&model);
+        let mut obs = Eventually {
+            vals: LastValues::default(),
+            props: &props,
+            held: vec![false],
+        };
+        sim.run(&mut Xoshiro256PlusPlus::seed_from_u64(1), &cfg, &mut obs);
+        assert_eq!(
+            int(&obs.vals, "bt_1000_response__status"),
+            expect,
+            "{children}"
+        );
+    }
+    // A leaf plugin given children is an error at the node.
+    let t = wrap("<Count n=\"1\">\n<AlwaysSuccess/>\n</Count>");
+    one_error(&t, &[COUNT], "t.xml", &t, "<Count", "leaf plugin");
+}
