@@ -1160,3 +1160,40 @@ fn custom_control_plugins_tick_and_hear_their_children() {
     let t = wrap("<Count n=\"1\">\n<AlwaysSuccess/>\n</Count>");
     one_error(&t, &[COUNT], "t.xml", &t, "<Count", "leaf plugin");
 }
+
+#[test]
+fn blackboard_reads_outside_transitions_are_errors() {
+    let reader = r#"<ascxml name="R" initial="s">
+  <bt_declare_port_in key="v" type="int32"/>
+  <datamodel><data id="x" type="int32" expr="0"/></datamodel>
+  <state id="s">
+    <onentry><assign location="x"><expr><bt_get_input key="v"/></expr></assign></onentry>
+    <bt_tick target="s"><bt_return_status status="SUCCESS"/></bt_tick>
+    <bt_halt target="s"><bt_return_halted/></bt_halt>
+  </state>
+</ascxml>"#;
+    // A constant is fine anywhere.
+    let ms = lower_texts(&wrap("<R v=\"3\"/>"), &[reader]).unwrap();
+    assert!(write::to_xml(&ms[1]).contains("<assign location=\"x\" expr=\"3\"/>"));
+    let t = wrap("<R v=\"{e}\"/>");
+    one_error(
+        &t,
+        &[reader],
+        "p0.ascxml",
+        reader,
+        "<onentry",
+        "only transitions can read the blackboard",
+    );
+    let in_data = reader.replace(
+        "<data id=\"x\" type=\"int32\" expr=\"0\"/>",
+        "<data id=\"x\" type=\"int32\"><expr><bt_get_input key=\"v\"/></expr></data>",
+    ).replace("<onentry><assign location=\"x\"><expr><bt_get_input key=\"v\"/></expr></assign></onentry>", "");
+    one_error(
+        &t,
+        &[&in_data],
+        "p0.ascxml",
+        &in_data,
+        "<datamodel",
+        "only transitions can read the blackboard",
+    );
+}

@@ -497,9 +497,17 @@ impl Lower<'_> {
                 match gi.required(self.sm, "key") {
                     Ok(k) => {
                         let key = k.value.trim().to_string();
-                        if let Some((v, bb)) = self.get_input(&key, gi.span, c.name == "expr") {
-                            el.set_attr_at(&c.name, v, gi.span);
-                            reads |= bb;
+                        let expr = matches!(c.name.as_str(), "expr" | "cond");
+                        if let Some((v, bb)) = self.get_input(&key, gi.span, expr) {
+                            if bb && c.name != "expr" {
+                                self.err(
+                                    gi.span,
+                                    format!("port `{key}` is a blackboard entry: a condition cannot read the blackboard (assign it to a variable first)"),
+                                );
+                            } else {
+                                el.set_attr_at(&c.name, v, gi.span);
+                                reads |= bb;
+                            }
                         }
                     }
                     Err(d) => self.errs.push(d),
