@@ -506,6 +506,8 @@ fn bt_test_cases_match_as2fm_machine_by_machine() {
 struct LastValues {
     ints: BTreeMap<String, i64>,
     sent: BTreeSet<String>,
+    /// How many times each event was sent.
+    counts: BTreeMap<String, u64>,
 }
 
 type Prop = fn(&LastValues) -> bool;
@@ -524,6 +526,7 @@ impl Observer for Eventually<'_> {
     fn on_send(&mut self, _time: u64, msg: &SentMessage<'_>) -> Flow {
         let ev = msg.event_name();
         self.vals.sent.insert(ev.to_string());
+        *self.vals.counts.entry(ev.to_string()).or_default() += 1;
         let params = msg.model().event_params(msg.event());
         for (i, (name, _)) in params.iter().enumerate() {
             if let Some(v) = msg.param(i).and_then(|v| v.as_i64()) {
@@ -1196,4 +1199,136 @@ fn blackboard_reads_outside_transitions_are_errors() {
         "<datamodel",
         "only transitions can read the blackboard",
     );
+}
+
+const FAIL_N: &str = r#"<ascxml name="FailN" initial="s">
+  <bt_declare_port_in key="n" type="int8"/>
+  <ros_topic_publisher name="pub" topic="ticks" type="std_msgs/Int16"/>
+  <datamodel>
+    <data id="c" type="int16" expr="0"/>
+    <data id="n" type="int8"><expr><bt_get_input key="n"/></expr></data>
+  </datamodel>
+  <state id="s">
+    <bt_tick target="s">
+      <assign location="c" expr="c + 1"/>
+      <ros_topic_publish name="pub"><field name="data" expr="c"/></ros_topic_publish>
+      <if cond="c &gt; n"><bt_return_status status="SUCCESS"/><else/><bt_return_status status="FAILURE"/></if>
+    </bt_tick>
+    <bt_halt target="s"><bt_return_halted/></bt_halt>
+  </state>
+</ascxml>"#;
+
+/// Runs `body` (with the FailN plugin: fails `n` times, then succeeds) for `seconds`
+/// ticks at 1 Hz and returns what was sent.
+fn run_small(body: &str, again: bool, seconds: u64) -> LastValues {
+    let mut sm = SourceMap::new();
+    let t = sm.add("small.xml", wrap(body));
+    let p = sm.add("fail_n.ascxml", FAIL_N.to_string());
+    let mut ms = bt::lower(
+        &sm,
+        &BtInput {
+            tree: t,
+            plugins: vec![p],
+            tick_rate_hz: 1.0,
+            tick_if_not_running: again,
+        },
+    )
+    .unwrap_or_else(|e| panic!("{}", Diagnostics(e)));
+    let mut timers = Vec::new();
+    for m in &mut ms {
+        shim(m, &mut timers);
+    }
+    let id = sm.add("timer.scxml", timer_machine(&timers, seconds));
+    ms.push(xml::parse(&sm, id).unwrap());
+    let model = compile(sm, &ms);
+    let props: [Check; 1] = [("never", |_| false, false)];
+    let cfg = RunConfig {
+        max_time: (seconds + 1) * MS_PER_S,
+        ..RunConfig::default()
+    };
+    let mut sim = Simulator::new(&model);
+    let mut obs = Eventually {
+        vals: LastValues::default(),
+        props: &props,
+        held: vec![false],
+    };
+    let out = sim.run(&mut Xoshiro256PlusPlus::seed_from_u64(7), &cfg, &mut obs);
+    assert!(
+        !matches!(
+            out.end,
+            hindsight::sim::EndReason::Error(_) | hindsight::sim::EndReason::Spin(_)
+        ),
+        "{body}: {:?}",
+        out.end
+    );
+    obs.vals
+}
+
+#[test]
+fn nodes_without_an_as2fm_reference_behave_as_behaviortree_cpp_says() {
+    let answers = |v: &LastValues| v.counts.get("bt_1000_response").copied().unwrap_or(0);
+    // RetryUntilSuccessful: fails twice, succeeds on the third attempt, in one tick.
+    let v = run_small(
+        "<RetryUntilSuccessful num_attempts=\"3\"><FailN n=\"2\"/></RetryUntilSuccessful>",
+        false,
+        3,
+    );
+    assert_eq!((root_is(&v, 1), answers(&v)), (true, 1));
+    assert_eq!(int(&v, "topic_ticks_msg__ros_fields__data"), 3);
+    // Two attempts are not enough.
+    let v = run_small(
+        "<RetryUntilSuccessful num_attempts=\"2\"><FailN n=\"2\"/></RetryUntilSuccessful>",
+        false,
+        3,
+    );
+    assert_eq!(
+        (root_is(&v, 2), int(&v, "topic_ticks_msg__ros_fields__data")),
+        (true, 2)
+    );
+    // ForceSuccess / ForceFailure.
+    let v = run_small("<ForceSuccess><FailN n=\"5\"/></ForceSuccess>", false, 3);
+    assert!(root_is(&v, 1));
+    let v = run_small("<ForceFailure><FailN n=\"0\"/></ForceFailure>", false, 3);
+    assert!(root_is(&v, 2));
+    // SequenceWithMemory resumes at the failed child: the first child is ticked once.
+    let v = run_small(
+        "<SequenceWithMemory><AlwaysSuccess/><FailN n=\"1\"/></SequenceWithMemory>",
+        true,
+        2,
+    );
+    assert_eq!(v.counts["bt_1001_response"], 1);
+    assert_eq!(v.counts["bt_1000_response"], 2);
+    assert!(root_is(&v, 1));
+    // A plain Sequence starts again from the first child.
+    let v = run_small(
+        "<Sequence><AlwaysSuccess/><FailN n=\"1\"/></Sequence>",
+        true,
+        2,
+    );
+    assert_eq!(v.counts["bt_1001_response"], 2);
+    // SetBlackboard then BlackboardCheckInt.
+    for (value, status) in [("7", 1), ("8", 2)] {
+        let v = run_small(
+            &format!(
+                "<Sequence><SetBlackboard output_key=\"x\" value=\"{value}\"/>\
+                 <BlackboardCheckInt value_A=\"{{x}}\" value_B=\"7\"><AlwaysSuccess/></BlackboardCheckInt></Sequence>"
+            ),
+            false,
+            2,
+        );
+        assert!(root_is(&v, status), "value {value}");
+    }
+    // Parallel with BehaviorTree.cpp's default thresholds: all must succeed, one failure fails.
+    let v = run_small(
+        "<Parallel><AlwaysSuccess/><FailN n=\"0\"/></Parallel>",
+        false,
+        2,
+    );
+    assert!(root_is(&v, 1));
+    let v = run_small(
+        "<Parallel><AlwaysSuccess/><FailN n=\"1\"/></Parallel>",
+        false,
+        2,
+    );
+    assert!(root_is(&v, 2));
 }
