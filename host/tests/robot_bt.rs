@@ -145,6 +145,10 @@ fn has_ros_tag(el: &Element) -> bool {
     el.name.starts_with("ros_") || el.elements().any(has_ros_tag)
 }
 
+fn has_prefixed(el: &Element, prefix: &str) -> bool {
+    el.name.starts_with(prefix) || el.elements().any(|c| has_prefixed(c, prefix))
+}
+
 fn is_bt_machine(name: &str) -> bool {
     name.starts_with("BT_plugin_")
         || name.starts_with("bt_root_fsm_")
@@ -164,6 +168,10 @@ fn every_corpus_tree_lowers_to_the_machines_as2fm_makes() {
             .map(|m| m.attr_value("name").unwrap().to_string())
             .collect();
         assert_eq!(names.len(), machines.len(), "{}", main.display());
+        // No BT tag is left; ROS tags are, for the ROS lowering.
+        for m in &machines {
+            assert!(!has_prefixed(m, "bt_"), "{}", main.display());
+        }
         // Machines without ROS tags are plain SCXML already and read as such; written out
         // and read back they are the same.
         for m in &machines {
@@ -938,6 +946,15 @@ fn unknown_nodes_and_plugins_are_errors_at_their_position() {
         &t,
         "<Frobnicate",
         "unknown node `Frobnicate`",
+    );
+    let t = wrap("<Timeout msec=\"10\">\n<AlwaysSuccess/>\n</Timeout>");
+    one_error(
+        &t,
+        &[],
+        "t.xml",
+        &t,
+        "<Timeout",
+        "`Timeout` is not supported",
     );
     let t = wrap("<Action ID=\"Nope\" n=\"1\"/>");
     one_error(&t, &[COUNT], "t.xml", &t, "Nope", "plugins: Count");
