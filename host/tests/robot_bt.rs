@@ -1349,3 +1349,38 @@ fn nodes_without_an_as2fm_reference_behave_as_behaviortree_cpp_says() {
     );
     assert!(root_is(&v, 2));
 }
+
+#[test]
+fn damaged_inputs_are_errors_never_panics() {
+    // Every corpus tree and plugin, cut short at many points, and swapped around.
+    let mut seen = 0;
+    for (main, _) in bt_mains().iter().take(12) {
+        let case = read_main(main);
+        let tree = std::fs::read_to_string(&case.tree).unwrap();
+        let plugins: Vec<String> = case
+            .plugins
+            .iter()
+            .map(|p| std::fs::read_to_string(p).unwrap())
+            .collect();
+        let refs: Vec<&str> = plugins.iter().map(|s| s.as_str()).collect();
+        for cut in (0..tree.len()).step_by(37) {
+            if tree.is_char_boundary(cut) {
+                let _ = lower_texts(&tree[..cut], &refs);
+                seen += 1;
+            }
+        }
+        for (i, p) in plugins.iter().enumerate() {
+            for cut in (0..p.len()).step_by(53) {
+                if p.is_char_boundary(cut) {
+                    let mut damaged = refs.clone();
+                    damaged[i] = &p[..cut];
+                    let _ = lower_texts(&tree, &damaged);
+                    seen += 1;
+                }
+            }
+            // A plugin given as the tree, the tree given as a plugin.
+            assert!(lower_texts(p, &[&tree]).is_err());
+        }
+    }
+    assert!(seen > 500, "{seen} damaged inputs");
+}
