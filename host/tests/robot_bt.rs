@@ -749,27 +749,34 @@ fn bt_cases_simulate_to_the_verdicts_as2fm_expects() {
 }
 
 #[test]
-fn blackboard_cases_reach_tree_success_in_every_run() {
-    // expected.json: blackboard_test_main and grid_robot_blackboard_simple_main,
-    // `Pmin F bt_1000_response__status == 1` is 1.0 with tolerance 0.
-    let as2fm = corpus().join("as2fm/test_data");
-    for (main, plain, runs) in [
-        ("blackboard_test/main.xml", "blackboard_test_main", 3),
-        (
-            "grid_robot_blackboard_simple/main.xml",
-            "grid_robot_blackboard_simple_main",
-            40,
-        ),
+fn blackboard_cases_reach_tree_success_as_expected_json_says() {
+    // Both cases' only property is `Pmin F bt_1000_response__status == 1`.
+    let as2fm = corpus().join("as2fm");
+    let expected: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(as2fm.join("expected.json")).unwrap())
+            .unwrap();
+    for (key, runs) in [
+        ("blackboard_test_main", 3),
+        ("grid_robot_blackboard_simple_main", 40),
     ] {
-        let props: [(&str, Prop, bool); 1] = [("tree_success", |v| root_is(v, 1), true)];
-        let counts = simulate(&as2fm.join(main), &props, runs);
-        let theirs = simulate_plain(&corpus().join("as2fm/plain").join(plain), &props, runs);
-        assert_eq!(counts, theirs, "{main}: ours vs AS2FM's translation");
-        assert_eq!(
-            counts[0], runs,
-            "{main}: tree_success held in {} of {runs} runs",
-            counts[0]
+        let case = &expected[key];
+        let want = &case["expected"][0];
+        assert_eq!(want["property"], "tree_success");
+        let (p, tol) = (
+            want["probability"].as_f64().unwrap(),
+            want["tolerance"].as_f64().unwrap(),
         );
+        let main = as2fm.join(case["main"].as_str().unwrap());
+        let props: [Check; 1] = [("tree_success", |v| root_is(v, 1), true)];
+        let counts = simulate(&main, &props, runs);
+        let theirs = simulate_plain(&as2fm.join("plain").join(key), &props, runs);
+        assert_eq!(counts, theirs, "{key}: ours vs AS2FM's translation");
+        let est = counts[0] as f64 / runs as f64;
+        if tol == 0.0 {
+            assert_eq!(est, p, "{key}: held in {} of {runs} runs", counts[0]);
+        } else {
+            assert!((est - p).abs() <= tol, "{key}: {est} vs {p}");
+        }
     }
 }
 
