@@ -882,6 +882,15 @@ fn subtrees_are_inlined_in_pre_order_with_remapped_blackboard_entries() {
     let bb = shape(ms.last().unwrap());
     let vars: Vec<&str> = bb.vars.iter().map(|(v, _)| v.as_str()).collect();
     assert_eq!(vars, ["Twice_1_scratch", "total"]);
+    // With `_autoremap`, the SubTree's names are the caller's.
+    let shared = tree.replace(
+        "out=\"{total}\"/>\n      <Action",
+        "_autoremap=\"true\"/>\n      <Action",
+    );
+    let ms2 = lower_texts(&shared, &[COUNT]).unwrap();
+    let bb2 = shape(ms2.last().unwrap());
+    let vars2: Vec<&str> = bb2.vars.iter().map(|(v, _)| v.as_str()).collect();
+    assert_eq!(vars2, ["out", "scratch", "total"]);
     // The port constant became the data's initial value.
     let count = shape(&ms[3]);
     assert!(count.vars.contains(&("k".to_string(), "2".to_string())));
