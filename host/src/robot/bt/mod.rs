@@ -14,8 +14,8 @@
 //!   (Sequence, ReactiveSequence, SequenceWithMemory, Fallback, ReactiveFallback,
 //!   Parallel, IfThenElse, Inverter, ForceSuccess, ForceFailure, Repeat,
 //!   RetryUntilSuccessful, AlwaysSuccess, AlwaysFailure, SetBlackboard,
-//!   BlackboardCheckInt) are generated ([`control`], [`blackboard`]); leaves are instances
-//!   of their plugin ([`plugin`]) and keep their ROS tags for the ROS lowering.
+//!   BlackboardCheckInt) are generated (`control.rs`, `blackboard.rs`); leaves are instances
+//!   of their plugin (`plugin.rs`) and keep their ROS tags for the ROS lowering.
 //! - `bt_blackboard_fsm` when the tree names `{entries}`.
 //!
 //! A parent ticks a child with `bt_<id>_tick`; the child answers `bt_<id>_response` with
