@@ -6,8 +6,9 @@
 //! 1. `main_file`: the main file (`<roaml>`, or the older `<convince_mc_tc>`) names the
 //!    tree, its plugins, the node models, data types and properties, and the parameters
 //!    (`max_time`, `bt_tick_rate`, ...).
-//! 2. `bt`: the behavior tree and its plugins become machines (one per tree node, plus the
-//!    root that ticks the tree); what is left of them is SCXML with ROS tags.
+//! 2. [`bt`]: the behavior tree and its plugins become machines (one per tree node, plus the
+//!    root that ticks the tree and the blackboard); what is left of them is SCXML with ROS
+//!    tags. [`bt::lower`] takes a [`bt::BtInput`] (tree file, plugin files, tick rate).
 //! 3. `ros`: every machine's ROS tags (timers, topics, services, actions) become plain
 //!    SCXML sends and transitions; generated machines (the global timer, service and
 //!    action handlers) are added. `interfaces` gives the message layouts.

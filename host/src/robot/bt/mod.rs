@@ -14,8 +14,8 @@
 //!   (Sequence, ReactiveSequence, SequenceWithMemory, Fallback, ReactiveFallback,
 //!   Parallel, IfThenElse, Inverter, ForceSuccess, ForceFailure, Repeat,
 //!   RetryUntilSuccessful, AlwaysSuccess, AlwaysFailure, SetBlackboard,
-//!   BlackboardCheckInt) are generated ([`control`], [`blackboard`]); leaves are instances
-//!   of their plugin ([`plugin`]) and keep their ROS tags for the ROS lowering.
+//!   BlackboardCheckInt) are generated (`control.rs`, `blackboard.rs`); leaves are instances
+//!   of their plugin (`plugin.rs`) and keep their ROS tags for the ROS lowering.
 //! - `bt_blackboard_fsm` when the tree names `{entries}`.
 //!
 //! A parent ticks a child with `bt_<id>_tick`; the child answers `bt_<id>_response` with
@@ -120,9 +120,21 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
     };
     let root_name = root_machine_name(sm, input.tree);
     let mut bb = blackboard::Blackboard::default();
+    // Entry types first (plugins' ports, BlackboardCheckInt's integers), so SetBlackboard
+    // anywhere in the tree knows the type of what it writes.
     for n in &tree.nodes {
-        if let Kind::Plugin(i) = n.kind {
-            plugin::check_ports(sm, &plugins[i], n, &mut bb, &mut errs);
+        match n.kind {
+            Kind::Plugin(i) => plugin::check_ports(sm, &plugins[i], n, &mut bb, &mut errs),
+            Kind::Control(Control::BlackboardCheckInt) => {
+                for p in &n.ports {
+                    if let (true, PortValue::Blackboard(b)) =
+                        (p.key.starts_with("value_"), &p.value)
+                    {
+                        plugin::register(sm, &mut bb, b, "int32", p.span, &mut errs);
+                    }
+                }
+            }
+            Kind::Control(_) => {}
         }
     }
     let mut out = Vec::with_capacity(tree.nodes.len() + 2);
@@ -297,10 +309,7 @@ fn builtin(
         }
         Control::BlackboardCheckInt => {
             let mut reads = false;
-            let mut side = |key: &str,
-                            errs: &mut Vec<Diagnostic>,
-                            bb: &mut blackboard::Blackboard|
-             -> Option<String> {
+            let mut side = |key: &str, errs: &mut Vec<Diagnostic>| -> Option<String> {
                 let Some(p) = n.port(key) else {
                     errs.push(sm.diag(n.span, format!("BlackboardCheckInt needs `{key}`")));
                     return None;
@@ -314,14 +323,13 @@ fn builtin(
                         }
                     },
                     PortValue::Blackboard(b) => {
-                        plugin::register(sm, bb, b, "int32", p.span, errs);
                         reads = true;
                         Some(format!("_event.data.{b}"))
                     }
                 }
             };
-            let a = side("value_A", errs, bb);
-            let bv = side("value_B", errs, bb);
+            let a = side("value_A", errs);
+            let bv = side("value_B", errs);
             let mismatch = match n.port("return_on_mismatch").map(|p| &p.value) {
                 None => "FAILURE".to_string(),
                 Some(PortValue::Literal(v)) if control::status_code(v).is_some() => v.clone(),

@@ -436,8 +436,9 @@ impl Lower<'_> {
         }
     }
 
-    /// The `id` attribute of a child tag: a child index of this node.
-    fn child_index(&mut self, el: &Element) -> Option<usize> {
+    /// The `id` attribute of a child tag: a child index of this node, or an expression
+    /// whose value is one.
+    fn child_ref(&mut self, el: &Element) -> Option<ChildRef> {
         let a = match el.required(self.sm, "id") {
             Ok(a) => a,
             Err(d) => {
@@ -445,19 +446,34 @@ impl Lower<'_> {
                 return None;
             }
         };
+        let n = self.ctx.children.len();
+        if n == 0 {
+            self.err(a.value_span, "this node has no children in the tree");
+            return None;
+        }
         match a.value.trim().parse::<usize>() {
-            Ok(i) if i < self.ctx.children.len() => Some(i),
-            _ => {
+            Ok(i) if i < n => Some(ChildRef::Index(i)),
+            Ok(_) => {
                 self.err(
                     a.value_span,
                     format!(
-                        "`{}` is not a child index of this node (it has {} children)",
-                        a.value,
-                        self.ctx.children.len()
+                        "`{}` is not a child index of this node (it has {n} children)",
+                        a.value
                     ),
                 );
                 None
             }
+            Err(_) => Some(ChildRef::Expr(a.value.trim().to_string())),
+        }
+    }
+
+    /// Children `id` may name: `(index, condition that it is that child)`.
+    fn children_of(&self, r: &ChildRef) -> Vec<(usize, Option<String>)> {
+        match r {
+            ChildRef::Index(i) => vec![(*i, None)],
+            ChildRef::Expr(e) => (0..self.ctx.children.len())
+                .map(|i| (i, Some(format!("({e}) == {i}"))))
+                .collect(),
         }
     }
 
@@ -481,9 +497,17 @@ impl Lower<'_> {
                 match gi.required(self.sm, "key") {
                     Ok(k) => {
                         let key = k.value.trim().to_string();
-                        if let Some((v, bb)) = self.get_input(&key, gi.span, c.name == "expr") {
-                            el.set_attr_at(&c.name, v, gi.span);
-                            reads |= bb;
+                        let expr = matches!(c.name.as_str(), "expr" | "cond");
+                        if let Some((v, bb)) = self.get_input(&key, gi.span, expr) {
+                            if bb && c.name != "expr" {
+                                self.err(
+                                    gi.span,
+                                    format!("port `{key}` is a blackboard entry: a condition cannot read the blackboard (assign it to a variable first)"),
+                                );
+                            } else {
+                                el.set_attr_at(&c.name, v, gi.span);
+                                reads |= bb;
+                            }
                         }
                     }
                     Err(d) => self.errs.push(d),
@@ -509,23 +533,43 @@ impl Lower<'_> {
                     }
                     out.push(Node::Element(c));
                 }
-                "bt_child_status" => {
-                    c.check_attrs(self.sm, &["id", "target", "cond"], self.errs);
-                    let Some(i) = self.child_index(&c) else {
+                "bt_child_status" | "bt_child_halted" => {
+                    let allowed: &[&str] = if tag == "bt_child_status" {
+                        &["id", "target", "cond"]
+                    } else {
+                        &["id", "target"]
+                    };
+                    c.check_attrs(self.sm, allowed, self.errs);
+                    let Some(r) = self.child_ref(&c) else {
                         continue;
                     };
                     c.remove_attr("id");
                     c.name = "transition".into();
-                    let at = c.span;
-                    c.set_attr_at("event", self.ctx.child_resp(i), at);
-                    if let Some(cond) = c.attr("cond").cloned() {
-                        c.set_attr_at("cond", status_cond(&cond.value), cond.value_span);
+                    let cond = c.remove_attr("cond");
+                    for (i, which) in self.children_of(&r) {
+                        let mut t = c.clone();
+                        let at = t.span;
+                        let ev = if tag == "bt_child_status" {
+                            self.ctx.child_resp(i)
+                        } else {
+                            self.ctx.child_halt_resp(i)
+                        };
+                        t.set_attr_at("event", ev, at);
+                        let user = cond.as_ref().map(|a| (status_cond(&a.value), a.value_span));
+                        match (which, user) {
+                            (None, Some((u, span))) => t.set_attr_at("cond", u, span),
+                            (Some(w), None) => t.set_attr_at("cond", w, at),
+                            (Some(w), Some((u, span))) => {
+                                t.set_attr_at("cond", format!("{w} && ({u})"), span)
+                            }
+                            (None, None) => {}
+                        }
+                        if self.block(&mut t) {
+                            reads = true;
+                            split.push((out.len(), tag.clone()));
+                        }
+                        out.push(Node::Element(t));
                     }
-                    if self.block(&mut c) {
-                        reads = true;
-                        split.push((out.len(), tag.clone()));
-                    }
-                    out.push(Node::Element(c));
                 }
                 "bt_return_status" => {
                     c.check_attrs(self.sm, &["status"], self.errs);
@@ -553,14 +597,27 @@ impl Lower<'_> {
                 }
                 "bt_tick_child" | "bt_halt_child" => {
                     c.check_attrs(self.sm, &["id"], self.errs);
-                    if let Some(i) = self.child_index(&c) {
+                    if let Some(r) = self.child_ref(&c) {
                         let ctx = Ctx { b, ..self.ctx.clone() };
-                        let s = if tag == "bt_tick_child" {
-                            ctx.tick_child(i)
-                        } else {
-                            ctx.halt_child(i)
+                        let send = |i: usize| {
+                            if tag == "bt_tick_child" {
+                                ctx.tick_child(i)
+                            } else {
+                                ctx.halt_child(i)
+                            }
                         };
-                        out.push(Node::Element(s));
+                        let branches: Vec<(String, Vec<Element>)> = self
+                            .children_of(&r)
+                            .into_iter()
+                            .map(|(i, w)| (w.unwrap_or_default(), vec![send(i)]))
+                            .collect();
+                        let el = match r {
+                            ChildRef::Index(_) => branches.into_iter().next().and_then(|b| b.1.into_iter().next()),
+                            ChildRef::Expr(_) => ctx.b.if_chain(branches, Vec::new()),
+                        };
+                        if let Some(el) = el {
+                            out.push(Node::Element(el));
+                        }
                     }
                 }
                 "bt_set_output" => {
@@ -580,7 +637,7 @@ impl Lower<'_> {
                 t if t.starts_with("bt_") => self.err(
                     c.span,
                     format!(
-                        "unknown BT tag <{t}> (known: bt_tick, bt_halt, bt_return_status, bt_return_halted, bt_get_input, bt_set_output, bt_declare_port_in, bt_declare_port_out, bt_tick_child, bt_halt_child, bt_child_status)"
+                        "unknown BT tag <{t}> (known: bt_tick, bt_halt, bt_return_status, bt_return_halted, bt_get_input, bt_set_output, bt_declare_port_in, bt_declare_port_out, bt_tick_child, bt_halt_child, bt_child_status, bt_child_halted)"
                     ),
                 ),
                 _ => {
@@ -707,6 +764,14 @@ impl Lower<'_> {
         }
         self.pending_states.append(&mut new_states);
     }
+}
+
+/// Which child a `bt_*_child` tag means.
+enum ChildRef {
+    /// A constant index.
+    Index(usize),
+    /// An expression over the plugin's data.
+    Expr(String),
 }
 
 /// A condition on a child's answer: `_bt.status` is the answer, status names are codes.

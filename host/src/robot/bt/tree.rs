@@ -91,6 +91,59 @@ impl Control {
     }
 }
 
+/// The built-in nodes, as listed in errors.
+const SUPPORTED: &[&str] = &[
+    "Sequence",
+    "ReactiveSequence",
+    "SequenceWithMemory",
+    "Fallback",
+    "ReactiveFallback",
+    "Parallel",
+    "IfThenElse",
+    "Inverter",
+    "ForceSuccess",
+    "ForceFailure",
+    "Repeat",
+    "RetryUntilSuccessful",
+    "AlwaysSuccess",
+    "AlwaysFailure",
+    "BlackboardCheckInt",
+    "SetBlackboard",
+    "SubTree",
+];
+
+/// BehaviorTree.cpp's other built-in nodes: named in a clear error.
+const UNSUPPORTED: &[&str] = &[
+    "FallbackWithMemory",
+    "ParallelAll",
+    "WhileDoElse",
+    "Switch2",
+    "Switch3",
+    "Switch4",
+    "Switch5",
+    "Switch6",
+    "ManualSelector",
+    "KeepRunningUntilFailure",
+    "Delay",
+    "Timeout",
+    "RunOnce",
+    "Precondition",
+    "LoopInt",
+    "LoopDouble",
+    "LoopString",
+    "LoopBool",
+    "BlackboardCheckDouble",
+    "BlackboardCheckString",
+    "UnsetBlackboard",
+    "Script",
+    "ScriptCondition",
+    "Sleep",
+    "WasEntryUpdated",
+    "SkipUnlessUpdated",
+    "WaitValueUpdate",
+    "EntryUpdated",
+];
+
 /// What a node is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Kind {
@@ -372,6 +425,16 @@ impl Reader<'_> {
             Some(i) => Kind::Plugin(i),
             None => match Control::from_name(&type_name) {
                 Some(c) => Kind::Control(c),
+                None if UNSUPPORTED.contains(&type_name.as_str()) => {
+                    self.err(
+                        type_span,
+                        format!(
+                            "the BehaviorTree.cpp node `{type_name}` is not supported (supported: {})",
+                            SUPPORTED.join(", ")
+                        ),
+                    );
+                    return;
+                }
                 None => {
                     let mut known: Vec<&str> =
                         self.plugins.iter().map(|p| p.name.as_str()).collect();
