@@ -25,7 +25,7 @@ const EXPR_ATTRS: [&str; 6] = [
 ];
 
 impl Cx<'_> {
-    pub(super) fn lower_unit(&mut self, machines: &[Element], ui: usize) -> Option<Element> {
+    pub(super) fn lower_unit(&mut self, machines: &[Element], ui: usize) -> Element {
         let u = self.units[ui].clone();
         let src = Self::unit_root(machines, &u);
         let ucx = UnitCx {
@@ -85,7 +85,7 @@ impl Cx<'_> {
                 root.children.insert(0, Node::Element(dm));
             }
         }
-        Some(root)
+        root
     }
 
     fn lower_state(&mut self, el: &Element, u: &UnitCx) -> Element {
@@ -386,19 +386,26 @@ impl Cx<'_> {
                 self.callback(el, u, scope, &format!("ros_time_rate.{alias}"), None)
             }
             "ros_topic_publish" => {
-                let Some(key) = find(&d.publishers, &alias).map(String::from) else {
+                let Some(a) = d.publishers.iter().find(|a| a.alias == alias) else {
                     return self.unknown_alias(el, "a topic publisher");
                 };
-                let Some(t) = self.topics.iter().find(|t| t.key == key).cloned() else {
+                let key = a.key.clone();
+                let Some((ty, fields)) = &a.msg else {
                     return Vec::new();
                 };
-                let what = format!("topic `{}` ({})", t.key, t.ty);
-                let params = self.params(el, &t.fields, &what, scope);
+                let what = format!("topic `{key}` ({ty})");
+                let params = self.params(el, fields, &what, scope);
                 let event = format!("topic_{key}_msg");
-                if t.subscribers.is_empty() {
+                let subscribers = self
+                    .topics
+                    .iter()
+                    .find(|t| t.key == key)
+                    .map(|t| t.subscribers.clone())
+                    .unwrap_or_default();
+                if subscribers.is_empty() {
                     return one(self.send(el.span, &event, "NONE", params));
                 }
-                t.subscribers
+                subscribers
                     .iter()
                     .map(|s| Node::Element(self.send(el.span, &event, s, params.clone())))
                     .collect()
@@ -673,12 +680,8 @@ impl Cx<'_> {
                 } else {
                     "goal_rejected"
                 };
-                let mut p = Self::param(el.span, "goal_id", g);
-                p.set_attr_at(
-                    "expr",
-                    p.attr_value("expr").unwrap_or("").to_string(),
-                    gspan,
-                );
+                let mut p = Element::new("param", el.span).with_attr("name", "goal_id");
+                p.set_attr_at("expr", g, gspan);
                 one(self.send(el.span, &ev(what), &handler, vec![p]))
             }
             "ros_action_start_thread" => {
