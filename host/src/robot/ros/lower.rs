@@ -99,6 +99,12 @@ impl Cx<'_> {
             }
         }
         self.probabilistic(&mut s);
+        // As AS2FM writes states: `onentry`, `onexit`, then the transitions.
+        s.children.sort_by_key(|n| match n {
+            Node::Element(e) if e.name == "onentry" => 0,
+            Node::Element(e) if e.name == "onexit" => 1,
+            _ => 2,
+        });
         s
     }
 
@@ -116,8 +122,23 @@ impl Cx<'_> {
                 continue;
             }
             uses_rand = true;
+            // Targets without `prob` share what the others leave, and the last one ends at 1.
+            let mut given = 0.0f64;
+            let mut unset = 0usize;
+            for c in t.elements().filter(|c| c.name == "target") {
+                match c.attr("prob") {
+                    Some(a) => given += a.value.trim().parse::<f64>().unwrap_or(0.0),
+                    None => unset += 1,
+                }
+            }
+            let rest = if unset > 0 {
+                ((1.0 - given) / unset as f64).max(0.0)
+            } else {
+                0.0
+            };
+            let count = t.elements().filter(|c| c.name == "target").count();
             let mut lo = 0.0f64;
-            for c in t.elements() {
+            for (k, c) in t.elements().enumerate() {
                 if c.name != "target" {
                     self.err(
                         c.span,
@@ -131,20 +152,20 @@ impl Cx<'_> {
                 let Some((id, id_span)) = self.attr_or_err(c, "id") else {
                     continue;
                 };
-                let Some((p, p_span)) = self.attr_or_err(c, "prob") else {
-                    continue;
+                let (p, p_span) = match c.attr("prob") {
+                    Some(a) => match a.value.trim().parse::<f64>() {
+                        Ok(v) if (0.0..=1.0).contains(&v) => (v, a.value_span),
+                        _ => {
+                            let msg =
+                                format!("`prob` must be a number in [0, 1], not `{}`", a.value);
+                            self.err(a.value_span, msg);
+                            continue;
+                        }
+                    },
+                    None => (rest, c.span),
                 };
-                let p = match p.trim().parse::<f64>() {
-                    Ok(v) if (0.0..=1.0).contains(&v) => v,
-                    _ => {
-                        self.err(
-                            p_span,
-                            format!("`prob` must be a number in [0, 1], not `{p}`"),
-                        );
-                        continue;
-                    }
-                };
-                let hi = lo + p;
+                let last = k + 1 == t.elements().count() && count > 0;
+                let hi = if last && unset > 0 { 1.0 } else { lo + p };
                 let range = format!("{lo:?} < __RAND__ && __RAND__ <= {hi:?}");
                 lo = hi;
                 let mut n = Element::new("transition", c.span);
