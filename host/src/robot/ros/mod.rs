@@ -25,7 +25,27 @@
 //!   `<a>_thread_<i>` that announce themselves free and start on `thread_start` events.
 //! - Probabilistic targets: a transition whose children are `<target id prob>` becomes one
 //!   transition per target guarded by an interval of `__RAND__`, drawn with
-//!   `Math.random()` at the end of the state's `onentry`.
+//!   `Math.random()` at the end of the state's `onentry`; targets without `prob` share
+//!   what the others leave.
+//! - A plain `<send event>` without a target goes to every machine with a transition on
+//!   that event (to `NONE` when there is none), as in AS2FM's translation.
+//!
+//! States are written `onentry`, `onexit`, then transitions, and the output is sorted by
+//! machine name: with the same seed, the lowered model runs exactly like a folder of
+//! AS2FM's files (`host/tests/robot_ros.rs` checks every corpus case without a tree).
+//!
+//! # Errors
+//!
+//! Every error is collected with the file, line and column of the tag or attribute:
+//! unknown interface types (the [`InterfaceLookup`]'s message at the `type` attribute), a
+//! topic declared with a type other than its publisher's, a `<field>` or a `_msg.x` /
+//! `_req.x` / `_res.x` / `_goal.x` / `_feedback.x` / `_wrapped_result.result.x` that the
+//! message does not have, a pseudo-variable outside its callback, an alias this machine
+//! did not declare, a service or action without a server, a rate that is not a
+//! frequency, probabilities above one, and unsupported ROS tags (action cancellation,
+//! which AS2FM does not translate either). Mistakes in plain SCXML, such as the paper's
+//! museum reading `_event.thread_id` for `_event.data.thread_id`, pass through unchanged
+//! and are reported at their position when the machines are compiled.
 //!
 //! Generated elements carry the span of the tag they come from, so errors found when the
 //! plain machines are read or compiled still name the user's file.
