@@ -228,4 +228,23 @@ mod tests {
             "_event.data.goal_id + _event.data.ros_fields__sequence[1] + _event.data.code"
         );
     }
+
+    #[test]
+    fn never_panics_on_odd_text() {
+        let fields = [f("data", "int32")];
+        let scope = Scope {
+            fields: vec![("_msg", &fields, "t".into())],
+            ..Scope::default()
+        };
+        let text = "é_msg.data'\\'\"ü_msg._msg.é.data\\_msg.";
+        let chars: Vec<(usize, char)> = text.char_indices().collect();
+        for &(i, _) in &chars {
+            for &(j, _) in &chars {
+                if i <= j {
+                    let _ = rewrite(&text[i..j], &scope);
+                }
+            }
+            let _ = rewrite(&text[i..], &scope);
+        }
+    }
 }

@@ -112,7 +112,10 @@ impl Cx<'_> {
             let key = &s.key;
             let (req, res) = (&s.fields.request, &s.fields.response);
             let mut m = machine(span, &format!("srv_handler_{key}"), "waiting");
-            m.push(datamodel(span, &[req, res], &[]));
+            let dm = datamodel(span, &[req, res], &[]);
+            if !dm.children.is_empty() {
+                m.push(dm);
+            }
             let mut waiting = Element::new("state", span).with_attr("id", "waiting");
             let mut busy = Vec::new();
             for c in &s.clients {

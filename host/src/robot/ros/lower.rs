@@ -25,7 +25,7 @@ const EXPR_ATTRS: [&str; 6] = [
 ];
 
 impl Cx<'_> {
-    pub(super) fn lower_unit(&mut self, machines: &[Element], ui: usize) -> Option<Element> {
+    pub(super) fn lower_unit(&mut self, machines: &[Element], ui: usize) -> Element {
         let u = self.units[ui].clone();
         let src = Self::unit_root(machines, &u);
         let ucx = UnitCx {
@@ -85,7 +85,7 @@ impl Cx<'_> {
                 root.children.insert(0, Node::Element(dm));
             }
         }
-        Some(root)
+        root
     }
 
     fn lower_state(&mut self, el: &Element, u: &UnitCx) -> Element {
@@ -99,6 +99,12 @@ impl Cx<'_> {
             }
         }
         self.probabilistic(&mut s);
+        // As AS2FM writes states: `onentry`, `onexit`, then the transitions.
+        s.children.sort_by_key(|n| match n {
+            Node::Element(e) if e.name == "onentry" => 0,
+            Node::Element(e) if e.name == "onexit" => 1,
+            _ => 2,
+        });
         s
     }
 
@@ -116,8 +122,23 @@ impl Cx<'_> {
                 continue;
             }
             uses_rand = true;
+            // Targets without `prob` share what the others leave, and the last one ends at 1.
+            let mut given = 0.0f64;
+            let mut unset = 0usize;
+            for c in t.elements().filter(|c| c.name == "target") {
+                match c.attr("prob") {
+                    Some(a) => given += a.value.trim().parse::<f64>().unwrap_or(0.0),
+                    None => unset += 1,
+                }
+            }
+            let rest = if unset > 0 {
+                ((1.0 - given) / unset as f64).max(0.0)
+            } else {
+                0.0
+            };
+            let count = t.elements().filter(|c| c.name == "target").count();
             let mut lo = 0.0f64;
-            for c in t.elements() {
+            for (k, c) in t.elements().enumerate() {
                 if c.name != "target" {
                     self.err(
                         c.span,
@@ -131,20 +152,20 @@ impl Cx<'_> {
                 let Some((id, id_span)) = self.attr_or_err(c, "id") else {
                     continue;
                 };
-                let Some((p, p_span)) = self.attr_or_err(c, "prob") else {
-                    continue;
+                let (p, p_span) = match c.attr("prob") {
+                    Some(a) => match a.value.trim().parse::<f64>() {
+                        Ok(v) if (0.0..=1.0).contains(&v) => (v, a.value_span),
+                        _ => {
+                            let msg =
+                                format!("`prob` must be a number in [0, 1], not `{}`", a.value);
+                            self.err(a.value_span, msg);
+                            continue;
+                        }
+                    },
+                    None => (rest, c.span),
                 };
-                let p = match p.trim().parse::<f64>() {
-                    Ok(v) if (0.0..=1.0).contains(&v) => v,
-                    _ => {
-                        self.err(
-                            p_span,
-                            format!("`prob` must be a number in [0, 1], not `{p}`"),
-                        );
-                        continue;
-                    }
-                };
-                let hi = lo + p;
+                let last = k + 1 == t.elements().count() && count > 0;
+                let hi = if last && unset > 0 { 1.0 } else { lo + p };
                 let range = format!("{lo:?} < __RAND__ && __RAND__ <= {hi:?}");
                 lo = hi;
                 let mut n = Element::new("transition", c.span);
@@ -386,19 +407,26 @@ impl Cx<'_> {
                 self.callback(el, u, scope, &format!("ros_time_rate.{alias}"), None)
             }
             "ros_topic_publish" => {
-                let Some(key) = find(&d.publishers, &alias).map(String::from) else {
+                let Some(a) = d.publishers.iter().find(|a| a.alias == alias) else {
                     return self.unknown_alias(el, "a topic publisher");
                 };
-                let Some(t) = self.topics.iter().find(|t| t.key == key).cloned() else {
+                let key = a.key.clone();
+                let Some((ty, fields)) = &a.msg else {
                     return Vec::new();
                 };
-                let what = format!("topic `{}` ({})", t.key, t.ty);
-                let params = self.params(el, &t.fields, &what, scope);
+                let what = format!("topic `{key}` ({ty})");
+                let params = self.params(el, fields, &what, scope);
                 let event = format!("topic_{key}_msg");
-                if t.subscribers.is_empty() {
+                let subscribers = self
+                    .topics
+                    .iter()
+                    .find(|t| t.key == key)
+                    .map(|t| t.subscribers.clone())
+                    .unwrap_or_default();
+                if subscribers.is_empty() {
                     return one(self.send(el.span, &event, "NONE", params));
                 }
-                t.subscribers
+                subscribers
                     .iter()
                     .map(|s| Node::Element(self.send(el.span, &event, s, params.clone())))
                     .collect()
@@ -673,12 +701,8 @@ impl Cx<'_> {
                 } else {
                     "goal_rejected"
                 };
-                let mut p = Self::param(el.span, "goal_id", g);
-                p.set_attr_at(
-                    "expr",
-                    p.attr_value("expr").unwrap_or("").to_string(),
-                    gspan,
-                );
+                let mut p = Element::new("param", el.span).with_attr("name", "goal_id");
+                p.set_attr_at("expr", g, gspan);
                 one(self.send(el.span, &ev(what), &handler, vec![p]))
             }
             "ros_action_start_thread" => {

@@ -25,7 +25,27 @@
 //!   `<a>_thread_<i>` that announce themselves free and start on `thread_start` events.
 //! - Probabilistic targets: a transition whose children are `<target id prob>` becomes one
 //!   transition per target guarded by an interval of `__RAND__`, drawn with
-//!   `Math.random()` at the end of the state's `onentry`.
+//!   `Math.random()` at the end of the state's `onentry`; targets without `prob` share
+//!   what the others leave.
+//! - A plain `<send event>` without a target goes to every machine with a transition on
+//!   that event (to `NONE` when there is none), as in AS2FM's translation.
+//!
+//! States are written `onentry`, `onexit`, then transitions, and the output is sorted by
+//! machine name: with the same seed, the lowered model runs exactly like a folder of
+//! AS2FM's files (`host/tests/robot_ros.rs` checks every corpus case without a tree).
+//!
+//! # Errors
+//!
+//! Every error is collected with the file, line and column of the tag or attribute:
+//! unknown interface types (the [`InterfaceLookup`]'s message at the `type` attribute), a
+//! topic declared with a type other than its publisher's, a `<field>` or a `_msg.x` /
+//! `_req.x` / `_res.x` / `_goal.x` / `_feedback.x` / `_wrapped_result.result.x` that the
+//! message does not have, a pseudo-variable outside its callback, an alias this machine
+//! did not declare, a service or action without a server, a rate that is not a
+//! frequency, probabilities above one, and unsupported ROS tags (action cancellation,
+//! which AS2FM does not translate either). Mistakes in plain SCXML, such as the paper's
+//! museum reading `_event.thread_id` for `_event.data.thread_id`, pass through unchanged
+//! and are reported at their position when the machines are compiled.
 //!
 //! Generated elements carry the span of the tag they come from, so errors found when the
 //! plain machines are read or compiled still name the user's file.
@@ -54,8 +74,8 @@ pub struct RosInput<'a> {
 /// The plain machines and the length of one time unit of their `delay`s.
 #[derive(Clone, Debug)]
 pub struct RosOutput {
-    /// Plain SCXML machines: the node models, their action threads, then the generated
-    /// service handlers, action handlers and the global timer.
+    /// Plain SCXML machines (the node models, their action threads, the generated service
+    /// handlers, action handlers and global timer), sorted by name.
     pub machines: Vec<Element>,
     /// Nanoseconds in one time unit (one tick of the global timer).
     pub time_unit_ns: u64,
@@ -83,15 +103,17 @@ pub fn lower(sm: &SourceMap, input: RosInput) -> Result<RosOutput, Vec<Diagnosti
     cx.check_topics();
     let mut out = Vec::new();
     for u in 0..cx.units.len() {
-        if let Some(m) = cx.lower_unit(&input.machines, u) {
-            out.push(m);
-        }
+        let m = cx.lower_unit(&input.machines, u);
+        out.push(m);
     }
     route(&mut out);
     out.extend(cx.service_handlers());
     out.extend(cx.action_handlers());
     let (timer, time_unit_ns) = cx.global_timer(input.max_time_ns);
     out.extend(timer);
+    // The order a folder of AS2FM's files (`<name>.scxml`) is read in, so that a seed gives
+    // the same run on the lowered model and on AS2FM's translation.
+    out.sort_by(|a, b| a.attr_value("name").cmp(&b.attr_value("name")));
     if cx.errs.is_empty() {
         Ok(RosOutput {
             machines: out,
@@ -166,6 +188,20 @@ pub fn sanitize(name: &str) -> String {
     name.trim().trim_start_matches('/').replace('/', "__")
 }
 
+/// The event a message on `topic` is sent as: `topic_<sanitized topic>_msg`; its parameters
+/// are the message's [`FlatField::param_name`]s.
+pub fn topic_event(topic: &str) -> String {
+    format!("topic_{}_msg", sanitize(topic))
+}
+
+/// The events of service `service` that a property may watch: the server receives
+/// `srv_<s>_request` and answers with `srv_<s>_response` (parameters are the request's and
+/// the response's [`FlatField::param_name`]s).
+pub fn service_events(service: &str) -> (String, String) {
+    let s = sanitize(service);
+    (format!("srv_{s}_request"), format!("srv_{s}_response"))
+}
+
 /// `pkg/msg/T` and `pkg/T` name the same type.
 fn type_key(t: &str) -> String {
     let parts: Vec<&str> = t.trim().split('/').collect();
@@ -216,9 +252,6 @@ struct Unit {
 #[derive(Clone, Debug)]
 struct Topic {
     key: String,
-    /// First declaration: type as written, its span.
-    ty: String,
-    fields: Vec<FlatField>,
     /// Every declaration: (type, type span, publisher?).
     decls: Vec<(String, Span, bool)>,
     subscribers: Vec<String>,
@@ -501,8 +534,6 @@ impl Cx<'_> {
             Some(t) => t.decls.push((ty.to_string(), ty_span, publisher)),
             None => self.topics.push(Topic {
                 key: key.to_string(),
-                ty: ty.trim().to_string(),
-                fields: fields.clone(),
                 decls: vec![(ty.to_string(), ty_span, publisher)],
                 subscribers: Vec::new(),
             }),
@@ -702,5 +733,23 @@ fn gcd(a: u64, b: u64) -> u64 {
         a
     } else {
         gcd(b, a % b)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_as_as2fm_spells_them() {
+        assert_eq!(
+            sanitize("/NavigationComponent/GoToPoi"),
+            "NavigationComponent__GoToPoi"
+        );
+        assert_eq!(sanitize("level"), "level");
+        assert_eq!(topic_event("/a/b"), "topic_a__b_msg");
+        assert_eq!(service_events("/adder").1, "srv_adder_response");
+        assert_eq!(type_key("std_msgs/msg/Int32"), type_key("std_msgs/Int32"));
+        assert_ne!(type_key("std_msgs/Int32"), type_key("std_msgs/Int16"));
     }
 }
