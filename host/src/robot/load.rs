@@ -211,7 +211,7 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
         machines: out.machines,
         model,
         time_unit_ns: unit,
-        max_time_steps: max_time_ns / unit + 2,
+        max_time_steps: max_time_ns / unit + 1,
         sources: sm,
     })
 }
