@@ -577,30 +577,16 @@ fn main_file_errors_point_at_the_input() {
 #[test]
 fn data_declarations_read() {
     use hindsight::model::types::{TypeDef, TypeDefs};
-    use hindsight::robot::datatypes::{read_data_declarations, DataFormat};
-    use hindsight::robot::main_file::{InputKind, MainFile};
+    use hindsight::robot::datatypes::{read_data_declarations, read_main_declarations, DataFormat};
+    use hindsight::robot::main_file::MainFile;
     let mut read = 0;
     for main in main_files() {
         let mut sm = SourceMap::new();
         let m = MainFile::parse(&mut sm, &main).unwrap();
-        let files: Vec<(&Path, DataFormat)> = m
-            .data_declarations
-            .iter()
-            .map(|i| {
-                let f = if i.kind == InputKind::DataJson {
-                    DataFormat::Json
-                } else {
-                    DataFormat::Xml
-                };
-                (i.path.as_path(), f)
-            })
-            .collect();
-        if files.is_empty() {
-            continue;
-        }
-        read_data_declarations(&mut sm, &files)
+        let defs = read_main_declarations(&mut sm, &m)
             .unwrap_or_else(|e| panic!("{}: {e:?}", main.display()));
-        read += 1;
+        assert_eq!(defs.defs.is_empty(), m.data_declarations.is_empty());
+        read += usize::from(!defs.defs.is_empty());
     }
     assert_eq!(read, 4);
     let shape = |defs: &TypeDefs| -> Vec<(String, Vec<(String, String)>)> {
