@@ -396,7 +396,7 @@ fn every_main_file_reads() {
             MainFile::read(&mut sm, main).unwrap_or_else(|e| panic!("{}: {e:?}", main.display()))
         };
         assert_eq!(m.form == MainForm::ConvinceMcTc, museum);
-        assert!(m.params.max_time_ns.is_some(), "{}", main.display());
+        assert!(m.params.max_time_ns.value > 0, "{}", main.display());
         inputs += m.inputs().count();
         if let Some(bt) = &m.behavior_tree {
             assert_eq!(bt.tree.kind, InputKind::BtCppXml);
@@ -412,10 +412,9 @@ fn every_main_file_reads() {
         &c.join("as2fm/test_data/uc3_museum_guide/Main/main.xml"),
     )
     .unwrap();
-    assert_eq!(
-        uc3.params.max_time_ns.as_ref().unwrap().value,
-        100_000_000_000
-    );
+    assert_eq!(uc3.params.max_time_ns.value, 100_000_000_000);
+    assert_eq!(uc3.params.bt_tick_period_ns(), 100_000_000);
+    assert_eq!(uc3.params.max_array_size_or_default(), 100, "the default");
     let rate = uc3.params.bt_tick_rate.as_ref().unwrap().value;
     assert_eq!(
         (rate.hz, rate.period_ns, rate.exact),
@@ -453,12 +452,22 @@ fn every_main_file_reads() {
     assert!(ds.behavior_tree.is_none());
 }
 
-/// Writes `text` as a main file in a fresh folder and reads it; the errors as text.
+/// Writes `text` as a main file in a fresh folder and reads it; the errors as text. A
+/// `<parameters>` element with a `max_time` is added on the first line when `text` has none.
 fn main_errors(name: &str, text: &str) -> (PathBuf, Vec<String>) {
     use hindsight::robot::main_file::MainFile;
     let d = temp_dir(name);
     let p = d.join("main.xml");
-    write(&p, text);
+    let text = if text.contains("<parameters>") {
+        text.to_string()
+    } else {
+        text.replacen(
+            "<roaml>",
+            "<roaml><parameters><max_time value=\"1\" unit=\"s\"/></parameters>",
+            1,
+        )
+    };
+    write(&p, &text);
     write(&d.join("bt.xml"), "<root/>");
     let mut sm = SourceMap::new();
     let errs = match MainFile::read(&mut sm, &p) {
@@ -540,6 +549,16 @@ fn main_file_errors_point_at_the_input() {
             "twice",
             "<roaml>\n<properties/>\n<properties/>\n</roaml>",
             ":3:1: <properties> is given twice (first on line 2)",
+        ),
+        (
+            "nomax",
+            "<roaml><parameters>\n<bt_tick_rate value=\"1\"/></parameters></roaml>",
+            ":1:8: the parameters need <max_time",
+        ),
+        (
+            "noparams",
+            "<roaml>\n<!-- without <parameters> -->\n</roaml>",
+            ":1:1: <roaml> needs <parameters> with <max_time",
         ),
         (
             "root",
