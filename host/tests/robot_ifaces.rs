@@ -94,6 +94,7 @@ fn every_corpus_interface_file_parses() {
 fn every_main_file_discovers_its_interfaces() {
     let mains = main_files();
     assert_eq!(mains.len(), 43, "main files in the corpus");
+    let mut resolved = 0;
     for main in &mains {
         let mut sm = SourceMap::new();
         let ifs = Interfaces::discover(&mut sm, main, &[])
@@ -128,10 +129,12 @@ fn every_main_file_discovers_its_interfaces() {
                         InterfaceKind::Action => ifs.action(ty).map(|_| ()),
                     };
                     r.unwrap_or_else(|e| panic!("{} ({}): {e}", model.display(), main.display()));
+                    resolved += 1;
                 }
             }
         }
     }
+    assert!(resolved >= 218, "{resolved} type references resolved");
 }
 
 /// Every `<!-- TYPE ros_fields__x:T -->` and `<param name="ros_fields__x">` in AS2FM's plain
