@@ -746,3 +746,65 @@ fn huge_messages_are_refused() {
     assert_eq!(ifs.message("deep_msgs/D10").unwrap()[0].path.len(), 31);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// Printing a definition and reading it back gives the same definition, for every built-in
+/// and corpus interface and for one that uses every feature.
+#[test]
+fn printed_definitions_read_back() {
+    use hindsight::robot::interfaces::{parse_interface, InterfaceDef};
+    let strip = |d: &InterfaceDef| {
+        let mut d = d.clone();
+        d.file = None;
+        for p in &mut d.parts {
+            for f in &mut p.fields {
+                f.span.offset = 0;
+                f.span.file = hindsight::model::source::FileId(0);
+            }
+            for c in &mut p.constants {
+                c.span.offset = 0;
+                c.span.file = hindsight::model::source::FileId(0);
+            }
+        }
+        d
+    };
+    let mut sm = SourceMap::new();
+    let mut ifs = Interfaces::discover(
+        &mut sm,
+        &corpus().join("as2fm/test_data/uc3_museum_guide/Main/main.xml"),
+        &[],
+    )
+    .unwrap();
+    let all_features = "# every feature\nstring NAME=robot # unquoted\nint8 FAST=-3\n\
+        byte b 7\nchar c\nwstring w \"w\\\"q\"\nstring<=5 s 'a#b'\nfloat32[3] v [1, 2.5, -0]\n\
+        uint64[<=2] u [18446744073709551615]\nbool[] flags [true, false]\n\
+        builtin_interfaces/Time t\nInternal i\n---\nint32 r\n---\n";
+    ifs.add_text(
+        &mut sm,
+        Path::new("all.action"),
+        all_features.to_string(),
+        "nested_interfaces",
+        InterfaceKind::Action,
+        "All",
+    )
+    .unwrap();
+    let mut n = 0;
+    for def in ifs.iter() {
+        let text = def.to_string();
+        let f = sm.add("printed", text.clone());
+        let back = parse_interface(&sm, f, &def.package, &def.name, def.kind)
+            .unwrap_or_else(|e| panic!("{}:\n{text}\n{e:?}", def.full_name()));
+        assert_eq!(strip(&back), strip(def), "{}:\n{text}", def.full_name());
+        n += 1;
+    }
+    assert!(n > 100, "{n} definitions");
+    let all = ifs
+        .get("nested_interfaces/All", InterfaceKind::Action)
+        .unwrap();
+    assert_eq!(
+        all.to_string(),
+        "string NAME='robot'\nint8 FAST=-3\nbyte b 7\nchar c\nwstring w 'w\"q'\n\
+         string<=5 s 'a#b'\nfloat32[3] v [1.0, 2.5, -0.0]\nuint64[<=2] u [18446744073709551615]\n\
+         bool[] flags [true, false]\nbuiltin_interfaces/Time t\nnested_interfaces/Internal i\n\
+         ---\nint32 r\n---\n"
+    );
+}
