@@ -291,6 +291,8 @@ fn unknown_types_list_close_names() {
         .service("example_interfaces/msg/AddTwoInts")
         .unwrap_err();
     assert!(e.contains("names a message"), "{e}");
+    let e = ifs.message("geometry_msgs/Twst").unwrap_err();
+    assert!(e.ends_with("did you mean geometry_msgs/Twist?"), "{e}");
     let e = ifs.message("Int32").unwrap_err();
     assert!(e.contains("std_msgs/Int32"), "{e}");
     let e = ifs.action("zzz_pkg/Qqqqqqq").unwrap_err();

@@ -1245,6 +1245,10 @@ impl Interfaces {
             })
             .collect();
         scored.sort();
+        // Only the closest few: a near miss should not drown in far ones.
+        if let Some(best) = scored.first().map(|(d, _)| *d) {
+            scored.retain(|(d, _)| *d <= best + 1);
+        }
         scored.truncate(5);
         if scored.is_empty() {
             let n = self.defs.values().filter(|d| d.kind == kind).count();
