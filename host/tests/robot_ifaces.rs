@@ -94,6 +94,7 @@ fn every_corpus_interface_file_parses() {
 fn every_main_file_discovers_its_interfaces() {
     let mains = main_files();
     assert_eq!(mains.len(), 43, "main files in the corpus");
+    let mut resolved = 0;
     for main in &mains {
         let mut sm = SourceMap::new();
         let ifs = Interfaces::discover(&mut sm, main, &[])
@@ -128,10 +129,12 @@ fn every_main_file_discovers_its_interfaces() {
                         InterfaceKind::Action => ifs.action(ty).map(|_| ()),
                     };
                     r.unwrap_or_else(|e| panic!("{} ({}): {e}", model.display(), main.display()));
+                    resolved += 1;
                 }
             }
         }
     }
+    assert!(resolved >= 218, "{resolved} type references resolved");
 }
 
 /// Every `<!-- TYPE ros_fields__x:T -->` and `<param name="ros_fields__x">` in AS2FM's plain
@@ -288,6 +291,8 @@ fn unknown_types_list_close_names() {
         .service("example_interfaces/msg/AddTwoInts")
         .unwrap_err();
     assert!(e.contains("names a message"), "{e}");
+    let e = ifs.message("geometry_msgs/Twst").unwrap_err();
+    assert!(e.ends_with("did you mean geometry_msgs/Twist?"), "{e}");
     let e = ifs.message("Int32").unwrap_err();
     assert!(e.contains("std_msgs/Int32"), "{e}");
     let e = ifs.action("zzz_pkg/Qqqqqqq").unwrap_err();
@@ -396,7 +401,7 @@ fn every_main_file_reads() {
             MainFile::read(&mut sm, main).unwrap_or_else(|e| panic!("{}: {e:?}", main.display()))
         };
         assert_eq!(m.form == MainForm::ConvinceMcTc, museum);
-        assert!(m.params.max_time_ns.is_some(), "{}", main.display());
+        assert!(m.params.max_time_ns.value > 0, "{}", main.display());
         inputs += m.inputs().count();
         if let Some(bt) = &m.behavior_tree {
             assert_eq!(bt.tree.kind, InputKind::BtCppXml);
@@ -412,10 +417,9 @@ fn every_main_file_reads() {
         &c.join("as2fm/test_data/uc3_museum_guide/Main/main.xml"),
     )
     .unwrap();
-    assert_eq!(
-        uc3.params.max_time_ns.as_ref().unwrap().value,
-        100_000_000_000
-    );
+    assert_eq!(uc3.params.max_time_ns.value, 100_000_000_000);
+    assert_eq!(uc3.params.bt_tick_period_ns(), 100_000_000);
+    assert_eq!(uc3.params.max_array_size_or_default(), 100, "the default");
     let rate = uc3.params.bt_tick_rate.as_ref().unwrap().value;
     assert_eq!(
         (rate.hz, rate.period_ns, rate.exact),
@@ -453,12 +457,22 @@ fn every_main_file_reads() {
     assert!(ds.behavior_tree.is_none());
 }
 
-/// Writes `text` as a main file in a fresh folder and reads it; the errors as text.
+/// Writes `text` as a main file in a fresh folder and reads it; the errors as text. A
+/// `<parameters>` element with a `max_time` is added on the first line when `text` has none.
 fn main_errors(name: &str, text: &str) -> (PathBuf, Vec<String>) {
     use hindsight::robot::main_file::MainFile;
     let d = temp_dir(name);
     let p = d.join("main.xml");
-    write(&p, text);
+    let text = if text.contains("<parameters>") {
+        text.to_string()
+    } else {
+        text.replacen(
+            "<roaml>",
+            "<roaml><parameters><max_time value=\"1\" unit=\"s\"/></parameters>",
+            1,
+        )
+    };
+    write(&p, &text);
     write(&d.join("bt.xml"), "<root/>");
     let mut sm = SourceMap::new();
     let errs = match MainFile::read(&mut sm, &p) {
@@ -542,6 +556,16 @@ fn main_file_errors_point_at_the_input() {
             ":3:1: <properties> is given twice (first on line 2)",
         ),
         (
+            "nomax",
+            "<roaml><parameters>\n<bt_tick_rate value=\"1\"/></parameters></roaml>",
+            ":1:8: the parameters need <max_time",
+        ),
+        (
+            "noparams",
+            "<roaml>\n<!-- without <parameters> -->\n</roaml>",
+            ":1:1: <roaml> needs <parameters> with <max_time",
+        ),
+        (
             "root",
             "<scxml/>",
             ":1:1: expected a main file",
@@ -577,30 +601,16 @@ fn main_file_errors_point_at_the_input() {
 #[test]
 fn data_declarations_read() {
     use hindsight::model::types::{TypeDef, TypeDefs};
-    use hindsight::robot::datatypes::{read_data_declarations, DataFormat};
-    use hindsight::robot::main_file::{InputKind, MainFile};
+    use hindsight::robot::datatypes::{read_data_declarations, read_main_declarations, DataFormat};
+    use hindsight::robot::main_file::MainFile;
     let mut read = 0;
     for main in main_files() {
         let mut sm = SourceMap::new();
         let m = MainFile::parse(&mut sm, &main).unwrap();
-        let files: Vec<(&Path, DataFormat)> = m
-            .data_declarations
-            .iter()
-            .map(|i| {
-                let f = if i.kind == InputKind::DataJson {
-                    DataFormat::Json
-                } else {
-                    DataFormat::Xml
-                };
-                (i.path.as_path(), f)
-            })
-            .collect();
-        if files.is_empty() {
-            continue;
-        }
-        read_data_declarations(&mut sm, &files)
+        let defs = read_main_declarations(&mut sm, &m)
             .unwrap_or_else(|e| panic!("{}: {e:?}", main.display()));
-        read += 1;
+        assert_eq!(defs.defs.is_empty(), m.data_declarations.is_empty());
+        read += usize::from(!defs.defs.is_empty());
     }
     assert_eq!(read, 4);
     let shape = |defs: &TypeDefs| -> Vec<(String, Vec<(String, String)>)> {
@@ -737,4 +747,66 @@ fn huge_messages_are_refused() {
     assert!(e.contains("nest deeper than 32 levels"), "{e}");
     assert_eq!(ifs.message("deep_msgs/D10").unwrap()[0].path.len(), 31);
     let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Printing a definition and reading it back gives the same definition, for every built-in
+/// and corpus interface and for one that uses every feature.
+#[test]
+fn printed_definitions_read_back() {
+    use hindsight::robot::interfaces::{parse_interface, InterfaceDef};
+    let strip = |d: &InterfaceDef| {
+        let mut d = d.clone();
+        d.file = None;
+        for p in &mut d.parts {
+            for f in &mut p.fields {
+                f.span.offset = 0;
+                f.span.file = hindsight::model::source::FileId(0);
+            }
+            for c in &mut p.constants {
+                c.span.offset = 0;
+                c.span.file = hindsight::model::source::FileId(0);
+            }
+        }
+        d
+    };
+    let mut sm = SourceMap::new();
+    let mut ifs = Interfaces::discover(
+        &mut sm,
+        &corpus().join("as2fm/test_data/uc3_museum_guide/Main/main.xml"),
+        &[],
+    )
+    .unwrap();
+    let all_features = "# every feature\nstring NAME=robot # unquoted\nint8 FAST=-3\n\
+        byte b 7\nchar c\nwstring w \"w\\\"q\"\nstring<=5 s 'a#b'\nfloat32[3] v [1, 2.5, -0]\n\
+        uint64[<=2] u [18446744073709551615]\nbool[] flags [true, false]\n\
+        builtin_interfaces/Time t\nInternal i\n---\nint32 r\n---\n";
+    ifs.add_text(
+        &mut sm,
+        Path::new("all.action"),
+        all_features.to_string(),
+        "nested_interfaces",
+        InterfaceKind::Action,
+        "All",
+    )
+    .unwrap();
+    let mut n = 0;
+    for def in ifs.iter() {
+        let text = def.to_string();
+        let f = sm.add("printed", text.clone());
+        let back = parse_interface(&sm, f, &def.package, &def.name, def.kind)
+            .unwrap_or_else(|e| panic!("{}:\n{text}\n{e:?}", def.full_name()));
+        assert_eq!(strip(&back), strip(def), "{}:\n{text}", def.full_name());
+        n += 1;
+    }
+    assert!(n > 100, "{n} definitions");
+    let all = ifs
+        .get("nested_interfaces/All", InterfaceKind::Action)
+        .unwrap();
+    assert_eq!(
+        all.to_string(),
+        "string NAME='robot'\nint8 FAST=-3\nbyte b 7\nchar c\nwstring w 'w\"q'\n\
+         string<=5 s 'a#b'\nfloat32[3] v [1.0, 2.5, -0.0]\nuint64[<=2] u [18446744073709551615]\n\
+         bool[] flags [true, false]\nbuiltin_interfaces/Time t\nnested_interfaces/Internal i\n\
+         ---\nint32 r\n---\n"
+    );
 }

@@ -21,6 +21,7 @@
 //!
 //! Every type a member names must be declared in one of the files given together.
 
+use super::main_file::{InputKind, MainFile};
 use crate::model::source::{Diagnostic, FileId, SourceMap, Span};
 use crate::model::types::{TypeDef, TypeDefs, TypeExpr};
 use crate::model::xml::{self, Node};
@@ -92,6 +93,27 @@ pub fn read_data_declarations(
     } else {
         Err(errs)
     }
+}
+
+/// Reads the `<data_declarations>` of a main file ([`read_data_declarations`] on its inputs);
+/// no declarations give no types.
+pub fn read_main_declarations(
+    sm: &mut SourceMap,
+    main: &MainFile,
+) -> Result<TypeDefs, Vec<Diagnostic>> {
+    let files: Vec<(&Path, DataFormat)> = main
+        .data_declarations
+        .iter()
+        .map(|i| {
+            let format = if i.kind == InputKind::DataJson {
+                DataFormat::Json
+            } else {
+                DataFormat::Xml
+            };
+            (i.path.as_path(), format)
+        })
+        .collect();
+    read_data_declarations(sm, &files)
 }
 
 fn declare(

@@ -309,6 +309,62 @@ impl InterfaceDef {
     }
 }
 
+impl Primitive {
+    /// The name as written in a `.msg` file.
+    pub fn msg_name(self) -> &'static str {
+        match self {
+            Primitive::Byte => "byte",
+            Primitive::Char => "char",
+            Primitive::WString => "wstring",
+            Primitive::String => "string",
+            other => other.scxml_name(),
+        }
+    }
+}
+
+impl std::fmt::Display for FieldType {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.base {
+            BaseType::Primitive { prim, string_bound } => {
+                write!(f, "{}", prim.msg_name())?;
+                if let Some(n) = string_bound {
+                    write!(f, "<={n}")?;
+                }
+            }
+            BaseType::Message { package, name } => write!(f, "{package}/{name}")?,
+        }
+        match self.array {
+            ArraySize::Scalar => Ok(()),
+            ArraySize::Fixed(n) => write!(f, "[{n}]"),
+            ArraySize::Bounded(n) => write!(f, "[<={n}]"),
+            ArraySize::Unbounded => write!(f, "[]"),
+        }
+    }
+}
+
+/// The definition in the `.msg`/`.srv`/`.action` format, normalised: constants first, types
+/// with their package, defaults as ECMAScript literals. Reading it back gives the same
+/// definition.
+impl std::fmt::Display for InterfaceDef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for (i, part) in self.parts.iter().enumerate() {
+            if i > 0 {
+                writeln!(f, "---")?;
+            }
+            for c in &part.constants {
+                writeln!(f, "{} {}={}", c.prim.msg_name(), c.name, c.value)?;
+            }
+            for fl in &part.fields {
+                match &fl.default {
+                    Some(d) => writeln!(f, "{} {} {d}", fl.ty, fl.name)?,
+                    None => writeln!(f, "{} {}", fl.ty, fl.name)?,
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Parses the text of interface file `file` (already in `sm`) as `package/kind/name`.
 ///
 /// Message types named without a package are looked for in `package`. Whether the named
@@ -1189,6 +1245,10 @@ impl Interfaces {
             })
             .collect();
         scored.sort();
+        // Only the closest few: a near miss should not drown in far ones.
+        if let Some(best) = scored.first().map(|(d, _)| *d) {
+            scored.retain(|(d, _)| *d <= best + 1);
+        }
         scored.truncate(5);
         if scored.is_empty() {
             let n = self.defs.values().filter(|d| d.kind == kind).count();

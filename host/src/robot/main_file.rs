@@ -23,6 +23,10 @@
 //! The older form is `<convince_mc_tc>` with `<mc_parameters>`, plugins of type
 //! `bt-plugin-ros-scxml` and node models of type `ros-scxml` (`.scxml` files with ROS tags).
 //! Either parameter element is accepted in either form. Paths are relative to the main file.
+//! `<parameters>` with `<max_time>` is required, as AS2FM requires it. AS2FM reads whole
+//! numbers of `s`, `ms`, `us` or `ns`; decimals (`2.5`, converted exactly) and `min`/`h`
+//! are accepted too. Several property inputs, `xml` and `hspec` ones, and no `<properties>`
+//! at all are extensions (AS2FM wants exactly one `jani`).
 //! Every element and attribute is checked: an unknown one is an error at its position.
 
 use std::path::{Path, PathBuf};
@@ -35,6 +39,9 @@ pub const DEFAULT_BT_TICK_RATE_HZ: f64 = 1.0;
 
 /// Whether AS2FM ticks a finished tree again when `bt_tick_if_not_running` is absent.
 pub const DEFAULT_BT_TICK_IF_NOT_RUNNING: bool = false;
+
+/// The length bound of unbounded arrays AS2FM uses when `max_array_size` is absent.
+pub const DEFAULT_MAX_ARRAY_SIZE: u32 = 100;
 
 /// Which of the two main file formats a file is written in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -131,25 +138,42 @@ pub struct TickRate {
     pub exact: bool,
 }
 
-/// The run parameters; `None` where the file does not set one.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// The run parameters. `max_time` is required (as AS2FM requires it); the others are `None`
+/// where the file does not set them, and their accessors give AS2FM's defaults.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Parameters {
     /// `max_time`, converted exactly to nanoseconds.
-    pub max_time_ns: Option<Param<u64>>,
+    pub max_time_ns: Param<u64>,
     /// `max_array_size`: the length bound of unbounded arrays.
     pub max_array_size: Option<Param<u32>>,
     /// `bt_tick_rate` (default [`DEFAULT_BT_TICK_RATE_HZ`]).
     pub bt_tick_rate: Option<Param<TickRate>>,
     /// `bt_tick_if_not_running` (default [`DEFAULT_BT_TICK_IF_NOT_RUNNING`]).
     pub bt_tick_if_not_running: Option<Param<bool>>,
+    /// Where the parameters element starts.
+    pub span: Span,
 }
 
 impl Parameters {
+    /// The length bound of unbounded arrays, or the default.
+    pub fn max_array_size_or_default(&self) -> u32 {
+        self.max_array_size
+            .as_ref()
+            .map_or(DEFAULT_MAX_ARRAY_SIZE, |p| p.value)
+    }
+
     /// The tick rate in Hz, or the default.
     pub fn bt_tick_rate_hz(&self) -> f64 {
         self.bt_tick_rate
             .as_ref()
             .map_or(DEFAULT_BT_TICK_RATE_HZ, |p| p.value.hz)
+    }
+
+    /// The tick period in nanoseconds (1 s by default).
+    pub fn bt_tick_period_ns(&self) -> u64 {
+        self.bt_tick_rate
+            .as_ref()
+            .map_or(1_000_000_000, |p| p.value.period_ns)
     }
 
     /// Whether a finished tree is ticked again, or the default.
@@ -158,6 +182,15 @@ impl Parameters {
             .as_ref()
             .map_or(DEFAULT_BT_TICK_IF_NOT_RUNNING, |p| p.value)
     }
+}
+
+/// Parameters as read, before `max_time` is known to be there.
+#[derive(Default)]
+struct RawParams {
+    max_time_ns: Option<Param<u64>>,
+    max_array_size: Option<Param<u32>>,
+    bt_tick_rate: Option<Param<TickRate>>,
+    bt_tick_if_not_running: Option<Param<bool>>,
 }
 
 /// The `<behavior_tree>` section.
@@ -239,7 +272,7 @@ impl MainFile {
             errs: Vec::new(),
         };
         root.check_attrs(sm, &[], &mut r.errs);
-        let mut params = Parameters::default();
+        let mut params: Option<(RawParams, Span)> = None;
         let mut seen: Vec<(String, Span)> = Vec::new();
         let mut data_declarations = Vec::new();
         let mut behavior_tree = None;
@@ -263,7 +296,7 @@ impl MainFile {
             seen.push((section.to_string(), el.span));
             el.check_attrs(sm, &[], &mut r.errs);
             match section {
-                "parameters" => params = r.parameters(el),
+                "parameters" => params = Some((r.parameters(el), el.span)),
                 "data_declarations" => {
                     data_declarations = r.inputs(
                         el,
@@ -309,8 +342,44 @@ impl MainFile {
                 )),
             }
         }
-        if r.errs.is_empty() {
-            Ok(MainFile {
+        let params = match params {
+            Some((
+                RawParams {
+                    max_time_ns: Some(max_time_ns),
+                    max_array_size,
+                    bt_tick_rate,
+                    bt_tick_if_not_running,
+                },
+                span,
+            )) => Some(Parameters {
+                max_time_ns,
+                max_array_size,
+                bt_tick_rate,
+                bt_tick_if_not_running,
+                span,
+            }),
+            Some((_, span)) => {
+                if r.errs.is_empty() {
+                    r.errs.push(sm.diag(
+                        span,
+                        "the parameters need <max_time value=... unit=...>: how long a run lasts",
+                    ));
+                }
+                None
+            }
+            None => {
+                r.errs.push(sm.diag(
+                    root.span,
+                    format!(
+                        "<{}> needs <parameters> with <max_time value=... unit=...>",
+                        root.name
+                    ),
+                ));
+                None
+            }
+        };
+        match params {
+            Some(params) if r.errs.is_empty() => Ok(MainFile {
                 path: path.to_path_buf(),
                 file,
                 form,
@@ -319,9 +388,8 @@ impl MainFile {
                 behavior_tree,
                 node_models,
                 properties,
-            })
-        } else {
-            Err(r.errs)
+            }),
+            _ => Err(r.errs),
         }
     }
 
@@ -380,9 +448,9 @@ impl<'a> Reader<'a> {
         out
     }
 
-    fn parameters(&mut self, el: &Element) -> Parameters {
+    fn parameters(&mut self, el: &Element) -> RawParams {
         let sm = self.sm;
-        let mut p = Parameters::default();
+        let mut p = RawParams::default();
         for c in self.children(el) {
             let allowed: &[&str] = if c.name == "max_time" {
                 &["value", "unit"]
