@@ -3,19 +3,13 @@
 use std::path::{Path, PathBuf};
 
 use super::bt::{self, BtInput};
-use super::datatypes::{read_data_declarations, DataFormat};
+use super::datatypes::read_main_declarations;
 use super::interfaces::Interfaces;
-use super::main_file::{Input, InputKind, MainFile};
+use super::main_file::{Input, MainFile};
 use super::ros::{self, RosInput};
 use crate::model::xml::{self, Element};
 use crate::model::{Diagnostic, Diagnostics, ModelSource, SourceMap};
 use crate::sim::CompiledModel;
-
-/// AS2FM's default `max_time` when a main file sets none: 100 s.
-pub const DEFAULT_MAX_TIME_NS: u64 = 100_000_000_000;
-
-/// AS2FM's default bound on dynamic arrays.
-pub const DEFAULT_MAX_ARRAY_SIZE: u32 = 100;
 
 /// A robot model, lowered to plain SCXML and compiled.
 pub struct RobotModel {
@@ -121,19 +115,7 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
     let mut sm = SourceMap::new();
     let main = MainFile::read(&mut sm, main_path).map_err(fail)?;
 
-    let decls: Vec<(&Path, DataFormat)> = main
-        .data_declarations
-        .iter()
-        .map(|i| {
-            let format = if i.kind == InputKind::DataJson {
-                DataFormat::Json
-            } else {
-                DataFormat::Xml
-            };
-            (i.path.as_path(), format)
-        })
-        .collect();
-    let types = read_data_declarations(&mut sm, &decls).map_err(fail)?;
+    let types = read_main_declarations(&mut sm, &main).map_err(fail)?;
     let interfaces = Interfaces::discover(&mut sm, main_path, &[]).map_err(fail)?;
 
     let mut errs = Vec::new();
@@ -170,16 +152,8 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
         return Err(fail(errs));
     }
 
-    let max_time_ns = main
-        .params
-        .max_time_ns
-        .as_ref()
-        .map_or(DEFAULT_MAX_TIME_NS, |p| p.value);
-    let max_array_size = main
-        .params
-        .max_array_size
-        .as_ref()
-        .map_or(DEFAULT_MAX_ARRAY_SIZE, |p| p.value);
+    let max_time_ns = main.params.max_time_ns.value;
+    let max_array_size = main.params.max_array_size_or_default();
     let out = ros::lower(
         &sm,
         RosInput {
