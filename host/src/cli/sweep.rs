@@ -170,7 +170,7 @@ impl BoundValue {
     }
 
     /// The value as people read it: `62`, `6.2s`.
-    fn display(self) -> String {
+    pub fn display(self) -> String {
         match self {
             BoundValue::Units(v) => v.to_string(),
             BoundValue::Nanos(v) => {

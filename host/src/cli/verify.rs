@@ -183,9 +183,11 @@ fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, CliE
 /// The model and property arguments every command that loads a model takes.
 #[derive(Debug, clap::Args)]
 pub struct ModelArgs {
-    /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
+    /// The model: a robot main file (`<roaml>` or `<convince_mc_tc>`) or a folder holding
+    /// `main.xml`; a folder of plain .scxml machines, a SCAN model.xml, or one .scxml file.
     pub model: PathBuf,
-    /// The property file; default: the one model.xml names, else MODEL/properties.xml.
+    /// The property file; default: the one the main file or model.xml names, else
+    /// MODEL/properties.xml.
     pub props: Option<PathBuf>,
     /// The length of one model time step (`100ms`), so that bounds with a unit (`6.2s`)
     /// and durations given to --max-time mean wall-clock time on a plain SCXML model.
@@ -205,13 +207,17 @@ pub struct Loaded {
     pub props_path: PathBuf,
     /// The length of one model time step in nanoseconds, when known.
     pub unit_ns: Option<u64>,
+    /// The run length the model asks for (a robot main file's `max_time`), in steps.
+    pub default_max_time: Option<u64>,
 }
 
 impl Loaded {
     /// `--max-time`: model steps, or a duration when the model has a time unit; by
-    /// default 10,000 steps.
+    /// default the main file's `max_time`, else 10,000 steps.
     pub fn max_time(&self, arg: Option<&str>) -> Result<u64, CliError> {
-        let Some(text) = arg else { return Ok(10_000) };
+        let Some(text) = arg else {
+            return Ok(self.default_max_time.unwrap_or(10_000));
+        };
         match super::sweep::BoundValue::parse(text).map_err(CliError::Input)? {
             super::sweep::BoundValue::Units(v) => Ok(v),
             super::sweep::BoundValue::Nanos(ns) => match self.unit_ns {
@@ -238,8 +244,12 @@ fn parse_time_unit(text: &str) -> Result<u64, CliError> {
     }
 }
 
-/// Loads the model and its properties.
+/// Loads the model and its properties: a robot model (a main file, or a folder holding
+/// `main.xml`) through the robot pipeline, anything else as plain SCXML.
 pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
+    if let Some(main) = crate::robot::load::main_file_of(&args.model) {
+        return load_robot(args, &main);
+    }
     let model = &args.model;
     let unit_ns = args.time_unit.as_deref().map(parse_time_unit).transpose()?;
     let compiled = CompiledModel::load(model).map_err(|d| CliError::Input(d.to_string()))?;
@@ -251,7 +261,25 @@ pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
         None => default_props(model, &compiled)?,
     };
     let file = props::parse_file(&props_path).map_err(|d| CliError::Input(d.to_string()))?;
-    let set = PropertySet::with_unit(&file, &compiled, unit_ns).map_err(|e| {
+    let set = compile_properties(&file, &compiled, unit_ns)?;
+    Ok(Loaded {
+        model: compiled,
+        file,
+        set,
+        props_path,
+        unit_ns,
+        default_max_time: None,
+    })
+}
+
+/// Compiles a property file against a model; a bound with a unit on a model without one
+/// gets a hint.
+fn compile_properties(
+    file: &props::PropertyFile,
+    model: &CompiledModel,
+    unit_ns: Option<u64>,
+) -> Result<PropertySet, CliError> {
+    PropertySet::with_unit(file, model, unit_ns).map_err(|e| {
         if unit_ns.is_none() && e.contains("no known duration") {
             CliError::Input(format!(
                 "{e}\nhint: give the length of one model step with --time-unit (for example \
@@ -260,13 +288,52 @@ pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
         } else {
             CliError::Input(e)
         }
-    })?;
+    })
+}
+
+/// Loads a robot model: the main file and everything it names, lowered and compiled; the
+/// properties are the file given, else the first one the main file names.
+fn load_robot(args: &ModelArgs, main: &Path) -> Result<Loaded, CliError> {
+    use crate::robot::main_file::InputKind;
+    let robot = crate::robot::load::load(main).map_err(|d| CliError::Input(d.to_string()))?;
+    if let Some(text) = &args.time_unit {
+        let given = parse_time_unit(text)?;
+        if given != robot.time_unit_ns {
+            return Err(CliError::Input(format!(
+                "--time-unit {text}: {} steps by {}, from its timers and max_time",
+                main.display(),
+                super::sweep::BoundValue::Nanos(robot.time_unit_ns).display()
+            )));
+        }
+    }
+    let props_path = match (&args.props, robot.main.properties.first()) {
+        (Some(p), _) => p.clone(),
+        (None, Some(input)) => {
+            if input.kind == InputKind::Hspec {
+                return Err(CliError::Input(format!(
+                    "{}: an .hspec file names no messages of the model; write the \
+                     properties over ROS names (XML) or give them on the command line",
+                    input.path.display()
+                )));
+            }
+            input.path.clone()
+        }
+        (None, None) => {
+            return Err(CliError::Input(format!(
+                "{}: the main file names no property file; give one after the model",
+                main.display()
+            )))
+        }
+    };
+    let file = props::parse_file(&props_path).map_err(|d| CliError::Input(d.to_string()))?;
+    let set = compile_properties(&file, &robot.model, Some(robot.time_unit_ns))?;
     Ok(Loaded {
-        model: compiled,
+        model: robot.model,
         file,
         set,
         props_path,
-        unit_ns,
+        unit_ns: Some(robot.time_unit_ns),
+        default_max_time: Some(robot.max_time_steps),
     })
 }
 
