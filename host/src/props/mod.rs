@@ -60,6 +60,8 @@
 //! file, line and column.
 
 mod error;
+pub mod jani;
+mod json;
 mod read;
 mod source;
 mod xml;
@@ -91,19 +93,25 @@ pub struct Port {
     pub kind: PortKind,
     /// The SCXML event (message) observed.
     pub event: String,
-    /// The machine that sends it.
+    /// The machine that sends it ([`ANY`]: every sender).
     pub origin: String,
-    /// The machine it is sent to.
+    /// The machine it is sent to ([`ANY`]: every target, the `NONE` sink included).
     pub target: String,
     /// Where the variable is declared (`<state_var>`, `<event_var>` or `<port>`).
     pub at: Location,
 }
+
+/// A port's origin or target that matches every machine (JANI properties observe an
+/// event whoever sends it).
+pub const ANY: &str = "*";
 
 /// What a variable holds.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum PortKind {
     /// True exactly at the point where the message is sent.
     Event,
+    /// False until the message is first sent, true from then on (JANI's `E.valid`).
+    Sent,
     /// The value of a message parameter as last sent.
     State {
         /// The message parameter.

@@ -14,20 +14,30 @@ use monitor_core::{valuation, Monitor, Ty, Value, VarKind};
 
 use super::settle::Settler;
 use crate::expr::Value as SimValue;
-use crate::props::{PortKind, PropertyFile};
+use crate::props::{PortKind, PropertyFile, ANY};
 use crate::sim::{CompiledModel, Flow, MachineId, Observer, SentMessage};
 use crate::smc::{RunEnd, RunOutcome, Verdict};
 
 /// One port resolved to model ids.
 #[derive(Clone, Debug)]
 struct Port {
-    origin: MachineId,
-    /// `None`: the `NONE` sink.
-    target: Option<MachineId>,
+    /// `None`: any sender.
+    origin: Option<MachineId>,
+    /// `None`: any target; `Some(None)`: the `NONE` sink.
+    target: Option<Option<MachineId>>,
     /// The spec variable it sets.
     var: usize,
-    /// The message parameter (state variables only).
-    param: Option<usize>,
+    /// What it sets the variable to.
+    value: PortValue,
+}
+
+/// What a port writes when its message is sent.
+#[derive(Clone, Copy, Debug)]
+enum PortValue {
+    /// `true` (event variables, and the sent-once flag).
+    True,
+    /// A message parameter.
+    Param(usize),
 }
 
 /// Guarantees and assumptions compiled to one program, with their ports resolved.
@@ -77,6 +87,11 @@ impl PropertySet {
             let at = origin(p.at.line, p.at.column);
             let (kind, type_name, init) = match &p.kind {
                 PortKind::Event => (VarKind::Event, "bool".to_string(), None),
+                PortKind::Sent => (
+                    VarKind::State,
+                    "bool".to_string(),
+                    Some("false".to_string()),
+                ),
                 PortKind::State { ty, init, .. } => match spec_type(ty) {
                     Some(t) => (
                         VarKind::State,
@@ -135,22 +150,27 @@ impl PropertySet {
                 errors.push(format!("{here}: the model sends no event `{}`", p.event));
                 continue;
             };
-            let Some(origin) = model.machine_id(&p.origin) else {
-                errors.push(format!("{here}: no machine `{}` in the model", p.origin));
-                continue;
+            let origin = match model.machine_id(&p.origin) {
+                Some(m) => Some(m),
+                None if p.origin == ANY => None,
+                None => {
+                    errors.push(format!("{here}: no machine `{}` in the model", p.origin));
+                    continue;
+                }
             };
             let target = match model.machine_id(&p.target) {
-                Some(m) => Some(m),
-                None if p.target == "NONE" => None,
+                Some(m) => Some(Some(m)),
+                None if p.target == "NONE" => Some(None),
+                None if p.target == ANY => None,
                 None => {
                     errors.push(format!("{here}: no machine `{}` in the model", p.target));
                     continue;
                 }
             };
-            let param = match &p.kind {
-                PortKind::Event => None,
+            let value = match &p.kind {
+                PortKind::Event | PortKind::Sent => PortValue::True,
                 PortKind::State { param, .. } => match model.param_index(event, param) {
-                    Some(i) => Some(i),
+                    Some(i) => PortValue::Param(i),
                     None => {
                         errors.push(format!(
                             "{here}: event `{}` has no parameter `{param}`",
@@ -167,7 +187,7 @@ impl PropertySet {
                 origin,
                 target,
                 var,
-                param,
+                value,
             });
         }
         if !errors.is_empty() {
@@ -340,13 +360,15 @@ impl Observer for Judge<'_> {
         self.begin();
         let ports = self.set.by_event.get(msg.event().0 as usize);
         for port in ports.into_iter().flatten() {
-            if port.origin != msg.origin() || port.target != msg.target() {
+            if port.origin.is_some_and(|o| o != msg.origin())
+                || port.target.is_some_and(|t| t != msg.target())
+            {
                 continue;
             }
             let decl = &self.monitor.program().vars[port.var];
-            let value = match port.param {
-                None => Some(Value::Bool(true)),
-                Some(i) => msg.param(i).and_then(|v| self.convert(v, decl.ty)),
+            let value = match port.value {
+                PortValue::True => Some(Value::Bool(true)),
+                PortValue::Param(i) => msg.param(i).and_then(|v| self.convert(v, decl.ty)),
             };
             match value {
                 Some(v) => self.vals[port.var] = v,
