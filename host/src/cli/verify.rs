@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use super::CliError;
 use crate::props;
-use crate::sim::{CompiledModel, EndReason, RunConfig, Simulator};
+use crate::sim::{CompiledModel, EndReason, EventSemantics, RunConfig, Simulator};
 use crate::smc::progress::TerminalProgress;
 use crate::smc::stats::{RuleConfig, RuleKind};
 use crate::smc::{run_study, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
@@ -28,13 +28,52 @@ pub enum Rule {
     ClopperPearson,
 }
 
+/// How sends are delivered, as named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Events {
+    /// SCAN's channel system: per-machine FIFO queues, a send goes to its target.
+    Queues,
+    /// AS2FM's JANI semantics: one pending message per event, broadcast to every
+    /// machine with a transition on it, senders blocking while it is pending.
+    As2fm,
+}
+
+impl From<Events> for EventSemantics {
+    fn from(e: Events) -> Self {
+        match e {
+            Events::Queues => EventSemantics::Queues,
+            Events::As2fm => EventSemantics::As2fm,
+        }
+    }
+}
+
+/// The event semantics for a property file when none is asked for: AS2FM's for a JANI
+/// property file (the model is then AS2FM's plain SCXML), SCAN's queues otherwise.
+pub fn default_events(props_path: &Path) -> EventSemantics {
+    if is_jani(props_path) {
+        EventSemantics::As2fm
+    } else {
+        EventSemantics::Queues
+    }
+}
+
+fn is_jani(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("jani"))
+}
+
 /// Arguments of `hindsight verify`.
 #[derive(Debug, clap::Args)]
 pub struct VerifyArgs {
     /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
     pub model: PathBuf,
-    /// The SCAN property file; default: the one model.xml names, else MODEL/properties.xml.
+    /// The property file: SCAN XML, or a JANI file (`.jani`, as AS2FM's models use);
+    /// default: the one model.xml names, else MODEL/properties.xml.
     pub props: Option<PathBuf>,
+    /// How sends are delivered: `queues` (SCAN) or `as2fm` (AS2FM's JANI translation);
+    /// default: `as2fm` with a `.jani` property file, `queues` otherwise.
+    #[arg(long, value_enum)]
+    pub events: Option<Events>,
     /// Confidence of the reported intervals.
     #[arg(long, default_value_t = 0.95)]
     pub confidence: f64,
@@ -193,7 +232,12 @@ pub fn load(
         Some(p) => p.to_path_buf(),
         None => default_props(model, &compiled)?,
     };
-    let file = props::parse_file(&props_path).map_err(|d| CliError::Input(d.to_string()))?;
+    let file = if is_jani(&props_path) {
+        props::jani::parse_file(&props_path, &compiled)
+    } else {
+        props::parse_file(&props_path)
+    }
+    .map_err(|d| CliError::Input(d.to_string()))?;
     let set = PropertySet::new(&file, &compiled).map_err(CliError::Input)?;
     Ok((compiled, set, props_path))
 }
@@ -426,8 +470,11 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
 pub struct TraceArgs {
     /// The model, as for `verify`.
     pub model: PathBuf,
-    /// The SCAN property file; default as for `verify`.
+    /// The property file; default as for `verify`.
     pub props: Option<PathBuf>,
+    /// How sends are delivered; default as for `verify`.
+    #[arg(long, value_enum)]
+    pub events: Option<Events>,
     /// The run to replay (its index in the study: run k uses stream k of the seed).
     #[arg(long, default_value_t = 0)]
     pub run: u64,
@@ -447,10 +494,13 @@ pub struct TraceArgs {
 
 /// Runs `hindsight trace`: one run of the study, every point as CSV.
 pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
-    let (model, set, _) = load(&args.model, args.props.as_deref())?;
+    let (model, set, props_path) = load(&args.model, args.props.as_deref())?;
     let run_cfg = RunConfig {
         max_time: args.max_time,
         max_steps: args.max_steps,
+        events: args
+            .events
+            .map_or_else(|| default_events(&props_path), Into::into),
         ..RunConfig::default()
     };
     let csv = replay_csv(&model, &set, &run_cfg, args.seed, args.run)?;
@@ -523,6 +573,9 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     let run_cfg = RunConfig {
         max_time: args.max_time,
         max_steps: args.max_steps,
+        events: args
+            .events
+            .map_or_else(|| default_events(&props_path), Into::into),
         ..RunConfig::default()
     };
     let study_cfg = StudyConfig {
@@ -639,7 +692,7 @@ fn print_table(r: &Report) {
 pub struct ValidateArgs {
     /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
     pub model: PathBuf,
-    /// The SCAN property file; default as for `verify`.
+    /// The property file (SCAN XML or JANI); default as for `verify`.
     pub props: Option<PathBuf>,
 }
 

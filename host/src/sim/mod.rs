@@ -51,7 +51,7 @@ pub use compiled::CompiledModel;
 pub use ids::{EventId, MachineId, StateId};
 pub use observer::{Flow, Observer, SentMessage};
 pub use run::{
-    EndReason, Quiescence, RunConfig, RunError, RunOutcome, Simulator, SpinKind, SpinReport,
-    TransitionChoice,
+    EndReason, EventSemantics, Quiescence, RunConfig, RunError, RunOutcome, Simulator, SpinKind,
+    SpinReport, TransitionChoice,
 };
 pub use trace::{TraceRecorder, TraceRow};
