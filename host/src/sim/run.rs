@@ -1232,8 +1232,8 @@ impl<'m> Simulator<'m> {
 
     /// [`EventSemantics::As2fm`]: whether event `e` may be sent now.
     fn send_enabled(&self, e: u32) -> bool {
-        !self.pending[e as usize]
-            && !(self.ev_flags[e as usize] & EV_BB_REQ != 0 && self.pending_bb_set > 0)
+        let bb_blocked = self.ev_flags[e as usize] & EV_BB_REQ != 0 && self.pending_bb_set > 0;
+        !self.pending[e as usize] && !bb_blocked
     }
 
     /// What receiver `r` does with pending event `e` now: `Some(Some(t))` fires
