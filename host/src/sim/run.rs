@@ -276,6 +276,10 @@ pub struct Simulator<'m> {
     blocked_list: Vec<u32>,
     /// Per event: parameters being evaluated before they replace the global ones.
     ev_scratch: Vec<Vec<Cell>>,
+    /// Per event: the pool slot of its first receiver's copy of a delivered message.
+    rx_base: Vec<u32>,
+    /// Pool slots reserved for [`EventSemantics::As2fm`] (never freed).
+    reserved: usize,
 }
 
 const EV_TIMER: u8 = 1;
@@ -414,7 +418,8 @@ impl<'m> Simulator<'m> {
                     vars: d.defaults.clone(),
                 })
                 .collect(),
-            // Slot `e` is event `e`'s global buffer under EventSemantics::As2fm.
+            // Under EventSemantics::As2fm, slot `e` is event `e`'s global buffer, and
+            // each receiver of `e` has its own copy at `rx_base[e] + position`.
             pool: model
                 .events
                 .iter()
@@ -425,7 +430,30 @@ impl<'m> Simulator<'m> {
                     target: u32::MAX,
                     params: d.defaults.clone(),
                 })
+                .chain(model.events.iter().enumerate().flat_map(|(e, d)| {
+                    d.receivers.iter().map(move |&r| Slot {
+                        event: e as u32,
+                        origin: 0,
+                        target: r,
+                        params: d.defaults.clone(),
+                    })
+                }))
                 .collect(),
+            rx_base: model
+                .events
+                .iter()
+                .scan(model.events.len() as u32, |next, d| {
+                    let base = *next;
+                    *next += d.receivers.len() as u32;
+                    Some(base)
+                })
+                .collect(),
+            reserved: model.events.len()
+                + model
+                    .events
+                    .iter()
+                    .map(|d| d.receivers.len())
+                    .sum::<usize>(),
             free: vec![Vec::new(); model.events.len()],
             runnable: Vec::with_capacity(n),
             rpos: vec![NOT_RUNNABLE; n],
@@ -504,8 +532,8 @@ impl<'m> Simulator<'m> {
     }
 
     fn free_slot(&mut self, slot: u32) {
-        // The first slots are the events' global buffers: never free.
-        if (slot as usize) < self.model.events.len() {
+        // The first slots are the events' global buffers and receiver copies: never free.
+        if (slot as usize) < self.reserved {
             return;
         }
         let ev = self.pool.get(slot as usize).map_or(0, |s| s.event as usize);
@@ -580,7 +608,7 @@ impl<'m> Simulator<'m> {
         for f in &mut self.free {
             f.clear();
         }
-        for i in (self.model.events.len()..self.pool.len()).rev() {
+        for i in (self.reserved..self.pool.len()).rev() {
             let ev = self.pool[i].event as usize;
             if let Some(f) = self.free.get_mut(ev) {
                 f.push(i as u32);
@@ -1076,6 +1104,10 @@ impl<'m> Simulator<'m> {
                         }
                     }
                     if self.as2fm {
+                        if sd.expanded_copy {
+                            self.ms[m].pc = pc + 1;
+                            continue;
+                        }
                         return self.as2fm_send(m, pc, sd, rng, obs);
                     }
                     let mut broadcast_len = 0usize;
@@ -1307,9 +1339,15 @@ impl<'m> Simulator<'m> {
         let model = self.model;
         let mut flow = Flow::Continue;
         let origin = self.pool[e as usize].origin;
-        for &r in &model.events[e as usize].receivers {
+        for (k, &r) in model.events[e as usize].receivers.iter().enumerate() {
             let m = r as usize;
             let choice = self.receive_choice(r, e, rng, cfg)?.flatten();
+            // The receiver keeps its own copy: JANI assigns it with the receive itself.
+            let rx = self.rx_base[e as usize] as usize + k;
+            let (global, copy) = self.pool.split_at_mut(rx);
+            copy[0].params.clone_from(&global[e as usize].params);
+            copy[0].origin = origin;
+            self.ms[m].cur = rx as u32;
             self.steps += 1;
             self.instant_steps += 1;
             self.instant_moves[m] = self.instant_moves[m].saturating_add(1);
