@@ -30,9 +30,10 @@
 //! `= ≠ < ≤ > ≥`, `+ - * / %`, literals, variables; `abs(e)` as an operand of a
 //! comparison (unfolded into two comparisons); `av` (an array value) compared with a
 //! string parameter, read as the string of those character codes (AS2FM stores strings
-//! as code arrays). Step, time and reward bounds, array parameters (`aa`, `.d1_len`),
-//! nested path formulas and other operators are reported as unsupported, with the
-//! file, line and column of the construct.
+//! as code arrays); `aa` with constant indices and `E__P.d1_len` on array and string
+//! parameters ([`PortKind::Part`]; a string's elements are its character codes). Step,
+//! time and reward bounds, nested path formulas, `.d2_len` and other operators are
+//! reported as unsupported, with the file, line and column of the construct.
 
 use std::path::Path;
 
@@ -361,6 +362,9 @@ impl Reader<'_, '_> {
     /// The port id for JANI variable `name`, declaring the port on first use.
     fn port(&mut self, name: &str, offset: usize) -> Option<(String, Ty)> {
         let at = self.at(offset);
+        if let Some(base) = name.strip_suffix(".d1_len") {
+            return self.part_port(base, Vec::new(), true, offset);
+        }
         let var = match self.resolve(name) {
             Some(v) => v,
             None => {
@@ -405,13 +409,18 @@ impl Reader<'_, '_> {
                 )
             }
         };
+        Some((self.declare(name, event, kind, at), ty))
+    }
+
+    /// The id of the port for `kind` on `event`, declared on first use (named after `name`).
+    fn declare(&mut self, name: &str, event: EventId, kind: PortKind, at: Location) -> String {
         let event_name = self.model.event_name(event).to_owned();
         if let Some(p) = self
             .ports
             .iter()
             .find(|p| p.event == event_name && p.kind.same_variable(&kind))
         {
-            return Some((p.id.clone(), ty));
+            return p.id.clone();
         }
         let base: String = name
             .chars()
@@ -436,7 +445,77 @@ impl Reader<'_, '_> {
             target: ANY.to_owned(),
             at,
         });
-        Some((id, ty))
+        id
+    }
+
+    /// A port on part of an array or string parameter: `path` into it, or its length.
+    fn part_port(
+        &mut self,
+        base: &str,
+        path: Vec<u32>,
+        length: bool,
+        offset: usize,
+    ) -> Option<(String, Ty)> {
+        let at = self.at(offset);
+        let Some(Var::Param(event, param, ty)) = self.resolve(base) else {
+            self.jani(
+                offset,
+                format!("`{base}` is not `E__P` for an event E of the model and an array or string parameter P"),
+            );
+            return None;
+        };
+        let mut cur = ty;
+        for (k, _) in path.iter().enumerate() {
+            cur = match cur {
+                Ty::Array(inner, _) => *inner,
+                Ty::Str if k + 1 == path.len() && !length => Ty::Int,
+                _ => {
+                    self.jani(
+                        offset,
+                        format!("`{base}` has no element at depth {}", k + 1),
+                    );
+                    return None;
+                }
+            };
+        }
+        let (ty, type_name) = if length {
+            if !matches!(cur, Ty::Array(..) | Ty::Str) {
+                self.jani(
+                    offset,
+                    format!("`{base}`: only arrays and strings have a length"),
+                );
+                return None;
+            }
+            (Ty::Int, "int64")
+        } else {
+            match cur {
+                Ty::Bool => (Ty::Bool, "bool"),
+                Ty::Int => (Ty::Int, "int64"),
+                Ty::Float => (Ty::Float, "float64"),
+                Ty::Str => (Ty::Str, "string"),
+                _ => {
+                    self.jani(
+                        offset,
+                        format!("`{base}`: only scalar elements can be observed"),
+                    );
+                    return None;
+                }
+            }
+        };
+        let mut name = base.to_owned();
+        for i in &path {
+            name.push_str(&format!("_{i}"));
+        }
+        if length {
+            name.push_str("_len");
+        }
+        let kind = PortKind::Part {
+            param,
+            path,
+            length,
+            ty: type_name.to_owned(),
+        };
+        Some((self.declare(&name, event, kind, at), ty))
     }
 
     fn leaf(&self, text: &str, ty: Ty, offset: usize) -> Rendered {
@@ -637,8 +716,31 @@ impl Reader<'_, '_> {
                         })
                     }
                     "aa" => {
-                        self.jani(node.offset, "array access (`aa`) is not supported: array parameters cannot be observed");
-                        None
+                        let mut path = Vec::new();
+                        let mut cur = node;
+                        while cur.get("op").and_then(Node::as_str) == Some("aa") {
+                            let index = match cur.get("index").map(|n| &n.value) {
+                                Some(Json::Number(n)) => n.parse::<u32>().ok(),
+                                _ => None,
+                            };
+                            let Some(index) = index else {
+                                self.jani(cur.offset, "`aa` is supported only with a constant non-negative integer `index`");
+                                return None;
+                            };
+                            path.push(index);
+                            let Some(exp) = cur.get("exp") else {
+                                self.jani(cur.offset, "`aa` needs `exp`");
+                                return None;
+                            };
+                            cur = exp;
+                        }
+                        path.reverse();
+                        let Some(base) = cur.as_str() else {
+                            self.jani(cur.offset, "`aa` is supported only on an event parameter");
+                            return None;
+                        };
+                        let (id, ty) = self.part_port(base, path, false, cur.offset)?;
+                        Some(self.leaf(&id, ty, node.offset))
                     }
                     "" => {
                         self.jani(node.offset, "an expression object needs `op`");
@@ -776,6 +878,20 @@ impl PortKind {
         match (self, other) {
             (PortKind::Sent, PortKind::Sent) | (PortKind::Event, PortKind::Event) => true,
             (PortKind::State { param: a, .. }, PortKind::State { param: b, .. }) => a == b,
+            (
+                PortKind::Part {
+                    param: a,
+                    path: pa,
+                    length: la,
+                    ..
+                },
+                PortKind::Part {
+                    param: b,
+                    path: pb,
+                    length: lb,
+                    ..
+                },
+            ) => a == b && pa == pb && la == lb,
             _ => false,
         }
     }

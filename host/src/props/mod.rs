@@ -112,6 +112,20 @@ pub enum PortKind {
     Event,
     /// False until the message is first sent, true from then on (JANI's `E.valid`).
     Sent,
+    /// Part of an array or string parameter as last sent (JANI's `aa` and `.d1_len`):
+    /// the element at `path` (indices from the outside in; inside a string, a
+    /// character's code) or, with `length`, the number of elements (characters) there.
+    /// An element the message does not have reads as `0`, `false` or `0.0`.
+    Part {
+        /// The message parameter.
+        param: String,
+        /// Indices into it.
+        path: Vec<u32>,
+        /// The length at `path` instead of the element.
+        length: bool,
+        /// The element's type, as for [`PortKind::State`].
+        ty: String,
+    },
     /// The value of a message parameter as last sent.
     State {
         /// The message parameter.

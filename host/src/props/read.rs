@@ -570,7 +570,9 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
         for port in ports {
             let ty = match &port.kind {
                 PortKind::Event | PortKind::Sent => Ty::Bool,
-                PortKind::State { ty, .. } => Ty::of(ty).unwrap_or(Ty::Int),
+                PortKind::State { ty, .. } | PortKind::Part { ty, .. } => {
+                    Ty::of(ty).unwrap_or(Ty::Int)
+                }
             };
             variables.entry(port.id.clone()).or_insert(VarInfo { ty });
         }

@@ -32,12 +32,18 @@ struct Port {
 }
 
 /// What a port writes when its message is sent.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 enum PortValue {
     /// `true` (event variables, and the sent-once flag).
     True,
     /// A message parameter.
     Param(usize),
+    /// An element (or, with `length`, the length) inside a message parameter.
+    Part {
+        param: usize,
+        path: Box<[u32]>,
+        length: bool,
+    },
 }
 
 /// Guarantees and assumptions compiled to one program, with their ports resolved.
@@ -92,6 +98,16 @@ impl PropertySet {
                     "bool".to_string(),
                     Some("false".to_string()),
                 ),
+                PortKind::Part { ty, .. } => match spec_type(ty) {
+                    Some(t) => (VarKind::State, t.to_string(), None),
+                    None => {
+                        errors.push(format!(
+                            "{file}:{}:{}: port `{}`: unsupported type `{ty}`",
+                            p.at.line, p.at.column, p.id
+                        ));
+                        continue;
+                    }
+                },
                 PortKind::State { ty, init, .. } => match spec_type(ty) {
                     Some(t) => (
                         VarKind::State,
@@ -169,6 +185,25 @@ impl PropertySet {
             };
             let value = match &p.kind {
                 PortKind::Event | PortKind::Sent => PortValue::True,
+                PortKind::Part {
+                    param,
+                    path,
+                    length,
+                    ..
+                } => match model.param_index(event, param) {
+                    Some(i) => PortValue::Part {
+                        param: i,
+                        path: path.clone().into_boxed_slice(),
+                        length: *length,
+                    },
+                    None => {
+                        errors.push(format!(
+                            "{here}: event `{}` has no parameter `{param}`",
+                            p.event
+                        ));
+                        continue;
+                    }
+                },
                 PortKind::State { param, .. } => match model.param_index(event, param) {
                     Some(i) => PortValue::Param(i),
                     None => {
@@ -322,6 +357,45 @@ impl<'a> Judge<'a> {
         })
     }
 
+    /// The element at `path` inside `v` (a string's characters are their codes), or its
+    /// length; the type's zero when `v` has no such element.
+    fn part(
+        &self,
+        v: SimValue<'_>,
+        path: &[u32],
+        length: bool,
+        ty: Ty,
+        model: &CompiledModel,
+    ) -> Option<Value> {
+        let zero = match ty {
+            Ty::Bool => Value::Bool(false),
+            Ty::Float => Value::Float(0.0),
+            _ => Value::Int(0),
+        };
+        let mut cur = v;
+        for (k, &i) in path.iter().enumerate() {
+            cur = match cur {
+                SimValue::List(l) => match l.get(i as usize) {
+                    Some(x) => x,
+                    None => return Some(zero),
+                },
+                SimValue::Str(s) if k + 1 == path.len() && !length => {
+                    let code = model.strings().get(s).chars().nth(i as usize);
+                    return Some(code.map_or(zero, |c| Value::Int(c as i64)));
+                }
+                _ => return None,
+            };
+        }
+        if length {
+            return match cur {
+                SimValue::List(l) => Some(Value::Int(l.len() as i64)),
+                SimValue::Str(s) => Some(Value::Int(model.strings().get(s).chars().count() as i64)),
+                _ => None,
+            };
+        }
+        self.convert(cur, ty)
+    }
+
     /// The run's outcome from the verdicts at its last point and why it ended.
     pub fn outcome(&self, end: RunEnd, steps: u64, time: u64) -> RunOutcome {
         let g = self.set.guarantees.len();
@@ -366,9 +440,16 @@ impl Observer for Judge<'_> {
                 continue;
             }
             let decl = &self.monitor.program().vars[port.var];
-            let value = match port.value {
+            let value = match &port.value {
                 PortValue::True => Some(Value::Bool(true)),
-                PortValue::Param(i) => msg.param(i).and_then(|v| self.convert(v, decl.ty)),
+                PortValue::Param(i) => msg.param(*i).and_then(|v| self.convert(v, decl.ty)),
+                PortValue::Part {
+                    param,
+                    path,
+                    length,
+                } => msg
+                    .param(*param)
+                    .and_then(|v| self.part(v, path, *length, decl.ty, msg.model())),
             };
             match value {
                 Some(v) => self.vals[port.var] = v,
