@@ -233,3 +233,34 @@ fn skipped_cases_still_disagree() {
         "{case} now reaches its goal: unskip it"
     );
 }
+
+/// `hindsight verify` on a plain folder with a JANI property file picks AS2FM's event
+/// semantics by itself; `--events queues` gives SCAN's, under which this model's two
+/// action clients mostly deadlock.
+#[test]
+fn verify_cli_chooses_as2fm_semantics_for_jani_properties() {
+    let root = corpus();
+    let plain = root.join("plain/fibonacci_action_example_main");
+    let props = root.join("test_data/fibonacci_action_example/properties.jani");
+    let run = |extra: &[&str]| -> f64 {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_hindsight"))
+            .arg("verify")
+            .arg(&plain)
+            .arg(&props)
+            .args(["--max-runs", "40", "--json", "--threads", "1"])
+            .args(extra)
+            .output()
+            .expect("run hindsight");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(report["properties"][0]["property"], "clients_ok");
+        report["properties"][0]["probability"].as_f64().unwrap()
+    };
+    assert_eq!(run(&[]), 1.0);
+    assert_eq!(run(&["--events", "as2fm"]), 1.0);
+    assert!(run(&["--events", "queues"]) < 0.5);
+}

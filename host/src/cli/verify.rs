@@ -68,7 +68,8 @@ pub struct VerifyArgs {
     /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
     pub model: PathBuf,
     /// The property file: SCAN XML, or a JANI file (`.jani`, as AS2FM's models use);
-    /// default: the one model.xml names, else MODEL/properties.xml.
+    /// default: the one model.xml names, else MODEL/properties.xml, else the only .jani
+    /// file in MODEL.
     pub props: Option<PathBuf>,
     /// How sends are delivered: `queues` (SCAN) or `as2fm` (AS2FM's JANI translation);
     /// default: `as2fm` with a `.jani` property file, `queues` otherwise.
@@ -209,14 +210,24 @@ fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, CliE
     };
     let p = dir.join("properties.xml");
     if p.is_file() {
-        Ok(p)
-    } else {
-        Err(CliError::Input(format!(
-            "{}: no property file given and none found (looked for {})",
-            model.display(),
-            p.display()
-        )))
+        return Ok(p);
     }
+    // A folder with exactly one JANI file (AS2FM's models keep their properties there).
+    let mut jani: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.is_file() && is_jani(p))
+                .collect()
+        })
+        .unwrap_or_default();
+    if jani.len() == 1 {
+        return Ok(jani.remove(0));
+    }
+    Err(CliError::Input(format!(
+        "{}: no property file given and none found (looked for {} and a single .jani file)",
+        model.display(),
+        p.display()
+    )))
 }
 
 /// Loads the model and its properties: everything `validate` checks.
