@@ -50,7 +50,8 @@ pub enum EventSemantics {
     ///   synchronised events (BT `bt_N_tick` / `_halt` / `_response` /
     ///   `_halt_response`, services `srv_*_request` / `_response` / `_req_client*`,
     ///   actions `action_*_goal_*`, `action_*_result*`, `action_*_thread_start|free`).
-    ///   BT root machines (`bt_root_fsm*`) never discard. All receivers take `E` at once.
+    ///   BT roots (`bt_root_fsm*`) and ROS interface handlers (`srv_handler_*`,
+    ///   `action_handler_*`) never discard. All receivers take `E` at once.
     /// - Receivers read `_event.data` from the event's global parameters, which the
     ///   next send of `E` overwrites (as in JANI); a send that leaves a parameter out
     ///   keeps its previous value.
@@ -260,8 +261,8 @@ pub struct Simulator<'m> {
     as2fm: bool,
     /// Per event: [`EV_TIMER`], [`EV_SYNCHED`], [`EV_BB_REQ`], [`EV_BB_SET`] flags.
     ev_flags: Vec<u8>,
-    /// Per machine: a BT root (never discards events).
-    bt_root: Vec<bool>,
+    /// Per machine: never discards events (BT roots and ROS interface handlers).
+    no_discard: Vec<bool>,
     /// Per event: pending (as2fm).
     pending: Vec<bool>,
     /// Pending events, in the order they were sent.
@@ -471,10 +472,14 @@ impl<'m> Simulator<'m> {
             idx: [0; MAX_PATH],
             as2fm: false,
             ev_flags: model.events.iter().map(|e| event_flags(&e.name)).collect(),
-            bt_root: model
+            no_discard: model
                 .machines
                 .iter()
-                .map(|d| d.name.starts_with("bt_root_fsm"))
+                .map(|d| {
+                    ["bt_root_fsm", "srv_handler_", "action_handler_"]
+                        .iter()
+                        .any(|p| d.name.starts_with(p))
+                })
                 .collect(),
             pending: vec![false; model.events.len()],
             pending_list: Vec::with_capacity(model.events.len()),
@@ -1305,7 +1310,7 @@ impl<'m> Simulator<'m> {
         if let Some(t) = self.select(m, def, Some(e), rng, cfg)? {
             return Ok(Some(Some(t)));
         }
-        let discard = !self.bt_root[m] && (has || self.ev_flags[e as usize] & EV_SYNCHED == 0);
+        let discard = !self.no_discard[m] && (has || self.ev_flags[e as usize] & EV_SYNCHED == 0);
         Ok(discard.then_some(None))
     }
 
