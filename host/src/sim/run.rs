@@ -52,14 +52,21 @@ pub enum EventSemantics {
     ///   actions `action_*_goal_*`, `action_*_result*`, `action_*_thread_start|free`).
     ///   BT roots (`bt_root_fsm*`) and ROS interface handlers (`srv_handler_*`,
     ///   `action_handler_*`) never discard. All receivers take `E` at once.
-    /// - Receivers read `_event.data` from the event's global parameters, which the
-    ///   next send of `E` overwrites (as in JANI); a send that leaves a parameter out
-    ///   keeps its previous value.
+    /// - A send writes the event's global parameters (one that it leaves out keeps its
+    ///   previous value); each receiver copies them when it takes the event and reads
+    ///   `_event.data` from its copy. (JANI reads the globals on each edge: the same
+    ///   values up to the transition's first `<send>` or `<if>`, which execute on later
+    ///   edges and could see a newer send of the event; the copy leaves out that race.)
+    /// - AS2FM's plain export writes one broadcast `<send>` as one send per receiver
+    ///   (same event, same parameters, targets exactly the event's receivers): such a
+    ///   run of sends is sent once.
     /// - Timer events (`ros_time_rate.*`) are a rendezvous: the sender waits until the
     ///   event is delivered, which needs no other event pending.
     /// - `bt_blackboard_req` cannot be sent while a `bt_blackboard_set_*` is pending.
     /// - Time advances only when nothing else can move and no event is pending; with an
-    ///   event pending that nobody can take, the run ends (JANI's deadlock).
+    ///   event pending that nobody can take, the run ends (JANI's deadlock). (JANI lets
+    ///   the global timer tick as soon as no event is pending, even while a machine is
+    ///   still inside a transition; here time waits for every machine, as in SCAN.)
     As2fm,
 }
 
