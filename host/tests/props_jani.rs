@@ -176,3 +176,29 @@ fn the_corpus_property_files_read() {
     );
     PropertySet::new(&f, &m).unwrap();
 }
+
+#[test]
+fn no_prefix_or_byte_flip_of_a_real_file_panics() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .map(|d| d.join("shared/corpus/as2fm"))
+        .find(|d| d.is_dir())
+        .unwrap();
+    let m = CompiledModel::load(&root.join("plain/ros_example_main")).unwrap();
+    let text = std::fs::read_to_string(root.join("test_data/ros_example/battery_properties.jani"))
+        .unwrap();
+    let path = Path::new("p.jani");
+    for end in (0..text.len()).filter(|&i| text.is_char_boundary(i)) {
+        let _ = props::jani::parse_str(&text[..end], path, &m);
+    }
+    let bytes = text.as_bytes();
+    for i in (0..bytes.len()).step_by(3) {
+        for b in [b'"', b'{', b'}', b'[', b']', b',', b':', b'\\', b'0', b'x'] {
+            let mut v = bytes.to_vec();
+            v[i] = b;
+            if let Ok(t) = String::from_utf8(v) {
+                let _ = props::jani::parse_str(&t, path, &m);
+            }
+        }
+    }
+}
