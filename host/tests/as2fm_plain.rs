@@ -264,3 +264,52 @@ fn verify_cli_chooses_as2fm_semantics_for_jani_properties() {
     assert_eq!(run(&["--events", "as2fm"]), 1.0);
     assert!(run(&["--events", "queues"]) < 0.5);
 }
+
+/// AS2FM's own JANI translation of the museum guide (`plain/uc3_museum_guide_main_jani`)
+/// synchronises each event's receive with exactly the machines that have a transition
+/// on it: the receivers the AS2FM semantics delivers to.
+#[test]
+fn receivers_match_as2fm_jani_translation_of_the_museum_guide() {
+    let root = corpus();
+    let model = CompiledModel::load(&root.join("plain/uc3_museum_guide_main")).unwrap();
+    let jani: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(root.join("plain/uc3_museum_guide_main_jani/main.jani")).unwrap(),
+    )
+    .unwrap();
+    let system = &jani["system"];
+    let names: Vec<&str> = system["elements"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["automaton"].as_str().unwrap())
+        .collect();
+    let mut checked = 0;
+    for sync in system["syncs"].as_array().unwrap() {
+        let Some(event) = sync["result"]
+            .as_str()
+            .and_then(|r| r.strip_suffix("_on_receive"))
+        else {
+            continue;
+        };
+        let mut jani_receivers: Vec<&str> = sync["synchronise"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(&names)
+            .filter(|(a, n)| a.as_str().is_some_and(|a| a.ends_with("_on_receive")) && **n != event)
+            .map(|(_, n)| *n)
+            .collect();
+        jani_receivers.sort();
+        let e = model
+            .event_id(event)
+            .unwrap_or_else(|| panic!("no event {event}"));
+        let mut ours: Vec<&str> = model
+            .event_receivers(e)
+            .map(|m| model.machine_name(m))
+            .collect();
+        ours.sort();
+        assert_eq!(ours, jani_receivers, "receivers of {event}");
+        checked += 1;
+    }
+    assert!(checked > 150, "only {checked} events");
+}
