@@ -45,6 +45,7 @@
 //!   eventless transitions in one step, or too many steps at one instant
 //!   ([`SpinReport`] names the machine and state).
 
+pub mod as2fm;
 mod compiled;
 mod ids;
 mod observer;

@@ -1,5 +1,6 @@
 //! The simulator: runs a [`CompiledModel`] as a channel system, step by step, without allocating.
 
+use super::as2fm::{event_flags, may_discard, never_discards, EV_BB_REQ, EV_BB_SET, EV_TIMER};
 use super::compiled::{CompiledModel, DelayDef, Instr, MachineDef, SendDef, SendTo};
 use super::ids::{MachineId, StateId};
 use super::observer::{Flow, Observer, SentMessage};
@@ -290,46 +291,6 @@ pub struct Simulator<'m> {
     reserved: usize,
 }
 
-const EV_TIMER: u8 = 1;
-const EV_SYNCHED: u8 = 2;
-const EV_BB_REQ: u8 = 4;
-const EV_BB_SET: u8 = 8;
-
-/// AS2FM's flags for an event name (see [`EventSemantics::As2fm`]).
-fn event_flags(name: &str) -> u8 {
-    let mut f = 0;
-    if name.starts_with("ros_time_rate.") {
-        f |= EV_TIMER;
-    }
-    if name == "bt_blackboard_req" {
-        f |= EV_BB_REQ;
-    }
-    if name.starts_with("bt_blackboard_set_") {
-        f |= EV_BB_SET;
-    }
-    let bt = name.strip_prefix("bt_").and_then(|rest| {
-        let digits = rest.find(|c: char| !c.is_ascii_digit())?;
-        (digits > 0).then(|| &rest[digits..])
-    });
-    let synched = matches!(bt, Some("_tick" | "_halt" | "_response" | "_halt_response"))
-        || name.strip_prefix("srv_").is_some_and(|rest| {
-            ["_response", "_request", "_req_client"]
-                .iter()
-                .any(|k| rest.find(k).is_some_and(|i| i > 0))
-        })
-        || name.strip_prefix("action_").is_some_and(|rest| {
-            rest.find("_goal_")
-                .is_some_and(|i| i > 0 && rest.len() > i + "_goal_".len())
-                || rest.find("_result").is_some_and(|i| i > 0)
-                || ((rest.ends_with("_thread_start") && rest.len() > "_thread_start".len())
-                    || (rest.ends_with("_thread_free") && rest.len() > "_thread_free".len()))
-        });
-    if synched {
-        f |= EV_SYNCHED;
-    }
-    f
-}
-
 impl std::fmt::Debug for Simulator<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Simulator")
@@ -482,11 +443,7 @@ impl<'m> Simulator<'m> {
             no_discard: model
                 .machines
                 .iter()
-                .map(|d| {
-                    ["bt_root_fsm", "srv_handler_", "action_handler_"]
-                        .iter()
-                        .any(|p| d.name.starts_with(p))
-                })
+                .map(|d| never_discards(&d.name))
                 .collect(),
             pending: vec![false; model.events.len()],
             pending_list: Vec::with_capacity(model.events.len()),
@@ -1317,7 +1274,7 @@ impl<'m> Simulator<'m> {
         if let Some(t) = self.select(m, def, Some(e), rng, cfg)? {
             return Ok(Some(Some(t)));
         }
-        let discard = !self.no_discard[m] && (has || self.ev_flags[e as usize] & EV_SYNCHED == 0);
+        let discard = may_discard(self.no_discard[m], has, self.ev_flags[e as usize]);
         Ok(discard.then_some(None))
     }
 
