@@ -328,6 +328,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     };
     let run_cfg = RunConfig {
         max_time: loaded.max_time(args.max_time.as_deref())?,
+        events: loaded.events,
         ..RunConfig::default()
     };
     let study_cfg = StudyConfig {

@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use super::CliError;
 use crate::props;
-use crate::sim::{CompiledModel, EndReason, RunConfig, Simulator};
+use crate::sim::{CompiledModel, EndReason, EventSemantics, RunConfig, Simulator};
 use crate::smc::progress::TerminalProgress;
 use crate::smc::stats::{RuleConfig, RuleKind};
 use crate::smc::{run_study, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
@@ -26,6 +26,40 @@ pub enum Rule {
     Wilson,
     /// Stop when the exact Clopper-Pearson interval is narrower than ±precision.
     ClopperPearson,
+}
+
+/// How sends are delivered, as named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Events {
+    /// SCAN's channel system: per-machine FIFO queues, a send goes to its target.
+    Queues,
+    /// AS2FM's JANI semantics: one pending message per event, broadcast to every
+    /// machine with a transition on it, senders blocking while it is pending.
+    As2fm,
+}
+
+impl From<Events> for EventSemantics {
+    fn from(e: Events) -> Self {
+        match e {
+            Events::Queues => EventSemantics::Queues,
+            Events::As2fm => EventSemantics::As2fm,
+        }
+    }
+}
+
+/// The event semantics for a property file when none is asked for: AS2FM's for a JANI
+/// property file (the model is then AS2FM's plain SCXML), SCAN's queues otherwise.
+pub fn default_events(props_path: &Path) -> EventSemantics {
+    if is_jani(props_path) {
+        EventSemantics::As2fm
+    } else {
+        EventSemantics::Queues
+    }
+}
+
+fn is_jani(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("jani"))
 }
 
 /// Arguments of `hindsight verify`.
@@ -170,14 +204,24 @@ fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, CliE
     };
     let p = dir.join("properties.xml");
     if p.is_file() {
-        Ok(p)
-    } else {
-        Err(CliError::Input(format!(
-            "{}: no property file given and none found (looked for {})",
-            model.display(),
-            p.display()
-        )))
+        return Ok(p);
     }
+    // A folder with exactly one JANI file (AS2FM's models keep their properties there).
+    let mut jani: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.is_file() && is_jani(p))
+                .collect()
+        })
+        .unwrap_or_default();
+    if jani.len() == 1 {
+        return Ok(jani.remove(0));
+    }
+    Err(CliError::Input(format!(
+        "{}: no property file given and none found (looked for {} and a single .jani file)",
+        model.display(),
+        p.display()
+    )))
 }
 
 /// The model and property arguments every command that loads a model takes.
@@ -193,6 +237,11 @@ pub struct ModelArgs {
     /// and durations given to --max-time mean wall-clock time on a plain SCXML model.
     #[arg(long, value_name = "DURATION")]
     pub time_unit: Option<String>,
+    /// How sends are delivered: `queues` (SCAN: per-machine FIFO queues) or `as2fm`
+    /// (AS2FM's JANI semantics: one pending message per event, broadcast); default:
+    /// `as2fm` for robot models and `.jani` property files, `queues` otherwise.
+    #[arg(long, value_enum)]
+    pub events: Option<Events>,
 }
 
 /// A model with its properties, compiled: everything `validate` checks.
@@ -209,6 +258,8 @@ pub struct Loaded {
     pub unit_ns: Option<u64>,
     /// The run length the model asks for (a robot main file's `max_time`), in steps.
     pub default_max_time: Option<u64>,
+    /// How sends are delivered.
+    pub events: EventSemantics,
 }
 
 impl Loaded {
@@ -260,8 +311,11 @@ pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
         Some(p) => p.to_path_buf(),
         None => default_props(model, &compiled)?,
     };
-    let file = props::parse_file(&props_path).map_err(|d| CliError::Input(d.to_string()))?;
+    let file = read_properties(&props_path, &compiled)?;
     let set = compile_properties(&file, &compiled, unit_ns)?;
+    let events = args
+        .events
+        .map_or_else(|| default_events(&props_path), Into::into);
     Ok(Loaded {
         model: compiled,
         file,
@@ -269,7 +323,18 @@ pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
         props_path,
         unit_ns,
         default_max_time: None,
+        events,
     })
+}
+
+/// Reads a property file: JANI (`.jani`) or SCAN XML (with ROS ports and patterns).
+fn read_properties(path: &Path, model: &CompiledModel) -> Result<props::PropertyFile, CliError> {
+    if is_jani(path) {
+        props::jani::parse_file(path, model)
+    } else {
+        props::parse_file(path)
+    }
+    .map_err(|d| CliError::Input(d.to_string()))
 }
 
 /// Compiles a property file against a model; a bound with a unit on a model without one
@@ -325,7 +390,7 @@ fn load_robot(args: &ModelArgs, main: &Path) -> Result<Loaded, CliError> {
             )))
         }
     };
-    let file = props::parse_file(&props_path).map_err(|d| CliError::Input(d.to_string()))?;
+    let file = read_properties(&props_path, &robot.model)?;
     let set = compile_properties(&file, &robot.model, Some(robot.time_unit_ns))?;
     Ok(Loaded {
         model: robot.model,
@@ -334,6 +399,8 @@ fn load_robot(args: &ModelArgs, main: &Path) -> Result<Loaded, CliError> {
         props_path,
         unit_ns: Some(robot.time_unit_ns),
         default_max_time: Some(robot.max_time_steps),
+        // The lowering is AS2FM's translation; its sends mean what AS2FM's JANI means.
+        events: args.events.map_or(EventSemantics::As2fm, Into::into),
     })
 }
 
@@ -590,6 +657,7 @@ pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
     let run_cfg = RunConfig {
         max_time: loaded.max_time(args.max_time.as_deref())?,
         max_steps: args.max_steps,
+        events: loaded.events,
         ..RunConfig::default()
     };
     let csv = replay_csv(model, set, &run_cfg, args.seed, args.run)?;
@@ -663,6 +731,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     let run_cfg = RunConfig {
         max_time: loaded.max_time(args.max_time.as_deref())?,
         max_steps: args.max_steps,
+        events: loaded.events,
         ..RunConfig::default()
     };
     let study_cfg = StudyConfig {
