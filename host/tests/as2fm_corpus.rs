@@ -1,7 +1,9 @@
-//! Every case of `shared/corpus/as2fm/expected.json`, run on AS2FM's own plain SCXML
-//! translation (`plain/<case>/`) with the case's JANI properties and AS2FM's event
-//! semantics: each property's estimate must lie within the tolerance of the probability
-//! AS2FM's system tests expect (tolerance 0: every run must agree).
+//! Every case of `shared/corpus/as2fm/expected.json`, run twice with the case's JANI
+//! properties and AS2FM's event semantics: on AS2FM's own plain SCXML translation
+//! (`plain/<case>/`), and on the high-level model itself through hindsight's robot
+//! pipeline (main file, behavior tree, ROS tags, interfaces). Each property's estimate
+//! must lie within the tolerance of the probability AS2FM's system tests expect
+//! (tolerance 0: every run must agree).
 //!
 //! Cases that cannot be checked are skipped with the reason printed (run with
 //! `--nocapture` to see them); the test fails if a skipped case starts passing, so the
@@ -48,10 +50,6 @@ fn corpus() -> PathBuf {
         .expect("shared/corpus/as2fm next to the repository")
 }
 
-fn skip_reason(key: &str) -> Option<&'static str> {
-    SKIPS.iter().find(|(k, _)| *k == key).map(|(_, r)| *r)
-}
-
 /// The `src` of the main file's `<input type="jani" src="..."/>`.
 fn jani_src(main: &str) -> Option<String> {
     let at = main.find("type=\"jani\"")?;
@@ -64,7 +62,11 @@ fn jani_src(main: &str) -> Option<String> {
 }
 
 /// Removes the properties listed in [`SKIPS`] from a JANI file's text (by name).
-fn without_skipped(text: &str, case: &str) -> (String, Vec<String>) {
+fn without_skipped(
+    text: &str,
+    case: &str,
+    skip_reason: &dyn Fn(&str) -> Option<&'static str>,
+) -> (String, Vec<String>) {
     let mut v: serde_json::Value = serde_json::from_str(text).expect("JSON");
     let mut dropped = Vec::new();
     if let Some(list) = v.get_mut("properties").and_then(|p| p.as_array_mut()) {
@@ -131,8 +133,13 @@ fn estimate(model: &CompiledModel, set: &PropertySet, runs: u64) -> Vec<Estimate
     out
 }
 
-#[test]
-fn plain_translations_match_as2fm_expected_probabilities() {
+/// Runs every case with the model `model_of(case, main file)` gives; `skips` lists the
+/// cases and properties not checked.
+fn check_corpus(
+    skips: &[(&str, &'static str)],
+    model_of: impl Fn(&str, &Path) -> Result<CompiledModel, String>,
+) {
+    let skip_reason = |key: &str| skips.iter().find(|(k, _)| *k == key).map(|(_, r)| *r);
     let root = corpus();
     let expected: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(root.join("expected.json")).unwrap())
@@ -153,15 +160,21 @@ fn plain_translations_match_as2fm_expected_probabilities() {
         let src = jani_src(&main).unwrap_or_else(|| panic!("{case}: no JANI input"));
         let jani_path = main_path.parent().unwrap().join(src);
         let text = std::fs::read_to_string(&jani_path).unwrap();
-        let (text, dropped) = without_skipped(&text, case);
+        let (text, dropped) = without_skipped(&text, case, &skip_reason);
         for d in &dropped {
             println!(
                 "SKIP {case}/{d}: {}",
                 skip_reason(&format!("{case}/{d}")).unwrap()
             );
         }
-        let model = CompiledModel::load(&root.join("plain").join(case))
-            .unwrap_or_else(|d| panic!("{case}: {d}"));
+        let model = match model_of(case, &main_path) {
+            Ok(m) => m,
+            Err(e) => {
+                println!("FAIL {case}: {e}");
+                failures.push(case.clone());
+                continue;
+            }
+        };
         let file = props::jani::parse_str(&text, &jani_path, &model)
             .unwrap_or_else(|d| panic!("{case}: {d}"));
         let set = PropertySet::new(&file, &model).unwrap_or_else(|e| panic!("{case}: {e}"));
@@ -209,13 +222,57 @@ fn plain_translations_match_as2fm_expected_probabilities() {
     }
     println!(
         "{passed} cases pass, {} skipped, in {:.1} s",
-        SKIPS.iter().filter(|(k, _)| !k.contains('/')).count(),
+        skips.iter().filter(|(k, _)| !k.contains('/')).count(),
         started.elapsed().as_secs_f64()
     );
     assert!(
         failures.is_empty(),
         "cases off their expected probability: {failures:?}"
     );
+}
+
+#[test]
+fn plain_translations_match_as2fm_expected_probabilities() {
+    let root = corpus();
+    check_corpus(SKIPS, |case, _| {
+        CompiledModel::load(&root.join("plain").join(case)).map_err(|d| d.to_string())
+    });
+}
+
+/// Cases the high-level pipeline does not check, and why (on top of [`SKIPS`]).
+const HIGH_LEVEL_SKIPS: &[(&str, &str)] = &[
+    (
+        "string_msg_comparison_main",
+        "the model publishes example_interfaces/String on a topic it subscribes as \
+         nested_interfaces/Internal; AS2FM accepts it, hindsight reports it as an error \
+         (robot_load.rs checks the message)",
+    ),
+    (
+        "array_of_data_structs_main",
+        "object literals are not in hindsight's expression language yet",
+    ),
+    (
+        "data_structs_main_json_def",
+        "struct types from data declarations are not compiled yet",
+    ),
+    (
+        "data_structs_main_xml_def",
+        "struct types from data declarations are not compiled yet",
+    ),
+    (
+        "overarching_tutorial_main_locations",
+        "object literals are not in hindsight's expression language yet",
+    ),
+];
+
+#[test]
+fn high_level_models_match_as2fm_expected_probabilities() {
+    let skips: Vec<(&str, &'static str)> = SKIPS.iter().chain(HIGH_LEVEL_SKIPS).copied().collect();
+    check_corpus(&skips, |_, main| {
+        hindsight::robot::load::load(main)
+            .map(|r| r.model)
+            .map_err(|d| d.to_string())
+    });
 }
 
 #[test]
