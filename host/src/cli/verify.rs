@@ -188,6 +188,12 @@ pub struct Report {
     pub quiescent: u64,
     /// Wall-clock seconds.
     pub seconds: f64,
+    /// Seconds of model time in one step, when the model has a time unit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub step_seconds: Option<f64>,
+    /// The run length in seconds of model time, when the model has a time unit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_time_seconds: Option<f64>,
     /// Per guarantee.
     pub properties: Vec<PropertyReport>,
 }
@@ -618,6 +624,8 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
         decided: m.runs.decided,
         quiescent: m.runs.quiescent,
         seconds: 0.0,
+        step_seconds: None,
+        max_time_seconds: None,
         properties: m
             .properties
             .iter()
@@ -750,12 +758,18 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     if args.save_failing > 0 {
         save_failing(args, model, set, &run_cfg, &result)?;
     }
-    let report = report(args, props_path, set, &result);
+    let mut report = report(args, props_path, set, &result);
+    if let Some(unit) = loaded.unit_ns {
+        report.step_seconds = Some(unit as f64 / 1e9);
+        report.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
+    }
     print_report(&report, args.json)
 }
 
 fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -> Report {
     Report {
+        step_seconds: None,
+        max_time_seconds: None,
         model: args.input.model.display().to_string(),
         properties_file: props.display().to_string(),
         seed: args.seed,
@@ -833,6 +847,9 @@ fn print_table(r: &Report) {
         r.quiescent,
         r.step_limit
     );
+    if let (Some(step), Some(max)) = (r.step_seconds, r.max_time_seconds) {
+        println!("model time: steps of {step} s, runs of at most {max} s");
+    }
 }
 
 /// Arguments of `hindsight validate`.
