@@ -10,8 +10,21 @@ use live_common::*;
 #[test]
 fn late_battery_makes_the_recurrence_fail_and_replay_agrees() {
     let svc = unique("battery");
-    let run = Running::start(&battery_topic(&svc), "late");
+    let verdict_svc = unique("verdicts");
+    let config = format!(
+        "[verdicts]\nservice = \"{verdict_svc}\"\n{}",
+        battery_topic(&svc)
+    );
+    let run = Running::start(&config, "late");
     let node = node();
+    let verdicts = node
+        .service_builder(&ServiceName::new(&verdict_svc).unwrap())
+        .publish_subscribe::<[u8]>()
+        .open()
+        .unwrap()
+        .subscriber_builder()
+        .create()
+        .unwrap();
     let p = publisher(&node, &svc);
     // On time: every 20 ms against a bound of 300 ms.
     for i in 0..10u64 {
@@ -25,7 +38,24 @@ fn late_battery_makes_the_recurrence_fail_and_replay_agrees() {
         send(&p, &battery(80, i));
     }
     run.wait_judged(12);
+    // The verdict lines also go out on the iceoryx2 verdict service.
+    let mut published = Vec::new();
+    let t = std::time::Instant::now();
+    while !published
+        .iter()
+        .any(|l: &String| l.contains("\"verdict\":\"false\""))
+    {
+        while let Some(s) = verdicts.receive().unwrap() {
+            published.push(String::from_utf8(s.payload().to_vec()).unwrap());
+        }
+        assert!(t.elapsed() < Duration::from_secs(20), "{published:?}");
+        std::thread::sleep(Duration::from_millis(2));
+    }
     let done = run.finish();
+    assert!(
+        done.lines.ends_with(&published[published.len() - 1..]),
+        "{published:?}"
+    );
     let rec = done.verdicts_of("battery_recurrence");
     assert_eq!(
         rec.first().map(String::as_str),

@@ -608,11 +608,20 @@ impl Sidecar {
         let verdict_pub = match &config.verdict_service {
             None => None,
             Some(v) => {
-                let f = node
-                    .service_builder(&service_name(v)?)
+                let name = service_name(v)?;
+                let f = match node
+                    .service_builder(&name)
                     .publish_subscribe::<[u8]>()
+                    .subscriber_max_buffer_size(256)
                     .open_or_create()
-                    .map_err(ipc(v))?;
+                {
+                    Ok(f) => f,
+                    Err(_) => node
+                        .service_builder(&name)
+                        .publish_subscribe::<[u8]>()
+                        .open()
+                        .map_err(ipc(v))?,
+                };
                 Some(
                     f.publisher_builder()
                         .initial_max_slice_len(256)
