@@ -180,6 +180,7 @@ struct Proxy {
     layout: Layout,
     action: Action,
     filter: Vec<String>,
+    filter_ids: Vec<usize>,
     var_names: Vec<String>,
     error: Vec<u8>,
     server: Server<Ipc, [u8], (), [u8], ()>,
@@ -203,24 +204,73 @@ struct Run<'c, 'o> {
 
 impl Run<'_, '_> {
     /// Logs and applies one input; returns the request decision if it was one.
-    fn feed(&mut self, input: Input) -> Result<Option<bool>, LiveError> {
+    fn write_record(&mut self, input: &Input) -> Result<(), LiveError> {
         if let Some(rec) = self.opts.record.as_mut() {
-            let line = serde_json::to_string(&input).map_err(|e| LiveError::Io(e.to_string()))?;
+            let line = serde_json::to_string(input).map_err(|e| LiveError::Io(e.to_string()))?;
             writeln!(rec, "{line}").map_err(|e| LiveError::Io(e.to_string()))?;
         }
+        Ok(())
+    }
+
+    /// Logs and applies one input (ticks, losses, restarts); the input log's path.
+    fn feed(&mut self, input: Input) -> Result<(), LiveError> {
+        self.write_record(&input)?;
         self.changes.clear();
-        let r = record::apply(self.spec, &mut self.engine, &input, &mut self.changes)
+        record::apply(self.spec, &mut self.engine, &input, &mut self.changes)
             .map_err(LiveError::Engine)?;
-        if matches!(
-            input,
-            Input::Sample { .. } | Input::Request { .. } | Input::Tick { .. }
-        ) {
+        let point = matches!(input, Input::Tick { .. });
+        let judged = matches!(input, Input::Loss { .. });
+        self.emit(point, judged)
+    }
+
+    /// A decoded sample or request: logged (when recording) and judged directly,
+    /// without the JSON round trip; `apply` in replay does the same engine calls.
+    /// Returns whether a request may pass.
+    fn judge(
+        &mut self,
+        time: u64,
+        source: &str,
+        sets: &[(usize, Value)],
+        request: Option<(&[String], Option<&[usize]>)>,
+    ) -> Result<bool, LiveError> {
+        if self.opts.record.is_some() {
+            let input = match request {
+                None => Input::Sample {
+                    time,
+                    source: source.to_string(),
+                    sets: record::sets_json(self.spec, sets),
+                },
+                Some((names, ids)) => Input::Request {
+                    time,
+                    source: source.to_string(),
+                    sets: record::sets_json(self.spec, sets),
+                    filter: ids.map(|_| names.to_vec()),
+                },
+            };
+            self.write_record(&input)?;
+        }
+        self.changes.clear();
+        let step = |e: monitor_core::StepError| LiveError::Engine(e.to_string());
+        let ok = match request {
+            None => {
+                self.engine
+                    .point(time, sets, source, &mut self.changes)
+                    .map_err(step)?;
+                true
+            }
+            Some((_, ids)) => self
+                .engine
+                .request(time, sets, source, ids, &mut self.changes)
+                .map_err(step)?,
+        };
+        self.emit(true, true)?;
+        Ok(ok)
+    }
+
+    fn emit(&mut self, point: bool, judged: bool) -> Result<(), LiveError> {
+        if point {
             self.points += 1;
         }
-        let judged = matches!(
-            input,
-            Input::Sample { .. } | Input::Request { .. } | Input::Loss { .. }
-        );
         for c in &self.changes {
             let line = record::verdict_line(self.spec, c);
             writeln!(self.opts.verdicts, "{line}").map_err(|e| LiveError::Io(e.to_string()))?;
@@ -237,7 +287,7 @@ impl Run<'_, '_> {
                 p.fetch_add(1, Ordering::SeqCst);
             }
         }
-        Ok(r)
+        Ok(())
     }
 
     fn note(&mut self, msg: String) {
@@ -248,13 +298,6 @@ impl Run<'_, '_> {
     fn now(&self) -> u64 {
         let t = self.clock.now();
         self.engine.last_time().map_or(t, |l| t.max(l))
-    }
-
-    fn sets_json(
-        &self,
-        sets: &[(usize, Value)],
-    ) -> std::collections::BTreeMap<String, serde_json::Value> {
-        record::sets_json(self.spec, sets)
     }
 
     fn drain_tap(
@@ -348,12 +391,7 @@ impl Run<'_, '_> {
             match tap.layout.decode(bytes, sets) {
                 Ok(()) => {
                     tap.stats.samples += 1;
-                    let sets_j = self.sets_json(sets);
-                    self.feed(Input::Sample {
-                        time,
-                        source: tap.source.clone(),
-                        sets: sets_j,
-                    })?;
+                    self.judge(time, &tap.source, sets, None)?;
                     if let Some(p) = self.opts.probe {
                         if let Some(Value::Int(sent)) = config::FieldTy::U64.read(bytes, p.offset) {
                             self.probed
@@ -421,15 +459,8 @@ impl Run<'_, '_> {
             let allowed = match px.layout.decode(bytes, sets) {
                 Ok(()) => {
                     px.stats.samples += 1;
-                    let sets_j = self.sets_json(sets);
-                    let filter = (px.action == Action::Filter).then(|| px.filter.clone());
-                    self.feed(Input::Request {
-                        time,
-                        source: px.source.clone(),
-                        sets: sets_j,
-                        filter,
-                    })?
-                    .unwrap_or(true)
+                    let ids = (px.action == Action::Filter).then_some(px.filter_ids.as_slice());
+                    self.judge(time, &px.source, sets, Some((&px.filter, ids)))?
                 }
                 Err(m) => {
                     px.stats.malformed += 1;
@@ -589,6 +620,7 @@ impl Sidecar {
                 real: s.real.clone(),
                 layout: s.layout.clone(),
                 action: s.action,
+                filter_ids: s.properties.clone(),
                 filter: s
                     .properties
                     .iter()
