@@ -148,7 +148,7 @@ fn phase(service: &str, n: u64, rate: Option<f64>) -> Result<Phase, String> {
                     w.copy_from_slice(&s.payload()[16..24]);
                     lat.push(now.saturating_sub(u64::from_le_bytes(w)));
                 }
-                std::hint::spin_loop();
+                std::thread::yield_now();
             }
             Ok(lat)
         })
@@ -184,7 +184,8 @@ fn phase(service: &str, n: u64, rate: Option<f64>) -> Result<Phase, String> {
         if let Some(r) = rate {
             let due = start + Duration::from_secs_f64(i as f64 / r);
             while Instant::now() < due {
-                std::hint::spin_loop();
+                // Yield, not spin: on a loaded machine the receivers need the core.
+                std::thread::yield_now();
             }
         }
         buf[0..4].copy_from_slice(&(50i32 + (i % 50) as i32).to_le_bytes());

@@ -89,7 +89,6 @@ struct Slot {
     state: Vec<u64>,
     verdicts: Vec<bool>,
     settler: Settler,
-    stepped: bool,
 }
 
 /// The monitors of one spec with the loss rule applied.
@@ -163,7 +162,6 @@ impl<'c> Engine<'c> {
             state: vec![0; monitor.state_words()],
             verdicts: vec![false; monitor.properties()],
             settler: Settler::new(monitor),
-            stepped: false,
         }
     }
 
@@ -204,26 +202,20 @@ impl<'c> Engine<'c> {
         out: &mut Vec<Change>,
     ) -> Result<(), StepError> {
         self.check_time(time)?;
-        let saved = self.vals.clone();
-        valuation::begin_point(self.monitor.program().vars, &mut self.vals);
+        // Types first, so an error changes nothing (the config makes this a bug check).
         for &(v, x) in sets {
-            if let Some(slot) = self.vals.get_mut(v) {
-                *slot = x;
+            if self.vals.get(v).is_none_or(|cur| cur.ty() != x.ty()) {
+                return Err(StepError::VarType { var: v as u16 });
             }
         }
-        for i in 0..self.slots.len() {
-            let s = &mut self.slots[i];
-            if let Err(e) = self
-                .monitor
-                .try_step(&mut s.state, time, &self.vals, &mut s.verdicts)
-            {
-                // Slots stepped before this one cannot be rolled back cheaply; the
-                // only errors are type errors from a caller bug, checked up front by
-                // the config, so restore the values and report.
-                self.vals = saved;
-                return Err(e);
-            }
-            s.stepped = true;
+        valuation::begin_point(self.monitor.program().vars, &mut self.vals);
+        for &(v, x) in sets {
+            self.vals[v] = x;
+        }
+        for s in &mut self.slots {
+            // Cannot fail: state sizes, the time and every type were checked.
+            self.monitor
+                .try_step(&mut s.state, time, &self.vals, &mut s.verdicts)?;
             s.settler.update(&self.monitor, &s.state);
         }
         self.last_time = Some(time);
