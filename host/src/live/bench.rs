@@ -30,6 +30,8 @@ pub struct BenchReport {
     pub paced: u64,
     /// Paced rate asked for, samples per second.
     pub rate: f64,
+    /// Paced phase: samples the sidecar counted lost (0: it kept up with the rate).
+    pub paced_lost: u64,
     /// Plain subscriber latency, p50 and p99, nanoseconds.
     pub plain_ns: (u64, u64),
     /// Sidecar publish-to-verdict latency, p50 and p99, nanoseconds.
@@ -49,7 +51,11 @@ pub struct BenchReport {
 impl std::fmt::Display for BenchReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let us = |n: u64| n as f64 / 1000.0;
-        writeln!(f, "paced: {} samples at {:.0}/s", self.paced, self.rate)?;
+        writeln!(
+            f,
+            "paced: {} samples at {:.0}/s, sidecar lost {}",
+            self.paced, self.rate, self.paced_lost
+        )?;
         writeln!(
             f,
             "  plain subscriber latency: p50 {:.1} us, p99 {:.1} us",
@@ -232,6 +238,7 @@ pub fn run(prefix: &str, paced: u64, rate: f64, flood: u64) -> Result<BenchRepor
     Ok(BenchReport {
         paced,
         rate,
+        paced_lost: a.lost,
         plain_ns: (percentile(&mut plain, 0.5), percentile(&mut plain, 0.99)),
         sidecar_ns: (percentile(&mut side, 0.5), percentile(&mut side, 0.99)),
         flood_sent: flood,
