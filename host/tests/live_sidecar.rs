@@ -285,3 +285,22 @@ fn proxy_log_forwards_and_judges_every_request() {
     );
     done.assert_replay_matches();
 }
+
+#[test]
+fn a_topic_without_safe_overflow_is_refused_because_a_tap_could_block_its_publisher() {
+    let svc = unique("strict");
+    let node = node();
+    let _service = node
+        .service_builder(&ServiceName::new(&svc).unwrap())
+        .publish_subscribe::<[u8]>()
+        .enable_safe_overflow(false)
+        .create()
+        .unwrap();
+    let spec = codegen::compile_spec(SPEC, "test.hspec").unwrap();
+    let config =
+        hindsight::live::config::Config::parse(&battery_topic(&svc), "t.toml", &spec).unwrap();
+    match hindsight::live::Sidecar::new(&config, &spec, false) {
+        Ok(_) => panic!("tapped a service without safe overflow"),
+        Err(e) => assert!(e.to_string().contains("no safe overflow"), "{e}"),
+    }
+}

@@ -70,6 +70,13 @@ Verdicts (JSON lines, on change):
   the verdict now; unknown: a sample the property reads was lost or malformed: the
   property restarts and is unknown for its largest time bound, then judges again.
 
+Time: without samples, a heartbeat point every `[clock] heartbeat` ticks (default 1)
+  lets a bounded property see its window expire (a late topic fails on time).
+Loss: counted exactly from a `seq` counter in the payload, else suspected when a
+  drain finds the tap's buffer full; either way the readers turn `unknown`.
+Filter: a request is refused when it would turn a listed property from
+  true/currently_true to false/currently_false; a refused request leaves no trace.
+
 Robustness: a restarted publisher is picked up (the gap is reported), malformed
   samples are counted and reported, SIGINT/SIGTERM flush every file and exit 0.
 

@@ -572,6 +572,14 @@ impl Sidecar {
                     .open()
                     .map_err(ipc(&t.service))?,
             };
+            if !factory.static_config().has_safe_overflow() {
+                // A slow tap on such a service would make its publisher wait or drop for everyone.
+                return Err(LiveError::Ipc(format!(
+                    "{}: the service has no safe overflow, so a tap could block its publisher; \
+                     create it with safe overflow (the iceoryx2 default)",
+                    t.service
+                )));
+            }
             let sub = factory
                 .subscriber_builder()
                 .create()
