@@ -150,7 +150,6 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         record: args.record.as_ref().map(create).transpose()?,
         every_point: args.every_point,
         poll: Duration::from_micros(args.poll_us),
-        handle_signals: true,
         log: Box::new(std::io::stderr()),
         probe: None,
         progress: None,

@@ -169,7 +169,6 @@ fn phase(service: &str, n: u64, rate: Option<f64>) -> Result<Phase, String> {
                 record: None,
                 every_point: false,
                 poll: Duration::ZERO,
-                handle_signals: false,
                 log: Box::new(std::io::sink()),
                 probe: Some(Probe { offset: 16, epoch }),
                 progress: None,

@@ -111,8 +111,6 @@ pub struct Options {
     pub every_point: bool,
     /// Sleep this long when nothing arrived (zero: busy polling).
     pub poll: Duration,
-    /// Stop on SIGINT/SIGTERM (the CLI); tests stop through the flag instead.
-    pub handle_signals: bool,
     /// Diagnostics (lost, malformed, restarts) as text lines, e.g. standard error.
     pub log: Box<dyn Write + Send>,
     /// Incremented after every judged sample or request (for tests and benchmarks that wait on progress).
@@ -542,6 +540,8 @@ pub struct Sidecar {
 impl Sidecar {
     /// Creates the node, the tap subscribers, the proxy ports and the verdict publisher.
     /// The services are opened, or created when their publisher has not started yet.
+    /// With `handle_signals`, SIGINT/SIGTERM make [`Sidecar::run`] flush and return
+    /// (the CLI); tests and embedders stop it through its flag instead.
     pub fn new(config: &Config, spec: &Compiled, handle_signals: bool) -> Result<Self, LiveError> {
         let mode = if handle_signals {
             SignalHandlingMode::HandleTerminationRequests

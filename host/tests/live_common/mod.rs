@@ -120,7 +120,6 @@ impl Running {
                     ))),
                     every_point: false,
                     poll: Duration::from_micros(200),
-                    handle_signals: false,
                     log: Box::new(Shared(log)),
                     probe: None,
                     progress: Some(progress),
