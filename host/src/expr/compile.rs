@@ -5,7 +5,7 @@
 //! slot's [`Cell`] and returns a `bool`, `i64`, `f64` or [`StrId`], or writes an
 //! array/struct into a caller-owned cell whose buffers are reused.
 
-use super::ast::{BinOp, Expr, ExprKind, UnOp};
+use super::ast::{BinOp, Expr, ExprKind, ObjField, UnOp};
 use super::value::{Cell, StrId, Strings, Ty, TypeTable};
 
 /// Source of randomness for `Math.random()`: any [`rand_core::Rng`].
@@ -376,6 +376,7 @@ impl Compiler<'_, '_> {
                 })
             }
             ExprKind::Array(items) => self.array(e, items, expect),
+            ExprKind::Object(fields) => self.object(e, fields, expect),
             ExprKind::Ident(name) => {
                 if let Some(p) = self.path(e)? {
                     return Ok(self.path_code(p));
@@ -471,6 +472,109 @@ impl Compiler<'_, '_> {
         let n = fns.len();
         Ok(Typed {
             ty: Ty::Array(Box::new(elem_ty), bound),
+            code: Code::Comp(Box::new(move |env, dest| {
+                if !matches!(dest, Cell::List(_)) {
+                    *dest = Cell::List(Vec::with_capacity(n));
+                }
+                if let Cell::List(v) = dest {
+                    v.truncate(n);
+                    while v.len() < n {
+                        v.push(Cell::Int(0));
+                    }
+                    for (f, slot) in fns.iter().zip(v.iter_mut()) {
+                        f(env, slot)?;
+                    }
+                }
+                Ok(())
+            })),
+        })
+    }
+
+    /// An object literal, typed by the struct `expect`ed where it is used: every field of
+    /// the struct exactly once, each converted to the field's type.
+    fn object(
+        &mut self,
+        e: &Expr,
+        fields: &[ObjField],
+        expect: Option<&Ty>,
+    ) -> Result<Typed, CompileError> {
+        let s = match expect {
+            Some(Ty::Struct(s)) => *s,
+            Some(t) => {
+                return Err(cerr(
+                    e.start,
+                    format!(
+                        "an object literal is not a value of type {}",
+                        self.tname(t)
+                    ),
+                ))
+            }
+            None => {
+                return Err(cerr(
+                    e.start,
+                    "the struct type of this object literal is not known: use it where a declared struct type is expected (a typed `<data>`, an assignment to a struct location, a typed parameter or array)",
+                ))
+            }
+        };
+        let Some(def) = self.scope.types.structs.get(s as usize) else {
+            return Err(cerr(e.start, "internal error: unknown struct type"));
+        };
+        let sname = def.name.clone();
+        let decl: Vec<(String, Ty)> = def.fields.clone();
+        let mut fns: Vec<Option<CellFn>> = (0..decl.len()).map(|_| None).collect();
+        for f in fields {
+            let Some(fi) = decl.iter().position(|(n, _)| *n == f.name) else {
+                let names: Vec<&str> = decl.iter().map(|(n, _)| n.as_str()).collect();
+                return Err(cerr(
+                    f.at,
+                    format!(
+                        "type {sname} has no field `{}` (its fields: {})",
+                        f.name,
+                        if names.is_empty() {
+                            "none".to_string()
+                        } else {
+                            names.join(", ")
+                        }
+                    ),
+                ));
+            };
+            let fty = &decl[fi].1;
+            let t = self.expr(&f.value, Some(fty))?;
+            let t = coerce(t, fty, self.scope.types).map_err(|found| {
+                cerr(
+                    f.value.start,
+                    format!(
+                        "field `{}` of {sname} has type {} but {} is expected",
+                        f.name,
+                        self.tname(&found),
+                        self.tname(fty)
+                    ),
+                )
+            })?;
+            if let Some(slot) = fns.get_mut(fi) {
+                *slot = Some(t.into_cell_fn());
+            }
+        }
+        let missing: Vec<&str> = decl
+            .iter()
+            .zip(&fns)
+            .filter(|(_, f)| f.is_none())
+            .map(|((n, _), _)| n.as_str())
+            .collect();
+        if !missing.is_empty() {
+            return Err(cerr(
+                e.start,
+                format!(
+                    "the object literal of type {sname} has no value for field{} `{}`",
+                    if missing.len() > 1 { "s" } else { "" },
+                    missing.join("`, `")
+                ),
+            ));
+        }
+        let fns: Vec<CellFn> = fns.into_iter().flatten().collect();
+        let n = fns.len();
+        Ok(Typed {
+            ty: Ty::Struct(s),
             code: Code::Comp(Box::new(move |env, dest| {
                 if !matches!(dest, Cell::List(_)) {
                     *dest = Cell::List(Vec::with_capacity(n));
@@ -752,8 +856,33 @@ impl Compiler<'_, '_> {
         if let Some(p) = self.path(e)? {
             return Ok(self.path_code(p));
         }
+        if let Some(p) = self.path(obj)? {
+            if field != "length" {
+                if let Some((fi, fty)) = self.projected_field(&p.ty, field) {
+                    return Ok(project(p, fi, fty));
+                }
+            }
+        }
         if field == "length" {
-            if let Some(p) = self.path(obj)? {
+            if let Some(mut p) = self.path(obj)? {
+                // AS2FM reads `s.length` of a struct as the length of its first field,
+                // descending through struct fields (its translation flattens structs into
+                // one array per leaf field and takes the first).
+                while let Ty::Struct(s) = p.ty {
+                    let first = self
+                        .scope
+                        .types
+                        .structs
+                        .get(s as usize)
+                        .and_then(|d| d.fields.first());
+                    match first {
+                        Some((_, t)) if p.steps.len() < MAX_PATH => {
+                            p.ty = t.clone();
+                            p.steps.push(Step::Field(0));
+                        }
+                        _ => break,
+                    }
+                }
                 let at = p.at;
                 return match p.ty {
                     Ty::Array(..) => Ok(Typed {
@@ -797,6 +926,20 @@ impl Compiler<'_, '_> {
                 self.tname(&t.ty)
             ),
         ))
+    }
+
+    /// For `a.f` with `a` an array of structs that have a field `f`: the field's index and
+    /// the type of the projection (an array of the field's values).
+    fn projected_field(&self, ty: &Ty, field: &str) -> Option<(u32, Ty)> {
+        let Ty::Array(elem, bound) = ty else {
+            return None;
+        };
+        let Ty::Struct(s) = **elem else {
+            return None;
+        };
+        let def = self.scope.types.structs.get(s as usize)?;
+        let fi = def.fields.iter().position(|(n, _)| n == field)?;
+        Some((fi as u32, Ty::Array(Box::new(def.fields[fi].1.clone()), *bound)))
     }
 
     fn call(&mut self, e: &Expr, callee: &Expr, args: &[Expr]) -> Result<Typed, CompileError> {
@@ -1212,6 +1355,38 @@ impl Compiler<'_, '_> {
     }
 }
 
+/// `a.f` for an array of structs `a`: the array of every element's field `f`, written into
+/// the destination's buffers.
+fn project(p: Path, fi: u32, ty: Ty) -> Typed {
+    let at = p.at;
+    Typed {
+        ty,
+        code: Code::Comp(Box::new(move |env, dest| {
+            let Cell::List(items) = p.resolve(env)? else {
+                return Err(internal(at));
+            };
+            if !matches!(dest, Cell::List(_)) {
+                *dest = Cell::List(Vec::with_capacity(items.len()));
+            }
+            let Cell::List(out) = dest else {
+                return Err(internal(at));
+            };
+            out.truncate(items.len());
+            for (k, item) in items.iter().enumerate() {
+                let Cell::List(fields) = item else {
+                    return Err(internal(at));
+                };
+                let v = fields.get(fi as usize).ok_or(internal(at))?;
+                match out.get_mut(k) {
+                    Some(o) => o.clone_from(v),
+                    None => out.push(v.clone()),
+                }
+            }
+            Ok(())
+        })),
+    }
+}
+
 /// An assignable location: a variable, then indices and fields.
 pub(crate) struct Place {
     /// Variable slot.
@@ -1223,6 +1398,9 @@ pub(crate) struct Place {
     pub bound: Option<u32>,
     /// `a.length = n`: the element default used when the array grows.
     set_length: Option<Cell>,
+    /// `a.f = v` for an array of structs `a`: the field index and the element default;
+    /// `a` takes the length of `v` and element `k` gets `v[k]` as its field `f`.
+    column: Option<(u32, Cell)>,
 }
 
 enum PlaceStep {
@@ -1234,12 +1412,39 @@ enum PlaceStep {
 impl Place {
     /// True when the location is a whole variable.
     pub fn is_whole_var(&self) -> bool {
-        self.steps.is_empty() && self.set_length.is_none()
+        self.steps.is_empty() && self.set_length.is_none() && self.column.is_none()
     }
 
     /// Stores `value`, reusing the destination's buffers.
     pub fn store(&self, vars: &mut [Cell], idx: &[i64; MAX_PATH], value: &Cell) -> Res<()> {
         let dst = self.target(vars, idx)?;
+        if let Some((fi, default)) = &self.column {
+            let (Cell::List(items), Cell::List(values)) = (dst, value) else {
+                return Err(internal(0));
+            };
+            if let Some(b) = self.bound {
+                if values.len() > b as usize {
+                    return Err(EvalError {
+                        at: 0,
+                        kind: EvalErrorKind::TooLong { bound: b },
+                    });
+                }
+            }
+            items.truncate(values.len());
+            while items.len() < values.len() {
+                items.push(default.clone());
+            }
+            for (item, v) in items.iter_mut().zip(values) {
+                let Cell::List(fields) = item else {
+                    return Err(internal(0));
+                };
+                fields
+                    .get_mut(*fi as usize)
+                    .ok_or(internal(0))?
+                    .clone_from(v);
+            }
+            return Ok(());
+        }
         let Some(default) = &self.set_length else {
             if let (Some(b), Cell::List(v)) = (self.bound, value) {
                 if v.len() > b as usize {
@@ -1358,6 +1563,7 @@ pub(crate) fn compile_place(
                     ty,
                     bound,
                     set_length: None,
+                    column: None,
                 })
             }
             None if name == "_event" => Err(cerr(e.start, "cannot assign to `_event`")),
@@ -1367,6 +1573,12 @@ pub(crate) fn compile_place(
             let mut p = compile_place(arr, scope, strings)?;
             if p.set_length.is_some() {
                 return Err(cerr(idx.start, "`length` cannot be indexed"));
+            }
+            if p.column.is_some() {
+                return Err(cerr(
+                    idx.start,
+                    "a field of every element (`a.f`) cannot be indexed here; write `a[i].f`",
+                ));
             }
             let Ty::Array(elem, bound) = p.ty.clone() else {
                 return Err(cerr(
@@ -1410,11 +1622,34 @@ pub(crate) fn compile_place(
             if p.set_length.is_some() {
                 return Err(cerr(*fat, format!("`length` has no field `{field}`")));
             }
+            if p.column.is_some() {
+                return Err(cerr(
+                    *fat,
+                    format!("a field of every element (`a.f`) has no field `{field}` here; write `a[i].f.{field}`"),
+                ));
+            }
             if let (Ty::Array(elem, _), "length") = (&p.ty, field.as_str()) {
                 // `a.length = n` truncates or extends with default values.
                 p.set_length = Some(scope.types.default_cell(elem));
                 p.ty = Ty::Int;
                 return Ok(p);
+            }
+            if let Ty::Array(elem, _) = &p.ty {
+                if let Ty::Struct(s) = **elem {
+                    let fi = scope
+                        .types
+                        .structs
+                        .get(s as usize)
+                        .and_then(|d| d.fields.iter().position(|(n, _)| n == field));
+                    if let Some(fi) = fi {
+                        // `a.f = v` writes field `f` of every element (AS2FM's flattened
+                        // structs make `a.f` the array of the elements' `f`).
+                        let fty = scope.types.structs[s as usize].fields[fi].1.clone();
+                        p.column = Some((fi as u32, scope.types.default_cell(elem)));
+                        p.ty = Ty::Array(Box::new(fty), p.bound);
+                        return Ok(p);
+                    }
+                }
             }
             let Ty::Struct(s) = p.ty else {
                 return Err(cerr(

@@ -440,6 +440,8 @@ impl<'s> Builder<'s> {
 
     fn build_types(&mut self) {
         let mut next_label = 0i64;
+        // Names first, so that a struct may name a type declared after it.
+        let mut structs = Vec::new();
         for (name, def, span) in &self.src.types.defs {
             match def {
                 TypeDef::Enumeration { labels } => {
@@ -452,18 +454,66 @@ impl<'s> Builder<'s> {
                     self.types.named.insert(name.clone(), Ty::Int);
                 }
                 TypeDef::Struct { fields } => {
-                    let mut fs = Vec::new();
-                    for (f, te) in fields {
-                        if let Some(t) = self.resolve(te, *span) {
-                            fs.push((f.clone(), t));
-                        }
-                    }
                     let idx = self.types.structs.len() as u32;
                     self.types.structs.push(StructDef {
                         name: name.clone(),
-                        fields: fs,
+                        fields: Vec::new(),
                     });
                     self.types.named.insert(name.clone(), Ty::Struct(idx));
+                    structs.push((idx, fields, *span));
+                }
+            }
+        }
+        for (idx, fields, span) in structs {
+            let mut fs = Vec::new();
+            for (f, te) in fields {
+                if let Some(t) = self.resolve(te, span) {
+                    fs.push((f.clone(), t));
+                }
+            }
+            if let Some(d) = self.types.structs.get_mut(idx as usize) {
+                d.fields = fs;
+            }
+        }
+        // A struct that contains itself (not through an array) has no finite value.
+        let n = self.types.structs.len();
+        for start in 0..n {
+            let mut seen = vec![false; n];
+            let mut stack = vec![start];
+            let mut cyclic = false;
+            while let Some(i) = stack.pop() {
+                for (_, t) in &self.types.structs[i].fields {
+                    if let Ty::Struct(j) = t {
+                        let j = *j as usize;
+                        if j == start {
+                            cyclic = true;
+                        } else if j < n && !seen[j] {
+                            seen[j] = true;
+                            stack.push(j);
+                        }
+                    }
+                }
+            }
+            if cyclic {
+                let name = self.types.structs[start].name.clone();
+                let span = self
+                    .src
+                    .types
+                    .defs
+                    .iter()
+                    .find(|(n, _, _)| *n == name)
+                    .map(|(_, _, s)| *s);
+                if let Some(span) = span {
+                    self.err(
+                        span,
+                        format!("struct `{name}` contains itself (only an array of it may)"),
+                    );
+                }
+                // Break the cycle so that default values stay finite.
+                for (_, t) in &mut self.types.structs[start].fields {
+                    if matches!(t, Ty::Struct(_)) {
+                        *t = Ty::Int;
+                    }
                 }
             }
         }
