@@ -617,8 +617,8 @@ mod tests {
         let ExprKind::Object(fs) = e.kind else {
             panic!()
         };
-        assert_eq!((fs[0].at, fs[1].at), (3, 12));
-        assert_eq!((fs[1].value.start, fs[1].value.end), (17, 18));
+        assert_eq!((fs[0].at, fs[1].at), (3, 11));
+        assert_eq!((fs[1].value.start, fs[1].value.end), (16, 17));
         for (t, at, msg) in [
             ("{x 1}", 3, "expected `:`"),
             ("{x: 1 y: 2}", 6, "expected `,` or `}`"),
