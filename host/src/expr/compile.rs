@@ -949,7 +949,10 @@ impl Compiler<'_, '_> {
         };
         let def = self.scope.types.structs.get(s as usize)?;
         let fi = def.fields.iter().position(|(n, _)| n == field)?;
-        Some((fi as u32, Ty::Array(Box::new(def.fields[fi].1.clone()), *bound)))
+        Some((
+            fi as u32,
+            Ty::Array(Box::new(def.fields[fi].1.clone()), *bound),
+        ))
     }
 
     fn call(&mut self, e: &Expr, callee: &Expr, args: &[Expr]) -> Result<Typed, CompileError> {
@@ -2003,7 +2006,8 @@ mod tests {
             };
             f(&mut env, &mut out).map_err(|e| e.message())?;
             if let Some(p) = &place {
-                p.eval_indices(&mut env, &mut idx).map_err(|e| e.message())?;
+                p.eval_indices(&mut env, &mut idx)
+                    .map_err(|e| e.message())?;
             }
         }
         if let Some(p) = &place {
@@ -2033,12 +2037,8 @@ mod tests {
         let (_, out, _) = eval_struct("[{points: []}, poly]", Some("Poly[]"), None).unwrap();
         assert!(matches!(out, Cell::List(ref v) if v.len() == 2));
         // Typed by the location it is assigned to, even deep inside a path.
-        let (vals, _, mut st) = eval_struct(
-            "{frame: 'n', x: 9, y: 8}",
-            None,
-            Some("polys[1].points[0]"),
-        )
-        .unwrap();
+        let (vals, _, mut st) =
+            eval_struct("{frame: 'n', x: 9, y: 8}", None, Some("polys[1].points[0]")).unwrap();
         assert_eq!(
             vals[2],
             Cell::List(vec![
@@ -2074,7 +2074,12 @@ mod tests {
                 26,
                 "field `x` of Point has type string",
             ),
-            ("{points: pt}", "Poly", 9, "has type Point but Point[] is expected"),
+            (
+                "{points: pt}",
+                "Poly",
+                9,
+                "has type Point but Point[] is expected",
+            ),
             ("pt", "Poly", 0, "has type Point but Poly is expected"),
         ] {
             let err = eval_struct(text, Some(expect), None).unwrap_err();
@@ -2082,7 +2087,10 @@ mod tests {
             assert!(err.ends_with(&format!("@{at}")), "{text}: {err}");
         }
         let err = eval_struct("{x: 1}", None, None).unwrap_err();
-        assert!(err.contains("struct type of this object literal is not known"), "{err}");
+        assert!(
+            err.contains("struct type of this object literal is not known"),
+            "{err}"
+        );
         let err = eval_struct("{x: 1}", None, Some("i")).unwrap_err();
         assert!(err.contains("not a value of type int"), "{err}");
         let err = eval_struct("1", None, Some("pt.z")).unwrap_err();
@@ -2123,8 +2131,12 @@ mod tests {
     fn struct_places() {
         // A whole struct into an array element, growing the array.
         let (vals, _, mut st) = eval_struct("pt", None, Some("poly.points[2]")).unwrap();
-        let Cell::List(fields) = &vals[1] else { panic!() };
-        assert!(matches!(&fields[0], Cell::List(ps) if ps.len() == 3 && ps[2] == point(&mut st, "a", 1.0, 2.0)));
+        let Cell::List(fields) = &vals[1] else {
+            panic!()
+        };
+        assert!(
+            matches!(&fields[0], Cell::List(ps) if ps.len() == 3 && ps[2] == point(&mut st, "a", 1.0, 2.0))
+        );
         // One field of every element: the array takes the value's length.
         let (vals, _, mut st) = eval_struct("[7, 8, 9]", None, Some("poly.points.x")).unwrap();
         assert_eq!(
@@ -2143,9 +2155,11 @@ mod tests {
                 Cell::List(vec![Cell::List(vec![])]),
             ])
         );
-        assert!(eval_struct("[[], [], [], [], []]", None, Some("polys.points"))
-            .unwrap_err()
-            .contains("at most 4"));
+        assert!(
+            eval_struct("[[], [], [], [], []]", None, Some("polys.points"))
+                .unwrap_err()
+                .contains("at most 4")
+        );
         assert!(eval_struct("1", None, Some("poly.points.x[0]"))
             .unwrap_err()
             .contains("write `a[i].f`"));

@@ -369,10 +369,13 @@ impl P {
             let at = self.off(r);
             let (r2, key) = match r.chars().next() {
                 Some(q @ ('\'' | '"')) => match self.string(r, q)? {
-                    (r2, Expr {
-                        kind: ExprKind::Str(k),
-                        ..
-                    }) => (r2, k),
+                    (
+                        r2,
+                        Expr {
+                            kind: ExprKind::Str(k),
+                            ..
+                        },
+                    ) => (r2, k),
                     _ => return Err(self.err(r, "expected a field name")),
                 },
                 Some(c) if ident_start(c) => match name(r) {
