@@ -436,3 +436,72 @@ fn a_struct_that_contains_itself_is_an_error() {
     );
     assert!(!err.contains("`List`"), "{err}");
 }
+
+mod alloc {
+    //! A counting allocator for this test binary (per thread, so parallel tests do not mix).
+    use std::alloc::{GlobalAlloc, Layout, System};
+    use std::cell::Cell;
+
+    pub struct Counting;
+
+    thread_local! {
+        static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+    }
+
+    // Forwards to the system allocator and counts calls.
+    #[allow(unsafe_code)]
+    unsafe impl GlobalAlloc for Counting {
+        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+            let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
+            // SAFETY: same contract as the caller's.
+            unsafe { System.alloc(layout) }
+        }
+        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+            // SAFETY: same contract as the caller's.
+            unsafe { System.dealloc(ptr, layout) }
+        }
+        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+            let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
+            // SAFETY: same contract as the caller's.
+            unsafe { System.realloc(ptr, layout, new_size) }
+        }
+    }
+
+    pub fn count() -> u64 {
+        ALLOCATIONS.with(|n| n.get())
+    }
+}
+
+#[global_allocator]
+static GLOBAL: alloc::Counting = alloc::Counting;
+
+/// Struct values live in buffers reused between steps and runs: once warm, whole runs of
+/// the struct cases (copying structs, sending them, growing arrays of structs) allocate
+/// nothing.
+#[test]
+fn struct_runs_allocate_nothing_once_warm() {
+    for name in [
+        "data_structs_main_xml_def",
+        "array_of_data_structs_main",
+        "overarching_tutorial_main_locations",
+    ] {
+        let m = load_case(name);
+        let cfg = config(&m);
+        let mut sim = Simulator::new(&m.model);
+        for seed in 0..3 {
+            sim.run(&mut Xoshiro256PlusPlus::seed_from_u64(seed), &cfg, &mut ());
+        }
+        for seed in 0..3 {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+            let before = alloc::count();
+            let out = sim.run(&mut rng, &cfg, &mut ());
+            let n = alloc::count() - before;
+            assert!(out.steps > 0);
+            assert_eq!(
+                n, 0,
+                "{name} run {seed}: {n} allocations in {} steps",
+                out.steps
+            );
+        }
+    }
+}

@@ -474,13 +474,10 @@ impl Compiler<'_, '_> {
             ty: Ty::Array(Box::new(elem_ty), bound),
             code: Code::Comp(Box::new(move |env, dest| {
                 if !matches!(dest, Cell::List(_)) {
-                    *dest = Cell::List(Vec::with_capacity(n));
+                    *dest = Cell::list(Vec::with_capacity(n));
                 }
                 if let Cell::List(v) = dest {
-                    v.truncate(n);
-                    while v.len() < n {
-                        v.push(Cell::Int(0));
-                    }
+                    v.set_len(n);
                     for (f, slot) in fns.iter().zip(v.iter_mut()) {
                         f(env, slot)?;
                     }
@@ -577,13 +574,10 @@ impl Compiler<'_, '_> {
             ty: Ty::Struct(s),
             code: Code::Comp(Box::new(move |env, dest| {
                 if !matches!(dest, Cell::List(_)) {
-                    *dest = Cell::List(Vec::with_capacity(n));
+                    *dest = Cell::list(Vec::with_capacity(n));
                 }
                 if let Cell::List(v) = dest {
-                    v.truncate(n);
-                    while v.len() < n {
-                        v.push(Cell::Int(0));
-                    }
+                    v.set_len(n);
                     for (f, slot) in fns.iter().zip(v.iter_mut()) {
                         f(env, slot)?;
                     }
@@ -1379,7 +1373,7 @@ fn project(p: Path, fi: u32, ty: Ty) -> Typed {
                 return Err(internal(at));
             };
             if !matches!(dest, Cell::List(_)) {
-                *dest = Cell::List(Vec::with_capacity(items.len()));
+                *dest = Cell::list(Vec::with_capacity(items.len()));
             }
             let Cell::List(out) = dest else {
                 return Err(internal(at));
@@ -1392,7 +1386,7 @@ fn project(p: Path, fi: u32, ty: Ty) -> Typed {
                 let v = fields.get(fi as usize).ok_or(internal(at))?;
                 match out.get_mut(k) {
                     Some(o) => o.clone_from(v),
-                    None => out.push(v.clone()),
+                    None => out.push_copy(v),
                 }
             }
             Ok(())
@@ -1443,11 +1437,8 @@ impl Place {
                     });
                 }
             }
-            items.truncate(values.len());
-            while items.len() < values.len() {
-                items.push(default.clone());
-            }
-            for (item, v) in items.iter_mut().zip(values) {
+            items.resize(values.len(), default);
+            for (item, v) in items.iter_mut().zip(values.iter()) {
                 let Cell::List(fields) = item else {
                     return Err(internal(0));
                 };
@@ -1497,7 +1488,7 @@ impl Place {
                 },
             });
         }
-        items.resize(n, default.clone());
+        items.resize(n, default);
         Ok(())
     }
 
@@ -1546,7 +1537,7 @@ impl Place {
                                 kind: EvalErrorKind::Index { index: i, len },
                             });
                         }
-                        items.resize(u + 1, default.clone());
+                        items.resize(u + 1, default);
                     }
                     cell = items.get_mut(u).ok_or(internal(*at))?;
                 }
@@ -1730,10 +1721,10 @@ mod tests {
             Cell::Float(2.5),
             Cell::Bool(true),
             Cell::Str(strings.intern("hi")),
-            Cell::List(vec![Cell::Int(1), Cell::Int(2), Cell::Int(3)]),
-            Cell::List(vec![
-                Cell::List(vec![]),
-                Cell::List(vec![Cell::Float(0.5), Cell::Float(1.5)]),
+            Cell::list(vec![Cell::Int(1), Cell::Int(2), Cell::Int(3)]),
+            Cell::list(vec![
+                Cell::list(vec![]),
+                Cell::list(vec![Cell::Float(0.5), Cell::Float(1.5)]),
             ]),
         ]
     }
@@ -1817,11 +1808,11 @@ mod tests {
         assert_eq!(eval("s.length"), Ok(Cell::Int(2)));
         assert_eq!(
             eval("[i, 2]"),
-            Ok(Cell::List(vec![Cell::Int(7), Cell::Int(2)]))
+            Ok(Cell::list(vec![Cell::Int(7), Cell::Int(2)]))
         );
         assert_eq!(
             eval("[1, 2.5]"),
-            Ok(Cell::List(vec![Cell::Float(1.0), Cell::Float(2.5)]))
+            Ok(Cell::list(vec![Cell::Float(1.0), Cell::Float(2.5)]))
         );
         assert!(eval("a[3]").unwrap_err().contains("out of bounds"));
         assert!(eval("a[-1]").unwrap_err().contains("out of bounds"));
@@ -1882,7 +1873,7 @@ mod tests {
         *p.target(&mut vals, &idx).unwrap() = Cell::Int(9);
         assert_eq!(
             vals[4],
-            Cell::List(vec![Cell::Int(1), Cell::Int(2), Cell::Int(3), Cell::Int(9)])
+            Cell::list(vec![Cell::Int(1), Cell::Int(2), Cell::Int(3), Cell::Int(9)])
         );
         // m is bounded to 3 rows: row 3 is out of range, row 2 is created.
         let q = compile_place(
@@ -1895,18 +1886,18 @@ mod tests {
         idx[0] = 3;
         assert!(q.target(&mut vals, &idx).is_err());
         idx[0] = 2;
-        *q.target(&mut vals, &idx).unwrap() = Cell::List(vec![Cell::Float(4.0)]);
+        *q.target(&mut vals, &idx).unwrap() = Cell::list(vec![Cell::Float(4.0)]);
         assert!(matches!(&vals[5], Cell::List(rows) if rows.len() == 3));
         assert!(
             compile_place(&parse_expr("_event.data.p").unwrap(), &scope, &mut strings).is_err()
         );
         let len = compile_place(&parse_expr("a.length").unwrap(), &scope, &mut strings).unwrap();
         len.store(&mut vals, &idx, &Cell::Int(1)).unwrap();
-        assert_eq!(vals[4], Cell::List(vec![Cell::Int(1)]));
+        assert_eq!(vals[4], Cell::list(vec![Cell::Int(1)]));
         len.store(&mut vals, &idx, &Cell::Int(3)).unwrap();
         assert_eq!(
             vals[4],
-            Cell::List(vec![Cell::Int(1), Cell::Int(0), Cell::Int(0)])
+            Cell::list(vec![Cell::Int(1), Cell::Int(0), Cell::Int(0)])
         );
         assert!(compile_place(&parse_expr("a.length.x").unwrap(), &scope, &mut strings).is_err());
         assert!(compile_place(&parse_expr("i + 1").unwrap(), &scope, &mut strings).is_err());
@@ -1938,7 +1929,7 @@ mod tests {
     }
 
     fn point(strings: &mut Strings, frame: &str, x: f64, y: f64) -> Cell {
-        Cell::List(vec![
+        Cell::list(vec![
             Cell::Str(strings.intern(frame)),
             Cell::Float(x),
             Cell::Float(y),
@@ -1985,10 +1976,10 @@ mod tests {
         let p1 = point(&mut strings, "b", 3.0, 4.0);
         let mut vals = vec![
             p0.clone(),
-            Cell::List(vec![Cell::List(vec![p0.clone(), p1.clone()])]),
-            Cell::List(vec![
-                Cell::List(vec![Cell::List(vec![])]),
-                Cell::List(vec![Cell::List(vec![p1])]),
+            Cell::list(vec![Cell::list(vec![p0.clone(), p1.clone()])]),
+            Cell::list(vec![
+                Cell::list(vec![Cell::list(vec![])]),
+                Cell::list(vec![Cell::list(vec![p1])]),
             ]),
             Cell::Int(1),
         ];
@@ -2029,7 +2020,7 @@ mod tests {
         .unwrap();
         assert_eq!(
             out,
-            Cell::List(vec![Cell::List(vec![
+            Cell::list(vec![Cell::list(vec![
                 point(&mut st, "a", 0.5, 1.0),
                 point(&mut st, "b", 2.0, 3.0)
             ])])
@@ -2041,9 +2032,9 @@ mod tests {
             eval_struct("{frame: 'n', x: 9, y: 8}", None, Some("polys[1].points[0]")).unwrap();
         assert_eq!(
             vals[2],
-            Cell::List(vec![
-                Cell::List(vec![Cell::List(vec![])]),
-                Cell::List(vec![Cell::List(vec![point(&mut st, "n", 9.0, 8.0)])]),
+            Cell::list(vec![
+                Cell::list(vec![Cell::list(vec![])]),
+                Cell::list(vec![Cell::list(vec![point(&mut st, "n", 9.0, 8.0)])]),
             ])
         );
         let (_, out, _) =
@@ -2110,12 +2101,12 @@ mod tests {
         // `a.f` over an array of structs: every element's field.
         assert_eq!(
             f("poly.points.y"),
-            Ok(Cell::List(vec![Cell::Float(2.0), Cell::Float(4.0)]))
+            Ok(Cell::list(vec![Cell::Float(2.0), Cell::Float(4.0)]))
         );
         assert_eq!(f("polys.points"), {
             let (vals, _, _) = eval_struct("1", None, None).unwrap();
             let Cell::List(ps) = &vals[2] else { panic!() };
-            Ok(Cell::List(
+            Ok(Cell::list(
                 ps.iter()
                     .map(|p| match p {
                         Cell::List(fs) => fs[0].clone(),
@@ -2141,7 +2132,7 @@ mod tests {
         let (vals, _, mut st) = eval_struct("[7, 8, 9]", None, Some("poly.points.x")).unwrap();
         assert_eq!(
             vals[1],
-            Cell::List(vec![Cell::List(vec![
+            Cell::list(vec![Cell::list(vec![
                 point(&mut st, "a", 7.0, 2.0),
                 point(&mut st, "b", 8.0, 4.0),
                 point(&mut st, "", 9.0, 0.0),
@@ -2150,9 +2141,9 @@ mod tests {
         let (vals, _, _) = eval_struct("[]", None, Some("polys[1].points.frame")).unwrap();
         assert_eq!(
             vals[2],
-            Cell::List(vec![
-                Cell::List(vec![Cell::List(vec![])]),
-                Cell::List(vec![Cell::List(vec![])]),
+            Cell::list(vec![
+                Cell::list(vec![Cell::list(vec![])]),
+                Cell::list(vec![Cell::list(vec![])]),
             ])
         );
         assert!(

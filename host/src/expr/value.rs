@@ -142,8 +142,8 @@ impl TypeTable {
             Ty::Int | Ty::Unknown => Cell::Int(0),
             Ty::Float => Cell::Float(0.0),
             Ty::Str => Cell::Str(StrId(0)),
-            Ty::Array(..) => Cell::List(Vec::new()),
-            Ty::Struct(i) => Cell::List(
+            Ty::Array(..) => Cell::List(List::default()),
+            Ty::Struct(i) => Cell::list(
                 self.structs
                     .get(*i as usize)
                     .map(|s| s.fields.iter().map(|(_, t)| self.default_cell(t)).collect())
@@ -160,7 +160,14 @@ pub(crate) enum Cell {
     Int(i64),
     Float(f64),
     Str(StrId),
-    List(Vec<Cell>),
+    List(List),
+}
+
+impl Cell {
+    /// A list cell holding `items`.
+    pub(crate) fn list(items: Vec<Cell>) -> Cell {
+        Cell::List(List::from(items))
+    }
 }
 
 impl Clone for Cell {
@@ -178,8 +185,107 @@ impl Clone for Cell {
     /// a value into a cell of the same shape does not allocate.
     fn clone_from(&mut self, source: &Self) {
         match (self, source) {
-            (Cell::List(dst), Cell::List(src)) => dst.clone_from(src),
+            (Cell::List(dst), Cell::List(src)) => dst.assign(src),
             (dst, src) => *dst = src.clone(),
+        }
+    }
+}
+
+/// The elements of an array or the fields of a struct.
+///
+/// Elements removed by shrinking are kept aside, buffers and all, and reused when the list
+/// grows again: an array of arrays or structs that a run empties and refills (or that
+/// messages of different lengths pass through) does not allocate once it has been as long
+/// before. Reads see only the live elements (the list derefs to a slice of them).
+#[derive(Debug, Default)]
+pub(crate) struct List {
+    items: Vec<Cell>,
+    /// Removed elements, reused by the next growth.
+    spare: Vec<Cell>,
+}
+
+impl From<Vec<Cell>> for List {
+    fn from(items: Vec<Cell>) -> Self {
+        List {
+            items,
+            spare: Vec::new(),
+        }
+    }
+}
+
+impl Clone for List {
+    fn clone(&self) -> Self {
+        List::from(self.items.clone())
+    }
+}
+
+impl PartialEq for List {
+    fn eq(&self, other: &Self) -> bool {
+        self.items == other.items
+    }
+}
+
+impl std::ops::Deref for List {
+    type Target = [Cell];
+    fn deref(&self) -> &[Cell] {
+        &self.items
+    }
+}
+
+impl std::ops::DerefMut for List {
+    fn deref_mut(&mut self) -> &mut [Cell] {
+        &mut self.items
+    }
+}
+
+impl List {
+    /// Keeps the first `n` elements; the others are set aside for reuse.
+    pub(crate) fn truncate(&mut self, n: usize) {
+        while self.items.len() > n {
+            if let Some(c) = self.items.pop() {
+                self.spare.push(c);
+            }
+        }
+    }
+
+    /// Appends a copy of `value`, into a set-aside element when there is one.
+    pub(crate) fn push_copy(&mut self, value: &Cell) {
+        match self.spare.pop() {
+            Some(mut c) => {
+                c.clone_from(value);
+                self.items.push(c);
+            }
+            None => self.items.push(value.clone()),
+        }
+    }
+
+    /// Grows to `n` elements with whatever set-aside elements hold (each is overwritten
+    /// by the caller), then `Int(0)`s; or shrinks to `n`.
+    pub(crate) fn set_len(&mut self, n: usize) {
+        self.truncate(n);
+        while self.items.len() < n {
+            let c = self.spare.pop().unwrap_or(Cell::Int(0));
+            self.items.push(c);
+        }
+    }
+
+    /// Shrinks to `n`, or grows to `n` with copies of `fill`.
+    pub(crate) fn resize(&mut self, n: usize, fill: &Cell) {
+        self.truncate(n);
+        while self.items.len() < n {
+            self.push_copy(fill);
+        }
+    }
+
+    /// Becomes a copy of `src`, reusing its own elements' buffers.
+    pub(crate) fn assign(&mut self, src: &List) {
+        self.truncate(src.len());
+        let live = self.items.len();
+        for (d, s) in self.items.iter_mut().zip(src.iter()) {
+            d.clone_from(s);
+        }
+        for s in src.iter().skip(live) {
+            self.push_copy(s);
         }
     }
 }
