@@ -353,6 +353,22 @@ fn a_struct_may_name_a_type_declared_after_it_and_literals_nest() {
     assert_eq!(ok, None);
 }
 
+/// An object literal sent as a parameter takes the parameter's declared type (`<param
+/// type>`); without one, the parameter's type cannot be inferred from the literal.
+#[test]
+fn object_literal_parameters_need_a_declared_type() {
+    let dm = r#"<data id="p" type="Point" expr="{x: 1, y: 2}" />"#;
+    let typed = r#"<onentry><send event="e"><param name="q" type="Point" expr="{x: p.x, y: 3}" /></send></onentry>"#;
+    assert_eq!(load_err("param-typed", TYPES, dm, typed), None);
+    let untyped =
+        r#"<onentry><send event="e"><param name="q" expr="{x: p.x, y: 3}" /></send></onentry>"#;
+    let err = load_err("param-untyped", TYPES, dm, untyped).expect("untyped literal parameter");
+    assert!(
+        err.contains("node.ascxml:6:") && err.contains("parameter `q`"),
+        "{err}"
+    );
+}
+
 #[test]
 fn bad_object_literals_are_errors_at_their_field() {
     // (datamodel, body, where: line:column, what)

@@ -1640,15 +1640,16 @@ pub(crate) fn compile_place(
             }
             if let Ty::Array(elem, _) = &p.ty {
                 if let Ty::Struct(s) = **elem {
-                    let fi = scope
-                        .types
-                        .structs
-                        .get(s as usize)
-                        .and_then(|d| d.fields.iter().position(|(n, _)| n == field));
-                    if let Some(fi) = fi {
+                    let found = scope.types.structs.get(s as usize).and_then(|d| {
+                        d.fields
+                            .iter()
+                            .enumerate()
+                            .find(|(_, (n, _))| n == field)
+                            .map(|(i, (_, t))| (i, t.clone()))
+                    });
+                    if let Some((fi, fty)) = found {
                         // `a.f = v` writes field `f` of every element (AS2FM's flattened
                         // structs make `a.f` the array of the elements' `f`).
-                        let fty = scope.types.structs[s as usize].fields[fi].1.clone();
                         p.column = Some((fi as u32, scope.types.default_cell(elem)));
                         p.ty = Ty::Array(Box::new(fty), p.bound);
                         return Ok(p);
