@@ -193,86 +193,86 @@ impl Clone for Cell {
 
 /// The elements of an array or the fields of a struct.
 ///
-/// Elements removed by shrinking are kept aside, buffers and all, and reused when the list
-/// grows again: an array of arrays or structs that a run empties and refills (or that
-/// messages of different lengths pass through) does not allocate once it has been as long
-/// before. Reads see only the live elements (the list derefs to a slice of them).
-#[derive(Debug, Default)]
+/// Elements removed by shrinking stay in the buffer past the live length, buffers and all,
+/// and are reused when the list grows again: an array of arrays or structs that a run
+/// empties and refills (or that messages of different lengths pass through) does not
+/// allocate once it has been as long before. Reads see only the live elements (the list
+/// derefs to a slice of them).
+#[derive(Default)]
 pub(crate) struct List {
+    /// Live elements first, then set-aside ones.
     items: Vec<Cell>,
-    /// Removed elements, reused by the next growth.
-    spare: Vec<Cell>,
+    /// Number of live elements (at most `items.len()`).
+    len: usize,
 }
 
 impl From<Vec<Cell>> for List {
     fn from(items: Vec<Cell>) -> Self {
-        List {
-            items,
-            spare: Vec::new(),
-        }
+        let len = items.len();
+        List { items, len }
     }
 }
 
 impl Clone for List {
     fn clone(&self) -> Self {
-        List::from(self.items.clone())
+        List::from(self.to_vec())
     }
 }
 
 impl PartialEq for List {
     fn eq(&self, other: &Self) -> bool {
-        self.items == other.items
+        **self == **other
+    }
+}
+
+impl std::fmt::Debug for List {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
     }
 }
 
 impl std::ops::Deref for List {
     type Target = [Cell];
     fn deref(&self) -> &[Cell] {
-        &self.items
+        self.items.get(..self.len).unwrap_or(&[])
     }
 }
 
 impl std::ops::DerefMut for List {
     fn deref_mut(&mut self) -> &mut [Cell] {
-        &mut self.items
+        let len = self.len.min(self.items.len());
+        &mut self.items[..len]
     }
 }
 
 impl List {
     /// Keeps the first `n` elements; the others are set aside for reuse.
     pub(crate) fn truncate(&mut self, n: usize) {
-        while self.items.len() > n {
-            if let Some(c) = self.items.pop() {
-                self.spare.push(c);
-            }
-        }
+        self.len = self.len.min(n);
     }
 
     /// Appends a copy of `value`, into a set-aside element when there is one.
     pub(crate) fn push_copy(&mut self, value: &Cell) {
-        match self.spare.pop() {
-            Some(mut c) => {
-                c.clone_from(value);
-                self.items.push(c);
-            }
+        match self.items.get_mut(self.len) {
+            Some(c) => c.clone_from(value),
             None => self.items.push(value.clone()),
         }
+        self.len += 1;
     }
 
     /// Grows to `n` elements with whatever set-aside elements hold (each is overwritten
     /// by the caller), then `Int(0)`s; or shrinks to `n`.
     pub(crate) fn set_len(&mut self, n: usize) {
-        self.truncate(n);
         while self.items.len() < n {
-            let c = self.spare.pop().unwrap_or(Cell::Int(0));
-            self.items.push(c);
+            self.items.push(Cell::Int(0));
         }
+        self.len = n;
     }
 
     /// Shrinks to `n`, or grows to `n` with copies of `fill`.
     pub(crate) fn resize(&mut self, n: usize, fill: &Cell) {
         self.truncate(n);
-        while self.items.len() < n {
+        while self.len < n {
             self.push_copy(fill);
         }
     }
@@ -280,8 +280,8 @@ impl List {
     /// Becomes a copy of `src`, reusing its own elements' buffers.
     pub(crate) fn assign(&mut self, src: &List) {
         self.truncate(src.len());
-        let live = self.items.len();
-        for (d, s) in self.items.iter_mut().zip(src.iter()) {
+        let live = self.len;
+        for (d, s) in self.iter_mut().zip(src.iter()) {
             d.clone_from(s);
         }
         for s in src.iter().skip(live) {
@@ -460,5 +460,47 @@ impl OwnedValue {
                 out.push(']');
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lists_reuse_the_elements_they_shrink_away() {
+        let inner = |n: i64| Cell::list((0..n).map(Cell::Int).collect());
+        let mut l = List::from(vec![inner(3), inner(4)]);
+        l.truncate(0);
+        assert!(l.is_empty());
+        assert_eq!(l, List::default());
+        assert_eq!(format!("{l:?}"), "[]");
+        // The set-aside element keeps its buffer: refilling it in place allocates nothing.
+        let before = match &l.items[0] {
+            Cell::List(v) => v.items.as_ptr(),
+            _ => unreachable!(),
+        };
+        l.push_copy(&inner(2));
+        assert_eq!(l.len(), 1);
+        assert_eq!(l[0], inner(2));
+        match &l[0] {
+            Cell::List(v) => assert_eq!(v.items.as_ptr(), before),
+            _ => unreachable!(),
+        }
+        l.resize(3, &Cell::Int(7));
+        assert_eq!(*l, [inner(2), Cell::Int(7), Cell::Int(7)]);
+        let mut m = List::from(vec![Cell::Int(1)]);
+        m.assign(&l);
+        assert_eq!(m, l);
+        l.set_len(1);
+        m.assign(&l);
+        assert_eq!(m.len(), 1);
+        assert_eq!(m.clone(), l);
+        // A cell stays small: every variable and parameter is one.
+        assert!(
+            std::mem::size_of::<Cell>() <= 32,
+            "{}",
+            std::mem::size_of::<Cell>()
+        );
     }
 }
