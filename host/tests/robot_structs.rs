@@ -421,6 +421,12 @@ fn bad_object_literals_are_errors_at_their_field() {
             "node.ascxml:3:40",
             "field `x` is given twice",
         ),
+        (
+            r#"<data id="p" type="Pointt" expr="{x: 1, y: 2}" />"#,
+            "",
+            "node.ascxml:3:20",
+            "unknown type `Pointt` (not a base type nor declared in types.xml or the data declarations; declared: Line, Point)",
+        ),
     ];
     for (i, (dm, body, at, what)) in cases.iter().enumerate() {
         let err = load_err(&format!("bad{i}"), TYPES, dm, body)

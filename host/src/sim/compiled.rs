@@ -519,6 +519,22 @@ impl<'s> Builder<'s> {
         }
     }
 
+    /// `; declared: A, B` (the declared type names), or nothing when there are none.
+    fn known_types(&self) -> String {
+        let names: Vec<&str> = self
+            .src
+            .types
+            .defs
+            .iter()
+            .map(|(n, _, _)| n.as_str())
+            .collect();
+        if names.is_empty() {
+            String::new()
+        } else {
+            format!("; declared: {}", names.join(", "))
+        }
+    }
+
     fn resolve(&mut self, te: &TypeExpr, span: Span) -> Option<Ty> {
         match te {
             TypeExpr::Base(b) => Some(match b {
@@ -532,7 +548,10 @@ impl<'s> Builder<'s> {
                 None => {
                     self.err(
                         span,
-                        format!("unknown type `{n}` (not a base type nor declared in types.xml)"),
+                        format!(
+                            "unknown type `{n}` (not a base type nor declared in types.xml or the data declarations{})",
+                            self.known_types()
+                        ),
                     );
                     None
                 }
