@@ -554,3 +554,42 @@ fn converted_struct_models_read_back_and_run_the_same() {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+/// SCAN property ports read fields of struct parameters, written `point.x` or as AS2FM
+/// flattens them (`point__y`); a field the struct does not have is an error.
+#[test]
+fn property_ports_read_struct_fields() {
+    use hindsight::cli::verify::Runner;
+    use hindsight::props::parse_str;
+    use hindsight::smc::runner::stream;
+    use hindsight::verify::observe::PropertySet;
+    let m = load_case("data_structs_main_xml_def");
+    let props = |px: &str| {
+        format!(
+            r#"<properties><ports>
+  <scxml_event_send event="data" origin="sender" target="receiver">
+    <state_var id="px" param="{px}" type="float64" expr="0"/>
+    <state_var id="py" param="point__y" type="float64" expr="0"/>
+    <state_var id="frame" param="point.frame" type="string" expr="''"/>
+  </scxml_event_send>
+</ports><guarantees>
+  <property id="reaches_100" logic="pmtl" expr="once {{px &gt;= 100 &amp;&amp; py &gt; 3.1 &amp;&amp; frame == 'world'}}"/>
+  <property id="stays_below_50" logic="pmtl" expr="historically {{px &lt; 50}}"/>
+</guarantees></properties>"#
+        )
+    };
+    let file = parse_str(&props("point.x"), Path::new("structs.xml")).unwrap();
+    let set = PropertySet::new(&file, &m.model).unwrap();
+    let cfg = config(&m);
+    let runner = Runner::new(&m.model, &set, &cfg);
+    for k in 0..3 {
+        let v = runner.run(k, &mut stream(7, k)).verdicts;
+        assert_eq!(format!("{v:?}"), "[True, False]", "run {k}");
+    }
+    let file = parse_str(&props("point.z"), Path::new("structs.xml")).unwrap();
+    let err = PropertySet::new(&file, &m.model).unwrap_err();
+    assert!(
+        err.contains("structs.xml:3:") && err.contains("no parameter `point.z`"),
+        "{err}"
+    );
+}

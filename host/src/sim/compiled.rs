@@ -255,6 +255,55 @@ impl CompiledModel {
         self.event_params(e).iter().position(|(n, _)| n == name)
     }
 
+    /// Where a property reads a message value: parameter `name` of event `e` (its index,
+    /// no fields), or a field of a struct parameter, written `param.field.sub` or, as
+    /// AS2FM's translation flattens structs, `param__field__sub` (the parameter's index and
+    /// the field indices on the way). Fields inside arrays are not reachable this way.
+    pub fn param_path(&self, e: EventId, name: &str) -> Option<(usize, Vec<u32>)> {
+        if let Some(i) = self.param_index(e, name) {
+            return Some((i, Vec::new()));
+        }
+        for (i, (pname, ty)) in self.event_params(e).iter().enumerate() {
+            let Some(rest) = name.strip_prefix(pname.as_str()).and_then(strip_sep) else {
+                continue;
+            };
+            let mut path = Vec::new();
+            if self.field_path(ty, rest, &mut path, 0) {
+                return Some((i, path));
+            }
+        }
+        None
+    }
+
+    /// Appends to `path` the fields that `rest` names inside `ty`; false when it names none.
+    fn field_path(&self, ty: &Ty, rest: &str, path: &mut Vec<u32>, depth: usize) -> bool {
+        let Ty::Struct(s) = ty else {
+            return false;
+        };
+        let Some(def) = self.types.structs.get(*s as usize) else {
+            return false;
+        };
+        if depth > 64 {
+            return false;
+        }
+        for (fi, (fname, fty)) in def.fields.iter().enumerate() {
+            let Some(after) = rest.strip_prefix(fname.as_str()) else {
+                continue;
+            };
+            path.push(fi as u32);
+            if after.is_empty() {
+                return true;
+            }
+            if let Some(sub) = strip_sep(after) {
+                if self.field_path(fty, sub, path, depth + 1) {
+                    return true;
+                }
+            }
+            path.pop();
+        }
+        false
+    }
+
     /// Machines that send event `e` (`<send>` or `<raise>`).
     pub fn event_senders(&self, e: EventId) -> impl Iterator<Item = MachineId> + '_ {
         self.events
@@ -865,6 +914,13 @@ impl<'s> Builder<'s> {
             },
         }
     }
+}
+
+/// The text after a leading field separator (`.` or `__`), if there is one.
+fn strip_sep(s: &str) -> Option<&str> {
+    s.strip_prefix('.')
+        .or_else(|| s.strip_prefix("__"))
+        .filter(|r| !r.is_empty())
 }
 
 fn contains_unknown(t: &Ty) -> bool {

@@ -29,6 +29,8 @@ struct Port {
     var: usize,
     /// The message parameter (state variables only).
     param: Option<usize>,
+    /// Fields to follow inside a struct parameter (`point.x`), outermost first.
+    fields: Vec<u32>,
 }
 
 /// Guarantees and assumptions compiled to one program, with their ports resolved.
@@ -60,6 +62,17 @@ fn spec_type(scan: &str) -> Option<&'static str> {
         "string" => "string",
         _ => return None,
     })
+}
+
+/// The value reached by following `fields` into a struct value.
+fn field_of<'v>(mut v: SimValue<'v>, fields: &[u32]) -> Option<SimValue<'v>> {
+    for f in fields {
+        let SimValue::List(l) = v else {
+            return None;
+        };
+        v = l.get(*f as usize)?;
+    }
+    Some(v)
 }
 
 /// A time unit of `ns` nanoseconds as the spec language writes it: `100ms`, `1s`, `7ns`.
@@ -175,10 +188,10 @@ impl PropertySet {
                     continue;
                 }
             };
-            let param = match &p.kind {
-                PortKind::Event => None,
-                PortKind::State { param, .. } => match model.param_index(event, param) {
-                    Some(i) => Some(i),
+            let (param, fields) = match &p.kind {
+                PortKind::Event => (None, Vec::new()),
+                PortKind::State { param, .. } => match model.param_path(event, param) {
+                    Some((i, fields)) => (Some(i), fields),
                     None => {
                         errors.push(format!(
                             "{here}: event `{}` has no parameter `{param}`",
@@ -196,6 +209,7 @@ impl PropertySet {
                 target,
                 var,
                 param,
+                fields,
             });
         }
         if !errors.is_empty() {
@@ -376,7 +390,10 @@ impl Observer for Judge<'_> {
             let decl = &self.monitor.program().vars[port.var];
             let value = match port.param {
                 None => Some(Value::Bool(true)),
-                Some(i) => msg.param(i).and_then(|v| self.convert(v, decl.ty)),
+                Some(i) => msg
+                    .param(i)
+                    .and_then(|v| field_of(v, &port.fields))
+                    .and_then(|v| self.convert(v, decl.ty)),
             };
             match value {
                 Some(v) => self.vals[port.var] = v,
