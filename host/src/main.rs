@@ -27,10 +27,12 @@ enum Command {
     ///
     /// Example: `hindsight replay examples/specs/museum.hspec trace.csv --changes`
     Replay(cli::replay::ReplayArgs),
-    /// Estimate each guarantee's probability on a plain SCXML model (statistical model checking).
+    /// Estimate each guarantee's probability on a model (statistical model checking).
     ///
-    /// The model is a folder of .scxml machines (what AS2FM emits, what SCAN reads) or a
-    /// SCAN model.xml; properties are a SCAN properties.xml (current or tree form).
+    /// The model is a robot model (a main file with a BehaviorTree.cpp tree and SCXML
+    /// with ROS 2 tags, or a folder holding main.xml), a folder of plain .scxml machines
+    /// (what AS2FM emits, what SCAN reads) or a SCAN model.xml; properties are SCAN XML
+    /// (current or tree form, ports over ROS names, patterns) or JANI.
     /// Runs are seeded (run k uses xoshiro256++ stream k) and consumed in run order, so the
     /// same --seed gives the same numbers on any number of threads. A run stops early only
     /// when every verdict can no longer change.
@@ -57,6 +59,12 @@ enum Command {
     ///
     /// Example: `hindsight trace examples/museum-scxml --run 3 --seed 1 -o run3.csv`
     Trace(cli::verify::TraceArgs),
+    /// Write a robot model (main file, behavior tree, SCXML with ROS tags) as the plain
+    /// SCXML machines hindsight simulates, a SCAN model.xml and the properties (ROS names
+    /// resolved to machines, bounds in steps; JANI files copied), for other tools.
+    ///
+    /// Example: `hindsight convert examples/museum-guide --out museum-plain`
+    Convert(cli::convert::ConvertArgs),
 }
 
 fn main() -> ExitCode {
@@ -76,6 +84,7 @@ fn main() -> ExitCode {
         Command::Sweep(a) => cli::sweep::run(a),
         Command::Merge(a) => cli::verify::merge(a),
         Command::Trace(a) => cli::verify::trace(a),
+        Command::Convert(a) => cli::convert::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

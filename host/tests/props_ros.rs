@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use hindsight::cli::verify::Runner;
-use hindsight::props::{parse_file, PortKind, ANY_MACHINE};
+use hindsight::props::{parse_file, PortKind, ANY};
 use hindsight::sim::{CompiledModel, RunConfig};
 use hindsight::smc::runner::stream;
 use hindsight::verify::observe::PropertySet;
@@ -32,7 +32,7 @@ fn ros_ports_name_the_translated_messages() {
         port("battery_level").event,
         "topic_BatteryComponent__battery_level_msg"
     );
-    assert_eq!(port("battery_level").origin, ANY_MACHINE);
+    assert_eq!(port("battery_level").origin, ANY);
     assert!(matches!(
         &port("battery_level").kind,
         PortKind::State { param, .. } if param == "ros_fields__data"

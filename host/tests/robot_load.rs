@@ -18,25 +18,39 @@ fn repo(relative: &str) -> PathBuf {
         .join(relative)
 }
 
+/// Corpus cases that do not load, each with the reason and a piece of the error.
+const DO_NOT_LOAD: &[(&str, &str, &str)] = &[(
+    "string_msg_comparison_main",
+    "publishes example_interfaces/String on a topic subscribed as nested_interfaces/Internal \
+         (AS2FM accepts it; we report it, as issue 5 asks)",
+    "string_receive.ascxml:9:70: topic `str_topic` is subscribed with type",
+)];
+
 #[test]
 fn every_corpus_main_file_loads() {
     let root = corpus_root().join("as2fm");
     let text = std::fs::read_to_string(root.join("expected.json")).unwrap();
     let doc: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let mut failed = Vec::new();
+    let mut wrong = Vec::new();
     for (case, v) in doc.as_object().unwrap() {
         let main = root.join(v["main"].as_str().unwrap());
-        match load(&main) {
-            Ok(m) => eprintln!(
-                "{case}: {} machines, unit {} ns, max_time {} steps",
-                m.model.machine_count(),
-                m.time_unit_ns,
-                m.max_time_steps
-            ),
-            Err(e) => failed.push(format!("{case}: {e}")),
+        let known = DO_NOT_LOAD.iter().find(|(c, _, _)| c == case);
+        match (load(&main), known) {
+            (Ok(m), None) => {
+                assert!(m.model.machine_count() > 0, "{case}");
+                assert!(m.time_unit_ns > 0 && m.max_time_steps > 1, "{case}");
+            }
+            (Err(e), Some((_, reason, piece))) => {
+                eprintln!("{case}: does not load ({reason})");
+                if !e.to_string().contains(piece) {
+                    wrong.push(format!("{case}: expected an error with `{piece}`, got {e}"));
+                }
+            }
+            (Ok(_), Some(_)) => wrong.push(format!("{case}: loads now; take it off DO_NOT_LOAD")),
+            (Err(e), None) => wrong.push(format!("{case}: {e}")),
         }
     }
-    assert!(failed.is_empty(), "{}", failed.join("\n"));
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
 }
 
 #[test]

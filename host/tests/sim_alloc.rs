@@ -4,7 +4,7 @@
 //! after that, whole runs - every step, every reset - must not allocate.
 
 use hindsight::model::ModelSource;
-use hindsight::sim::{CompiledModel, EndReason, RunConfig, Simulator};
+use hindsight::sim::{CompiledModel, EndReason, EventSemantics, RunConfig, Simulator};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -131,5 +131,24 @@ fn array_models_allocate_nothing_once_warm() {
             .join(name);
         let m = CompiledModel::load(&dir).unwrap();
         assert_steady_state_allocation_free(&m, &RunConfig::default(), 3, 5);
+    }
+}
+
+/// AS2FM's event semantics (global pending events, broadcast deliveries, receivers'
+/// copies) on AS2FM's plain translations: a BT with a blackboard, action threads with
+/// array messages, and the museum guide's 60 machines.
+#[test]
+fn as2fm_semantics_allocate_nothing_once_warm() {
+    let cfg = RunConfig {
+        events: EventSemantics::As2fm,
+        ..RunConfig::default()
+    };
+    for case in [
+        "grid_robot_blackboard_simple_main",
+        "fibonacci_action_example_main",
+        "uc3_museum_guide_main",
+    ] {
+        let m = CompiledModel::load(&corpus().join("as2fm/plain").join(case)).unwrap();
+        assert_steady_state_allocation_free(&m, &cfg, 3, 3);
     }
 }

@@ -1,6 +1,7 @@
 //! The `hindsight` subcommands, one module each; `main.rs` only parses arguments and dispatches.
 
 pub mod compile;
+pub mod convert;
 pub mod plot;
 pub mod replay;
 pub mod sweep;

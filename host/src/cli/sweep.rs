@@ -170,7 +170,7 @@ impl BoundValue {
     }
 
     /// The value as people read it: `62`, `6.2s`.
-    fn display(self) -> String {
+    pub fn display(self) -> String {
         match self {
             BoundValue::Units(v) => v.to_string(),
             BoundValue::Nanos(v) => {
@@ -217,25 +217,37 @@ pub fn grid(from: &str, to: &str, step: Option<&str>) -> Result<Vec<BoundValue>,
 /// `2.5s`) by `value`; text inside `{...}` atoms is left alone. Returns the new formula and
 /// how many numbers were replaced.
 pub fn set_bounds(formula: &str, value: &str) -> (String, usize) {
+    map_bounds(formula, |_| Ok::<_, ()>(value.to_string())).unwrap_or_default()
+}
+
+/// Replaces every number inside `[...]` bounds of `formula` (with its unit, if any) by
+/// what `f` makes of it; text inside `{...}` atoms is left alone. Returns the new formula
+/// and how many numbers were replaced, or `f`'s first error.
+pub fn map_bounds<E>(
+    formula: &str,
+    mut f: impl FnMut(&str) -> Result<String, E>,
+) -> Result<(String, usize), E> {
     let mut out = String::with_capacity(formula.len());
     let mut replaced = 0;
     let mut in_bound = false;
     let mut atom_depth = 0usize;
-    let mut chars = formula.chars().peekable();
-    while let Some(c) = chars.next() {
+    let mut chars = formula.char_indices().peekable();
+    while let Some((start, c)) = chars.next() {
         match c {
             '{' => atom_depth += 1,
             '}' => atom_depth = atom_depth.saturating_sub(1),
             '[' if atom_depth == 0 => in_bound = true,
             ']' if atom_depth == 0 => in_bound = false,
             d if in_bound && d.is_ascii_digit() => {
-                while chars
-                    .peek()
-                    .is_some_and(|c| c.is_ascii_alphanumeric() || *c == '.' || *c == '_')
-                {
+                let mut end = start + 1;
+                while let Some(&(i, c)) = chars.peek() {
+                    if !(c.is_ascii_alphanumeric() || c == '.' || c == '_') {
+                        break;
+                    }
+                    end = i + c.len_utf8();
                     chars.next();
                 }
-                out.push_str(value);
+                out.push_str(&f(&formula[start..end])?);
                 replaced += 1;
                 continue;
             }
@@ -243,7 +255,7 @@ pub fn set_bounds(formula: &str, value: &str) -> (String, usize) {
         }
         out.push(c);
     }
-    (out, replaced)
+    Ok((out, replaced))
 }
 
 /// One bound's counts for one property.
@@ -328,6 +340,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     };
     let run_cfg = RunConfig {
         max_time: loaded.max_time(args.max_time.as_deref())?,
+        events: loaded.events,
         ..RunConfig::default()
     };
     let study_cfg = StudyConfig {

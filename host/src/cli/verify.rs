@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use super::CliError;
 use crate::props;
-use crate::sim::{CompiledModel, EndReason, RunConfig, Simulator};
+use crate::sim::{CompiledModel, EndReason, EventSemantics, RunConfig, Simulator};
 use crate::smc::progress::TerminalProgress;
 use crate::smc::stats::{RuleConfig, RuleKind};
 use crate::smc::{run_study, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
@@ -26,6 +26,40 @@ pub enum Rule {
     Wilson,
     /// Stop when the exact Clopper-Pearson interval is narrower than ±precision.
     ClopperPearson,
+}
+
+/// How sends are delivered, as named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Events {
+    /// SCAN's channel system: per-machine FIFO queues, a send goes to its target.
+    Queues,
+    /// AS2FM's JANI semantics: one pending message per event, broadcast to every
+    /// machine with a transition on it, senders blocking while it is pending.
+    As2fm,
+}
+
+impl From<Events> for EventSemantics {
+    fn from(e: Events) -> Self {
+        match e {
+            Events::Queues => EventSemantics::Queues,
+            Events::As2fm => EventSemantics::As2fm,
+        }
+    }
+}
+
+/// The event semantics for a property file when none is asked for: AS2FM's for a JANI
+/// property file (the model is then AS2FM's plain SCXML), SCAN's queues otherwise.
+pub fn default_events(props_path: &Path) -> EventSemantics {
+    if is_jani(props_path) {
+        EventSemantics::As2fm
+    } else {
+        EventSemantics::Queues
+    }
+}
+
+fn is_jani(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("jani"))
 }
 
 /// Arguments of `hindsight verify`.
@@ -154,6 +188,12 @@ pub struct Report {
     pub quiescent: u64,
     /// Wall-clock seconds.
     pub seconds: f64,
+    /// Seconds of model time in one step, when the model has a time unit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub step_seconds: Option<f64>,
+    /// The run length in seconds of model time, when the model has a time unit.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_time_seconds: Option<f64>,
     /// Per guarantee.
     pub properties: Vec<PropertyReport>,
 }
@@ -170,27 +210,44 @@ fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, CliE
     };
     let p = dir.join("properties.xml");
     if p.is_file() {
-        Ok(p)
-    } else {
-        Err(CliError::Input(format!(
-            "{}: no property file given and none found (looked for {})",
-            model.display(),
-            p.display()
-        )))
+        return Ok(p);
     }
+    // A folder with exactly one JANI file (AS2FM's models keep their properties there).
+    let mut jani: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.is_file() && is_jani(p))
+                .collect()
+        })
+        .unwrap_or_default();
+    if jani.len() == 1 {
+        return Ok(jani.remove(0));
+    }
+    Err(CliError::Input(format!(
+        "{}: no property file given and none found (looked for {} and a single .jani file)",
+        model.display(),
+        p.display()
+    )))
 }
 
 /// The model and property arguments every command that loads a model takes.
 #[derive(Debug, clap::Args)]
 pub struct ModelArgs {
-    /// The model: a folder of .scxml machines, a SCAN model.xml, or one .scxml file.
+    /// The model: a robot main file (`<roaml>` or `<convince_mc_tc>`) or a folder holding
+    /// `main.xml`; a folder of plain .scxml machines, a SCAN model.xml, or one .scxml file.
     pub model: PathBuf,
-    /// The property file; default: the one model.xml names, else MODEL/properties.xml.
+    /// The property file; default: the one the main file or model.xml names, else
+    /// MODEL/properties.xml.
     pub props: Option<PathBuf>,
     /// The length of one model time step (`100ms`), so that bounds with a unit (`6.2s`)
     /// and durations given to --max-time mean wall-clock time on a plain SCXML model.
     #[arg(long, value_name = "DURATION")]
     pub time_unit: Option<String>,
+    /// How sends are delivered: `queues` (SCAN: per-machine FIFO queues) or `as2fm`
+    /// (AS2FM's JANI semantics: one pending message per event, broadcast); default:
+    /// `as2fm` for robot models and `.jani` property files, `queues` otherwise.
+    #[arg(long, value_enum)]
+    pub events: Option<Events>,
 }
 
 /// A model with its properties, compiled: everything `validate` checks.
@@ -205,13 +262,19 @@ pub struct Loaded {
     pub props_path: PathBuf,
     /// The length of one model time step in nanoseconds, when known.
     pub unit_ns: Option<u64>,
+    /// The run length the model asks for (a robot main file's `max_time`), in steps.
+    pub default_max_time: Option<u64>,
+    /// How sends are delivered.
+    pub events: EventSemantics,
 }
 
 impl Loaded {
     /// `--max-time`: model steps, or a duration when the model has a time unit; by
-    /// default 10,000 steps.
+    /// default the main file's `max_time`, else 10,000 steps.
     pub fn max_time(&self, arg: Option<&str>) -> Result<u64, CliError> {
-        let Some(text) = arg else { return Ok(10_000) };
+        let Some(text) = arg else {
+            return Ok(self.default_max_time.unwrap_or(10_000));
+        };
         match super::sweep::BoundValue::parse(text).map_err(CliError::Input)? {
             super::sweep::BoundValue::Units(v) => Ok(v),
             super::sweep::BoundValue::Nanos(ns) => match self.unit_ns {
@@ -238,8 +301,12 @@ fn parse_time_unit(text: &str) -> Result<u64, CliError> {
     }
 }
 
-/// Loads the model and its properties.
+/// Loads the model and its properties: a robot model (a main file, or a folder holding
+/// `main.xml`) through the robot pipeline, anything else as plain SCXML.
 pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
+    if let Some(main) = crate::robot::load::main_file_of(&args.model) {
+        return load_robot(args, &main);
+    }
     let model = &args.model;
     let unit_ns = args.time_unit.as_deref().map(parse_time_unit).transpose()?;
     let compiled = CompiledModel::load(model).map_err(|d| CliError::Input(d.to_string()))?;
@@ -250,8 +317,40 @@ pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
         Some(p) => p.to_path_buf(),
         None => default_props(model, &compiled)?,
     };
-    let file = props::parse_file(&props_path).map_err(|d| CliError::Input(d.to_string()))?;
-    let set = PropertySet::with_unit(&file, &compiled, unit_ns).map_err(|e| {
+    let file = read_properties(&props_path, &compiled)?;
+    let set = compile_properties(&file, &compiled, unit_ns)?;
+    let events = args
+        .events
+        .map_or_else(|| default_events(&props_path), Into::into);
+    Ok(Loaded {
+        model: compiled,
+        file,
+        set,
+        props_path,
+        unit_ns,
+        default_max_time: None,
+        events,
+    })
+}
+
+/// Reads a property file: JANI (`.jani`) or SCAN XML (with ROS ports and patterns).
+fn read_properties(path: &Path, model: &CompiledModel) -> Result<props::PropertyFile, CliError> {
+    if is_jani(path) {
+        props::jani::parse_file(path, model)
+    } else {
+        props::parse_file(path)
+    }
+    .map_err(|d| CliError::Input(d.to_string()))
+}
+
+/// Compiles a property file against a model; a bound with a unit on a model without one
+/// gets a hint.
+fn compile_properties(
+    file: &props::PropertyFile,
+    model: &CompiledModel,
+    unit_ns: Option<u64>,
+) -> Result<PropertySet, CliError> {
+    PropertySet::with_unit(file, model, unit_ns).map_err(|e| {
         if unit_ns.is_none() && e.contains("no known duration") {
             CliError::Input(format!(
                 "{e}\nhint: give the length of one model step with --time-unit (for example \
@@ -260,13 +359,54 @@ pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
         } else {
             CliError::Input(e)
         }
-    })?;
+    })
+}
+
+/// Loads a robot model: the main file and everything it names, lowered and compiled; the
+/// properties are the file given, else the first one the main file names.
+fn load_robot(args: &ModelArgs, main: &Path) -> Result<Loaded, CliError> {
+    use crate::robot::main_file::InputKind;
+    let robot = crate::robot::load::load(main).map_err(|d| CliError::Input(d.to_string()))?;
+    if let Some(text) = &args.time_unit {
+        let given = parse_time_unit(text)?;
+        if given != robot.time_unit_ns {
+            return Err(CliError::Input(format!(
+                "--time-unit {text}: {} steps by {}, from its timers and max_time",
+                main.display(),
+                super::sweep::BoundValue::Nanos(robot.time_unit_ns).display()
+            )));
+        }
+    }
+    let props_path = match (&args.props, robot.main.properties.first()) {
+        (Some(p), _) => p.clone(),
+        (None, Some(input)) => {
+            if input.kind == InputKind::Hspec {
+                return Err(CliError::Input(format!(
+                    "{}: an .hspec file names no messages of the model; write the \
+                     properties over ROS names (XML) or give them on the command line",
+                    input.path.display()
+                )));
+            }
+            input.path.clone()
+        }
+        (None, None) => {
+            return Err(CliError::Input(format!(
+                "{}: the main file names no property file; give one after the model",
+                main.display()
+            )))
+        }
+    };
+    let file = read_properties(&props_path, &robot.model)?;
+    let set = compile_properties(&file, &robot.model, Some(robot.time_unit_ns))?;
     Ok(Loaded {
-        model: compiled,
+        model: robot.model,
         file,
         set,
         props_path,
-        unit_ns,
+        unit_ns: Some(robot.time_unit_ns),
+        default_max_time: Some(robot.max_time_steps),
+        // The lowering is AS2FM's translation; its sends mean what AS2FM's JANI means.
+        events: args.events.map_or(EventSemantics::As2fm, Into::into),
     })
 }
 
@@ -484,6 +624,8 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
         decided: m.runs.decided,
         quiescent: m.runs.quiescent,
         seconds: 0.0,
+        step_seconds: None,
+        max_time_seconds: None,
         properties: m
             .properties
             .iter()
@@ -523,6 +665,7 @@ pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
     let run_cfg = RunConfig {
         max_time: loaded.max_time(args.max_time.as_deref())?,
         max_steps: args.max_steps,
+        events: loaded.events,
         ..RunConfig::default()
     };
     let csv = replay_csv(model, set, &run_cfg, args.seed, args.run)?;
@@ -596,6 +739,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     let run_cfg = RunConfig {
         max_time: loaded.max_time(args.max_time.as_deref())?,
         max_steps: args.max_steps,
+        events: loaded.events,
         ..RunConfig::default()
     };
     let study_cfg = StudyConfig {
@@ -614,12 +758,18 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     if args.save_failing > 0 {
         save_failing(args, model, set, &run_cfg, &result)?;
     }
-    let report = report(args, props_path, set, &result);
+    let mut report = report(args, props_path, set, &result);
+    if let Some(unit) = loaded.unit_ns {
+        report.step_seconds = Some(unit as f64 / 1e9);
+        report.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
+    }
     print_report(&report, args.json)
 }
 
 fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -> Report {
     Report {
+        step_seconds: None,
+        max_time_seconds: None,
         model: args.input.model.display().to_string(),
         properties_file: props.display().to_string(),
         seed: args.seed,
@@ -697,6 +847,9 @@ fn print_table(r: &Report) {
         r.quiescent,
         r.step_limit
     );
+    if let (Some(step), Some(max)) = (r.step_seconds, r.max_time_seconds) {
+        println!("model time: steps of {step} s, runs of at most {max} s");
+    }
 }
 
 /// Arguments of `hindsight validate`.

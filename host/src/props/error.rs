@@ -99,6 +99,10 @@ pub enum PropsErrorKind {
         /// The element containing it.
         element: String,
     },
+    /// The file is not well-formed JSON.
+    Json(String),
+    /// A JANI construct that is wrong or not supported here.
+    Jani(String),
 }
 
 impl fmt::Display for PropsErrorKind {
@@ -154,6 +158,8 @@ impl fmt::Display for PropsErrorKind {
             PropsErrorKind::UnexpectedText { element } => {
                 write!(f, "unexpected text inside <{element}>")
             }
+            PropsErrorKind::Json(message) => write!(f, "malformed JSON: {message}"),
+            PropsErrorKind::Jani(message) => f.write_str(message),
         }
     }
 }

@@ -60,6 +60,8 @@
 //! file, line and column.
 
 mod error;
+pub mod jani;
+mod json;
 mod read;
 pub mod ros;
 mod source;
@@ -69,10 +71,6 @@ use std::path::{Path, PathBuf};
 
 pub use error::{Diagnostics, PropsError, PropsErrorKind};
 pub use source::{Location, SourceText};
-
-/// The `origin` / `target` of a port that matches any machine (ROS ports: whoever
-/// publishes or serves).
-pub const ANY_MACHINE: &str = "*";
 
 /// A property file, read and checked.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -96,19 +94,39 @@ pub struct Port {
     pub kind: PortKind,
     /// The SCXML event (message) observed.
     pub event: String,
-    /// The machine that sends it.
+    /// The machine that sends it ([`ANY`]: every sender).
     pub origin: String,
-    /// The machine it is sent to.
+    /// The machine it is sent to ([`ANY`]: every target, the `NONE` sink included).
     pub target: String,
     /// Where the variable is declared (`<state_var>`, `<event_var>` or `<port>`).
     pub at: Location,
 }
+
+/// A port's origin or target that matches every machine (JANI properties observe an
+/// event whoever sends it).
+pub const ANY: &str = "*";
 
 /// What a variable holds.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum PortKind {
     /// True exactly at the point where the message is sent.
     Event,
+    /// False until the message is first sent, true from then on (JANI's `E.valid`).
+    Sent,
+    /// Part of an array or string parameter as last sent (JANI's `aa` and `.d1_len`):
+    /// the element at `path` (indices from the outside in; inside a string, a
+    /// character's code) or, with `length`, the number of elements (characters) there.
+    /// An element the message does not have reads as `0`, `false` or `0.0`.
+    Part {
+        /// The message parameter.
+        param: String,
+        /// Indices into it.
+        path: Vec<u32>,
+        /// The length at `path` instead of the element.
+        length: bool,
+        /// The element's type, as for [`PortKind::State`].
+        ty: String,
+    },
     /// The value of a message parameter as last sent.
     State {
         /// The message parameter.

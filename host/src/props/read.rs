@@ -624,8 +624,10 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
         let mut variables = HashMap::new();
         for port in ports {
             let ty = match &port.kind {
-                PortKind::Event => Ty::Bool,
-                PortKind::State { ty, .. } => Ty::of(ty).unwrap_or(Ty::Int),
+                PortKind::Event | PortKind::Sent => Ty::Bool,
+                PortKind::State { ty, .. } | PortKind::Part { ty, .. } => {
+                    Ty::of(ty).unwrap_or(Ty::Int)
+                }
             };
             variables.entry(port.id.clone()).or_insert(VarInfo { ty });
         }

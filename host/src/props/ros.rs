@@ -34,7 +34,7 @@ use super::error::PropsErrorKind;
 use super::read::FileReader;
 use super::source::{Location, SourceText};
 use super::xml::Element;
-use super::{Port, PortKind, Property, ANY_MACHINE};
+use super::{Port, PortKind, Property, ANY};
 
 /// The message name of a ROS topic in the translated model: `/a/b` -> `topic_a__b_msg`.
 pub fn topic_event(topic: &str) -> String {
@@ -136,8 +136,8 @@ impl<'a> FileReader<'_, 'a> {
                     id,
                     kind,
                     event: event.to_owned(),
-                    origin: ANY_MACHINE.to_owned(),
-                    target: ANY_MACHINE.to_owned(),
+                    origin: ANY.to_owned(),
+                    target: ANY.to_owned(),
                     at: var.at,
                 });
             }

@@ -120,7 +120,7 @@ fn write_element(el: &Element, depth: usize, out: &mut String) {
 }
 
 /// Appends `text` escaped for an attribute value in double quotes.
-fn escape_into(text: &str, out: &mut String) {
+pub fn escape_into(text: &str, out: &mut String) {
     for c in text.chars() {
         match c {
             '&' => out.push_str("&amp;"),

@@ -47,6 +47,10 @@ pub(crate) struct SendDef {
     pub params: Vec<(u32, CellFn)>,
     /// Parameter indices this send leaves at their default.
     pub missing: Vec<u32>,
+    /// One of a run of identical sends, one to each receiver of the event, after the
+    /// first: AS2FM's plain export writes its one broadcast send this way, so
+    /// [`super::EventSemantics::As2fm`] skips these copies.
+    pub expanded_copy: bool,
 }
 
 /// One instruction of a machine's code.
@@ -1067,9 +1071,69 @@ impl<'b, 's> MachineCompiler<'b, 's> {
     }
 
     fn block(&mut self, execs: &[Exec], event: Option<u32>) {
-        for x in execs {
+        for (i, x) in execs.iter().enumerate() {
+            let before = self.code.len();
             self.exec(x, event);
+            if self.code.len() > before && self.expanded_copy(execs, i) {
+                if let Some(Instr::Send(sd)) = self.code.last_mut() {
+                    sd.expanded_copy = true;
+                }
+            }
         }
+    }
+
+    /// Whether `execs[i]` is a send that repeats the one before it for another target,
+    /// in a run whose targets are exactly the event's receivers (AS2FM's expansion of a
+    /// broadcast send for SCAN).
+    fn expanded_copy(&self, execs: &[Exec], i: usize) -> bool {
+        let as_send = |k: usize| match execs.get(k) {
+            Some(Exec::Send(s)) if s.delay.is_none() => Some(s),
+            _ => None,
+        };
+        let same = |a: &crate::model::ast::Send, b: &crate::model::ast::Send| {
+            a.event.name == b.event.name
+                && a.params.len() == b.params.len()
+                && a.params
+                    .iter()
+                    .zip(&b.params)
+                    .all(|(p, q)| p.name.name == q.name.name && p.expr.text == q.expr.text)
+        };
+        let (Some(cur), Some(prev)) = (as_send(i), i.checked_sub(1).and_then(as_send)) else {
+            return false;
+        };
+        if !same(cur, prev) {
+            return false;
+        }
+        let mut start = i - 1;
+        while start > 0 && as_send(start - 1).is_some_and(|s| same(s, cur)) {
+            start -= 1;
+        }
+        let mut end = i;
+        while as_send(end + 1).is_some_and(|s| same(s, cur)) {
+            end += 1;
+        }
+        let Some(&ev) = self.b.event_index.get(&cur.event.name) else {
+            return false;
+        };
+        let mut targets = BTreeSet::new();
+        for k in start..=end {
+            let Some(SendTarget::Id(t)) = as_send(k).and_then(|s| s.target.as_ref()) else {
+                return false;
+            };
+            let Some(m) = self
+                .b
+                .src
+                .machines
+                .iter()
+                .position(|m| m.name.name == t.name)
+            else {
+                return false;
+            };
+            if !targets.insert(m as u32) {
+                return false;
+            }
+        }
+        targets == self.b.events[ev as usize].receivers
     }
 
     fn exec(&mut self, x: &Exec, event: Option<u32>) {
@@ -1234,6 +1298,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                         delay,
                         params,
                         missing,
+                        expanded_copy: false,
                     })),
                     s.span,
                 );

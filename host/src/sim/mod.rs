@@ -36,11 +36,16 @@
 //!   runs one machine up to and including its next communication (send or
 //!   receive). Time advances by one unit only when no machine can move and a
 //!   delayed send is pending; with nothing pending the run is quiescent.
+//! - [`RunConfig::events`] = [`EventSemantics::As2fm`] replaces the queues with the
+//!   semantics of AS2FM's JANI translation, for the plain SCXML AS2FM generates: one
+//!   pending message per event, delivered to all its receivers at once, senders
+//!   blocking while it is pending (details on [`EventSemantics::As2fm`]).
 //! - Runs end at quiescence, `max_time`, `max_steps`, when an observer stops
 //!   them, at a run-time error, or when a loop is detected: too many
 //!   eventless transitions in one step, or too many steps at one instant
 //!   ([`SpinReport`] names the machine and state).
 
+pub mod as2fm;
 mod compiled;
 mod ids;
 mod observer;
@@ -51,7 +56,7 @@ pub use compiled::CompiledModel;
 pub use ids::{EventId, MachineId, StateId};
 pub use observer::{Flow, Observer, SentMessage};
 pub use run::{
-    EndReason, Quiescence, RunConfig, RunError, RunOutcome, Simulator, SpinKind, SpinReport,
-    TransitionChoice,
+    EndReason, EventSemantics, Quiescence, RunConfig, RunError, RunOutcome, Simulator, SpinKind,
+    SpinReport, TransitionChoice,
 };
 pub use trace::{TraceRecorder, TraceRow};

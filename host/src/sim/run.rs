@@ -1,6 +1,7 @@
 //! The simulator: runs a [`CompiledModel`] as a channel system, step by step, without allocating.
 
-use super::compiled::{CompiledModel, DelayDef, Instr, MachineDef, SendTo};
+use super::as2fm::{event_flags, may_discard, never_discards, EV_BB_REQ, EV_BB_SET, EV_TIMER};
+use super::compiled::{CompiledModel, DelayDef, Instr, MachineDef, SendDef, SendTo};
 use super::ids::{MachineId, StateId};
 use super::observer::{Flow, Observer, SentMessage};
 use crate::expr::compile::{Code, Entropy, Env, EvalError, EvalErrorKind, MAX_PATH};
@@ -30,6 +31,46 @@ pub enum Quiescence {
     AdvanceTime,
 }
 
+/// How `<send>`s are delivered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum EventSemantics {
+    /// SCAN's channel system: each machine has a FIFO queue; a send goes to its target.
+    #[default]
+    Queues,
+    /// AS2FM's JANI translation, for the plain SCXML AS2FM generates: one global
+    /// one-place buffer per event, broadcast to every machine with a transition on it.
+    ///
+    /// - The `target` of a `<send>` is ignored. Sending `E` while `E` is pending blocks
+    ///   the sender until `E` is delivered; an event no machine has a transition on is
+    ///   observed and never pending.
+    /// - Delivering a pending `E` is a step of its own, chosen at random among the
+    ///   machine steps and the other deliverable events. It is possible only when every
+    ///   receiver is idle in a state where it can take `E`: an enabled transition on `E`
+    ///   (the first in document order fires), or a discard: the state has transitions
+    ///   on `E` none of which is enabled, or it has none and `E` is not one of AS2FM's
+    ///   synchronised events (BT `bt_N_tick` / `_halt` / `_response` /
+    ///   `_halt_response`, services `srv_*_request` / `_response` / `_req_client*`,
+    ///   actions `action_*_goal_*`, `action_*_result*`, `action_*_thread_start|free`).
+    ///   BT roots (`bt_root_fsm*`) and ROS interface handlers (`srv_handler_*`,
+    ///   `action_handler_*`) never discard. All receivers take `E` at once.
+    /// - A send writes the event's global parameters (one that it leaves out keeps its
+    ///   previous value); each receiver copies them when it takes the event and reads
+    ///   `_event.data` from its copy. (JANI reads the globals on each edge: the same
+    ///   values up to the transition's first `<send>` or `<if>`, which execute on later
+    ///   edges and could see a newer send of the event; the copy leaves out that race.)
+    /// - AS2FM's plain export writes one broadcast `<send>` as one send per receiver
+    ///   (same event, same parameters, targets exactly the event's receivers): such a
+    ///   run of sends is sent once.
+    /// - Timer events (`ros_time_rate.*`) are a rendezvous: the sender waits until the
+    ///   event is delivered, which needs no other event pending.
+    /// - `bt_blackboard_req` cannot be sent while a `bt_blackboard_set_*` is pending.
+    /// - Time advances only when nothing else can move and no event is pending; with an
+    ///   event pending that nobody can take, the run ends (JANI's deadlock). (JANI lets
+    ///   the global timer tick as soon as no event is pending, even while a machine is
+    ///   still inside a transition; here time waits for every machine, as in SCAN.)
+    As2fm,
+}
+
 /// Limits and choices for one run.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RunConfig {
@@ -51,6 +92,8 @@ pub struct RunConfig {
     pub transitions: TransitionChoice,
     /// What quiescence does.
     pub quiescence: Quiescence,
+    /// How sends are delivered.
+    pub events: EventSemantics,
 }
 
 impl Default for RunConfig {
@@ -62,6 +105,7 @@ impl Default for RunConfig {
             max_steps_per_instant: 1_000_000,
             transitions: TransitionChoice::DocumentOrder,
             quiescence: Quiescence::Stop,
+            events: EventSemantics::Queues,
         }
     }
 }
@@ -175,6 +219,11 @@ struct MachineRt {
     pc: u32,
     /// Blocked by a delayed send until `wake`.
     waiting: bool,
+    /// [`EventSemantics::As2fm`]: blocked at a send (its event is pending) or waiting
+    /// for a timer event it sent to be delivered (`awaiting`).
+    blocked: bool,
+    /// The timer event this machine waits to see delivered (`NO_MSG`: none).
+    awaiting: u32,
     wake: u64,
     /// Index of the next target of a send without target.
     bcast: u32,
@@ -216,6 +265,30 @@ pub struct Simulator<'m> {
     /// so each keeps its buffers' shape from step to step and run to run.
     scratch: Vec<Vec<Cell>>,
     idx: [i64; MAX_PATH],
+    /// The current run uses [`EventSemantics::As2fm`].
+    as2fm: bool,
+    /// Per event: [`EV_TIMER`], [`EV_SYNCHED`], [`EV_BB_REQ`], [`EV_BB_SET`] flags.
+    ev_flags: Vec<u8>,
+    /// Per machine: never discards events (BT roots and ROS interface handlers).
+    no_discard: Vec<bool>,
+    /// Per event: pending (as2fm).
+    pending: Vec<bool>,
+    /// Pending events, in the order they were sent.
+    pending_list: Vec<u32>,
+    /// Pending events other than timer events.
+    pending_regular: u32,
+    /// Pending `bt_blackboard_set_*` events.
+    pending_bb_set: u32,
+    /// Scratch: events deliverable at this step.
+    deliverable: Vec<u32>,
+    /// Machines blocked at a send.
+    blocked_list: Vec<u32>,
+    /// Per event: parameters being evaluated before they replace the global ones.
+    ev_scratch: Vec<Vec<Cell>>,
+    /// Per event: the pool slot of its first receiver's copy of a delivered message.
+    rx_base: Vec<u32>,
+    /// Pool slots reserved for [`EventSemantics::As2fm`] (never freed).
+    reserved: usize,
 }
 
 impl std::fmt::Debug for Simulator<'_> {
@@ -301,6 +374,8 @@ impl<'m> Simulator<'m> {
                     state: d.initial,
                     pc: IDLE,
                     waiting: false,
+                    blocked: false,
+                    awaiting: NO_MSG,
                     wake: 0,
                     bcast: 0,
                     delay_done: false,
@@ -312,7 +387,42 @@ impl<'m> Simulator<'m> {
                     vars: d.defaults.clone(),
                 })
                 .collect(),
-            pool: Vec::new(),
+            // Under EventSemantics::As2fm, slot `e` is event `e`'s global buffer, and
+            // each receiver of `e` has its own copy at `rx_base[e] + position`.
+            pool: model
+                .events
+                .iter()
+                .enumerate()
+                .map(|(e, d)| Slot {
+                    event: e as u32,
+                    origin: 0,
+                    target: u32::MAX,
+                    params: d.defaults.clone(),
+                })
+                .chain(model.events.iter().enumerate().flat_map(|(e, d)| {
+                    d.receivers.iter().map(move |&r| Slot {
+                        event: e as u32,
+                        origin: 0,
+                        target: r,
+                        params: d.defaults.clone(),
+                    })
+                }))
+                .collect(),
+            rx_base: model
+                .events
+                .iter()
+                .scan(model.events.len() as u32, |next, d| {
+                    let base = *next;
+                    *next += d.receivers.len() as u32;
+                    Some(base)
+                })
+                .collect(),
+            reserved: model.events.len()
+                + model
+                    .events
+                    .iter()
+                    .map(|d| d.receivers.len())
+                    .sum::<usize>(),
             free: vec![Vec::new(); model.events.len()],
             runnable: Vec::with_capacity(n),
             rpos: vec![NOT_RUNNABLE; n],
@@ -328,6 +438,20 @@ impl<'m> Simulator<'m> {
                 .map(|d| vec![Cell::Int(0); d.n_scratch as usize])
                 .collect(),
             idx: [0; MAX_PATH],
+            as2fm: false,
+            ev_flags: model.events.iter().map(|e| event_flags(&e.name)).collect(),
+            no_discard: model
+                .machines
+                .iter()
+                .map(|d| never_discards(&d.name))
+                .collect(),
+            pending: vec![false; model.events.len()],
+            pending_list: Vec::with_capacity(model.events.len()),
+            pending_regular: 0,
+            pending_bb_set: 0,
+            deliverable: Vec::with_capacity(model.events.len()),
+            blocked_list: Vec::with_capacity(n),
+            ev_scratch: model.events.iter().map(|d| d.defaults.clone()).collect(),
         }
     }
 
@@ -360,7 +484,8 @@ impl<'m> Simulator<'m> {
 
     fn refresh(&mut self, m: usize) {
         let r = &self.ms[m];
-        let can = !r.waiting && (r.pc != IDLE || !r.intq.is_empty() || !r.extq.is_empty());
+        let can =
+            !r.waiting && !r.blocked && (r.pc != IDLE || !r.intq.is_empty() || !r.extq.is_empty());
         let pos = self.rpos[m];
         if can && pos == NOT_RUNNABLE {
             self.rpos[m] = self.runnable.len() as u32;
@@ -376,6 +501,10 @@ impl<'m> Simulator<'m> {
     }
 
     fn free_slot(&mut self, slot: u32) {
+        // The first slots are the events' global buffers and receiver copies: never free.
+        if (slot as usize) < self.reserved {
+            return;
+        }
         let ev = self.pool.get(slot as usize).map_or(0, |s| s.event as usize);
         if let Some(f) = self.free.get_mut(ev) {
             f.push(slot);
@@ -384,7 +513,7 @@ impl<'m> Simulator<'m> {
 
     fn release(&mut self, m: usize) {
         let cur = self.ms[m].cur;
-        if cur != NO_MSG {
+        if cur != NO_MSG && !self.as2fm {
             self.free_slot(cur);
             self.ms[m].cur = NO_MSG;
         }
@@ -448,7 +577,7 @@ impl<'m> Simulator<'m> {
         for f in &mut self.free {
             f.clear();
         }
-        for i in (0..self.pool.len()).rev() {
+        for i in (self.reserved..self.pool.len()).rev() {
             let ev = self.pool[i].event as usize;
             if let Some(f) = self.free.get_mut(ev) {
                 f.push(i as u32);
@@ -466,6 +595,8 @@ impl<'m> Simulator<'m> {
                 .get(def.initial as usize)
                 .map_or(IDLE, |s| s.entry);
             r.waiting = false;
+            r.blocked = false;
+            r.awaiting = NO_MSG;
             r.wake = 0;
             r.bcast = 0;
             r.delay_done = false;
@@ -525,6 +656,17 @@ impl<'m> Simulator<'m> {
                 }
             }
         }
+        self.pending.iter_mut().for_each(|p| *p = false);
+        self.pending_list.clear();
+        self.pending_regular = 0;
+        self.pending_bb_set = 0;
+        self.blocked_list.clear();
+        for (slot, d) in self.pool.iter_mut().zip(&model.events) {
+            for (c, dc) in slot.params.iter_mut().zip(&d.defaults) {
+                c.clone_from(dc);
+            }
+            slot.origin = 0;
+        }
         for m in 0..self.ms.len() {
             self.refresh(m);
         }
@@ -557,9 +699,26 @@ impl<'m> Simulator<'m> {
         cfg: &RunConfig,
         obs: &mut O,
     ) -> Result<EndReason, Stop> {
+        self.as2fm = cfg.events == EventSemantics::As2fm;
         self.reset(rng)?;
         loop {
-            if self.runnable.is_empty() {
+            if self.as2fm {
+                self.deliverable.clear();
+                for i in 0..self.pending_list.len() {
+                    let e = self.pending_list[i];
+                    if self.deliverable_now(e, rng, cfg)? {
+                        self.deliverable.push(e);
+                    }
+                }
+                if self.runnable.is_empty()
+                    && self.deliverable.is_empty()
+                    && !self.pending_list.is_empty()
+                {
+                    // An event nobody can ever take blocks time: JANI's deadlock.
+                    return Ok(EndReason::Quiescent);
+                }
+            }
+            if self.runnable.is_empty() && self.deliverable.is_empty() {
                 if self.delayed.is_empty() && cfg.quiescence == Quiescence::Stop {
                     return Ok(EndReason::Quiescent);
                 }
@@ -595,7 +754,19 @@ impl<'m> Simulator<'m> {
                     .unwrap_or(0);
                 return Err(self.spin(busiest, SpinKind::NoTimeProgress));
             }
-            let k = below(rng, self.runnable.len() as u32) as usize;
+            let n_deliver = if self.as2fm {
+                self.deliverable.len()
+            } else {
+                0
+            };
+            let k = below(rng, (self.runnable.len() + n_deliver) as u32) as usize;
+            if k >= self.runnable.len() {
+                let e = self.deliverable[k - self.runnable.len()];
+                if self.deliver(e, rng, cfg, obs)? == Flow::Stop {
+                    return Ok(EndReason::Stopped);
+                }
+                continue;
+            }
             let m = self.runnable[k] as usize;
             self.instant_moves[m] = self.instant_moves[m].saturating_add(1);
             if self.step(m, rng, cfg, obs)? == Flow::Stop {
@@ -901,6 +1072,13 @@ impl<'m> Simulator<'m> {
                             }
                         }
                     }
+                    if self.as2fm {
+                        if sd.expanded_copy {
+                            self.ms[m].pc = pc + 1;
+                            continue;
+                        }
+                        return self.as2fm_send(m, pc, sd, rng, obs);
+                    }
                     let mut broadcast_len = 0usize;
                     let target: Option<u32> = match &sd.to {
                         SendTo::Machine(t) => Some(*t),
@@ -1039,6 +1217,237 @@ impl<'m> Simulator<'m> {
                 }
             }
         }
+    }
+
+    /// Whether a blocked machine's send (or awaited rendezvous) can go on now.
+    fn send_possible(&self, m: usize) -> bool {
+        let r = &self.ms[m];
+        if r.awaiting != NO_MSG {
+            return !self.pending[r.awaiting as usize];
+        }
+        match self.model.machines[m].code.get(r.pc as usize) {
+            Some(Instr::Send(sd)) => self.send_enabled(sd.event),
+            _ => true,
+        }
+    }
+
+    /// [`EventSemantics::As2fm`]: whether event `e` may be sent now.
+    fn send_enabled(&self, e: u32) -> bool {
+        let bb_blocked = self.ev_flags[e as usize] & EV_BB_REQ != 0 && self.pending_bb_set > 0;
+        !self.pending[e as usize] && !bb_blocked
+    }
+
+    /// What receiver `r` does with pending event `e` now: `Some(Some(t))` fires
+    /// transition `t`, `Some(None)` discards it, `None` cannot take it yet.
+    /// Points the receiver's `_event` at the event's global buffer.
+    fn receive_choice(
+        &mut self,
+        r: u32,
+        e: u32,
+        rng: &mut dyn Entropy,
+        cfg: &RunConfig,
+    ) -> Result<Option<Option<u32>>, Stop> {
+        let model = self.model;
+        let m = r as usize;
+        let rt = &self.ms[m];
+        if rt.pc != IDLE || rt.blocked || rt.waiting || !rt.intq.is_empty() {
+            return Ok(None);
+        }
+        let def = &model.machines[m];
+        let Some(st) = def.states.get(rt.state as usize) else {
+            return Ok(None);
+        };
+        let has = !st.transitions(e, &def.dispatch).is_empty();
+        let origin = self.pool[e as usize].origin;
+        {
+            let rt = &mut self.ms[m];
+            rt.cur = e;
+            rt.cur_event = model
+                .events
+                .get(e as usize)
+                .map_or(StrId(0), |d| d.name_str);
+            rt.cur_origin = model
+                .machines
+                .get(origin as usize)
+                .map_or(StrId(0), |d| d.name_str);
+        }
+        if let Some(t) = self.select(m, def, Some(e), rng, cfg)? {
+            return Ok(Some(Some(t)));
+        }
+        let discard = may_discard(self.no_discard[m], has, self.ev_flags[e as usize]);
+        Ok(discard.then_some(None))
+    }
+
+    /// Whether pending event `e` can be delivered now (every receiver can take it).
+    fn deliverable_now(
+        &mut self,
+        e: u32,
+        rng: &mut dyn Entropy,
+        cfg: &RunConfig,
+    ) -> Result<bool, Stop> {
+        if self.ev_flags[e as usize] & EV_TIMER != 0 && self.pending_regular > 0 {
+            return Ok(false);
+        }
+        let model = self.model;
+        for &r in &model.events[e as usize].receivers {
+            if self.receive_choice(r, e, rng, cfg)?.is_none() {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+
+    /// Delivers pending event `e` to all its receivers at once (one point each).
+    fn deliver<O: Observer + ?Sized>(
+        &mut self,
+        e: u32,
+        rng: &mut dyn Entropy,
+        cfg: &RunConfig,
+        obs: &mut O,
+    ) -> Result<Flow, Stop> {
+        let model = self.model;
+        let mut flow = Flow::Continue;
+        let origin = self.pool[e as usize].origin;
+        for (k, &r) in model.events[e as usize].receivers.iter().enumerate() {
+            let m = r as usize;
+            let choice = self.receive_choice(r, e, rng, cfg)?.flatten();
+            // The receiver keeps its own copy: JANI assigns it with the receive itself.
+            let rx = self.rx_base[e as usize] as usize + k;
+            let (global, copy) = self.pool.split_at_mut(rx);
+            copy[0].params.clone_from(&global[e as usize].params);
+            copy[0].origin = origin;
+            self.ms[m].cur = rx as u32;
+            self.steps += 1;
+            self.instant_steps += 1;
+            self.instant_moves[m] = self.instant_moves[m].saturating_add(1);
+            let f = obs.on_receive(
+                self.time,
+                &SentMessage {
+                    model,
+                    event: super::ids::EventId(e),
+                    origin: MachineId(origin),
+                    target: Some(MachineId(r)),
+                    params: &self.pool[e as usize].params,
+                },
+            );
+            if f == Flow::Stop {
+                flow = Flow::Stop;
+            }
+            if let Some(t) = choice {
+                self.ms[m].pc = model.machines[m].trans[t as usize].pc;
+                self.refresh(m);
+            }
+        }
+        self.pending[e as usize] = false;
+        if let Some(i) = self.pending_list.iter().position(|&x| x == e) {
+            self.pending_list.remove(i);
+        }
+        let flags = self.ev_flags[e as usize];
+        if flags & EV_TIMER == 0 {
+            self.pending_regular = self.pending_regular.saturating_sub(1);
+        }
+        if flags & EV_BB_SET != 0 {
+            self.pending_bb_set = self.pending_bb_set.saturating_sub(1);
+        }
+        let mut i = 0;
+        while i < self.blocked_list.len() {
+            let m = self.blocked_list[i] as usize;
+            if self.send_possible(m) {
+                self.ms[m].blocked = false;
+                self.ms[m].awaiting = NO_MSG;
+                self.blocked_list.swap_remove(i);
+                self.refresh(m);
+            } else {
+                i += 1;
+            }
+        }
+        Ok(flow)
+    }
+
+    /// A `<send>` under [`EventSemantics::As2fm`]: blocks while its event is pending,
+    /// else writes the event's global parameters and makes it pending.
+    fn as2fm_send<O: Observer + ?Sized>(
+        &mut self,
+        m: usize,
+        pc: u32,
+        sd: &SendDef,
+        rng: &mut dyn Entropy,
+        obs: &mut O,
+    ) -> Result<Flow, Stop> {
+        let model = self.model;
+        let e = sd.event as usize;
+        if !self.send_enabled(sd.event) {
+            self.ms[m].blocked = true;
+            self.blocked_list.push(m as u32);
+            self.refresh(m);
+            return Ok(Flow::Continue);
+        }
+        let mut out = std::mem::take(&mut self.ev_scratch[e]);
+        for &i in &sd.missing {
+            if let (Some(dst), Some(cur)) =
+                (out.get_mut(i as usize), self.pool[e].params.get(i as usize))
+            {
+                dst.clone_from(cur);
+            }
+        }
+        let res = {
+            let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
+            let mut res = Ok(());
+            for (i, f) in &sd.params {
+                if let Some(dst) = out.get_mut(*i as usize) {
+                    res = f(&mut env, dst);
+                    if res.is_err() {
+                        break;
+                    }
+                }
+            }
+            res
+        };
+        if let Err(err) = res {
+            self.ev_scratch[e] = out;
+            return Err(self.diag_error(m, Some(pc as usize), err));
+        }
+        std::mem::swap(&mut self.pool[e].params, &mut out);
+        self.ev_scratch[e] = out;
+        let declared = match &sd.to {
+            SendTo::Machine(t) => *t,
+            _ => u32::MAX,
+        };
+        self.pool[e].origin = m as u32;
+        self.pool[e].target = declared;
+        self.steps += 1;
+        self.instant_steps += 1;
+        let flow = obs.on_send(
+            self.time,
+            &SentMessage {
+                model,
+                event: super::ids::EventId(sd.event),
+                origin: MachineId(m as u32),
+                target: (declared != u32::MAX).then_some(MachineId(declared)),
+                params: &self.pool[e].params,
+            },
+        );
+        let r = &mut self.ms[m];
+        r.bcast = 0;
+        r.delay_done = false;
+        r.pc = pc + 1;
+        if !model.events[e].receivers.is_empty() {
+            let flags = self.ev_flags[e];
+            self.pending[e] = true;
+            self.pending_list.push(sd.event);
+            if flags & EV_TIMER != 0 {
+                r.blocked = true;
+                r.awaiting = sd.event;
+                self.blocked_list.push(m as u32);
+            } else {
+                self.pending_regular += 1;
+            }
+            if flags & EV_BB_SET != 0 {
+                self.pending_bb_set += 1;
+            }
+            self.refresh(m);
+        }
+        Ok(flow)
     }
 
     fn internal(&self, m: usize, pc: u32) -> Stop {

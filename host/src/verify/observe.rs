@@ -14,23 +14,36 @@ use monitor_core::{valuation, Monitor, Ty, Value, VarKind};
 
 use super::settle::Settler;
 use crate::expr::Value as SimValue;
-use crate::props::{PortKind, PropertyFile, ANY_MACHINE};
+use crate::props::{PortKind, PropertyFile, ANY};
 use crate::sim::{CompiledModel, Flow, MachineId, Observer, SentMessage};
 use crate::smc::{RunEnd, RunOutcome, Verdict};
 
 /// One port resolved to model ids.
 #[derive(Clone, Debug)]
 struct Port {
-    /// `None`: any machine ([`ANY_MACHINE`]).
+    /// `None`: any sender.
     origin: Option<MachineId>,
-    /// `None`: any target ([`ANY_MACHINE`]); `Some(None)`: the `NONE` sink.
+    /// `None`: any target; `Some(None)`: the `NONE` sink.
     target: Option<Option<MachineId>>,
     /// The spec variable it sets.
     var: usize,
-    /// The message parameter (state variables only).
-    param: Option<usize>,
-    /// Fields to follow inside a struct parameter (`point.x`), outermost first.
-    fields: Vec<u32>,
+    /// What it sets the variable to.
+    value: PortValue,
+}
+
+/// What a port writes when its message is sent.
+#[derive(Clone, Debug)]
+enum PortValue {
+    /// `true` (event variables, and the sent-once flag).
+    True,
+    /// A message parameter.
+    Param(usize),
+    /// An element (or, with `length`, the length) inside a message parameter.
+    Part {
+        param: usize,
+        path: Box<[u32]>,
+        length: bool,
+    },
 }
 
 /// Guarantees and assumptions compiled to one program, with their ports resolved.
@@ -62,17 +75,6 @@ fn spec_type(scan: &str) -> Option<&'static str> {
         "string" => "string",
         _ => return None,
     })
-}
-
-/// The value reached by following `fields` into a struct value.
-fn field_of<'v>(mut v: SimValue<'v>, fields: &[u32]) -> Option<SimValue<'v>> {
-    for f in fields {
-        let SimValue::List(l) = v else {
-            return None;
-        };
-        v = l.get(*f as usize)?;
-    }
-    Some(v)
 }
 
 /// A time unit of `ns` nanoseconds as the spec language writes it: `100ms`, `1s`, `7ns`.
@@ -112,6 +114,21 @@ impl PropertySet {
             let at = origin(p.at.line, p.at.column);
             let (kind, type_name, init) = match &p.kind {
                 PortKind::Event => (VarKind::Event, "bool".to_string(), None),
+                PortKind::Sent => (
+                    VarKind::State,
+                    "bool".to_string(),
+                    Some("false".to_string()),
+                ),
+                PortKind::Part { ty, .. } => match spec_type(ty) {
+                    Some(t) => (VarKind::State, t.to_string(), None),
+                    None => {
+                        errors.push(format!(
+                            "{file}:{}:{}: port `{}`: unsupported type `{ty}`",
+                            p.at.line, p.at.column, p.id
+                        ));
+                        continue;
+                    }
+                },
                 PortKind::State { ty, init, .. } => match spec_type(ty) {
                     Some(t) => (
                         VarKind::State,
@@ -173,7 +190,7 @@ impl PropertySet {
             };
             let origin = match model.machine_id(&p.origin) {
                 Some(m) => Some(m),
-                None if p.origin == ANY_MACHINE => None,
+                None if p.origin == ANY => None,
                 None => {
                     errors.push(format!("{here}: no machine `{}` in the model", p.origin));
                     continue;
@@ -181,17 +198,46 @@ impl PropertySet {
             };
             let target = match model.machine_id(&p.target) {
                 Some(m) => Some(Some(m)),
-                None if p.target == ANY_MACHINE => None,
                 None if p.target == "NONE" => Some(None),
+                None if p.target == ANY => None,
                 None => {
                     errors.push(format!("{here}: no machine `{}` in the model", p.target));
                     continue;
                 }
             };
-            let (param, fields) = match &p.kind {
-                PortKind::Event => (None, Vec::new()),
+            let value = match &p.kind {
+                PortKind::Event | PortKind::Sent => PortValue::True,
+                PortKind::Part {
+                    param,
+                    path,
+                    length,
+                    ..
+                } => match model.param_path(event, param) {
+                    // Struct fields first (`point.xs`), then the indices given.
+                    Some((i, mut fields)) => PortValue::Part {
+                        param: i,
+                        path: {
+                            fields.extend(path);
+                            fields.into_boxed_slice()
+                        },
+                        length: *length,
+                    },
+                    None => {
+                        errors.push(format!(
+                            "{here}: event `{}` has no parameter `{param}`",
+                            p.event
+                        ));
+                        continue;
+                    }
+                },
                 PortKind::State { param, .. } => match model.param_path(event, param) {
-                    Some((i, fields)) => (Some(i), fields),
+                    Some((i, fields)) if fields.is_empty() => PortValue::Param(i),
+                    // A field of a struct parameter (`point.x`, `point__x`).
+                    Some((i, fields)) => PortValue::Part {
+                        param: i,
+                        path: fields.into_boxed_slice(),
+                        length: false,
+                    },
                     None => {
                         errors.push(format!(
                             "{here}: event `{}` has no parameter `{param}`",
@@ -208,8 +254,7 @@ impl PropertySet {
                 origin,
                 target,
                 var,
-                param,
-                fields,
+                value,
             });
         }
         if !errors.is_empty() {
@@ -344,6 +389,45 @@ impl<'a> Judge<'a> {
         })
     }
 
+    /// The element at `path` inside `v` (a string's characters are their codes), or its
+    /// length; the type's zero when `v` has no such element.
+    fn part(
+        &self,
+        v: SimValue<'_>,
+        path: &[u32],
+        length: bool,
+        ty: Ty,
+        model: &CompiledModel,
+    ) -> Option<Value> {
+        let zero = match ty {
+            Ty::Bool => Value::Bool(false),
+            Ty::Float => Value::Float(0.0),
+            _ => Value::Int(0),
+        };
+        let mut cur = v;
+        for (k, &i) in path.iter().enumerate() {
+            cur = match cur {
+                SimValue::List(l) => match l.get(i as usize) {
+                    Some(x) => x,
+                    None => return Some(zero),
+                },
+                SimValue::Str(s) if k + 1 == path.len() && !length => {
+                    let code = model.strings().get(s).chars().nth(i as usize);
+                    return Some(code.map_or(zero, |c| Value::Int(c as i64)));
+                }
+                _ => return None,
+            };
+        }
+        if length {
+            return match cur {
+                SimValue::List(l) => Some(Value::Int(l.len() as i64)),
+                SimValue::Str(s) => Some(Value::Int(model.strings().get(s).chars().count() as i64)),
+                _ => None,
+            };
+        }
+        self.convert(cur, ty)
+    }
+
     /// The run's outcome from the verdicts at its last point and why it ended.
     pub fn outcome(&self, end: RunEnd, steps: u64, time: u64) -> RunOutcome {
         let g = self.set.guarantees.len();
@@ -388,12 +472,16 @@ impl Observer for Judge<'_> {
                 continue;
             }
             let decl = &self.monitor.program().vars[port.var];
-            let value = match port.param {
-                None => Some(Value::Bool(true)),
-                Some(i) => msg
-                    .param(i)
-                    .and_then(|v| field_of(v, &port.fields))
-                    .and_then(|v| self.convert(v, decl.ty)),
+            let value = match &port.value {
+                PortValue::True => Some(Value::Bool(true)),
+                PortValue::Param(i) => msg.param(*i).and_then(|v| self.convert(v, decl.ty)),
+                PortValue::Part {
+                    param,
+                    path,
+                    length,
+                } => msg
+                    .param(*param)
+                    .and_then(|v| self.part(v, path, *length, decl.ty, msg.model())),
             };
             match value {
                 Some(v) => self.vals[port.var] = v,

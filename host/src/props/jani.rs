@@ -1,0 +1,898 @@
+//! JANI property files, as AS2FM uses them: `Pmin` / `Pmax` / `P` of `F`, `G` and `U`
+//! over the global variables AS2FM declares for every event, read into a
+//! [`PropertyFile`] of ports and Past-MTL guarantees.
+//!
+//! # Variables
+//!
+//! AS2FM turns each SCXML event `E` into global JANI variables that its `<send>`s set:
+//! `E.valid` (false until `E` is first sent, then true for good) and `E__P` for each
+//! parameter `P` (the value of the last send; before any, the type's default `0`,
+//! `false`, `0.0`, `""`). Event and parameter names may both contain `__`, so a name is
+//! resolved against the model: `E__P` must name an event of the model and one of its
+//! scalar parameters. Both become ports on every sender and target ([`super::ANY`]):
+//! `E.valid` a [`PortKind::Sent`], `E__P` a [`PortKind::State`].
+//!
+//! # Formulas
+//!
+//! A property is `{"name", "expression"}`; the expression may be wrapped in
+//! `filter` (`fun` `values`, `states` `initial`), then `Pmin`, `Pmax` or `P` of a path
+//! formula. Every run is judged at its last point (DESIGN.md section 2), and on a finite
+//! run:
+//!
+//! | JANI | Past-MTL at the last point |
+//! | --- | --- |
+//! | `F f` | `P {f}` (f held once) |
+//! | `G f` | `H {f}` |
+//! | `f U g` | `P ({g} && Z H {f})` (g held once, f at every earlier point) |
+//!
+//! The min/max of a probability is the same estimate here: the simulator resolves
+//! nondeterminism at random. State formulas become one atom each: `∧ ∨ ¬ ⇒`,
+//! `= ≠ < ≤ > ≥`, `+ - * / %`, literals, variables; `abs(e)` as an operand of a
+//! comparison (unfolded into two comparisons); `av` (an array value) compared with a
+//! string parameter, read as the string of those character codes (AS2FM stores strings
+//! as code arrays); `aa` with constant indices and `E__P.d1_len` on array and string
+//! parameters ([`PortKind::Part`]; a string's elements are its character codes). Step,
+//! time and reward bounds, nested path formulas, `.d2_len` and other operators are
+//! reported as unsupported, with the file, line and column of the construct.
+
+use std::path::Path;
+
+use super::error::{Diagnostics, PropsError, PropsErrorKind};
+use super::json::{self, Json, Node};
+use super::source::{LineIndex, Location, SourceText};
+use super::{Port, PortKind, Property, PropertyFile, ANY};
+use crate::expr::value::Ty;
+use crate::sim::{CompiledModel, EventId};
+
+/// Reads the JANI property file at `path` and resolves its variables against `model`.
+pub fn parse_file(path: &Path, model: &CompiledModel) -> Result<PropertyFile, Diagnostics> {
+    let fail = |kind| {
+        Diagnostics(vec![PropsError {
+            path: path.to_path_buf(),
+            at: Location::new(1, 1),
+            kind,
+        }])
+    };
+    let bytes = std::fs::read(path).map_err(|e| fail(PropsErrorKind::Io(e.to_string())))?;
+    let text = String::from_utf8(bytes).map_err(|_| fail(PropsErrorKind::Encoding))?;
+    parse_str(&text, path, model)
+}
+
+/// Reads a JANI property file's text; `path` is only used in errors.
+pub fn parse_str(
+    text: &str,
+    path: &Path,
+    model: &CompiledModel,
+) -> Result<PropertyFile, Diagnostics> {
+    let lines = LineIndex::new(text);
+    let root = json::parse(text).map_err(|(offset, message)| {
+        Diagnostics(vec![PropsError {
+            path: path.to_path_buf(),
+            at: lines.location(offset),
+            kind: PropsErrorKind::Json(message),
+        }])
+    })?;
+    let mut r = Reader {
+        path,
+        lines: &lines,
+        model,
+        ports: Vec::new(),
+        errors: Vec::new(),
+    };
+    let mut guarantees: Vec<Property> = Vec::new();
+    match root.get("properties").map(|p| &p.value) {
+        Some(Json::Array(items)) => {
+            for item in items {
+                if let Some(p) = r.property(item) {
+                    if let Some(first) = guarantees.iter().find(|g| g.id == p.id) {
+                        let first = first.at;
+                        r.error(
+                            item.offset,
+                            PropsErrorKind::Duplicate {
+                                what: "property",
+                                id: p.id.clone(),
+                                first,
+                            },
+                        );
+                    } else {
+                        guarantees.push(p);
+                    }
+                }
+            }
+        }
+        _ => r.jani(root.offset, "expected an object with a `properties` array"),
+    }
+    if !r.errors.is_empty() {
+        let mut errors = r.errors;
+        errors.sort_by_key(|e| e.at);
+        errors.dedup();
+        return Err(Diagnostics(errors));
+    }
+    Ok(PropertyFile {
+        path: path.to_path_buf(),
+        ports: r.ports,
+        guarantees,
+        assumptions: Vec::new(),
+    })
+}
+
+/// What a JANI variable name refers to in the model.
+enum Var {
+    Valid(EventId),
+    Param(EventId, String, Ty),
+}
+
+/// A rendered state expression: its text (with locations) and its type.
+struct Rendered {
+    text: SourceText,
+    ty: Ty,
+    /// An `abs(e)` whose operand this is: only a comparison may use it.
+    abs: Option<SourceText>,
+    /// An array value's elements (only a string comparison may use it).
+    codes: Option<Vec<i64>>,
+}
+
+struct Reader<'r, 'a> {
+    path: &'r Path,
+    lines: &'r LineIndex<'a>,
+    model: &'r CompiledModel,
+    ports: Vec<Port>,
+    errors: Vec<PropsError>,
+}
+
+impl Reader<'_, '_> {
+    fn at(&self, offset: usize) -> Location {
+        self.lines.location(offset)
+    }
+
+    fn error(&mut self, offset: usize, kind: PropsErrorKind) {
+        let at = self.at(offset);
+        self.errors.push(PropsError {
+            path: self.path.to_path_buf(),
+            at,
+            kind,
+        });
+    }
+
+    fn jani(&mut self, offset: usize, message: impl Into<String>) {
+        self.error(offset, PropsErrorKind::Jani(message.into()));
+    }
+
+    fn property(&mut self, node: &Node) -> Option<Property> {
+        let Some(name) = node.get("name").and_then(Node::as_str) else {
+            self.jani(node.offset, "a property needs a string `name`");
+            return None;
+        };
+        let name = name.to_owned();
+        let Some(expr) = node.get("expression") else {
+            self.jani(
+                node.offset,
+                format!("property `{name}` has no `expression`"),
+            );
+            return None;
+        };
+        let formula = self.probability(expr)?;
+        Some(Property {
+            id: name,
+            formula,
+            at: self.at(node.offset),
+            converted: true,
+        })
+    }
+
+    /// `filter(values, P.. (path), initial)` or `P.. (path)`.
+    fn probability(&mut self, node: &Node) -> Option<SourceText> {
+        let op = node.get("op").and_then(Node::as_str).unwrap_or("");
+        match op {
+            "filter" => {
+                let fun = node.get("fun").and_then(Node::as_str).unwrap_or("");
+                if fun != "values" {
+                    self.jani(
+                        node.offset,
+                        format!("filter function `{fun}` is not supported (only `values`)"),
+                    );
+                    return None;
+                }
+                if let Some(states) = node.get("states") {
+                    if states.get("op").and_then(Node::as_str) != Some("initial") {
+                        self.jani(
+                            states.offset,
+                            "only `\"states\": {\"op\": \"initial\"}` is supported",
+                        );
+                        return None;
+                    }
+                }
+                match node.get("values") {
+                    Some(v) => self.probability(v),
+                    None => {
+                        self.jani(node.offset, "filter needs `values`");
+                        None
+                    }
+                }
+            }
+            "Pmin" | "Pmax" | "P" => match node.get("exp") {
+                Some(path) => self.path_formula(path),
+                None => {
+                    self.jani(node.offset, format!("`{op}` needs `exp`"));
+                    None
+                }
+            },
+            _ => {
+                self.jani(
+                    node.offset,
+                    format!("`{op}`: only probabilities (`Pmin`, `Pmax`, `P`) are supported"),
+                );
+                None
+            }
+        }
+    }
+
+    fn check_bounds(&mut self, node: &Node) -> bool {
+        if let Json::Object(members) = &node.value {
+            for (key, at, _) in members {
+                if matches!(
+                    key.as_str(),
+                    "step-bounds" | "time-bounds" | "reward-bounds"
+                ) {
+                    self.jani(
+                        *at,
+                        format!(
+                            "`{key}` are not supported: a run's steps and time do not match JANI's"
+                        ),
+                    );
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    fn path_formula(&mut self, node: &Node) -> Option<SourceText> {
+        let at = self.at(node.offset);
+        let op = node.get("op").and_then(Node::as_str).unwrap_or("");
+        if !self.check_bounds(node) {
+            return None;
+        }
+        let mut out = SourceText::empty();
+        match op {
+            "F" | "G" => {
+                let Some(f) = node.get("exp") else {
+                    self.jani(node.offset, format!("`{op}` needs `exp`"));
+                    return None;
+                };
+                let f = self.atom(f)?;
+                out.push_generated(if op == "F" { "P " } else { "H " }, at);
+                out.push_source(&f);
+            }
+            "U" => {
+                let (Some(l), Some(r)) = (node.get("left"), node.get("right")) else {
+                    self.jani(node.offset, "`U` needs `left` and `right`");
+                    return None;
+                };
+                let left_true = l.value == Json::Bool(true);
+                let l = self.atom(l);
+                let r = self.atom(r);
+                let (l, r) = (l?, r?);
+                if left_true {
+                    out.push_generated("P ", at);
+                    out.push_source(&r);
+                } else {
+                    out.push_generated("P (", at);
+                    out.push_source(&r);
+                    out.push_generated(" && Z H ", at);
+                    out.push_source(&l);
+                    out.push_generated(")", at);
+                }
+            }
+            _ => {
+                self.jani(
+                    node.offset,
+                    format!("path operator `{op}` is not supported (only `F`, `G`, `U`)"),
+                );
+                return None;
+            }
+        }
+        Some(out)
+    }
+
+    /// A state formula as one atom `{...}` (or `true` / `false`).
+    fn atom(&mut self, node: &Node) -> Option<SourceText> {
+        let at = self.at(node.offset);
+        if let Json::Bool(b) = node.value {
+            return Some(SourceText::generated(if b { "true" } else { "false" }, at));
+        }
+        let e = self.expr(node)?;
+        if e.ty != Ty::Bool {
+            self.error(
+                node.offset,
+                PropsErrorKind::Type {
+                    message: "a state formula must be boolean".into(),
+                },
+            );
+            return None;
+        }
+        let e = self.plain(node, e)?;
+        let mut out = SourceText::empty();
+        out.push_generated("{", at);
+        out.push_source(&e);
+        out.push_generated("}", at);
+        Some(out)
+    }
+
+    /// The text of an operand that is not `abs` or an array value.
+    fn plain(&mut self, node: &Node, r: Rendered) -> Option<SourceText> {
+        if r.abs.is_some() {
+            self.jani(
+                node.offset,
+                "`abs` is supported only as an operand of a comparison",
+            );
+            return None;
+        }
+        if r.codes.is_some() {
+            self.jani(
+                node.offset,
+                "an array value is supported only when compared with a string",
+            );
+            return None;
+        }
+        Some(r.text)
+    }
+
+    fn resolve(&self, name: &str) -> Option<Var> {
+        if let Some(event) = name.strip_suffix(".valid") {
+            if let Some(e) = self.model.event_id(event) {
+                return Some(Var::Valid(e));
+            }
+        }
+        let mut start = 0;
+        while let Some(i) = name[start..].find("__") {
+            let split = start + i;
+            if let Some(e) = self.model.event_id(&name[..split]) {
+                let param = &name[split + 2..];
+                if let Some(k) = self.model.param_index(e, param) {
+                    let ty = self.model.event_params(e)[k].1.clone();
+                    return Some(Var::Param(e, param.to_owned(), ty));
+                }
+            }
+            start = split + 1;
+        }
+        None
+    }
+
+    /// The port id for JANI variable `name`, declaring the port on first use.
+    fn port(&mut self, name: &str, offset: usize) -> Option<(String, Ty)> {
+        let at = self.at(offset);
+        if let Some(base) = name.strip_suffix(".d1_len") {
+            return self.part_port(base, Vec::new(), true, offset);
+        }
+        let var = match self.resolve(name) {
+            Some(v) => v,
+            None => {
+                let hint = if name.ends_with(".d1_len") || name.contains(".d") {
+                    " (array parameters are not supported)"
+                } else {
+                    ""
+                };
+                self.error(
+                    offset,
+                    PropsErrorKind::Jani(format!(
+                        "`{name}` is neither `E.valid` nor `E__P` for an event E of the model and one of its parameters P{hint}"
+                    )),
+                );
+                return None;
+            }
+        };
+        let (event, kind, ty) = match var {
+            Var::Valid(e) => (e, PortKind::Sent, Ty::Bool),
+            Var::Param(e, param, ty) => {
+                let (type_name, init) = match ty {
+                    Ty::Bool => ("bool", "false"),
+                    Ty::Int => ("int64", "0"),
+                    Ty::Float => ("float64", "0.0"),
+                    Ty::Str => ("string", "''"),
+                    _ => {
+                        self.jani(
+                            offset,
+                            format!("`{name}`: array and struct parameters are not supported"),
+                        );
+                        return None;
+                    }
+                };
+                (
+                    e,
+                    PortKind::State {
+                        param,
+                        ty: type_name.to_owned(),
+                        init: SourceText::generated(init, at),
+                    },
+                    ty,
+                )
+            }
+        };
+        Some((self.declare(name, event, kind, at), ty))
+    }
+
+    /// The id of the port for `kind` on `event`, declared on first use (named after `name`).
+    fn declare(&mut self, name: &str, event: EventId, kind: PortKind, at: Location) -> String {
+        let event_name = self.model.event_name(event).to_owned();
+        if let Some(p) = self
+            .ports
+            .iter()
+            .find(|p| p.event == event_name && p.kind.same_variable(&kind))
+        {
+            return p.id.clone();
+        }
+        let base: String = name
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect();
+        let base = if base.starts_with(|c: char| c.is_ascii_digit()) {
+            format!("v_{base}")
+        } else {
+            base
+        };
+        let mut id = base.clone();
+        let mut n = 1;
+        while self.ports.iter().any(|p| p.id == id) {
+            n += 1;
+            id = format!("{base}_{n}");
+        }
+        self.ports.push(Port {
+            id: id.clone(),
+            kind,
+            event: event_name,
+            origin: ANY.to_owned(),
+            target: ANY.to_owned(),
+            at,
+        });
+        id
+    }
+
+    /// A port on part of an array or string parameter: `path` into it, or its length.
+    fn part_port(
+        &mut self,
+        base: &str,
+        path: Vec<u32>,
+        length: bool,
+        offset: usize,
+    ) -> Option<(String, Ty)> {
+        let at = self.at(offset);
+        let Some(Var::Param(event, param, ty)) = self.resolve(base) else {
+            self.jani(
+                offset,
+                format!("`{base}` is not `E__P` for an event E of the model and an array or string parameter P"),
+            );
+            return None;
+        };
+        let mut cur = ty;
+        for (k, _) in path.iter().enumerate() {
+            cur = match cur {
+                Ty::Array(inner, _) => *inner,
+                Ty::Str if k + 1 == path.len() && !length => Ty::Int,
+                _ => {
+                    self.jani(
+                        offset,
+                        format!("`{base}` has no element at depth {}", k + 1),
+                    );
+                    return None;
+                }
+            };
+        }
+        let (ty, type_name) = if length {
+            if !matches!(cur, Ty::Array(..) | Ty::Str) {
+                self.jani(
+                    offset,
+                    format!("`{base}`: only arrays and strings have a length"),
+                );
+                return None;
+            }
+            (Ty::Int, "int64")
+        } else {
+            match cur {
+                Ty::Bool => (Ty::Bool, "bool"),
+                Ty::Int => (Ty::Int, "int64"),
+                Ty::Float => (Ty::Float, "float64"),
+                Ty::Str => (Ty::Str, "string"),
+                _ => {
+                    self.jani(
+                        offset,
+                        format!("`{base}`: only scalar elements can be observed"),
+                    );
+                    return None;
+                }
+            }
+        };
+        let mut name = base.to_owned();
+        for i in &path {
+            name.push_str(&format!("_{i}"));
+        }
+        if length {
+            name.push_str("_len");
+        }
+        let kind = PortKind::Part {
+            param,
+            path,
+            length,
+            ty: type_name.to_owned(),
+        };
+        Some((self.declare(&name, event, kind, at), ty))
+    }
+
+    fn leaf(&self, text: &str, ty: Ty, offset: usize) -> Rendered {
+        Rendered {
+            text: SourceText::generated(text, self.at(offset)),
+            ty,
+            abs: None,
+            codes: None,
+        }
+    }
+
+    fn operand<'n>(&mut self, node: &'n Node, key: &str) -> Option<&'n Node> {
+        let op = node.get("op").and_then(Node::as_str).unwrap_or("");
+        let found = node.get(key);
+        if found.is_none() {
+            self.jani(node.offset, format!("`{op}` needs `{key}`"));
+        }
+        found
+    }
+
+    fn expr(&mut self, node: &Node) -> Option<Rendered> {
+        let at = self.at(node.offset);
+        match &node.value {
+            Json::Bool(b) => {
+                Some(self.leaf(if *b { "true" } else { "false" }, Ty::Bool, node.offset))
+            }
+            Json::Number(n) => {
+                let ty = if n.contains(['.', 'e', 'E']) {
+                    Ty::Float
+                } else {
+                    Ty::Int
+                };
+                Some(self.leaf(n, ty, node.offset))
+            }
+            Json::Str(name) => {
+                let (id, ty) = self.port(name, node.offset)?;
+                Some(self.leaf(&id, ty, node.offset))
+            }
+            Json::Object(_) => {
+                let op = node
+                    .get("op")
+                    .and_then(Node::as_str)
+                    .unwrap_or("")
+                    .to_owned();
+                match op.as_str() {
+                    "∧" | "∨" | "⇒" => {
+                        let l = self.operand(node, "left");
+                        let r = self.operand(node, "right");
+                        let (l, r) = (l?, r?);
+                        let (lr, rr) = (self.expr(l), self.expr(r));
+                        let (lr, rr) = (lr?, rr?);
+                        if lr.ty != Ty::Bool || rr.ty != Ty::Bool {
+                            self.error(
+                                node.offset,
+                                PropsErrorKind::Type {
+                                    message: format!("`{op}` takes booleans"),
+                                },
+                            );
+                            return None;
+                        }
+                        let (lt, rt) = (self.plain(l, lr)?, self.plain(r, rr)?);
+                        let mut out = SourceText::empty();
+                        out.push_generated(if op == "⇒" { "(!(" } else { "((" }, at);
+                        out.push_source(&lt);
+                        out.push_generated(
+                            match op.as_str() {
+                                "∧" => ") && (",
+                                _ => ") || (",
+                            },
+                            at,
+                        );
+                        out.push_source(&rt);
+                        out.push_generated("))", at);
+                        Some(Rendered {
+                            text: out,
+                            ty: Ty::Bool,
+                            abs: None,
+                            codes: None,
+                        })
+                    }
+                    "¬" => {
+                        let e = self.operand(node, "exp")?;
+                        let r = self.expr(e)?;
+                        if r.ty != Ty::Bool {
+                            self.error(
+                                node.offset,
+                                PropsErrorKind::Type {
+                                    message: "`¬` takes a boolean".into(),
+                                },
+                            );
+                            return None;
+                        }
+                        let t = self.plain(e, r)?;
+                        let mut out = SourceText::empty();
+                        out.push_generated("!(", at);
+                        out.push_source(&t);
+                        out.push_generated(")", at);
+                        Some(Rendered {
+                            text: out,
+                            ty: Ty::Bool,
+                            abs: None,
+                            codes: None,
+                        })
+                    }
+                    "=" | "≠" | "<" | "≤" | ">" | "≥" => self.comparison(node, &op),
+                    "+" | "-" | "*" | "/" | "%" => {
+                        let l = self.operand(node, "left");
+                        let r = self.operand(node, "right");
+                        let (l, r) = (l?, r?);
+                        let (lr, rr) = (self.expr(l), self.expr(r));
+                        let (lr, rr) = (lr?, rr?);
+                        let numeric = |t: &Ty| matches!(t, Ty::Int | Ty::Float);
+                        if !numeric(&lr.ty) || !numeric(&rr.ty) {
+                            self.error(
+                                node.offset,
+                                PropsErrorKind::Type {
+                                    message: format!("`{op}` takes numbers"),
+                                },
+                            );
+                            return None;
+                        }
+                        let ty = if op == "/" || lr.ty == Ty::Float || rr.ty == Ty::Float {
+                            Ty::Float
+                        } else {
+                            Ty::Int
+                        };
+                        let (lt, rt) = (self.plain(l, lr)?, self.plain(r, rr)?);
+                        let mut out = SourceText::empty();
+                        out.push_generated("(", at);
+                        out.push_source(&lt);
+                        out.push_generated(&format!(" {op} "), at);
+                        out.push_source(&rt);
+                        out.push_generated(")", at);
+                        Some(Rendered {
+                            text: out,
+                            ty,
+                            abs: None,
+                            codes: None,
+                        })
+                    }
+                    "abs" => {
+                        let e = self.operand(node, "exp")?;
+                        let r = self.expr(e)?;
+                        if !matches!(r.ty, Ty::Int | Ty::Float) {
+                            self.error(
+                                node.offset,
+                                PropsErrorKind::Type {
+                                    message: "`abs` takes a number".into(),
+                                },
+                            );
+                            return None;
+                        }
+                        let ty = r.ty.clone();
+                        let t = self.plain(e, r)?;
+                        let mut neg = SourceText::empty();
+                        neg.push_generated("(-(", at);
+                        neg.push_source(&t);
+                        neg.push_generated("))", at);
+                        Some(Rendered {
+                            text: t,
+                            ty,
+                            abs: Some(neg),
+                            codes: None,
+                        })
+                    }
+                    "av" => {
+                        let Some(Json::Array(items)) = node.get("elements").map(|n| &n.value)
+                        else {
+                            self.jani(node.offset, "`av` needs an `elements` array");
+                            return None;
+                        };
+                        let mut codes = Vec::new();
+                        for it in items {
+                            match &it.value {
+                                Json::Number(n) => {
+                                    match n.parse::<i64>() {
+                                        Ok(c) => codes.push(c),
+                                        Err(_) => {
+                                            self.jani(it.offset, "array values are supported only as character codes");
+                                            return None;
+                                        }
+                                    }
+                                }
+                                _ => {
+                                    self.jani(
+                                        it.offset,
+                                        "array values are supported only as character codes",
+                                    );
+                                    return None;
+                                }
+                            }
+                        }
+                        Some(Rendered {
+                            text: SourceText::empty(),
+                            ty: Ty::Str,
+                            abs: None,
+                            codes: Some(codes),
+                        })
+                    }
+                    "aa" => {
+                        let mut path = Vec::new();
+                        let mut cur = node;
+                        while cur.get("op").and_then(Node::as_str) == Some("aa") {
+                            let index = match cur.get("index").map(|n| &n.value) {
+                                Some(Json::Number(n)) => n.parse::<u32>().ok(),
+                                _ => None,
+                            };
+                            let Some(index) = index else {
+                                self.jani(cur.offset, "`aa` is supported only with a constant non-negative integer `index`");
+                                return None;
+                            };
+                            path.push(index);
+                            let Some(exp) = cur.get("exp") else {
+                                self.jani(cur.offset, "`aa` needs `exp`");
+                                return None;
+                            };
+                            cur = exp;
+                        }
+                        path.reverse();
+                        let Some(base) = cur.as_str() else {
+                            self.jani(cur.offset, "`aa` is supported only on an event parameter");
+                            return None;
+                        };
+                        let (id, ty) = self.part_port(base, path, false, cur.offset)?;
+                        Some(self.leaf(&id, ty, node.offset))
+                    }
+                    "" => {
+                        self.jani(node.offset, "an expression object needs `op`");
+                        None
+                    }
+                    _ => {
+                        self.jani(node.offset, format!("operator `{op}` is not supported"));
+                        None
+                    }
+                }
+            }
+            _ => {
+                self.jani(
+                    node.offset,
+                    "expected a variable, a constant or an operator object",
+                );
+                None
+            }
+        }
+    }
+
+    fn comparison(&mut self, node: &Node, op: &str) -> Option<Rendered> {
+        let at = self.at(node.offset);
+        let l = self.operand(node, "left");
+        let r = self.operand(node, "right");
+        let (l, r) = (l?, r?);
+        let (lr, rr) = (self.expr(l), self.expr(r));
+        let (mut lr, mut rr) = (lr?, rr?);
+        let sym = match op {
+            "=" => "==",
+            "≠" => "!=",
+            "≤" => "<=",
+            "≥" => ">=",
+            other => other,
+        };
+        // A string compared with an array of character codes.
+        for left in [true, false] {
+            let (a, b_ty) = if left {
+                (&mut lr, rr.ty.clone())
+            } else {
+                (&mut rr, lr.ty.clone())
+            };
+            if let (Some(codes), Ty::Str) = (&a.codes, b_ty) {
+                let s: Option<String> = codes
+                    .iter()
+                    .map(|&c| u32::try_from(c).ok().and_then(char::from_u32))
+                    .collect();
+                let Some(s) = s else {
+                    self.jani(
+                        node.offset,
+                        "the array value is not a string's character codes",
+                    );
+                    return None;
+                };
+                let quoted = format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""));
+                a.text = SourceText::generated(quoted, at);
+                a.codes = None;
+            }
+        }
+        let numeric = |t: &Ty| matches!(t, Ty::Int | Ty::Float);
+        let fits =
+            (numeric(&lr.ty) && numeric(&rr.ty)) || (lr.ty == rr.ty && matches!(op, "=" | "≠"));
+        if !fits || lr.codes.is_some() || rr.codes.is_some() {
+            self.error(
+                node.offset,
+                PropsErrorKind::Type {
+                    message: format!("`{op}` cannot compare these operands"),
+                },
+            );
+            return None;
+        }
+        if lr.abs.is_some() && rr.abs.is_some() {
+            self.jani(
+                node.offset,
+                "`abs` on both sides of a comparison is not supported",
+            );
+            return None;
+        }
+        // abs(e) op c: both signs of e compared, joined by && for < and <=, || otherwise.
+        let (abs_side_left, abs) = match (lr.abs.take(), rr.abs.take()) {
+            (Some(n), None) => (true, Some(n)),
+            (None, Some(n)) => (false, Some(n)),
+            _ => (true, None),
+        };
+        let cmp = |l: &SourceText, r: &SourceText| {
+            let mut out = SourceText::empty();
+            out.push_generated("(", at);
+            out.push_source(l);
+            out.push_generated(&format!(" {sym} "), at);
+            out.push_source(r);
+            out.push_generated(")", at);
+            out
+        };
+        let text = match abs {
+            None => cmp(&lr.text, &rr.text),
+            Some(neg) => {
+                let (first, second) = if abs_side_left {
+                    (cmp(&lr.text, &rr.text), cmp(&neg, &rr.text))
+                } else {
+                    (cmp(&lr.text, &rr.text), cmp(&lr.text, &neg))
+                };
+                // |e| < c  <=>  e < c && -e < c (on the abs side); |e| > c  <=>  e > c || -e > c.
+                let small = if abs_side_left {
+                    matches!(op, "<" | "≤")
+                } else {
+                    matches!(op, ">" | "≥")
+                };
+                let join = match op {
+                    "=" => " || ",
+                    "≠" => " && ",
+                    _ if small => " && ",
+                    _ => " || ",
+                };
+                let mut out = SourceText::empty();
+                out.push_generated("(", at);
+                out.push_source(&first);
+                out.push_generated(join, at);
+                out.push_source(&second);
+                out.push_generated(")", at);
+                out
+            }
+        };
+        Some(Rendered {
+            text,
+            ty: Ty::Bool,
+            abs: None,
+            codes: None,
+        })
+    }
+}
+
+impl PortKind {
+    /// Whether two kinds declare the same variable of one event (same parameter).
+    fn same_variable(&self, other: &PortKind) -> bool {
+        match (self, other) {
+            (PortKind::Sent, PortKind::Sent) | (PortKind::Event, PortKind::Event) => true,
+            (PortKind::State { param: a, .. }, PortKind::State { param: b, .. }) => a == b,
+            (
+                PortKind::Part {
+                    param: a,
+                    path: pa,
+                    length: la,
+                    ..
+                },
+                PortKind::Part {
+                    param: b,
+                    path: pb,
+                    length: lb,
+                    ..
+                },
+            ) => a == b && pa == pb && la == lb,
+            _ => false,
+        }
+    }
+}

@@ -1,0 +1,197 @@
+//! `hindsight` on robot models: the museum guide in its high-level form (verify, sweep in
+//! seconds, convert), and bad robot models rejected with positions and exit code 2.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn hindsight(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_hindsight"))
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .args(args)
+        .output()
+        .expect("run hindsight");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hindsight-robot-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), &target).unwrap();
+        }
+    }
+}
+
+const GUIDE: &str = "examples/museum-guide";
+
+#[test]
+fn the_museum_guide_verifies_from_its_main_file() {
+    let (code, out, err) =
+        hindsight(&["verify", GUIDE, "--seed", "4", "--max-runs", "8", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let report: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let props = report["properties"].as_array().unwrap();
+    assert_eq!(props.len(), 5);
+    for p in props {
+        assert_eq!(p["successes"], 8, "{p}");
+    }
+    // The table says how long a run is, in seconds.
+    let (code, out, err) = hindsight(&["verify", GUIDE, "--seed", "4", "--max-runs", "2"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("model time: steps of 0.1 s, runs of at most 100.1 s"),
+        "{out}"
+    );
+}
+
+#[test]
+fn sweeping_the_museum_guide_finds_thresholds_in_seconds() {
+    let (code, out, err) = hindsight(&[
+        "sweep",
+        GUIDE,
+        "--property",
+        "poi_response",
+        "--from",
+        "0.1s",
+        "--to",
+        "0.3s",
+        "--runs",
+        "3",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(doc["properties"][0]["threshold"], "0.2s");
+}
+
+#[test]
+fn converted_plain_scxml_runs_exactly_like_the_robot_model() {
+    let dir = scratch("convert");
+    let out_dir = dir.join("plain");
+    let (code, _, err) = hindsight(&["convert", GUIDE, "--out", out_dir.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out_dir.join("model.xml").is_file());
+    let props = std::fs::read_to_string(out_dir.join("properties.xml")).unwrap();
+    // ROS names became machines, seconds became 100 ms steps.
+    assert!(props.contains("origin=\"BatteryComponent\""), "{props}");
+    assert!(props.contains("since[62:]"), "{props}");
+    let model = out_dir.join("model.xml");
+    let (code, high, err) = hindsight(&["trace", GUIDE, "--run", "1", "--seed", "9"]);
+    assert_eq!(code, 0, "{err}");
+    let (code, plain, err) = hindsight(&[
+        "trace",
+        model.to_str().unwrap(),
+        "--events",
+        "as2fm",
+        "--max-time",
+        "1001",
+        "--run",
+        "1",
+        "--seed",
+        "9",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(high.lines().count() > 1000);
+    assert!(high == plain, "the converted model runs differently");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn bad_robot_models_name_file_line_and_column() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-guide");
+    // (what to change, file, line, old, new, expected in the message)
+    let cases: &[(&str, &str, usize, &str, &str, &str)] = &[
+        (
+            "unknown plugin",
+            "policy.xml",
+            6,
+            "ID=\"ROS2Condition\"",
+            "ID=\"ROS2Conditio\"",
+            "policy.xml:6:32: unknown node `ROS2Conditio`",
+        ),
+        (
+            "unknown node",
+            "policy.xml",
+            12,
+            "<Inverter>",
+            "<Invertr>",
+            "policy.xml:12:21: unknown node `Invertr`",
+        ),
+        (
+            "port of the wrong type",
+            "policy.xml",
+            12,
+            "<Inverter>",
+            "<Repeat num_cycles=\"many\">",
+            "policy.xml:12:41: `num_cycles` must be a whole number",
+        ),
+        (
+            "subscriber type differs from the publisher's",
+            "Skills/BatteryLevelSkill.scxml",
+            18,
+            "std_msgs/Int32",
+            "std_msgs/Bool",
+            "BatteryLevelSkill.scxml:18:73: topic `BatteryComponent__battery_level` is subscribed with type `std_msgs/Bool`",
+        ),
+        (
+            "unsupported tag",
+            "Components/BatteryComponent.scxml",
+            14,
+            "type=\"std_msgs/Int32\" />",
+            "type=\"std_msgs/Int32\" /><ros_parameter name=\"level\" />",
+            "BatteryComponent.scxml:14:88: unsupported ROS tag <ros_parameter>",
+        ),
+    ];
+    for (what, file, line, old, new, expected) in cases {
+        let dir = scratch("bad");
+        let model = dir.join("guide");
+        copy_dir(&root, &model);
+        let path = model.join(file);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut lines: Vec<String> = text.lines().map(String::from).collect();
+        assert!(
+            lines[line - 1].contains(old),
+            "{what}: line {line} of {file}"
+        );
+        lines[line - 1] = lines[line - 1].replacen(old, new, 1);
+        if *new == "<Repeat num_cycles=\"many\">" {
+            lines[line + 1] = lines[line + 1].replacen("</Inverter>", "</Repeat>", 1);
+        }
+        if *new == "<Invertr>" {
+            lines[line + 1] = lines[line + 1].replacen("</Inverter>", "</Invertr>", 1);
+        }
+        std::fs::write(&path, lines.join("\n")).unwrap();
+        let (code, _, err) = hindsight(&["validate", model.to_str().unwrap()]);
+        assert_eq!(code, 2, "{what}: {err}");
+        assert!(err.contains(expected), "{what}: {err}");
+        let _ = std::fs::remove_dir_all(dir);
+    }
+    // A missing interface file: the service type is reported where it is used.
+    let dir = scratch("iface");
+    let model = dir.join("guide");
+    copy_dir(&root, &model);
+    std::fs::remove_file(model.join("Interfaces/notify_user_interfaces_dummy/srv/StartAlarm.srv"))
+        .unwrap();
+    let (code, _, err) = hindsight(&["validate", model.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("NotifyUserComponent.scxml:13:76: no service type `notify_user_interfaces_dummy/StartAlarm`"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
