@@ -5,7 +5,9 @@
 
 use hindsight::expr::{OwnedValue, Strings, Ty, TypeTable};
 use hindsight::robot::load::{load, RobotModel};
-use hindsight::sim::{CompiledModel, EndReason, Flow, Observer, RunConfig, SentMessage, Simulator};
+use hindsight::sim::{
+    CompiledModel, EndReason, EventSemantics, Flow, Observer, RunConfig, SentMessage, Simulator,
+};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::collections::BTreeMap;
@@ -508,22 +510,27 @@ fn struct_runs_allocate_nothing_once_warm() {
         "overarching_tutorial_main_locations",
     ] {
         let m = load_case(name);
-        let cfg = config(&m);
-        let mut sim = Simulator::new(&m.model);
-        for seed in 0..3 {
-            sim.run(&mut Xoshiro256PlusPlus::seed_from_u64(seed), &cfg, &mut ());
-        }
-        for seed in 0..3 {
-            let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-            let before = alloc::count();
-            let out = sim.run(&mut rng, &cfg, &mut ());
-            let n = alloc::count() - before;
-            assert!(out.steps > 0);
-            assert_eq!(
-                n, 0,
-                "{name} run {seed}: {n} allocations in {} steps",
-                out.steps
-            );
+        for events in [EventSemantics::Queues, EventSemantics::As2fm] {
+            let cfg = RunConfig {
+                events,
+                ..config(&m)
+            };
+            let mut sim = Simulator::new(&m.model);
+            for seed in 0..3 {
+                sim.run(&mut Xoshiro256PlusPlus::seed_from_u64(seed), &cfg, &mut ());
+            }
+            for seed in 0..3 {
+                let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+                let before = alloc::count();
+                let out = sim.run(&mut rng, &cfg, &mut ());
+                let n = alloc::count() - before;
+                assert!(out.steps > 0);
+                assert_eq!(
+                    n, 0,
+                    "{name} {events:?} run {seed}: {n} allocations in {} steps",
+                    out.steps
+                );
+            }
         }
     }
 }
