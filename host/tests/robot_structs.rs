@@ -600,3 +600,34 @@ fn property_ports_read_struct_fields() {
         "{err}"
     );
 }
+
+/// `hindsight convert` on a model with data declarations writes them as `types.xml`, named
+/// by `model.xml`; the converted model runs like the robot model.
+#[test]
+fn convert_cli_writes_the_declared_types() {
+    let (main, _) = case("data_structs_main_json_def");
+    let out = std::env::temp_dir().join(format!(
+        "hindsight-robot-structs-{}-convert-cli",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&out);
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_hindsight"))
+        .arg("convert")
+        .arg(&main)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .expect("run hindsight");
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let spec = std::fs::read_to_string(out.join("model.xml")).unwrap();
+    assert!(spec.contains("<types path=\"./types.xml\"/>"), "{spec}");
+    let back = CompiledModel::load(&out.join("model.xml")).unwrap_or_else(|e| panic!("{e}"));
+    let m = load(&main).unwrap();
+    let cfg = config(&m);
+    assert_eq!(run(&m.model, &cfg, 0), run(&back, &cfg, 0));
+    let _ = std::fs::remove_dir_all(&out);
+}
