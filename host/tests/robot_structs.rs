@@ -631,3 +631,57 @@ fn convert_cli_writes_the_declared_types() {
     assert_eq!(run(&m.model, &cfg, 0), run(&back, &cfg, 0));
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// Mutated struct models (literals, paths, declarations) load or fail with a diagnostic,
+/// and those that load run, without a panic.
+#[test]
+fn mutated_struct_models_never_panic() {
+    use rand_core::Rng;
+    let seeds = [
+        r#"<data id="l" type="Line" expr="{a: {x: 1, y: 2}, 'b': {'y': -1, 'x': 0.5}}" />
+<data id="ls" type="Line[]" expr="[{a: {x: 0, y: 0}, b: {x: 1, y: 1}},]" />"#,
+        r#"<onentry><assign location="ls[1].b" expr="l.a" /><assign location="ls.a" expr="ls.b" /><send event="e"><param name="n" expr="ls.length + ls[0].a.y" /><param name="v" expr="ls[0]" /></send></onentry>"#,
+    ];
+    let alphabet = b"{}[]().,:'\"ablsxyLinePot0123456789-_ ";
+    assert_eq!(load_err("mutant-seed", TYPES, seeds[0], seeds[1]), None);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+    let (mut loaded, mut ran) = (0, 0);
+    for k in 0..300 {
+        let which = rng.next_u32() as usize % 2;
+        let mut t: Vec<u8> = seeds[which].bytes().collect();
+        for _ in 0..1 + rng.next_u32() % 3 {
+            let at = rng.next_u32() as usize % (t.len() + 1);
+            let c = alphabet[rng.next_u32() as usize % alphabet.len()];
+            if rng.next_u32() % 2 == 0 && at < t.len() {
+                t.remove(at);
+            } else {
+                t.insert(at, c);
+            }
+        }
+        let text = String::from_utf8_lossy(&t).into_owned();
+        let (dm, body) = if which == 0 {
+            (text, seeds[1].to_string())
+        } else {
+            (seeds[0].to_string(), text)
+        };
+        let main = write_case(
+            &format!("mutant{k}"),
+            &[
+                ("main.xml", MAIN),
+                ("types.xml", TYPES),
+                ("node.ascxml", &node(&dm, &body)),
+            ],
+        );
+        if let Ok(m) = load(&main) {
+            loaded += 1;
+            let cfg = RunConfig {
+                max_steps: 1_000,
+                ..config(&m)
+            };
+            Simulator::new(&m.model).run(&mut Xoshiro256PlusPlus::seed_from_u64(1), &cfg, &mut ());
+            ran += 1;
+        }
+        let _ = std::fs::remove_dir_all(main.parent().unwrap());
+    }
+    assert!(loaded > 0 && ran == loaded, "{loaded} loaded");
+}
