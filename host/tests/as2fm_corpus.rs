@@ -9,6 +9,8 @@
 //! `--nocapture` to see them); the test fails if a skipped case starts passing, so the
 //! list stays honest.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -43,11 +45,7 @@ const SKIPS: &[(&str, &str)] = &[
 ];
 
 fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus/as2fm"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus/as2fm next to the repository")
+    common::corpus_root().join("as2fm")
 }
 
 /// The `src` of the main file's `<input type="jani" src="..."/>`.

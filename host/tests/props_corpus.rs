@@ -1,18 +1,14 @@
 //! Reads the two real SCAN property files of the shared corpus, one in each format, and
 //! checks ports, formulas and the mapping of formula offsets back to file positions.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::PathBuf;
 
 use hindsight::props::{parse_file, Location, PortKind, PropertyFile};
 
-/// `shared/corpus`, found next to the repository or a worktree container above it (the
-/// repository may be checked out at `X/repo` or `X/wt/name`, with `X/shared`).
 fn corpus_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus next to the repository")
+    common::corpus_root()
 }
 
 fn corpus(relative: &str) -> PathBuf {

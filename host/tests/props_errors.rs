@@ -1,6 +1,8 @@
 //! Bad property files: every error names the file, line and column, and independent
 //! problems are all reported.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use hindsight::props::{parse_file, parse_str, Location, PropsError, PropsErrorKind};
@@ -453,12 +455,6 @@ fn damaged_corpus_files_never_panic() {
     }
 }
 
-/// `shared/corpus`, found next to the repository or a worktree container above it (the
-/// repository may be checked out at `X/repo` or `X/wt/name`, with `X/shared`).
 fn corpus_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus next to the repository")
+    common::corpus_root()
 }

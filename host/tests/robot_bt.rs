@@ -3,6 +3,8 @@
 //! tags (after a small test-only topic/timer shim) simulate to AS2FM's expected verdicts;
 //! bad trees and plugins are errors with positions.
 
+mod common;
+
 use hindsight::model::source::{FileId, SourceMap};
 use hindsight::model::xml::{self, Element, Node};
 use hindsight::model::{Diagnostics, ModelSource};
@@ -15,11 +17,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus next to the repository")
+    common::corpus_root()
 }
 
 /// What a main file says about its tree (a minimal reader for this test; the real one is

@@ -2,6 +2,8 @@
 //! messages match the parameter names and types of AS2FM's plain translations, every
 //! main file reads, and bad input gives a diagnostic at the right file, line and column.
 
+mod common;
+
 use hindsight::model::source::SourceMap;
 use hindsight::robot::interfaces::{InterfaceKind, Interfaces};
 use hindsight::robot::types::{FlatField, InterfaceLookup};
@@ -9,11 +11,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus next to the repository")
+    common::corpus_root()
 }
 
 /// Every file under `dir` whose name ends with one of `exts`, sorted.

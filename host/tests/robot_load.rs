@@ -1,15 +1,13 @@
 //! The whole robot pipeline on every corpus main file: read, lower, compile.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use hindsight::robot::load::{load, main_file_of};
 
 fn corpus_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus next to the repository")
+    common::corpus_root()
 }
 
 fn repo(relative: &str) -> PathBuf {

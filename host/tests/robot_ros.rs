@@ -2,6 +2,8 @@
 //! museum guide's node models lower, read and compile; runs reproduce AS2FM's expected
 //! probabilities where the property is a plain reachability; bad models give positioned errors.
 
+mod common;
+
 use hindsight::model::source::{Diagnostic, SourceMap};
 use hindsight::model::xml::{self, Element};
 use hindsight::model::{Diagnostics, ModelSource};
@@ -14,11 +16,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus next to the repository")
+    common::corpus_root()
 }
 
 /// A test-only interface reader: the standard types the corpus uses, written out here, and

@@ -3,6 +3,8 @@
 //! plain translation (which flattens every struct into one variable per leaf field); bad
 //! object literals and struct declarations are errors with file, line and column.
 
+mod common;
+
 use hindsight::expr::{OwnedValue, Strings, Ty, TypeTable};
 use hindsight::robot::load::{load, RobotModel};
 use hindsight::sim::{
@@ -14,11 +16,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus/as2fm"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus next to the repository")
+    common::corpus_root().join("as2fm")
 }
 
 /// The main file of an `expected.json` case, and its expected probabilities by property.

@@ -1,6 +1,8 @@
 //! Every corpus model (AS2FM plain SCXML, the museum guide, UC3) loads and compiles; the
 //! museum's known `_event.thread_id` bug is reported precisely; corrected, the museum runs.
 
+mod common;
+
 use hindsight::model::ModelSource;
 use hindsight::sim::{CompiledModel, EndReason, RunConfig, Simulator, TraceRecorder};
 use rand_core::SeedableRng;
@@ -8,11 +10,7 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 use std::path::{Path, PathBuf};
 
 fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus next to the repository")
+    common::corpus_root()
 }
 
 fn rng(seed: u64) -> Xoshiro256PlusPlus {
