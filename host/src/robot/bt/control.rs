@@ -125,6 +125,50 @@ pub(crate) fn machine(c: Control, ctx: &Ctx, num: &[i64]) -> Element {
     }
 }
 
+/// One transition per child, as AS2FM writes them: the child's response with `status`
+/// while `idx` points at it goes to `target` doing `body()`.
+fn on_child_status(
+    ctx: &Ctx,
+    t: &mut Element,
+    idx: &str,
+    status: u8,
+    target: &str,
+    body: impl Fn() -> Vec<Element>,
+) {
+    for i in 0..ctx.children.len() {
+        t.push(ctx.b.tr(
+            Some(&ctx.child_resp(i)),
+            Some(&format!("_event.data.status == {status} && {idx} == {i}")),
+            Some(target),
+            body(),
+        ));
+    }
+}
+
+/// The start of Sequence, Fallback and SequenceWithMemory: the child index, the result
+/// `flags`, the init check, and `wait_for_tick` (a tick ticks the children, a halt resets
+/// them).
+fn sequence_head(ctx: &Ctx, idx: &str, flags: &[&str]) -> Element {
+    let b = &ctx.b;
+    let mut m = b.scxml(&ctx.machine, "init");
+    let mut data = vec![(idx, "int8", "0".to_string())];
+    data.extend(flags.iter().map(|f| (*f, "bool", "false".to_string())));
+    data.push(("children_count", "int8", n_children(ctx)));
+    m.push(b.datamodel(&data));
+    m.push(init_state(ctx, "children_count < 1"));
+    m.push(
+        b.state("wait_for_tick")
+            .with_child(b.tr(Some(&ctx.tick_ev()), None, Some("tick_children"), vec![]))
+            .with_child(b.tr(
+                Some(&ctx.halt_ev()),
+                None,
+                Some("reset_children"),
+                vec![b.assign(idx, "0")],
+            )),
+    );
+    m
+}
+
 fn n_children(ctx: &Ctx) -> String {
     ctx.children.len().to_string()
 }
@@ -168,24 +212,7 @@ fn init_state(ctx: &Ctx, bad: &str) -> Element {
 fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
     let b = &ctx.b;
     let idx = "current_child_idx";
-    let mut m = b.scxml(&ctx.machine, "init");
-    m.push(b.datamodel(&[
-        (idx, "int8", "0".into()),
-        ("seq_failure", "bool", "false".into()),
-        ("seq_success", "bool", "false".into()),
-        ("children_count", "int8", n_children(ctx)),
-    ]));
-    m.push(init_state(ctx, "children_count < 1"));
-    m.push(
-        b.state("wait_for_tick")
-            .with_child(b.tr(Some(&ctx.tick_ev()), None, Some("tick_children"), vec![]))
-            .with_child(b.tr(
-                Some(&ctx.halt_ev()),
-                None,
-                Some("reset_children"),
-                vec![b.assign(idx, "0")],
-            )),
-    );
+    let mut m = sequence_head(ctx, idx, &["seq_failure", "seq_success"]);
     let finish = vec![
         b.if_chain(
             vec![
@@ -212,30 +239,15 @@ fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
             "seq_failure"
         }
     };
-    for i in 0..ctx.children.len() {
-        t.push(b.tr(
-            Some(&ctx.child_resp(i)),
-            Some(&format!("_event.data.status == {cont} && {idx} == {i}")),
-            Some("tick_children"),
-            vec![b.assign(idx, &format!("{idx} + 1"))],
-        ));
-    }
-    for i in 0..ctx.children.len() {
-        t.push(b.tr(
-            Some(&ctx.child_resp(i)),
-            Some(&format!("_event.data.status == {stop} && {idx} == {i}")),
-            Some("reset_children"),
-            vec![b.assign(idx, "0"), b.assign(flag(stop), "true")],
-        ));
-    }
-    for i in 0..ctx.children.len() {
-        t.push(b.tr(
-            Some(&ctx.child_resp(i)),
-            Some(&format!("_event.data.status == {RUNNING} && {idx} == {i}")),
-            Some("wait_for_tick"),
-            vec![ctx.respond(RUNNING)],
-        ));
-    }
+    on_child_status(ctx, &mut t, idx, cont, "tick_children", || {
+        vec![b.assign(idx, &format!("{idx} + 1"))]
+    });
+    on_child_status(ctx, &mut t, idx, stop, "reset_children", || {
+        vec![b.assign(idx, "0"), b.assign(flag(stop), "true")]
+    });
+    on_child_status(ctx, &mut t, idx, RUNNING, "wait_for_tick", || {
+        vec![ctx.respond(RUNNING)]
+    });
     t.push(b.tr(
         None,
         Some(&format!("{idx} == children_count")),
@@ -258,23 +270,7 @@ fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
 fn sequence_with_memory(ctx: &Ctx) -> Element {
     let b = &ctx.b;
     let idx = "current_child_idx";
-    let mut m = b.scxml(&ctx.machine, "init");
-    m.push(b.datamodel(&[
-        (idx, "int8", "0".into()),
-        ("seq_success", "bool", "false".into()),
-        ("children_count", "int8", n_children(ctx)),
-    ]));
-    m.push(init_state(ctx, "children_count < 1"));
-    m.push(
-        b.state("wait_for_tick")
-            .with_child(b.tr(Some(&ctx.tick_ev()), None, Some("tick_children"), vec![]))
-            .with_child(b.tr(
-                Some(&ctx.halt_ev()),
-                None,
-                Some("reset_children"),
-                vec![b.assign(idx, "0")],
-            )),
-    );
+    let mut m = sequence_head(ctx, idx, &["seq_success"]);
     let finish = vec![
         b.if_chain(
             vec![("seq_success".into(), vec![ctx.respond(SUCCESS)])],
@@ -291,30 +287,13 @@ fn sequence_with_memory(ctx: &Ctx) -> Element {
     );
     let mut t = b.state_entry("tick_children", vec![guard]);
     let n = ctx.children.len();
-    for i in 0..n {
-        t.push(b.tr(
-            Some(&ctx.child_resp(i)),
-            Some(&format!("_event.data.status == {SUCCESS} && {idx} == {i}")),
-            Some("tick_children"),
-            vec![b.assign(idx, &format!("{idx} + 1"))],
-        ));
-    }
-    for i in 0..n {
-        t.push(b.tr(
-            Some(&ctx.child_resp(i)),
-            Some(&format!("_event.data.status == {FAILURE} && {idx} == {i}")),
-            Some("halt_current_child"),
-            vec![],
-        ));
-    }
-    for i in 0..n {
-        t.push(b.tr(
-            Some(&ctx.child_resp(i)),
-            Some(&format!("_event.data.status == {RUNNING} && {idx} == {i}")),
-            Some("wait_for_tick"),
-            vec![ctx.respond(RUNNING)],
-        ));
-    }
+    on_child_status(ctx, &mut t, idx, SUCCESS, "tick_children", || {
+        vec![b.assign(idx, &format!("{idx} + 1"))]
+    });
+    on_child_status(ctx, &mut t, idx, FAILURE, "halt_current_child", Vec::new);
+    on_child_status(ctx, &mut t, idx, RUNNING, "wait_for_tick", || {
+        vec![ctx.respond(RUNNING)]
+    });
     t.push(b.tr(
         None,
         Some(&format!("{idx} == children_count")),
@@ -406,33 +385,18 @@ fn reactive(ctx: &Ctx, seq: bool) -> Element {
     );
     let mut t = b.state_entry("tick_children", vec![guard]);
     let n = ctx.children.len();
-    for i in 0..n {
-        t.push(b.tr(
-            Some(&ctx.child_resp(i)),
-            Some(&format!("_event.data.status == {cont} && {idx} == {i}")),
-            Some("tick_children"),
-            vec![
-                b.assign(count, &format!("{count} + 1")),
-                b.assign(idx, &format!("{idx} + 1")),
-            ],
-        ));
-    }
-    for i in 0..n {
-        t.push(b.tr(
-            Some(&ctx.child_resp(i)),
-            Some(&format!("_event.data.status == {stop} && {idx} == {i}")),
-            Some("reset_children"),
-            vec![b.assign(stop_child, idx), b.assign(idx, "0")],
-        ));
-    }
-    for i in 0..n {
-        t.push(b.tr(
-            Some(&ctx.child_resp(i)),
-            Some(&format!("_event.data.status == {RUNNING} && {idx} == {i}")),
-            Some("reset_other_children"),
-            vec![b.assign("running_child", idx), b.assign(idx, "0")],
-        ));
-    }
+    on_child_status(ctx, &mut t, idx, cont, "tick_children", || {
+        vec![
+            b.assign(count, &format!("{count} + 1")),
+            b.assign(idx, &format!("{idx} + 1")),
+        ]
+    });
+    on_child_status(ctx, &mut t, idx, stop, "reset_children", || {
+        vec![b.assign(stop_child, idx), b.assign(idx, "0")]
+    });
+    on_child_status(ctx, &mut t, idx, RUNNING, "reset_other_children", || {
+        vec![b.assign("running_child", idx), b.assign(idx, "0")]
+    });
     t.push(b.tr(
         None,
         Some(&format!("{count} == children_count")),
@@ -611,7 +575,6 @@ fn parallel(ctx: &Ctx, success: i64, failure: i64) -> Element {
 fn if_then_else(ctx: &Ctx) -> Element {
     let b = &ctx.b;
     let idx = "child_idx";
-    let n = ctx.children.len();
     let mut m = b.scxml(&ctx.machine, "init");
     m.push(b.datamodel(&[
         (idx, "int8", "0".into()),
@@ -702,23 +665,13 @@ fn if_then_else(ctx: &Ctx) -> Element {
         vec![],
     ));
     for (status, flag) in [(SUCCESS, "ret_success"), (FAILURE, "ret_failure")] {
-        for i in 0..n {
-            t.push(b.tr(
-                Some(&ctx.child_resp(i)),
-                Some(&format!("_event.data.status == {status} && {idx} == {i}")),
-                Some("reset_children"),
-                vec![b.assign(idx, "0"), b.assign(flag, "true")],
-            ));
-        }
+        on_child_status(ctx, &mut t, idx, status, "reset_children", || {
+            vec![b.assign(idx, "0"), b.assign(flag, "true")]
+        });
     }
-    for i in 0..n {
-        t.push(b.tr(
-            Some(&ctx.child_resp(i)),
-            Some(&format!("_event.data.status == {RUNNING} && {idx} == {i}")),
-            Some("wait_for_tick"),
-            vec![ctx.respond(RUNNING)],
-        ));
-    }
+    on_child_status(ctx, &mut t, idx, RUNNING, "wait_for_tick", || {
+        vec![ctx.respond(RUNNING)]
+    });
     m.push(t);
     m.push(b.state("error"));
     m
