@@ -1,6 +1,6 @@
 //! Runs per second of the museum guide: the high-level robot model against its plain-SCXML translation.
 //!
-//! `cargo bench -p hindsight --bench museum [-- --runs N --reps R]`
+//! `cargo bench -p hindsight --bench museum [-- --runs N --reps R --only K]`
 //!
 //! Issue 5 asks for at least as many runs per second on the high-level model
 //! (`examples/museum-guide`, loaded through the robot pipeline, AS2FM's event semantics)
@@ -124,8 +124,16 @@ fn main() {
         .iter()
         .map(|c| Simulator::new(&c.loaded.model))
         .collect();
+    // `--only K`: time configuration K alone (for a profiler); the ratios then mean nothing.
+    let only = args
+        .iter()
+        .any(|a| a == "--only")
+        .then(|| arg(&args, "--only", 0) as usize);
     // Warm-up: fills the runners' pools and the simulators' buffers.
     for (i, c) in cases.iter().enumerate() {
+        if only.is_some_and(|k| k != i) {
+            continue;
+        }
         judged_pass(&runners[i], 1);
         sim_pass(&mut sims[i], &c.cfg, 1);
     }
@@ -134,7 +142,7 @@ fn main() {
     let mut alone = vec![Vec::new(); n];
     let mut steps = vec![0u64; n];
     for _ in 0..reps {
-        for i in 0..n {
+        for i in (0..n).filter(|&i| only.is_none_or(|k| k == i)) {
             let (dt, s) = judged_pass(&runners[i], runs);
             judged[i].push(dt);
             steps[i] = s;
@@ -149,7 +157,7 @@ fn main() {
     println!("|--------------------------------|---------|-----------|-----------------|");
     let mut rate = vec![0.0; n];
     let mut sim_rate = vec![0.0; n];
-    for i in 0..n {
+    for i in (0..n).filter(|&i| only.is_none_or(|k| k == i)) {
         rate[i] = runs as f64 / median(&mut judged[i]);
         sim_rate[i] = runs as f64 / median(&mut alone[i]);
         println!(
