@@ -289,7 +289,26 @@ pub struct Simulator<'m> {
     rx_base: Vec<u32>,
     /// Pool slots reserved for [`EventSemantics::As2fm`] (never freed).
     reserved: usize,
+    /// No transition condition draws random numbers: with [`TransitionChoice::DocumentOrder`]
+    /// a receiver's choice depends only on its own state, so it can be kept.
+    pure_guards: bool,
+    /// The current run keeps receivers' choices ([`EventSemantics::As2fm`], pure guards,
+    /// document order).
+    keep_choices: bool,
+    /// Scheduler iterations so far (never reset): the stamps below are its values.
+    clock: u64,
+    /// Per machine: the iteration it last changed in (state, variables, position, flags).
+    changed: Vec<u64>,
+    /// Per event: the iteration its deliverability was computed in (0: not computed).
+    checked: Vec<u64>,
+    /// Per event: deliverable as of `checked` (every receiver can take it).
+    deliverable_kept: Vec<bool>,
+    /// Per receiver copy (indexed like the pool slots past the events' buffers): the
+    /// transition it fires (`NO_TRANS`: it discards), valid when the event is deliverable.
+    choice_kept: Vec<u32>,
 }
+
+const NO_TRANS: u32 = u32::MAX;
 
 impl std::fmt::Debug for Simulator<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -452,6 +471,23 @@ impl<'m> Simulator<'m> {
             deliverable: Vec::with_capacity(model.events.len()),
             blocked_list: Vec::with_capacity(n),
             ev_scratch: model.events.iter().map(|d| d.defaults.clone()).collect(),
+            pure_guards: model
+                .machines
+                .iter()
+                .all(|d| d.trans.iter().all(|t| !t.cond_draws)),
+            keep_choices: false,
+            clock: 0,
+            changed: vec![0; n],
+            checked: vec![0; model.events.len()],
+            deliverable_kept: vec![false; model.events.len()],
+            choice_kept: vec![
+                NO_TRANS;
+                model
+                    .events
+                    .iter()
+                    .map(|d| d.receivers.len())
+                    .sum::<usize>()
+            ],
         }
     }
 
@@ -657,6 +693,7 @@ impl<'m> Simulator<'m> {
             }
         }
         self.pending.iter_mut().for_each(|p| *p = false);
+        self.checked.iter_mut().for_each(|c| *c = 0);
         self.pending_list.clear();
         self.pending_regular = 0;
         self.pending_bb_set = 0;
@@ -700,13 +737,21 @@ impl<'m> Simulator<'m> {
         obs: &mut O,
     ) -> Result<EndReason, Stop> {
         self.as2fm = cfg.events == EventSemantics::As2fm;
+        self.keep_choices =
+            self.as2fm && self.pure_guards && cfg.transitions == TransitionChoice::DocumentOrder;
         self.reset(rng)?;
         loop {
+            self.clock += 1;
             if self.as2fm {
                 self.deliverable.clear();
                 for i in 0..self.pending_list.len() {
                     let e = self.pending_list[i];
-                    if self.deliverable_now(e, rng, cfg)? {
+                    let now = if self.keep_choices {
+                        self.deliverable_kept(e, rng, cfg)?
+                    } else {
+                        self.deliverable_now(e, rng, cfg)?
+                    };
+                    if now {
                         self.deliverable.push(e);
                     }
                 }
@@ -734,6 +779,7 @@ impl<'m> Simulator<'m> {
                     let m = self.delayed[i] as usize;
                     if self.ms[m].wake <= self.time {
                         self.ms[m].waiting = false;
+                        self.changed[m] = self.clock;
                         self.delayed.swap_remove(i);
                         self.refresh(m);
                     } else {
@@ -768,6 +814,7 @@ impl<'m> Simulator<'m> {
                 continue;
             }
             let m = self.runnable[k] as usize;
+            self.changed[m] = self.clock;
             self.instant_moves[m] = self.instant_moves[m].saturating_add(1);
             if self.step(m, rng, cfg, obs)? == Flow::Stop {
                 return Ok(EndReason::Stopped);
@@ -1297,6 +1344,42 @@ impl<'m> Simulator<'m> {
         Ok(true)
     }
 
+    /// [`Simulator::deliverable_now`] for a run that keeps receivers' choices: computed
+    /// again only when a receiver changed since (same guards, same order, same result,
+    /// and errors at the same iteration, since guards then read nothing else), with each
+    /// receiver's choice kept for [`Simulator::deliver`].
+    fn deliverable_kept(
+        &mut self,
+        e: u32,
+        rng: &mut dyn Entropy,
+        cfg: &RunConfig,
+    ) -> Result<bool, Stop> {
+        let ei = e as usize;
+        if self.ev_flags[ei] & EV_TIMER != 0 && self.pending_regular > 0 {
+            return Ok(false);
+        }
+        let model = self.model;
+        let receivers = &model.events[ei].receivers;
+        let at = self.checked[ei];
+        if at != 0 && receivers.iter().all(|&r| self.changed[r as usize] < at) {
+            return Ok(self.deliverable_kept[ei]);
+        }
+        let base = self.rx_base[ei] as usize - model.events.len();
+        let mut all = true;
+        for (k, &r) in receivers.iter().enumerate() {
+            match self.receive_choice(r, e, rng, cfg)? {
+                Some(t) => self.choice_kept[base + k] = t.unwrap_or(NO_TRANS),
+                None => {
+                    all = false;
+                    break;
+                }
+            }
+        }
+        self.checked[ei] = self.clock;
+        self.deliverable_kept[ei] = all;
+        Ok(all)
+    }
+
     /// Delivers pending event `e` to all its receivers at once (one point each).
     fn deliver<O: Observer + ?Sized>(
         &mut self,
@@ -1310,7 +1393,22 @@ impl<'m> Simulator<'m> {
         let origin = self.pool[e as usize].origin;
         for (k, &r) in model.events[e as usize].receivers.iter().enumerate() {
             let m = r as usize;
-            let choice = self.receive_choice(r, e, rng, cfg)?.flatten();
+            let choice = if self.keep_choices {
+                // Computed at this iteration by `deliverable_kept`; set `_event` as
+                // `receive_choice` does.
+                let kept =
+                    self.choice_kept[self.rx_base[e as usize] as usize - model.events.len() + k];
+                let rt = &mut self.ms[m];
+                rt.cur_event = model.events[e as usize].name_str;
+                rt.cur_origin = model
+                    .machines
+                    .get(origin as usize)
+                    .map_or(StrId(0), |d| d.name_str);
+                (kept != NO_TRANS).then_some(kept)
+            } else {
+                self.receive_choice(r, e, rng, cfg)?.flatten()
+            };
+            self.changed[m] = self.clock;
             // The receiver keeps its own copy: JANI assigns it with the receive itself.
             let rx = self.rx_base[e as usize] as usize + k;
             let (global, copy) = self.pool.split_at_mut(rx);
@@ -1353,6 +1451,7 @@ impl<'m> Simulator<'m> {
         while i < self.blocked_list.len() {
             let m = self.blocked_list[i] as usize;
             if self.send_possible(m) {
+                self.changed[m] = self.clock;
                 self.ms[m].blocked = false;
                 self.ms[m].awaiting = NO_MSG;
                 self.blocked_list.swap_remove(i);
@@ -1434,6 +1533,7 @@ impl<'m> Simulator<'m> {
         if !model.events[e].receivers.is_empty() {
             let flags = self.ev_flags[e];
             self.pending[e] = true;
+            self.checked[e] = 0;
             self.pending_list.push(sd.event);
             if flags & EV_TIMER != 0 {
                 r.blocked = true;
