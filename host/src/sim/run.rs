@@ -299,16 +299,16 @@ pub struct Simulator<'m> {
     clock: u64,
     /// Per machine: the iteration it last changed in (state, variables, position, flags).
     changed: Vec<u64>,
-    /// Per event: the iteration its deliverability was computed in (0: not computed).
+    /// Per receiver of each event (indexed like the receivers' pool slots past the
+    /// events' buffers): the iteration its choice was computed in (0: not computed).
     checked: Vec<u64>,
-    /// Per event: deliverable as of `checked` (every receiver can take it).
-    deliverable_kept: Vec<bool>,
-    /// Per receiver copy (indexed like the pool slots past the events' buffers): the
-    /// transition it fires (`NO_TRANS`: it discards), valid when the event is deliverable.
+    /// Per receiver of each event: the transition it fires on the pending event
+    /// (`NO_TRANS`: it discards it, `CANNOT_TAKE`: not now), as of `checked`.
     choice_kept: Vec<u32>,
 }
 
 const NO_TRANS: u32 = u32::MAX;
+const CANNOT_TAKE: u32 = u32::MAX - 1;
 
 impl std::fmt::Debug for Simulator<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -478,8 +478,14 @@ impl<'m> Simulator<'m> {
             keep_choices: false,
             clock: 0,
             changed: vec![0; n],
-            checked: vec![0; model.events.len()],
-            deliverable_kept: vec![false; model.events.len()],
+            checked: vec![
+                0;
+                model
+                    .events
+                    .iter()
+                    .map(|d| d.receivers.len())
+                    .sum::<usize>()
+            ],
             choice_kept: vec![
                 NO_TRANS;
                 model
@@ -1344,10 +1350,11 @@ impl<'m> Simulator<'m> {
         Ok(true)
     }
 
-    /// [`Simulator::deliverable_now`] for a run that keeps receivers' choices: computed
-    /// again only when a receiver changed since (same guards, same order, same result,
-    /// and errors at the same iteration, since guards then read nothing else), with each
-    /// receiver's choice kept for [`Simulator::deliver`].
+    /// [`Simulator::deliverable_now`] for a run that keeps receivers' choices: a
+    /// receiver's choice is computed again only when it changed since (or the event was
+    /// sent again). Receivers are gone through in the same order up to the first that
+    /// cannot take the event, so the same guards run at the same iterations, with the
+    /// same results and errors: a guard reads only its machine and the event.
     fn deliverable_kept(
         &mut self,
         e: u32,
@@ -1359,25 +1366,26 @@ impl<'m> Simulator<'m> {
             return Ok(false);
         }
         let model = self.model;
-        let receivers = &model.events[ei].receivers;
-        let at = self.checked[ei];
-        if at != 0 && receivers.iter().all(|&r| self.changed[r as usize] < at) {
-            return Ok(self.deliverable_kept[ei]);
-        }
         let base = self.rx_base[ei] as usize - model.events.len();
-        let mut all = true;
-        for (k, &r) in receivers.iter().enumerate() {
-            match self.receive_choice(r, e, rng, cfg)? {
-                Some(t) => self.choice_kept[base + k] = t.unwrap_or(NO_TRANS),
-                None => {
-                    all = false;
-                    break;
-                }
+        for (k, &r) in model.events[ei].receivers.iter().enumerate() {
+            let at = self.checked[base + k];
+            let choice = if at != 0 && self.changed[r as usize] < at {
+                self.choice_kept[base + k]
+            } else {
+                let c = match self.receive_choice(r, e, rng, cfg)? {
+                    Some(Some(t)) => t,
+                    Some(None) => NO_TRANS,
+                    None => CANNOT_TAKE,
+                };
+                self.checked[base + k] = self.clock;
+                self.choice_kept[base + k] = c;
+                c
+            };
+            if choice == CANNOT_TAKE {
+                return Ok(false);
             }
         }
-        self.checked[ei] = self.clock;
-        self.deliverable_kept[ei] = all;
-        Ok(all)
+        Ok(true)
     }
 
     /// Delivers pending event `e` to all its receivers at once (one point each).
@@ -1533,7 +1541,9 @@ impl<'m> Simulator<'m> {
         if !model.events[e].receivers.is_empty() {
             let flags = self.ev_flags[e];
             self.pending[e] = true;
-            self.checked[e] = 0;
+            // New parameters: every receiver's choice is computed again.
+            let base = self.rx_base[e] as usize - model.events.len();
+            self.checked[base..base + model.events[e].receivers.len()].fill(0);
             self.pending_list.push(sd.event);
             if flags & EV_TIMER != 0 {
                 r.blocked = true;
