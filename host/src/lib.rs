@@ -2,6 +2,7 @@
 
 pub mod cli;
 pub mod expr;
+pub mod live;
 pub mod model;
 pub mod props;
 pub mod robot;

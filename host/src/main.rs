@@ -65,6 +65,10 @@ enum Command {
     ///
     /// Example: `hindsight convert examples/museum-guide --out museum-plain`
     Convert(cli::convert::ConvertArgs),
+    /// Monitor a running system on-line: tap iceoryx2 services, judge every sample, report verdicts.
+    ///
+    /// Example: `hindsight monitor --props museum.hspec --config museum.toml --record in.jsonl`
+    Monitor(cli::monitor::MonitorArgs),
 }
 
 fn main() -> ExitCode {
@@ -85,6 +89,7 @@ fn main() -> ExitCode {
         Command::Merge(a) => cli::verify::merge(a),
         Command::Trace(a) => cli::verify::trace(a),
         Command::Convert(a) => cli::convert::run(a),
+        Command::Monitor(a) => cli::monitor::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

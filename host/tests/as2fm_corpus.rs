@@ -240,30 +240,12 @@ fn plain_translations_match_as2fm_expected_probabilities() {
 }
 
 /// Cases the high-level pipeline does not check, and why (on top of [`SKIPS`]).
-const HIGH_LEVEL_SKIPS: &[(&str, &str)] = &[
-    (
-        "string_msg_comparison_main",
-        "the model publishes example_interfaces/String on a topic it subscribes as \
+const HIGH_LEVEL_SKIPS: &[(&str, &str)] = &[(
+    "string_msg_comparison_main",
+    "the model publishes example_interfaces/String on a topic it subscribes as \
          nested_interfaces/Internal; AS2FM accepts it, hindsight reports it as an error \
          (robot_load.rs checks the message)",
-    ),
-    (
-        "array_of_data_structs_main",
-        "object literals are not in hindsight's expression language yet",
-    ),
-    (
-        "data_structs_main_json_def",
-        "struct types from data declarations are not compiled yet",
-    ),
-    (
-        "data_structs_main_xml_def",
-        "struct types from data declarations are not compiled yet",
-    ),
-    (
-        "overarching_tutorial_main_locations",
-        "object literals are not in hindsight's expression language yet",
-    ),
-];
+)];
 
 #[test]
 fn high_level_models_match_as2fm_expected_probabilities() {

@@ -19,34 +19,12 @@ fn repo(relative: &str) -> PathBuf {
 }
 
 /// Corpus cases that do not load, each with the reason and a piece of the error.
-const DO_NOT_LOAD: &[(&str, &str, &str)] = &[
-    (
-        "string_msg_comparison_main",
-        "publishes example_interfaces/String on a topic subscribed as nested_interfaces/Internal \
+const DO_NOT_LOAD: &[(&str, &str, &str)] = &[(
+    "string_msg_comparison_main",
+    "publishes example_interfaces/String on a topic subscribed as nested_interfaces/Internal \
          (AS2FM accepts it; we report it, as issue 5 asks)",
-        "string_receive.ascxml:9:70: topic `str_topic` is subscribed with type",
-    ),
-    (
-        "array_of_data_structs_main",
-        "object literals are not in our expression language yet",
-        "sender.ascxml:12:13",
-    ),
-    (
-        "data_structs_main_json_def",
-        "struct types from data declarations are not compiled yet",
-        "my_types.json",
-    ),
-    (
-        "data_structs_main_xml_def",
-        "struct types from data declarations are not compiled yet",
-        "my_types.xml",
-    ),
-    (
-        "overarching_tutorial_main_locations",
-        "object literals are not in our expression language yet",
-        "world_multiple_locations.ascxml:20:56",
-    ),
-];
+    "string_receive.ascxml:9:70: topic `str_topic` is subscribed with type",
+)];
 
 #[test]
 fn every_corpus_main_file_loads() {

@@ -206,6 +206,7 @@ fn mutated_expressions_never_panic() {
         "Math.floor(Math.random() * n) + a[i][j].length",
         "x > 3 ? -y : (z == 'a' && !b) || c[0] % 7",
         "_event.data.p.q[1] + 0x1f - .5e3",
+        "{'a': [{x: 1, \"y\": -2.5},], b: c.d[0].e}",
     ];
     let alphabet = b"()[]{}.,?:!&|=<>+-*/%'\"0123456789abcxyz_ \\$#";
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);

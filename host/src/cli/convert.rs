@@ -9,7 +9,7 @@ use crate::model::xml::Element;
 use crate::props::{self, PortKind, PropertyFile, ANY};
 use crate::robot::load::{load, main_file_of};
 use crate::robot::main_file::InputKind;
-use crate::robot::write::{escape_into, to_xml};
+use crate::robot::write::{escape_into, to_xml, types_xml};
 
 /// Arguments of `hindsight convert`.
 #[derive(Debug, clap::Args)]
@@ -40,6 +40,12 @@ pub fn run(args: &ConvertArgs) -> Result<(), CliError> {
         std::fs::write(&path, text)
             .map_err(|e| CliError::Failed(format!("{}: {e}", path.display())))
     };
+
+    // The declared data types the machines name, as SCAN's types.xml.
+    let has_types = !robot.types.defs.is_empty();
+    if has_types {
+        write("types.xml", &types_xml(&robot.types))?;
+    }
 
     let mut names = Vec::new();
     for m in &robot.machines {
@@ -90,6 +96,9 @@ pub fn run(args: &ConvertArgs) -> Result<(), CliError> {
         ));
     }
     model.push_str("        </processList>\n    </model>\n");
+    if has_types {
+        model.push_str("    <types path=\"./types.xml\"/>\n");
+    }
     if let Some(p) = props_written.as_deref().filter(|p| p.ends_with(".xml")) {
         model.push_str(&format!("    <properties path=\"./{p}\"/>\n"));
     }

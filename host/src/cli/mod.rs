@@ -2,6 +2,7 @@
 
 pub mod compile;
 pub mod convert;
+pub mod monitor;
 pub mod plot;
 pub mod replay;
 pub mod sweep;

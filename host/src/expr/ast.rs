@@ -87,6 +87,8 @@ pub enum ExprKind {
     Str(String),
     /// `[a, b, ...]`.
     Array(Vec<Expr>),
+    /// `{a: x, 'b': y}`: an object literal, typed by the declared struct it is stored in.
+    Object(Vec<ObjField>),
     /// A name: a variable, an enumeration label, `_event` or `Math`.
     Ident(String),
     /// `object.field`; the `u32` is the field name's offset.
@@ -101,4 +103,15 @@ pub enum ExprKind {
     Binary(BinOp, Box<Expr>, Box<Expr>),
     /// `c ? a : b`.
     Cond(Box<Expr>, Box<Expr>, Box<Expr>),
+}
+
+/// One `key: value` entry of an object literal.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjField {
+    /// The key (quotes removed).
+    pub name: String,
+    /// Byte offset of the key.
+    pub at: u32,
+    /// The value.
+    pub value: Expr,
 }

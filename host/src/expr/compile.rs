@@ -5,7 +5,7 @@
 //! slot's [`Cell`] and returns a `bool`, `i64`, `f64` or [`StrId`], or writes an
 //! array/struct into a caller-owned cell whose buffers are reused.
 
-use super::ast::{BinOp, Expr, ExprKind, UnOp};
+use super::ast::{BinOp, Expr, ExprKind, ObjField, UnOp};
 use super::value::{Cell, StrId, Strings, Ty, TypeTable};
 
 /// Source of randomness for `Math.random()`: any [`rand_core::Rng`].
@@ -376,6 +376,7 @@ impl Compiler<'_, '_> {
                 })
             }
             ExprKind::Array(items) => self.array(e, items, expect),
+            ExprKind::Object(fields) => self.object(e, fields, expect),
             ExprKind::Ident(name) => {
                 if let Some(p) = self.path(e)? {
                     return Ok(self.path_code(p));
@@ -473,13 +474,110 @@ impl Compiler<'_, '_> {
             ty: Ty::Array(Box::new(elem_ty), bound),
             code: Code::Comp(Box::new(move |env, dest| {
                 if !matches!(dest, Cell::List(_)) {
-                    *dest = Cell::List(Vec::with_capacity(n));
+                    *dest = Cell::list(Vec::with_capacity(n));
                 }
                 if let Cell::List(v) = dest {
-                    v.truncate(n);
-                    while v.len() < n {
-                        v.push(Cell::Int(0));
+                    v.set_len(n);
+                    for (f, slot) in fns.iter().zip(v.iter_mut()) {
+                        f(env, slot)?;
                     }
+                }
+                Ok(())
+            })),
+        })
+    }
+
+    /// An object literal, typed by the struct `expect`ed where it is used: every field of
+    /// the struct exactly once, each converted to the field's type.
+    fn object(
+        &mut self,
+        e: &Expr,
+        fields: &[ObjField],
+        expect: Option<&Ty>,
+    ) -> Result<Typed, CompileError> {
+        let s = match expect {
+            Some(Ty::Struct(s)) => *s,
+            Some(t) => {
+                return Err(cerr(
+                    e.start,
+                    format!(
+                        "an object literal is not a value of type {}",
+                        self.tname(t)
+                    ),
+                ))
+            }
+            None => {
+                return Err(cerr(
+                    e.start,
+                    "the struct type of this object literal is not known: use it where a declared struct type is expected (a typed `<data>`, an assignment to a struct location, a typed parameter or array)",
+                ))
+            }
+        };
+        let Some(def) = self.scope.types.structs.get(s as usize) else {
+            return Err(cerr(e.start, "internal error: unknown struct type"));
+        };
+        let sname = def.name.clone();
+        let decl: Vec<(String, Ty)> = def.fields.clone();
+        let mut fns: Vec<Option<CellFn>> = (0..decl.len()).map(|_| None).collect();
+        for f in fields {
+            let Some(fi) = decl.iter().position(|(n, _)| *n == f.name) else {
+                let names: Vec<&str> = decl.iter().map(|(n, _)| n.as_str()).collect();
+                return Err(cerr(
+                    f.at,
+                    format!(
+                        "type {sname} has no field `{}` (its fields: {})",
+                        f.name,
+                        if names.is_empty() {
+                            "none".to_string()
+                        } else {
+                            names.join(", ")
+                        }
+                    ),
+                ));
+            };
+            let fty = &decl[fi].1;
+            let t = self.expr(&f.value, Some(fty))?;
+            let t = coerce(t, fty, self.scope.types).map_err(|found| {
+                cerr(
+                    f.value.start,
+                    format!(
+                        "field `{}` of {sname} has type {} but {} is expected",
+                        f.name,
+                        self.tname(&found),
+                        self.tname(fty)
+                    ),
+                )
+            })?;
+            if let Some(slot) = fns.get_mut(fi) {
+                *slot = Some(t.into_cell_fn());
+            }
+        }
+        let missing: Vec<&str> = decl
+            .iter()
+            .zip(&fns)
+            .filter(|(_, f)| f.is_none())
+            .map(|((n, _), _)| n.as_str())
+            .collect();
+        if !missing.is_empty() {
+            return Err(cerr(
+                e.start,
+                format!(
+                    "the object literal of type {sname} has no value for field{} `{}`",
+                    if missing.len() > 1 { "s" } else { "" },
+                    missing.join("`, `")
+                ),
+            ));
+        }
+        let fns: Vec<CellFn> = fns.into_iter().flatten().collect();
+        let n = fns.len();
+        Ok(Typed {
+            ty: Ty::Struct(s),
+            code: Code::Comp(Box::new(move |env, dest| {
+                if !matches!(dest, Cell::List(_)) {
+                    *dest = Cell::list(Vec::with_capacity(n));
+                }
+                if let Cell::List(v) = dest {
+                    v.set_len(n);
                     for (f, slot) in fns.iter().zip(v.iter_mut()) {
                         f(env, slot)?;
                     }
@@ -752,8 +850,43 @@ impl Compiler<'_, '_> {
         if let Some(p) = self.path(e)? {
             return Ok(self.path_code(p));
         }
+        if let Some(p) = self.path(obj)? {
+            if field != "length" {
+                if let Some((fi, fty)) = self.projected_field(&p.ty, field) {
+                    return Ok(project(p, fi, fty));
+                }
+            }
+        }
         if field == "length" {
-            if let Some(p) = self.path(obj)? {
+            if let Some(mut p) = self.path(obj)? {
+                let whole = p.ty.clone();
+                // AS2FM reads `s.length` of a struct as the length of its first field,
+                // descending through struct fields (its translation flattens structs into
+                // one array per leaf field and takes the first).
+                while let Ty::Struct(s) = p.ty {
+                    let first = self
+                        .scope
+                        .types
+                        .structs
+                        .get(s as usize)
+                        .and_then(|d| d.fields.first());
+                    match first {
+                        Some((_, t)) if p.steps.len() < MAX_PATH => {
+                            p.ty = t.clone();
+                            p.steps.push(Step::Field(0));
+                        }
+                        _ => break,
+                    }
+                }
+                if matches!(whole, Ty::Struct(_)) && !matches!(p.ty, Ty::Array(..)) {
+                    return Err(cerr(
+                        fat,
+                        format!(
+                            "a value of type {} has no `length` (only a struct whose first field is an array has one)",
+                            self.tname(&whole)
+                        ),
+                    ));
+                }
                 let at = p.at;
                 return match p.ty {
                     Ty::Array(..) => Ok(Typed {
@@ -796,6 +929,23 @@ impl Compiler<'_, '_> {
                 "a value of type {} has no field `{field}`",
                 self.tname(&t.ty)
             ),
+        ))
+    }
+
+    /// For `a.f` with `a` an array of structs that have a field `f`: the field's index and
+    /// the type of the projection (an array of the field's values).
+    fn projected_field(&self, ty: &Ty, field: &str) -> Option<(u32, Ty)> {
+        let Ty::Array(elem, bound) = ty else {
+            return None;
+        };
+        let Ty::Struct(s) = **elem else {
+            return None;
+        };
+        let def = self.scope.types.structs.get(s as usize)?;
+        let fi = def.fields.iter().position(|(n, _)| n == field)?;
+        Some((
+            fi as u32,
+            Ty::Array(Box::new(def.fields[fi].1.clone()), *bound),
         ))
     }
 
@@ -1212,6 +1362,38 @@ impl Compiler<'_, '_> {
     }
 }
 
+/// `a.f` for an array of structs `a`: the array of every element's field `f`, written into
+/// the destination's buffers.
+fn project(p: Path, fi: u32, ty: Ty) -> Typed {
+    let at = p.at;
+    Typed {
+        ty,
+        code: Code::Comp(Box::new(move |env, dest| {
+            let Cell::List(items) = p.resolve(env)? else {
+                return Err(internal(at));
+            };
+            if !matches!(dest, Cell::List(_)) {
+                *dest = Cell::list(Vec::with_capacity(items.len()));
+            }
+            let Cell::List(out) = dest else {
+                return Err(internal(at));
+            };
+            out.truncate(items.len());
+            for (k, item) in items.iter().enumerate() {
+                let Cell::List(fields) = item else {
+                    return Err(internal(at));
+                };
+                let v = fields.get(fi as usize).ok_or(internal(at))?;
+                match out.get_mut(k) {
+                    Some(o) => o.clone_from(v),
+                    None => out.push_copy(v),
+                }
+            }
+            Ok(())
+        })),
+    }
+}
+
 /// An assignable location: a variable, then indices and fields.
 pub(crate) struct Place {
     /// Variable slot.
@@ -1223,6 +1405,9 @@ pub(crate) struct Place {
     pub bound: Option<u32>,
     /// `a.length = n`: the element default used when the array grows.
     set_length: Option<Cell>,
+    /// `a.f = v` for an array of structs `a`: the field index and the element default;
+    /// `a` takes the length of `v` and element `k` gets `v[k]` as its field `f`.
+    column: Option<(u32, Cell)>,
 }
 
 enum PlaceStep {
@@ -1234,12 +1419,36 @@ enum PlaceStep {
 impl Place {
     /// True when the location is a whole variable.
     pub fn is_whole_var(&self) -> bool {
-        self.steps.is_empty() && self.set_length.is_none()
+        self.steps.is_empty() && self.set_length.is_none() && self.column.is_none()
     }
 
     /// Stores `value`, reusing the destination's buffers.
     pub fn store(&self, vars: &mut [Cell], idx: &[i64; MAX_PATH], value: &Cell) -> Res<()> {
         let dst = self.target(vars, idx)?;
+        if let Some((fi, default)) = &self.column {
+            let (Cell::List(items), Cell::List(values)) = (dst, value) else {
+                return Err(internal(0));
+            };
+            if let Some(b) = self.bound {
+                if values.len() > b as usize {
+                    return Err(EvalError {
+                        at: 0,
+                        kind: EvalErrorKind::TooLong { bound: b },
+                    });
+                }
+            }
+            items.resize(values.len(), default);
+            for (item, v) in items.iter_mut().zip(values.iter()) {
+                let Cell::List(fields) = item else {
+                    return Err(internal(0));
+                };
+                fields
+                    .get_mut(*fi as usize)
+                    .ok_or(internal(0))?
+                    .clone_from(v);
+            }
+            return Ok(());
+        }
         let Some(default) = &self.set_length else {
             if let (Some(b), Cell::List(v)) = (self.bound, value) {
                 if v.len() > b as usize {
@@ -1279,7 +1488,7 @@ impl Place {
                 },
             });
         }
-        items.resize(n, default.clone());
+        items.resize(n, default);
         Ok(())
     }
 
@@ -1328,7 +1537,7 @@ impl Place {
                                 kind: EvalErrorKind::Index { index: i, len },
                             });
                         }
-                        items.resize(u + 1, default.clone());
+                        items.resize(u + 1, default);
                     }
                     cell = items.get_mut(u).ok_or(internal(*at))?;
                 }
@@ -1358,6 +1567,7 @@ pub(crate) fn compile_place(
                     ty,
                     bound,
                     set_length: None,
+                    column: None,
                 })
             }
             None if name == "_event" => Err(cerr(e.start, "cannot assign to `_event`")),
@@ -1367,6 +1577,12 @@ pub(crate) fn compile_place(
             let mut p = compile_place(arr, scope, strings)?;
             if p.set_length.is_some() {
                 return Err(cerr(idx.start, "`length` cannot be indexed"));
+            }
+            if p.column.is_some() {
+                return Err(cerr(
+                    idx.start,
+                    "a field of every element (`a.f`) cannot be indexed here; write `a[i].f`",
+                ));
             }
             let Ty::Array(elem, bound) = p.ty.clone() else {
                 return Err(cerr(
@@ -1410,11 +1626,35 @@ pub(crate) fn compile_place(
             if p.set_length.is_some() {
                 return Err(cerr(*fat, format!("`length` has no field `{field}`")));
             }
+            if p.column.is_some() {
+                return Err(cerr(
+                    *fat,
+                    format!("a field of every element (`a.f`) has no field `{field}` here; write `a[i].f.{field}`"),
+                ));
+            }
             if let (Ty::Array(elem, _), "length") = (&p.ty, field.as_str()) {
                 // `a.length = n` truncates or extends with default values.
                 p.set_length = Some(scope.types.default_cell(elem));
                 p.ty = Ty::Int;
                 return Ok(p);
+            }
+            if let Ty::Array(elem, _) = &p.ty {
+                if let Ty::Struct(s) = **elem {
+                    let found = scope.types.structs.get(s as usize).and_then(|d| {
+                        d.fields
+                            .iter()
+                            .enumerate()
+                            .find(|(_, (n, _))| n == field)
+                            .map(|(i, (_, t))| (i, t.clone()))
+                    });
+                    if let Some((fi, fty)) = found {
+                        // `a.f = v` writes field `f` of every element (AS2FM's flattened
+                        // structs make `a.f` the array of the elements' `f`).
+                        p.column = Some((fi as u32, scope.types.default_cell(elem)));
+                        p.ty = Ty::Array(Box::new(fty), p.bound);
+                        return Ok(p);
+                    }
+                }
             }
             let Ty::Struct(s) = p.ty else {
                 return Err(cerr(
@@ -1452,6 +1692,7 @@ pub(crate) fn compile_place(
 #[cfg(test)]
 mod tests {
     use super::super::parse::parse_expr;
+    use super::super::value::StructDef;
     use super::*;
 
     struct Fixed(u64);
@@ -1481,10 +1722,10 @@ mod tests {
             Cell::Float(2.5),
             Cell::Bool(true),
             Cell::Str(strings.intern("hi")),
-            Cell::List(vec![Cell::Int(1), Cell::Int(2), Cell::Int(3)]),
-            Cell::List(vec![
-                Cell::List(vec![]),
-                Cell::List(vec![Cell::Float(0.5), Cell::Float(1.5)]),
+            Cell::list(vec![Cell::Int(1), Cell::Int(2), Cell::Int(3)]),
+            Cell::list(vec![
+                Cell::list(vec![]),
+                Cell::list(vec![Cell::Float(0.5), Cell::Float(1.5)]),
             ]),
         ]
     }
@@ -1568,11 +1809,11 @@ mod tests {
         assert_eq!(eval("s.length"), Ok(Cell::Int(2)));
         assert_eq!(
             eval("[i, 2]"),
-            Ok(Cell::List(vec![Cell::Int(7), Cell::Int(2)]))
+            Ok(Cell::list(vec![Cell::Int(7), Cell::Int(2)]))
         );
         assert_eq!(
             eval("[1, 2.5]"),
-            Ok(Cell::List(vec![Cell::Float(1.0), Cell::Float(2.5)]))
+            Ok(Cell::list(vec![Cell::Float(1.0), Cell::Float(2.5)]))
         );
         assert!(eval("a[3]").unwrap_err().contains("out of bounds"));
         assert!(eval("a[-1]").unwrap_err().contains("out of bounds"));
@@ -1633,7 +1874,7 @@ mod tests {
         *p.target(&mut vals, &idx).unwrap() = Cell::Int(9);
         assert_eq!(
             vals[4],
-            Cell::List(vec![Cell::Int(1), Cell::Int(2), Cell::Int(3), Cell::Int(9)])
+            Cell::list(vec![Cell::Int(1), Cell::Int(2), Cell::Int(3), Cell::Int(9)])
         );
         // m is bounded to 3 rows: row 3 is out of range, row 2 is created.
         let q = compile_place(
@@ -1646,20 +1887,276 @@ mod tests {
         idx[0] = 3;
         assert!(q.target(&mut vals, &idx).is_err());
         idx[0] = 2;
-        *q.target(&mut vals, &idx).unwrap() = Cell::List(vec![Cell::Float(4.0)]);
+        *q.target(&mut vals, &idx).unwrap() = Cell::list(vec![Cell::Float(4.0)]);
         assert!(matches!(&vals[5], Cell::List(rows) if rows.len() == 3));
         assert!(
             compile_place(&parse_expr("_event.data.p").unwrap(), &scope, &mut strings).is_err()
         );
         let len = compile_place(&parse_expr("a.length").unwrap(), &scope, &mut strings).unwrap();
         len.store(&mut vals, &idx, &Cell::Int(1)).unwrap();
-        assert_eq!(vals[4], Cell::List(vec![Cell::Int(1)]));
+        assert_eq!(vals[4], Cell::list(vec![Cell::Int(1)]));
         len.store(&mut vals, &idx, &Cell::Int(3)).unwrap();
         assert_eq!(
             vals[4],
-            Cell::List(vec![Cell::Int(1), Cell::Int(0), Cell::Int(0)])
+            Cell::list(vec![Cell::Int(1), Cell::Int(0), Cell::Int(0)])
         );
         assert!(compile_place(&parse_expr("a.length.x").unwrap(), &scope, &mut strings).is_err());
         assert!(compile_place(&parse_expr("i + 1").unwrap(), &scope, &mut strings).is_err());
+    }
+
+    /// Point {frame: string, x: float, y: float}, Poly {points: Point[]}, and variables
+    /// `pt: Point`, `poly: Poly`, `polys: Poly[]`, `i: int`.
+    fn struct_scope() -> (Vec<(String, Ty)>, TypeTable) {
+        let mut types = TypeTable::default();
+        types.structs.push(StructDef {
+            name: "Point".into(),
+            fields: vec![
+                ("frame".into(), Ty::Str),
+                ("x".into(), Ty::Float),
+                ("y".into(), Ty::Float),
+            ],
+        });
+        types.structs.push(StructDef {
+            name: "Poly".into(),
+            fields: vec![("points".into(), Ty::Array(Box::new(Ty::Struct(0)), None))],
+        });
+        let vars = vec![
+            ("pt".into(), Ty::Struct(0)),
+            ("poly".into(), Ty::Struct(1)),
+            ("polys".into(), Ty::Array(Box::new(Ty::Struct(1)), Some(4))),
+            ("i".into(), Ty::Int),
+        ];
+        (vars, types)
+    }
+
+    fn point(strings: &mut Strings, frame: &str, x: f64, y: f64) -> Cell {
+        Cell::list(vec![
+            Cell::Str(strings.intern(frame)),
+            Cell::Float(x),
+            Cell::Float(y),
+        ])
+    }
+
+    /// Compiles `text` as a value of `expect` in [`struct_scope`], evaluates it, and (when
+    /// `place` is given) stores it there; returns the variables afterwards.
+    fn eval_struct(
+        text: &str,
+        expect: Option<&str>,
+        place: Option<&str>,
+    ) -> Result<(Vec<Cell>, Cell, Strings), String> {
+        let (vs, types) = struct_scope();
+        let mut strings = Strings::default();
+        let scope = Scope {
+            vars: &vs,
+            event: EventScope::None,
+            types: &types,
+            abs: &|k| k,
+        };
+        let place = match place {
+            Some(p) => Some(
+                compile_place(&parse_expr(p).unwrap(), &scope, &mut strings)
+                    .map_err(|e| format!("{}@{}", e.msg, e.at))?,
+            ),
+            None => None,
+        };
+        let want = match (expect, &place) {
+            (Some("Point"), _) => Some(Ty::Struct(0)),
+            (Some("Poly"), _) => Some(Ty::Struct(1)),
+            (Some("Poly[]"), _) => Some(Ty::Array(Box::new(Ty::Struct(1)), None)),
+            (_, Some(p)) => Some(p.ty.clone()),
+            _ => None,
+        };
+        let e = parse_expr(text).map_err(|e| e.to_string())?;
+        let t = match &want {
+            Some(w) => compile_as(&e, &scope, &mut strings, w, "the value"),
+            None => compile(&e, &scope, &mut strings, None),
+        }
+        .map_err(|e| format!("{}@{}", e.msg, e.at))?;
+        let f = t.into_cell_fn();
+        let p0 = point(&mut strings, "a", 1.0, 2.0);
+        let p1 = point(&mut strings, "b", 3.0, 4.0);
+        let mut vals = vec![
+            p0.clone(),
+            Cell::list(vec![Cell::list(vec![p0.clone(), p1.clone()])]),
+            Cell::list(vec![
+                Cell::list(vec![Cell::list(vec![])]),
+                Cell::list(vec![Cell::list(vec![p1])]),
+            ]),
+            Cell::Int(1),
+        ];
+        let mut out = Cell::Int(0);
+        let mut idx = [0i64; MAX_PATH];
+        {
+            let mut rng = Fixed(0);
+            let mut env = Env {
+                vars: &vals,
+                params: &[],
+                event: StrId(0),
+                origin: StrId(0),
+                rng: &mut rng,
+                strings: &strings,
+            };
+            f(&mut env, &mut out).map_err(|e| e.message())?;
+            if let Some(p) = &place {
+                p.eval_indices(&mut env, &mut idx)
+                    .map_err(|e| e.message())?;
+            }
+        }
+        if let Some(p) = &place {
+            p.store(&mut vals, &idx, &out).map_err(|e| e.message())?;
+        }
+        Ok((vals, out, strings))
+    }
+
+    #[test]
+    fn object_literals_take_the_declared_struct_type() {
+        let (_, out, mut st) =
+            eval_struct("{'frame': 'w', y: 2, x: -1}", Some("Point"), None).unwrap();
+        assert_eq!(out, point(&mut st, "w", -1.0, 2.0));
+        let (_, out, mut st) = eval_struct(
+            "{points: [{frame: 'a', x: 0.5, y: 1}, {frame: 'b', x: 2, y: 3},]}",
+            Some("Poly"),
+            None,
+        )
+        .unwrap();
+        assert_eq!(
+            out,
+            Cell::list(vec![Cell::list(vec![
+                point(&mut st, "a", 0.5, 1.0),
+                point(&mut st, "b", 2.0, 3.0)
+            ])])
+        );
+        let (_, out, _) = eval_struct("[{points: []}, poly]", Some("Poly[]"), None).unwrap();
+        assert!(matches!(out, Cell::List(ref v) if v.len() == 2));
+        // Typed by the location it is assigned to, even deep inside a path.
+        let (vals, _, mut st) =
+            eval_struct("{frame: 'n', x: 9, y: 8}", None, Some("polys[1].points[0]")).unwrap();
+        assert_eq!(
+            vals[2],
+            Cell::list(vec![
+                Cell::list(vec![Cell::list(vec![])]),
+                Cell::list(vec![Cell::list(vec![point(&mut st, "n", 9.0, 8.0)])]),
+            ])
+        );
+        let (_, out, _) =
+            eval_struct("i > 0 ? {frame: '', x: 1, y: 1} : pt", Some("Point"), None).unwrap();
+        assert!(matches!(out, Cell::List(ref v) if v[1] == Cell::Float(1.0)));
+    }
+
+    #[test]
+    fn bad_object_literals_are_errors_at_their_position() {
+        for (text, expect, at, needle) in [
+            ("{x: 1, y: 2}", "Point", 0, "no value for field `frame`"),
+            ("{x: 1}", "Point", 0, "fields `frame`, `y`"),
+            (
+                "{frame: '', x: 1, y: 2, z: 3}",
+                "Point",
+                24,
+                "type Point has no field `z` (its fields: frame, x, y)",
+            ),
+            (
+                "{frame: 1, x: 1, y: 2}",
+                "Point",
+                8,
+                "field `frame` of Point has type int but string is expected",
+            ),
+            (
+                "{points: [{frame: 'a', x: 'no', y: 1}]}",
+                "Poly",
+                26,
+                "field `x` of Point has type string",
+            ),
+            (
+                "{points: pt}",
+                "Poly",
+                9,
+                "has type Point but Point[] is expected",
+            ),
+            ("pt", "Poly", 0, "has type Point but Poly is expected"),
+        ] {
+            let err = eval_struct(text, Some(expect), None).unwrap_err();
+            assert!(err.contains(needle), "{text}: {err}");
+            assert!(err.ends_with(&format!("@{at}")), "{text}: {err}");
+        }
+        let err = eval_struct("{x: 1}", None, None).unwrap_err();
+        assert!(
+            err.contains("struct type of this object literal is not known"),
+            "{err}"
+        );
+        let err = eval_struct("{x: 1}", None, Some("i")).unwrap_err();
+        assert!(err.contains("not a value of type int"), "{err}");
+        let err = eval_struct("1", None, Some("pt.z")).unwrap_err();
+        assert!(err.contains("type Point has no field `z`"), "{err}");
+    }
+
+    #[test]
+    fn struct_paths_projections_and_length() {
+        let f = |t: &str| eval_struct(t, None, None).map(|r| r.1);
+        assert_eq!(f("poly.points[1].x + pt.y"), Ok(Cell::Float(5.0)));
+        assert_eq!(f("polys[1].points[0].frame == 'b'"), Ok(Cell::Bool(true)));
+        assert_eq!(f("poly.points.length"), Ok(Cell::Int(2)));
+        // AS2FM: the length of a struct is that of its first field.
+        assert_eq!(f("poly.length"), Ok(Cell::Int(2)));
+        assert_eq!(f("polys[0].length"), Ok(Cell::Int(0)));
+        assert!(f("pt.length").unwrap_err().contains("no `length`"));
+        // `a.f` over an array of structs: every element's field.
+        assert_eq!(
+            f("poly.points.y"),
+            Ok(Cell::list(vec![Cell::Float(2.0), Cell::Float(4.0)]))
+        );
+        assert_eq!(f("polys.points"), {
+            let (vals, _, _) = eval_struct("1", None, None).unwrap();
+            let Cell::List(ps) = &vals[2] else { panic!() };
+            Ok(Cell::list(
+                ps.iter()
+                    .map(|p| match p {
+                        Cell::List(fs) => fs[0].clone(),
+                        _ => panic!(),
+                    })
+                    .collect(),
+            ))
+        });
+        assert!(f("poly.points[2].x").unwrap_err().contains("out of bounds"));
+    }
+
+    #[test]
+    fn struct_places() {
+        // A whole struct into an array element, growing the array.
+        let (vals, _, mut st) = eval_struct("pt", None, Some("poly.points[2]")).unwrap();
+        let Cell::List(fields) = &vals[1] else {
+            panic!()
+        };
+        assert!(
+            matches!(&fields[0], Cell::List(ps) if ps.len() == 3 && ps[2] == point(&mut st, "a", 1.0, 2.0))
+        );
+        // One field of every element: the array takes the value's length.
+        let (vals, _, mut st) = eval_struct("[7, 8, 9]", None, Some("poly.points.x")).unwrap();
+        assert_eq!(
+            vals[1],
+            Cell::list(vec![Cell::list(vec![
+                point(&mut st, "a", 7.0, 2.0),
+                point(&mut st, "b", 8.0, 4.0),
+                point(&mut st, "", 9.0, 0.0),
+            ])])
+        );
+        let (vals, _, _) = eval_struct("[]", None, Some("polys[1].points.frame")).unwrap();
+        assert_eq!(
+            vals[2],
+            Cell::list(vec![
+                Cell::list(vec![Cell::list(vec![])]),
+                Cell::list(vec![Cell::list(vec![])]),
+            ])
+        );
+        assert!(
+            eval_struct("[[], [], [], [], []]", None, Some("polys.points"))
+                .unwrap_err()
+                .contains("at most 4")
+        );
+        assert!(eval_struct("1", None, Some("poly.points.x[0]"))
+            .unwrap_err()
+            .contains("write `a[i].f`"));
+        assert!(eval_struct("1", None, Some("pt.x.y"))
+            .unwrap_err()
+            .contains("has no field `y`"));
     }
 }

@@ -6,10 +6,12 @@
 //! `rel := add (('<'|'<='|'>'|'>=') add)*`, `add := mul (('+'|'-') mul)*`,
 //! `mul := unary (('*'|'/'|'%') unary)*`, `unary := ('!'|'-'|'+') unary | postfix`,
 //! `postfix := primary ('.' name | '[' cond ']' | '(' args ')')*`,
-//! `primary := number | string | true | false | name | '(' cond ')' | '[' items ']'`.
+//! `primary := number | string | true | false | name | '(' cond ')' | '[' items ']'
+//!   | '{' (key ':' cond),* '}'` where `key := name | string`. Array and object literals
+//! accept a trailing comma, as ECMAScript does.
 //! Nesting is limited to [`MAX_NESTING`] so hostile input cannot overflow the stack.
 
-use super::ast::{BinOp, Expr, ExprKind, UnOp};
+use super::ast::{BinOp, Expr, ExprKind, ObjField, UnOp};
 use nom::branch::alt;
 use nom::bytes::complete::{tag, take_while, take_while1};
 use nom::character::complete::hex_digit1;
@@ -319,7 +321,7 @@ impl P {
                 e = self.node(ExprKind::Index(Box::new(e), Box::new(idx)), start, r);
                 rest = r;
             } else if let Some(r) = r.strip_prefix('(') {
-                let (r, args) = self.list(r, ')')?;
+                let (r, args) = self.list(r, ')', false)?;
                 e = self.node(ExprKind::Call(Box::new(e), args), start, r);
                 rest = r;
             } else {
@@ -329,8 +331,9 @@ impl P {
         }
     }
 
-    /// Comma-separated expressions up to `close` (already past the opening bracket).
-    fn list<'a>(&mut self, i: &'a str, close: char) -> R<'a, Vec<Expr>> {
+    /// Comma-separated expressions up to `close` (already past the opening bracket); a
+    /// trailing comma is accepted when `trailing` (array literals).
+    fn list<'a>(&mut self, i: &'a str, close: char, trailing: bool) -> R<'a, Vec<Expr>> {
         let mut items = Vec::new();
         let mut r = self.ws(i);
         if let Some(after) = r.strip_prefix(close) {
@@ -345,6 +348,70 @@ impl P {
             }
             let Some(after) = r2.strip_prefix(',') else {
                 return Err(self.err(r2, format!("expected `,` or `{close}`")));
+            };
+            r = self.ws(after);
+            if trailing {
+                if let Some(after) = r.strip_prefix(close) {
+                    return Ok((after, items));
+                }
+            }
+        }
+    }
+
+    /// `key: value` entries up to `}` (already past the `{`); a trailing comma is accepted.
+    fn object<'a>(&mut self, i: &'a str) -> R<'a, Vec<ObjField>> {
+        let mut fields: Vec<ObjField> = Vec::new();
+        let mut r = self.ws(i);
+        loop {
+            if let Some(after) = r.strip_prefix('}') {
+                return Ok((after, fields));
+            }
+            let at = self.off(r);
+            let (r2, key) = match r.chars().next() {
+                Some(q @ ('\'' | '"')) => match self.string(r, q)? {
+                    (
+                        r2,
+                        Expr {
+                            kind: ExprKind::Str(k),
+                            ..
+                        },
+                    ) => (r2, k),
+                    _ => return Err(self.err(r, "expected a field name")),
+                },
+                Some(c) if ident_start(c) => match name(r) {
+                    Ok((r2, n)) => (r2, n.to_string()),
+                    Err(_) => return Err(self.err(r, "expected a field name")),
+                },
+                _ => {
+                    return Err(self.err(
+                        r,
+                        "expected a field name (a name or a quoted string) or `}`",
+                    ))
+                }
+            };
+            if fields.iter().any(|f| f.name == key) {
+                return Err(ParseError {
+                    offset: at,
+                    message: format!("field `{key}` is given twice"),
+                });
+            }
+            let r2 = self.ws(r2);
+            let Some(r2) = r2.strip_prefix(':') else {
+                return Err(self.err(r2, format!("expected `:` after the field name `{key}`")));
+            };
+            let r2 = self.ws(r2);
+            let (r2, value) = self.cond(r2)?;
+            fields.push(ObjField {
+                name: key,
+                at,
+                value,
+            });
+            let r2 = self.ws(r2);
+            if let Some(after) = r2.strip_prefix('}') {
+                return Ok((after, fields));
+            }
+            let Some(after) = r2.strip_prefix(',') else {
+                return Err(self.err(r2, "expected `,` or `}`"));
             };
             r = self.ws(after);
         }
@@ -376,9 +443,15 @@ impl P {
         }
         if c == '[' {
             self.enter(i)?;
-            let (r, items) = self.list(&i[1..], ']')?;
+            let (r, items) = self.list(&i[1..], ']', true)?;
             self.depth -= 1;
             return Ok((r, self.node(ExprKind::Array(items), start, r)));
+        }
+        if c == '{' {
+            self.enter(i)?;
+            let (r, fields) = self.object(&i[1..])?;
+            self.depth -= 1;
+            return Ok((r, self.node(ExprKind::Object(fields), start, r)));
         }
         if c == '\'' || c == '"' {
             return self.string(i, c);
@@ -473,6 +546,13 @@ mod tests {
             ExprKind::Array(v) => {
                 format!("[{}]", v.iter().map(show).collect::<Vec<_>>().join(","))
             }
+            ExprKind::Object(fs) => format!(
+                "{{{}}}",
+                fs.iter()
+                    .map(|f| format!("{}:{}", f.name, show(&f.value)))
+                    .collect::<Vec<_>>()
+                    .join(",")
+            ),
             ExprKind::Ident(n) => n.clone(),
             ExprKind::Member(o, f, _) => format!("{}.{f}", show(o)),
             ExprKind::Index(a, i) => format!("{}[{}]", show(a), show(i)),
@@ -523,6 +603,42 @@ mod tests {
             "((((0.131 + 2.6) + 1000.0) + 0.25) + 7.0)"
         );
         assert_eq!(p("!('' == s)"), "(Not ('' == s))");
+    }
+
+    #[test]
+    fn object_literals() {
+        assert_eq!(p("{x: 1, 'y': -2.5}"), "{x:1,y:(Neg 2.5)}");
+        assert_eq!(p("{\"a b\": [], }"), "{a b:[]}");
+        assert_eq!(p("{}"), "{}");
+        assert_eq!(
+            p("{'points': [{'x': 1}, {'x': a.b[0]},]}"),
+            "{points:[{x:1},{x:a.b[0]}]}"
+        );
+        assert_eq!(p("[1, 2, ]"), "[1,2]");
+        let e = parse_expr("  {ab: 1,  'c': 2}").unwrap();
+        assert_eq!((e.start, e.end), (2, 18));
+        let ExprKind::Object(fs) = e.kind else {
+            panic!()
+        };
+        assert_eq!((fs[0].at, fs[1].at), (3, 11));
+        assert_eq!((fs[1].value.start, fs[1].value.end), (16, 17));
+        for (t, at, msg) in [
+            ("{x 1}", 3, "expected `:`"),
+            ("{x: 1 y: 2}", 6, "expected `,` or `}`"),
+            ("{x: 1, x: 2}", 7, "given twice"),
+            ("{1: 2}", 1, "expected a field name"),
+            ("{x: 1", 5, "expected `,` or `}`"),
+            ("{x: }", 4, "unexpected `}`"),
+            ("{,}", 1, "expected a field name"),
+            ("[1,,]", 3, "unexpected `,`"),
+            ("f(1,)", 4, "unexpected `)`"),
+        ] {
+            let err = parse_expr(t).unwrap_err();
+            assert_eq!(err.offset, at, "{t:?}: {err}");
+            assert!(err.message.contains(msg), "{t:?}: {err}");
+        }
+        let deep = "{a:".repeat(10_000) + "1" + &"}".repeat(10_000);
+        assert!(parse_expr(&deep).unwrap_err().message.contains("deeply"));
     }
 
     #[test]

@@ -142,8 +142,8 @@ impl TypeTable {
             Ty::Int | Ty::Unknown => Cell::Int(0),
             Ty::Float => Cell::Float(0.0),
             Ty::Str => Cell::Str(StrId(0)),
-            Ty::Array(..) => Cell::List(Vec::new()),
-            Ty::Struct(i) => Cell::List(
+            Ty::Array(..) => Cell::List(List::default()),
+            Ty::Struct(i) => Cell::list(
                 self.structs
                     .get(*i as usize)
                     .map(|s| s.fields.iter().map(|(_, t)| self.default_cell(t)).collect())
@@ -160,7 +160,14 @@ pub(crate) enum Cell {
     Int(i64),
     Float(f64),
     Str(StrId),
-    List(Vec<Cell>),
+    List(List),
+}
+
+impl Cell {
+    /// A list cell holding `items`.
+    pub(crate) fn list(items: Vec<Cell>) -> Cell {
+        Cell::List(List::from(items))
+    }
 }
 
 impl Clone for Cell {
@@ -178,8 +185,107 @@ impl Clone for Cell {
     /// a value into a cell of the same shape does not allocate.
     fn clone_from(&mut self, source: &Self) {
         match (self, source) {
-            (Cell::List(dst), Cell::List(src)) => dst.clone_from(src),
+            (Cell::List(dst), Cell::List(src)) => dst.assign(src),
             (dst, src) => *dst = src.clone(),
+        }
+    }
+}
+
+/// The elements of an array or the fields of a struct.
+///
+/// Elements removed by shrinking stay in the buffer past the live length, buffers and all,
+/// and are reused when the list grows again: an array of arrays or structs that a run
+/// empties and refills (or that messages of different lengths pass through) does not
+/// allocate once it has been as long before. Reads see only the live elements (the list
+/// derefs to a slice of them).
+#[derive(Default)]
+pub(crate) struct List {
+    /// Live elements first, then set-aside ones.
+    items: Vec<Cell>,
+    /// Number of live elements (at most `items.len()`).
+    len: usize,
+}
+
+impl From<Vec<Cell>> for List {
+    fn from(items: Vec<Cell>) -> Self {
+        let len = items.len();
+        List { items, len }
+    }
+}
+
+impl Clone for List {
+    fn clone(&self) -> Self {
+        List::from(self.to_vec())
+    }
+}
+
+impl PartialEq for List {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
+    }
+}
+
+impl std::fmt::Debug for List {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
+}
+
+impl std::ops::Deref for List {
+    type Target = [Cell];
+    fn deref(&self) -> &[Cell] {
+        self.items.get(..self.len).unwrap_or(&[])
+    }
+}
+
+impl std::ops::DerefMut for List {
+    fn deref_mut(&mut self) -> &mut [Cell] {
+        let len = self.len.min(self.items.len());
+        &mut self.items[..len]
+    }
+}
+
+impl List {
+    /// Keeps the first `n` elements; the others are set aside for reuse.
+    pub(crate) fn truncate(&mut self, n: usize) {
+        self.len = self.len.min(n);
+    }
+
+    /// Appends a copy of `value`, into a set-aside element when there is one.
+    pub(crate) fn push_copy(&mut self, value: &Cell) {
+        match self.items.get_mut(self.len) {
+            Some(c) => c.clone_from(value),
+            None => self.items.push(value.clone()),
+        }
+        self.len += 1;
+    }
+
+    /// Grows to `n` elements with whatever set-aside elements hold (each is overwritten
+    /// by the caller), then `Int(0)`s; or shrinks to `n`.
+    pub(crate) fn set_len(&mut self, n: usize) {
+        while self.items.len() < n {
+            self.items.push(Cell::Int(0));
+        }
+        self.len = n;
+    }
+
+    /// Shrinks to `n`, or grows to `n` with copies of `fill`.
+    pub(crate) fn resize(&mut self, n: usize, fill: &Cell) {
+        self.truncate(n);
+        while self.len < n {
+            self.push_copy(fill);
+        }
+    }
+
+    /// Becomes a copy of `src`, reusing its own elements' buffers.
+    pub(crate) fn assign(&mut self, src: &List) {
+        self.truncate(src.len());
+        let live = self.len;
+        for (d, s) in self.iter_mut().zip(src.iter()) {
+            d.clone_from(s);
+        }
+        for s in src.iter().skip(live) {
+            self.push_copy(s);
         }
     }
 }
@@ -354,5 +460,47 @@ impl OwnedValue {
                 out.push(']');
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lists_reuse_the_elements_they_shrink_away() {
+        let inner = |n: i64| Cell::list((0..n).map(Cell::Int).collect());
+        let mut l = List::from(vec![inner(3), inner(4)]);
+        l.truncate(0);
+        assert!(l.is_empty());
+        assert_eq!(l, List::default());
+        assert_eq!(format!("{l:?}"), "[]");
+        // The set-aside element keeps its buffer: refilling it in place allocates nothing.
+        let before = match &l.items[0] {
+            Cell::List(v) => v.items.as_ptr(),
+            _ => unreachable!(),
+        };
+        l.push_copy(&inner(2));
+        assert_eq!(l.len(), 1);
+        assert_eq!(l[0], inner(2));
+        match &l[0] {
+            Cell::List(v) => assert_eq!(v.items.as_ptr(), before),
+            _ => unreachable!(),
+        }
+        l.resize(3, &Cell::Int(7));
+        assert_eq!(*l, [inner(2), Cell::Int(7), Cell::Int(7)]);
+        let mut m = List::from(vec![Cell::Int(1)]);
+        m.assign(&l);
+        assert_eq!(m, l);
+        l.set_len(1);
+        m.assign(&l);
+        assert_eq!(m.len(), 1);
+        assert_eq!(m.clone(), l);
+        // A cell stays small: every variable and parameter is one.
+        assert!(
+            std::mem::size_of::<Cell>() <= 32,
+            "{}",
+            std::mem::size_of::<Cell>()
+        );
     }
 }

@@ -8,7 +8,7 @@ use super::interfaces::Interfaces;
 use super::main_file::{Input, MainFile};
 use super::ros::{self, RosInput};
 use crate::model::xml::{self, Element};
-use crate::model::{Diagnostic, Diagnostics, ModelSource, SourceMap};
+use crate::model::{Diagnostic, Diagnostics, ModelSource, SourceMap, TypeDefs};
 use crate::sim::CompiledModel;
 
 /// A robot model, lowered to plain SCXML and compiled.
@@ -17,6 +17,9 @@ pub struct RobotModel {
     pub main: MainFile,
     /// The plain machines, in model order (what `hindsight convert` writes).
     pub machines: Vec<Element>,
+    /// The declared data types the machines name (what `hindsight convert` writes as
+    /// `types.xml`, with [`super::write::types_xml`]).
+    pub types: TypeDefs,
     /// The compiled model the simulator runs.
     pub model: CompiledModel,
     /// Nanoseconds in one model time step.
@@ -167,7 +170,7 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
 
     let mut src = ModelSource {
         sources: sm.clone(),
-        types,
+        types: types.clone(),
         ..ModelSource::default()
     };
     let mut errs = Diagnostics::default();
@@ -183,6 +186,7 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
     Ok(RobotModel {
         main,
         machines: out.machines,
+        types,
         model,
         time_unit_ns: unit,
         max_time_steps: max_time_ns / unit + 1,

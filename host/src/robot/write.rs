@@ -1,5 +1,7 @@
 //! Writes element trees back to XML text: how `hindsight convert` saves a lowered model as plain SCXML.
 
+use crate::model::source::{FileId, Span};
+use crate::model::types::{BaseType, TypeDef, TypeDefs, TypeExpr};
 use crate::model::xml::{Element, Node};
 
 /// The XML text of `root` and everything below it, indented by four spaces per level,
@@ -11,6 +13,64 @@ pub fn to_xml(root: &Element) -> String {
     let mut out = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     write_element(root, 0, &mut out);
     out
+}
+
+/// A model's declared types as a SCAN `types.xml` (`<dataTypeList>` of `<struct id>` with
+/// `<field id type>`, and `<enumeration id>` with `<label id>`), which the plain reader
+/// takes back from a model folder: the types a converted robot model's machines name.
+pub fn types_xml(defs: &TypeDefs) -> String {
+    let at = Span {
+        file: FileId(0),
+        offset: 0,
+    };
+    let mut root = Element::new("dataTypeList", at);
+    for (name, def, _) in &defs.defs {
+        match def {
+            TypeDef::Struct { fields } => {
+                let mut st = Element::new("struct", at).with_attr("id", name.as_str());
+                for (f, t) in fields {
+                    st.push(
+                        Element::new("field", at)
+                            .with_attr("id", f.as_str())
+                            .with_attr("type", type_text(t)),
+                    );
+                }
+                root.push(st);
+            }
+            TypeDef::Enumeration { labels } => {
+                let mut en = Element::new("enumeration", at).with_attr("id", name.as_str());
+                for l in labels {
+                    en.push(Element::new("label", at).with_attr("id", l.as_str()));
+                }
+                root.push(en);
+            }
+        }
+    }
+    to_xml(&root)
+}
+
+/// A type as a type attribute spells it (widths as stored: 64 bits).
+fn type_text(t: &TypeExpr) -> String {
+    match t {
+        TypeExpr::Base(BaseType::Bool) => "bool".into(),
+        TypeExpr::Base(BaseType::Int) => "int64".into(),
+        TypeExpr::Base(BaseType::Float) => "float64".into(),
+        TypeExpr::Base(BaseType::Str) => "string".into(),
+        TypeExpr::Named(n) => n.clone(),
+        // `T[2][3]` is 2 arrays of 3: the outermost dimension is written first.
+        TypeExpr::Array(..) => {
+            let mut dims = String::new();
+            let mut t = t;
+            while let TypeExpr::Array(inner, n) = t {
+                match n {
+                    Some(n) => dims.push_str(&format!("[{n}]")),
+                    None => dims.push_str("[]"),
+                }
+                t = inner;
+            }
+            format!("{}{dims}", type_text(t))
+        }
+    }
 }
 
 fn indent(depth: usize, out: &mut String) {
@@ -110,6 +170,34 @@ mod tests {
         assert!(matches!(&dm.children[0], Node::Comment(c, _) if c == " TYPE x:int32 "));
         let data = dm.elements().next().expect("data");
         assert_eq!(data.attr_value("expr"), Some("a < 3 && b > \"q\"\n"));
+    }
+
+    #[test]
+    fn types_round_trip_through_types_xml() {
+        let mut sm = SourceMap::new();
+        let src = r#"<dataTypeList>
+            <struct id="Poly"><field id="points" type="Point[]"/><field id="m" type="int32[2][]"/></struct>
+            <struct id="Point"><field id="frame" type="string"/><field id="x" type="float32"/><field id="ok" type="bool"/></struct>
+            <enumeration id="Color"><label id="RED"/><label id="GREEN"/></enumeration>
+        </dataTypeList>"#;
+        let f = sm.add("types.xml", src.to_string());
+        let mut defs = TypeDefs::default();
+        defs.read(&sm, f).unwrap();
+        let text = types_xml(&defs);
+        assert!(
+            text.contains("<field id=\"m\" type=\"int64[2][]\"/>"),
+            "{text}"
+        );
+        let g = sm.add("again.xml", text);
+        let mut back = TypeDefs::default();
+        back.read(&sm, g).unwrap();
+        let show = |d: &TypeDefs| {
+            format!(
+                "{:?}",
+                d.defs.iter().map(|(n, t, _)| (n, t)).collect::<Vec<_>>()
+            )
+        };
+        assert_eq!(show(&defs), show(&back));
     }
 
     #[test]

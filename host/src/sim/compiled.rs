@@ -262,6 +262,55 @@ impl CompiledModel {
         self.event_params(e).iter().position(|(n, _)| n == name)
     }
 
+    /// Where a property reads a message value: parameter `name` of event `e` (its index,
+    /// no fields), or a field of a struct parameter, written `param.field.sub` or, as
+    /// AS2FM's translation flattens structs, `param__field__sub` (the parameter's index and
+    /// the field indices on the way). Fields inside arrays are not reachable this way.
+    pub fn param_path(&self, e: EventId, name: &str) -> Option<(usize, Vec<u32>)> {
+        if let Some(i) = self.param_index(e, name) {
+            return Some((i, Vec::new()));
+        }
+        for (i, (pname, ty)) in self.event_params(e).iter().enumerate() {
+            let Some(rest) = name.strip_prefix(pname.as_str()).and_then(strip_sep) else {
+                continue;
+            };
+            let mut path = Vec::new();
+            if self.field_path(ty, rest, &mut path, 0) {
+                return Some((i, path));
+            }
+        }
+        None
+    }
+
+    /// Appends to `path` the fields that `rest` names inside `ty`; false when it names none.
+    fn field_path(&self, ty: &Ty, rest: &str, path: &mut Vec<u32>, depth: usize) -> bool {
+        let Ty::Struct(s) = ty else {
+            return false;
+        };
+        let Some(def) = self.types.structs.get(*s as usize) else {
+            return false;
+        };
+        if depth > 64 {
+            return false;
+        }
+        for (fi, (fname, fty)) in def.fields.iter().enumerate() {
+            let Some(after) = rest.strip_prefix(fname.as_str()) else {
+                continue;
+            };
+            path.push(fi as u32);
+            if after.is_empty() {
+                return true;
+            }
+            if let Some(sub) = strip_sep(after) {
+                if self.field_path(fty, sub, path, depth + 1) {
+                    return true;
+                }
+            }
+            path.pop();
+        }
+        false
+    }
+
     /// Machines that send event `e` (`<send>` or `<raise>`).
     pub fn event_senders(&self, e: EventId) -> impl Iterator<Item = MachineId> + '_ {
         self.events
@@ -447,6 +496,8 @@ impl<'s> Builder<'s> {
 
     fn build_types(&mut self) {
         let mut next_label = 0i64;
+        // Names first, so that a struct may name a type declared after it.
+        let mut structs = Vec::new();
         for (name, def, span) in &self.src.types.defs {
             match def {
                 TypeDef::Enumeration { labels } => {
@@ -459,20 +510,84 @@ impl<'s> Builder<'s> {
                     self.types.named.insert(name.clone(), Ty::Int);
                 }
                 TypeDef::Struct { fields } => {
-                    let mut fs = Vec::new();
-                    for (f, te) in fields {
-                        if let Some(t) = self.resolve(te, *span) {
-                            fs.push((f.clone(), t));
-                        }
-                    }
                     let idx = self.types.structs.len() as u32;
                     self.types.structs.push(StructDef {
                         name: name.clone(),
-                        fields: fs,
+                        fields: Vec::new(),
                     });
                     self.types.named.insert(name.clone(), Ty::Struct(idx));
+                    structs.push((idx, fields, *span));
                 }
             }
+        }
+        for (idx, fields, span) in structs {
+            let mut fs = Vec::new();
+            for (f, te) in fields {
+                if let Some(t) = self.resolve(te, span) {
+                    fs.push((f.clone(), t));
+                }
+            }
+            if let Some(d) = self.types.structs.get_mut(idx as usize) {
+                d.fields = fs;
+            }
+        }
+        // A struct that contains itself (not through an array) has no finite value.
+        let n = self.types.structs.len();
+        for start in 0..n {
+            let mut seen = vec![false; n];
+            let mut stack = vec![start];
+            let mut cyclic = false;
+            while let Some(i) = stack.pop() {
+                for (_, t) in &self.types.structs[i].fields {
+                    if let Ty::Struct(j) = t {
+                        let j = *j as usize;
+                        if j == start {
+                            cyclic = true;
+                        } else if j < n && !seen[j] {
+                            seen[j] = true;
+                            stack.push(j);
+                        }
+                    }
+                }
+            }
+            if cyclic {
+                let name = self.types.structs[start].name.clone();
+                let span = self
+                    .src
+                    .types
+                    .defs
+                    .iter()
+                    .find(|(n, _, _)| *n == name)
+                    .map(|(_, _, s)| *s);
+                if let Some(span) = span {
+                    self.err(
+                        span,
+                        format!("struct `{name}` contains itself (only an array of it may)"),
+                    );
+                }
+                // Break the cycle so that default values stay finite.
+                for (_, t) in &mut self.types.structs[start].fields {
+                    if matches!(t, Ty::Struct(_)) {
+                        *t = Ty::Int;
+                    }
+                }
+            }
+        }
+    }
+
+    /// `; declared: A, B` (the declared type names), or nothing when there are none.
+    fn known_types(&self) -> String {
+        let names: Vec<&str> = self
+            .src
+            .types
+            .defs
+            .iter()
+            .map(|(n, _, _)| n.as_str())
+            .collect();
+        if names.is_empty() {
+            String::new()
+        } else {
+            format!("; declared: {}", names.join(", "))
         }
     }
 
@@ -489,7 +604,10 @@ impl<'s> Builder<'s> {
                 None => {
                     self.err(
                         span,
-                        format!("unknown type `{n}` (not a base type nor declared in types.xml)"),
+                        format!(
+                            "unknown type `{n}` (not a base type nor declared in types.xml or the data declarations{})",
+                            self.known_types()
+                        ),
                     );
                     None
                 }
@@ -803,6 +921,13 @@ impl<'s> Builder<'s> {
             },
         }
     }
+}
+
+/// The text after a leading field separator (`.` or `__`), if there is one.
+fn strip_sep(s: &str) -> Option<&str> {
+    s.strip_prefix('.')
+        .or_else(|| s.strip_prefix("__"))
+        .filter(|r| !r.is_empty())
 }
 
 fn contains_unknown(t: &Ty) -> bool {

@@ -212,10 +212,14 @@ impl PropertySet {
                     path,
                     length,
                     ..
-                } => match model.param_index(event, param) {
-                    Some(i) => PortValue::Part {
+                } => match model.param_path(event, param) {
+                    // Struct fields first (`point.xs`), then the indices given.
+                    Some((i, mut fields)) => PortValue::Part {
                         param: i,
-                        path: path.clone().into_boxed_slice(),
+                        path: {
+                            fields.extend(path);
+                            fields.into_boxed_slice()
+                        },
                         length: *length,
                     },
                     None => {
@@ -226,8 +230,14 @@ impl PropertySet {
                         continue;
                     }
                 },
-                PortKind::State { param, .. } => match model.param_index(event, param) {
-                    Some(i) => PortValue::Param(i),
+                PortKind::State { param, .. } => match model.param_path(event, param) {
+                    Some((i, fields)) if fields.is_empty() => PortValue::Param(i),
+                    // A field of a struct parameter (`point.x`, `point__x`).
+                    Some((i, fields)) => PortValue::Part {
+                        param: i,
+                        path: fields.into_boxed_slice(),
+                        length: false,
+                    },
                     None => {
                         errors.push(format!(
                             "{here}: event `{}` has no parameter `{param}`",

@@ -1,0 +1,164 @@
+//! `hindsight monitor`: the on-line sidecar over iceoryx2, its off-line replay and its benchmark.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::sync::atomic::AtomicBool;
+use std::time::Duration;
+
+use super::{compile_spec_file, read_file, CliError};
+use crate::live::{self, config::Config, Options, Sidecar};
+
+/// Arguments of `hindsight monitor`.
+#[derive(Debug, clap::Args)]
+#[command(after_long_help = AFTER_HELP)]
+pub struct MonitorArgs {
+    /// The properties: a spec (`.hspec`) whose unit is the clock's tick.
+    #[arg(long, value_name = "SPEC", required_unless_present = "bench")]
+    pub props: Option<PathBuf>,
+    /// The sidecar config (TOML): topics to tap, services to proxy, payload layouts.
+    #[arg(long, value_name = "FILE", required_unless_present_any = ["replay", "bench"])]
+    pub config: Option<PathBuf>,
+    /// Off-line: replay an input log written by `--record` and print its verdicts.
+    #[arg(long, value_name = "LOG", conflicts_with_all = ["config", "record", "bench"])]
+    pub replay: Option<PathBuf>,
+    /// Verdict JSON lines to this file instead of standard output.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: Option<PathBuf>,
+    /// Write every judged input (samples, requests, heartbeats, losses) as JSON lines, for `--replay`.
+    #[arg(long, value_name = "LOG")]
+    pub record: Option<PathBuf>,
+    /// Write every property's verdict at every point, not only changes.
+    #[arg(long)]
+    pub every_point: bool,
+    /// Microseconds to sleep when nothing arrived (0: busy polling, lowest latency, one core).
+    #[arg(long, value_name = "US", default_value_t = 100)]
+    pub poll_us: u64,
+    /// Measure samples per second and added latency against a plain subscriber, then exit.
+    #[arg(long, conflicts_with_all = ["props", "config", "replay"])]
+    pub bench: bool,
+    /// Benchmark: samples in the paced (latency) phase.
+    #[arg(long, value_name = "N", default_value_t = 20_000, requires = "bench")]
+    pub bench_samples: u64,
+    /// Benchmark: rate of the paced phase, samples per second.
+    #[arg(
+        long,
+        value_name = "HZ",
+        default_value_t = 10_000.0,
+        requires = "bench"
+    )]
+    pub bench_rate: f64,
+    /// Benchmark: samples in the flood (throughput) phase.
+    #[arg(long, value_name = "N", default_value_t = 200_000, requires = "bench")]
+    pub bench_flood: u64,
+}
+
+const AFTER_HELP: &str = "\
+How it works:
+  Every [[topic]] of the config is an iceoryx2 publish-subscribe service with a
+  `[u8]` payload of a fixed size. The monitor adds one subscriber (publishers are
+  never blocked: a full buffer drops the monitor's oldest sample), stamps each
+  sample with a monotonic clock in ticks of the spec's `unit`, sets the spec
+  variables named by the layout, and steps the compiled monitors. Every
+  [[service]] is a request-response service the monitor serves itself and
+  forwards to the renamed real server (`NAME.real`); with `action = \"filter\"` a
+  request that would make a listed property false is answered with the `error`
+  reply and never reaches the server.
+
+Verdicts (JSON lines, on change):
+  {\"property\":\"battery_recurrence\",\"time\":12,\"verdict\":\"currently_false\",\"event\":\"museum/battery\"}
+  true/false: final, no later point can change it; currently_true/currently_false:
+  the verdict now; unknown: a sample the property reads was lost or malformed: the
+  property restarts and is unknown for its largest time bound, then judges again.
+
+Time: without samples, a heartbeat point every `[clock] heartbeat` ticks (default 1)
+  lets a bounded property see its window expire (a late topic fails on time).
+Loss: counted exactly from a `seq` counter in the payload, else suspected when a
+  drain finds the tap's buffer full; either way the readers turn `unknown`.
+Filter: a request is refused when it would turn a listed property from
+  true/currently_true to false/currently_false; a refused request leaves no trace.
+
+Robustness: a restarted publisher is picked up (the gap is reported), malformed
+  samples are counted and reported, SIGINT/SIGTERM flush every file and exit 0.
+
+Config example (see `hindsight::live::config` for every key):
+  [[topic]]
+  service = \"museum/battery\"
+  size = 16
+  event = \"battery_published\"
+  seq = { offset = 8, type = \"u64\" }
+  [[topic.field]]
+  var = \"battery_level\"
+  offset = 0
+  type = \"i32\"
+
+Examples:
+  hindsight monitor --props museum.hspec --config museum.toml --record in.jsonl -o verdicts.jsonl
+  hindsight monitor --props museum.hspec --replay in.jsonl     # the same verdicts, off-line
+  hindsight monitor --bench
+
+Exit codes: 0 stopped by a signal, or replay/bench done; 2 bad spec, config or log; 1 iceoryx2 or I/O failure.";
+
+fn create(path: &PathBuf) -> Result<Box<dyn Write + Send>, CliError> {
+    let f = std::fs::File::create(path)
+        .map_err(|e| CliError::Failed(format!("{}: cannot write: {e}", path.display())))?;
+    Ok(Box::new(std::io::BufWriter::new(f)))
+}
+
+/// Runs `hindsight monitor`.
+pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
+    // iceoryx2 warns on stderr about a missing config file; RUST_LOG-style `IOX2_LOG_LEVEL` overrides.
+    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
+    if args.bench {
+        let prefix = format!("hindsight-bench/{}", std::process::id());
+        let r = live::bench::run(
+            &prefix,
+            args.bench_samples,
+            args.bench_rate,
+            args.bench_flood,
+        )
+        .map_err(CliError::Failed)?;
+        print!("{r}");
+        return Ok(());
+    }
+    let Some(props) = &args.props else {
+        return Err(CliError::Input("--props SPEC is required".into()));
+    };
+    let spec = compile_spec_file(props)?;
+    let mut out: Box<dyn Write + Send> = match &args.output {
+        Some(p) => create(p)?,
+        None => Box::new(std::io::stdout()),
+    };
+    if let Some(log) = &args.replay {
+        let text = read_file(log)?;
+        let lines =
+            live::record::replay(&spec, &text, &log.display().to_string(), args.every_point)
+                .map_err(CliError::Input)?;
+        let io = |e: std::io::Error| CliError::Failed(format!("output: {e}"));
+        for l in lines {
+            writeln!(out, "{l}").map_err(io)?;
+        }
+        return out.flush().map_err(io);
+    }
+    let Some(config_path) = &args.config else {
+        return Err(CliError::Input("--config FILE is required".into()));
+    };
+    let text = read_file(config_path)?;
+    let config =
+        Config::parse(&text, &config_path.display().to_string(), &spec).map_err(CliError::Input)?;
+    let mut opts = Options {
+        verdicts: out,
+        record: args.record.as_ref().map(create).transpose()?,
+        every_point: args.every_point,
+        poll: Duration::from_micros(args.poll_us),
+        log: Box::new(std::io::stderr()),
+        probe: None,
+        progress: None,
+    };
+    let sidecar =
+        Sidecar::new(&config, &spec, true).map_err(|e| CliError::Failed(e.to_string()))?;
+    let stop = AtomicBool::new(false);
+    sidecar
+        .run(&config, &spec, &mut opts, &stop)
+        .map(|_| ())
+        .map_err(|e| CliError::Failed(e.to_string()))
+}

@@ -1,0 +1,782 @@
+//! On-line monitoring over iceoryx2: the `hindsight monitor` sidecar.
+//!
+//! Pipeline: a [`config::Config`] names iceoryx2 services and the byte layout of
+//! their `[u8]` payloads -> [`Sidecar`] taps every publish-subscribe topic with one
+//! extra subscriber and proxies every request-response service -> each sample is
+//! stamped with the [`Clock`] (monotonic, quantised to the spec's unit), decoded
+//! into variable sets and written to the input log ([`record::Input`]) -> the
+//! [`engine::Engine`] steps the compiled monitors -> verdict changes go out as JSON
+//! lines and on an optional iceoryx2 service. [`record::replay`] feeds a recorded
+//! input log through the same engine off-line, so it prints the same verdicts.
+//!
+//! - [`config`]: the TOML config, checked against the spec (`file:line:col` errors).
+//! - [`engine`]: five-valued verdicts and the loss rule (see its docs).
+//! - [`record`]: the verdict line and input log formats; replay.
+//! - [`bench`]: throughput and added latency against a plain subscriber.
+//!
+//! Taps never slow a publisher: the services keep iceoryx2's safe overflow, so a
+//! full tap buffer drops the tap's oldest sample. Lost samples are found from a
+//! sequence counter in the payload when the config names one, otherwise from a
+//! drain that found the buffer full (a conservative "may have lost").
+
+pub mod bench;
+pub mod config;
+pub mod engine;
+pub mod record;
+
+use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use codegen::Compiled;
+use iceoryx2::active_request::ActiveRequest;
+use iceoryx2::identifiers::UniquePublisherId;
+use iceoryx2::pending_response::PendingResponse;
+use iceoryx2::port::client::Client;
+use iceoryx2::port::publisher::Publisher;
+use iceoryx2::port::server::Server;
+use iceoryx2::port::subscriber::Subscriber;
+use iceoryx2::prelude::*;
+use monitor_core::Value;
+
+use config::{Action, Config, Layout};
+use engine::{Change, Engine};
+use record::Input;
+
+type Ipc = ipc::Service;
+type Req = ActiveRequest<Ipc, [u8], (), [u8], ()>;
+type Pending = PendingResponse<Ipc, [u8], (), [u8], ()>;
+
+/// A monotonic clock quantised to the spec's time unit: ticks since the sidecar started.
+#[derive(Clone, Copy, Debug)]
+pub struct Clock {
+    start: Instant,
+    tick_ns: u64,
+}
+
+impl Clock {
+    /// A clock starting now with ticks of `tick_ns` nanoseconds.
+    pub fn new(tick_ns: u64) -> Self {
+        Clock {
+            start: Instant::now(),
+            tick_ns: tick_ns.max(1),
+        }
+    }
+
+    /// Whole ticks elapsed since the start (never decreases).
+    pub fn now(&self) -> u64 {
+        (self.start.elapsed().as_nanos() / self.tick_ns as u128) as u64
+    }
+}
+
+/// Counts for one tapped topic or proxied service.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SourceStats {
+    /// The service name.
+    pub service: String,
+    /// Samples or requests judged.
+    pub samples: u64,
+    /// Samples known or suspected lost.
+    pub lost: u64,
+    /// Samples or requests of the wrong size or with an invalid field.
+    pub malformed: u64,
+    /// New publishers seen after a first one (restarts).
+    pub restarts: u64,
+    /// Requests refused by `filter` (or undeliverable).
+    pub blocked: u64,
+    /// Requests forwarded to the real service.
+    pub forwarded: u64,
+}
+
+/// What a run of the sidecar saw.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Report {
+    /// One entry per topic, then per service, in config order.
+    pub sources: Vec<SourceStats>,
+    /// Points judged (samples, requests and heartbeats).
+    pub points: u64,
+    /// Verdict lines written.
+    pub verdict_lines: u64,
+    /// With a [`Probe`]: `(sent, judged)` in nanoseconds since its epoch, per tapped sample.
+    pub probed: Vec<(u64, u64)>,
+}
+
+/// Where the sidecar writes and how it waits.
+pub struct Options {
+    /// Verdict JSON lines.
+    pub verdicts: Box<dyn Write + Send>,
+    /// The input log for `--replay`, if wanted.
+    pub record: Option<Box<dyn Write + Send>>,
+    /// Report every verdict at every point, not only changes.
+    pub every_point: bool,
+    /// Sleep this long when nothing arrived (zero: busy polling).
+    pub poll: Duration,
+    /// Diagnostics (lost, malformed, restarts) as text lines, e.g. standard error.
+    pub log: Box<dyn Write + Send>,
+    /// Incremented after every judged sample or request (for tests and benchmarks that wait on progress).
+    pub progress: Option<std::sync::Arc<std::sync::atomic::AtomicU64>>,
+    /// Benchmarks only: read a send time at this byte offset of every tapped sample.
+    pub probe: Option<Probe>,
+}
+
+/// A latency probe for [`bench`]: each tapped sample carries, as a little-endian
+/// `u64` at `offset`, the nanoseconds since `epoch` when it was sent.
+#[derive(Clone, Copy, Debug)]
+pub struct Probe {
+    /// Byte offset of the send time.
+    pub offset: usize,
+    /// The publisher's time origin.
+    pub epoch: Instant,
+}
+
+/// Why the sidecar could not run.
+#[derive(Debug)]
+pub enum LiveError {
+    /// iceoryx2 refused a node, service or port.
+    Ipc(String),
+    /// Writing an output failed.
+    Io(String),
+    /// The engine rejected a point (a bug: the config checks types).
+    Engine(String),
+}
+
+impl std::fmt::Display for LiveError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LiveError::Ipc(m) => write!(f, "iceoryx2: {m}"),
+            LiveError::Io(m) => write!(f, "output: {m}"),
+            LiveError::Engine(m) => write!(f, "monitor: {m}"),
+        }
+    }
+}
+
+impl std::error::Error for LiveError {}
+
+fn ipc<E: std::fmt::Debug>(what: &str) -> impl Fn(E) -> LiveError + '_ {
+    move |e| LiveError::Ipc(format!("{what}: {e:?}"))
+}
+
+/// Parses an iceoryx2 service name.
+pub fn service_name(s: &str) -> Result<ServiceName, LiveError> {
+    ServiceName::new(s).map_err(|e| LiveError::Ipc(format!("service name `{s}`: {e:?}")))
+}
+
+struct Tap {
+    source: String,
+    layout: Layout,
+    seq: Option<config::Seq>,
+    vars: Vec<String>,
+    sub: Subscriber<Ipc, [u8], ()>,
+    publishers: Vec<(UniquePublisherId, Option<u64>)>,
+    last_sample: Option<u64>,
+    stats: SourceStats,
+}
+
+struct Proxy {
+    source: String,
+    real: String,
+    layout: Layout,
+    action: Action,
+    filter: Vec<String>,
+    filter_ids: Vec<usize>,
+    var_names: Vec<String>,
+    error: Vec<u8>,
+    server: Server<Ipc, [u8], (), [u8], ()>,
+    client: Client<Ipc, [u8], (), [u8], ()>,
+    inflight: Vec<(Req, Pending)>,
+    stats: SourceStats,
+}
+
+/// The running sidecar's state between iterations.
+struct Run<'c, 'o> {
+    spec: &'c Compiled,
+    engine: Engine<'c>,
+    opts: &'o mut Options,
+    clock: Clock,
+    changes: Vec<Change>,
+    verdict_pub: Option<Publisher<Ipc, [u8], ()>>,
+    points: u64,
+    lines: u64,
+    probed: Vec<(u64, u64)>,
+}
+
+impl Run<'_, '_> {
+    /// Logs and applies one input; returns the request decision if it was one.
+    fn write_record(&mut self, input: &Input) -> Result<(), LiveError> {
+        if let Some(rec) = self.opts.record.as_mut() {
+            let line = serde_json::to_string(input).map_err(|e| LiveError::Io(e.to_string()))?;
+            writeln!(rec, "{line}").map_err(|e| LiveError::Io(e.to_string()))?;
+        }
+        Ok(())
+    }
+
+    /// Logs and applies one input (ticks, losses, restarts); the input log's path.
+    fn feed(&mut self, input: Input) -> Result<(), LiveError> {
+        self.write_record(&input)?;
+        self.changes.clear();
+        record::apply(self.spec, &mut self.engine, &input, &mut self.changes)
+            .map_err(LiveError::Engine)?;
+        let point = matches!(input, Input::Tick { .. });
+        let judged = matches!(input, Input::Loss { .. });
+        self.emit(point, judged)
+    }
+
+    /// A decoded sample or request: logged (when recording) and judged directly,
+    /// without the JSON round trip; `apply` in replay does the same engine calls.
+    /// Returns whether a request may pass.
+    fn judge(
+        &mut self,
+        time: u64,
+        source: &str,
+        sets: &[(usize, Value)],
+        request: Option<(&[String], Option<&[usize]>)>,
+    ) -> Result<bool, LiveError> {
+        if self.opts.record.is_some() {
+            let input = match request {
+                None => Input::Sample {
+                    time,
+                    source: source.to_string(),
+                    sets: record::sets_json(self.spec, sets),
+                },
+                Some((names, ids)) => Input::Request {
+                    time,
+                    source: source.to_string(),
+                    sets: record::sets_json(self.spec, sets),
+                    filter: ids.map(|_| names.to_vec()),
+                },
+            };
+            self.write_record(&input)?;
+        }
+        self.changes.clear();
+        let step = |e: monitor_core::StepError| LiveError::Engine(e.to_string());
+        let ok = match request {
+            None => {
+                self.engine
+                    .point(time, sets, source, &mut self.changes)
+                    .map_err(step)?;
+                true
+            }
+            Some((_, ids)) => self
+                .engine
+                .request(time, sets, source, ids, &mut self.changes)
+                .map_err(step)?,
+        };
+        self.emit(true, true)?;
+        Ok(ok)
+    }
+
+    fn emit(&mut self, point: bool, judged: bool) -> Result<(), LiveError> {
+        if point {
+            self.points += 1;
+        }
+        for c in &self.changes {
+            let line = record::verdict_line(self.spec, c);
+            writeln!(self.opts.verdicts, "{line}").map_err(|e| LiveError::Io(e.to_string()))?;
+            self.lines += 1;
+            if let Some(p) = &self.verdict_pub {
+                // A verdict subscriber that is gone or slow must not stop the monitor.
+                if let Ok(s) = p.loan_slice_uninit(line.len()) {
+                    let _ = s.write_from_slice(line.as_bytes()).send();
+                }
+            }
+        }
+        if judged {
+            if let Some(p) = &self.opts.progress {
+                p.fetch_add(1, Ordering::SeqCst);
+            }
+        }
+        Ok(())
+    }
+
+    fn note(&mut self, msg: String) {
+        let _ = writeln!(self.opts.log, "monitor: {msg}");
+    }
+
+    /// A time no earlier than the engine's last point.
+    fn now(&self) -> u64 {
+        let t = self.clock.now();
+        self.engine.last_time().map_or(t, |l| t.max(l))
+    }
+
+    fn drain_tap(
+        &mut self,
+        tap: &mut Tap,
+        sets: &mut Vec<(usize, Value)>,
+    ) -> Result<bool, LiveError> {
+        let mut n = 0usize;
+        loop {
+            let sample = match tap.sub.receive() {
+                Ok(Some(s)) => s,
+                Ok(None) => break,
+                Err(e) => {
+                    self.note(format!("{}: receive failed: {e:?}", tap.source));
+                    break;
+                }
+            };
+            n += 1;
+            let time = self.now();
+            let bytes: &[u8] = sample.payload();
+            let pid = sample.header().publisher_id();
+            let seq = tap
+                .seq
+                .and_then(|s| s.ty.read(bytes, s.offset))
+                .and_then(|v| match v {
+                    Value::Int(i) => Some(i as u64),
+                    _ => None,
+                });
+            // A publisher we have not seen after another one: a restart (or a second publisher).
+            let known = tap.publishers.iter().position(|(p, _)| *p == pid);
+            let idx = match known {
+                Some(i) => i,
+                None => {
+                    if !tap.publishers.is_empty() {
+                        let gap = time - tap.last_sample.unwrap_or(time).min(time);
+                        tap.stats.restarts += 1;
+                        self.note(format!(
+                            "{}: new publisher after a gap of {gap} ticks",
+                            tap.source
+                        ));
+                        self.feed(Input::Restart {
+                            time,
+                            source: tap.source.clone(),
+                            gap,
+                        })?;
+                        // Keep the list small: a restarted publisher never comes back.
+                        if tap.publishers.len() >= 8 {
+                            tap.publishers.remove(0);
+                        }
+                    }
+                    tap.publishers.push((pid, None));
+                    tap.publishers.len() - 1
+                }
+            };
+            if let (Some(s), Some(cfg)) = (seq, tap.seq) {
+                if let Some(prev) = tap.publishers[idx].1 {
+                    let modulus = if cfg.ty.size() == 8 {
+                        0
+                    } else {
+                        1u64 << (8 * cfg.ty.size())
+                    };
+                    let expected = prev.wrapping_add(1);
+                    let expected = if modulus == 0 {
+                        expected
+                    } else {
+                        expected % modulus
+                    };
+                    if s != expected {
+                        let lost = if modulus == 0 {
+                            s.wrapping_sub(expected)
+                        } else {
+                            (s + modulus - expected) % modulus
+                        };
+                        tap.stats.lost += lost;
+                        self.note(format!(
+                            "{}: {lost} samples lost (sequence {expected} to {s})",
+                            tap.source
+                        ));
+                        self.feed(Input::Loss {
+                            time,
+                            source: tap.source.clone(),
+                            vars: tap.vars.clone(),
+                            count: lost,
+                            reason: "sequence gap".into(),
+                        })?;
+                    }
+                }
+                tap.publishers[idx].1 = Some(s);
+            }
+            tap.last_sample = Some(time);
+            match tap.layout.decode(bytes, sets) {
+                Ok(()) => {
+                    tap.stats.samples += 1;
+                    self.judge(time, &tap.source, sets, None)?;
+                    if let Some(p) = self.opts.probe {
+                        if let Some(Value::Int(sent)) = config::FieldTy::U64.read(bytes, p.offset) {
+                            self.probed
+                                .push((sent as u64, p.epoch.elapsed().as_nanos() as u64));
+                        }
+                    }
+                }
+                Err(m) => {
+                    tap.stats.malformed += 1;
+                    self.note(format!("{}: malformed sample: {m}", tap.source));
+                    self.feed(Input::Loss {
+                        time,
+                        source: tap.source.clone(),
+                        vars: tap.vars.clone(),
+                        count: 1,
+                        reason: format!("malformed: {m}"),
+                    })?;
+                }
+            }
+        }
+        if n > 0 && tap.seq.is_none() && n >= tap.sub.buffer_size() {
+            // The buffer was full at some moment: the oldest samples may have been overwritten.
+            tap.stats.lost += 1;
+            self.note(format!(
+                "{}: buffer of {} samples full, samples may be lost",
+                tap.source,
+                tap.sub.buffer_size()
+            ));
+            let time = self.now();
+            self.feed(Input::Loss {
+                time,
+                source: tap.source.clone(),
+                vars: tap.vars.clone(),
+                count: 1,
+                reason: "buffer full".into(),
+            })?;
+        }
+        Ok(n > 0)
+    }
+
+    /// Serves one proxy. Before judging a request it drains `taps` again, so a
+    /// request is judged after every sample published before it was sent.
+    fn serve(
+        &mut self,
+        px: &mut Proxy,
+        taps: &mut [Tap],
+        sets: &mut Vec<(usize, Value)>,
+    ) -> Result<bool, LiveError> {
+        let mut busy = false;
+        loop {
+            let req = match px.server.receive() {
+                Ok(Some(r)) => r,
+                Ok(None) => break,
+                Err(e) => {
+                    self.note(format!("{}: receive failed: {e:?}", px.source));
+                    break;
+                }
+            };
+            busy = true;
+            for tap in taps.iter_mut() {
+                self.drain_tap(tap, sets)?;
+            }
+            let time = self.now();
+            let bytes: &[u8] = req.payload();
+            let allowed = match px.layout.decode(bytes, sets) {
+                Ok(()) => {
+                    px.stats.samples += 1;
+                    let ids = (px.action == Action::Filter).then_some(px.filter_ids.as_slice());
+                    self.judge(time, &px.source, sets, Some((&px.filter, ids)))?
+                }
+                Err(m) => {
+                    px.stats.malformed += 1;
+                    self.note(format!("{}: malformed request: {m}", px.source));
+                    self.feed(Input::Loss {
+                        time,
+                        source: px.source.clone(),
+                        vars: px.var_names.clone(),
+                        count: 1,
+                        reason: format!("malformed: {m}"),
+                    })?;
+                    // filter cannot judge it, so it does not pass; log forwards it.
+                    px.action == Action::Log
+                }
+            };
+            if !allowed {
+                px.stats.blocked += 1;
+                self.note(format!("{}: request blocked at time {time}", px.source));
+                reply(&req, &px.error);
+                continue;
+            }
+            let sent = px
+                .client
+                .loan_slice_uninit(bytes.len())
+                .map_err(|e| format!("{e:?}"))
+                .and_then(|r| {
+                    r.write_from_slice(bytes)
+                        .send()
+                        .map_err(|e| format!("{e:?}"))
+                });
+            match sent {
+                Ok(pending) if pending.number_of_server_connections() > 0 => {
+                    px.stats.forwarded += 1;
+                    px.inflight.push((req, pending));
+                }
+                Ok(_) => {
+                    px.stats.blocked += 1;
+                    self.note(format!(
+                        "{}: no server on `{}`, answered with the error reply",
+                        px.source, px.real
+                    ));
+                    reply(&req, &px.error);
+                }
+                Err(e) => {
+                    px.stats.blocked += 1;
+                    self.note(format!("{}: cannot forward: {e}", px.source));
+                    reply(&req, &px.error);
+                }
+            }
+        }
+        // Responses back to the callers; a finished exchange is dropped on both sides.
+        px.inflight.retain(|(req, pending)| {
+            while let Ok(Some(resp)) = pending.receive() {
+                reply(req, resp.payload());
+                busy = true;
+            }
+            pending.is_connected() && req.is_connected()
+        });
+        Ok(busy)
+    }
+}
+
+fn reply(req: &Req, bytes: &[u8]) {
+    // A caller that went away cannot be answered; that is not the monitor's failure.
+    if let Ok(r) = req.loan_slice_uninit(bytes.len()) {
+        let _ = r.write_from_slice(bytes).send();
+    }
+}
+
+/// The sidecar: owns the iceoryx2 node and ports; [`Sidecar::run`] judges until stopped.
+pub struct Sidecar {
+    // Ports first: fields drop in order, and the node must outlive its ports.
+    taps: Vec<Tap>,
+    proxies: Vec<Proxy>,
+    verdict_pub: Option<Publisher<Ipc, [u8], ()>>,
+    node: Node<Ipc>,
+}
+
+impl Sidecar {
+    /// Creates the node, the tap subscribers, the proxy ports and the verdict publisher.
+    /// The services are opened, or created when their publisher has not started yet.
+    /// With `handle_signals`, SIGINT/SIGTERM make [`Sidecar::run`] flush and return
+    /// (the CLI); tests and embedders stop it through its flag instead.
+    pub fn new(config: &Config, spec: &Compiled, handle_signals: bool) -> Result<Self, LiveError> {
+        let mode = if handle_signals {
+            SignalHandlingMode::HandleTerminationRequests
+        } else {
+            SignalHandlingMode::Disabled
+        };
+        let node = NodeBuilder::new()
+            .signal_handling_mode(mode)
+            .create::<Ipc>()
+            .map_err(ipc("node"))?;
+        let names = |vars: &[usize]| -> Vec<String> {
+            vars.iter().map(|&v| spec.vars()[v].name.clone()).collect()
+        };
+        let mut taps = Vec::new();
+        for t in &config.topics {
+            let name = service_name(&t.service)?;
+            let factory = match node
+                .service_builder(&name)
+                .publish_subscribe::<[u8]>()
+                .subscriber_max_buffer_size(t.buffer)
+                .open_or_create()
+            {
+                Ok(f) => f,
+                // It exists with a smaller buffer: take it as it is.
+                Err(_) => node
+                    .service_builder(&name)
+                    .publish_subscribe::<[u8]>()
+                    .open()
+                    .map_err(ipc(&t.service))?,
+            };
+            if !factory.static_config().has_safe_overflow() {
+                // A slow tap on such a service would make its publisher wait or drop for everyone.
+                return Err(LiveError::Ipc(format!(
+                    "{}: the service has no safe overflow, so a tap could block its publisher; \
+                     create it with safe overflow (the iceoryx2 default)",
+                    t.service
+                )));
+            }
+            let sub = factory
+                .subscriber_builder()
+                .create()
+                .map_err(ipc(&t.service))?;
+            let var_ids = t.layout.vars();
+            taps.push(Tap {
+                source: t.service.clone(),
+                layout: t.layout.clone(),
+                seq: t.seq,
+                vars: names(&var_ids),
+                sub,
+                publishers: Vec::new(),
+                last_sample: None,
+                stats: SourceStats {
+                    service: t.service.clone(),
+                    ..SourceStats::default()
+                },
+            });
+        }
+        let mut proxies = Vec::new();
+        for s in &config.services {
+            let front = node
+                .service_builder(&service_name(&s.service)?)
+                .request_response::<[u8], [u8]>()
+                .open_or_create()
+                .map_err(ipc(&s.service))?;
+            let server = front
+                .server_builder()
+                .initial_max_slice_len(4096)
+                .allocation_strategy(AllocationStrategy::PowerOfTwo)
+                .create()
+                .map_err(ipc(&s.service))?;
+            let back = node
+                .service_builder(&service_name(&s.real)?)
+                .request_response::<[u8], [u8]>()
+                .open_or_create()
+                .map_err(ipc(&s.real))?;
+            let client = back
+                .client_builder()
+                .initial_max_slice_len(s.layout.size)
+                .allocation_strategy(AllocationStrategy::PowerOfTwo)
+                .create()
+                .map_err(ipc(&s.real))?;
+            proxies.push(Proxy {
+                source: s.service.clone(),
+                real: s.real.clone(),
+                layout: s.layout.clone(),
+                action: s.action,
+                filter_ids: s.properties.clone(),
+                filter: s
+                    .properties
+                    .iter()
+                    .map(|&p| spec.properties()[p].name.clone())
+                    .collect(),
+                var_names: names(&s.layout.vars()),
+                error: s.error.clone(),
+                server,
+                client,
+                inflight: Vec::new(),
+                stats: SourceStats {
+                    service: s.service.clone(),
+                    ..SourceStats::default()
+                },
+            });
+        }
+        let verdict_pub = match &config.verdict_service {
+            None => None,
+            Some(v) => {
+                let name = service_name(v)?;
+                let f = match node
+                    .service_builder(&name)
+                    .publish_subscribe::<[u8]>()
+                    .subscriber_max_buffer_size(256)
+                    .open_or_create()
+                {
+                    Ok(f) => f,
+                    Err(_) => node
+                        .service_builder(&name)
+                        .publish_subscribe::<[u8]>()
+                        .open()
+                        .map_err(ipc(v))?,
+                };
+                Some(
+                    f.publisher_builder()
+                        .initial_max_slice_len(256)
+                        .allocation_strategy(AllocationStrategy::PowerOfTwo)
+                        .create()
+                        .map_err(ipc(v))?,
+                )
+            }
+        };
+        Ok(Sidecar {
+            node,
+            taps,
+            proxies,
+            verdict_pub,
+        })
+    }
+
+    /// Judges until `stop` is set (or, with signal handling, SIGINT/SIGTERM),
+    /// then flushes every output. `config.heartbeat` adds empty points when idle.
+    pub fn run(
+        mut self,
+        config: &Config,
+        spec: &Compiled,
+        opts: &mut Options,
+        stop: &AtomicBool,
+    ) -> Result<Report, LiveError> {
+        let engine = Engine::new(spec, opts.every_point).map_err(LiveError::Engine)?;
+        let poll = opts.poll;
+        let mut run = Run {
+            spec,
+            engine,
+            opts,
+            clock: Clock::new(spec.tick_ns()),
+            changes: Vec::new(),
+            verdict_pub: self.verdict_pub.take(),
+            points: 0,
+            lines: 0,
+            probed: Vec::new(),
+        };
+        let mut sets = Vec::new();
+        let mut last_cleanup = Instant::now();
+        let mut idle_since_flush = false;
+        let mut idle_spins = 0u64;
+        let result = loop {
+            if stop.load(Ordering::Relaxed) {
+                break Ok(());
+            }
+            let mut busy = false;
+            for tap in &mut self.taps {
+                match run.drain_tap(tap, &mut sets) {
+                    Ok(b) => busy |= b,
+                    Err(e) => return Err(e),
+                }
+            }
+            for px in &mut self.proxies {
+                busy |= run.serve(px, &mut self.taps, &mut sets)?;
+            }
+            if config.heartbeat > 0 {
+                let now = run.clock.now();
+                let due = run
+                    .engine
+                    .last_time()
+                    .is_none_or(|l| now >= l + config.heartbeat);
+                if due {
+                    run.feed(Input::Tick { time: run.now() })?;
+                }
+            }
+            if last_cleanup.elapsed() >= Duration::from_secs(1) {
+                // Dead publishers' resources go, so a restarted one can connect.
+                let _ = Node::<Ipc>::try_cleanup_dead_nodes(self.node.config());
+                last_cleanup = Instant::now();
+            }
+            if busy {
+                idle_since_flush = false;
+                continue;
+            }
+            if !idle_since_flush {
+                let _ = run.opts.verdicts.flush();
+                idle_since_flush = true;
+            }
+            if poll.is_zero() {
+                // Busy polling: yield instead of sleeping (a zero sleep still costs the
+                // timer slack, about 50 us); look at the signals now and then.
+                idle_spins += 1;
+                if idle_spins % 1024 != 0 {
+                    std::thread::yield_now();
+                    continue;
+                }
+            }
+            if self.node.wait(poll).is_err() {
+                break Ok(());
+            }
+        };
+        let flush = |w: &mut dyn Write| w.flush().map_err(|e| LiveError::Io(e.to_string()));
+        flush(&mut run.opts.verdicts)?;
+        if let Some(r) = run.opts.record.as_mut() {
+            flush(r)?;
+        }
+        // The verdict publisher goes before the node does.
+        drop(run.verdict_pub.take());
+        let mut sources: Vec<SourceStats> = self.taps.iter().map(|t| t.stats.clone()).collect();
+        sources.extend(self.proxies.iter().map(|p| p.stats.clone()));
+        for s in &sources {
+            let _ = writeln!(
+                run.opts.log,
+                "monitor: {}: {} judged, {} lost, {} malformed, {} restarts, {} forwarded, {} blocked",
+                s.service, s.samples, s.lost, s.malformed, s.restarts, s.forwarded, s.blocked
+            );
+        }
+        let _ = run.opts.log.flush();
+        result.map(|()| Report {
+            sources,
+            points: run.points,
+            verdict_lines: run.lines,
+            probed: run.probed,
+        })
+    }
+}

@@ -1,0 +1,241 @@
+//! The sidecar's two JSON-lines streams: verdict lines out, and the input log that `--replay` reads back.
+//!
+//! Verdict line: `{"property":"battery_recurrence","time":42,"verdict":"currently_false","event":"museum/battery"}`.
+//!
+//! Input log, one record per line, every time in ticks of the spec's unit:
+//! - `{"kind":"sample","time":T,"source":S,"sets":{VAR:VALUE,..}}`: a tapped sample;
+//! - `{"kind":"request","time":T,"source":S,"sets":{..},"filter":[PROP,..]|null}`: a proxied request;
+//! - `{"kind":"tick","time":T}`: a heartbeat point with no sample;
+//! - `{"kind":"loss","time":T,"source":S,"vars":[VAR,..],"count":N,"reason":R}`: lost or malformed samples;
+//! - `{"kind":"restart","time":T,"source":S,"gap":TICKS}`: a new publisher (informational).
+//!
+//! Values are JSON booleans, integers and floats, typed by the spec's variables.
+
+use std::collections::BTreeMap;
+
+use codegen::Compiled;
+use monitor_core::{Ty, Value};
+use serde::{Deserialize, Serialize};
+
+use super::engine::{Change, Engine, Verdict};
+
+/// One record of the input log.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Input {
+    /// A tapped sample.
+    Sample {
+        /// Quantised time.
+        time: u64,
+        /// The service it came from.
+        source: String,
+        /// Variable name to value.
+        sets: BTreeMap<String, serde_json::Value>,
+    },
+    /// A proxied request.
+    Request {
+        /// Quantised time.
+        time: u64,
+        /// The service it came from.
+        source: String,
+        /// Variable name to value.
+        sets: BTreeMap<String, serde_json::Value>,
+        /// The properties it may not falsify (`filter`), `None` for `log`.
+        filter: Option<Vec<String>>,
+    },
+    /// A heartbeat point.
+    Tick {
+        /// Quantised time.
+        time: u64,
+    },
+    /// Samples lost or unreadable.
+    Loss {
+        /// Quantised time.
+        time: u64,
+        /// The service.
+        source: String,
+        /// The variables its samples set.
+        vars: Vec<String>,
+        /// How many samples (at least; 1 when unknown).
+        count: u64,
+        /// Why: `sequence gap`, `buffer full`, `malformed: ...`.
+        reason: String,
+    },
+    /// A new publisher appeared on a topic after another one.
+    Restart {
+        /// Quantised time.
+        time: u64,
+        /// The service.
+        source: String,
+        /// Ticks since the previous publisher's last sample.
+        gap: u64,
+    },
+}
+
+/// Value to JSON.
+pub fn value_json(spec: &Compiled, v: Value) -> serde_json::Value {
+    match v {
+        Value::Bool(b) => b.into(),
+        Value::Int(i) => i.into(),
+        Value::Float(f) => {
+            serde_json::Number::from_f64(f).map_or(serde_json::Value::Null, Into::into)
+        }
+        Value::Str(s) => spec
+            .strings()
+            .get(s as usize)
+            .cloned()
+            .unwrap_or_default()
+            .into(),
+    }
+}
+
+/// Variable sets to a JSON object keyed by variable name.
+pub fn sets_json(spec: &Compiled, sets: &[(usize, Value)]) -> BTreeMap<String, serde_json::Value> {
+    sets.iter()
+        .map(|&(v, x)| (spec.vars()[v].name.clone(), value_json(spec, x)))
+        .collect()
+}
+
+fn sets_back(
+    spec: &Compiled,
+    sets: &BTreeMap<String, serde_json::Value>,
+) -> Result<Vec<(usize, Value)>, String> {
+    let mut out = Vec::with_capacity(sets.len());
+    for (name, j) in sets {
+        let var = spec
+            .var_index(name)
+            .ok_or_else(|| format!("`{name}` is not a variable of the spec"))?;
+        let v = match (spec.vars()[var].ty, j) {
+            (Ty::Bool, serde_json::Value::Bool(b)) => Value::Bool(*b),
+            (Ty::Int, serde_json::Value::Number(n)) if n.is_i64() => {
+                Value::Int(n.as_i64().unwrap_or(0))
+            }
+            (Ty::Float, serde_json::Value::Number(n)) => Value::Float(n.as_f64().unwrap_or(0.0)),
+            _ => {
+                return Err(format!(
+                    "`{j}` is not a {} value for `{name}`",
+                    spec.vars()[var].type_name
+                ))
+            }
+        };
+        out.push((var, v));
+    }
+    Ok(out)
+}
+
+fn vars_back(spec: &Compiled, names: &[String]) -> Result<Vec<usize>, String> {
+    names
+        .iter()
+        .map(|n| {
+            spec.var_index(n)
+                .ok_or_else(|| format!("`{n}` is not a variable of the spec"))
+        })
+        .collect()
+}
+
+/// The verdict line of `c`.
+pub fn verdict_line(spec: &Compiled, c: &Change) -> String {
+    let line = serde_json::json!({
+        "property": spec.properties()[c.property].name,
+        "time": c.time,
+        "verdict": c.verdict.as_str(),
+        "event": c.event,
+    });
+    line.to_string()
+}
+
+/// A parsed verdict line.
+#[derive(Clone, Debug, PartialEq, Eq, Deserialize)]
+pub struct VerdictLine {
+    /// Property name.
+    pub property: String,
+    /// Time in ticks.
+    pub time: u64,
+    /// `true`, `false`, `currently_true`, `currently_false` or `unknown`.
+    pub verdict: String,
+    /// What made the point.
+    pub event: String,
+}
+
+impl VerdictLine {
+    /// The verdict, parsed.
+    pub fn verdict(&self) -> Option<Verdict> {
+        Verdict::parse(&self.verdict)
+    }
+}
+
+/// Feeds one input record to `engine`; the same call serves the live loop and replay.
+pub fn apply(
+    spec: &Compiled,
+    engine: &mut Engine<'_>,
+    input: &Input,
+    out: &mut Vec<Change>,
+) -> Result<Option<bool>, String> {
+    let step = |e: monitor_core::StepError| e.to_string();
+    match input {
+        Input::Sample { time, source, sets } => {
+            let sets = sets_back(spec, sets)?;
+            engine.point(*time, &sets, source, out).map_err(step)?;
+        }
+        Input::Request {
+            time,
+            source,
+            sets,
+            filter,
+        } => {
+            let sets = sets_back(spec, sets)?;
+            let props = match filter {
+                None => None,
+                Some(names) => Some(
+                    names
+                        .iter()
+                        .map(|n| {
+                            spec.property_names()
+                                .position(|p| p == n)
+                                .ok_or_else(|| format!("`{n}` is not a property of the spec"))
+                        })
+                        .collect::<Result<Vec<_>, _>>()?,
+                ),
+            };
+            let ok = engine
+                .request(*time, &sets, source, props.as_deref(), out)
+                .map_err(step)?;
+            return Ok(Some(ok));
+        }
+        Input::Tick { time } => engine.point(*time, &[], "tick", out).map_err(step)?,
+        Input::Loss {
+            time, source, vars, ..
+        } => {
+            let vars = vars_back(spec, vars)?;
+            engine
+                .loss(*time, &vars, &format!("lost {source}"), out)
+                .map_err(step)?;
+        }
+        Input::Restart { .. } => {}
+    }
+    Ok(None)
+}
+
+/// Replays an input log: every verdict line, in order. Errors name `file:line`.
+pub fn replay(
+    spec: &Compiled,
+    text: &str,
+    file: &str,
+    every_point: bool,
+) -> Result<Vec<String>, String> {
+    let mut engine = Engine::new(spec, every_point)?;
+    let mut lines = Vec::new();
+    let mut out = Vec::new();
+    for (i, l) in text.lines().enumerate() {
+        if l.trim().is_empty() {
+            continue;
+        }
+        let input: Input =
+            serde_json::from_str(l).map_err(|e| format!("{file}:{}:{}: {e}", i + 1, e.column()))?;
+        out.clear();
+        apply(spec, &mut engine, &input, &mut out)
+            .map_err(|e| format!("{file}:{}:1: {e}", i + 1))?;
+        lines.extend(out.iter().map(|c| verdict_line(spec, c)));
+    }
+    Ok(lines)
+}
