@@ -90,6 +90,9 @@ pub(crate) enum Instr {
 
 pub(crate) struct TransDef {
     pub cond: Option<BoolFn>,
+    /// The condition may draw random numbers (`Math.random()`): evaluating it twice
+    /// is not the same as evaluating it once.
+    pub cond_draws: bool,
     /// Start of the transition's code.
     pub pc: u32,
 }
@@ -1382,6 +1385,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                             continue;
                         }
                     }
+                    let cond_draws = t.cond.as_ref().is_some_and(|c| c.text.contains("random"));
                     let cond = match &t.cond {
                         Some(c) => match self.bool_code(c, ev) {
                             Some(f) => Some(f),
@@ -1397,7 +1401,11 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                         None => self.emit(Instr::CheckEventless, t.span),
                     };
                     let id = trans.len() as u32;
-                    trans.push(TransDef { cond, pc });
+                    trans.push(TransDef {
+                        cond,
+                        cond_draws,
+                        pc,
+                    });
                     match ev {
                         Some(e) => per_state[si].entry(e).or_default().push(id),
                         None => states[si].eventless.push(id),

@@ -289,7 +289,26 @@ pub struct Simulator<'m> {
     rx_base: Vec<u32>,
     /// Pool slots reserved for [`EventSemantics::As2fm`] (never freed).
     reserved: usize,
+    /// No transition condition draws random numbers: with [`TransitionChoice::DocumentOrder`]
+    /// a receiver's choice depends only on its own state, so it can be kept.
+    pure_guards: bool,
+    /// The current run keeps receivers' choices ([`EventSemantics::As2fm`], pure guards,
+    /// document order).
+    keep_choices: bool,
+    /// Scheduler iterations so far (never reset): the stamps below are its values.
+    clock: u64,
+    /// Per machine: the iteration it last changed in (state, variables, position, flags).
+    changed: Vec<u64>,
+    /// Per receiver of each event (indexed like the receivers' pool slots past the
+    /// events' buffers): the iteration its choice was computed in (0: not computed).
+    checked: Vec<u64>,
+    /// Per receiver of each event: the transition it fires on the pending event
+    /// (`NO_TRANS`: it discards it, `CANNOT_TAKE`: not now), as of `checked`.
+    choice_kept: Vec<u32>,
 }
+
+const NO_TRANS: u32 = u32::MAX;
+const CANNOT_TAKE: u32 = u32::MAX - 1;
 
 impl std::fmt::Debug for Simulator<'_> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -452,6 +471,29 @@ impl<'m> Simulator<'m> {
             deliverable: Vec::with_capacity(model.events.len()),
             blocked_list: Vec::with_capacity(n),
             ev_scratch: model.events.iter().map(|d| d.defaults.clone()).collect(),
+            pure_guards: model
+                .machines
+                .iter()
+                .all(|d| d.trans.iter().all(|t| !t.cond_draws)),
+            keep_choices: false,
+            clock: 0,
+            changed: vec![0; n],
+            checked: vec![
+                0;
+                model
+                    .events
+                    .iter()
+                    .map(|d| d.receivers.len())
+                    .sum::<usize>()
+            ],
+            choice_kept: vec![
+                NO_TRANS;
+                model
+                    .events
+                    .iter()
+                    .map(|d| d.receivers.len())
+                    .sum::<usize>()
+            ],
         }
     }
 
@@ -657,6 +699,7 @@ impl<'m> Simulator<'m> {
             }
         }
         self.pending.iter_mut().for_each(|p| *p = false);
+        self.checked.iter_mut().for_each(|c| *c = 0);
         self.pending_list.clear();
         self.pending_regular = 0;
         self.pending_bb_set = 0;
@@ -700,13 +743,21 @@ impl<'m> Simulator<'m> {
         obs: &mut O,
     ) -> Result<EndReason, Stop> {
         self.as2fm = cfg.events == EventSemantics::As2fm;
+        self.keep_choices =
+            self.as2fm && self.pure_guards && cfg.transitions == TransitionChoice::DocumentOrder;
         self.reset(rng)?;
         loop {
+            self.clock += 1;
             if self.as2fm {
                 self.deliverable.clear();
                 for i in 0..self.pending_list.len() {
                     let e = self.pending_list[i];
-                    if self.deliverable_now(e, rng, cfg)? {
+                    let now = if self.keep_choices {
+                        self.deliverable_kept(e, rng, cfg)?
+                    } else {
+                        self.deliverable_now(e, rng, cfg)?
+                    };
+                    if now {
                         self.deliverable.push(e);
                     }
                 }
@@ -734,6 +785,7 @@ impl<'m> Simulator<'m> {
                     let m = self.delayed[i] as usize;
                     if self.ms[m].wake <= self.time {
                         self.ms[m].waiting = false;
+                        self.changed[m] = self.clock;
                         self.delayed.swap_remove(i);
                         self.refresh(m);
                     } else {
@@ -768,6 +820,7 @@ impl<'m> Simulator<'m> {
                 continue;
             }
             let m = self.runnable[k] as usize;
+            self.changed[m] = self.clock;
             self.instant_moves[m] = self.instant_moves[m].saturating_add(1);
             if self.step(m, rng, cfg, obs)? == Flow::Stop {
                 return Ok(EndReason::Stopped);
@@ -1297,6 +1350,44 @@ impl<'m> Simulator<'m> {
         Ok(true)
     }
 
+    /// [`Simulator::deliverable_now`] for a run that keeps receivers' choices: a
+    /// receiver's choice is computed again only when it changed since (or the event was
+    /// sent again). Receivers are gone through in the same order up to the first that
+    /// cannot take the event, so the same guards run at the same iterations, with the
+    /// same results and errors: a guard reads only its machine and the event.
+    fn deliverable_kept(
+        &mut self,
+        e: u32,
+        rng: &mut dyn Entropy,
+        cfg: &RunConfig,
+    ) -> Result<bool, Stop> {
+        let ei = e as usize;
+        if self.ev_flags[ei] & EV_TIMER != 0 && self.pending_regular > 0 {
+            return Ok(false);
+        }
+        let model = self.model;
+        let base = self.rx_base[ei] as usize - model.events.len();
+        for (k, &r) in model.events[ei].receivers.iter().enumerate() {
+            let at = self.checked[base + k];
+            let choice = if at != 0 && self.changed[r as usize] < at {
+                self.choice_kept[base + k]
+            } else {
+                let c = match self.receive_choice(r, e, rng, cfg)? {
+                    Some(Some(t)) => t,
+                    Some(None) => NO_TRANS,
+                    None => CANNOT_TAKE,
+                };
+                self.checked[base + k] = self.clock;
+                self.choice_kept[base + k] = c;
+                c
+            };
+            if choice == CANNOT_TAKE {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+
     /// Delivers pending event `e` to all its receivers at once (one point each).
     fn deliver<O: Observer + ?Sized>(
         &mut self,
@@ -1310,7 +1401,22 @@ impl<'m> Simulator<'m> {
         let origin = self.pool[e as usize].origin;
         for (k, &r) in model.events[e as usize].receivers.iter().enumerate() {
             let m = r as usize;
-            let choice = self.receive_choice(r, e, rng, cfg)?.flatten();
+            let choice = if self.keep_choices {
+                // Computed at this iteration by `deliverable_kept`; set `_event` as
+                // `receive_choice` does.
+                let kept =
+                    self.choice_kept[self.rx_base[e as usize] as usize - model.events.len() + k];
+                let rt = &mut self.ms[m];
+                rt.cur_event = model.events[e as usize].name_str;
+                rt.cur_origin = model
+                    .machines
+                    .get(origin as usize)
+                    .map_or(StrId(0), |d| d.name_str);
+                (kept != NO_TRANS).then_some(kept)
+            } else {
+                self.receive_choice(r, e, rng, cfg)?.flatten()
+            };
+            self.changed[m] = self.clock;
             // The receiver keeps its own copy: JANI assigns it with the receive itself.
             let rx = self.rx_base[e as usize] as usize + k;
             let (global, copy) = self.pool.split_at_mut(rx);
@@ -1353,6 +1459,7 @@ impl<'m> Simulator<'m> {
         while i < self.blocked_list.len() {
             let m = self.blocked_list[i] as usize;
             if self.send_possible(m) {
+                self.changed[m] = self.clock;
                 self.ms[m].blocked = false;
                 self.ms[m].awaiting = NO_MSG;
                 self.blocked_list.swap_remove(i);
@@ -1434,6 +1541,9 @@ impl<'m> Simulator<'m> {
         if !model.events[e].receivers.is_empty() {
             let flags = self.ev_flags[e];
             self.pending[e] = true;
+            // New parameters: every receiver's choice is computed again.
+            let base = self.rx_base[e] as usize - model.events.len();
+            self.checked[base..base + model.events[e].receivers.len()].fill(0);
             self.pending_list.push(sd.event);
             if flags & EV_TIMER != 0 {
                 r.blocked = true;

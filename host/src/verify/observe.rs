@@ -10,7 +10,7 @@
 //! verdict is final ([`super::settle`]) it stops the run.
 
 use codegen::{Compiled, DeclInput, FormulaInput, Origin, SpecInput};
-use monitor_core::{valuation, Monitor, Ty, Value, VarKind};
+use monitor_core::{valuation, Monitor, Op, Ty, Value, VarKind};
 
 use super::settle::Settler;
 use crate::expr::Value as SimValue;
@@ -303,6 +303,12 @@ pub struct Judge<'a> {
     /// The first error (a payload of the wrong type, a timestamp going back).
     pub error: Option<String>,
     decided: bool,
+    /// The program has no `Y` / `Z` node: a point equal to the last one stepped (same
+    /// time, same values) leaves the monitor state and verdicts exactly as they are.
+    repeat_is_noop: bool,
+    /// The time and values of the last point stepped (`None` before the first).
+    last_time: Option<u64>,
+    last_vals: Vec<Value>,
 }
 
 impl<'a> Judge<'a> {
@@ -313,15 +319,23 @@ impl<'a> Judge<'a> {
         let vars = monitor.program().vars;
         let mut vals = vec![Value::Bool(false); vars.len()];
         valuation::init(vars, &mut vals);
+        let repeat_is_noop = monitor
+            .program()
+            .nodes
+            .iter()
+            .all(|n| !matches!(n.op, Op::Yesterday(_) | Op::WeakYesterday(_)));
         Ok(Judge {
             set,
             settler: Settler::new(&monitor),
             state: vec![0; monitor.state_words()],
             verdicts: vec![false; monitor.properties()],
             monitor,
-            vals,
             error: None,
             decided: false,
+            repeat_is_noop,
+            last_time: None,
+            last_vals: vals.clone(),
+            vals,
         })
     }
 
@@ -332,6 +346,7 @@ impl<'a> Judge<'a> {
         self.state.fill(0);
         self.error = None;
         self.decided = false;
+        self.last_time = None;
         self.step(0)
     }
 
@@ -351,6 +366,20 @@ impl<'a> Judge<'a> {
     }
 
     fn step(&mut self, time: u64) -> Flow {
+        // Skipping a repeated point is exact, not an approximation: without `Y` / `Z`
+        // every node's update is idempotent at one time with the same inputs (atoms are
+        // pure, `S` keeps or resets the same witness, windows expire nothing more and
+        // extend the newest run to the same time), so the state after the step would be
+        // bit for bit the one before it, and so the verdicts and their finality. Most
+        // points of a run (messages that set no port) repeat the last one.
+        if self.repeat_is_noop
+            && self.last_time == Some(time)
+            && same_values(&self.vals, &self.last_vals)
+        {
+            return Flow::Continue;
+        }
+        self.last_time = Some(time);
+        self.last_vals.copy_from_slice(&self.vals);
         if let Err(e) = self
             .monitor
             .try_step(&mut self.state, time, &self.vals, &mut self.verdicts)
@@ -461,6 +490,19 @@ impl<'a> Judge<'a> {
     }
 }
 
+/// Whether two valuations are identical (floats bit for bit, so `-0.0` differs from `0.0`
+/// and a NaN equals itself: the atoms see exactly the same input).
+fn same_values(a: &[Value], b: &[Value]) -> bool {
+    a.len() == b.len()
+        && a.iter().zip(b).all(|(x, y)| match (x, y) {
+            (Value::Bool(x), Value::Bool(y)) => x == y,
+            (Value::Int(x), Value::Int(y)) => x == y,
+            (Value::Float(x), Value::Float(y)) => x.to_bits() == y.to_bits(),
+            (Value::Str(x), Value::Str(y)) => x == y,
+            _ => false,
+        })
+}
+
 impl Observer for Judge<'_> {
     fn on_send(&mut self, time: u64, msg: &SentMessage<'_>) -> Flow {
         self.begin();
@@ -509,5 +551,85 @@ impl Observer for Judge<'_> {
     fn on_time(&mut self, time: u64) -> Flow {
         self.begin();
         self.step(time)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::same_values;
+    use monitor_core::{valuation, Monitor, Op, Value};
+
+    /// The fact [`super::Judge`] relies on to skip repeated points: without `Y` / `Z`, a
+    /// step at the same time with the same values leaves the state bit for bit unchanged.
+    #[test]
+    fn repeated_point_leaves_the_state_unchanged() {
+        let formulas = [
+            "H({p} -> P {q})",
+            "{p} S {q}",
+            "{p} S[3:] {q}",
+            "{p} S[:4] {q}",
+            "{p} S[2:5] {q}",
+            "!{p} S[1:1] ({q} && {n > 2})",
+            "H(P[10:] true -> P[:10] {q})",
+            "H(({p} -> P {n <= 3}) && !((!{p}) S[6:] {n <= 3}))",
+            "P[0:3] ({p} || H[0:2] !{q})",
+        ];
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut repeats = 0;
+        for f in formulas {
+            let src = format!("event p;\nevent q;\nstate n: i64 = 0;\nproperty f = {f};\n");
+            let c = codegen::compile_spec(&src, "t.hspec").unwrap();
+            let m = Monitor::try_new(c.program()).unwrap();
+            assert!(m
+                .program()
+                .nodes
+                .iter()
+                .all(|n| !matches!(n.op, Op::Yesterday(_) | Op::WeakYesterday(_))));
+            for _ in 0..40 {
+                let mut st = vec![0; m.state_words()];
+                let mut vals = vec![Value::Bool(false); c.program().vars.len()];
+                valuation::init(c.program().vars, &mut vals);
+                let mut out = [false];
+                let mut t = 0;
+                for _ in 0..80 {
+                    t += next() % 3;
+                    valuation::begin_point(c.program().vars, &mut vals);
+                    let r = next();
+                    vals[0] = Value::Bool(r % 4 == 0);
+                    vals[1] = Value::Bool(r % 5 == 0);
+                    if r % 7 == 0 {
+                        vals[2] = Value::Int((r % 6) as i64);
+                    }
+                    m.try_step(&mut st, t, &vals, &mut out).unwrap();
+                    let (before, verdict) = (st.clone(), out[0]);
+                    // The same point again, once or twice.
+                    for _ in 0..1 + next() % 2 {
+                        m.try_step(&mut st, t, &vals, &mut out).unwrap();
+                        assert_eq!(st, before, "{f} at {t}");
+                        assert_eq!(out[0], verdict, "{f} at {t}");
+                        repeats += 1;
+                    }
+                }
+            }
+        }
+        assert!(repeats > 1000);
+    }
+
+    #[test]
+    fn floats_compare_bit_for_bit() {
+        let a = [Value::Float(0.0), Value::Int(1)];
+        assert!(same_values(&a, &a));
+        assert!(!same_values(&a, &[Value::Float(-0.0), Value::Int(1)]));
+        assert!(same_values(
+            &[Value::Float(f64::NAN)],
+            &[Value::Float(f64::NAN)]
+        ));
+        assert!(!same_values(&[Value::Int(1)], &[Value::Float(1.0)]));
     }
 }

@@ -1,0 +1,182 @@
+//! Runs per second of the museum guide: the high-level robot model against its plain-SCXML translation.
+//!
+//! `cargo bench -p hindsight --bench museum [-- --runs N --reps R --only K]`
+//!
+//! Issue 5 asks for at least as many runs per second on the high-level model
+//! (`examples/museum-guide`, loaded through the robot pipeline, AS2FM's event semantics)
+//! as on the paper's plain translation (`examples/museum-scxml`, SCAN's queues, runs of
+//! 1001 steps like the guide's `max_time` of 100.1 s). Each model runs N seeded runs
+//! (stream k of seed 1, as `hindsight verify --seed 1` does) judged by its five
+//! requirements, exactly as a study runs them; passes of all configurations are
+//! interleaved and the median pass is reported, so that load on a shared machine falls
+//! on every configuration alike. The figure to read is the ratio, measured in the same
+//! run: guide runs/s over plain runs/s (>= 1 meets the goal). The `sim only` lines run
+//! the simulator without properties, to show where the time goes.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use hindsight::cli::verify::{load, Events, Loaded, ModelArgs, Runner};
+use hindsight::sim::{RunConfig, Simulator};
+use hindsight::smc::runner::stream;
+
+fn examples() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("host/ inside the workspace")
+        .join("examples")
+}
+
+/// One benchmarked configuration: a loaded model and how its runs are configured.
+struct Case {
+    name: &'static str,
+    loaded: Loaded,
+    cfg: RunConfig,
+}
+
+impl Case {
+    fn new(name: &'static str, dir: &str, events: Option<Events>, max_time: Option<u64>) -> Case {
+        let args = ModelArgs {
+            model: examples().join(dir),
+            props: None,
+            time_unit: None,
+            events,
+        };
+        let loaded = match load(&args) {
+            Ok(l) => l,
+            Err(e) => panic!("{dir}: {e}"),
+        };
+        let cfg = RunConfig {
+            max_time: max_time.unwrap_or_else(|| loaded.default_max_time.unwrap_or(10_000)),
+            events: loaded.events,
+            ..RunConfig::default()
+        };
+        Case { name, loaded, cfg }
+    }
+}
+
+/// Seconds for `runs` judged runs (streams 0.. of seed 1), and the steps they took.
+fn judged_pass(runner: &Runner<'_>, runs: u64) -> (f64, u64) {
+    let t0 = Instant::now();
+    let mut steps = 0;
+    for k in 0..runs {
+        let out = runner.run(k, &mut stream(1, k));
+        steps += out.steps;
+    }
+    (t0.elapsed().as_secs_f64(), steps)
+}
+
+/// Seconds for `runs` runs of the simulator alone (no observer).
+fn sim_pass(sim: &mut Simulator<'_>, cfg: &RunConfig, runs: u64) -> (f64, u64) {
+    let t0 = Instant::now();
+    let mut steps = 0;
+    for k in 0..runs {
+        steps += sim.run(&mut stream(1, k), cfg, &mut ()).steps;
+    }
+    (t0.elapsed().as_secs_f64(), steps)
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn arg(args: &[String], name: &str, default: u64) -> u64 {
+    args.iter()
+        .position(|a| a == name)
+        .and_then(|i| args.get(i + 1))
+        .map_or(default, |v| {
+            v.parse()
+                .unwrap_or_else(|_| panic!("{name}: expected a number"))
+        })
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let runs = arg(&args, "--runs", 20).max(1);
+    let reps = arg(&args, "--reps", 5).max(1) as usize;
+    let cases = [
+        Case::new("guide (robot model, as2fm)", "museum-guide", None, None),
+        Case::new(
+            "guide (robot model, queues)",
+            "museum-guide",
+            Some(Events::Queues),
+            None,
+        ),
+        Case::new(
+            "plain (museum-scxml, queues)",
+            "museum-scxml",
+            None,
+            Some(1001),
+        ),
+        Case::new(
+            "plain (museum-scxml, as2fm)",
+            "museum-scxml",
+            Some(Events::As2fm),
+            Some(1001),
+        ),
+    ];
+    let runners: Vec<Runner<'_>> = cases
+        .iter()
+        .map(|c| Runner::new(&c.loaded.model, &c.loaded.set, &c.cfg))
+        .collect();
+    let mut sims: Vec<Simulator<'_>> = cases
+        .iter()
+        .map(|c| Simulator::new(&c.loaded.model))
+        .collect();
+    // `--only K`: time configuration K alone (for a profiler); the ratios then mean nothing.
+    let only = args
+        .iter()
+        .any(|a| a == "--only")
+        .then(|| arg(&args, "--only", 0) as usize);
+    // Warm-up: fills the runners' pools and the simulators' buffers.
+    for (i, c) in cases.iter().enumerate() {
+        if only.is_some_and(|k| k != i) {
+            continue;
+        }
+        judged_pass(&runners[i], 1);
+        sim_pass(&mut sims[i], &c.cfg, 1);
+    }
+    let n = cases.len();
+    let mut judged = vec![Vec::new(); n];
+    let mut alone = vec![Vec::new(); n];
+    let mut steps = vec![0u64; n];
+    for _ in 0..reps {
+        for i in (0..n).filter(|&i| only.is_none_or(|k| k == i)) {
+            let (dt, s) = judged_pass(&runners[i], runs);
+            judged[i].push(dt);
+            steps[i] = s;
+            let (dt, _) = sim_pass(&mut sims[i], &cases[i].cfg, runs);
+            alone[i].push(dt);
+        }
+    }
+    println!(
+        "museum guide: {runs} runs of 100.1 s model time per pass, median of {reps} passes (seed 1)\n"
+    );
+    println!("| configuration                  |  runs/s | steps/run | sim only runs/s |");
+    println!("|--------------------------------|---------|-----------|-----------------|");
+    let mut rate = vec![0.0; n];
+    let mut sim_rate = vec![0.0; n];
+    for i in (0..n).filter(|&i| only.is_none_or(|k| k == i)) {
+        rate[i] = runs as f64 / median(&mut judged[i]);
+        sim_rate[i] = runs as f64 / median(&mut alone[i]);
+        println!(
+            "| {:<30} | {:>7.1} | {:>9} | {:>15.1} |",
+            cases[i].name,
+            rate[i],
+            steps[i] / runs,
+            sim_rate[i]
+        );
+    }
+    println!();
+    println!(
+        "ratio guide (as2fm) / plain (queues): {:.2}x runs/s (goal: >= 1), simulator alone {:.2}x",
+        rate[0] / rate[2],
+        sim_rate[0] / sim_rate[2]
+    );
+    println!(
+        "ratio guide (as2fm) / plain (as2fm):  {:.2}x runs/s, simulator alone {:.2}x",
+        rate[0] / rate[3],
+        sim_rate[0] / sim_rate[3]
+    );
+}
