@@ -156,6 +156,14 @@ fn bad_robot_models_name_file_line_and_column() {
             "type=\"std_msgs/Int32\" /><ros_parameter name=\"level\" />",
             "BatteryComponent.scxml:14:88: unsupported ROS tag <ros_parameter>",
         ),
+        (
+            "misspelled tag",
+            "Components/BatteryComponent.scxml",
+            14,
+            "<ros_topic_publisher",
+            "<ros_topic_publisher_x",
+            "BatteryComponent.scxml:14:3: unsupported ROS tag <ros_topic_publisher_x>",
+        ),
     ];
     for (what, file, line, old, new, expected) in cases {
         let dir = scratch("bad");

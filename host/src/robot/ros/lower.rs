@@ -6,6 +6,42 @@ use crate::model::source::Span;
 use crate::model::xml::{Element, Node};
 use crate::robot::types::FlatField;
 
+/// Every ROS tag the lowering knows: declarations and the tags inside states.
+const KNOWN_TAGS: &[&str] = &[
+    "ros_time_rate",
+    "ros_topic_publisher",
+    "ros_topic_subscriber",
+    "ros_service_server",
+    "ros_service_client",
+    "ros_action_server",
+    "ros_action_client",
+    "ros_action_thread",
+    "ros_rate_callback",
+    "ros_topic_publish",
+    "ros_topic_callback",
+    "ros_service_send_request",
+    "ros_service_handle_request",
+    "ros_service_send_response",
+    "ros_service_handle_response",
+    "ros_action_send_goal",
+    "ros_action_handle_goal",
+    "ros_action_accept_goal",
+    "ros_action_reject_goal",
+    "ros_action_handle_goal_response",
+    "ros_action_start_thread",
+    "ros_action_handle_thread_start",
+    "ros_action_thread_free",
+    "ros_action_handle_thread_free",
+    "ros_action_feedback",
+    "ros_action_handle_feedback",
+    "ros_action_succeed",
+    "ros_action_aborted",
+    "ros_action_canceled",
+    "ros_action_handle_success_result",
+    "ros_action_handle_aborted_result",
+    "ros_action_handle_canceled_result",
+];
+
 /// What the machine being lowered is.
 struct UnitCx {
     name: String,
@@ -393,6 +429,17 @@ impl Cx<'_> {
 
     /// One ROS tag inside a state or executable content.
     fn lower_ros(&mut self, el: &Element, u: &UnitCx, scope: &Scope) -> Vec<Node> {
+        if !KNOWN_TAGS.contains(&el.name.as_str()) {
+            self.err(
+                el.span,
+                format!(
+                    "unsupported ROS tag <{}> (AS2FM's translation has no equivalent either, \
+                     or it is not implemented yet)",
+                    el.name
+                ),
+            );
+            return Vec::new();
+        }
         let Some((alias, _)) = self.attr_or_err(el, "name") else {
             return Vec::new();
         };
