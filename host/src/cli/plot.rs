@@ -24,6 +24,8 @@ pub struct Curve {
     pub points: Vec<Point>,
     /// The threshold found (the smallest bound from which every run succeeded), if any.
     pub threshold: Option<f64>,
+    /// The threshold as the legend writes it (`6.2s`); the bare number when `None`.
+    pub threshold_text: Option<String>,
 }
 
 const W: f64 = 820.0;
@@ -214,9 +216,10 @@ pub fn svg(title: &str, x_label: &str, curves: &[Curve]) -> String {
             ly + 4.0,
             esc(&c.name)
         );
-        let th = match c.threshold {
-            Some(t) => format!("threshold {}", label(t)),
-            None => "no threshold in range".to_string(),
+        let th = match (&c.threshold_text, c.threshold) {
+            (Some(text), Some(_)) => format!("threshold {text}"),
+            (None, Some(t)) => format!("threshold {}", label(t)),
+            (_, None) => "no threshold in range".to_string(),
         };
         let _ = writeln!(
             o,
@@ -246,6 +249,7 @@ mod tests {
                 })
                 .collect(),
             threshold,
+            threshold_text: None,
         }
     }
 

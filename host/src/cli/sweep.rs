@@ -453,11 +453,12 @@ fn finish(
                     })
                     .filter(|p| p.rate.is_finite())
                     .collect();
-                let threshold = threshold_index(&c.points).map(|i| values[i].axis());
+                let found = threshold_index(&c.points);
                 plot::Curve {
                     name: c.property.clone(),
                     points,
-                    threshold,
+                    threshold: found.map(|i| values[i].axis()),
+                    threshold_text: found.map(|i| values[i].display()),
                 }
             })
             .collect();
