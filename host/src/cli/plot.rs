@@ -284,8 +284,10 @@ mod tests {
                 upper: 1.0,
             }],
             threshold: Some(2.0),
+            threshold_text: Some("2s".into()),
         };
         let s = svg("t", "x", &[one]);
+        assert!(s.contains("threshold 2s"), "{s}");
         assert!(!s.contains("NaN") && !s.contains("inf"));
     }
 
