@@ -9,7 +9,7 @@ type Ipc = ipc::Service;
 
 use super::verify::{load, ModelArgs};
 use super::CliError;
-use crate::live::publish::{layout_toml, layouts, TopicPublisher};
+use crate::live::publish::{layout_toml, layouts, name_from_ports, TopicPublisher};
 use crate::sim::{EndReason, Flow, Observer, Quiescence, RunConfig, SentMessage, Simulator};
 
 /// Arguments of `hindsight run`.
@@ -51,10 +51,10 @@ Payload (`[u8]`, little-endian, no padding), from the message's fields in order:
   then a u64 `seq`: 0, 1, 2, ... per topic, so a subscriber counts lost samples.
   std_msgs/Int32 `data` is 16 bytes: data i64 at 0, seq u64 at 8.
 
-Monitoring it:
+Monitoring it (--layout names `event` and `var` after the property file's
+  <event_var> and <state_var> on each topic; other fields are commented out):
   hindsight run examples/museum-guide --layout > museum.toml
-  # set each field's `var` (and `event`) to your spec's names, then
-  hindsight monitor --props museum.hspec --config museum.toml &
+  hindsight monitor --props examples/specs/museum.hspec --config museum.toml &
   hindsight run examples/museum-guide --speed 10
 
 Progress goes to stderr; SIGINT/SIGTERM end the run cleanly (exit 0).
@@ -133,7 +133,8 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     }
     let loaded = load(&args.input)?;
     let model = &loaded.model;
-    let (topics, warnings) = layouts(model);
+    let (mut topics, warnings) = layouts(model);
+    name_from_ports(&mut topics, model, &loaded.file.ports);
     for w in &warnings {
         eprintln!("warning: {w}");
     }

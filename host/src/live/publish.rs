@@ -24,6 +24,7 @@ type Ipc = ipc::Service;
 type RawPublisher = Publisher<Ipc, [u8], ()>;
 
 use crate::expr::{Ty, Value};
+use crate::props::{Port, PortKind};
 use crate::sim::{CompiledModel, EventId, Flow, Observer, SentMessage};
 
 /// The type of one payload field as `hindsight run` writes it.
@@ -64,6 +65,8 @@ pub struct WireField {
     pub name: String,
     /// Index in the event's parameter list.
     pub param: usize,
+    /// The spec variable the property file names for it (`<state_var field=...>`), if any.
+    pub var: Option<String>,
     /// Byte offset in the payload.
     pub offset: usize,
     /// How it is written.
@@ -81,6 +84,8 @@ pub struct TopicLayout {
     pub topic: String,
     /// The fields, in parameter order.
     pub fields: Vec<WireField>,
+    /// The event variable the property file names for the topic (`<event_var>`), if any.
+    pub event_var: Option<String>,
     /// Offset of the `u64` sequence counter (the last 8 bytes).
     pub seq_offset: usize,
     /// Total payload bytes.
@@ -150,6 +155,7 @@ pub fn layouts(model: &CompiledModel) -> (Vec<TopicLayout>, Vec<String>) {
             fields.push(WireField {
                 name: field_name(pname),
                 param: i,
+                var: None,
                 offset,
                 ty: wire,
             });
@@ -160,11 +166,34 @@ pub fn layouts(model: &CompiledModel) -> (Vec<TopicLayout>, Vec<String>) {
             event_name: name.to_string(),
             topic,
             fields,
+            event_var: None,
             seq_offset: offset,
             size: offset + 8,
         });
     }
     (out, warnings)
+}
+
+/// Names the spec variables of each layout after the property file's ports on the
+/// same event: a `<state_var>` on a field names that field's `var`, an `<event_var>`
+/// the topic's `event` (the first one wins).
+pub fn name_from_ports(layouts: &mut [TopicLayout], model: &CompiledModel, ports: &[Port]) {
+    for l in layouts {
+        for p in ports.iter().filter(|p| p.event == l.event_name) {
+            match &p.kind {
+                PortKind::Event => {
+                    l.event_var.get_or_insert_with(|| p.id.clone());
+                }
+                PortKind::State { param, .. } => {
+                    let idx = model.param_index(l.event, param);
+                    if let Some(f) = l.fields.iter_mut().find(|f| Some(f.param) == idx) {
+                        f.var.get_or_insert_with(|| p.id.clone());
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
 }
 
 /// `ros_fields__pose__x` → `pose.x`.
@@ -196,9 +225,12 @@ fn toml_str(s: &str) -> String {
     o
 }
 
-/// The layouts as `[[topic]]` tables of the sidecar's config. Each field's `var`
-/// is its name with `.` turned into `_` ([`default_var`]); rename it to the spec
-/// variable (and uncomment `event`) before monitoring.
+/// The layouts as `[[topic]]` tables of the sidecar's config.
+///
+/// A topic's `event` and a field's `var` are the property file's names when
+/// [`name_from_ports`] found them; otherwise the line (for a field, its whole
+/// table) is written commented out, with a suggested name ([`default_var`]), to
+/// be named after the spec's variables and uncommented.
 pub fn layout_toml(layouts: &[TopicLayout], prefix: &str) -> String {
     let mut s = String::new();
     for l in layouts {
@@ -206,21 +238,25 @@ pub fn layout_toml(layouts: &[TopicLayout], prefix: &str) -> String {
         let _ = writeln!(s, "[[topic]]");
         let _ = writeln!(s, "service = {}", toml_str(&l.service(prefix)));
         let _ = writeln!(s, "size = {}", l.size);
-        let _ = writeln!(
-            s,
-            "# event = \"...\"   # uncomment: a spec event true at each sample"
-        );
+        match &l.event_var {
+            Some(e) => {
+                let _ = writeln!(s, "event = {}", toml_str(e));
+            }
+            None => {
+                let _ = writeln!(s, "# event = \"...\"   # a spec event true at each sample");
+            }
+        }
         let _ = writeln!(s, "seq = {{ offset = {}, type = \"u64\" }}", l.seq_offset);
         for f in &l.fields {
-            let _ = writeln!(s, "[[topic.field]]");
-            let _ = writeln!(s, "name = {}", toml_str(&f.name));
-            let _ = writeln!(
-                s,
-                "var = {}   # rename to the spec variable",
-                toml_str(&default_var(&f.name))
-            );
-            let _ = writeln!(s, "offset = {}", f.offset);
-            let _ = writeln!(s, "type = \"{}\"", f.ty.name());
+            let (c, var) = match &f.var {
+                Some(v) => ("", v.clone()),
+                None => ("# ", default_var(&f.name)),
+            };
+            let _ = writeln!(s, "{c}[[topic.field]]");
+            let _ = writeln!(s, "{c}name = {}", toml_str(&f.name));
+            let _ = writeln!(s, "{c}var = {}", toml_str(&var));
+            let _ = writeln!(s, "{c}offset = {}", f.offset);
+            let _ = writeln!(s, "{c}type = \"{}\"", f.ty.name());
         }
         s.push('\n');
     }
