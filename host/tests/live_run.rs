@@ -180,3 +180,113 @@ fn layout_is_a_monitor_config() {
     assert_eq!(config.topics.len(), topics.len());
     assert_eq!(config.topics[0].layout.size, 16);
 }
+
+const DEMO: &str = r#"<scxml name="Demo" initial="s" xmlns="http://www.w3.org/2005/07/scxml">
+  <datamodel><!-- TYPE n:int32 --><data id="n" expr="0"/><!-- TYPE x:float64 --><data id="x" expr="0.5"/></datamodel>
+  <state id="s">
+    <onexit><send event="topic_demo__pose_msg" target="NONE" delay="1">
+      <param name="ros_fields__x" expr="x"/><param name="ros_fields__ok" expr="n % 2 == 0"/>
+      <param name="ros_fields__name" expr="'hi'"/><param name="ros_fields__n" expr="n"/>
+    </send></onexit>
+    <transition target="s"><assign location="n" expr="n + 1"/><assign location="x" expr="x * 2"/></transition>
+  </state>
+</scxml>
+"#;
+
+const DEMO_PROPS: &str = r#"<properties>
+  <ports>
+    <scxml_event_send event="topic_demo__pose_msg" origin="Demo" target="NONE">
+      <state_var id="px" param="ros_fields__x" type="float64" expr="0.0"/>
+      <event_var id="pose"/>
+    </scxml_event_send>
+  </ports>
+  <guarantees>
+    <property id="p" logic="pmtl" expr="historically({px &gt;= 0.0})"/>
+  </guarantees>
+</properties>
+"#;
+
+#[test]
+fn bool_int_and_float_fields_are_packed_and_strings_left_out() {
+    let dir = live_common::scratch("run-demo");
+    std::fs::write(dir.join("demo.scxml"), DEMO).unwrap();
+    std::fs::write(dir.join("properties.xml"), DEMO_PROPS).unwrap();
+    let run = |extra: &[&str]| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_hindsight"));
+        c.arg("run").arg(&dir).args(extra);
+        c
+    };
+    // Without a time unit a plain SCXML model cannot be paced: a clear error, exit 2.
+    let out = run(&["--duration", "3"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--time-unit"));
+
+    let node = node();
+    let prefix = unique("run-demo");
+    let name = ServiceName::new(&format!("{prefix}/demo/pose")).unwrap();
+    let svc = node
+        .service_builder(&name)
+        .publish_subscribe::<[u8]>()
+        .subscriber_max_buffer_size(64)
+        .open_or_create()
+        .unwrap();
+    let sub = svc.subscriber_builder().buffer_size(64).create().unwrap();
+    let child = run(&[
+        "--time-unit",
+        "100ms",
+        "--speed",
+        "100",
+        "--duration",
+        "3",
+        "--prefix",
+        &prefix,
+    ])
+    .stdout(Stdio::null())
+    .stderr(Stdio::piped())
+    .spawn()
+    .unwrap();
+    let mut guard = Guard(Some(child));
+    // Samples are read while the publisher lives (its memory goes with it).
+    let mut got = Vec::new();
+    let mut drain = || {
+        while let Some(s) = sub.receive().unwrap() {
+            let p = s.payload();
+            assert_eq!(p.len(), 25);
+            got.push((
+                i64::from_le_bytes(p[0..8].try_into().unwrap()),
+                p[8],
+                f64::from_le_bytes(p[9..17].try_into().unwrap()),
+                u64::from_le_bytes(p[17..25].try_into().unwrap()),
+            ));
+        }
+    };
+    let (status, err) = loop {
+        drain();
+        if guard.0.as_mut().unwrap().try_wait().unwrap().is_some() {
+            break finish(&mut guard);
+        }
+        std::thread::sleep(Duration::from_millis(2));
+    };
+    drain();
+    assert!(status.success(), "{err}");
+    assert!(err.contains("field `name` (Str) is not published"), "{err}");
+    // Parameters n (i64 @0), ok (bool @8), x (f64 @9), seq (u64 @17): 25 bytes.
+    assert_eq!(
+        got,
+        vec![(0, 1, 0.5, 0), (1, 0, 1.0, 1), (2, 1, 2.0, 2)],
+        "{err}"
+    );
+
+    let layout = run(&["--layout", "--prefix", "d"]).output().unwrap();
+    let text = String::from_utf8(layout.stdout).unwrap();
+    let doc: toml::Table = toml::from_str(&text).unwrap();
+    let topic = &doc["topic"][0];
+    assert_eq!(topic["size"].as_integer(), Some(25));
+    assert_eq!(topic["event"].as_str(), Some("pose"));
+    assert_eq!(topic["seq"]["offset"].as_integer(), Some(17));
+    let field = &topic["field"][0];
+    assert_eq!(field["var"].as_str(), Some("px"));
+    assert_eq!(field["offset"].as_integer(), Some(9));
+    assert_eq!(field["type"].as_str(), Some("f64"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -5,7 +5,8 @@
 //! publish-subscribe service `<prefix>/<topic name>` (the `__` of the sanitized
 //! name turned back into `/`) with a `[u8]` payload in a fixed layout:
 //!
-//! - the event's parameters in declaration order, packed without padding:
+//! - the event's parameters in the order of its parameter list
+//!   ([`CompiledModel::event_params`]), packed without padding:
 //!   `bool` one byte (0 or 1), every integer as `i64` little-endian (8 bytes),
 //!   every float as `f64` little-endian (8 bytes);
 //! - strings, arrays and structs are left out (one warning per field);
@@ -146,8 +147,9 @@ pub fn layouts(model: &CompiledModel) -> (Vec<TopicLayout>, Vec<String>) {
                 Ty::Float => WireTy::F64,
                 other => {
                     warnings.push(format!(
-                        "topic /{topic}: field `{pname}` ({other:?}) is not published \
-                         (only bool, integer and float fields are)"
+                        "topic /{topic}: field `{}` ({other:?}) is not published \
+                         (only bool, integer and float fields are)",
+                        field_name(pname)
                     ));
                     continue;
                 }
