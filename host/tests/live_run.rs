@@ -221,6 +221,12 @@ fn bool_int_and_float_fields_are_packed_and_strings_left_out() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--time-unit"));
 
+    let out = run(&["--speed", "0", "--time-unit", "100ms"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--speed 0: must be a positive number"));
+
     let node = node();
     let prefix = unique("run-demo");
     let name = ServiceName::new(&format!("{prefix}/demo/pose")).unwrap();

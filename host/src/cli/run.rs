@@ -22,9 +22,13 @@ pub struct RunArgs {
     /// Model time per wall-clock time: 1 is real time, 10 ten times faster.
     #[arg(long, value_name = "S", default_value_t = 1.0)]
     pub speed: f64,
-    /// The seed of the run (the same seed gives the same run; it is run 0 of `verify --seed N`).
+    /// The study seed: the run is run `--run` of `verify --seed N` (the same seed, the same run).
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub seed: u64,
+    /// Which run of the study to play (run k uses xoshiro256++ stream k of the seed), e.g. a
+    /// failing run that `verify --save-failing` named.
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub run: u64,
     /// The prefix of every service name: topic `/a/b` is published on `PREFIX/a/b`.
     #[arg(long, value_name = "P", default_value = "hindsight")]
     pub prefix: String,
@@ -38,8 +42,8 @@ pub struct RunArgs {
 
 const AFTER_HELP: &str = "\
 What it does:
-  Loads the model as `hindsight verify` does and runs ONE simulation (run 0 of
-  --seed), paced so that model time t happens at wall-clock start + t / speed.
+  Loads the model as `hindsight verify` does and runs ONE simulation (run --run
+  of `verify --seed`, the same steps up to --duration), paced so that model time t happens at wall-clock start + t / speed.
   Every message on a ROS topic (the event `topic_<name>_msg`) is published on
   the iceoryx2 publish-subscribe service `PREFIX/<topic name>` (`/` kept) as it
   is sent. Services keep iceoryx2's safe overflow: a slow subscriber loses its
@@ -176,7 +180,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         last_progress: Instant::now(),
         tty: std::io::stderr().is_terminal(),
     };
-    let mut rng = crate::smc::runner::stream(args.seed, 0);
+    let mut rng = crate::smc::runner::stream(args.seed, args.run);
     let outcome = Simulator::new(model).run(&mut rng, &cfg, &mut live);
     live.progress(outcome.time, true);
     if live.tty {
