@@ -296,3 +296,39 @@ fn bool_int_and_float_fields_are_packed_and_strings_left_out() {
     assert_eq!(field["type"].as_str(), Some("f64"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_sidecar_judges_every_battery_sample_of_a_live_run() {
+    let prefix = unique("run-sidecar");
+    // The battery table of `--layout`, as the test spec names its variables.
+    let out = hindsight(&["--layout", "--prefix", &prefix])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    let block = text
+        .split("\n\n")
+        .find(|b| b.contains("BatteryComponent/battery_level\""))
+        .unwrap()
+        .to_string();
+    let sidecar = live_common::Running::start(&block, "run-sidecar");
+    let child = hindsight(&["--speed", "20", "--duration", "5s", "--prefix", &prefix])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut guard = Guard(Some(child));
+    // The sidecar judges while the run lives (samples go with their publisher).
+    sidecar.wait_judged(6);
+    let (status, err) = finish(&mut guard);
+    assert!(status.success(), "{err}");
+    let done = sidecar.finish();
+    let battery = &done.report.sources[0];
+    assert_eq!(
+        (battery.samples, battery.lost, battery.malformed),
+        (6, 0, 0)
+    );
+    let absence = done.verdicts_of("absence");
+    assert!(!absence.is_empty());
+    assert!(absence.iter().all(|v| v.contains("true")), "{absence:?}");
+    done.assert_replay_matches();
+}
