@@ -69,6 +69,11 @@ enum Command {
     ///
     /// Example: `hindsight monitor --props museum.hspec --config museum.toml --record in.jsonl`
     Monitor(cli::monitor::MonitorArgs),
+    /// Run one seeded simulation of a model live, paced in wall-clock time, publishing its
+    /// ROS topics over iceoryx2 (e.g. for `hindsight monitor`).
+    ///
+    /// Example: `hindsight run examples/museum-guide --speed 10 --prefix museum`
+    Run(cli::run::RunArgs),
 }
 
 fn main() -> ExitCode {
@@ -90,6 +95,7 @@ fn main() -> ExitCode {
         Command::Trace(a) => cli::verify::trace(a),
         Command::Convert(a) => cli::convert::run(a),
         Command::Monitor(a) => cli::monitor::run(a),
+        Command::Run(a) => cli::run::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

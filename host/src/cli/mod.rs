@@ -5,6 +5,7 @@ pub mod convert;
 pub mod monitor;
 pub mod plot;
 pub mod replay;
+pub mod run;
 pub mod sweep;
 pub mod verify;
 

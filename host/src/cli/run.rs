@@ -1,0 +1,206 @@
+//! `hindsight run`: one seeded simulation of a model, paced in wall-clock time, its ROS topics published over iceoryx2.
+
+use std::io::{IsTerminal, Write};
+use std::time::{Duration, Instant};
+
+use iceoryx2::prelude::*;
+
+type Ipc = ipc::Service;
+
+use super::verify::{load, ModelArgs};
+use super::CliError;
+use crate::live::publish::{layout_toml, layouts, name_from_ports, TopicPublisher};
+use crate::sim::{EndReason, Flow, Observer, Quiescence, RunConfig, SentMessage, Simulator};
+
+/// Arguments of `hindsight run`.
+#[derive(Debug, clap::Args)]
+#[command(after_long_help = AFTER_HELP)]
+pub struct RunArgs {
+    /// The model and its properties, as for `verify`.
+    #[command(flatten)]
+    pub input: ModelArgs,
+    /// Model time per wall-clock time: 1 is real time, 10 ten times faster.
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    pub speed: f64,
+    /// The study seed: the run is run `--run` of `verify --seed N` (the same seed, the same run).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub seed: u64,
+    /// Which run of the study to play (run k uses xoshiro256++ stream k of the seed), e.g. a
+    /// failing run that `verify --save-failing` named.
+    #[arg(long, value_name = "K", default_value_t = 0)]
+    pub run: u64,
+    /// The prefix of every service name: topic `/a/b` is published on `PREFIX/a/b`.
+    #[arg(long, value_name = "P", default_value = "hindsight")]
+    pub prefix: String,
+    /// Model time to run (`100s`, or steps); default: the main file's `max_time`, else 10,000 steps.
+    #[arg(long, value_name = "T")]
+    pub duration: Option<String>,
+    /// Print each topic's service and payload layout as `hindsight monitor` config (TOML), then exit.
+    #[arg(long)]
+    pub layout: bool,
+}
+
+const AFTER_HELP: &str = "\
+What it does:
+  Loads the model as `hindsight verify` does and runs ONE simulation (run --run
+  of `verify --seed`, the same steps up to --duration), paced so that model time t happens at wall-clock start + t / speed.
+  Every message on a ROS topic (the event `topic_<name>_msg`) is published on
+  the iceoryx2 publish-subscribe service `PREFIX/<topic name>` (`/` kept) as it
+  is sent. Services keep iceoryx2's safe overflow: a slow subscriber loses its
+  oldest samples, it never slows the run.
+
+Payload (`[u8]`, little-endian, no padding), from the message's fields in order:
+  bool: 1 byte (0/1); every integer: i64, 8 bytes; every float: f64, 8 bytes;
+  strings, arrays and structs are left out (with a warning);
+  then a u64 `seq`: 0, 1, 2, ... per topic, so a subscriber counts lost samples.
+  std_msgs/Int32 `data` is 16 bytes: data i64 at 0, seq u64 at 8.
+
+Monitoring it (--layout names `event` and `var` after the property file's
+  <event_var> and <state_var> on each topic; other fields are commented out):
+  hindsight run examples/museum-guide --layout > museum.toml
+  hindsight monitor --props examples/specs/museum.hspec --config museum.toml &
+  hindsight run examples/museum-guide --speed 10
+
+Progress goes to stderr; SIGINT/SIGTERM end the run cleanly (exit 0).
+Plain SCXML models need --time-unit (e.g. 100ms) to be paced.
+
+Exit codes: 0 the run ended (or was stopped); 2 bad model or argument; 1 iceoryx2 failure.";
+
+/// Paces the run in wall-clock time and publishes topic messages.
+struct Live<'n> {
+    node: &'n Node<Ipc>,
+    publisher: TopicPublisher,
+    start: Instant,
+    /// Wall-clock nanoseconds per model time unit.
+    ns_per_unit: f64,
+    unit_ns: u64,
+    stopped: bool,
+    last_progress: Instant,
+    tty: bool,
+}
+
+impl Live<'_> {
+    fn progress(&mut self, time: u64, force: bool) {
+        if !force && self.last_progress.elapsed() < Duration::from_millis(500) {
+            return;
+        }
+        self.last_progress = Instant::now();
+        let secs = time as f64 * self.unit_ns as f64 / 1e9;
+        let line = format!(
+            "run: model time {secs:.1} s ({time} steps), {} samples published",
+            self.publisher.published()
+        );
+        let mut err = std::io::stderr().lock();
+        let _ = if self.tty {
+            write!(err, "\r{line}")
+        } else {
+            writeln!(err, "{line}")
+        };
+        let _ = err.flush();
+    }
+}
+
+impl Observer for Live<'_> {
+    fn on_send(&mut self, time: u64, msg: &SentMessage<'_>) -> Flow {
+        self.publisher.publish(msg);
+        let _ = time;
+        Flow::Continue
+    }
+
+    fn on_time(&mut self, time: u64) -> Flow {
+        let due = self.start + Duration::from_nanos((time as f64 * self.ns_per_unit) as u64);
+        loop {
+            let now = Instant::now();
+            if now >= due {
+                break;
+            }
+            // `wait` also returns on SIGINT/SIGTERM (the node handles them).
+            let step = (due - now).min(Duration::from_millis(200));
+            if self.node.wait(step).is_err() {
+                self.stopped = true;
+                return Flow::Stop;
+            }
+        }
+        self.progress(time, false);
+        Flow::Continue
+    }
+}
+
+/// Runs `hindsight run`.
+pub fn run(args: &RunArgs) -> Result<(), CliError> {
+    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
+    if !(args.speed.is_finite() && args.speed > 0.0) {
+        return Err(CliError::Input(format!(
+            "--speed {}: must be a positive number",
+            args.speed
+        )));
+    }
+    let loaded = load(&args.input)?;
+    let model = &loaded.model;
+    let (mut topics, warnings) = layouts(model);
+    name_from_ports(&mut topics, model, &loaded.file.ports);
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    if args.layout {
+        print!("{}", layout_toml(&topics, &args.prefix));
+        return Ok(());
+    }
+    let Some(unit_ns) = loaded.unit_ns else {
+        return Err(CliError::Input(format!(
+            "{}: the model has no time unit; give --time-unit (e.g. 100ms) to pace it",
+            args.input.model.display()
+        )));
+    };
+    if topics.is_empty() {
+        eprintln!(
+            "warning: the model has no ROS topics (events `topic_*_msg`); nothing is published"
+        );
+    }
+    let max_time = loaded.max_time(args.duration.as_deref())?;
+    let node = NodeBuilder::new()
+        .signal_handling_mode(SignalHandlingMode::HandleTerminationRequests)
+        .create::<Ipc>()
+        .map_err(|e| CliError::Failed(format!("iceoryx2: node: {e:?}")))?;
+    let publisher = TopicPublisher::new(&node, model, topics, &args.prefix)
+        .map_err(|e| CliError::Failed(e.to_string()))?;
+    let cfg = RunConfig {
+        max_time,
+        events: loaded.events,
+        quiescence: Quiescence::AdvanceTime,
+        ..RunConfig::default()
+    };
+    let mut live = Live {
+        node: &node,
+        publisher,
+        start: Instant::now(),
+        ns_per_unit: unit_ns as f64 / args.speed,
+        unit_ns,
+        stopped: false,
+        last_progress: Instant::now(),
+        tty: std::io::stderr().is_terminal(),
+    };
+    let mut rng = crate::smc::runner::stream(args.seed, args.run);
+    let outcome = Simulator::new(model).run(&mut rng, &cfg, &mut live);
+    live.progress(outcome.time, true);
+    if live.tty {
+        eprintln!();
+    }
+    let (failed, why) = live.publisher.failed();
+    if failed > 0 {
+        eprintln!(
+            "warning: {failed} samples could not be published (last: {})",
+            why.unwrap_or("?")
+        );
+    }
+    let how = if live.stopped {
+        "stopped by a signal".to_string()
+    } else {
+        match &outcome.end {
+            EndReason::MaxTime => "reached the duration".to_string(),
+            other => format!("{other:?}"),
+        }
+    };
+    eprintln!("run: ended at model step {}: {how}", outcome.time);
+    Ok(())
+}
