@@ -541,19 +541,34 @@ impl Cx<'_> {
         Some(fields)
     }
 
+    /// `i`, the index of a `what` (service, action) declared again: a different type at
+    /// `ty_span` than the first declaration's `first` is an error.
+    fn redeclared(
+        &mut self,
+        what: &str,
+        key: &str,
+        ty: &str,
+        ty_span: Span,
+        i: usize,
+        first: &str,
+    ) -> usize {
+        if type_key(first) != type_key(ty) {
+            self.err(
+                ty_span,
+                format!(
+                    "{what} `{key}` is declared with type `{}` here but `{first}` elsewhere",
+                    ty.trim()
+                ),
+            );
+        }
+        i
+    }
+
     fn declare_service(&mut self, key: &str, ty: &str, ty_span: Span) -> Option<usize> {
-        if let Some(i) = self.services.iter().position(|s| s.key == key) {
-            if type_key(&self.services[i].ty) != type_key(ty) {
-                let first = self.services[i].ty.clone();
-                self.err(
-                    ty_span,
-                    format!(
-                        "service `{key}` is declared with type `{}` here but `{first}` elsewhere",
-                        ty.trim()
-                    ),
-                );
-            }
-            return Some(i);
+        let found = self.services.iter().position(|s| s.key == key);
+        if let Some(i) = found {
+            let first = self.services[i].ty.clone();
+            return Some(self.redeclared("service", key, ty, ty_span, i, &first));
         }
         match self.interfaces.service(ty.trim()) {
             Ok(fields) => {
@@ -575,18 +590,10 @@ impl Cx<'_> {
     }
 
     fn declare_action(&mut self, key: &str, ty: &str, ty_span: Span) -> Option<usize> {
-        if let Some(i) = self.actions.iter().position(|s| s.key == key) {
-            if type_key(&self.actions[i].ty) != type_key(ty) {
-                let first = self.actions[i].ty.clone();
-                self.err(
-                    ty_span,
-                    format!(
-                        "action `{key}` is declared with type `{}` here but `{first}` elsewhere",
-                        ty.trim()
-                    ),
-                );
-            }
-            return Some(i);
+        let found = self.actions.iter().position(|s| s.key == key);
+        if let Some(i) = found {
+            let first = self.actions[i].ty.clone();
+            return Some(self.redeclared("action", key, ty, ty_span, i, &first));
         }
         match self.interfaces.action(ty.trim()) {
             Ok(fields) => {
