@@ -43,12 +43,14 @@ enum Command {
     ///
     /// Example: `hindsight validate examples/museum-scxml`
     Validate(cli::verify::ValidateArgs),
-    /// Success rate of one guarantee as its time bounds sweep a range (CSV).
+    /// Success rate of each bounded guarantee as its time bounds sweep a range: CSV, the
+    /// thresholds, and an SVG chart.
     ///
-    /// Every integer bound in the guarantee's formula takes the swept value, which finds
-    /// the threshold of a response or recurrence requirement.
+    /// Every bound in a guarantee's formula takes each swept value (steps, or durations
+    /// like 6.2s when the model has a time unit), all values judged on the same runs; the
+    /// threshold is the smallest bound from which every run succeeds.
     ///
-    /// Example: `hindsight sweep examples/museum-scxml --property alarm_response --from 58 --to 64 --max-runs 50`
+    /// Example: `hindsight sweep examples/museum-guide --from 0.1s --to 7s --svg sweep.svg`
     Sweep(cli::sweep::SweepArgs),
     /// Combine the partial results of `verify --shard I/N --runs R` into one report.
     ///
