@@ -27,15 +27,6 @@ pub struct RobotModel {
     /// The run length in model steps: `max_time` plus the step at which the global
     /// timer stops, so that every event due at `max_time` is delivered.
     pub max_time_steps: u64,
-    /// The source files read (main file, trees, node models, interfaces).
-    pub sources: SourceMap,
-}
-
-impl RobotModel {
-    /// The property files the main file names, in order.
-    pub fn property_inputs(&self) -> &[Input] {
-        &self.main.properties
-    }
 }
 
 /// The main file a path stands for: the path itself if it is an XML file whose root is
@@ -169,7 +160,7 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
     .map_err(fail)?;
 
     let mut src = ModelSource {
-        sources: sm.clone(),
+        sources: sm,
         types: types.clone(),
         ..ModelSource::default()
     };
@@ -190,6 +181,5 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
         model,
         time_unit_ns: unit,
         max_time_steps: max_time_ns / unit + 1,
-        sources: sm,
     })
 }
