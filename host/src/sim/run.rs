@@ -346,6 +346,17 @@ fn env<'s>(
     }
 }
 
+/// Evaluates a send's parameter expressions into `out` (the message's cells), stopping at
+/// the first error.
+fn eval_params(sd: &SendDef, env: &mut Env<'_>, out: &mut [Cell]) -> Result<(), EvalError> {
+    for (i, f) in &sd.params {
+        if let Some(dst) = out.get_mut(*i as usize) {
+            f(env, dst)?;
+        }
+    }
+    Ok(())
+}
+
 fn below(rng: &mut dyn Entropy, n: u32) -> u32 {
     let n = n as u64;
     let mut m = (rng.next_u64() as u128) * (n as u128);
@@ -1217,16 +1228,7 @@ impl<'m> Simulator<'m> {
                     }
                     let res = {
                         let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
-                        let mut res = Ok(());
-                        for (i, f) in &sd.params {
-                            if let Some(dst) = out.get_mut(*i as usize) {
-                                res = f(&mut env, dst);
-                                if res.is_err() {
-                                    break;
-                                }
-                            }
-                        }
-                        res
+                        eval_params(sd, &mut env, &mut out)
                     };
                     {
                         let s = &mut self.pool[slot as usize];
@@ -1499,16 +1501,7 @@ impl<'m> Simulator<'m> {
         }
         let res = {
             let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
-            let mut res = Ok(());
-            for (i, f) in &sd.params {
-                if let Some(dst) = out.get_mut(*i as usize) {
-                    res = f(&mut env, dst);
-                    if res.is_err() {
-                        break;
-                    }
-                }
-            }
-            res
+            eval_params(sd, &mut env, &mut out)
         };
         if let Err(err) = res {
             self.ev_scratch[e] = out;
