@@ -121,6 +121,19 @@ impl<'p, 'a> FileReader<'p, 'a> {
 
     /// Reports unknown attributes and text content; returns nothing.
     pub(super) fn check_attrs(&mut self, element: &Element<'a>, allowed: &[&str]) {
+        self.check_attrs_allow_text(element, allowed);
+        if let Some(at) = element.text {
+            self.error(
+                at,
+                PropsErrorKind::UnexpectedText {
+                    element: element.name.to_owned(),
+                },
+            );
+        }
+    }
+
+    /// Reports unknown attributes of an element whose text is its content.
+    pub(super) fn check_attrs_allow_text(&mut self, element: &Element<'a>, allowed: &[&str]) {
         for attr in &element.attrs {
             if !allowed.contains(&attr.name) {
                 self.error(
@@ -132,23 +145,6 @@ impl<'p, 'a> FileReader<'p, 'a> {
                 );
             }
         }
-        if let Some(at) = element.text {
-            self.error(
-                at,
-                PropsErrorKind::UnexpectedText {
-                    element: element.name.to_owned(),
-                },
-            );
-        }
-    }
-
-    /// Like [`FileReader::check_attrs`], for an element whose text is its content.
-    pub(super) fn check_attrs_allow_text(&mut self, element: &Element<'a>, allowed: &[&str]) {
-        let plain = Element {
-            text: None,
-            ..element.clone()
-        };
-        self.check_attrs(&plain, allowed);
     }
 
     /// The unescaped text content of an element (`None`, with an error, if it has none).
