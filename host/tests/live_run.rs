@@ -171,14 +171,26 @@ fn layout_is_a_monitor_config() {
     // The property file names nothing on the alarm topic: its bool field is commented out.
     assert!(alarm.get("field").is_none());
     assert!(text.contains("# type = \"bool\""), "{text}");
+    // Services are published as the server sees them, named after the property file too.
+    let alarm_request = topics
+        .iter()
+        .find(|t| {
+            t["service"].as_str() == Some("museum/NotifyUserComponent/StartAlarm/request")
+        })
+        .unwrap();
+    assert_eq!(alarm_request["event"].as_str(), Some("alarm"));
     // Named after the property file's ports, the whole output is a config for the
-    // museum spec as it is.
-    let spec_path = museum().join("../specs/museum.hspec");
-    let spec_src = std::fs::read_to_string(&spec_path).unwrap();
-    let spec = codegen::compile_spec(&spec_src, "museum.hspec").unwrap();
-    let config = Config::parse(&text, "museum.toml", &spec).unwrap();
+    // monitors `verify` compiles from the model's own properties.
+    let args = hindsight::cli::verify::ModelArgs {
+        model: museum(),
+        props: None,
+        time_unit: None,
+        events: None,
+    };
+    let loaded = hindsight::cli::verify::load(&args).unwrap_or_else(|e| panic!("{e:?}"));
+    let spec = loaded.set.compiled();
+    let config = Config::parse(&text, "museum.toml", spec).unwrap();
     assert_eq!(config.topics.len(), topics.len());
-    assert_eq!(config.topics[0].layout.size, 16);
 }
 
 const DEMO: &str = r#"<scxml name="Demo" initial="s" xmlns="http://www.w3.org/2005/07/scxml">

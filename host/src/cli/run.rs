@@ -7,10 +7,14 @@ use iceoryx2::prelude::*;
 
 type Ipc = ipc::Service;
 
-use super::verify::{load, ModelArgs};
+use super::verify::{load_without, ModelArgs};
 use super::CliError;
-use crate::live::publish::{layout_toml, layouts, name_from_ports, TopicPublisher};
-use crate::sim::{EndReason, Flow, Observer, Quiescence, RunConfig, SentMessage, Simulator};
+use crate::live::inject::TopicSubscriber;
+use crate::live::publish::{layout_toml, layouts, name_from_ports, TopicLayout, TopicPublisher};
+use crate::props::ros::topic_event;
+use crate::sim::{
+    EndReason, EventSemantics, Flow, Inbox, Observer, Quiescence, RunConfig, SentMessage, Simulator,
+};
 
 /// Arguments of `hindsight run`.
 #[derive(Debug, clap::Args)]
@@ -38,6 +42,11 @@ pub struct RunArgs {
     /// Print each topic's service and payload layout as `hindsight monitor` config (TOML), then exit.
     #[arg(long)]
     pub layout: bool,
+    /// A node model (its `<scxml name>`) that a real process plays instead: it is left out
+    /// of the run, and what the process publishes on the node's topics is posted into the
+    /// model (repeat for several). Only nodes whose ROS interfaces are topics.
+    #[arg(long, value_name = "NAME")]
+    pub external: Vec<String>,
 }
 
 const AFTER_HELP: &str = "\
@@ -55,6 +64,18 @@ Payload (`[u8]`, little-endian, no padding), from the message's fields in order:
   then a u64 `seq`: 0, 1, 2, ... per topic, so a subscriber counts lost samples.
   std_msgs/Int32 `data` is 16 bytes: data i64 at 0, seq u64 at 8.
 
+Services and actions are published too, as the server sees them:
+  PREFIX/<service>/request and /response, PREFIX/<action>/goal, /feedback, /result.
+
+Replacing a component by a process (--external NAME):
+  The node model NAME is left out; its timers stop with it. Every topic it
+  published is read from PREFIX/<topic> in the same layout (fields, then seq) and
+  posted into the model at the next model time unit; the topics it subscribed to
+  are published as usual. Malformed samples are counted, never posted. Example (a
+  battery written in Rust that publishes every 1.2 s):
+  hindsight run examples/museum-guide --external BatteryComponent --speed 5 &
+  cargo run -p hindsight --example battery_component -- --period 1.2s --speed 5
+
 Monitoring it (--layout names `event` and `var` after the property file's
   <event_var> and <state_var> on each topic; other fields are commented out):
   hindsight run examples/museum-guide --layout > museum.toml
@@ -70,6 +91,8 @@ Exit codes: 0 the run ended (or was stopped); 2 bad model or argument; 1 iceoryx
 struct Live<'n> {
     node: &'n Node<Ipc>,
     publisher: TopicPublisher,
+    inbound: TopicSubscriber,
+    inbound_error: Option<String>,
     start: Instant,
     /// Wall-clock nanoseconds per model time unit.
     ns_per_unit: f64,
@@ -86,10 +109,14 @@ impl Live<'_> {
         }
         self.last_progress = Instant::now();
         let secs = time as f64 * self.unit_ns as f64 / 1e9;
-        let line = format!(
+        let received: u64 = self.inbound.stats().map(|s| s.received).sum();
+        let mut line = format!(
             "run: model time {secs:.1} s ({time} steps), {} samples published",
             self.publisher.published()
         );
+        if self.inbound.stats().next().is_some() {
+            line.push_str(&format!(", {received} received"));
+        }
         let mut err = std::io::stderr().lock();
         let _ = if self.tty {
             write!(err, "\r{line}")
@@ -124,6 +151,35 @@ impl Observer for Live<'_> {
         self.progress(time, false);
         Flow::Continue
     }
+
+    fn inputs(&mut self, _time: u64, inbox: &mut Inbox) {
+        if let Err(e) = self.inbound.poll(inbox) {
+            self.inbound_error.get_or_insert(e);
+        }
+    }
+}
+
+/// The layouts of the topics the external components publish, taken out of `topics` (the
+/// run does not publish them: their processes do).
+fn inbound_layouts(
+    topics: &mut Vec<TopicLayout>,
+    external: &[crate::robot::load::ExternalComponent],
+) -> Vec<TopicLayout> {
+    let mut inbound = Vec::new();
+    for c in external {
+        for (topic, _) in &c.publishes {
+            let event = topic_event(topic);
+            match topics.iter().position(|l| l.event_name == event) {
+                Some(i) => inbound.push(topics.remove(i)),
+                None => eprintln!(
+                    "warning: --external {}: nothing in the model subscribes to {topic}; \
+                     its samples are not read",
+                    c.name
+                ),
+            }
+        }
+    }
+    inbound
 }
 
 /// Runs `hindsight run`.
@@ -135,17 +191,26 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
             args.speed
         )));
     }
-    let loaded = load(&args.input)?;
+    let (loaded, external) = load_without(&args.input, &args.external)?;
     let model = &loaded.model;
     let (mut topics, warnings) = layouts(model);
     name_from_ports(&mut topics, model, &loaded.file.ports);
     for w in &warnings {
         eprintln!("warning: {w}");
     }
+    if !external.is_empty() && loaded.events != EventSemantics::As2fm {
+        return Err(CliError::Input(
+            "--external needs --events as2fm (messages from processes are posted as AS2FM's \
+             translation sends them)"
+                .into(),
+        ));
+    }
     if args.layout {
         print!("{}", layout_toml(&topics, &args.prefix));
         return Ok(());
     }
+    // The monitor taps what processes publish too: the layout above keeps their topics.
+    let inbound = inbound_layouts(&mut topics, &external);
     let Some(unit_ns) = loaded.unit_ns else {
         return Err(CliError::Input(format!(
             "{}: the model has no time unit; give --time-unit (e.g. 100ms) to pace it",
@@ -164,6 +229,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         .map_err(|e| CliError::Failed(format!("iceoryx2: node: {e:?}")))?;
     let publisher = TopicPublisher::new(&node, model, topics, &args.prefix)
         .map_err(|e| CliError::Failed(e.to_string()))?;
+    let inbound = TopicSubscriber::new(&node, inbound, &args.prefix).map_err(CliError::Failed)?;
     let cfg = RunConfig {
         max_time,
         events: loaded.events,
@@ -173,6 +239,8 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let mut live = Live {
         node: &node,
         publisher,
+        inbound,
+        inbound_error: None,
         start: Instant::now(),
         ns_per_unit: unit_ns as f64 / args.speed,
         unit_ns,
@@ -192,6 +260,15 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
             "warning: {failed} samples could not be published (last: {})",
             why.unwrap_or("?")
         );
+    }
+    for st in live.inbound.stats() {
+        eprintln!(
+            "run: from {}: {} samples posted, {} malformed, {} lost",
+            st.service, st.received, st.malformed, st.lost
+        );
+    }
+    if let Some(e) = &live.inbound_error {
+        eprintln!("warning: reading from external components failed: {e}");
     }
     let how = if live.stopped {
         "stopped by a signal".to_string()

@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use super::CliError;
 use crate::props;
+use crate::robot::load::ExternalComponent;
 use crate::sim::{CompiledModel, EndReason, EventSemantics, RunConfig, Simulator};
 use crate::smc::progress::TerminalProgress;
 use crate::smc::stats::{RuleConfig, RuleKind};
@@ -304,8 +305,24 @@ fn parse_time_unit(text: &str) -> Result<u64, CliError> {
 /// Loads the model and its properties: a robot model (a main file, or a folder holding
 /// `main.xml`) through the robot pipeline, anything else as plain SCXML.
 pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
+    load_without(args, &[]).map(|(l, _)| l)
+}
+
+/// [`load`] without the robot model's node models named in `external`, which processes
+/// play instead (`hindsight run --external`); what each declared comes back with it.
+pub fn load_without(
+    args: &ModelArgs,
+    external: &[String],
+) -> Result<(Loaded, Vec<ExternalComponent>), CliError> {
     if let Some(main) = crate::robot::load::main_file_of(&args.model) {
-        return load_robot(args, &main);
+        return load_robot(args, &main, external);
+    }
+    if let Some(name) = external.first() {
+        return Err(CliError::Input(format!(
+            "--external {name}: {} is not a robot model (a main file, or a folder with \
+             main.xml); only a robot model's node models can be replaced by processes",
+            args.model.display()
+        )));
     }
     let model = &args.model;
     let unit_ns = args.time_unit.as_deref().map(parse_time_unit).transpose()?;
@@ -322,15 +339,18 @@ pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
     let events = args
         .events
         .map_or_else(|| default_events(&props_path), Into::into);
-    Ok(Loaded {
-        model: compiled,
-        file,
-        set,
-        props_path,
-        unit_ns,
-        default_max_time: None,
-        events,
-    })
+    Ok((
+        Loaded {
+            model: compiled,
+            file,
+            set,
+            props_path,
+            unit_ns,
+            default_max_time: None,
+            events,
+        },
+        Vec::new(),
+    ))
 }
 
 /// Reads a property file: JANI (`.jani`) or SCAN XML (with ROS ports and patterns).
@@ -364,9 +384,14 @@ fn compile_properties(
 
 /// Loads a robot model: the main file and everything it names, lowered and compiled; the
 /// properties are the file given, else the first one the main file names.
-fn load_robot(args: &ModelArgs, main: &Path) -> Result<Loaded, CliError> {
+fn load_robot(
+    args: &ModelArgs,
+    main: &Path,
+    external: &[String],
+) -> Result<(Loaded, Vec<ExternalComponent>), CliError> {
     use crate::robot::main_file::InputKind;
-    let robot = crate::robot::load::load(main).map_err(|d| CliError::Input(d.to_string()))?;
+    let (robot, external) = crate::robot::load::load_without(main, external)
+        .map_err(|d| CliError::Input(d.to_string()))?;
     if let Some(text) = &args.time_unit {
         let given = parse_time_unit(text)?;
         if given != robot.time_unit_ns {
@@ -398,16 +423,19 @@ fn load_robot(args: &ModelArgs, main: &Path) -> Result<Loaded, CliError> {
     };
     let file = read_properties(&props_path, &robot.model)?;
     let set = compile_properties(&file, &robot.model, Some(robot.time_unit_ns))?;
-    Ok(Loaded {
-        model: robot.model,
-        file,
-        set,
-        props_path,
-        unit_ns: Some(robot.time_unit_ns),
-        default_max_time: Some(robot.max_time_steps),
-        // The lowering is AS2FM's translation; its sends mean what AS2FM's JANI means.
-        events: args.events.map_or(EventSemantics::As2fm, Into::into),
-    })
+    Ok((
+        Loaded {
+            model: robot.model,
+            file,
+            set,
+            props_path,
+            unit_ns: Some(robot.time_unit_ns),
+            default_max_time: Some(robot.max_time_steps),
+            // The lowering is AS2FM's translation; its sends mean what AS2FM's JANI means.
+            events: args.events.map_or(EventSemantics::As2fm, Into::into),
+        },
+        external,
+    ))
 }
 
 /// Runs a study of `set` on `model`: the function `verify` and `sweep` share.

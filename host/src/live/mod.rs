@@ -22,6 +22,7 @@
 pub mod bench;
 pub mod config;
 pub mod engine;
+pub mod inject;
 pub mod publish;
 pub mod record;
 

@@ -1,9 +1,20 @@
-//! `hindsight run`'s output side: the byte layout of each ROS topic of a model and an observer that publishes its messages over iceoryx2.
+//! `hindsight run`'s wire: the byte layout of each ROS message of a model, an observer that publishes them over iceoryx2, and the decoder for messages a process sends in.
 //!
-//! Every event named `topic_<sanitized name>_msg` (AS2FM's naming, see
-//! [`crate::robot::ros::topic_event`]) is a ROS topic; its messages go to the
-//! publish-subscribe service `<prefix>/<topic name>` (the `__` of the sanitized
-//! name turned back into `/`) with a `[u8]` payload in a fixed layout:
+//! Every ROS message of the translated model (AS2FM's event names, see
+//! [`crate::props::ros::topic_event`]) goes to a publish-subscribe service whose
+//! name is the ROS name (the `__` of the sanitized name turned back into `/`)
+//! under a prefix:
+//!
+//! | model event | service |
+//! |---|---|
+//! | `topic_<t>_msg` | `<prefix>/<t>` (every publication) |
+//! | `srv_<s>_request` | `<prefix>/<s>/request` (the server receiving a request) |
+//! | `srv_<s>_response` | `<prefix>/<s>/response` (the server answering) |
+//! | `action_<a>_goal_handle` | `<prefix>/<a>/goal` (the server receiving a goal) |
+//! | `action_<a>_feedback` | `<prefix>/<a>/feedback` |
+//! | `action_<a>_result` | `<prefix>/<a>/result` |
+//!
+//! Each payload is `[u8]` in a fixed layout:
 //!
 //! - the event's parameters in the order of its parameter list
 //!   ([`CompiledModel::event_params`]), packed without padding:
@@ -26,7 +37,7 @@ type RawPublisher = Publisher<Ipc, [u8], ()>;
 
 use crate::expr::{Ty, Value};
 use crate::props::{Port, PortKind};
-use crate::sim::{CompiledModel, EventId, Flow, Observer, SentMessage};
+use crate::sim::{CompiledModel, EventId, Flow, Observer, Scalar, SentMessage, EXTERNAL};
 
 /// The type of one payload field as `hindsight run` writes it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -74,15 +85,66 @@ pub struct WireField {
     pub ty: WireTy,
 }
 
-/// The payload layout of one ROS topic of a model.
+/// What kind of ROS message a layout carries.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WireKind {
+    /// A topic publication.
+    Topic,
+    /// A service request, as the server receives it.
+    Request,
+    /// A service response, as the server sends it.
+    Response,
+    /// An action goal, as the server receives it.
+    Goal,
+    /// An action feedback.
+    Feedback,
+    /// An action result.
+    Result,
+}
+
+impl WireKind {
+    /// How a person calls it (`topic`, `service request`, ...).
+    pub fn describe(self) -> &'static str {
+        match self {
+            WireKind::Topic => "topic",
+            WireKind::Request => "service request",
+            WireKind::Response => "service response",
+            WireKind::Goal => "action goal",
+            WireKind::Feedback => "action feedback",
+            WireKind::Result => "action result",
+        }
+    }
+}
+
+/// The ROS name and kind of a model event that carries a ROS message, `None` for others:
+/// `topic_a__b_msg` -> (`a/b`, topic), `srv_s_request` -> (`s/request`, request), ...
+pub fn wire_name(event: &str) -> Option<(String, WireKind)> {
+    let table: [(&str, &str, &str, WireKind); 6] = [
+        ("topic_", "_msg", "", WireKind::Topic),
+        ("srv_", "_request", "/request", WireKind::Request),
+        ("srv_", "_response", "/response", WireKind::Response),
+        ("action_", "_goal_handle", "/goal", WireKind::Goal),
+        ("action_", "_feedback", "/feedback", WireKind::Feedback),
+        ("action_", "_result", "/result", WireKind::Result),
+    ];
+    table.iter().find_map(|(pre, suf, tail, kind)| {
+        let core = event.strip_prefix(pre)?.strip_suffix(suf)?;
+        (!core.is_empty()).then(|| (format!("{}{tail}", core.replace("__", "/")), *kind))
+    })
+}
+
+/// The payload layout of one ROS message of a model.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TopicLayout {
     /// The model event (`topic_BatteryComponent__battery_level_msg`).
     pub event: EventId,
     /// The event's name.
     pub event_name: String,
-    /// The ROS topic name without the leading `/` (`BatteryComponent/battery_level`).
+    /// The service path without prefix: the ROS name without the leading `/`, plus
+    /// `/request`, `/goal`, ... for services and actions (`BatteryComponent/battery_level`).
     pub topic: String,
+    /// What it carries.
+    pub kind: WireKind,
     /// The fields, in parameter order.
     pub fields: Vec<WireField>,
     /// The event variable the property file names for the topic (`<event_var>`), if any.
@@ -118,26 +180,48 @@ impl TopicLayout {
         }
         buf[self.seq_offset..self.seq_offset + 8].copy_from_slice(&seq.to_le_bytes());
     }
+
+    /// Reads a payload written in this layout (by [`Self::encode`] or a process that
+    /// speaks it): the parameters it sets and its `seq`; `None` if it is not exactly
+    /// [`Self::size`] bytes or a `bool` byte is neither 0 nor 1.
+    pub fn decode(&self, buf: &[u8]) -> Option<(Vec<(usize, Scalar)>, u64)> {
+        if buf.len() != self.size {
+            return None;
+        }
+        let mut out = Vec::with_capacity(self.fields.len());
+        for f in &self.fields {
+            let at = buf.get(f.offset..f.offset + f.ty.size())?;
+            let v = match f.ty {
+                WireTy::Bool => match at[0] {
+                    0 => Scalar::Bool(false),
+                    1 => Scalar::Bool(true),
+                    _ => return None,
+                },
+                WireTy::I64 => Scalar::Int(i64::from_le_bytes(at.try_into().ok()?)),
+                WireTy::F64 => Scalar::Float(f64::from_le_bytes(at.try_into().ok()?)),
+            };
+            out.push((f.param, v));
+        }
+        let seq = u64::from_le_bytes(
+            buf.get(self.seq_offset..self.seq_offset + 8)?
+                .try_into()
+                .ok()?,
+        );
+        Some((out, seq))
+    }
 }
 
-/// The layouts of every ROS topic of `model`, in event order, and a warning per
-/// field that cannot be laid out (strings, arrays, structs).
+/// The layouts of every ROS message of `model` ([`wire_name`]), in event order, and a
+/// warning per field that cannot be laid out (strings, arrays, structs).
 pub fn layouts(model: &CompiledModel) -> (Vec<TopicLayout>, Vec<String>) {
     let mut out = Vec::new();
     let mut warnings = Vec::new();
     for e in 0..model.event_count() {
         let event = EventId(e as u32);
         let name = model.event_name(event);
-        let Some(sanitized) = name
-            .strip_prefix("topic_")
-            .and_then(|s| s.strip_suffix("_msg"))
-        else {
+        let Some((topic, kind)) = wire_name(name) else {
             continue;
         };
-        if sanitized.is_empty() {
-            continue;
-        }
-        let topic = sanitized.replace("__", "/");
         let mut fields = Vec::new();
         let mut offset = 0;
         for (i, (pname, ty)) in model.event_params(event).iter().enumerate() {
@@ -147,8 +231,9 @@ pub fn layouts(model: &CompiledModel) -> (Vec<TopicLayout>, Vec<String>) {
                 Ty::Float => WireTy::F64,
                 other => {
                     warnings.push(format!(
-                        "topic /{topic}: field `{}` ({other:?}) is not published \
+                        "{} /{topic}: field `{}` ({other:?}) is not published \
                          (only bool, integer and float fields are)",
+                        kind.describe(),
                         field_name(pname)
                     ));
                     continue;
@@ -167,6 +252,7 @@ pub fn layouts(model: &CompiledModel) -> (Vec<TopicLayout>, Vec<String>) {
             event,
             event_name: name.to_string(),
             topic,
+            kind,
             fields,
             event_var: None,
             seq_offset: offset,
@@ -236,7 +322,13 @@ fn toml_str(s: &str) -> String {
 pub fn layout_toml(layouts: &[TopicLayout], prefix: &str) -> String {
     let mut s = String::new();
     for l in layouts {
-        let _ = writeln!(s, "# ROS topic /{} (model event {})", l.topic, l.event_name);
+        let _ = writeln!(
+            s,
+            "# ROS {} /{} (model event {})",
+            l.kind.describe(),
+            l.topic,
+            l.event_name
+        );
         let _ = writeln!(s, "[[topic]]");
         let _ = writeln!(s, "service = {}", toml_str(&l.service(prefix)));
         let _ = writeln!(s, "size = {}", l.size);
@@ -322,8 +414,12 @@ impl TopicPublisher {
         (self.failed, self.last_error.as_deref())
     }
 
-    /// Publishes `msg` if its event is a topic.
+    /// Publishes `msg` if its event is laid out, unless a process sent it in
+    /// ([`EXTERNAL`]: it is on the service already).
     pub fn publish(&mut self, msg: &SentMessage<'_>) {
+        if msg.origin() == EXTERNAL {
+            return;
+        }
         let Some(Some(i)) = self.by_event.get(msg.event().0 as usize) else {
             return;
         };
@@ -351,5 +447,92 @@ impl Observer for TopicPublisher {
     fn on_send(&mut self, _time: u64, msg: &SentMessage<'_>) -> Flow {
         self.publish(msg);
         Flow::Continue
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ros_messages_get_their_ros_names() {
+        let cases = [
+            ("topic_a__b_msg", Some(("a/b", WireKind::Topic))),
+            (
+                "srv_Notify__Start_request",
+                Some(("Notify/Start/request", WireKind::Request)),
+            ),
+            ("srv_s_response", Some(("s/response", WireKind::Response))),
+            ("action_nav_goal_handle", Some(("nav/goal", WireKind::Goal))),
+            (
+                "action_nav_feedback",
+                Some(("nav/feedback", WireKind::Feedback)),
+            ),
+            ("action_nav_result", Some(("nav/result", WireKind::Result))),
+            // What clients and handlers see is the same message again: not republished.
+            ("srv_s_response_client_c", None),
+            ("srv_s_req_client_c", None),
+            ("action_nav_result_handle_client_c", None),
+            ("topic__msg", None),
+            ("bt_1_tick", None),
+        ];
+        for (event, want) in cases {
+            let got = wire_name(event);
+            assert_eq!(got.as_ref().map(|(n, k)| (n.as_str(), *k)), want, "{event}");
+        }
+    }
+
+    #[test]
+    fn decode_reads_what_encode_layout_says_and_refuses_bad_payloads() {
+        let layout = TopicLayout {
+            event: EventId(3),
+            event_name: "topic_t_msg".into(),
+            topic: "t".into(),
+            kind: WireKind::Topic,
+            fields: vec![
+                WireField {
+                    name: "ok".into(),
+                    param: 0,
+                    var: None,
+                    offset: 0,
+                    ty: WireTy::Bool,
+                },
+                WireField {
+                    name: "n".into(),
+                    param: 2,
+                    var: None,
+                    offset: 1,
+                    ty: WireTy::I64,
+                },
+                WireField {
+                    name: "x".into(),
+                    param: 1,
+                    var: None,
+                    offset: 9,
+                    ty: WireTy::F64,
+                },
+            ],
+            event_var: None,
+            seq_offset: 17,
+            size: 25,
+        };
+        let mut buf = vec![0u8; 25];
+        buf[0] = 1;
+        buf[1..9].copy_from_slice(&(-7i64).to_le_bytes());
+        buf[9..17].copy_from_slice(&2.5f64.to_le_bytes());
+        buf[17..25].copy_from_slice(&42u64.to_le_bytes());
+        let (params, seq) = layout.decode(&buf).unwrap();
+        assert_eq!(seq, 42);
+        assert_eq!(
+            params,
+            vec![
+                (0, Scalar::Bool(true)),
+                (2, Scalar::Int(-7)),
+                (1, Scalar::Float(2.5))
+            ]
+        );
+        assert!(layout.decode(&buf[..24]).is_none(), "short");
+        buf[0] = 2;
+        assert!(layout.decode(&buf).is_none(), "a bool byte of 2");
     }
 }

@@ -103,9 +103,114 @@ fn fail(ds: Vec<Diagnostic>) -> Diagnostics {
     Diagnostics(ds)
 }
 
+/// A node model left out of the model because a real process plays it
+/// (`hindsight run --external NAME`): the ROS topics that process publishes into the run
+/// and those it listens to.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ExternalComponent {
+    /// The node model's `name`.
+    pub name: String,
+    /// Topics it publishes: `(topic, ROS type)`, e.g. `("/BatteryComponent/battery_level", "std_msgs/Int32")`.
+    pub publishes: Vec<(String, String)>,
+    /// Topics it subscribes to.
+    pub subscribes: Vec<(String, String)>,
+}
+
 /// Reads a main file and everything it names, lowers the behavior tree and the ROS tags,
 /// and compiles the plain machines. Every error names the user's file, line and column.
 pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
+    load_without(main_path, &[]).map(|(m, _)| m)
+}
+
+/// What a node model declares that a process replacing it must speak, or an error at the
+/// declaration it cannot bridge (only topics are: services and actions are not yet).
+fn external_component(
+    sm: &SourceMap,
+    root: &Element,
+    name: &str,
+) -> Result<ExternalComponent, Diagnostic> {
+    let mut c = ExternalComponent {
+        name: name.to_string(),
+        publishes: Vec::new(),
+        subscribes: Vec::new(),
+    };
+    for el in root.elements() {
+        match el.name.as_str() {
+            "ros_topic_publisher" | "ros_topic_subscriber" => {
+                let topic = el.required(sm, "topic")?.value.trim().to_string();
+                let ty = el.required(sm, "type")?.value.trim().to_string();
+                if el.name == "ros_topic_publisher" {
+                    c.publishes.push((topic, ty));
+                } else {
+                    c.subscribes.push((topic, ty));
+                }
+            }
+            "ros_service_server" | "ros_service_client" | "ros_action_server"
+            | "ros_action_client" => {
+                return Err(sm.diag(
+                    el.span,
+                    format!(
+                        "`{name}` cannot be replaced by a process: it declares <{}>, and only \
+                         ROS topics are bridged to external processes so far",
+                        el.name
+                    ),
+                ));
+            }
+            _ => {}
+        }
+    }
+    Ok(c)
+}
+
+/// The node model a process plays, reduced to what the model still needs from it: its
+/// datamodel, its topic publishers, and one copy of each `<ros_topic_publish>` under a
+/// transition that never fires, so the topics keep their message fields (a message's
+/// fields are those its senders give) while nothing in the model publishes them.
+fn inert_stub(root: &Element) -> Element {
+    fn publishes<'e>(el: &'e Element, out: &mut Vec<&'e Element>) {
+        for c in el.elements() {
+            if c.name == "ros_topic_publish" {
+                let name = c.attr_value("name");
+                if !out.iter().any(|p| p.attr_value("name") == name) {
+                    out.push(c);
+                }
+            } else {
+                publishes(c, out);
+            }
+        }
+    }
+    let mut found = Vec::new();
+    publishes(root, &mut found);
+    let mut stub = Element::new(root.name.clone(), root.span);
+    stub.attrs = root.attrs.clone();
+    stub.set_attr("initial", "external");
+    for c in root.elements() {
+        if matches!(c.name.as_str(), "datamodel" | "ros_topic_publisher") {
+            stub.push(c.clone());
+        }
+    }
+    let mut never = Element::new("transition", root.span)
+        .with_attr("cond", "false")
+        .with_attr("target", "external");
+    for p in found {
+        never.push(p.clone());
+    }
+    stub.push(
+        Element::new("state", root.span)
+            .with_attr("id", "external")
+            .with_child(never),
+    );
+    stub
+}
+
+/// [`load`], leaving out the node models named in `external` (their `<scxml name>`):
+/// the model runs without their behaviour ([`inert_stub`]), and what each declared is
+/// returned so that a process can take its place. An unknown name, or a node model that serves or calls a service or
+/// an action, is an error.
+pub fn load_without(
+    main_path: &Path,
+    external: &[String],
+) -> Result<(RobotModel, Vec<ExternalComponent>), Diagnostics> {
     let mut sm = SourceMap::new();
     let main = MainFile::read(&mut sm, main_path).map_err(fail)?;
 
@@ -137,9 +242,37 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
             _ => errs.push(sm.diag(tree.span, "cannot read the behavior tree or a plugin")),
         }
     }
+    let mut left_out = Vec::new();
+    let from_tree = machines.len();
     for input in &main.node_models {
         if let Some(e) = read_xml(&mut sm, input, &mut errs) {
-            machines.push(e);
+            let name = e.attr_value("name").unwrap_or("").trim().to_string();
+            if external.contains(&name) {
+                match external_component(&sm, &e, &name) {
+                    Ok(c) => left_out.push(c),
+                    Err(d) => errs.push(d),
+                }
+                machines.push(inert_stub(&e));
+            } else {
+                machines.push(e);
+            }
+        }
+    }
+    if errs.is_empty() {
+        for name in external {
+            if !left_out.iter().any(|c| &c.name == name) {
+                let known: Vec<&str> = machines[from_tree..]
+                    .iter()
+                    .filter_map(|m| m.attr_value("name"))
+                    .collect();
+                errs.push(Diagnostic::file(
+                    main_path,
+                    format!(
+                        "--external {name}: no node model is called `{name}` (node models: {})",
+                        known.join(", ")
+                    ),
+                ));
+            }
         }
     }
     if !errs.is_empty() {
@@ -174,12 +307,15 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
     }
     let model = CompiledModel::compile(src)?;
     let unit = out.time_unit_ns.max(1);
-    Ok(RobotModel {
-        main,
-        machines: out.machines,
-        types,
-        model,
-        time_unit_ns: unit,
-        max_time_steps: max_time_ns / unit + 1,
-    })
+    Ok((
+        RobotModel {
+            main,
+            machines: out.machines,
+            types,
+            model,
+            time_unit_ns: unit,
+            max_time_steps: max_time_ns / unit + 1,
+        },
+        left_out,
+    ))
 }

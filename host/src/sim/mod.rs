@@ -54,7 +54,7 @@ mod trace;
 
 pub use compiled::CompiledModel;
 pub use ids::{EventId, MachineId, StateId};
-pub use observer::{Flow, Observer, SentMessage};
+pub use observer::{Flow, Inbox, Observer, Scalar, SentMessage, EXTERNAL};
 pub use run::{
     EndReason, EventSemantics, Quiescence, RunConfig, RunError, RunOutcome, Simulator, SpinKind,
     SpinReport, TransitionChoice,

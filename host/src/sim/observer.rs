@@ -115,6 +115,53 @@ pub trait Observer {
     fn on_log(&mut self, time: u64, machine: MachineId, label: &str, value: Option<Value<'_>>) {
         let _ = (time, machine, label, value);
     }
+
+    /// Messages from outside the model to post now, right after [`Observer::on_time`]
+    /// (a component replaced by a real process). The simulator posts what it can as if
+    /// a machine had sent it (an [`Observer::on_send`] point with [`SentMessage::origin`]
+    /// [`EXTERNAL`]) and leaves in `inbox` what cannot be posted yet (its event is still
+    /// pending under [`super::EventSemantics::As2fm`]), to try again at the next unit.
+    fn inputs(&mut self, time: u64, inbox: &mut Inbox) {
+        let _ = (time, inbox);
+    }
+}
+
+/// The origin of a message posted from outside the model ([`Observer::inputs`]).
+pub const EXTERNAL: MachineId = MachineId(u32::MAX);
+
+/// Messages waiting to enter a run from outside ([`Observer::inputs`]), oldest first.
+#[derive(Debug, Default)]
+pub struct Inbox {
+    pub(crate) items: std::collections::VecDeque<(EventId, Vec<(usize, Scalar)>)>,
+}
+
+/// A scalar parameter value of an external message.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Scalar {
+    /// A boolean.
+    Bool(bool),
+    /// An integer.
+    Int(i64),
+    /// A float.
+    Float(f64),
+}
+
+impl Inbox {
+    /// Queues a message of `event` whose parameters `(index, value)` are given; the
+    /// others keep their declared defaults.
+    pub fn push(&mut self, event: EventId, params: Vec<(usize, Scalar)>) {
+        self.items.push_back((event, params));
+    }
+
+    /// Messages not posted yet.
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// Whether nothing waits.
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
 }
 
 /// Observes nothing.
@@ -132,6 +179,9 @@ impl<O: Observer + ?Sized> Observer for &mut O {
     }
     fn on_log(&mut self, time: u64, machine: MachineId, label: &str, value: Option<Value<'_>>) {
         (**self).on_log(time, machine, label, value)
+    }
+    fn inputs(&mut self, time: u64, inbox: &mut Inbox) {
+        (**self).inputs(time, inbox)
     }
 }
 
@@ -160,5 +210,9 @@ impl<A: Observer, B: Observer> Observer for (A, B) {
     fn on_log(&mut self, time: u64, machine: MachineId, label: &str, value: Option<Value<'_>>) {
         self.0.on_log(time, machine, label, value);
         self.1.on_log(time, machine, label, value);
+    }
+    fn inputs(&mut self, time: u64, inbox: &mut Inbox) {
+        self.0.inputs(time, inbox);
+        self.1.inputs(time, inbox);
     }
 }

@@ -3,7 +3,7 @@
 use super::as2fm::{event_flags, may_discard, never_discards, EV_BB_REQ, EV_BB_SET, EV_TIMER};
 use super::compiled::{CompiledModel, DelayDef, Instr, MachineDef, SendDef, SendTo};
 use super::ids::{MachineId, StateId};
-use super::observer::{Flow, Observer, SentMessage};
+use super::observer::{Flow, Inbox, Observer, Scalar, SentMessage, EXTERNAL};
 use crate::expr::compile::{Code, Entropy, Env, EvalError, EvalErrorKind, MAX_PATH};
 use crate::expr::value::{Cell, StrId, Strings};
 use crate::expr::Value;
@@ -281,6 +281,8 @@ pub struct Simulator<'m> {
     pending_bb_set: u32,
     /// Scratch: events deliverable at this step.
     deliverable: Vec<u32>,
+    /// Messages from outside the model not posted yet ([`Observer::inputs`]).
+    inbox: Inbox,
     /// Machines blocked at a send.
     blocked_list: Vec<u32>,
     /// Per event: parameters being evaluated before they replace the global ones.
@@ -480,6 +482,7 @@ impl<'m> Simulator<'m> {
             pending_regular: 0,
             pending_bb_set: 0,
             deliverable: Vec::with_capacity(model.events.len()),
+            inbox: Inbox::default(),
             blocked_list: Vec::with_capacity(n),
             ev_scratch: model.events.iter().map(|d| d.defaults.clone()).collect(),
             pure_guards: model
@@ -712,6 +715,7 @@ impl<'m> Simulator<'m> {
         self.pending.iter_mut().for_each(|p| *p = false);
         self.checked.iter_mut().for_each(|c| *c = 0);
         self.pending_list.clear();
+        self.inbox.items.clear();
         self.pending_regular = 0;
         self.pending_bb_set = 0;
         self.blocked_list.clear();
@@ -805,6 +809,12 @@ impl<'m> Simulator<'m> {
                 }
                 if flow == Flow::Stop {
                     return Ok(EndReason::Stopped);
+                }
+                if self.as2fm {
+                    obs.inputs(self.time, &mut self.inbox);
+                    if !self.inbox.is_empty() && self.post_inputs(obs) == Flow::Stop {
+                        return Ok(EndReason::Stopped);
+                    }
                 }
                 continue;
             }
@@ -1471,6 +1481,78 @@ impl<'m> Simulator<'m> {
             }
         }
         Ok(flow)
+    }
+
+    /// Posts the messages of [`Self::inbox`] whose events are not pending, oldest first,
+    /// as [`Self::as2fm_send`] does for a machine's send; the rest wait for the next unit.
+    fn post_inputs<O: Observer + ?Sized>(&mut self, obs: &mut O) -> Flow {
+        let model = self.model;
+        let mut flow = Flow::Continue;
+        let mut left = std::mem::take(&mut self.inbox.items);
+        let mut i = 0;
+        while i < left.len() {
+            let e = left[i].0 .0 as usize;
+            if e >= model.events.len() {
+                left.remove(i);
+                continue;
+            }
+            if !self.send_enabled(e as u32) {
+                i += 1;
+                continue;
+            }
+            let Some((_, params)) = left.remove(i) else {
+                break;
+            };
+            let slot = &mut self.pool[e];
+            for (c, d) in slot.params.iter_mut().zip(&model.events[e].defaults) {
+                c.clone_from(d);
+            }
+            for (k, v) in params {
+                let Some(c) = slot.params.get_mut(k) else {
+                    continue;
+                };
+                // Only a value of the parameter's own kind replaces its default.
+                match (c, v) {
+                    (Cell::Bool(b), Scalar::Bool(x)) => *b = x,
+                    (Cell::Int(b), Scalar::Int(x)) => *b = x,
+                    (Cell::Float(b), Scalar::Float(x)) => *b = x,
+                    (Cell::Float(b), Scalar::Int(x)) => *b = x as f64,
+                    _ => {}
+                }
+            }
+            slot.origin = EXTERNAL.0;
+            slot.target = u32::MAX;
+            self.steps += 1;
+            self.instant_steps += 1;
+            let f = obs.on_send(
+                self.time,
+                &SentMessage {
+                    model,
+                    event: super::ids::EventId(e as u32),
+                    origin: EXTERNAL,
+                    target: None,
+                    params: &self.pool[e].params,
+                },
+            );
+            if f == Flow::Stop {
+                flow = Flow::Stop;
+            }
+            if !model.events[e].receivers.is_empty() {
+                self.pending[e] = true;
+                let base = self.rx_base[e] as usize - model.events.len();
+                self.checked[base..base + model.events[e].receivers.len()].fill(0);
+                self.pending_list.push(e as u32);
+                let flags = self.ev_flags[e];
+                if flags & EV_TIMER == 0 {
+                    self.pending_regular += 1;
+                }
+                if flags & EV_BB_SET != 0 {
+                    self.pending_bb_set += 1;
+                }
+            }
+        }
+        self.inbox.items = left;
+        flow
     }
 
     /// A `<send>` under [`EventSemantics::As2fm`]: blocks while its event is pending,
