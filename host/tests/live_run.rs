@@ -4,12 +4,12 @@
 mod live_common;
 
 use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use hindsight::live::config::Config;
 use iceoryx2::prelude::*;
-use live_common::{node, unique};
+use live_common::{finish, node, unique, Guard};
 
 fn museum() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-guide")
@@ -19,42 +19,6 @@ fn hindsight(args: &[&str]) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_hindsight"));
     c.arg("run").arg(museum()).args(args);
     c
-}
-
-/// Kills the child if a test fails before it is waited for.
-struct Guard(Option<Child>);
-
-impl Drop for Guard {
-    fn drop(&mut self) {
-        if let Some(c) = self.0.as_mut() {
-            let _ = c.kill();
-            let _ = c.wait();
-        }
-    }
-}
-
-/// Waits for the child to exit (a guard of 60 s against a hang) and returns its stderr.
-fn finish(guard: &mut Guard) -> (std::process::ExitStatus, String) {
-    let mut child = guard.0.take().unwrap();
-    let t = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            let mut err = String::new();
-            use std::io::Read;
-            child
-                .stderr
-                .take()
-                .unwrap()
-                .read_to_string(&mut err)
-                .unwrap();
-            return (status, err);
-        }
-        if t.elapsed() > Duration::from_secs(60) {
-            let _ = child.kill();
-            panic!("hindsight run did not end");
-        }
-        std::thread::sleep(Duration::from_millis(10));
-    }
 }
 
 type Sub = iceoryx2::port::subscriber::Subscriber<ipc::Service, [u8], ()>;
@@ -174,9 +138,7 @@ fn layout_is_a_monitor_config() {
     // Services are published as the server sees them, named after the property file too.
     let alarm_request = topics
         .iter()
-        .find(|t| {
-            t["service"].as_str() == Some("museum/NotifyUserComponent/StartAlarm/request")
-        })
+        .find(|t| t["service"].as_str() == Some("museum/NotifyUserComponent/StartAlarm/request"))
         .unwrap();
     assert_eq!(alarm_request["event"].as_str(), Some("alarm"));
     // Named after the property file's ports, the whole output is a config for the

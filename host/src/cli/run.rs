@@ -9,9 +9,9 @@ type Ipc = ipc::Service;
 
 use super::verify::{load_without, ModelArgs};
 use super::CliError;
-use crate::live::inject::TopicSubscriber;
+use crate::live::inject::{ServiceBridge, TopicSubscriber};
 use crate::live::publish::{layout_toml, layouts, name_from_ports, TopicLayout, TopicPublisher};
-use crate::props::ros::topic_event;
+use crate::props::ros::{service_event, topic_event};
 use crate::sim::{
     EndReason, EventSemantics, Flow, Inbox, Observer, Quiescence, RunConfig, SentMessage, Simulator,
 };
@@ -92,6 +92,7 @@ struct Live<'n> {
     node: &'n Node<Ipc>,
     publisher: TopicPublisher,
     inbound: TopicSubscriber,
+    services: ServiceBridge,
     inbound_error: Option<String>,
     start: Instant,
     /// Wall-clock nanoseconds per model time unit.
@@ -130,6 +131,9 @@ impl Live<'_> {
 impl Observer for Live<'_> {
     fn on_send(&mut self, time: u64, msg: &SentMessage<'_>) -> Flow {
         self.publisher.publish(msg);
+        if let Err(e) = self.services.forward(msg) {
+            self.inbound_error.get_or_insert(e);
+        }
         let _ = time;
         Flow::Continue
     }
@@ -156,6 +160,7 @@ impl Observer for Live<'_> {
         if let Err(e) = self.inbound.poll(inbox) {
             self.inbound_error.get_or_insert(e);
         }
+        self.services.poll(inbox);
     }
 }
 
@@ -180,6 +185,34 @@ fn inbound_layouts(
         }
     }
     inbound
+}
+
+/// The services the external components serve: `(service path, request layout, response
+/// layout)`. Their mirrors stay in `topics`: the run publishes requests and responses.
+fn bridged_services(
+    topics: &[TopicLayout],
+    external: &[crate::robot::load::ExternalComponent],
+) -> Vec<(String, TopicLayout, TopicLayout)> {
+    let mut out = Vec::new();
+    for c in external {
+        for (service, _) in &c.serves {
+            let find = |response: bool| {
+                let event = service_event(service, response);
+                topics.iter().find(|l| l.event_name == event).cloned()
+            };
+            match (find(false), find(true)) {
+                (Some(req), Some(resp)) => {
+                    out.push((service.trim_start_matches('/').to_string(), req, resp))
+                }
+                _ => eprintln!(
+                    "warning: --external {}: nothing in the model calls {service}; it is not \
+                     bridged",
+                    c.name
+                ),
+            }
+        }
+    }
+    out
 }
 
 /// Runs `hindsight run`.
@@ -211,6 +244,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     }
     // The monitor taps what processes publish too: the layout above keeps their topics.
     let inbound = inbound_layouts(&mut topics, &external);
+    let served = bridged_services(&topics, &external);
     let Some(unit_ns) = loaded.unit_ns else {
         return Err(CliError::Input(format!(
             "{}: the model has no time unit; give --time-unit (e.g. 100ms) to pace it",
@@ -230,6 +264,8 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let publisher = TopicPublisher::new(&node, model, topics, &args.prefix)
         .map_err(|e| CliError::Failed(e.to_string()))?;
     let inbound = TopicSubscriber::new(&node, inbound, &args.prefix).map_err(CliError::Failed)?;
+    let services = ServiceBridge::new(&node, model.event_count(), served, &args.prefix)
+        .map_err(CliError::Failed)?;
     let cfg = RunConfig {
         max_time,
         events: loaded.events,
@@ -240,6 +276,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         node: &node,
         publisher,
         inbound,
+        services,
         inbound_error: None,
         start: Instant::now(),
         ns_per_unit: unit_ns as f64 / args.speed,
@@ -265,6 +302,12 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         eprintln!(
             "run: from {}: {} samples posted, {} malformed, {} lost",
             st.service, st.received, st.malformed, st.lost
+        );
+    }
+    for st in live.services.stats() {
+        eprintln!(
+            "run: service {}: {} requests, {} answered, {} unanswered, {} malformed answers",
+            st.service, st.requests, st.answered, st.unanswered, st.malformed
         );
     }
     if let Some(e) = &live.inbound_error {

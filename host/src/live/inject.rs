@@ -1,19 +1,31 @@
-//! `hindsight run`'s input side: messages that processes replacing node models publish, read from iceoryx2 and posted into the running model.
+//! `hindsight run`'s input side: messages that processes replacing node models publish or answer, read from iceoryx2 and posted into the running model.
 //!
 //! A process that plays a node model (`hindsight run --external NAME`) publishes each
 //! of the model's topics in the layout [`super::publish`] defines, on the same service
 //! `hindsight run` would have published it on. [`TopicSubscriber`] holds one subscriber
 //! per such topic; at every model time unit the run drains them and hands each sample to
 //! the simulator ([`crate::sim::Inbox`]), which posts it as if a machine had sent it.
+//!
+//! A service the process serves is an iceoryx2 request-response service named after the
+//! ROS service (`<prefix>/NotifyUserComponent/StartAlarm`, `[u8]` both ways). When the
+//! model's server would receive a request (`srv_<s>_request`), [`ServiceBridge`] sends it
+//! there in the request's layout; the answer, in the response's layout, is posted into
+//! the model as the server's `srv_<s>_response` at the next model time unit.
 
+use std::collections::VecDeque;
+
+use iceoryx2::pending_response::PendingResponse;
+use iceoryx2::port::client::Client;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 
 use super::publish::TopicLayout;
-use crate::sim::Inbox;
+use crate::sim::{Inbox, SentMessage, EXTERNAL};
 
 type Ipc = ipc::Service;
 type RawSubscriber = Subscriber<Ipc, [u8], ()>;
+type RawClient = Client<Ipc, [u8], (), [u8], ()>;
+type Pending = PendingResponse<Ipc, [u8], (), [u8], ()>;
 
 /// Counts of what came in on one topic.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -95,5 +107,154 @@ impl TopicSubscriber {
     /// What came in on each topic so far.
     pub fn stats(&self) -> impl Iterator<Item = &InboundStats> {
         self.topics.iter().map(|t| &t.2)
+    }
+}
+
+/// Counts of one bridged service.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ServiceStats {
+    /// The request-response service name.
+    pub service: String,
+    /// Requests sent to the process.
+    pub requests: u64,
+    /// Responses posted into the model.
+    pub answered: u64,
+    /// Requests sent while no server was connected: the model's client waits for ever,
+    /// as a ROS client of a missing server does.
+    pub unanswered: u64,
+    /// Responses of the wrong size or with a bad `bool` byte: counted, never posted.
+    pub malformed: u64,
+}
+
+struct Bridged {
+    request: TopicLayout,
+    response: TopicLayout,
+    client: RawClient,
+    pending: VecDeque<Pending>,
+    seq: u64,
+    stats: ServiceStats,
+}
+
+/// Clients of the services processes serve: requests out, responses into the model.
+pub struct ServiceBridge {
+    /// Per event id: the index into `services` if it is a bridged request.
+    by_event: Vec<Option<usize>>,
+    services: Vec<Bridged>,
+}
+
+impl ServiceBridge {
+    /// Opens (or creates) one request-response service per `(service path, request
+    /// layout, response layout)` under `prefix`, with a client each.
+    pub fn new(
+        node: &Node<Ipc>,
+        event_count: usize,
+        services: Vec<(String, TopicLayout, TopicLayout)>,
+        prefix: &str,
+    ) -> Result<ServiceBridge, String> {
+        let mut by_event = vec![None; event_count];
+        let mut out = Vec::new();
+        for (path, request, response) in services {
+            let p = prefix.trim_end_matches('/');
+            let svc = if p.is_empty() {
+                path
+            } else {
+                format!("{p}/{path}")
+            };
+            let name = super::service_name(&svc).map_err(|e| e.to_string())?;
+            let factory = node
+                .service_builder(&name)
+                .request_response::<[u8], [u8]>()
+                .open_or_create()
+                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
+            let client = factory
+                .client_builder()
+                .initial_max_slice_len(request.size)
+                .create()
+                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
+            if let Some(slot) = by_event.get_mut(request.event.0 as usize) {
+                *slot = Some(out.len());
+            }
+            out.push(Bridged {
+                request,
+                response,
+                client,
+                pending: VecDeque::new(),
+                seq: 0,
+                stats: ServiceStats {
+                    service: svc,
+                    ..ServiceStats::default()
+                },
+            });
+        }
+        Ok(ServiceBridge {
+            by_event,
+            services: out,
+        })
+    }
+
+    /// Sends `msg` to its process if it is a request of a bridged service.
+    pub fn forward(&mut self, msg: &SentMessage<'_>) -> Result<(), String> {
+        if msg.origin() == EXTERNAL {
+            return Ok(());
+        }
+        let Some(Some(i)) = self.by_event.get(msg.event().0 as usize) else {
+            return Ok(());
+        };
+        let b = &mut self.services[*i];
+        let size = b.request.size;
+        let seq = b.seq;
+        b.seq += 1;
+        let request = &b.request;
+        let pending = b
+            .client
+            .loan_slice_uninit(size)
+            .map_err(|e| format!("iceoryx2: {}: {e:?}", b.stats.service))
+            .and_then(|r| {
+                let mut r = r.write_from_fn(|_| 0u8);
+                request.encode(msg, seq, r.payload_mut());
+                r.send()
+                    .map_err(|e| format!("iceoryx2: {}: {e:?}", b.stats.service))
+            })?;
+        b.stats.requests += 1;
+        if pending.number_of_server_connections() == 0 {
+            b.stats.unanswered += 1;
+        } else {
+            b.pending.push_back(pending);
+        }
+        Ok(())
+    }
+
+    /// Takes every response that arrived and queues it in `inbox`, oldest request first.
+    pub fn poll(&mut self, inbox: &mut Inbox) {
+        for b in &mut self.services {
+            let mut k = 0;
+            while k < b.pending.len() {
+                let mut done = false;
+                while let Ok(Some(resp)) = b.pending[k].receive() {
+                    match b.response.decode(resp.payload()) {
+                        Some((params, _seq)) => {
+                            b.stats.answered += 1;
+                            inbox.push(b.response.event, params);
+                        }
+                        None => b.stats.malformed += 1,
+                    }
+                    done = true;
+                }
+                // One response per request; a server that went away answers nothing.
+                if done || !b.pending[k].is_connected() {
+                    if !done {
+                        b.stats.unanswered += 1;
+                    }
+                    b.pending.remove(k);
+                } else {
+                    k += 1;
+                }
+            }
+        }
+    }
+
+    /// What each bridged service did so far.
+    pub fn stats(&self) -> impl Iterator<Item = &ServiceStats> {
+        self.services.iter().map(|b| &b.stats)
     }
 }

@@ -37,7 +37,7 @@ type RawPublisher = Publisher<Ipc, [u8], ()>;
 
 use crate::expr::{Ty, Value};
 use crate::props::{Port, PortKind};
-use crate::sim::{CompiledModel, EventId, Flow, Observer, Scalar, SentMessage, EXTERNAL};
+use crate::sim::{CompiledModel, EventId, Flow, Observer, Scalar, SentMessage};
 
 /// The type of one payload field as `hindsight run` writes it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -414,12 +414,9 @@ impl TopicPublisher {
         (self.failed, self.last_error.as_deref())
     }
 
-    /// Publishes `msg` if its event is laid out, unless a process sent it in
-    /// ([`EXTERNAL`]: it is on the service already).
+    /// Publishes `msg` if its event is laid out (a topic that a process publishes into
+    /// the run is not: `hindsight run` leaves it out of the layouts it gives here).
     pub fn publish(&mut self, msg: &SentMessage<'_>) {
-        if msg.origin() == EXTERNAL {
-            return;
-        }
         let Some(Some(i)) = self.by_event.get(msg.event().0 as usize) else {
             return;
         };

@@ -114,6 +114,8 @@ pub struct ExternalComponent {
     pub publishes: Vec<(String, String)>,
     /// Topics it subscribes to.
     pub subscribes: Vec<(String, String)>,
+    /// Services it serves: `(service, ROS type)`; the process answers their requests.
+    pub serves: Vec<(String, String)>,
 }
 
 /// Reads a main file and everything it names, lowers the behavior tree and the ROS tags,
@@ -133,6 +135,7 @@ fn external_component(
         name: name.to_string(),
         publishes: Vec::new(),
         subscribes: Vec::new(),
+        serves: Vec::new(),
     };
     for el in root.elements() {
         match el.name.as_str() {
@@ -145,13 +148,17 @@ fn external_component(
                     c.subscribes.push((topic, ty));
                 }
             }
-            "ros_service_server" | "ros_service_client" | "ros_action_server"
-            | "ros_action_client" => {
+            "ros_service_server" => {
+                let service = el.required(sm, "service_name")?.value.trim().to_string();
+                let ty = el.required(sm, "type")?.value.trim().to_string();
+                c.serves.push((service, ty));
+            }
+            "ros_service_client" | "ros_action_server" | "ros_action_client" => {
                 return Err(sm.diag(
                     el.span,
                     format!(
                         "`{name}` cannot be replaced by a process: it declares <{}>, and only \
-                         ROS topics are bridged to external processes so far",
+                         topics and served services are bridged to processes so far",
                         el.name
                     ),
                 ));
@@ -163,10 +170,22 @@ fn external_component(
 }
 
 /// The node model a process plays, reduced to what the model still needs from it: its
-/// datamodel, its topic publishers, and one copy of each `<ros_topic_publish>` under a
-/// transition that never fires, so the topics keep their message fields (a message's
-/// fields are those its senders give) while nothing in the model publishes them.
+/// datamodel, its topic publishers and service servers, and one copy of each
+/// `<ros_topic_publish>` under a transition that never fires, so the topics keep their
+/// message fields (a message's fields are those its senders give) while nothing in the
+/// model publishes them. Each served service keeps one of its request handlers, disabled
+/// (`cond="false"`), for the response's fields, and gets one that takes a request and
+/// does nothing: the process answers it.
 fn inert_stub(root: &Element) -> Element {
+    fn handler<'e>(el: &'e Element, alias: &str) -> Option<&'e Element> {
+        el.elements().find_map(|c| {
+            if c.name == "ros_service_handle_request" && c.attr_value("name") == Some(alias) {
+                Some(c)
+            } else {
+                handler(c, alias)
+            }
+        })
+    }
     fn publishes<'e>(el: &'e Element, out: &mut Vec<&'e Element>) {
         for c in el.elements() {
             if c.name == "ros_topic_publish" {
@@ -184,9 +203,29 @@ fn inert_stub(root: &Element) -> Element {
     let mut stub = Element::new(root.name.clone(), root.span);
     stub.attrs = root.attrs.clone();
     stub.set_attr("initial", "external");
+    let mut state = Element::new("state", root.span).with_attr("id", "external");
     for c in root.elements() {
-        if matches!(c.name.as_str(), "datamodel" | "ros_topic_publisher") {
+        if matches!(
+            c.name.as_str(),
+            "datamodel" | "ros_topic_publisher" | "ros_service_server"
+        ) {
             stub.push(c.clone());
+        }
+        if c.name == "ros_service_server" {
+            let Some(alias) = c.attr_value("name").or(c.attr_value("service_name")) else {
+                continue;
+            };
+            if let Some(h) = handler(root, alias) {
+                let mut disabled = h.clone();
+                disabled.set_attr("cond", "false");
+                disabled.set_attr("target", "external");
+                state.push(disabled);
+            }
+            state.push(
+                Element::new("ros_service_handle_request", c.span)
+                    .with_attr("name", alias)
+                    .with_attr("target", "external"),
+            );
         }
     }
     let mut never = Element::new("transition", root.span)
@@ -195,18 +234,15 @@ fn inert_stub(root: &Element) -> Element {
     for p in found {
         never.push(p.clone());
     }
-    stub.push(
-        Element::new("state", root.span)
-            .with_attr("id", "external")
-            .with_child(never),
-    );
+    state.push(never);
+    stub.push(state);
     stub
 }
 
 /// [`load`], leaving out the node models named in `external` (their `<scxml name>`):
 /// the model runs without their behaviour ([`inert_stub`]), and what each declared is
-/// returned so that a process can take its place. An unknown name, or a node model that serves or calls a service or
-/// an action, is an error.
+/// returned so that a process can take its place. An unknown name, or a node model that
+/// calls a service or takes part in an action, is an error.
 pub fn load_without(
     main_path: &Path,
     external: &[String],

@@ -225,3 +225,50 @@ pub fn publisher(
         .create()
         .unwrap()
 }
+
+/// A child process (`hindsight run`, `hindsight monitor`) killed if a test fails before
+/// it is waited for.
+pub struct Guard(pub Option<std::process::Child>);
+
+impl Drop for Guard {
+    fn drop(&mut self) {
+        if let Some(c) = self.0.as_mut() {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+}
+
+/// Waits for the child to exit (a guard of 60 s against a hang) and returns its stderr.
+pub fn finish(guard: &mut Guard) -> (std::process::ExitStatus, String) {
+    finish_polling(guard, || {})
+}
+
+/// [`finish`], calling `poll` every few milliseconds while the child runs (samples of a
+/// process that exits are gone: a subscriber must read them while it lives).
+pub fn finish_polling(
+    guard: &mut Guard,
+    mut poll: impl FnMut(),
+) -> (std::process::ExitStatus, String) {
+    let mut child = guard.0.take().unwrap();
+    let t = Instant::now();
+    loop {
+        poll();
+        if let Some(status) = child.try_wait().unwrap() {
+            let mut err = String::new();
+            use std::io::Read;
+            child
+                .stderr
+                .take()
+                .unwrap()
+                .read_to_string(&mut err)
+                .unwrap();
+            return (status, err);
+        }
+        if t.elapsed() > Duration::from_secs(60) {
+            let _ = child.kill();
+            panic!("the child process did not end");
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}

@@ -1,0 +1,265 @@
+//! `hindsight run --external`: node models of the museum guide played by code in this test over iceoryx2 (a battery topic in, an alarm service answered), and the hand-written battery example.
+
+#[path = "live_common/mod.rs"]
+mod live_common;
+
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use iceoryx2::prelude::*;
+use live_common::{finish, finish_polling, node, unique, Guard};
+
+fn museum() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-guide")
+}
+
+/// `target/<profile>/examples/<name>`, built by `cargo test` with the tests.
+fn example(name: &str) -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let dir = exe.parent().unwrap().parent().unwrap();
+    let path = dir.join("examples").join(name);
+    assert!(
+        path.exists(),
+        "{} is missing: `cargo test` builds examples, `cargo test --test X` does not \
+         (cargo build -p hindsight --example {name})",
+        path.display()
+    );
+    path
+}
+
+/// Plays BatteryComponent (a low level every `period`) and NotifyUserComponent (answers
+/// StartAlarm with is_ok = true) until `stop`; counts the requests it answered.
+fn play_battery_and_alarm(
+    prefix: String,
+    level: i64,
+    period: Duration,
+    stop: Arc<AtomicBool>,
+    requests: Arc<AtomicU64>,
+) -> std::thread::JoinHandle<()> {
+    let (ready_tx, ready_rx) = std::sync::mpsc::channel();
+    let player = std::thread::spawn(move || {
+        // iceoryx2 ports are not `Send`: the thread makes its own.
+        let node = node();
+        let battery =
+            ServiceName::new(&format!("{prefix}/BatteryComponent/battery_level")).unwrap();
+        let publisher = node
+            .service_builder(&battery)
+            .publish_subscribe::<[u8]>()
+            .open_or_create()
+            .unwrap()
+            .publisher_builder()
+            .initial_max_slice_len(16)
+            .create()
+            .unwrap();
+        let alarm = ServiceName::new(&format!("{prefix}/NotifyUserComponent/StartAlarm")).unwrap();
+        let server = node
+            .service_builder(&alarm)
+            .request_response::<[u8], [u8]>()
+            .open_or_create()
+            .unwrap()
+            .server_builder()
+            .initial_max_slice_len(16)
+            .create()
+            .unwrap();
+        ready_tx.send(()).unwrap();
+        let mut seq = 0u64;
+        let mut last: Option<std::time::Instant> = None;
+        while !stop.load(Ordering::SeqCst) {
+            if last.is_none_or(|t| t.elapsed() >= period) {
+                last = Some(std::time::Instant::now());
+                let mut p = [0u8; 16];
+                p[0..8].copy_from_slice(&level.to_le_bytes());
+                p[8..16].copy_from_slice(&seq.to_le_bytes());
+                let s = publisher.loan_slice_uninit(16).unwrap();
+                s.write_from_slice(&p).send().unwrap();
+                seq += 1;
+            }
+            while let Some(req) = server.receive().unwrap() {
+                // StartAlarm's request has no field: 8 bytes of seq.
+                assert_eq!(req.payload().len(), 8);
+                let n = requests.fetch_add(1, Ordering::SeqCst);
+                let mut answer = [0u8; 9];
+                answer[0] = 1;
+                answer[1..9].copy_from_slice(&n.to_le_bytes());
+                let r = req.loan_slice_uninit(9).unwrap();
+                r.write_from_slice(&answer).send().unwrap();
+            }
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    });
+    ready_rx.recv().unwrap();
+    player
+}
+
+/// The run's mirror of StartAlarm's responses (`.../StartAlarm/response`): is_ok bytes.
+fn response_mirror(
+    node: &Node<ipc::Service>,
+    prefix: &str,
+) -> iceoryx2::port::subscriber::Subscriber<ipc::Service, [u8], ()> {
+    let name =
+        ServiceName::new(&format!("{prefix}/NotifyUserComponent/StartAlarm/response")).unwrap();
+    node.service_builder(&name)
+        .publish_subscribe::<[u8]>()
+        .open_or_create()
+        .unwrap()
+        .subscriber_builder()
+        .create()
+        .unwrap()
+}
+
+fn run_museum(prefix: &str, extra: &[&str]) -> Guard {
+    let child = Command::new(env!("CARGO_BIN_EXE_hindsight"))
+        .arg("run")
+        .arg(museum())
+        .args(["--prefix", prefix, "--seed", "1"])
+        .args(extra)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    Guard(Some(child))
+}
+
+#[test]
+fn a_low_battery_from_a_process_makes_the_model_call_the_alarm_process() {
+    let prefix = unique("external");
+    let stop = Arc::new(AtomicBool::new(false));
+    let requests = Arc::new(AtomicU64::new(0));
+    let node = node();
+    let mirror = response_mirror(&node, &prefix);
+    // 20 % every 50 ms of wall-clock time: every model second at speed 20.
+    let player = play_battery_and_alarm(
+        prefix.clone(),
+        20,
+        Duration::from_millis(50),
+        stop.clone(),
+        requests.clone(),
+    );
+    let mut run = run_museum(
+        &prefix,
+        &[
+            "--external",
+            "BatteryComponent",
+            "--external",
+            "NotifyUserComponent",
+            "--speed",
+            "20",
+            "--duration",
+            "20s",
+        ],
+    );
+    let mut mirrored = Vec::new();
+    let (status, err) = finish_polling(&mut run, || {
+        while let Some(s) = mirror.receive().unwrap() {
+            mirrored.push(s.payload().to_vec());
+        }
+    });
+    stop.store(true, Ordering::SeqCst);
+    player.join().unwrap();
+    assert!(status.success(), "{err}");
+    let n = requests.load(Ordering::SeqCst);
+    assert!(n >= 1, "no StartAlarm request reached the process:\n{err}");
+    assert!(
+        err.contains(&format!(
+            "NotifyUserComponent/StartAlarm: {n} requests, {n} answered, 0 unanswered, 0 malformed"
+        )),
+        "{err}"
+    );
+    assert!(err.contains("samples posted, 0 malformed, 0 lost"), "{err}");
+    // The answers entered the model: the run mirrors the server's responses.
+    for (k, m) in mirrored.iter().enumerate() {
+        assert_eq!(m.len(), 9, "is_ok + seq");
+        assert_eq!(m[0], 1, "is_ok as the process answered");
+        assert_eq!(u64::from_le_bytes(m[1..9].try_into().unwrap()), k as u64);
+    }
+    assert_eq!(mirrored.len() as u64, n, "{err}");
+}
+
+#[test]
+fn without_a_process_the_battery_stays_silent_and_nobody_is_alarmed() {
+    // The component is left out and nobody plays it: the level never falls, no alarm.
+    let prefix = unique("external-silent");
+    let mut run = run_museum(
+        &prefix,
+        &[
+            "--external",
+            "NotifyUserComponent",
+            "--speed",
+            "50",
+            "--duration",
+            "20s",
+        ],
+    );
+    let (status, err) = finish(&mut run);
+    assert!(status.success(), "{err}");
+    assert!(
+        err.contains("NotifyUserComponent/StartAlarm: 0 requests"),
+        "{err}"
+    );
+}
+
+#[test]
+fn the_hand_written_battery_replaces_its_model() {
+    let prefix = unique("external-example");
+    let node = node();
+    let name = ServiceName::new(&format!("{prefix}/BatteryComponent/battery_level")).unwrap();
+    let tap = node
+        .service_builder(&name)
+        .publish_subscribe::<[u8]>()
+        .open_or_create()
+        .unwrap()
+        .subscriber_builder()
+        .create()
+        .unwrap();
+    let mut run = run_museum(
+        &prefix,
+        &[
+            "--external",
+            "BatteryComponent",
+            "--speed",
+            "20",
+            "--duration",
+            "10s",
+        ],
+    );
+    let battery = Command::new(example("battery_component"))
+        .args(["--prefix", &prefix, "--period", "1s", "--speed", "20"])
+        .args(["--count", "8"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut battery = Guard(Some(battery));
+    // What the process published: 100, 99, ... with seq 0, 1, ...
+    let mut got = Vec::new();
+    let mut drain = || {
+        while let Some(s) = tap.receive().unwrap() {
+            let p = s.payload();
+            assert_eq!(p.len(), 16);
+            got.push((
+                i64::from_le_bytes(p[0..8].try_into().unwrap()),
+                u64::from_le_bytes(p[8..16].try_into().unwrap()),
+            ));
+        }
+    };
+    let (battery_status, battery_err) = finish_polling(&mut battery, &mut drain);
+    let (status, err) = finish_polling(&mut run, &mut drain);
+    assert!(status.success(), "{err}");
+    assert!(battery_status.success(), "{battery_err}");
+    let want: Vec<(i64, u64)> = (0..8).map(|k| (100 - k as i64, k)).collect();
+    assert_eq!(got, want);
+    // And the run took them in (all but those published before its subscriber existed).
+    let posted: u64 = err
+        .lines()
+        .find_map(|l| {
+            l.strip_prefix(&format!(
+                "run: from {prefix}/BatteryComponent/battery_level: "
+            ))
+            .and_then(|rest| rest.split(' ').next())
+            .and_then(|n| n.parse().ok())
+        })
+        .unwrap_or_else(|| panic!("no inbound report:\n{err}"));
+    assert!(posted >= 4, "{posted} posted:\n{err}");
+}
