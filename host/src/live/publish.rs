@@ -318,20 +318,28 @@ fn toml_str(s: &str) -> String {
 /// A topic's `event` and a field's `var` are the property file's names when
 /// [`name_from_ports`] found them; otherwise the line (for a field, its whole
 /// table) is written commented out, with a suggested name ([`default_var`]), to
-/// be named after the spec's variables and uncommented.
+/// be named after the spec's variables and uncommented. A message the property file
+/// names nothing of is written commented out as a whole: tapping it would only cost.
 pub fn layout_toml(layouts: &[TopicLayout], prefix: &str) -> String {
     let mut s = String::new();
     for l in layouts {
+        let named = l.event_var.is_some() || l.fields.iter().any(|f| f.var.is_some());
+        let all = if named { "" } else { "# " };
         let _ = writeln!(
             s,
-            "# ROS {} /{} (model event {})",
+            "# ROS {} /{} (model event {}){}",
             l.kind.describe(),
             l.topic,
-            l.event_name
+            l.event_name,
+            if named {
+                ""
+            } else {
+                ": the property file names nothing of it"
+            }
         );
-        let _ = writeln!(s, "[[topic]]");
-        let _ = writeln!(s, "service = {}", toml_str(&l.service(prefix)));
-        let _ = writeln!(s, "size = {}", l.size);
+        let _ = writeln!(s, "{all}[[topic]]");
+        let _ = writeln!(s, "{all}service = {}", toml_str(&l.service(prefix)));
+        let _ = writeln!(s, "{all}size = {}", l.size);
         match &l.event_var {
             Some(e) => {
                 let _ = writeln!(s, "event = {}", toml_str(e));
@@ -340,7 +348,11 @@ pub fn layout_toml(layouts: &[TopicLayout], prefix: &str) -> String {
                 let _ = writeln!(s, "# event = \"...\"   # a spec event true at each sample");
             }
         }
-        let _ = writeln!(s, "seq = {{ offset = {}, type = \"u64\" }}", l.seq_offset);
+        let _ = writeln!(
+            s,
+            "{all}seq = {{ offset = {}, type = \"u64\" }}",
+            l.seq_offset
+        );
         for f in &l.fields {
             let (c, var) = match &f.var {
                 Some(v) => ("", v.clone()),
