@@ -1,20 +1,38 @@
 //! `hindsight monitor`: the on-line sidecar over iceoryx2, its off-line replay and its benchmark.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
+use codegen::Compiled;
+
+use super::verify::{load, ModelArgs};
 use super::{compile_spec_file, read_file, CliError};
 use crate::live::{self, config::Config, Options, Sidecar};
+use crate::verify::observe::PropertySet;
 
 /// Arguments of `hindsight monitor`.
 #[derive(Debug, clap::Args)]
 #[command(after_long_help = AFTER_HELP)]
 pub struct MonitorArgs {
-    /// The properties: a spec (`.hspec`) whose unit is the clock's tick.
-    #[arg(long, value_name = "SPEC", required_unless_present = "bench")]
+    /// The properties: a spec (`.hspec`) whose unit is the clock's tick. A folder or an
+    /// `.xml` file here is read as a model, as with --model.
+    #[arg(long, value_name = "SPEC", required_unless_present_any = ["bench", "model"], conflicts_with = "model")]
     pub props: Option<PathBuf>,
+    /// Monitor the guarantees of a model's property file, compiled exactly as `verify`
+    /// compiles them (variables: the ports' ids; tick: the model's time unit). MODEL is a
+    /// robot main file, a folder holding `main.xml`, or a plain SCXML model (with
+    /// --time-unit). Assumptions are not monitored.
+    #[arg(long, value_name = "MODEL")]
+    pub model: Option<PathBuf>,
+    /// With --model: the property file; default: the one the main file names, else
+    /// MODEL/properties.xml.
+    #[arg(long, value_name = "FILE")]
+    pub model_props: Option<PathBuf>,
+    /// With a plain SCXML --model: the length of one model time step (`100ms`).
+    #[arg(long, value_name = "DURATION")]
+    pub time_unit: Option<String>,
     /// The sidecar config (TOML): topics to tap, services to proxy, payload layouts.
     #[arg(long, value_name = "FILE", required_unless_present_any = ["replay", "bench"])]
     pub config: Option<PathBuf>,
@@ -34,7 +52,7 @@ pub struct MonitorArgs {
     #[arg(long, value_name = "US", default_value_t = 100)]
     pub poll_us: u64,
     /// Measure samples per second and added latency against a plain subscriber, then exit.
-    #[arg(long, conflicts_with_all = ["props", "config", "replay"])]
+    #[arg(long, conflicts_with_all = ["props", "model", "config", "replay"])]
     pub bench: bool,
     /// Benchmark: samples in the paced (latency) phase.
     #[arg(long, value_name = "N", default_value_t = 20_000, requires = "bench")]
@@ -104,6 +122,76 @@ fn create(path: &PathBuf) -> Result<Box<dyn Write + Send>, CliError> {
     Ok(Box::new(std::io::BufWriter::new(f)))
 }
 
+/// Whether `--props PATH` names a model rather than a spec: a folder, or an `.xml` file.
+fn is_model_path(path: &Path) -> bool {
+    path.is_dir()
+        || path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+}
+
+/// The spec the monitor runs: `--props SPEC`, or the guarantees of `--model` (or of a
+/// model given to `--props`).
+fn spec_of(args: &MonitorArgs) -> Result<Compiled, CliError> {
+    let model = match (&args.model, &args.props) {
+        (Some(m), _) => m.clone(),
+        (None, Some(p)) if is_model_path(p) => p.clone(),
+        (None, Some(p)) => {
+            if args.model_props.is_some() || args.time_unit.is_some() {
+                return Err(CliError::Input(
+                    "--model-props and --time-unit go with a model (--model MODEL)".into(),
+                ));
+            }
+            return compile_spec_file(p);
+        }
+        (None, None) => {
+            return Err(CliError::Input(
+                "give the properties: --props SPEC or --model MODEL".into(),
+            ))
+        }
+    };
+    guarantees_spec(&ModelArgs {
+        model,
+        props: args.model_props.clone(),
+        time_unit: args.time_unit.clone(),
+        events: None,
+    })
+}
+
+/// The guarantees of a model's property file compiled into one spec, exactly as `verify`
+/// compiles them: its variables are the ports' ids and its tick is the model's time unit.
+/// Assumptions are left out (they are not monitored); a model without a time unit, or a
+/// property file without guarantees, is an input error.
+pub fn guarantees_spec(args: &ModelArgs) -> Result<Compiled, CliError> {
+    let loaded = load(args)?;
+    let Some(unit_ns) = loaded.unit_ns else {
+        return Err(CliError::Input(format!(
+            "{}: the model has no time unit, so the monitor's clock has no tick; give the \
+             length of one model step with --time-unit (for example --time-unit 100ms)",
+            args.model.display()
+        )));
+    };
+    if loaded.file.guarantees.is_empty() {
+        return Err(CliError::Input(format!(
+            "{}: no guarantee to monitor",
+            loaded.props_path.display()
+        )));
+    }
+    if loaded.file.assumptions.is_empty() {
+        return Ok(loaded.set.compiled().clone());
+    }
+    eprintln!(
+        "monitor: {}: {} assumption(s) not monitored (only guarantees are)",
+        loaded.props_path.display(),
+        loaded.file.assumptions.len()
+    );
+    let mut file = loaded.file;
+    file.assumptions.clear();
+    PropertySet::with_unit(&file, &loaded.model, Some(unit_ns))
+        .map(|set| set.compiled().clone())
+        .map_err(CliError::Input)
+}
+
 /// Runs `hindsight monitor`.
 pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
     // iceoryx2 warns on stderr about a missing config file; RUST_LOG-style `IOX2_LOG_LEVEL` overrides.
@@ -120,10 +208,7 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         print!("{r}");
         return Ok(());
     }
-    let Some(props) = &args.props else {
-        return Err(CliError::Input("--props SPEC is required".into()));
-    };
-    let spec = compile_spec_file(props)?;
+    let spec = spec_of(args)?;
     let mut out: Box<dyn Write + Send> = match &args.output {
         Some(p) => create(p)?,
         None => Box::new(std::io::stdout()),
