@@ -262,3 +262,46 @@ fn bad_monitor_inputs_exit_2_and_say_why() {
         assert!(err.contains(want), "{args:?}: want {want}, got {err}");
     }
 }
+
+#[test]
+fn the_config_clock_speed_is_read_and_checked() {
+    let spec =
+        codegen::compile_spec("unit 100ms;\nevent e;\nproperty p = H({e});\n", "s.hspec").unwrap();
+    let topic = "[[topic]]\nservice = \"x/y\"\nsize = 1\nevent = \"e\"\n";
+    let parse = |clock: &str| {
+        hindsight::live::config::Config::parse(&format!("{clock}{topic}"), "c.toml", &spec)
+    };
+    assert_eq!(parse("").unwrap().speed, 1.0);
+    assert_eq!(parse("[clock]\nspeed = 10\n").unwrap().speed, 10.0);
+    assert_eq!(parse("[clock]\nspeed = 0.5\n").unwrap().speed, 0.5);
+    let err = parse("[clock]\nspeed = 0\n").unwrap_err();
+    assert!(
+        err.starts_with("c.toml:2:9: speed 0: must be a number"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_bad_speed_on_the_command_line_exits_2() {
+    let dir = scratch("speed");
+    let spec = write(
+        &dir,
+        "s.hspec",
+        "unit 100ms;\nevent e;\nproperty p = H({e});\n",
+    );
+    let cfg = write(
+        &dir,
+        "c.toml",
+        "[[topic]]\nservice = \"x/y\"\nsize = 1\nevent = \"e\"\n",
+    );
+    let (code, _, err) = hindsight(&[
+        "monitor", "--props", &spec, "--config", &cfg, "--speed", "0",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--speed: speed 0: must be a number"), "{err}");
+    // --speed means nothing to a replay.
+    let (code, _, err) = hindsight(&[
+        "monitor", "--props", &spec, "--replay", &cfg, "--speed", "2",
+    ]);
+    assert_eq!(code, 2, "{err}");
+}

@@ -45,6 +45,12 @@ pub struct MonitorArgs {
     /// Write every judged input (samples, requests, heartbeats, losses) as JSON lines, for `--replay`.
     #[arg(long, value_name = "LOG")]
     pub record: Option<PathBuf>,
+    /// The monitored system runs S times faster than real time (as `hindsight run --speed
+    /// S` runs a model), so the clock counts model time: ticks = wall-clock time * S /
+    /// unit, and bounds mean model seconds (with 1, wall-clock seconds). Overrides the
+    /// config's `[clock] speed`. Recorded logs keep ticks of the unit, so --replay needs no speed.
+    #[arg(long, value_name = "S", conflicts_with_all = ["replay", "bench"])]
+    pub speed: Option<f64>,
     /// Write every property's verdict at every point, not only changes.
     #[arg(long)]
     pub every_point: bool,
@@ -228,8 +234,12 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         return Err(CliError::Input("--config FILE is required".into()));
     };
     let text = read_file(config_path)?;
-    let config =
+    let mut config =
         Config::parse(&text, &config_path.display().to_string(), &spec).map_err(CliError::Input)?;
+    if let Some(s) = args.speed {
+        config.speed =
+            live::check_speed(s).map_err(|m| CliError::Input(format!("--speed: {m}")))?;
+    }
     let mut opts = Options {
         verdicts: out,
         record: args.record.as_ref().map(create).transpose()?,

@@ -5,6 +5,7 @@
 //! ```toml
 //! [clock]
 //! heartbeat = 1        # a point with no sample every N ticks of the spec's unit (0: never)
+//! speed = 1            # the system runs this many times faster than real time (`run --speed`)
 //!
 //! [verdicts]
 //! service = "museum/verdicts"   # also publish each verdict line on this service
@@ -283,6 +284,9 @@ pub struct Config {
     pub heartbeat: u64,
     /// Publish verdict lines on this service too.
     pub verdict_service: Option<String>,
+    /// The monitored system runs this many times faster than real time (1: real time),
+    /// so the clock counts model time; see [`super::Clock`].
+    pub speed: f64,
 }
 
 #[derive(Deserialize)]
@@ -300,6 +304,7 @@ struct RawConfig {
 #[serde(deny_unknown_fields)]
 struct RawClock {
     heartbeat: Option<u64>,
+    speed: Option<Spanned<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -599,6 +604,13 @@ impl Config {
                 "nothing to monitor: add a [[topic]] or a [[service]]".into(),
             );
         }
+        let speed = match raw.clock.as_ref().and_then(|k| k.speed.as_ref()) {
+            None => 1.0,
+            Some(s) => super::check_speed(*s.get_ref()).unwrap_or_else(|m| {
+                c.err(s.span(), m);
+                1.0
+            }),
+        };
         if !c.errors.is_empty() {
             return Err(c.errors.join("\n"));
         }
@@ -607,6 +619,7 @@ impl Config {
             services,
             heartbeat: raw.clock.and_then(|c| c.heartbeat).unwrap_or(1),
             verdict_service,
+            speed,
         })
     }
 }
