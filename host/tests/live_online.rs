@@ -305,3 +305,205 @@ fn a_bad_speed_on_the_command_line_exits_2() {
     ]);
     assert_eq!(code, 2, "{err}");
 }
+
+/// A sidecar input log with a heartbeat at every tick from 0 to `end`, then at the same
+/// time the battery sample (level) and the alarm request of that tick, as the sidecar
+/// writes them when a sample arrives after its tick's heartbeat.
+fn heartbeat_log(
+    end: u64,
+    battery: &[(u64, i64)],
+    alarm: Option<u64>,
+    tick_at_alarm: bool,
+) -> String {
+    let mut out = String::new();
+    for t in 0..=end {
+        if alarm != Some(t) || tick_at_alarm {
+            out.push_str(&format!("{{\"kind\":\"tick\",\"time\":{t}}}\n"));
+        }
+        if let Some(&(_, level)) = battery.iter().find(|(at, _)| *at == t) {
+            out.push_str(&format!(
+                "{{\"kind\":\"sample\",\"time\":{t},\"source\":\"museum/battery\",\"sets\":{{\"battery_level\":{level},\"battery_published\":true}}}}\n"
+            ));
+        }
+        if alarm == Some(t) {
+            // A filtered request: the sweep judges it as the point it would have been.
+            out.push_str(&format!(
+                "{{\"kind\":\"request\",\"time\":{t},\"source\":\"museum/alarm\",\"sets\":{{\"alarm\":true}},\"filter\":[\"alarm_response\"]}}\n"
+            ));
+        }
+    }
+    out
+}
+
+/// `sweep --online ... --json`: the report.
+fn online_sweep(logs: &[&str], property: &str, from: &str, to: &str) -> serde_json::Value {
+    let mut args = vec!["sweep", "examples/museum-guide"];
+    for l in logs {
+        args.extend(["--online", l]);
+    }
+    args.extend(["--property", property, "--from", from, "--to", to, "--json"]);
+    let (code, out, err) = hindsight(&args);
+    assert_eq!(code, 0, "{args:?}: {err}");
+    serde_json::from_str(&out).unwrap()
+}
+
+/// `(bound, successes, failures, unknown)` of every point of the report's only property.
+fn rows(report: &serde_json::Value) -> Vec<(String, u64, u64, u64)> {
+    report["properties"][0]["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            (
+                p["bound"].as_str().unwrap().to_string(),
+                p["successes"].as_u64().unwrap(),
+                p["failures"].as_u64().unwrap(),
+                p["unknown"].as_u64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn online_sweep_finds_the_battery_recurrence_threshold_of_a_recorded_run() {
+    let dir = scratch("sweep-battery");
+    let battery: Vec<(u64, i64)> = (0..5).map(|k| (10 * k, 100 - k as i64)).collect();
+    let log = write(&dir, "rec.jsonl", &heartbeat_log(40, &battery, None, true));
+    let r = online_sweep(&[&log], "battery_recurrence", "0.5s", "1.5s");
+    assert_eq!(r["runs"], 1);
+    assert_eq!(r["properties"][0]["threshold"], "1s");
+    let rows = rows(&r);
+    assert_eq!(rows.len(), 11);
+    // Samples 10 ticks apart with a heartbeat before each: 0.9 s misses at the heartbeat.
+    assert_eq!(rows[4], ("0.9s".to_string(), 0, 1, 0));
+    assert_eq!(rows[5], ("1s".to_string(), 1, 0, 0));
+    assert_eq!(rows[10], ("1.5s".to_string(), 1, 0, 0));
+}
+
+#[test]
+fn online_sweep_finds_the_alarm_response_threshold_with_the_offline_boundary() {
+    let dir = scratch("sweep-alarm");
+    let battery = [(0, 40), (5, 29), (15, 28), (25, 27)];
+    // The level drops below 30 at tick 5 and the alarm comes at tick 30, 25 ticks later.
+    // With the heartbeat of tick 30 before the alarm (the sidecar's order when the alarm
+    // arrives after its tick began, and the off-line order: a time advance, then the
+    // send), the point at 30 has gone 2.5 s without an alarm, so `since[2.5s:]` fails and
+    // the threshold is one tick more: 2.6 s. Off-line alike, the museum's alarms 61 ticks
+    // apart give its 6.2 s.
+    let late = write(
+        &dir,
+        "late.jsonl",
+        &heartbeat_log(30, &battery, Some(30), true),
+    );
+    let r = online_sweep(&[&late], "alarm_response", "2.0s", "3.0s");
+    assert_eq!(r["properties"][0]["threshold"], "2.6s");
+    assert_eq!(rows(&r)[5], ("2.5s".to_string(), 0, 1, 0));
+    assert_eq!(rows(&r)[6], ("2.6s".to_string(), 1, 0, 0));
+    // Without a heartbeat at the alarm's tick the last alarm-free point is 2.4 s after
+    // the drop: the threshold is the delay itself, 2.5 s.
+    let direct = write(
+        &dir,
+        "direct.jsonl",
+        &heartbeat_log(30, &battery, Some(30), false),
+    );
+    let r = online_sweep(&[&direct], "alarm_response", "2.0s", "3.0s");
+    assert_eq!(r["properties"][0]["threshold"], "2.5s");
+    // Two logs are two runs: each bound counts both, the threshold is the later one.
+    let quick = write(
+        &dir,
+        "quick.jsonl",
+        &heartbeat_log(25, &battery, Some(25), true),
+    );
+    let r = online_sweep(&[&late, &quick], "alarm_response", "1.5s", "3s");
+    assert_eq!(r["runs"], 2);
+    assert_eq!(r["properties"][0]["threshold"], "2.6s");
+    let rows = rows(&r);
+    assert_eq!(rows[5], ("2s".to_string(), 0, 2, 0));
+    assert_eq!(rows[6], ("2.1s".to_string(), 1, 1, 0));
+    assert_eq!(rows[11], ("2.6s".to_string(), 2, 0, 0));
+    let p = &r["properties"][0]["points"][6];
+    assert_eq!(p["probability"], 0.5);
+}
+
+#[test]
+fn online_sweep_prints_the_offline_csv_and_draws_the_chart() {
+    let dir = scratch("sweep-csv");
+    let battery: Vec<(u64, i64)> = (0..3).map(|k| (10 * k, 100 - k as i64)).collect();
+    let log = write(&dir, "rec.jsonl", &heartbeat_log(20, &battery, None, true));
+    let svg = dir.join("s.svg").display().to_string();
+    let (code, out, err) = hindsight(&[
+        "sweep",
+        "examples/museum-guide",
+        "--online",
+        &log,
+        "--property",
+        "battery_recurrence",
+        "--from",
+        "0.9s",
+        "--to",
+        "1s",
+        "--svg",
+        &svg,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        out,
+        "property,bound,successes,failures,unknown,probability,lower,upper\n\
+         battery_recurrence,0.9s,0,1,0,0.0000,0.0000,0.9750\n\
+         battery_recurrence,1s,1,0,0,1.0000,0.0250,1.0000\n"
+    );
+    assert!(
+        err.contains("battery_recurrence: every run succeeds from bound 1s on"),
+        "{err}"
+    );
+    let chart = std::fs::read_to_string(&svg).unwrap();
+    assert!(chart.contains("1 recorded run(s)"), "{chart}");
+}
+
+#[test]
+fn online_sweep_rejects_bad_logs_naming_file_and_line() {
+    let dir = scratch("sweep-bad");
+    let wrong_var = write(
+        &dir,
+        "var.jsonl",
+        "{\"kind\":\"tick\",\"time\":0}\n{\"kind\":\"sample\",\"time\":1,\"source\":\"s\",\"sets\":{\"level\":3}}\n",
+    );
+    let bad_line = write(
+        &dir,
+        "line.jsonl",
+        "{\"kind\":\"tick\",\"time\":0}\n\n{\"kind\":\"tock\"}\n",
+    );
+    let backwards = write(
+        &dir,
+        "back.jsonl",
+        "{\"kind\":\"tick\",\"time\":5}\n{\"kind\":\"tick\",\"time\":4}\n",
+    );
+    let base = [
+        "sweep",
+        "examples/museum-guide",
+        "--from",
+        "1s",
+        "--to",
+        "2s",
+    ];
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["--online", &wrong_var],
+            "var.jsonl:2:1: `level` is not a variable of the spec",
+        ),
+        (vec!["--online", &bad_line], "line.jsonl:3:"),
+        (vec!["--online", &backwards], "back.jsonl:2:1:"),
+        (vec!["--online", "no/such.jsonl"], "no/such.jsonl"),
+        (
+            vec!["--online", &backwards, "--runs", "5"],
+            "cannot be used with",
+        ),
+    ];
+    for (extra, want) in cases {
+        let mut args = base.to_vec();
+        args.extend(extra);
+        let (code, _, err) = hindsight(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: want {want}, got {err}");
+    }
+}

@@ -216,6 +216,21 @@ pub fn apply(
     Ok(None)
 }
 
+/// Parses an input log: every record with its line number (1-based); blank lines are
+/// skipped. Errors name `file:line:col`.
+pub fn parse_log(text: &str, file: &str) -> Result<Vec<(usize, Input)>, String> {
+    let mut out = Vec::new();
+    for (i, l) in text.lines().enumerate() {
+        if l.trim().is_empty() {
+            continue;
+        }
+        let input: Input =
+            serde_json::from_str(l).map_err(|e| format!("{file}:{}:{}: {e}", i + 1, e.column()))?;
+        out.push((i + 1, input));
+    }
+    Ok(out)
+}
+
 /// Replays an input log: every verdict line, in order. Errors name `file:line`.
 pub fn replay(
     spec: &Compiled,
@@ -226,16 +241,47 @@ pub fn replay(
     let mut engine = Engine::new(spec, every_point)?;
     let mut lines = Vec::new();
     let mut out = Vec::new();
-    for (i, l) in text.lines().enumerate() {
-        if l.trim().is_empty() {
-            continue;
-        }
-        let input: Input =
-            serde_json::from_str(l).map_err(|e| format!("{file}:{}:{}: {e}", i + 1, e.column()))?;
+    for (line, input) in parse_log(text, file)? {
         out.clear();
-        apply(spec, &mut engine, &input, &mut out)
-            .map_err(|e| format!("{file}:{}:1: {e}", i + 1))?;
+        apply(spec, &mut engine, &input, &mut out).map_err(|e| format!("{file}:{line}:1: {e}"))?;
         lines.extend(out.iter().map(|c| verdict_line(spec, c)));
     }
     Ok(lines)
+}
+
+/// Replays parsed log records (from [`parse_log`] on `file`) and returns every
+/// property's verdict after the last one (`None`: no point was judged).
+///
+/// This judges what the log records, against properties that may differ from the ones
+/// it was recorded with (`hindsight sweep --online` replays each log against every bound
+/// of a property): a request is judged as the point it would have been had it passed,
+/// and its `filter` list is not applied (the names are those of the recording's
+/// properties). Every variable a record sets must be a variable of `spec`, or the error
+/// names `file:line`.
+pub fn final_verdicts(
+    spec: &Compiled,
+    records: &[(usize, Input)],
+    file: &str,
+) -> Result<Vec<Option<Verdict>>, String> {
+    let mut engine = Engine::new(spec, false)?;
+    let mut out = Vec::new();
+    for (line, input) in records {
+        out.clear();
+        let as_point;
+        let input = match input {
+            Input::Request {
+                time, source, sets, ..
+            } => {
+                as_point = Input::Sample {
+                    time: *time,
+                    source: source.clone(),
+                    sets: sets.clone(),
+                };
+                &as_point
+            }
+            other => other,
+        };
+        apply(spec, &mut engine, input, &mut out).map_err(|e| format!("{file}:{line}:1: {e}"))?;
+    }
+    Ok(engine.verdicts().to_vec())
 }
