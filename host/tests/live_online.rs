@@ -507,3 +507,75 @@ fn online_sweep_rejects_bad_logs_naming_file_and_line() {
         assert!(err.contains(want), "{args:?}: want {want}, got {err}");
     }
 }
+
+#[test]
+fn a_recorded_log_starts_with_its_unit_and_replays_only_with_that_unit() {
+    iceoryx2::prelude::set_log_level(iceoryx2::prelude::LogLevel::Error);
+    let dir = scratch("start");
+    let spec =
+        codegen::compile_spec("unit 100ms;\nevent e;\nproperty p = H({e});\n", "s.hspec").unwrap();
+    let service = format!(
+        "hindsight-test/{}/{}/start",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::SeqCst)
+    );
+    let toml = format!(
+        "[clock]\nspeed = 10\n[[topic]]\nservice = \"{service}\"\nsize = 1\nevent = \"e\"\n"
+    );
+    let config = hindsight::live::config::Config::parse(&toml, "c.toml", &spec).unwrap();
+    let record = dir.join("in.jsonl");
+    let sidecar = hindsight::live::Sidecar::new(&config, &spec, false).unwrap();
+    let mut opts = hindsight::live::Options {
+        verdicts: Box::new(std::io::sink()),
+        record: Some(Box::new(std::fs::File::create(&record).unwrap())),
+        every_point: false,
+        poll: std::time::Duration::from_micros(100),
+        log: Box::new(std::io::sink()),
+        progress: None,
+        probe: None,
+    };
+    // Stopped before the first iteration: the log holds the start record only.
+    let stop = std::sync::atomic::AtomicBool::new(true);
+    sidecar.run(&config, &spec, &mut opts, &stop).unwrap();
+    let text = std::fs::read_to_string(&record).unwrap();
+    assert_eq!(
+        text,
+        "{\"kind\":\"start\",\"unit_ns\":100000000,\"speed\":10.0}\n"
+    );
+    // It replays against its own unit, and not against the museum's spec in another unit.
+    assert_eq!(
+        hindsight::live::record::replay(&spec, &text, "in.jsonl", false),
+        Ok(Vec::new())
+    );
+    let ms =
+        codegen::compile_spec("unit 1ms;\nevent e;\nproperty p = H({e});\n", "t.hspec").unwrap();
+    assert_eq!(
+        hindsight::live::record::replay(&ms, &text, "in.jsonl", false),
+        Err(
+            "in.jsonl:1:1: the log's ticks are 100ms long, the spec's are 1ms: record and \
+             replay with the same unit"
+                .to_string()
+        )
+    );
+    // The on-line sweep checks it too: the museum's unit is 100 ms.
+    let other = write(
+        &dir,
+        "ms.jsonl",
+        "{\"kind\":\"start\",\"unit_ns\":1000000,\"speed\":1.0}\n{\"kind\":\"tick\",\"time\":0}\n",
+    );
+    let (code, _, err) = hindsight(&[
+        "sweep",
+        "examples/museum-guide",
+        "--online",
+        &other,
+        "--from",
+        "1s",
+        "--to",
+        "2s",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("ms.jsonl:1:1: the log's ticks are 1ms long, the spec's are 100ms"),
+        "{err}"
+    );
+}

@@ -247,7 +247,7 @@ struct Run<'c, 'o> {
 }
 
 impl Run<'_, '_> {
-    /// Logs and applies one input; returns the request decision if it was one.
+    /// Writes one record to the input log, when recording.
     fn write_record(&mut self, input: &Input) -> Result<(), LiveError> {
         if let Some(rec) = self.opts.record.as_mut() {
             let line = serde_json::to_string(input).map_err(|e| LiveError::Io(e.to_string()))?;
@@ -748,6 +748,10 @@ impl Sidecar {
             lines: 0,
             probed: Vec::new(),
         };
+        run.write_record(&Input::Start {
+            unit_ns: spec.tick_ns(),
+            speed: config.speed,
+        })?;
         let mut sets = Vec::new();
         let mut last_cleanup = Instant::now();
         let mut idle_since_flush = false;

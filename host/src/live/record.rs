@@ -3,6 +3,9 @@
 //! Verdict line: `{"property":"battery_recurrence","time":42,"verdict":"currently_false","event":"museum/battery"}`.
 //!
 //! Input log, one record per line, every time in ticks of the spec's unit:
+//! - `{"kind":"start","unit_ns":N,"speed":S}`: the first line the sidecar writes: the
+//!   tick's length in nanoseconds and the system's speed (a log without it is accepted;
+//!   one with another unit than the replaying spec's is rejected);
 //! - `{"kind":"sample","time":T,"source":S,"sets":{VAR:VALUE,..}}`: a tapped sample;
 //! - `{"kind":"request","time":T,"source":S,"sets":{..},"filter":[PROP,..]|null}`: a proxied request;
 //! - `{"kind":"tick","time":T}`: a heartbeat point with no sample;
@@ -23,6 +26,13 @@ use super::engine::{Change, Engine, Verdict};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Input {
+    /// What the log's times mean; the sidecar writes it first.
+    Start {
+        /// Nanoseconds of model time in one tick: the spec's unit.
+        unit_ns: u64,
+        /// How many times faster than real time the system ran (informational).
+        speed: f64,
+    },
     /// A tapped sample.
     Sample {
         /// Quantised time.
@@ -212,6 +222,16 @@ pub fn apply(
                 .map_err(step)?;
         }
         Input::Restart { .. } => {}
+        Input::Start { unit_ns, .. } => {
+            if *unit_ns != spec.tick_ns() {
+                return Err(format!(
+                    "the log's ticks are {} long, the spec's are {}: record and replay with \
+                     the same unit",
+                    duration_text(*unit_ns),
+                    duration_text(spec.tick_ns())
+                ));
+            }
+        }
     }
     Ok(None)
 }
@@ -229,6 +249,16 @@ pub fn parse_log(text: &str, file: &str) -> Result<Vec<(usize, Input)>, String> 
         out.push((i + 1, input));
     }
     Ok(out)
+}
+
+/// `100ms`, `1s`, `250us`, `7ns`.
+fn duration_text(ns: u64) -> String {
+    for (unit, size) in [("s", 1_000_000_000), ("ms", 1_000_000), ("us", 1_000)] {
+        if ns % size == 0 && ns > 0 {
+            return format!("{}{unit}", ns / size);
+        }
+    }
+    format!("{ns}ns")
 }
 
 /// Replays an input log: every verdict line, in order. Errors name `file:line`.
