@@ -378,6 +378,34 @@ fn online_sweep_finds_the_battery_recurrence_threshold_of_a_recorded_run() {
     assert_eq!(rows[4], ("0.9s".to_string(), 0, 1, 0));
     assert_eq!(rows[5], ("1s".to_string(), 1, 0, 0));
     assert_eq!(rows[10], ("1.5s".to_string(), 1, 0, 0));
+    // A monitor started 2 s before the system and stopped 3 s after it: its heartbeats
+    // while waiting are not the run, and the same threshold comes out.
+    let battery: Vec<(u64, i64)> = (2..5).map(|k| (10 * k, 100 - k as i64)).collect();
+    let waiting = write(&dir, "wait.jsonl", &heartbeat_log(70, &battery, None, true));
+    let again = online_sweep(&[&waiting], "battery_recurrence", "0.5s", "1.5s");
+    assert_eq!(again["properties"][0]["threshold"], "1s");
+    assert_eq!(self::rows(&again), rows);
+}
+
+#[test]
+fn a_run_spans_its_first_to_its_last_message() {
+    use hindsight::live::record::{parse_log, run_span, Input};
+    let log = "{\"kind\":\"start\",\"unit_ns\":100000000,\"speed\":1.0}\n\
+               {\"kind\":\"tick\",\"time\":0}\n\
+               {\"kind\":\"tick\",\"time\":1}\n\
+               {\"kind\":\"sample\",\"time\":1,\"source\":\"s\",\"sets\":{}}\n\
+               {\"kind\":\"tick\",\"time\":2}\n\
+               {\"kind\":\"request\",\"time\":3,\"source\":\"r\",\"sets\":{},\"filter\":null}\n\
+               {\"kind\":\"tick\",\"time\":3}\n\
+               {\"kind\":\"tick\",\"time\":4}\n";
+    let records = parse_log(log, "l.jsonl").unwrap();
+    let kept: Vec<usize> = run_span(&records).iter().map(|(line, _)| *line).collect();
+    // The start record, the tick at the first sample's time, and everything up to the
+    // last message's time; not the ticks at 0 and 4.
+    assert_eq!(kept, [1, 3, 4, 5, 6, 7]);
+    // Without a message the log is kept whole.
+    let ticks = parse_log("{\"kind\":\"tick\",\"time\":0}\n", "t.jsonl").unwrap();
+    assert_eq!(run_span(&ticks), [(1, Input::Tick { time: 0 })]);
 }
 
 #[test]

@@ -495,7 +495,7 @@ fn read_logs(paths: &[PathBuf]) -> Result<Vec<Log>, CliError> {
             let name = p.display().to_string();
             let text = super::read_file(p)?;
             let records = live::record::parse_log(&text, &name).map_err(CliError::Input)?;
-            Ok((name, records))
+            Ok((name, live::record::run_span(&records)))
         })
         .collect()
 }

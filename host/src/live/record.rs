@@ -279,6 +279,31 @@ pub fn replay(
     Ok(lines)
 }
 
+/// The records of a run: without the heartbeats before the first sample or request and
+/// after the last one, when the monitor was waiting for the system or outlived it.
+///
+/// A sidecar started before the system, or stopped after it, records heartbeats in
+/// which nothing can arrive; judged, they would make every recurrence fail at both ends.
+/// `hindsight sweep --online` judges a log as one run from its first message to its last,
+/// as the off-line sweep judges a simulated run from its start to its end. A log with no
+/// sample or request is returned whole.
+pub fn run_span(records: &[(usize, Input)]) -> Vec<(usize, Input)> {
+    let message_time = |r: &Input| match r {
+        Input::Sample { time, .. } | Input::Request { time, .. } => Some(*time),
+        _ => None,
+    };
+    let mut times = records.iter().filter_map(|(_, r)| message_time(r));
+    let Some(first) = times.next() else {
+        return records.to_vec();
+    };
+    let last = times.next_back().unwrap_or(first);
+    records
+        .iter()
+        .filter(|(_, r)| !matches!(r, Input::Tick { time } if *time < first || *time > last))
+        .cloned()
+        .collect()
+}
+
 /// Replays parsed log records (from [`parse_log`] on `file`) and returns every
 /// property's verdict after the last one (`None`: no point was judged).
 ///
