@@ -1,6 +1,8 @@
 //! The properties written once: `hindsight monitor --model` runs the guarantees `verify`
 //! compiles from a robot model's ROS-named property file, and its input logs replay.
 
+mod live_common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -606,4 +608,57 @@ fn a_recorded_log_starts_with_its_unit_and_replays_only_with_that_unit() {
         err.contains("ms.jsonl:1:1: the log's ticks are 1ms long, the spec's are 100ms"),
         "{err}"
     );
+}
+
+#[test]
+fn from_first_message_judges_nothing_before_the_first_sample() {
+    let svc = live_common::unique("first");
+    let config = format!(
+        "[clock]\nfrom_first_message = true\n{}",
+        live_common::battery_topic(&svc)
+    );
+    let run = live_common::Running::start(&config, "first");
+    let node = live_common::node();
+    let publisher = live_common::publisher(&node, &svc);
+    live_common::send(&publisher, &live_common::battery(50, 0));
+    run.wait_judged(1);
+    let done = run.finish();
+    let kinds: Vec<String> = done
+        .record
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["kind"].to_string())
+        .collect();
+    // The start record, then the sample: no heartbeat while the monitor waited.
+    assert_eq!(kinds[..2], ["\"start\"", "\"sample\""], "{}", done.record);
+    done.assert_replay_matches();
+}
+
+#[test]
+fn help_teaches_the_model_the_speed_and_the_online_sweep() {
+    let (code, monitor, _) = hindsight(&["monitor", "--help"]);
+    assert_eq!(code, 0);
+    for want in [
+        "--model examples/museum-guide",
+        "Assumptions are not monitored",
+        "--speed S",
+        "ticks = wall-clock time * S / unit",
+        "--from-first-message",
+        "{\"kind\":\"start\",\"unit_ns\":..}",
+        "sweep examples/museum-guide --online run.jsonl",
+    ] {
+        assert!(
+            monitor.contains(want),
+            "monitor --help lacks {want}: {monitor}"
+        );
+    }
+    let (code, sweep, _) = hindsight(&["sweep", "--help"]);
+    assert_eq!(code, 0);
+    for want in [
+        "--online <LOG>",
+        "each input log",
+        "first sample or request to its last",
+        "--online run1.jsonl --online run2.jsonl",
+    ] {
+        assert!(sweep.contains(want), "sweep --help lacks {want}: {sweep}");
+    }
 }

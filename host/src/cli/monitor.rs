@@ -51,6 +51,11 @@ pub struct MonitorArgs {
     /// config's `[clock] speed`. Recorded logs keep ticks of the unit, so --replay needs no speed.
     #[arg(long, value_name = "S", conflicts_with_all = ["replay", "bench"])]
     pub speed: Option<f64>,
+    /// No heartbeat before the first sample or request, so a monitor started before the
+    /// system does not judge the wait (its first point is the system's first message).
+    /// Same as the config's `[clock] from_first_message = true`.
+    #[arg(long, conflicts_with_all = ["replay", "bench"])]
+    pub from_first_message: bool,
     /// Write every property's verdict at every point, not only changes.
     #[arg(long)]
     pub every_point: bool,
@@ -94,8 +99,23 @@ Verdicts (JSON lines, on change):
   the verdict now; unknown: a sample the property reads was lost or malformed: the
   property restarts and is unknown for its largest time bound, then judges again.
 
-Time: without samples, a heartbeat point every `[clock] heartbeat` ticks (default 1)
-  lets a bounded property see its window expire (a late topic fails on time).
+Properties written once (--model):
+  `--model examples/museum-guide` monitors the guarantees of the model's property
+  file exactly as `hindsight verify` compiles them: the variables are the ports'
+  ids (battery_level, battery_published, alarm, ...), the tick is the model's time
+  unit (100 ms), and the bounds are in seconds as written (`within=\"1\"` is 10
+  ticks). `hindsight run MODEL --layout` prints a config whose `var`/`event` names
+  are those ids. Assumptions are not monitored: off-line they discard runs,
+  on-line there is no run to discard.
+
+Time: the clock counts ticks of the unit from the monitor's start. With --speed S
+  (or `[clock] speed = S`) the system runs S times faster than real time, as
+  `hindsight run --speed S` plays a model, and ticks = wall-clock time * S / unit:
+  bounds mean model time (with S = 1, wall-clock time). Without samples, a
+  heartbeat point every `[clock] heartbeat` ticks (default 1) lets a bounded
+  property see its window expire (a late topic fails on time). Heartbeats start at
+  once, so a bounded property fails while the monitor waits for a system started
+  later; --from-first-message starts them with the first sample or request.
 Loss: counted exactly from a `seq` counter in the payload, else suspected when a
   drain finds the tap's buffer full; either way the readers turn `unknown`.
 Filter: a request is refused when it would turn a listed property from
@@ -103,6 +123,11 @@ Filter: a request is refused when it would turn a listed property from
 
 Robustness: a restarted publisher is picked up (the gap is reported), malformed
   samples are counted and reported, SIGINT/SIGTERM flush every file and exit 0.
+
+Input log (--record): JSON lines, the first `{\"kind\":\"start\",\"unit_ns\":..}`, then
+  every sample, request, heartbeat and loss in ticks of the unit (whatever the
+  speed). --replay and `hindsight sweep MODEL --online LOG` read it back and refuse a
+  log recorded in another unit.
 
 Config example (see `hindsight::live::config` for every key):
   [[topic]]
@@ -119,6 +144,13 @@ Examples:
   hindsight monitor --props museum.hspec --config museum.toml --record in.jsonl -o verdicts.jsonl
   hindsight monitor --props museum.hspec --replay in.jsonl     # the same verdicts, off-line
   hindsight monitor --bench
+The museum end to end, ten times faster than real time (two shells):
+  hindsight run examples/museum-guide --layout > museum.toml
+  hindsight monitor --model examples/museum-guide --config museum.toml --speed 10 \\
+      --from-first-message --record run.jsonl
+  hindsight run examples/museum-guide --speed 10 --duration 60s   # then Ctrl-C the monitor
+  hindsight monitor --model examples/museum-guide --replay run.jsonl
+  hindsight sweep examples/museum-guide --online run.jsonl --from 0.5s --to 1.5s
 
 Exit codes: 0 stopped by a signal, or replay/bench done; 2 bad spec, config or log; 1 iceoryx2 or I/O failure.";
 
@@ -236,6 +268,7 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
     let text = read_file(config_path)?;
     let mut config =
         Config::parse(&text, &config_path.display().to_string(), &spec).map_err(CliError::Input)?;
+    config.from_first_message |= args.from_first_message;
     if let Some(s) = args.speed {
         config.speed =
             live::check_speed(s).map_err(|m| CliError::Input(format!("--speed: {m}")))?;

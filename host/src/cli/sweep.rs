@@ -29,8 +29,20 @@ Output: CSV `property,bound,successes,failures,unknown,probability,lower,upper` 
 the thresholds on stderr (or everything as one JSON object with --json), and with --svg
 a chart of success rate against the bound.
 
-Example:
-  hindsight sweep examples/museum-scxml --property battery_recurrence --from 5 --to 15 --svg sweep.svg")]
+On-line (--online LOG, repeatable): instead of simulating, each input log that
+`hindsight monitor --model MODEL --record LOG` wrote is one run. Every bound's variant is
+replayed over it, from the log's first sample or request to its last (heartbeats while
+the monitor waited for the system, or outlived it, are not the run), and the run succeeds
+when the variant's last verdict is true or currently_true (false or currently_false: a
+failure; unknown, after a lost sample: unknown). Requests are judged as the points they
+would have been; a `filter` is not applied. The output is the off-line one, so the two
+thresholds compare (the paper's Tables II and III). A log in another unit than the
+model's, or setting a variable that is not a port of the property file, is an error
+naming the file and line.
+
+Examples:
+  hindsight sweep examples/museum-scxml --property battery_recurrence --from 5 --to 15 --svg sweep.svg
+  hindsight sweep examples/museum-guide --online run1.jsonl --online run2.jsonl --from 0.5s --to 7s")]
 pub struct SweepArgs {
     /// The model and its properties, as for `verify`.
     #[command(flatten)]

@@ -6,6 +6,7 @@
 //! [clock]
 //! heartbeat = 1        # a point with no sample every N ticks of the spec's unit (0: never)
 //! speed = 1            # the system runs this many times faster than real time (`run --speed`)
+//! from_first_message = false   # true: no heartbeat before the first sample or request
 //!
 //! [verdicts]
 //! service = "museum/verdicts"   # also publish each verdict line on this service
@@ -287,6 +288,9 @@ pub struct Config {
     /// The monitored system runs this many times faster than real time (1: real time),
     /// so the clock counts model time; see [`super::Clock`].
     pub speed: f64,
+    /// No heartbeat before the first sample or request: a monitor started before the
+    /// system judges nothing while it waits (its first point is the first message).
+    pub from_first_message: bool,
 }
 
 #[derive(Deserialize)]
@@ -305,6 +309,7 @@ struct RawConfig {
 struct RawClock {
     heartbeat: Option<u64>,
     speed: Option<Spanned<f64>>,
+    from_first_message: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -617,9 +622,14 @@ impl Config {
         Ok(Config {
             topics,
             services,
-            heartbeat: raw.clock.and_then(|c| c.heartbeat).unwrap_or(1),
+            heartbeat: raw.clock.as_ref().and_then(|c| c.heartbeat).unwrap_or(1),
             verdict_service,
             speed,
+            from_first_message: raw
+                .clock
+                .as_ref()
+                .and_then(|c| c.from_first_message)
+                .unwrap_or(false),
         })
     }
 }

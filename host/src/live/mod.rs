@@ -244,6 +244,8 @@ struct Run<'c, 'o> {
     points: u64,
     lines: u64,
     probed: Vec<(u64, u64)>,
+    /// A sample or request has been judged.
+    started: bool,
 }
 
 impl Run<'_, '_> {
@@ -294,6 +296,7 @@ impl Run<'_, '_> {
             self.write_record(&input)?;
         }
         self.changes.clear();
+        self.started = true;
         let step = |e: monitor_core::StepError| LiveError::Engine(e.to_string());
         let ok = match request {
             None => {
@@ -726,7 +729,8 @@ impl Sidecar {
     }
 
     /// Judges until `stop` is set (or, with signal handling, SIGINT/SIGTERM),
-    /// then flushes every output. `config.heartbeat` adds empty points when idle;
+    /// then flushes every output. `config.heartbeat` adds empty points when idle
+    /// (with `config.from_first_message`, only once a sample or request came);
     /// `config.speed` makes the clock count model time of a faster (or slower) system.
     pub fn run(
         mut self,
@@ -747,6 +751,7 @@ impl Sidecar {
             points: 0,
             lines: 0,
             probed: Vec::new(),
+            started: false,
         };
         run.write_record(&Input::Start {
             unit_ns: spec.tick_ns(),
@@ -770,7 +775,8 @@ impl Sidecar {
             for px in &mut self.proxies {
                 busy |= run.serve(px, &mut self.taps, &mut sets)?;
             }
-            if config.heartbeat > 0 {
+            // With `from_first_message`, no heartbeat before the system's first message.
+            if config.heartbeat > 0 && (run.started || !config.from_first_message) {
                 let now = run.clock.now();
                 let due = run
                     .engine
