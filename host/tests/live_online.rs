@@ -662,3 +662,57 @@ fn help_teaches_the_model_the_speed_and_the_online_sweep() {
         assert!(sweep.contains(want), "sweep --help lacks {want}: {sweep}");
     }
 }
+
+#[test]
+fn a_plain_model_is_monitored_with_its_time_unit_and_without_its_assumptions() {
+    let coin = "host/tests/data/verify/coin";
+    let props = "host/tests/data/verify/coin/assume-tails.xml";
+    let spec = guarantees_spec(&ModelArgs {
+        model: root().join(coin),
+        props: Some(root().join(props)),
+        time_unit: Some("100ms".into()),
+        events: None,
+    })
+    .unwrap();
+    // The guarantee only: the assumption `tails_thrown` is not monitored.
+    assert_eq!(spec.property_names().collect::<Vec<_>>(), ["no_heads"]);
+    assert_eq!(spec.tick_ns(), 100_000_000);
+    let dir = scratch("coin");
+    let log = write(
+        &dir,
+        "in.jsonl",
+        "{\"kind\":\"tick\",\"time\":0}\n{\"kind\":\"sample\",\"time\":3,\"source\":\"c\",\"sets\":{\"heads\":true}}\n",
+    );
+    let (code, out, err) = hindsight(&[
+        "monitor",
+        "--model",
+        coin,
+        "--model-props",
+        props,
+        "--time-unit",
+        "100ms",
+        "--replay",
+        &log,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("1 assumption(s) not monitored"), "{err}");
+    assert_eq!(
+        verdicts(&out),
+        [
+            ("no_heads".to_string(), 0, "currently_true".to_string()),
+            ("no_heads".to_string(), 3, "false".to_string())
+        ]
+    );
+    // Without a time unit the clock has no tick.
+    let (code, _, err) = hindsight(&[
+        "monitor",
+        "--model",
+        coin,
+        "--model-props",
+        props,
+        "--replay",
+        &log,
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("the model has no time unit"), "{err}");
+}
