@@ -188,11 +188,19 @@ fn spec_of(args: &MonitorArgs) -> Result<Compiled, CliError> {
             ))
         }
     };
+    let from_props = args.model.is_none();
     guarantees_spec(&ModelArgs {
         model,
         props: args.model_props.clone(),
         time_unit: args.time_unit.clone(),
         events: None,
+    })
+    .map_err(|e| match e {
+        CliError::Input(m) if from_props => CliError::Input(format!(
+            "{m}\nhint: --props read a folder or an .xml file as a model; a property file \
+             goes with its model: --model MODEL --model-props FILE"
+        )),
+        other => other,
     })
 }
 
