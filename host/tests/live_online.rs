@@ -237,6 +237,16 @@ fn bad_monitor_inputs_exit_2_and_say_why() {
             vec![
                 "monitor",
                 "--props",
+                "examples/museum-guide/properties.xml",
+                "--replay",
+                &log,
+            ],
+            "hint: --props read a folder or an .xml file as a model",
+        ),
+        (
+            vec![
+                "monitor",
+                "--props",
                 &spec,
                 "--time-unit",
                 "1ms",
