@@ -497,7 +497,7 @@ fn online_sweep_prints_the_offline_csv_and_draws_the_chart() {
         "{err}"
     );
     let chart = std::fs::read_to_string(&svg).unwrap();
-    assert!(chart.contains("1 recorded run(s)"), "{chart}");
+    assert!(chart.contains("(1 recorded run)"), "{chart}");
 }
 
 #[test]
@@ -725,4 +725,55 @@ fn a_plain_model_is_monitored_with_its_time_unit_and_without_its_assumptions() {
     ]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("the model has no time unit"), "{err}");
+}
+
+#[test]
+fn the_recorded_museum_runs_give_the_online_thresholds() {
+    // examples/museum-guide/online: three runs of the museum (`run --run K`, K = 0, 1, 2,
+    // 100 s at --speed 10) recorded by `monitor --model examples/museum-guide --speed 10
+    // --from-first-message --record`. Wall-clock scheduling stretched one visitors
+    // publication to 1.1 s; every other requirement keeps its off-line threshold.
+    let logs: Vec<String> = (0..3)
+        .map(|k| format!("examples/museum-guide/online/run{k}.jsonl"))
+        .collect();
+    let mut args = vec!["sweep", "examples/museum-guide"];
+    for l in &logs {
+        args.extend(["--online", l.as_str()]);
+    }
+    args.extend(["--from", "0.1s", "--to", "7s", "--json"]);
+    let (code, out, err) = hindsight(&args);
+    assert_eq!(code, 0, "{err}");
+    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(r["runs"], 3);
+    let thresholds: Vec<(String, String)> = r["properties"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            (
+                p["property"].as_str().unwrap().to_string(),
+                p["threshold"].as_str().unwrap_or("none").to_string(),
+            )
+        })
+        .collect();
+    let want = [
+        ("alarm_response", "6.2s"),
+        ("battery_recurrence", "1s"),
+        ("poi_response", "0.2s"),
+        ("visitors_recurrence", "1.1s"),
+    ];
+    assert_eq!(
+        thresholds,
+        want.map(|(p, t)| (p.to_string(), t.to_string())).to_vec()
+    );
+    // At 1 s, two of the three runs published the visitors every second.
+    let visitors = &r["properties"][3]["points"][9];
+    assert_eq!(visitors["bound"], "1s");
+    assert_eq!(
+        (
+            visitors["successes"].as_u64(),
+            visitors["failures"].as_u64()
+        ),
+        (Some(2), Some(1))
+    );
 }

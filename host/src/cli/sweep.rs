@@ -586,10 +586,11 @@ fn finish(
                 args.runs
             )
         } else {
+            let n = args.online.len();
             format!(
-                "{}: success rate against the bound ({} recorded run(s))",
+                "{}: success rate against the bound ({n} recorded run{})",
                 args.input.model.display(),
-                args.online.len()
+                if n == 1 { "" } else { "s" }
             )
         };
         std::fs::write(path, plot::svg(&title, unit_label, &plot_curves))
