@@ -654,7 +654,7 @@ fn help_teaches_the_model_the_speed_and_the_online_sweep() {
         "ticks = wall-clock time * S / unit",
         "--from-first-message",
         "{\"kind\":\"start\",\"unit_ns\":..}",
-        "sweep examples/museum-guide --online run.jsonl",
+        "sweep examples/museum-guide --online run.jsonl --from 0.1s --to 7s",
     ] {
         assert!(
             monitor.contains(want),

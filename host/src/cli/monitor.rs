@@ -114,8 +114,8 @@ Time: the clock counts ticks of the unit from the monitor's start. With --speed 
   bounds mean model time (with S = 1, wall-clock time). Without samples, a
   heartbeat point every `[clock] heartbeat` ticks (default 1) lets a bounded
   property see its window expire (a late topic fails on time). Heartbeats start at
-  once, so a bounded property fails while the monitor waits for a system started
-  later; --from-first-message starts them with the first sample or request.
+  once, so a recurrence fails while the monitor waits for a system started later;
+  --from-first-message starts them with the first sample or request.
 Loss: counted exactly from a `seq` counter in the payload, else suspected when a
   drain finds the tap's buffer full; either way the readers turn `unknown`.
 Filter: a request is refused when it would turn a listed property from
@@ -148,9 +148,9 @@ The museum end to end, ten times faster than real time (two shells):
   hindsight run examples/museum-guide --layout > museum.toml
   hindsight monitor --model examples/museum-guide --config museum.toml --speed 10 \\
       --from-first-message --record run.jsonl
-  hindsight run examples/museum-guide --speed 10 --duration 60s   # then Ctrl-C the monitor
+  hindsight run examples/museum-guide --speed 10 --duration 100s  # then Ctrl-C the monitor
   hindsight monitor --model examples/museum-guide --replay run.jsonl
-  hindsight sweep examples/museum-guide --online run.jsonl --from 0.5s --to 1.5s
+  hindsight sweep examples/museum-guide --online run.jsonl --from 0.1s --to 7s
 
 Exit codes: 0 stopped by a signal, or replay/bench done; 2 bad spec, config or log; 1 iceoryx2 or I/O failure.";
 
