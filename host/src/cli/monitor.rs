@@ -1,20 +1,38 @@
 //! `hindsight monitor`: the on-line sidecar over iceoryx2, its off-line replay and its benchmark.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
+use codegen::Compiled;
+
+use super::verify::{load, ModelArgs};
 use super::{compile_spec_file, read_file, CliError};
 use crate::live::{self, config::Config, Options, Sidecar};
+use crate::verify::observe::PropertySet;
 
 /// Arguments of `hindsight monitor`.
 #[derive(Debug, clap::Args)]
 #[command(after_long_help = AFTER_HELP)]
 pub struct MonitorArgs {
-    /// The properties: a spec (`.hspec`) whose unit is the clock's tick.
-    #[arg(long, value_name = "SPEC", required_unless_present = "bench")]
+    /// The properties: a spec (`.hspec`) whose unit is the clock's tick. A folder or an
+    /// `.xml` file here is read as a model, as with --model.
+    #[arg(long, value_name = "SPEC", required_unless_present_any = ["bench", "model"], conflicts_with = "model")]
     pub props: Option<PathBuf>,
+    /// Monitor the guarantees of a model's property file, compiled exactly as `verify`
+    /// compiles them (variables: the ports' ids; tick: the model's time unit). MODEL is a
+    /// robot main file, a folder holding `main.xml`, or a plain SCXML model (with
+    /// --time-unit). Assumptions are not monitored.
+    #[arg(long, value_name = "MODEL")]
+    pub model: Option<PathBuf>,
+    /// With --model: the property file; default: the one the main file names, else
+    /// MODEL/properties.xml.
+    #[arg(long, value_name = "FILE")]
+    pub model_props: Option<PathBuf>,
+    /// With a plain SCXML --model: the length of one model time step (`100ms`).
+    #[arg(long, value_name = "DURATION")]
+    pub time_unit: Option<String>,
     /// The sidecar config (TOML): topics to tap, services to proxy, payload layouts.
     #[arg(long, value_name = "FILE", required_unless_present_any = ["replay", "bench"])]
     pub config: Option<PathBuf>,
@@ -27,6 +45,17 @@ pub struct MonitorArgs {
     /// Write every judged input (samples, requests, heartbeats, losses) as JSON lines, for `--replay`.
     #[arg(long, value_name = "LOG")]
     pub record: Option<PathBuf>,
+    /// The monitored system runs S times faster than real time (as `hindsight run --speed
+    /// S` runs a model), so the clock counts model time: ticks = wall-clock time * S /
+    /// unit, and bounds mean model seconds (with 1, wall-clock seconds). Overrides the
+    /// config's `[clock] speed`. Recorded logs keep ticks of the unit, so --replay needs no speed.
+    #[arg(long, value_name = "S", conflicts_with_all = ["replay", "bench"])]
+    pub speed: Option<f64>,
+    /// No heartbeat before the first sample or request, so a monitor started before the
+    /// system does not judge the wait (its first point is the system's first message).
+    /// Same as the config's `[clock] from_first_message = true`.
+    #[arg(long, conflicts_with_all = ["replay", "bench"])]
+    pub from_first_message: bool,
     /// Write every property's verdict at every point, not only changes.
     #[arg(long)]
     pub every_point: bool,
@@ -34,7 +63,7 @@ pub struct MonitorArgs {
     #[arg(long, value_name = "US", default_value_t = 100)]
     pub poll_us: u64,
     /// Measure samples per second and added latency against a plain subscriber, then exit.
-    #[arg(long, conflicts_with_all = ["props", "config", "replay"])]
+    #[arg(long, conflicts_with_all = ["props", "model", "config", "replay"])]
     pub bench: bool,
     /// Benchmark: samples in the paced (latency) phase.
     #[arg(long, value_name = "N", default_value_t = 20_000, requires = "bench")]
@@ -70,8 +99,23 @@ Verdicts (JSON lines, on change):
   the verdict now; unknown: a sample the property reads was lost or malformed: the
   property restarts and is unknown for its largest time bound, then judges again.
 
-Time: without samples, a heartbeat point every `[clock] heartbeat` ticks (default 1)
-  lets a bounded property see its window expire (a late topic fails on time).
+Properties written once (--model):
+  `--model examples/museum-guide` monitors the guarantees of the model's property
+  file exactly as `hindsight verify` compiles them: the variables are the ports'
+  ids (battery_level, battery_published, alarm, ...), the tick is the model's time
+  unit (100 ms), and the bounds are in seconds as written (`within=\"1\"` is 10
+  ticks). `hindsight run MODEL --layout` prints a config whose `var`/`event` names
+  are those ids. Assumptions are not monitored: off-line they discard runs,
+  on-line there is no run to discard.
+
+Time: the clock counts ticks of the unit from the monitor's start. With --speed S
+  (or `[clock] speed = S`) the system runs S times faster than real time, as
+  `hindsight run --speed S` plays a model, and ticks = wall-clock time * S / unit:
+  bounds mean model time (with S = 1, wall-clock time). Without samples, a
+  heartbeat point every `[clock] heartbeat` ticks (default 1) lets a bounded
+  property see its window expire (a late topic fails on time). Heartbeats start at
+  once, so a recurrence fails while the monitor waits for a system started later;
+  --from-first-message starts them with the first sample or request.
 Loss: counted exactly from a `seq` counter in the payload, else suspected when a
   drain finds the tap's buffer full; either way the readers turn `unknown`.
 Filter: a request is refused when it would turn a listed property from
@@ -79,6 +123,11 @@ Filter: a request is refused when it would turn a listed property from
 
 Robustness: a restarted publisher is picked up (the gap is reported), malformed
   samples are counted and reported, SIGINT/SIGTERM flush every file and exit 0.
+
+Input log (--record): JSON lines, the first `{\"kind\":\"start\",\"unit_ns\":..}`, then
+  every sample, request, heartbeat and loss in ticks of the unit (whatever the
+  speed). --replay and `hindsight sweep MODEL --online LOG` read it back and refuse a
+  log recorded in another unit.
 
 Config example (see `hindsight::live::config` for every key):
   [[topic]]
@@ -95,6 +144,13 @@ Examples:
   hindsight monitor --props museum.hspec --config museum.toml --record in.jsonl -o verdicts.jsonl
   hindsight monitor --props museum.hspec --replay in.jsonl     # the same verdicts, off-line
   hindsight monitor --bench
+The museum end to end, ten times faster than real time (two shells):
+  hindsight run examples/museum-guide --layout > museum.toml
+  hindsight monitor --model examples/museum-guide --config museum.toml --speed 10 \\
+      --from-first-message --record run.jsonl
+  hindsight run examples/museum-guide --speed 10 --duration 100s  # then Ctrl-C the monitor
+  hindsight monitor --model examples/museum-guide --replay run.jsonl
+  hindsight sweep examples/museum-guide --online run.jsonl --from 0.1s --to 7s
 
 Exit codes: 0 stopped by a signal, or replay/bench done; 2 bad spec, config or log; 1 iceoryx2 or I/O failure.";
 
@@ -102,6 +158,84 @@ fn create(path: &PathBuf) -> Result<Box<dyn Write + Send>, CliError> {
     let f = std::fs::File::create(path)
         .map_err(|e| CliError::Failed(format!("{}: cannot write: {e}", path.display())))?;
     Ok(Box::new(std::io::BufWriter::new(f)))
+}
+
+/// Whether `--props PATH` names a model rather than a spec: a folder, or an `.xml` file.
+fn is_model_path(path: &Path) -> bool {
+    path.is_dir()
+        || path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
+}
+
+/// The spec the monitor runs: `--props SPEC`, or the guarantees of `--model` (or of a
+/// model given to `--props`).
+fn spec_of(args: &MonitorArgs) -> Result<Compiled, CliError> {
+    let model = match (&args.model, &args.props) {
+        (Some(m), _) => m.clone(),
+        (None, Some(p)) if is_model_path(p) => p.clone(),
+        (None, Some(p)) => {
+            if args.model_props.is_some() || args.time_unit.is_some() {
+                return Err(CliError::Input(
+                    "--model-props and --time-unit go with a model (--model MODEL)".into(),
+                ));
+            }
+            return compile_spec_file(p);
+        }
+        (None, None) => {
+            return Err(CliError::Input(
+                "give the properties: --props SPEC or --model MODEL".into(),
+            ))
+        }
+    };
+    let from_props = args.model.is_none();
+    guarantees_spec(&ModelArgs {
+        model,
+        props: args.model_props.clone(),
+        time_unit: args.time_unit.clone(),
+        events: None,
+    })
+    .map_err(|e| match e {
+        CliError::Input(m) if from_props => CliError::Input(format!(
+            "{m}\nhint: --props read a folder or an .xml file as a model; a property file \
+             goes with its model: --model MODEL --model-props FILE"
+        )),
+        other => other,
+    })
+}
+
+/// The guarantees of a model's property file compiled into one spec, exactly as `verify`
+/// compiles them: its variables are the ports' ids and its tick is the model's time unit.
+/// Assumptions are left out (they are not monitored); a model without a time unit, or a
+/// property file without guarantees, is an input error.
+pub fn guarantees_spec(args: &ModelArgs) -> Result<Compiled, CliError> {
+    let loaded = load(args)?;
+    let Some(unit_ns) = loaded.unit_ns else {
+        return Err(CliError::Input(format!(
+            "{}: the model has no time unit, so the monitor's clock has no tick; give the \
+             length of one model step with --time-unit (for example --time-unit 100ms)",
+            args.model.display()
+        )));
+    };
+    if loaded.file.guarantees.is_empty() {
+        return Err(CliError::Input(format!(
+            "{}: no guarantee to monitor",
+            loaded.props_path.display()
+        )));
+    }
+    if loaded.file.assumptions.is_empty() {
+        return Ok(loaded.set.compiled().clone());
+    }
+    eprintln!(
+        "monitor: {}: {} assumption(s) not monitored (only guarantees are)",
+        loaded.props_path.display(),
+        loaded.file.assumptions.len()
+    );
+    let mut file = loaded.file;
+    file.assumptions.clear();
+    PropertySet::with_unit(&file, &loaded.model, Some(unit_ns))
+        .map(|set| set.compiled().clone())
+        .map_err(CliError::Input)
 }
 
 /// Runs `hindsight monitor`.
@@ -120,10 +254,7 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         print!("{r}");
         return Ok(());
     }
-    let Some(props) = &args.props else {
-        return Err(CliError::Input("--props SPEC is required".into()));
-    };
-    let spec = compile_spec_file(props)?;
+    let spec = spec_of(args)?;
     let mut out: Box<dyn Write + Send> = match &args.output {
         Some(p) => create(p)?,
         None => Box::new(std::io::stdout()),
@@ -143,8 +274,13 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         return Err(CliError::Input("--config FILE is required".into()));
     };
     let text = read_file(config_path)?;
-    let config =
+    let mut config =
         Config::parse(&text, &config_path.display().to_string(), &spec).map_err(CliError::Input)?;
+    config.from_first_message |= args.from_first_message;
+    if let Some(s) = args.speed {
+        config.speed =
+            live::check_speed(s).map_err(|m| CliError::Input(format!("--speed: {m}")))?;
+    }
     let mut opts = Options {
         verdicts: out,
         record: args.record.as_ref().map(create).transpose()?,

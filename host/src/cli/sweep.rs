@@ -6,8 +6,10 @@ use std::time::Duration;
 
 use super::verify::{load, study};
 use super::{plot, CliError};
+use crate::live::{self, engine::Verdict};
 use crate::props::{self, SourceText};
 use crate::sim::RunConfig;
+use crate::smc::runner::{widened_interval, PropertyCounts};
 use crate::smc::stats::{RuleConfig, RuleKind};
 use crate::smc::StudyConfig;
 use crate::verify::observe::PropertySet;
@@ -27,8 +29,20 @@ Output: CSV `property,bound,successes,failures,unknown,probability,lower,upper` 
 the thresholds on stderr (or everything as one JSON object with --json), and with --svg
 a chart of success rate against the bound.
 
-Example:
-  hindsight sweep examples/museum-scxml --property battery_recurrence --from 5 --to 15 --svg sweep.svg")]
+On-line (--online LOG, repeatable): instead of simulating, each input log that
+`hindsight monitor --model MODEL --record LOG` wrote is one run. Every bound's variant is
+replayed over it, from the log's first sample or request to its last (heartbeats while
+the monitor waited for the system, or outlived it, are not the run), and the run succeeds
+when the variant's last verdict is true or currently_true (false or currently_false: a
+failure; unknown, after a lost sample: unknown). Requests are judged as the points they
+would have been; a `filter` is not applied. The output is the off-line one, so the two
+thresholds compare (the paper's Tables II and III). A log in another unit than the
+model's, or setting a variable that is not a port of the property file, is an error
+naming the file and line.
+
+Examples:
+  hindsight sweep examples/museum-scxml --property battery_recurrence --from 5 --to 15 --svg sweep.svg
+  hindsight sweep examples/museum-guide --online run1.jsonl --online run2.jsonl --from 0.5s --to 7s")]
 pub struct SweepArgs {
     /// The model and its properties, as for `verify`.
     #[command(flatten)]
@@ -66,6 +80,16 @@ pub struct SweepArgs {
     /// Print one JSON object instead of CSV and the threshold summary.
     #[arg(long)]
     pub json: bool,
+    /// On-line: judge input logs recorded by `hindsight monitor --record` instead of
+    /// simulating; each log is one run (repeat for several). Their variables are the
+    /// property file's port ids and their times ticks of the model's time unit, as
+    /// `monitor --model MODEL --record LOG` writes them.
+    #[arg(
+        long = "online",
+        value_name = "LOG",
+        conflicts_with_all = ["runs", "seed", "threads", "max_time"]
+    )]
+    pub online: Vec<PathBuf>,
 }
 
 /// A bound value as written: model time units, or an exact duration.
@@ -338,6 +362,53 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         // Never done before `--runs`: every bound gets the same runs.
         precision: 1e-9,
     };
+    if !args.online.is_empty() {
+        let logs = read_logs(&args.online)?;
+        if !args.json {
+            println!("property,bound,successes,failures,unknown,probability,lower,upper");
+        }
+        let mut curves = Vec::new();
+        for target in &targets {
+            let mut one = variants(file, target, &values);
+            // The sidecar monitors guarantees only.
+            one.assumptions.clear();
+            let set =
+                PropertySet::with_unit(&one, model, loaded.unit_ns).map_err(CliError::Input)?;
+            let mut counts = vec![PropertyCounts::default(); values.len()];
+            for (name, records) in &logs {
+                let finals = live::record::final_verdicts(set.compiled(), records, name)
+                    .map_err(CliError::Input)?;
+                for (c, v) in counts.iter_mut().zip(&finals) {
+                    match v {
+                        Some(Verdict::True | Verdict::CurrentlyTrue) => c.successes += 1,
+                        Some(Verdict::False | Verdict::CurrentlyFalse) => c.failures += 1,
+                        Some(Verdict::Unknown) | None => c.unknown += 1,
+                    }
+                }
+            }
+            let rules = rule
+                .build()
+                .map_err(|e| CliError::Input(format!("statistics: {e}")))?;
+            let points: Vec<SweepPoint> = values
+                .iter()
+                .zip(&counts)
+                .map(|(v, c)| {
+                    let interval = widened_interval(rules.as_ref(), c);
+                    SweepPoint {
+                        bound: v.display(),
+                        successes: c.successes,
+                        failures: c.failures,
+                        unknown: c.unknown,
+                        probability: rules.estimate(c.successes, c.judged()).estimate,
+                        lower: interval.lower,
+                        upper: interval.upper,
+                    }
+                })
+                .collect();
+            curves.push(curve(args, target, points));
+        }
+        return finish(args, &values, curves);
+    }
     let run_cfg = RunConfig {
         max_time: loaded.max_time(args.max_time.as_deref())?,
         events: loaded.events,
@@ -356,19 +427,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     }
     let mut curves = Vec::new();
     for target in &targets {
-        let mut one = file.clone();
-        one.guarantees = values
-            .iter()
-            .map(|v| {
-                let mut g = target.clone();
-                g.id = format!("{}@{}", target.id, v.display());
-                g.formula = SourceText::generated(
-                    set_bounds(target.formula.as_str(), &v.formula_text()).0,
-                    target.at,
-                );
-                g
-            })
-            .collect();
+        let one = variants(file, target, &values);
         let set = PropertySet::with_unit(&one, model, loaded.unit_ns).map_err(CliError::Input)?;
         let r = study(model, &set, &run_cfg, &study_cfg, &rule, show_progress)?;
         let points: Vec<SweepPoint> = values
@@ -384,29 +443,73 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
                 upper: p.interval.upper,
             })
             .collect();
-        if !args.json {
-            for p in &points {
-                println!(
-                    "{},{},{},{},{},{},{:.4},{:.4}",
-                    target.id,
-                    p.bound,
-                    p.successes,
-                    p.failures,
-                    p.unknown,
-                    p.probability.map_or("".into(), |x| format!("{x:.4}")),
-                    p.lower,
-                    p.upper
-                );
-            }
-        }
-        let threshold = threshold_index(&points).map(|i| points[i].bound.clone());
-        curves.push(SweepCurve {
-            property: target.id.clone(),
-            threshold,
-            points,
-        });
+        curves.push(curve(args, target, points));
     }
     finish(args, &values, curves)
+}
+
+/// The property file with `target`'s variants, one per bound value, as its guarantees
+/// (named `ID@BOUND`).
+fn variants(
+    file: &props::PropertyFile,
+    target: &props::Property,
+    values: &[BoundValue],
+) -> props::PropertyFile {
+    let mut one = file.clone();
+    one.guarantees = values
+        .iter()
+        .map(|v| {
+            let mut g = target.clone();
+            g.id = format!("{}@{}", target.id, v.display());
+            g.formula = SourceText::generated(
+                set_bounds(target.formula.as_str(), &v.formula_text()).0,
+                target.at,
+            );
+            g
+        })
+        .collect();
+    one
+}
+
+/// Prints a property's CSV rows (unless --json) and finds its threshold.
+fn curve(args: &SweepArgs, target: &props::Property, points: Vec<SweepPoint>) -> SweepCurve {
+    if !args.json {
+        for p in &points {
+            println!(
+                "{},{},{},{},{},{},{:.4},{:.4}",
+                target.id,
+                p.bound,
+                p.successes,
+                p.failures,
+                p.unknown,
+                p.probability.map_or("".into(), |x| format!("{x:.4}")),
+                p.lower,
+                p.upper
+            );
+        }
+    }
+    let threshold = threshold_index(&points).map(|i| points[i].bound.clone());
+    SweepCurve {
+        property: target.id.clone(),
+        threshold,
+        points,
+    }
+}
+
+/// A parsed `--online` log: its name and its records with their line numbers.
+type Log = (String, Vec<(usize, live::record::Input)>);
+
+/// Reads and parses every `--online` log.
+fn read_logs(paths: &[PathBuf]) -> Result<Vec<Log>, CliError> {
+    paths
+        .iter()
+        .map(|p| {
+            let name = p.display().to_string();
+            let text = super::read_file(p)?;
+            let records = live::record::parse_log(&text, &name).map_err(CliError::Input)?;
+            Ok((name, live::record::run_span(&records)))
+        })
+        .collect()
 }
 
 /// Prints the thresholds (or the JSON object) and writes the chart.
@@ -420,12 +523,26 @@ fn finish(
         _ => "bound (model time units)",
     };
     if args.json {
-        let doc = serde_json::json!({
-            "runs": args.runs,
-            "seed": args.seed,
-            "confidence": args.confidence,
-            "properties": curves,
-        });
+        let doc = if args.online.is_empty() {
+            serde_json::json!({
+                "runs": args.runs,
+                "seed": args.seed,
+                "confidence": args.confidence,
+                "properties": curves,
+            })
+        } else {
+            let logs: Vec<String> = args
+                .online
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect();
+            serde_json::json!({
+                "runs": logs.len(),
+                "logs": logs,
+                "confidence": args.confidence,
+                "properties": curves,
+            })
+        };
         println!("{doc}");
     } else {
         for c in &curves {
@@ -462,11 +579,20 @@ fn finish(
                 }
             })
             .collect();
-        let title = format!(
-            "{}: success rate against the bound ({} runs each)",
-            args.input.model.display(),
-            args.runs
-        );
+        let title = if args.online.is_empty() {
+            format!(
+                "{}: success rate against the bound ({} runs each)",
+                args.input.model.display(),
+                args.runs
+            )
+        } else {
+            let n = args.online.len();
+            format!(
+                "{}: success rate against the bound ({n} recorded run{})",
+                args.input.model.display(),
+                if n == 1 { "" } else { "s" }
+            )
+        };
         std::fs::write(path, plot::svg(&title, unit_label, &plot_curves))
             .map_err(|e| CliError::Failed(format!("{}: cannot write: {e}", path.display())))?;
         if !args.json {

@@ -5,6 +5,8 @@
 //! ```toml
 //! [clock]
 //! heartbeat = 1        # a point with no sample every N ticks of the spec's unit (0: never)
+//! speed = 1            # the system runs this many times faster than real time (`run --speed`)
+//! from_first_message = false   # true: no heartbeat before the first sample or request
 //!
 //! [verdicts]
 //! service = "museum/verdicts"   # also publish each verdict line on this service
@@ -283,6 +285,12 @@ pub struct Config {
     pub heartbeat: u64,
     /// Publish verdict lines on this service too.
     pub verdict_service: Option<String>,
+    /// The monitored system runs this many times faster than real time (1: real time),
+    /// so the clock counts model time; see [`super::Clock`].
+    pub speed: f64,
+    /// No heartbeat before the first sample or request: a monitor started before the
+    /// system judges nothing while it waits (its first point is the first message).
+    pub from_first_message: bool,
 }
 
 #[derive(Deserialize)]
@@ -300,6 +308,8 @@ struct RawConfig {
 #[serde(deny_unknown_fields)]
 struct RawClock {
     heartbeat: Option<u64>,
+    speed: Option<Spanned<f64>>,
+    from_first_message: Option<bool>,
 }
 
 #[derive(Deserialize)]
@@ -599,14 +609,27 @@ impl Config {
                 "nothing to monitor: add a [[topic]] or a [[service]]".into(),
             );
         }
+        let speed = match raw.clock.as_ref().and_then(|k| k.speed.as_ref()) {
+            None => 1.0,
+            Some(s) => super::check_speed(*s.get_ref()).unwrap_or_else(|m| {
+                c.err(s.span(), m);
+                1.0
+            }),
+        };
         if !c.errors.is_empty() {
             return Err(c.errors.join("\n"));
         }
         Ok(Config {
             topics,
             services,
-            heartbeat: raw.clock.and_then(|c| c.heartbeat).unwrap_or(1),
+            heartbeat: raw.clock.as_ref().and_then(|c| c.heartbeat).unwrap_or(1),
             verdict_service,
+            speed,
+            from_first_message: raw
+                .clock
+                .as_ref()
+                .and_then(|c| c.from_first_message)
+                .unwrap_or(false),
         })
     }
 }

@@ -3,7 +3,8 @@
 //! Pipeline: a [`config::Config`] names iceoryx2 services and the byte layout of
 //! their `[u8]` payloads -> [`Sidecar`] taps every publish-subscribe topic with one
 //! extra subscriber and proxies every request-response service -> each sample is
-//! stamped with the [`Clock`] (monotonic, quantised to the spec's unit), decoded
+//! stamped with the [`Clock`] (monotonic, quantised to the spec's unit, counting model
+//! time when the system runs faster than real time), decoded
 //! into variable sets and written to the input log ([`record::Input`]) -> the
 //! [`engine::Engine`] steps the compiled monitors -> verdict changes go out as JSON
 //! lines and on an optional iceoryx2 service. [`record::replay`] feeds a recorded
@@ -49,25 +50,69 @@ type Ipc = ipc::Service;
 type Req = ActiveRequest<Ipc, [u8], (), [u8], ()>;
 type Pending = PendingResponse<Ipc, [u8], (), [u8], ()>;
 
-/// A monotonic clock quantised to the spec's time unit: ticks since the sidecar started.
+/// A monotonic clock quantised to the spec's time unit: ticks of model time since the
+/// sidecar started.
+///
+/// The monitored system may run `speed` times faster than real time (`hindsight run
+/// --speed S`); the clock then counts model time, `ticks = elapsed * speed / tick`, so
+/// the spec's bounds keep meaning model time. The speed is kept exactly to a millionth
+/// (an integer ratio), so the arithmetic is exact and never decreases.
 #[derive(Clone, Copy, Debug)]
 pub struct Clock {
     start: Instant,
     tick_ns: u64,
+    /// Millionths of the speed: model nanoseconds per 10^6 wall-clock nanoseconds.
+    speed_micros: u64,
+}
+
+/// The slowest and fastest speeds a [`Clock`] takes.
+pub const SPEED_RANGE: (f64, f64) = (1e-6, 1e9);
+
+/// Checks a speed for [`Clock::with_speed`]: finite, within [`SPEED_RANGE`].
+pub fn check_speed(speed: f64) -> Result<f64, String> {
+    if speed.is_finite() && speed >= SPEED_RANGE.0 && speed <= SPEED_RANGE.1 {
+        Ok(speed)
+    } else {
+        Err(format!(
+            "speed {speed}: must be a number from {} to {} (1: real time)",
+            SPEED_RANGE.0, SPEED_RANGE.1
+        ))
+    }
 }
 
 impl Clock {
-    /// A clock starting now with ticks of `tick_ns` nanoseconds.
+    /// A real-time clock starting now with ticks of `tick_ns` nanoseconds.
     pub fn new(tick_ns: u64) -> Self {
+        Self::with_speed(tick_ns, 1.0)
+    }
+
+    /// A clock starting now that counts ticks of `tick_ns` nanoseconds of model time in a
+    /// system running `speed` times faster than real time (rounded to a millionth and
+    /// clamped to [`SPEED_RANGE`]; see [`check_speed`]).
+    pub fn with_speed(tick_ns: u64, speed: f64) -> Self {
+        let speed = if speed.is_nan() {
+            1.0
+        } else {
+            speed.clamp(SPEED_RANGE.0, SPEED_RANGE.1)
+        };
         Clock {
             start: Instant::now(),
             tick_ns: tick_ns.max(1),
+            speed_micros: (speed * 1e6).round() as u64,
         }
     }
 
     /// Whole ticks elapsed since the start (never decreases).
     pub fn now(&self) -> u64 {
-        (self.start.elapsed().as_nanos() / self.tick_ns as u128) as u64
+        self.ticks(self.start.elapsed())
+    }
+
+    /// Whole ticks of model time in `elapsed` wall-clock time:
+    /// `floor(elapsed * speed / tick)`, saturating.
+    pub fn ticks(&self, elapsed: Duration) -> u64 {
+        let model_ns = elapsed.as_nanos().saturating_mul(self.speed_micros as u128);
+        let t = model_ns / (self.tick_ns as u128 * 1_000_000);
+        u64::try_from(t).unwrap_or(u64::MAX)
     }
 }
 
@@ -200,10 +245,12 @@ struct Run<'c, 'o> {
     points: u64,
     lines: u64,
     probed: Vec<(u64, u64)>,
+    /// A sample or request has been judged.
+    started: bool,
 }
 
 impl Run<'_, '_> {
-    /// Logs and applies one input; returns the request decision if it was one.
+    /// Writes one record to the input log, when recording.
     fn write_record(&mut self, input: &Input) -> Result<(), LiveError> {
         if let Some(rec) = self.opts.record.as_mut() {
             let line = serde_json::to_string(input).map_err(|e| LiveError::Io(e.to_string()))?;
@@ -250,6 +297,7 @@ impl Run<'_, '_> {
             self.write_record(&input)?;
         }
         self.changes.clear();
+        self.started = true;
         let step = |e: monitor_core::StepError| LiveError::Engine(e.to_string());
         let ok = match request {
             None => {
@@ -682,7 +730,9 @@ impl Sidecar {
     }
 
     /// Judges until `stop` is set (or, with signal handling, SIGINT/SIGTERM),
-    /// then flushes every output. `config.heartbeat` adds empty points when idle.
+    /// then flushes every output. `config.heartbeat` adds empty points when idle
+    /// (with `config.from_first_message`, only once a sample or request came);
+    /// `config.speed` makes the clock count model time of a faster (or slower) system.
     pub fn run(
         mut self,
         config: &Config,
@@ -696,13 +746,18 @@ impl Sidecar {
             spec,
             engine,
             opts,
-            clock: Clock::new(spec.tick_ns()),
+            clock: Clock::with_speed(spec.tick_ns(), config.speed),
             changes: Vec::new(),
             verdict_pub: self.verdict_pub.take(),
             points: 0,
             lines: 0,
             probed: Vec::new(),
+            started: false,
         };
+        run.write_record(&Input::Start {
+            unit_ns: spec.tick_ns(),
+            speed: config.speed,
+        })?;
         let mut sets = Vec::new();
         let mut last_cleanup = Instant::now();
         let mut idle_since_flush = false;
@@ -721,7 +776,8 @@ impl Sidecar {
             for px in &mut self.proxies {
                 busy |= run.serve(px, &mut self.taps, &mut sets)?;
             }
-            if config.heartbeat > 0 {
+            // With `from_first_message`, no heartbeat before the system's first message.
+            if config.heartbeat > 0 && (run.started || !config.from_first_message) {
                 let now = run.clock.now();
                 let due = run
                     .engine
@@ -780,5 +836,58 @@ impl Sidecar {
             verdict_lines: run.lines,
             probed: run.probed,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clock_counts_model_time_at_any_speed() {
+        let ms = Duration::from_millis;
+        // Real time, 100 ms ticks: whole ticks, rounded down.
+        let c = Clock::new(100_000_000);
+        assert_eq!(c.ticks(ms(0)), 0);
+        assert_eq!(c.ticks(ms(99)), 0);
+        assert_eq!(c.ticks(ms(100)), 1);
+        assert_eq!(c.ticks(ms(2_550)), 25);
+        // Ten times faster: 10 ms of wall-clock time is one 100 ms tick of model time.
+        let c = Clock::with_speed(100_000_000, 10.0);
+        assert_eq!(c.ticks(ms(9)), 0);
+        assert_eq!(c.ticks(ms(10)), 1);
+        assert_eq!(c.ticks(ms(1_000)), 100);
+        // Slower than real time, exactly at the boundaries (no floating rounding).
+        let c = Clock::with_speed(100_000_000, 0.1);
+        assert_eq!(c.ticks(Duration::from_nanos(999_999_999)), 0);
+        assert_eq!(c.ticks(ms(1_000)), 1);
+        let c = Clock::with_speed(1_000_000, 2.5);
+        assert_eq!(c.ticks(Duration::from_nanos(399_999)), 0);
+        assert_eq!(c.ticks(Duration::from_nanos(400_000)), 1);
+        assert_eq!(c.ticks(ms(4)), 10);
+        // Saturates instead of wrapping.
+        let c = Clock::with_speed(1, SPEED_RANGE.1);
+        assert_eq!(c.ticks(Duration::MAX), u64::MAX);
+    }
+
+    #[test]
+    fn clock_ticks_never_decrease() {
+        let c = Clock::with_speed(100_000_000, 3.7);
+        let mut last = 0;
+        for ns in (0..5_000_000_000u64).step_by(7_777_777) {
+            let t = c.ticks(Duration::from_nanos(ns));
+            assert!(t >= last);
+            last = t;
+        }
+        assert_eq!(last, 184); // floor(4.9933 s * 3.7 / 0.1 s), the last time taken
+    }
+
+    #[test]
+    fn speeds_are_checked() {
+        assert_eq!(check_speed(1.0), Ok(1.0));
+        assert_eq!(check_speed(10.0), Ok(10.0));
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e-7, 1e10] {
+            assert!(check_speed(bad).is_err(), "{bad}");
+        }
     }
 }

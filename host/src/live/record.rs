@@ -3,6 +3,9 @@
 //! Verdict line: `{"property":"battery_recurrence","time":42,"verdict":"currently_false","event":"museum/battery"}`.
 //!
 //! Input log, one record per line, every time in ticks of the spec's unit:
+//! - `{"kind":"start","unit_ns":N,"speed":S}`: the first line the sidecar writes: the
+//!   tick's length in nanoseconds and the system's speed (a log without it is accepted;
+//!   one with another unit than the replaying spec's is rejected);
 //! - `{"kind":"sample","time":T,"source":S,"sets":{VAR:VALUE,..}}`: a tapped sample;
 //! - `{"kind":"request","time":T,"source":S,"sets":{..},"filter":[PROP,..]|null}`: a proxied request;
 //! - `{"kind":"tick","time":T}`: a heartbeat point with no sample;
@@ -23,6 +26,13 @@ use super::engine::{Change, Engine, Verdict};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Input {
+    /// What the log's times mean; the sidecar writes it first.
+    Start {
+        /// Nanoseconds of model time in one tick: the spec's unit.
+        unit_ns: u64,
+        /// How many times faster than real time the system ran (informational).
+        speed: f64,
+    },
     /// A tapped sample.
     Sample {
         /// Quantised time.
@@ -212,8 +222,43 @@ pub fn apply(
                 .map_err(step)?;
         }
         Input::Restart { .. } => {}
+        Input::Start { unit_ns, .. } => {
+            if *unit_ns != spec.tick_ns() {
+                return Err(format!(
+                    "the log's ticks are {} long, the spec's are {}: record and replay with \
+                     the same unit",
+                    duration_text(*unit_ns),
+                    duration_text(spec.tick_ns())
+                ));
+            }
+        }
     }
     Ok(None)
+}
+
+/// Parses an input log: every record with its line number (1-based); blank lines are
+/// skipped. Errors name `file:line:col`.
+pub fn parse_log(text: &str, file: &str) -> Result<Vec<(usize, Input)>, String> {
+    let mut out = Vec::new();
+    for (i, l) in text.lines().enumerate() {
+        if l.trim().is_empty() {
+            continue;
+        }
+        let input: Input =
+            serde_json::from_str(l).map_err(|e| format!("{file}:{}:{}: {e}", i + 1, e.column()))?;
+        out.push((i + 1, input));
+    }
+    Ok(out)
+}
+
+/// `100ms`, `1s`, `250us`, `7ns`.
+fn duration_text(ns: u64) -> String {
+    for (unit, size) in [("s", 1_000_000_000), ("ms", 1_000_000), ("us", 1_000)] {
+        if ns % size == 0 && ns > 0 {
+            return format!("{}{unit}", ns / size);
+        }
+    }
+    format!("{ns}ns")
 }
 
 /// Replays an input log: every verdict line, in order. Errors name `file:line`.
@@ -226,16 +271,72 @@ pub fn replay(
     let mut engine = Engine::new(spec, every_point)?;
     let mut lines = Vec::new();
     let mut out = Vec::new();
-    for (i, l) in text.lines().enumerate() {
-        if l.trim().is_empty() {
-            continue;
-        }
-        let input: Input =
-            serde_json::from_str(l).map_err(|e| format!("{file}:{}:{}: {e}", i + 1, e.column()))?;
+    for (line, input) in parse_log(text, file)? {
         out.clear();
-        apply(spec, &mut engine, &input, &mut out)
-            .map_err(|e| format!("{file}:{}:1: {e}", i + 1))?;
+        apply(spec, &mut engine, &input, &mut out).map_err(|e| format!("{file}:{line}:1: {e}"))?;
         lines.extend(out.iter().map(|c| verdict_line(spec, c)));
     }
     Ok(lines)
+}
+
+/// The records of a run: without the heartbeats before the first sample or request and
+/// after the last one, when the monitor was waiting for the system or outlived it.
+///
+/// A sidecar started before the system, or stopped after it, records heartbeats in
+/// which nothing can arrive; judged, they would make every recurrence fail at both ends.
+/// `hindsight sweep --online` judges a log as one run from its first message to its last,
+/// as the off-line sweep judges a simulated run from its start to its end. A log with no
+/// sample or request is returned whole.
+pub fn run_span(records: &[(usize, Input)]) -> Vec<(usize, Input)> {
+    let message_time = |r: &Input| match r {
+        Input::Sample { time, .. } | Input::Request { time, .. } => Some(*time),
+        _ => None,
+    };
+    let mut times = records.iter().filter_map(|(_, r)| message_time(r));
+    let Some(first) = times.next() else {
+        return records.to_vec();
+    };
+    let last = times.next_back().unwrap_or(first);
+    records
+        .iter()
+        .filter(|(_, r)| !matches!(r, Input::Tick { time } if *time < first || *time > last))
+        .cloned()
+        .collect()
+}
+
+/// Replays parsed log records (from [`parse_log`] on `file`) and returns every
+/// property's verdict after the last one (`None`: no point was judged).
+///
+/// This judges what the log records, against properties that may differ from the ones
+/// it was recorded with (`hindsight sweep --online` replays each log against every bound
+/// of a property): a request is judged as the point it would have been had it passed,
+/// and its `filter` list is not applied (the names are those of the recording's
+/// properties). Every variable a record sets must be a variable of `spec`, or the error
+/// names `file:line`.
+pub fn final_verdicts(
+    spec: &Compiled,
+    records: &[(usize, Input)],
+    file: &str,
+) -> Result<Vec<Option<Verdict>>, String> {
+    let mut engine = Engine::new(spec, false)?;
+    let mut out = Vec::new();
+    for (line, input) in records {
+        out.clear();
+        let as_point;
+        let input = match input {
+            Input::Request {
+                time, source, sets, ..
+            } => {
+                as_point = Input::Sample {
+                    time: *time,
+                    source: source.clone(),
+                    sets: sets.clone(),
+                };
+                &as_point
+            }
+            other => other,
+        };
+        apply(spec, &mut engine, input, &mut out).map_err(|e| format!("{file}:{line}:1: {e}"))?;
+    }
+    Ok(engine.verdicts().to_vec())
 }
