@@ -102,6 +102,19 @@ impl Clock {
         }
     }
 
+    /// Restarts the clock so that now is tick 0 and later instants are rounded to the
+    /// nearest tick instead of truncated: it starts half a tick of wall-clock time ago.
+    /// A system that steps on whole ticks from now on is stamped on whole ticks despite
+    /// up to half a tick of scheduling jitter either way.
+    pub fn anchor_now(&mut self) {
+        let half_tick_wall_ns =
+            (self.tick_ns as u128 * 1_000_000 / (2 * self.speed_micros.max(1) as u128)) as u64;
+        let now = Instant::now();
+        self.start = now
+            .checked_sub(Duration::from_nanos(half_tick_wall_ns))
+            .unwrap_or(now);
+    }
+
     /// Whole ticks elapsed since the start (never decreases).
     pub fn now(&self) -> u64 {
         self.ticks(self.start.elapsed())
@@ -236,6 +249,8 @@ struct Proxy {
 
 /// The running sidecar's state between iterations.
 struct Run<'c, 'o> {
+    /// The clock is still to be anchored at the first message (`from_first_message`).
+    anchor_pending: bool,
     spec: &'c Compiled,
     engine: Engine<'c>,
     opts: &'o mut Options,
@@ -342,8 +357,13 @@ impl Run<'_, '_> {
         let _ = writeln!(self.opts.log, "monitor: {msg}");
     }
 
-    /// A time no earlier than the engine's last point.
-    fn now(&self) -> u64 {
+    /// A time no earlier than the engine's last point. With `from_first_message`, the
+    /// first call (the first message) anchors the clock there ([`Clock::anchor_now`]).
+    fn now(&mut self) -> u64 {
+        if self.anchor_pending {
+            self.anchor_pending = false;
+            self.clock.anchor_now();
+        }
         let t = self.clock.now();
         self.engine.last_time().map_or(t, |l| t.max(l))
     }
@@ -753,11 +773,19 @@ impl Sidecar {
             lines: 0,
             probed: Vec::new(),
             started: false,
+            anchor_pending: config.from_first_message,
         };
         run.write_record(&Input::Start {
             unit_ns: spec.tick_ns(),
             speed: config.speed,
         })?;
+        // Scripts start the monitored system after this line: every tap exists now.
+        run.note(format!(
+            "ready: {} topics tapped, {} services proxied",
+            self.taps.len(),
+            self.proxies.len()
+        ));
+        let _ = run.opts.log.flush();
         let mut sets = Vec::new();
         let mut last_cleanup = Instant::now();
         let mut idle_since_flush = false;
@@ -784,7 +812,8 @@ impl Sidecar {
                     .last_time()
                     .is_none_or(|l| now >= l + config.heartbeat);
                 if due {
-                    run.feed(Input::Tick { time: run.now() })?;
+                    let time = run.now();
+                    run.feed(Input::Tick { time })?;
                 }
             }
             if last_cleanup.elapsed() >= Duration::from_secs(1) {

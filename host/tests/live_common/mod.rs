@@ -257,12 +257,10 @@ pub fn finish_polling(
         if let Some(status) = child.try_wait().unwrap() {
             let mut err = String::new();
             use std::io::Read;
-            child
-                .stderr
-                .take()
-                .unwrap()
-                .read_to_string(&mut err)
-                .unwrap();
+            // A child whose stderr goes to a file has nothing to read here.
+            if let Some(mut e) = child.stderr.take() {
+                e.read_to_string(&mut err).unwrap();
+            }
             return (status, err);
         }
         if t.elapsed() > Duration::from_secs(60) {
