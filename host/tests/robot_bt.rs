@@ -8,7 +8,7 @@ mod common;
 use hindsight::model::source::{FileId, SourceMap};
 use hindsight::model::xml::{self, Element, Node};
 use hindsight::model::{Diagnostics, ModelSource};
-use hindsight::robot::bt::{self, BtInput};
+use hindsight::robot::bt::{self, BtInput, Halts};
 use hindsight::robot::write;
 use hindsight::sim::{CompiledModel, Flow, Observer, RunConfig, SentMessage, Simulator};
 use rand_core::SeedableRng;
@@ -77,6 +77,7 @@ fn lower_case(case: &Case) -> (SourceMap, FileId, Vec<Element>) {
         plugins,
         tick_rate_hz: case.rate,
         tick_if_not_running: case.tick_if_not_running,
+        halts: Halts::As2fm,
     };
     match bt::lower(&sm, &input) {
         Ok(m) => (sm, tree, m),
@@ -810,6 +811,7 @@ fn lower_texts(
             plugins,
             tick_rate_hz: 2.0,
             tick_if_not_running: true,
+            halts: Halts::As2fm,
         },
     )
 }
@@ -921,6 +923,7 @@ fn the_root_machine_ticks_on_a_ros_timer_and_stops_unless_told_otherwise() {
                 plugins: vec![],
                 tick_rate_hz: 10.0,
                 tick_if_not_running: again,
+                halts: Halts::As2fm,
             },
         )
         .unwrap();
@@ -1094,6 +1097,7 @@ fn probabilistic_targets_in_a_plugin_split_the_runs_by_their_shares() {
             plugins: vec![p],
             tick_rate_hz: 1.0,
             tick_if_not_running: false,
+            halts: Halts::As2fm,
         },
     )
     .unwrap();
@@ -1156,6 +1160,7 @@ fn custom_control_plugins_tick_and_hear_their_children() {
                 plugins: vec![p],
                 tick_rate_hz: 1.0,
                 tick_if_not_running: false,
+                halts: Halts::As2fm,
             },
         )
         .unwrap_or_else(|e| panic!("{}", Diagnostics(e)));
@@ -1262,6 +1267,7 @@ fn run_small(body: &str, again: bool, seconds: u64) -> LastValues {
             plugins: vec![p],
             tick_rate_hz: 1.0,
             tick_if_not_running: again,
+            halts: Halts::As2fm,
         },
     )
     .unwrap_or_else(|e| panic!("{}", Diagnostics(e)));

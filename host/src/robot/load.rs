@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::bt::{self, BtInput};
+use super::bt::{self, BtInput, Halts};
 use super::datatypes::read_main_declarations;
 use super::interfaces::Interfaces;
 use super::main_file::{Input, MainFile};
@@ -105,7 +105,14 @@ fn fail(ds: Vec<Diagnostic>) -> Diagnostics {
 
 /// Reads a main file and everything it names, lowers the behavior tree and the ROS tags,
 /// and compiles the plain machines. Every error names the user's file, line and column.
+/// Control nodes halt only the children a halt can change ([`Halts::WhenNeeded`]).
 pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
+    load_with(main_path, Halts::default())
+}
+
+/// [`load`] with the halting rule of the tree's control nodes chosen: [`Halts::As2fm`]
+/// gives AS2FM's machines one for one.
+pub fn load_with(main_path: &Path, halts: Halts) -> Result<RobotModel, Diagnostics> {
     let mut sm = SourceMap::new();
     let main = MainFile::read(&mut sm, main_path).map_err(fail)?;
 
@@ -128,6 +135,7 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
                     plugins,
                     tick_rate_hz: main.params.bt_tick_rate_hz(),
                     tick_if_not_running: main.params.tick_if_not_running(),
+                    halts,
                 };
                 match bt::lower(&sm, &input) {
                     Ok(ms) => machines.extend(ms),
