@@ -1255,8 +1255,31 @@ const FAIL_N: &str = r#"<ascxml name="FailN" initial="s">
 </ascxml>"#;
 
 /// Runs `body` (with the FailN plugin: fails `n` times, then succeeds) for `seconds`
-/// ticks at 1 Hz and returns what was sent.
+/// ticks at 1 Hz and returns what was sent; with either halting rule, which must send
+/// the same messages but halts.
 fn run_small(body: &str, again: bool, seconds: u64) -> LastValues {
+    let a = run_small_with(body, again, seconds, Halts::As2fm);
+    let b = run_small_with(body, again, seconds, Halts::WhenNeeded);
+    let no_halts = |v: &LastValues| -> (BTreeMap<String, i64>, BTreeMap<String, u64>) {
+        let keep = |k: &String| !k.contains("_halt");
+        (
+            v.ints
+                .iter()
+                .filter(|(k, _)| keep(k))
+                .map(|(k, x)| (k.clone(), *x))
+                .collect(),
+            v.counts
+                .iter()
+                .filter(|(k, _)| keep(k))
+                .map(|(k, x)| (k.clone(), *x))
+                .collect(),
+        )
+    };
+    assert_eq!(no_halts(&a), no_halts(&b), "{body}");
+    a
+}
+
+fn run_small_with(body: &str, again: bool, seconds: u64, halts: Halts) -> LastValues {
     let mut sm = SourceMap::new();
     let t = sm.add("small.xml", wrap(body));
     let p = sm.add("fail_n.ascxml", FAIL_N.to_string());
@@ -1267,7 +1290,7 @@ fn run_small(body: &str, again: bool, seconds: u64) -> LastValues {
             plugins: vec![p],
             tick_rate_hz: 1.0,
             tick_if_not_running: again,
-            halts: Halts::As2fm,
+            halts,
         },
     )
     .unwrap_or_else(|e| panic!("{}", Diagnostics(e)));

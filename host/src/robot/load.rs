@@ -105,13 +105,14 @@ fn fail(ds: Vec<Diagnostic>) -> Diagnostics {
 
 /// Reads a main file and everything it names, lowers the behavior tree and the ROS tags,
 /// and compiles the plain machines. Every error names the user's file, line and column.
-/// Control nodes halt only the children a halt can change ([`Halts::WhenNeeded`]).
+/// Control nodes halt their children as AS2FM's translation does ([`Halts::As2fm`]).
 pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
     load_with(main_path, Halts::default())
 }
 
-/// [`load`] with the halting rule of the tree's control nodes chosen: [`Halts::As2fm`]
-/// gives AS2FM's machines one for one.
+/// [`load`] with the halting rule of the tree's control nodes chosen:
+/// [`Halts::WhenNeeded`] runs faster, with the same ROS messages under one schedule but
+/// other verdict probabilities where the model races (see [`Halts`]).
 pub fn load_with(main_path: &Path, halts: Halts) -> Result<RobotModel, Diagnostics> {
     let mut sm = SourceMap::new();
     let main = MainFile::read(&mut sm, main_path).map_err(fail)?;
