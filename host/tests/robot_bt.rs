@@ -65,6 +65,10 @@ fn read_main(main: &Path) -> Case {
 }
 
 fn lower_case(case: &Case) -> (SourceMap, FileId, Vec<Element>) {
+    lower_case_with(case, Halts::As2fm)
+}
+
+fn lower_case_with(case: &Case, halts: Halts) -> (SourceMap, FileId, Vec<Element>) {
     let mut sm = SourceMap::new();
     let tree = sm.add(&case.tree, std::fs::read_to_string(&case.tree).unwrap());
     let plugins = case
@@ -77,7 +81,7 @@ fn lower_case(case: &Case) -> (SourceMap, FileId, Vec<Element>) {
         plugins,
         tick_rate_hz: case.rate,
         tick_if_not_running: case.tick_if_not_running,
-        halts: Halts::As2fm,
+        halts,
     };
     match bt::lower(&sm, &input) {
         Ok(m) => (sm, tree, m),
@@ -327,7 +331,11 @@ fn gcd(a: u64, b: u64) -> u64 {
 
 /// The lowered case with the shim applied: (source map, machines).
 fn shimmed(case: &Case) -> (SourceMap, Vec<Element>) {
-    let (mut sm, _, mut machines) = lower_case(case);
+    shimmed_with(case, Halts::As2fm)
+}
+
+fn shimmed_with(case: &Case, halts: Halts) -> (SourceMap, Vec<Element>) {
+    let (mut sm, _, mut machines) = lower_case_with(case, halts);
     let mut timers = Vec::new();
     for m in &mut machines {
         shim(m, &mut timers);
@@ -598,10 +606,18 @@ fn repeats(v: &LastValues) -> bool {
         && root_is(v, 1)
 }
 
-/// Runs `runs` seeds of the case and returns, per property, how many runs it held in.
+/// Runs `runs` seeds of the case and returns, per property, how many runs it held in;
+/// the same with both halting rules (checked here).
 fn simulate(main: &Path, props: &[(&str, Prop, bool)], runs: u64) -> Vec<u64> {
+    let exact = simulate_with(main, props, runs, Halts::As2fm);
+    let fast = simulate_with(main, props, runs, Halts::WhenNeeded);
+    assert_eq!(exact, fast, "{}: halting rules disagree", main.display());
+    exact
+}
+
+fn simulate_with(main: &Path, props: &[(&str, Prop, bool)], runs: u64, halts: Halts) -> Vec<u64> {
     let case = read_main(main);
-    let (sm, machines) = shimmed(&case);
+    let (sm, machines) = shimmed_with(&case, halts);
     let model = compile(sm, &machines);
     let cfg = RunConfig {
         max_time: 100 * MS_PER_S + 1,
