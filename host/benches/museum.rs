@@ -145,7 +145,7 @@ fn main() {
             Some(Events::As2fm),
             Some(1001),
         ),
-        Case::guide_with("guide (halts when needed, as2fm)", Halts::WhenNeeded),
+        Case::guide_with("guide (halts needed, as2fm)", Halts::WhenNeeded),
     ];
     let runners: Vec<Runner<'_>> = cases
         .iter()
@@ -211,7 +211,7 @@ fn main() {
         sim_rate[0] / sim_rate[3]
     );
     println!(
-        "ratio guide (halts when needed) / plain (queues): {:.2}x runs/s, simulator alone {:.2}x",
+        "ratio guide (halts needed) / plain (queues): {:.2}x runs/s, simulator alone {:.2}x",
         rate[4] / rate[2],
         sim_rate[4] / sim_rate[2]
     );
