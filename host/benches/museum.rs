@@ -11,14 +11,18 @@
 //! interleaved and the median pass is reported, so that load on a shared machine falls
 //! on every configuration alike. The figure to read is the ratio, measured in the same
 //! run: guide runs/s over plain runs/s (>= 1 meets the goal). The `sim only` lines run
-//! the simulator without properties, to show where the time goes.
+//! the simulator without properties, to show where the time goes. The `halts when
+//! needed` line is the guide lowered with `Halts::WhenNeeded` (not the default: it
+//! changes how races at one instant come out, see `hindsight::robot::bt::Halts`).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use hindsight::cli::verify::{load, Events, Loaded, ModelArgs, Runner};
-use hindsight::sim::{RunConfig, Simulator};
+use hindsight::robot::bt::Halts;
+use hindsight::sim::{EventSemantics, RunConfig, Simulator};
 use hindsight::smc::runner::stream;
+use hindsight::verify::observe::PropertySet;
 
 fn examples() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -46,12 +50,38 @@ impl Case {
             Ok(l) => l,
             Err(e) => panic!("{dir}: {e}"),
         };
+        Case::of(name, loaded, max_time)
+    }
+
+    fn of(name: &'static str, loaded: Loaded, max_time: Option<u64>) -> Case {
         let cfg = RunConfig {
             max_time: max_time.unwrap_or_else(|| loaded.default_max_time.unwrap_or(10_000)),
             events: loaded.events,
             ..RunConfig::default()
         };
         Case { name, loaded, cfg }
+    }
+
+    /// The guide lowered with `halts`, AS2FM's event semantics.
+    fn guide_with(name: &'static str, halts: Halts) -> Case {
+        let dir = examples().join("museum-guide");
+        let robot = hindsight::robot::load::load_with(&dir.join("main.xml"), halts)
+            .unwrap_or_else(|e| panic!("museum-guide: {e}"));
+        let props_path = dir.join("properties.xml");
+        let file = hindsight::props::parse_file(&props_path)
+            .unwrap_or_else(|e| panic!("museum-guide properties: {e}"));
+        let set = PropertySet::with_unit(&file, &robot.model, Some(robot.time_unit_ns))
+            .unwrap_or_else(|e| panic!("museum-guide properties: {e}"));
+        let loaded = Loaded {
+            model: robot.model,
+            file,
+            set,
+            props_path,
+            unit_ns: Some(robot.time_unit_ns),
+            default_max_time: Some(robot.max_time_steps),
+            events: EventSemantics::As2fm,
+        };
+        Case::of(name, loaded, None)
     }
 }
 
@@ -115,6 +145,7 @@ fn main() {
             Some(Events::As2fm),
             Some(1001),
         ),
+        Case::guide_with("guide (halts needed, as2fm)", Halts::WhenNeeded),
     ];
     let runners: Vec<Runner<'_>> = cases
         .iter()
@@ -178,5 +209,10 @@ fn main() {
         "ratio guide (as2fm) / plain (as2fm):  {:.2}x runs/s, simulator alone {:.2}x",
         rate[0] / rate[3],
         sim_rate[0] / sim_rate[3]
+    );
+    println!(
+        "ratio guide (halts needed) / plain (queues): {:.2}x runs/s, simulator alone {:.2}x",
+        rate[4] / rate[2],
+        sim_rate[4] / sim_rate[2]
     );
 }

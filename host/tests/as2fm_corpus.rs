@@ -257,6 +257,17 @@ fn high_level_models_match_as2fm_expected_probabilities() {
     });
 }
 
+/// The same with the opt-in halting rule (`Halts::WhenNeeded`): the same cases pass.
+#[test]
+fn high_level_models_with_halts_when_needed_match_as2fm_expected_probabilities() {
+    let skips: Vec<(&str, &'static str)> = SKIPS.iter().chain(HIGH_LEVEL_SKIPS).copied().collect();
+    check_corpus(&skips, |_, main| {
+        hindsight::robot::load::load_with(main, hindsight::robot::bt::Halts::WhenNeeded)
+            .map(|r| r.model)
+            .map_err(|d| d.to_string())
+    });
+}
+
 #[test]
 fn skipped_cases_still_disagree() {
     // A skip must stay justified: the skipped case still misses its expected value.

@@ -8,7 +8,7 @@ mod common;
 use hindsight::model::source::{FileId, SourceMap};
 use hindsight::model::xml::{self, Element, Node};
 use hindsight::model::{Diagnostics, ModelSource};
-use hindsight::robot::bt::{self, BtInput};
+use hindsight::robot::bt::{self, BtInput, Halts};
 use hindsight::robot::write;
 use hindsight::sim::{CompiledModel, Flow, Observer, RunConfig, SentMessage, Simulator};
 use rand_core::SeedableRng;
@@ -65,6 +65,10 @@ fn read_main(main: &Path) -> Case {
 }
 
 fn lower_case(case: &Case) -> (SourceMap, FileId, Vec<Element>) {
+    lower_case_with(case, Halts::As2fm)
+}
+
+fn lower_case_with(case: &Case, halts: Halts) -> (SourceMap, FileId, Vec<Element>) {
     let mut sm = SourceMap::new();
     let tree = sm.add(&case.tree, std::fs::read_to_string(&case.tree).unwrap());
     let plugins = case
@@ -77,6 +81,7 @@ fn lower_case(case: &Case) -> (SourceMap, FileId, Vec<Element>) {
         plugins,
         tick_rate_hz: case.rate,
         tick_if_not_running: case.tick_if_not_running,
+        halts,
     };
     match bt::lower(&sm, &input) {
         Ok(m) => (sm, tree, m),
@@ -326,7 +331,11 @@ fn gcd(a: u64, b: u64) -> u64 {
 
 /// The lowered case with the shim applied: (source map, machines).
 fn shimmed(case: &Case) -> (SourceMap, Vec<Element>) {
-    let (mut sm, _, mut machines) = lower_case(case);
+    shimmed_with(case, Halts::As2fm)
+}
+
+fn shimmed_with(case: &Case, halts: Halts) -> (SourceMap, Vec<Element>) {
+    let (mut sm, _, mut machines) = lower_case_with(case, halts);
     let mut timers = Vec::new();
     for m in &mut machines {
         shim(m, &mut timers);
@@ -597,10 +606,18 @@ fn repeats(v: &LastValues) -> bool {
         && root_is(v, 1)
 }
 
-/// Runs `runs` seeds of the case and returns, per property, how many runs it held in.
+/// Runs `runs` seeds of the case and returns, per property, how many runs it held in;
+/// the same with both halting rules (checked here).
 fn simulate(main: &Path, props: &[(&str, Prop, bool)], runs: u64) -> Vec<u64> {
+    let exact = simulate_with(main, props, runs, Halts::As2fm);
+    let fast = simulate_with(main, props, runs, Halts::WhenNeeded);
+    assert_eq!(exact, fast, "{}: halting rules disagree", main.display());
+    exact
+}
+
+fn simulate_with(main: &Path, props: &[(&str, Prop, bool)], runs: u64, halts: Halts) -> Vec<u64> {
     let case = read_main(main);
-    let (sm, machines) = shimmed(&case);
+    let (sm, machines) = shimmed_with(&case, halts);
     let model = compile(sm, &machines);
     let cfg = RunConfig {
         max_time: 100 * MS_PER_S + 1,
@@ -810,6 +827,7 @@ fn lower_texts(
             plugins,
             tick_rate_hz: 2.0,
             tick_if_not_running: true,
+            halts: Halts::As2fm,
         },
     )
 }
@@ -921,6 +939,7 @@ fn the_root_machine_ticks_on_a_ros_timer_and_stops_unless_told_otherwise() {
                 plugins: vec![],
                 tick_rate_hz: 10.0,
                 tick_if_not_running: again,
+                halts: Halts::As2fm,
             },
         )
         .unwrap();
@@ -1094,6 +1113,7 @@ fn probabilistic_targets_in_a_plugin_split_the_runs_by_their_shares() {
             plugins: vec![p],
             tick_rate_hz: 1.0,
             tick_if_not_running: false,
+            halts: Halts::As2fm,
         },
     )
     .unwrap();
@@ -1156,6 +1176,7 @@ fn custom_control_plugins_tick_and_hear_their_children() {
                 plugins: vec![p],
                 tick_rate_hz: 1.0,
                 tick_if_not_running: false,
+                halts: Halts::As2fm,
             },
         )
         .unwrap_or_else(|e| panic!("{}", Diagnostics(e)));
@@ -1250,8 +1271,31 @@ const FAIL_N: &str = r#"<ascxml name="FailN" initial="s">
 </ascxml>"#;
 
 /// Runs `body` (with the FailN plugin: fails `n` times, then succeeds) for `seconds`
-/// ticks at 1 Hz and returns what was sent.
+/// ticks at 1 Hz and returns what was sent; with either halting rule, which must send
+/// the same messages but halts.
 fn run_small(body: &str, again: bool, seconds: u64) -> LastValues {
+    let a = run_small_with(body, again, seconds, Halts::As2fm);
+    let b = run_small_with(body, again, seconds, Halts::WhenNeeded);
+    let no_halts = |v: &LastValues| -> (BTreeMap<String, i64>, BTreeMap<String, u64>) {
+        let keep = |k: &String| !k.contains("_halt");
+        (
+            v.ints
+                .iter()
+                .filter(|(k, _)| keep(k))
+                .map(|(k, x)| (k.clone(), *x))
+                .collect(),
+            v.counts
+                .iter()
+                .filter(|(k, _)| keep(k))
+                .map(|(k, x)| (k.clone(), *x))
+                .collect(),
+        )
+    };
+    assert_eq!(no_halts(&a), no_halts(&b), "{body}");
+    a
+}
+
+fn run_small_with(body: &str, again: bool, seconds: u64, halts: Halts) -> LastValues {
     let mut sm = SourceMap::new();
     let t = sm.add("small.xml", wrap(body));
     let p = sm.add("fail_n.ascxml", FAIL_N.to_string());
@@ -1262,6 +1306,7 @@ fn run_small(body: &str, again: bool, seconds: u64) -> LastValues {
             plugins: vec![p],
             tick_rate_hz: 1.0,
             tick_if_not_running: again,
+            halts,
         },
     )
     .unwrap_or_else(|e| panic!("{}", Diagnostics(e)));

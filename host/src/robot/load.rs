@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::bt::{self, BtInput};
+use super::bt::{self, BtInput, Halts};
 use super::datatypes::read_main_declarations;
 use super::interfaces::Interfaces;
 use super::main_file::{Input, MainFile};
@@ -120,8 +120,16 @@ pub struct ExternalComponent {
 
 /// Reads a main file and everything it names, lowers the behavior tree and the ROS tags,
 /// and compiles the plain machines. Every error names the user's file, line and column.
+/// Control nodes halt their children as AS2FM's translation does ([`Halts::As2fm`]).
 pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
-    load_without(main_path, &[]).map(|(m, _)| m)
+    load_full(main_path, &[], Halts::default()).map(|(m, _)| m)
+}
+
+/// [`load`] with the halting rule of the tree's control nodes chosen:
+/// [`Halts::WhenNeeded`] runs faster, with the same ROS messages under one schedule but
+/// other verdict probabilities where the model races (see [`Halts`]).
+pub fn load_with(main_path: &Path, halts: Halts) -> Result<RobotModel, Diagnostics> {
+    load_full(main_path, &[], halts).map(|(m, _)| m)
 }
 
 /// What a node model declares that a process replacing it must speak, or an error at the
@@ -247,6 +255,14 @@ pub fn load_without(
     main_path: &Path,
     external: &[String],
 ) -> Result<(RobotModel, Vec<ExternalComponent>), Diagnostics> {
+    load_full(main_path, external, Halts::default())
+}
+
+fn load_full(
+    main_path: &Path,
+    external: &[String],
+    halts: Halts,
+) -> Result<(RobotModel, Vec<ExternalComponent>), Diagnostics> {
     let mut sm = SourceMap::new();
     let main = MainFile::read(&mut sm, main_path).map_err(fail)?;
 
@@ -269,6 +285,7 @@ pub fn load_without(
                     plugins,
                     tick_rate_hz: main.params.bt_tick_rate_hz(),
                     tick_if_not_running: main.params.tick_if_not_running(),
+                    halts,
                 };
                 match bt::lower(&sm, &input) {
                     Ok(ms) => machines.extend(ms),

@@ -143,6 +143,14 @@ pub(crate) fn check_int(ctx: &Ctx, a: &str, b_expr: &str, reads: bool, mismatch:
     let b = &ctx.b;
     let mismatch = status_code(mismatch).unwrap_or(FAILURE);
     let mut m = b.scxml(&ctx.machine, "idle");
+    let flags = ctx.running_data();
+    if !flags.is_empty() {
+        let data: Vec<(&str, &str, String)> = flags
+            .iter()
+            .map(|(v, t, e)| (v.as_str(), *t, e.clone()))
+            .collect();
+        m.push(b.datamodel(&data));
+    }
     let compare = |event: Option<&str>| {
         vec![
             b.tr(
@@ -165,7 +173,10 @@ pub(crate) fn check_int(ctx: &Ctx, a: &str, b_expr: &str, reads: bool, mismatch:
     } else {
         idle.push(b.tr(Some(&ctx.tick_ev()), None, Some("compare"), vec![]));
     }
-    idle.push(b.tr(Some(&ctx.halt_ev()), None, Some("halting_child"), vec![]));
+    for t in ctx.halt_single("halting_child", Vec::new()) {
+        // The idle state here is `idle`, not `wait_for_tick`.
+        idle.push(retarget(t, "wait_for_tick", "idle"));
+    }
     m.push(idle);
     if reads {
         let mut r = b.state("read_blackboard");
@@ -186,12 +197,12 @@ pub(crate) fn check_int(ctx: &Ctx, a: &str, b_expr: &str, reads: bool, mismatch:
             Some(&ctx.child_resp(0)),
             Some(&format!("_event.data.status == {s}")),
             Some("idle"),
-            vec![ctx.respond(s)],
+            ctx.marked(0, s, vec![ctx.respond(s)]),
         ));
     }
     m.push(t);
     m.push(
-        b.state_entry("halting_child", vec![ctx.halt_child(0)])
+        b.state_entry("halting_child", ctx.halt_child_body(0))
             .with_child(b.tr(
                 Some(&ctx.child_halt_resp(0)),
                 None,
@@ -200,4 +211,12 @@ pub(crate) fn check_int(ctx: &Ctx, a: &str, b_expr: &str, reads: bool, mismatch:
             )),
     );
     m
+}
+
+/// `t` with target `from` changed to `to`.
+fn retarget(mut t: Element, from: &str, to: &str) -> Element {
+    if t.attr_value("target") == Some(from) {
+        t.set_attr("target", to);
+    }
+    t
 }

@@ -26,6 +26,22 @@ pub(crate) fn status_code(name: &str) -> Option<u8> {
     }
 }
 
+/// What halting a node in the idle state does, as far as anyone else can tell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum HaltEffect {
+    /// Nothing, in any state: a leaf plugin without `<bt_halt>` (it answers at once and
+    /// stays where it is), AlwaysSuccess, AlwaysFailure, SetBlackboard, and decorators
+    /// without variables over such a child.
+    Never,
+    /// Nothing once it answered SUCCESS or FAILURE (or was halted, or never ticked): a
+    /// built-in control node over children that are `Never` or `WhenRunning`. Its
+    /// variables are then already reset, and its children idle.
+    WhenRunning,
+    /// Possibly something: user code runs (`<bt_halt>` in a plugin, a custom control
+    /// plugin), or the node keeps memory across answers (SequenceWithMemory).
+    Always,
+}
+
 /// Everything a node's machine needs to know about its place in the tree.
 #[derive(Clone, Debug)]
 pub(crate) struct Ctx {
@@ -41,6 +57,9 @@ pub(crate) struct Ctx {
     pub halt_target: String,
     /// The children: id and machine.
     pub children: Vec<(u32, String)>,
+    /// `None`: halt every child as AS2FM does. `Some`: the [`HaltEffect`] of each child;
+    /// a child is halted only if that can change something.
+    pub effects: Option<Vec<HaltEffect>>,
 }
 
 impl Ctx {
@@ -75,6 +94,97 @@ impl Ctx {
         let (id, m) = &self.children[i];
         self.b.send(&format!("bt_{id}_halt"), m)
     }
+    /// What halting child `i` may change: always `Always` when every child is halted.
+    pub fn effect(&self, i: usize) -> HaltEffect {
+        self.effects.as_ref().map_or(HaltEffect::Always, |e| e[i])
+    }
+    /// The variable that says child `i` last answered RUNNING (kept for children whose
+    /// halt matters only while they run).
+    fn running_var(&self, i: usize) -> Option<String> {
+        (self.effect(i) == HaltEffect::WhenRunning).then(|| format!("child_{i}_running"))
+    }
+    /// The datamodel entries of the running flags.
+    pub(crate) fn running_data(&self) -> Vec<(String, &'static str, String)> {
+        (0..self.children.len())
+            .filter_map(|i| self.running_var(i))
+            .map(|v| (v, "bool", "false".to_string()))
+            .collect()
+    }
+    /// Records that child `i` answered `status` (for children whose flag is kept).
+    pub fn mark(&self, i: usize, status: u8) -> Option<Element> {
+        let v = self.running_var(i)?;
+        Some(
+            self.b
+                .assign(&v, if status == RUNNING { "true" } else { "false" }),
+        )
+    }
+    /// Halts child `i`, forgetting that it ran.
+    pub fn halt_child_body(&self, i: usize) -> Vec<Element> {
+        let mut v: Vec<Element> = self
+            .running_var(i)
+            .map(|r| self.b.assign(&r, "false"))
+            .into_iter()
+            .collect();
+        v.push(self.halt_child(i));
+        v
+    }
+    /// The transitions on the node's own halt in the idle state of a one-child node:
+    /// to `halting` (which halts the child and answers), or, when the child needs no
+    /// halt, `also` and the answer at once.
+    pub fn halt_single(&self, halting: &str, also: Vec<Element>) -> Vec<Element> {
+        let b = &self.b;
+        let at_once = |cond: Option<&str>| {
+            let mut body = also.clone();
+            body.push(self.respond_halted());
+            b.tr(Some(&self.halt_ev()), cond, Some("wait_for_tick"), body)
+        };
+        let go = b.tr(Some(&self.halt_ev()), None, Some(halting), vec![]);
+        match self.skip_cond(0) {
+            None => vec![go],
+            Some(c) if c == "true" => vec![at_once(None)],
+            Some(c) => vec![at_once(Some(&c)), go],
+        }
+    }
+    /// `body` followed by the record that child `i` answered `status`.
+    pub(crate) fn marked(&self, i: usize, status: u8, mut body: Vec<Element>) -> Vec<Element> {
+        body.extend(self.mark(i, status));
+        body
+    }
+    /// The condition under which halting child `i` is skipped: `None` never skips it.
+    fn skip_cond(&self, i: usize) -> Option<String> {
+        match self.effect(i) {
+            HaltEffect::Never => Some("true".into()),
+            HaltEffect::WhenRunning => self.running_var(i).map(|v| format!("!{v}")),
+            HaltEffect::Always => None,
+        }
+    }
+    /// In `reset_children`-like states: moves `idx` past the children that need no
+    /// halt (and past `also`, a child index variable that is never halted here); empty
+    /// when every child is halted.
+    fn skip_idle(&self, idx: &str, also: Option<&str>) -> Vec<Element> {
+        if self.effects.is_none() {
+            return Vec::new();
+        }
+        (0..self.children.len())
+            .filter_map(|i| {
+                let skip = match (self.skip_cond(i), also) {
+                    (Some(c), Some(a)) if c != "true" => format!("{idx} == {a} || {c}"),
+                    (Some(c), _) => c,
+                    (None, Some(a)) => format!("{idx} == {a}"),
+                    (None, None) => return None,
+                };
+                let cond = if skip == "true" {
+                    format!("{idx} == {i}")
+                } else {
+                    format!("{idx} == {i} && ({skip})")
+                };
+                Some(
+                    self.b
+                        .if_then(&cond, vec![self.b.assign(idx, &format!("{idx} + 1"))]),
+                )
+            })
+            .collect()
+    }
     /// `bt_<child>_response` of child `i`.
     pub fn child_resp(&self, i: usize) -> String {
         format!("bt_{}_response", self.children[i].0)
@@ -87,12 +197,12 @@ impl Ctx {
     fn dispatch(&self, var: &str, halt: bool) -> Element {
         let branches = (0..self.children.len())
             .map(|i| {
-                let s = if halt {
-                    self.halt_child(i)
+                let body = if halt {
+                    self.halt_child_body(i)
                 } else {
-                    self.tick_child(i)
+                    vec![self.tick_child(i)]
                 };
-                (format!("{var} == {i}"), vec![s])
+                (format!("{var} == {i}"), body)
             })
             .collect();
         self.b
@@ -140,7 +250,7 @@ fn on_child_status(
             Some(&ctx.child_resp(i)),
             Some(&format!("_event.data.status == {status} && {idx} == {i}")),
             Some(target),
-            body(),
+            ctx.marked(i, status, body()),
         ));
     }
 }
@@ -154,6 +264,8 @@ fn sequence_head(ctx: &Ctx, idx: &str, flags: &[&str]) -> Element {
     let mut data = vec![(idx, "int8", "0".to_string())];
     data.extend(flags.iter().map(|f| (*f, "bool", "false".to_string())));
     data.push(("children_count", "int8", n_children(ctx)));
+    let flags = ctx.running_data();
+    data.extend(flags.iter().map(|(v, t, e)| (v.as_str(), *t, e.clone())));
     m.push(b.datamodel(&data));
     m.push(init_state(ctx, "children_count < 1"));
     m.push(
@@ -181,7 +293,9 @@ fn reset_children(ctx: &Ctx, idx: &str, finish: Vec<Element>) -> Element {
         &format!("{idx} < children_count"),
         vec![ctx.dispatch(idx, true)],
     );
-    let mut s = b.state_entry("reset_children", vec![guard]);
+    let mut entry = ctx.skip_idle(idx, None);
+    entry.push(guard);
+    let mut s = b.state_entry("reset_children", entry);
     for i in 0..ctx.children.len() {
         s.push(b.tr(
             Some(&ctx.child_halt_resp(i)),
@@ -290,7 +404,20 @@ fn sequence_with_memory(ctx: &Ctx) -> Element {
     on_child_status(ctx, &mut t, idx, SUCCESS, "tick_children", || {
         vec![b.assign(idx, &format!("{idx} + 1"))]
     });
-    on_child_status(ctx, &mut t, idx, FAILURE, "halt_current_child", Vec::new);
+    // A failing child is idle: it needs a halt only if halting does more than that.
+    for i in 0..n {
+        let (target, body) = if ctx.effect(i) == HaltEffect::Always {
+            ("halt_current_child", vec![])
+        } else {
+            ("wait_for_tick", vec![ctx.respond(FAILURE)])
+        };
+        t.push(b.tr(
+            Some(&ctx.child_resp(i)),
+            Some(&format!("_event.data.status == {FAILURE} && {idx} == {i}")),
+            Some(target),
+            ctx.marked(i, FAILURE, body),
+        ));
+    }
     on_child_status(ctx, &mut t, idx, RUNNING, "wait_for_tick", || {
         vec![ctx.respond(RUNNING)]
     });
@@ -333,13 +460,16 @@ fn reactive(ctx: &Ctx, seq: bool) -> Element {
     };
     let idx = "child_idx";
     let mut m = b.scxml(&ctx.machine, "init");
-    m.push(b.datamodel(&[
-        (count, "int8", "0".into()),
+    let flags = ctx.running_data();
+    let mut data = vec![
+        (count, "int8", "0".to_string()),
         ("running_child", "int8", "-1".into()),
         (stop_child, "int8", "-1".into()),
         (idx, "int8", "0".into()),
         ("children_count", "int8", n_children(ctx)),
-    ]));
+    ];
+    data.extend(flags.iter().map(|(v, t, e)| (v.as_str(), *t, e.clone())));
+    m.push(b.datamodel(&data));
     m.push(init_state(ctx, "children_count < 1"));
     m.push(
         b.state("wait_for_tick")
@@ -418,7 +548,13 @@ fn reactive(ctx: &Ctx, seq: bool) -> Element {
         &format!("{idx} < children_count"),
         vec![ctx.dispatch(idx, true)],
     );
-    let mut r = b.state_entry("reset_other_children", vec![skip, guard]);
+    let mut entry = if ctx.effects.is_some() {
+        ctx.skip_idle(idx, Some("running_child"))
+    } else {
+        vec![skip]
+    };
+    entry.push(guard);
+    let mut r = b.state_entry("reset_other_children", entry);
     for i in 0..n {
         r.push(b.tr(
             Some(&ctx.child_halt_resp(i)),
@@ -444,15 +580,23 @@ fn parallel(ctx: &Ctx, success: i64, failure: i64) -> Element {
     let b = &ctx.b;
     let idx = "current_child_idx";
     let n = ctx.children.len();
+    let flags = ctx.running_data();
     let mut m = b.scxml(&ctx.machine, "init");
-    m.push(b.datamodel(&[
-        ("children_count", "uint8", n_children(ctx)),
-        ("success_threshold", "uint8", success.to_string()),
-        ("failure_threshold", "uint8", failure.to_string()),
-        (idx, "uint8", "0".into()),
-        ("success_count", "uint8", "0".into()),
-        ("failure_count", "uint8", "0".into()),
-    ]));
+    m.push(
+        b.datamodel(
+            &[
+                ("children_count", "uint8", n_children(ctx)),
+                ("success_threshold", "uint8", success.to_string()),
+                ("failure_threshold", "uint8", failure.to_string()),
+                (idx, "uint8", "0".into()),
+                ("success_count", "uint8", "0".into()),
+                ("failure_count", "uint8", "0".into()),
+            ]
+            .into_iter()
+            .chain(flags.iter().map(|(v, t, e)| (v.as_str(), *t, e.clone())))
+            .collect::<Vec<_>>(),
+        ),
+    );
     m.push(
         b.state("init")
             .with_child(b.tr(None, Some("children_count <= 0"), Some("error"), vec![]))
@@ -517,7 +661,7 @@ fn parallel(ctx: &Ctx, success: i64, failure: i64) -> Element {
                 Some(&ctx.child_resp(i)),
                 Some(&format!("_event.data.status == {status} && {idx} == {i}")),
                 Some("eval_after_child"),
-                body,
+                ctx.marked(i, status, body),
             ));
         }
     }
@@ -548,7 +692,9 @@ fn parallel(ctx: &Ctx, success: i64, failure: i64) -> Element {
         ("halting_after_failure", ctx.respond(FAILURE)),
         ("halting_on_parent_halt", ctx.respond_halted()),
     ] {
-        let mut h = b.state_entry(state, vec![ctx.dispatch(idx, true)]);
+        let mut entry = ctx.skip_idle(idx, None);
+        entry.push(ctx.dispatch(idx, true));
+        let mut h = b.state_entry(state, entry);
         h.push(b.tr(
             None,
             Some(&format!("{idx} >= children_count")),
@@ -576,12 +722,15 @@ fn if_then_else(ctx: &Ctx) -> Element {
     let b = &ctx.b;
     let idx = "child_idx";
     let mut m = b.scxml(&ctx.machine, "init");
-    m.push(b.datamodel(&[
-        (idx, "int8", "0".into()),
+    let flags = ctx.running_data();
+    let mut data = vec![
+        (idx, "int8", "0".to_string()),
         ("ret_failure", "bool", "false".into()),
         ("ret_success", "bool", "false".into()),
         ("children_count", "int8", n_children(ctx)),
-    ]));
+    ];
+    data.extend(flags.iter().map(|(v, t, e)| (v.as_str(), *t, e.clone())));
+    m.push(b.datamodel(&data));
     m.push(init_state(ctx, "children_count < 2 || children_count > 3"));
     m.push(
         b.state("wait_for_tick")
@@ -626,7 +775,7 @@ fn if_then_else(ctx: &Ctx) -> Element {
                 Some(&cond_resp),
                 Some(&format!("_event.data.status == {SUCCESS}")),
                 Some("tick_exec_child"),
-                vec![b.assign(idx, "1")],
+                ctx.marked(0, SUCCESS, vec![b.assign(idx, "1")]),
             ))
             .with_child(b.tr(
                 Some(&cond_resp),
@@ -634,7 +783,7 @@ fn if_then_else(ctx: &Ctx) -> Element {
                     "_event.data.status == {FAILURE} && children_count == 3"
                 )),
                 Some("tick_exec_child"),
-                vec![b.assign(idx, "2")],
+                ctx.marked(0, FAILURE, vec![b.assign(idx, "2")]),
             ))
             .with_child(b.tr(
                 Some(&cond_resp),
@@ -642,13 +791,13 @@ fn if_then_else(ctx: &Ctx) -> Element {
                     "_event.data.status == {FAILURE} && children_count < 3"
                 )),
                 Some("wait_for_tick"),
-                vec![ctx.respond(FAILURE)],
+                ctx.marked(0, FAILURE, vec![ctx.respond(FAILURE)]),
             ))
             .with_child(b.tr(
                 Some(&cond_resp),
                 Some(&format!("_event.data.status == {RUNNING}")),
                 Some("wait_for_tick"),
-                vec![ctx.respond(RUNNING)],
+                ctx.marked(0, RUNNING, vec![ctx.respond(RUNNING)]),
             )),
     );
     let mut t = b.state_entry("tick_exec_child", vec![ctx.dispatch(idx, false)]);
@@ -681,15 +830,26 @@ fn if_then_else(ctx: &Ctx) -> Element {
 fn decorator(ctx: &Ctx, map: [u8; 3]) -> Element {
     let b = &ctx.b;
     let mut m = b.scxml(&ctx.machine, "init");
-    m.push(b.datamodel(&[("children_count", "int8", n_children(ctx))]));
+    let mut data = vec![("children_count".to_string(), "int8", n_children(ctx))];
+    data.extend(ctx.running_data());
+    let data: Vec<(&str, &str, String)> = data
+        .iter()
+        .map(|(v, t, e)| (v.as_str(), *t, e.clone()))
+        .collect();
+    m.push(b.datamodel(&data));
     m.push(init_state(ctx, "children_count != 1"));
+    let mut w = b.state("wait_for_tick").with_child(b.tr(
+        Some(&ctx.tick_ev()),
+        None,
+        Some("tick_child"),
+        vec![],
+    ));
+    for t in ctx.halt_single("halting_child", Vec::new()) {
+        w.push(t);
+    }
+    m.push(w);
     m.push(
-        b.state("wait_for_tick")
-            .with_child(b.tr(Some(&ctx.tick_ev()), None, Some("tick_child"), vec![]))
-            .with_child(b.tr(Some(&ctx.halt_ev()), None, Some("halting_child"), vec![])),
-    );
-    m.push(
-        b.state_entry("halting_child", vec![ctx.halt_child(0)])
+        b.state_entry("halting_child", ctx.halt_child_body(0))
             .with_child(b.tr(
                 Some(&ctx.child_halt_resp(0)),
                 None,
@@ -703,7 +863,7 @@ fn decorator(ctx: &Ctx, map: [u8; 3]) -> Element {
             Some(&ctx.child_resp(0)),
             Some(&format!("_event.data.status == {from}")),
             Some("wait_for_tick"),
-            vec![ctx.respond(to)],
+            ctx.marked(0, from, vec![ctx.respond(to)]),
         ));
     }
     m.push(t);
@@ -728,29 +888,33 @@ fn repeat(ctx: &Ctx, n: i64, retry: bool) -> Element {
     };
     let more = format!("{limit} == -1 || {count} < {limit}");
     let mut m = b.scxml(&ctx.machine, "init");
-    m.push(b.datamodel(&[
+    let flags = ctx.running_data();
+    let mut data = vec![
         ("children_count", "int8", n_children(ctx)),
         (count, "int8", "0".into()),
         (limit, "int8", n.to_string()),
-    ]));
+    ];
+    data.extend(flags.iter().map(|(v, t, e)| (v.as_str(), *t, e.clone())));
+    m.push(b.datamodel(&data));
     m.push(init_state(ctx, "children_count != 1"));
-    m.push(
-        b.state("wait_for_tick")
-            .with_child(b.tr(Some(&ctx.tick_ev()), None, Some("start_tick"), vec![]))
-            .with_child(b.tr(Some(&ctx.halt_ev()), None, Some("halting_child"), vec![])),
-    );
-    m.push(
-        b.state_entry(
-            "halting_child",
-            vec![ctx.halt_child(0), b.assign(count, "0")],
-        )
-        .with_child(b.tr(
-            Some(&ctx.child_halt_resp(0)),
-            None,
-            Some("wait_for_tick"),
-            vec![ctx.respond_halted()],
-        )),
-    );
+    let mut w = b.state("wait_for_tick").with_child(b.tr(
+        Some(&ctx.tick_ev()),
+        None,
+        Some("start_tick"),
+        vec![],
+    ));
+    for t in ctx.halt_single("halting_child", vec![b.assign(count, "0")]) {
+        w.push(t);
+    }
+    m.push(w);
+    let mut halting = ctx.halt_child_body(0);
+    halting.push(b.assign(count, "0"));
+    m.push(b.state_entry("halting_child", halting).with_child(b.tr(
+        Some(&ctx.child_halt_resp(0)),
+        None,
+        Some("wait_for_tick"),
+        vec![ctx.respond_halted()],
+    )));
     // Out of cycles: Repeat succeeded, Retry failed.
     m.push(
         b.state("start_tick")
@@ -788,25 +952,42 @@ fn repeat(ctx: &Ctx, n: i64, retry: bool) -> Element {
         Some("wait_for_tick"),
         vec![ctx.respond(stop)],
     )));
+    // A child that finished an attempt is idle: halted only if that does more.
+    let halts = ctx.effect(0) == HaltEffect::Always;
+    let (again_to, again_body, stop_to, stop_body) = if halts {
+        (
+            "handle_tick_loop",
+            vec![b.assign(count, &format!("{count} + 1")), ctx.halt_child(0)],
+            stop_state,
+            vec![b.assign(count, "0"), ctx.halt_child(0)],
+        )
+    } else {
+        (
+            "start_tick",
+            vec![b.assign(count, &format!("{count} + 1"))],
+            "wait_for_tick",
+            vec![b.assign(count, "0"), ctx.respond(stop)],
+        )
+    };
     m.push(
         b.state_entry("tick_child", vec![ctx.tick_child(0)])
             .with_child(b.tr(
                 Some(&ctx.child_resp(0)),
                 Some(&format!("_event.data.status == {again}")),
-                Some("handle_tick_loop"),
-                vec![b.assign(count, &format!("{count} + 1")), ctx.halt_child(0)],
+                Some(again_to),
+                ctx.marked(0, again, again_body),
             ))
             .with_child(b.tr(
                 Some(&ctx.child_resp(0)),
                 Some(&format!("_event.data.status == {stop}")),
-                Some(stop_state),
-                vec![b.assign(count, "0"), ctx.halt_child(0)],
+                Some(stop_to),
+                ctx.marked(0, stop, stop_body),
             ))
             .with_child(b.tr(
                 Some(&ctx.child_resp(0)),
                 Some(&format!("_event.data.status == {RUNNING}")),
                 Some("wait_for_tick"),
-                vec![ctx.respond(RUNNING)],
+                ctx.marked(0, RUNNING, vec![ctx.respond(RUNNING)]),
             )),
     );
     m.push(b.state("error"));
