@@ -10,24 +10,10 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use iceoryx2::prelude::*;
-use live_common::{finish, finish_polling, node, unique, Guard};
+use live_common::{example, finish, finish_polling, node, unique, Guard};
 
 fn museum() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-guide")
-}
-
-/// `target/<profile>/examples/<name>`, built by `cargo test` with the tests.
-fn example(name: &str) -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().unwrap().parent().unwrap();
-    let path = dir.join("examples").join(name);
-    assert!(
-        path.exists(),
-        "{} is missing: `cargo test` builds examples, `cargo test --test X` does not \
-         (cargo build -p hindsight --example {name})",
-        path.display()
-    );
-    path
 }
 
 /// Plays BatteryComponent (a low level every `period`) and NotifyUserComponent (answers

@@ -9,7 +9,7 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use iceoryx2::prelude::*;
-use live_common::{finish, scratch, unique, Guard};
+use live_common::{example, finish, scratch, unique, Guard};
 
 /// Model time per wall-clock time: a model step of 100 ms takes 20 ms, so the sidecar's
 /// rounding to the nearest tick absorbs 10 ms of scheduling jitter either way.
@@ -32,24 +32,6 @@ fn museum() -> PathBuf {
 
 fn hindsight() -> Command {
     Command::new(env!("CARGO_BIN_EXE_hindsight"))
-}
-
-/// `target/<profile>/examples/<name>`, built by `cargo test` with the tests.
-fn example(name: &str) -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let path = exe
-        .parent()
-        .unwrap()
-        .parent()
-        .unwrap()
-        .join("examples")
-        .join(name);
-    assert!(
-        path.exists(),
-        "{} is missing: `cargo test` builds examples, `cargo test --test X` does not",
-        path.display()
-    );
-    path
 }
 
 /// What one live session produced.

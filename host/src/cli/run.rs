@@ -43,8 +43,9 @@ pub struct RunArgs {
     #[arg(long)]
     pub layout: bool,
     /// A node model (its `<scxml name>`) that a real process plays instead: it is left out
-    /// of the run, and what the process publishes on the node's topics is posted into the
-    /// model (repeat for several). Only nodes whose ROS interfaces are topics.
+    /// of the run, what the process publishes on the node's topics is posted into the
+    /// model, and the requests of services the node served go to the process (repeat for
+    /// several). Nodes that call services or take part in actions cannot be replaced yet.
     #[arg(long, value_name = "NAME")]
     pub external: Vec<String>,
 }
@@ -71,8 +72,11 @@ Replacing a component by a process (--external NAME):
   The node model NAME is left out; its timers stop with it. Every topic it
   published is read from PREFIX/<topic> in the same layout (fields, then seq) and
   posted into the model at the next model time unit; the topics it subscribed to
-  are published as usual. Malformed samples are counted, never posted. Example (a
-  battery written in Rust that publishes every 1.2 s):
+  are published as usual. A service it served is the iceoryx2 request-response
+  service PREFIX/<service>: the model's requests go there in the request's layout,
+  and the process's answer (the response's layout, fields then seq) is posted as the
+  server's response. Malformed samples and answers are counted, never posted. Example
+  (a battery written in Rust that publishes every 1.2 s):
   hindsight run examples/museum-guide --external BatteryComponent --speed 5 &
   cargo run -p hindsight --example battery_component -- --period 1.2s --speed 5
 

@@ -57,12 +57,7 @@ impl TopicSubscriber {
         let mut topics = Vec::new();
         for l in layouts {
             let svc = l.service(prefix);
-            let name = super::service_name(&svc).map_err(|e| e.to_string())?;
-            let factory = node
-                .service_builder(&name)
-                .publish_subscribe::<[u8]>()
-                .open_or_create()
-                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
+            let factory = super::open_raw_topic(node, &svc)?;
             let sub = factory
                 .subscriber_builder()
                 .create()

@@ -221,6 +221,20 @@ pub fn service_name(s: &str) -> Result<ServiceName, LiveError> {
     ServiceName::new(s).map_err(|e| LiveError::Ipc(format!("service name `{s}`: {e:?}")))
 }
 
+/// Opens the `[u8]` publish-subscribe service `svc` on `node`, or creates it with
+/// iceoryx2's defaults: what `hindsight run` and the processes beside it agree on.
+pub(crate) fn open_raw_topic(
+    node: &Node<Ipc>,
+    svc: &str,
+) -> Result<iceoryx2::service::port_factory::publish_subscribe::PortFactory<Ipc, [u8], ()>, String>
+{
+    let name = service_name(svc).map_err(|e| e.to_string())?;
+    node.service_builder(&name)
+        .publish_subscribe::<[u8]>()
+        .open_or_create()
+        .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))
+}
+
 struct Tap {
     source: String,
     layout: Layout,

@@ -120,7 +120,8 @@ pub trait Observer {
     /// (a component replaced by a real process). The simulator posts what it can as if
     /// a machine had sent it (an [`Observer::on_send`] point with [`SentMessage::origin`]
     /// [`EXTERNAL`]) and leaves in `inbox` what cannot be posted yet (its event is still
-    /// pending under [`super::EventSemantics::As2fm`]), to try again at the next unit.
+    /// pending under [`super::EventSemantics::As2fm`]), to try again as soon as the model
+    /// is idle at this instant. Only runs under [`super::EventSemantics::As2fm`] call it.
     fn inputs(&mut self, time: u64, inbox: &mut Inbox) {
         let _ = (time, inbox);
     }

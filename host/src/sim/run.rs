@@ -785,6 +785,18 @@ impl<'m> Simulator<'m> {
                 }
             }
             if self.runnable.is_empty() && self.deliverable.is_empty() {
+                // Messages from outside that waited for their event's previous message go
+                // in at this instant, before time moves: the model takes them as fast as
+                // it can, and a fast process is never left further and further behind.
+                if self.as2fm && !self.inbox.is_empty() {
+                    let before = self.inbox.len();
+                    if self.post_inputs(obs) == Flow::Stop {
+                        return Ok(EndReason::Stopped);
+                    }
+                    if self.inbox.len() < before {
+                        continue;
+                    }
+                }
                 if self.delayed.is_empty() && cfg.quiescence == Quiescence::Stop {
                     return Ok(EndReason::Quiescent);
                 }
@@ -1484,7 +1496,8 @@ impl<'m> Simulator<'m> {
     }
 
     /// Posts the messages of [`Self::inbox`] whose events are not pending, oldest first,
-    /// as [`Self::as2fm_send`] does for a machine's send; the rest wait for the next unit.
+    /// as [`Self::as2fm_send`] does for a machine's send; the rest wait until the model is
+    /// idle again at this instant, or for the next unit.
     fn post_inputs<O: Observer + ?Sized>(&mut self, obs: &mut O) -> Flow {
         let model = self.model;
         let mut flow = Flow::Continue;

@@ -270,3 +270,17 @@ pub fn finish_polling(
         std::thread::sleep(Duration::from_millis(5));
     }
 }
+
+/// `target/<profile>/examples/<name>`, built by `cargo test` with the tests.
+pub fn example(name: &str) -> std::path::PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let dir = exe.parent().unwrap().parent().unwrap();
+    let path = dir.join("examples").join(name);
+    assert!(
+        path.exists(),
+        "{} is missing: `cargo test` builds examples, `cargo test --test X` does not \
+         (cargo build -p hindsight --example {name})",
+        path.display()
+    );
+    path
+}
