@@ -249,3 +249,125 @@ fn the_hand_written_battery_replaces_its_model() {
         .unwrap_or_else(|| panic!("no inbound report:\n{err}"));
     assert!(posted >= 4, "{posted} posted:\n{err}");
 }
+
+const ADDER_MAIN: &str = r#"<roaml>
+  <parameters><max_time value="30" unit="s"/></parameters>
+  <node_models>
+    <input type="ros-scxml" src="./adder.scxml"/>
+    <input type="ros-scxml" src="./asker.scxml"/>
+  </node_models>
+  <properties><input type="xml" src="./props.xml"/></properties>
+</roaml>
+"#;
+
+const ADDER: &str = r#"<scxml name="Adder" initial="idle" version="1.0" xmlns="http://www.w3.org/2005/07/scxml">
+  <ros_service_server service_name="/adder/add" type="example_interfaces/AddTwoInts"/>
+  <state id="idle">
+    <ros_service_handle_request name="/adder/add" target="idle">
+      <ros_service_send_response name="/adder/add">
+        <field name="sum" expr="_req.a + _req.b"/>
+      </ros_service_send_response>
+    </ros_service_handle_request>
+  </state>
+</scxml>
+"#;
+
+const ASKER: &str = r#"<scxml name="Asker" initial="ask" version="1.0" xmlns="http://www.w3.org/2005/07/scxml">
+  <ros_service_client service_name="/adder/add" type="example_interfaces/AddTwoInts"/>
+  <ros_time_rate name="t" rate_hz="1"/>
+  <state id="ask">
+    <ros_rate_callback name="t" target="wait">
+      <ros_service_send_request name="/adder/add">
+        <field name="a" expr="1"/>
+        <field name="b" expr="2"/>
+      </ros_service_send_request>
+    </ros_rate_callback>
+  </state>
+  <state id="wait">
+    <ros_service_handle_response name="/adder/add" target="ask"/>
+  </state>
+</scxml>
+"#;
+
+const ADDER_PROPS: &str = r#"<properties>
+  <ports>
+    <ros_service service_name="/adder/add" type="example_interfaces/AddTwoInts" event="response">
+      <state_var id="sum" type="int64" field="sum" expr="0"/>
+    </ros_service>
+  </ports>
+  <guarantees>
+    <property id="small_sums" logic="pmtl" expr="historically({sum &lt; 100})"/>
+  </guarantees>
+</properties>
+"#;
+
+#[test]
+fn a_process_calls_a_service_the_model_serves() {
+    let dir = live_common::scratch("adder");
+    for (name, text) in [
+        ("main.xml", ADDER_MAIN),
+        ("adder.scxml", ADDER),
+        ("asker.scxml", ASKER),
+        ("props.xml", ADDER_PROPS),
+    ] {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let prefix = unique("external-client");
+    let node = node();
+    let name = ServiceName::new(&format!("{prefix}/adder/add")).unwrap();
+    let client = node
+        .service_builder(&name)
+        .request_response::<[u8], [u8]>()
+        .open_or_create()
+        .unwrap()
+        .client_builder()
+        .initial_max_slice_len(24)
+        .create()
+        .unwrap();
+    let mut run = Guard(Some(
+        Command::new(env!("CARGO_BIN_EXE_hindsight"))
+            .arg("run")
+            .arg(&dir)
+            .args(["--prefix", &prefix, "--external", "Asker"])
+            .args(["--speed", "10", "--duration", "20s"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    ));
+    // AddTwoInts request: a i64, b i64, seq u64; response: sum i64, seq u64.
+    let mut sums = Vec::new();
+    let mut asked = 0i64;
+    let mut pending = None;
+    let (status, err) = live_common::finish_polling(&mut run, || {
+        if pending.is_none() && asked < 3 {
+            let mut p = [0u8; 24];
+            p[0..8].copy_from_slice(&(asked * 100).to_le_bytes());
+            p[8..16].copy_from_slice(&7i64.to_le_bytes());
+            p[16..24].copy_from_slice(&(asked as u64).to_le_bytes());
+            let r = client.loan_slice_uninit(24).unwrap();
+            let sent = r.write_from_slice(&p).send().unwrap();
+            if sent.number_of_server_connections() > 0 {
+                pending = Some(sent);
+                asked += 1;
+            }
+        }
+        if let Some(p) = &pending {
+            if let Some(resp) = p.receive().unwrap() {
+                let b = resp.payload();
+                assert_eq!(b.len(), 16, "sum + seq");
+                sums.push(i64::from_le_bytes(b[0..8].try_into().unwrap()));
+                drop(resp);
+                pending = None;
+            }
+        }
+    });
+    assert!(status.success(), "{err}");
+    assert_eq!(sums, vec![7, 107, 207], "{err}");
+    assert!(
+        err.contains(&format!(
+            "run: serving {prefix}/adder/add: 3 requests from processes, 3 answered"
+        )),
+        "{err}"
+    );
+}

@@ -136,20 +136,30 @@ fn two_messages_at_one_instant_are_both_posted_in_order() {
 }
 
 #[test]
-fn an_unknown_component_or_a_service_client_is_refused() {
+fn an_unknown_component_or_an_action_participant_is_refused() {
     let e = match load_without(&museum(), &["NoSuchNode".to_string()]) {
         Err(e) => e.to_string(),
         Ok(_) => panic!("an unknown name loads"),
     };
     assert!(e.contains("no node model is called `NoSuchNode`"), "{e}");
     assert!(e.contains("BatteryComponent"), "lists the node models: {e}");
-    let e = match load_without(&museum(), &["AlarmSkill".to_string()]) {
+    let e = match load_without(&museum(), &["NavigationComponent".to_string()]) {
         Err(e) => e.to_string(),
-        Ok(_) => panic!("a service client is replaced"),
+        Ok(_) => panic!("an action server is replaced"),
     };
     assert!(
-        e.contains("AlarmSkill.scxml:") && e.contains("<ros_service_client>"),
+        e.contains("NavigationComponent.scxml:") && e.contains("<ros_action_server>"),
         "{e}"
+    );
+    // A service client can be: the process calls the model's server.
+    let (_, ext) =
+        load_without(&museum(), &["AlarmSkill".to_string()]).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        ext[0].calls,
+        vec![(
+            "/NotifyUserComponent/StartAlarm".to_string(),
+            "notify_user_interfaces_dummy/StartAlarm".to_string()
+        )]
     );
     // A service server can be: its requests go to the process.
     let (_, ext) = load_without(&museum(), &["NotifyUserComponent".to_string()])

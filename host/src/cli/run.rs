@@ -9,9 +9,11 @@ type Ipc = ipc::Service;
 
 use super::verify::{load_without, ModelArgs};
 use super::CliError;
-use crate::live::inject::{ServiceBridge, TopicSubscriber};
-use crate::live::publish::{layout_toml, layouts, name_from_ports, TopicLayout, TopicPublisher};
-use crate::props::ros::{service_event, topic_event};
+use crate::live::inject::{ServiceBridge, ServiceServers, TopicSubscriber};
+use crate::live::publish::{
+    layout_of, layout_toml, layouts, name_from_ports, TopicLayout, TopicPublisher, WireKind,
+};
+use crate::props::ros::{service_client_event, service_event, topic_event};
 use crate::sim::{
     EndReason, EventSemantics, Flow, Inbox, Observer, Quiescence, RunConfig, SentMessage, Simulator,
 };
@@ -44,8 +46,9 @@ pub struct RunArgs {
     pub layout: bool,
     /// A node model (its `<scxml name>`) that a real process plays instead: it is left out
     /// of the run, what the process publishes on the node's topics is posted into the
-    /// model, and the requests of services the node served go to the process (repeat for
-    /// several). Nodes that call services or take part in actions cannot be replaced yet.
+    /// model, the requests of services the node served go to the process, and the process
+    /// may call the services the node called (repeat for several). Nodes that take part
+    /// in actions cannot be replaced yet.
     #[arg(long, value_name = "NAME")]
     pub external: Vec<String>,
 }
@@ -75,7 +78,10 @@ Replacing a component by a process (--external NAME):
   are published as usual. A service it served is the iceoryx2 request-response
   service PREFIX/<service>: the model's requests go there in the request's layout,
   and the process's answer (the response's layout, fields then seq) is posted as the
-  server's response. Malformed samples and answers are counted, never posted. Example
+  server's response. A service it called is served by the run under the same name:
+  a process's request (the request's layout) goes to the model's server, and the
+  model's answer comes back. Malformed samples and answers are counted, never posted.
+  Nodes with actions cannot be replaced yet. Example
   (a battery written in Rust that publishes every 1.2 s):
   hindsight run examples/museum-guide --external BatteryComponent --speed 5 &
   cargo run -p hindsight --example battery_component -- --period 1.2s --speed 5
@@ -97,6 +103,7 @@ struct Live<'n> {
     publisher: TopicPublisher,
     inbound: TopicSubscriber,
     services: ServiceBridge,
+    servers: ServiceServers,
     inbound_error: Option<String>,
     start: Instant,
     /// Wall-clock nanoseconds per model time unit.
@@ -135,7 +142,11 @@ impl Live<'_> {
 impl Observer for Live<'_> {
     fn on_send(&mut self, time: u64, msg: &SentMessage<'_>) -> Flow {
         self.publisher.publish(msg);
-        if let Err(e) = self.services.forward(msg) {
+        if let Err(e) = self
+            .services
+            .forward(msg)
+            .and_then(|()| self.servers.answer(msg))
+        {
             self.inbound_error.get_or_insert(e);
         }
         let _ = time;
@@ -165,6 +176,7 @@ impl Observer for Live<'_> {
             self.inbound_error.get_or_insert(e);
         }
         self.services.poll(inbox);
+        self.servers.poll(inbox);
     }
 }
 
@@ -219,6 +231,39 @@ fn bridged_services(
     out
 }
 
+/// The services the external components call: `(service path, the client's request
+/// layout, the model's answer layout)`.
+fn called_services(
+    model: &crate::sim::CompiledModel,
+    external: &[crate::robot::load::ExternalComponent],
+) -> Vec<(String, TopicLayout, TopicLayout)> {
+    let mut out = Vec::new();
+    let mut warnings = Vec::new();
+    for c in external {
+        for (service, _) in &c.calls {
+            let event =
+                |response| model.event_id(&service_client_event(service, &c.name, response));
+            let path = service.trim_start_matches('/').to_string();
+            match (event(false), event(true)) {
+                (Some(req), Some(resp)) => out.push((
+                    path.clone(),
+                    layout_of(model, req, path.clone(), WireKind::Request, &mut warnings),
+                    layout_of(model, resp, path, WireKind::Response, &mut warnings),
+                )),
+                _ => eprintln!(
+                    "warning: --external {}: nothing in the model serves {service}; it is not \
+                     bridged",
+                    c.name
+                ),
+            }
+        }
+    }
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
+    out
+}
+
 /// Runs `hindsight run`.
 pub fn run(args: &RunArgs) -> Result<(), CliError> {
     iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
@@ -249,6 +294,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     // The monitor taps what processes publish too: the layout above keeps their topics.
     let inbound = inbound_layouts(&mut topics, &external);
     let served = bridged_services(&topics, &external);
+    let called = called_services(model, &external);
     let Some(unit_ns) = loaded.unit_ns else {
         return Err(CliError::Input(format!(
             "{}: the model has no time unit; give --time-unit (e.g. 100ms) to pace it",
@@ -270,6 +316,8 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let inbound = TopicSubscriber::new(&node, inbound, &args.prefix).map_err(CliError::Failed)?;
     let services = ServiceBridge::new(&node, model.event_count(), served, &args.prefix)
         .map_err(CliError::Failed)?;
+    let servers = ServiceServers::new(&node, model.event_count(), called, &args.prefix)
+        .map_err(CliError::Failed)?;
     let cfg = RunConfig {
         max_time,
         events: loaded.events,
@@ -281,6 +329,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         publisher,
         inbound,
         services,
+        servers,
         inbound_error: None,
         start: Instant::now(),
         ns_per_unit: unit_ns as f64 / args.speed,
@@ -311,6 +360,12 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     for st in live.services.stats() {
         eprintln!(
             "run: service {}: {} requests, {} answered, {} unanswered, {} malformed answers",
+            st.service, st.requests, st.answered, st.unanswered, st.malformed
+        );
+    }
+    for st in live.servers.stats() {
+        eprintln!(
+            "run: serving {}: {} requests from processes, {} answered, {} callers gone, {} malformed",
             st.service, st.requests, st.answered, st.unanswered, st.malformed
         );
     }

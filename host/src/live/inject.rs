@@ -14,8 +14,10 @@
 
 use std::collections::VecDeque;
 
+use iceoryx2::active_request::ActiveRequest;
 use iceoryx2::pending_response::PendingResponse;
 use iceoryx2::port::client::Client;
+use iceoryx2::port::server::Server;
 use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 
@@ -26,6 +28,8 @@ type Ipc = ipc::Service;
 type RawSubscriber = Subscriber<Ipc, [u8], ()>;
 type RawClient = Client<Ipc, [u8], (), [u8], ()>;
 type Pending = PendingResponse<Ipc, [u8], (), [u8], ()>;
+type RawServer = Server<Ipc, [u8], (), [u8], ()>;
+type Active = ActiveRequest<Ipc, [u8], (), [u8], ()>;
 
 /// Counts of what came in on one topic.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -149,12 +153,7 @@ impl ServiceBridge {
         let mut by_event = vec![None; event_count];
         let mut out = Vec::new();
         for (path, request, response) in services {
-            let p = prefix.trim_end_matches('/');
-            let svc = if p.is_empty() {
-                path
-            } else {
-                format!("{p}/{path}")
-            };
+            let svc = prefixed(prefix, path);
             let name = super::service_name(&svc).map_err(|e| e.to_string())?;
             let factory = node
                 .service_builder(&name)
@@ -251,5 +250,131 @@ impl ServiceBridge {
     /// What each bridged service did so far.
     pub fn stats(&self) -> impl Iterator<Item = &ServiceStats> {
         self.services.iter().map(|b| &b.stats)
+    }
+}
+
+struct Served {
+    request: TopicLayout,
+    response: TopicLayout,
+    server: RawServer,
+    /// Requests posted into the model, oldest first: the model answers in order.
+    waiting: VecDeque<Active>,
+    seq: u64,
+    stats: ServiceStats,
+}
+
+/// Servers of the model's services that processes call: requests into the model, its
+/// answers back.
+pub struct ServiceServers {
+    /// Per event id: the index into `services` if it is a bridged answer to a client.
+    by_event: Vec<Option<usize>>,
+    services: Vec<Served>,
+}
+
+impl ServiceServers {
+    /// Opens (or creates) one request-response service per `(service path, the client's
+    /// request layout, the answer's layout)` under `prefix`, with a server each.
+    pub fn new(
+        node: &Node<Ipc>,
+        event_count: usize,
+        services: Vec<(String, TopicLayout, TopicLayout)>,
+        prefix: &str,
+    ) -> Result<ServiceServers, String> {
+        let mut by_event = vec![None; event_count];
+        let mut out = Vec::new();
+        for (path, request, response) in services {
+            let svc = prefixed(prefix, path);
+            let name = super::service_name(&svc).map_err(|e| e.to_string())?;
+            let server = node
+                .service_builder(&name)
+                .request_response::<[u8], [u8]>()
+                .open_or_create()
+                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?
+                .server_builder()
+                .initial_max_slice_len(response.size)
+                .create()
+                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
+            if let Some(slot) = by_event.get_mut(response.event.0 as usize) {
+                *slot = Some(out.len());
+            }
+            out.push(Served {
+                request,
+                response,
+                server,
+                waiting: VecDeque::new(),
+                seq: 0,
+                stats: ServiceStats {
+                    service: svc,
+                    ..ServiceStats::default()
+                },
+            });
+        }
+        Ok(ServiceServers {
+            by_event,
+            services: out,
+        })
+    }
+
+    /// Takes every request that arrived and queues it in `inbox` as the client's request.
+    /// A malformed request is counted and gets no answer.
+    pub fn poll(&mut self, inbox: &mut Inbox) {
+        for s in &mut self.services {
+            while let Ok(Some(req)) = s.server.receive() {
+                match s.request.decode(req.payload()) {
+                    Some((params, _seq)) => {
+                        s.stats.requests += 1;
+                        inbox.push(s.request.event, params);
+                        s.waiting.push_back(req);
+                    }
+                    None => s.stats.malformed += 1,
+                }
+            }
+        }
+    }
+
+    /// Answers the oldest waiting request with `msg` if it is the model's answer to a
+    /// bridged client.
+    pub fn answer(&mut self, msg: &SentMessage<'_>) -> Result<(), String> {
+        let Some(Some(i)) = self.by_event.get(msg.event().0 as usize) else {
+            return Ok(());
+        };
+        let s = &mut self.services[*i];
+        let Some(req) = s.waiting.pop_front() else {
+            return Ok(());
+        };
+        let seq = s.seq;
+        s.seq += 1;
+        if !req.is_connected() {
+            // The caller went away: nobody to answer.
+            s.stats.unanswered += 1;
+            return Ok(());
+        }
+        let response = &s.response;
+        req.loan_slice_uninit(response.size)
+            .map_err(|e| format!("iceoryx2: {}: {e:?}", s.stats.service))
+            .and_then(|r| {
+                let mut r = r.write_from_fn(|_| 0u8);
+                response.encode(msg, seq, r.payload_mut());
+                r.send()
+                    .map_err(|e| format!("iceoryx2: {}: {e:?}", s.stats.service))
+            })?;
+        s.stats.answered += 1;
+        Ok(())
+    }
+
+    /// What each served service did so far (`requests`: from processes; `answered`: by
+    /// the model).
+    pub fn stats(&self) -> impl Iterator<Item = &ServiceStats> {
+        self.services.iter().map(|s| &s.stats)
+    }
+}
+
+/// `prefix/path`, or `path` with an empty prefix.
+fn prefixed(prefix: &str, path: String) -> String {
+    let p = prefix.trim_end_matches('/');
+    if p.is_empty() {
+        path
+    } else {
+        format!("{p}/{path}")
     }
 }

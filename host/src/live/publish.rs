@@ -218,48 +218,59 @@ pub fn layouts(model: &CompiledModel) -> (Vec<TopicLayout>, Vec<String>) {
     let mut warnings = Vec::new();
     for e in 0..model.event_count() {
         let event = EventId(e as u32);
-        let name = model.event_name(event);
-        let Some((topic, kind)) = wire_name(name) else {
+        let Some((topic, kind)) = wire_name(model.event_name(event)) else {
             continue;
         };
-        let mut fields = Vec::new();
-        let mut offset = 0;
-        for (i, (pname, ty)) in model.event_params(event).iter().enumerate() {
-            let wire = match ty {
-                Ty::Bool => WireTy::Bool,
-                Ty::Int => WireTy::I64,
-                Ty::Float => WireTy::F64,
-                other => {
-                    warnings.push(format!(
-                        "{} /{topic}: field `{}` ({other:?}) is not published \
-                         (only bool, integer and float fields are)",
-                        kind.describe(),
-                        field_name(pname)
-                    ));
-                    continue;
-                }
-            };
-            fields.push(WireField {
-                name: field_name(pname),
-                param: i,
-                var: None,
-                offset,
-                ty: wire,
-            });
-            offset += wire.size();
-        }
-        out.push(TopicLayout {
-            event,
-            event_name: name.to_string(),
-            topic,
-            kind,
-            fields,
-            event_var: None,
-            seq_offset: offset,
-            size: offset + 8,
-        });
+        out.push(layout_of(model, event, topic, kind, &mut warnings));
     }
     (out, warnings)
+}
+
+/// The layout of any event's parameters, published under `topic` as a `kind`; a warning
+/// per field that cannot be laid out.
+pub fn layout_of(
+    model: &CompiledModel,
+    event: EventId,
+    topic: String,
+    kind: WireKind,
+    warnings: &mut Vec<String>,
+) -> TopicLayout {
+    let mut fields = Vec::new();
+    let mut offset = 0;
+    for (i, (pname, ty)) in model.event_params(event).iter().enumerate() {
+        let wire = match ty {
+            Ty::Bool => WireTy::Bool,
+            Ty::Int => WireTy::I64,
+            Ty::Float => WireTy::F64,
+            other => {
+                warnings.push(format!(
+                    "{} /{topic}: field `{}` ({other:?}) is not published \
+                     (only bool, integer and float fields are)",
+                    kind.describe(),
+                    field_name(pname)
+                ));
+                continue;
+            }
+        };
+        fields.push(WireField {
+            name: field_name(pname),
+            param: i,
+            var: None,
+            offset,
+            ty: wire,
+        });
+        offset += wire.size();
+    }
+    TopicLayout {
+        event,
+        event_name: model.event_name(event).to_string(),
+        topic,
+        kind,
+        fields,
+        event_var: None,
+        seq_offset: offset,
+        size: offset + 8,
+    }
 }
 
 /// Names the spec variables of each layout after the property file's ports on the

@@ -47,6 +47,13 @@ pub fn service_event(service: &str, response: bool) -> String {
     format!("srv_{}_{part}", ros_name(service))
 }
 
+/// The message name of a client's request to a service's handler (`response` false), or of
+/// the handler's answer to that client: `srv_<s>_req_client_<c>`, `srv_<s>_response_client_<c>`.
+pub fn service_client_event(service: &str, client: &str, response: bool) -> String {
+    let part = if response { "response" } else { "req" };
+    format!("srv_{}_{part}_client_{client}", ros_name(service))
+}
+
 /// A ROS name as AS2FM spells it inside event names: no leading `/`, `/` -> `__`.
 fn ros_name(name: &str) -> String {
     name.trim_start_matches('/').replace('/', "__")

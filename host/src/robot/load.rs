@@ -116,6 +116,8 @@ pub struct ExternalComponent {
     pub subscribes: Vec<(String, String)>,
     /// Services it serves: `(service, ROS type)`; the process answers their requests.
     pub serves: Vec<(String, String)>,
+    /// Services it calls: `(service, ROS type)`; the model answers the process.
+    pub calls: Vec<(String, String)>,
 }
 
 /// Reads a main file and everything it names, lowers the behavior tree and the ROS tags,
@@ -133,7 +135,7 @@ pub fn load_with(main_path: &Path, halts: Halts) -> Result<RobotModel, Diagnosti
 }
 
 /// What a node model declares that a process replacing it must speak, or an error at the
-/// declaration it cannot bridge (only topics are: services and actions are not yet).
+/// declaration it cannot bridge (topics and services are; actions are not yet).
 fn external_component(
     sm: &SourceMap,
     root: &Element,
@@ -144,6 +146,7 @@ fn external_component(
         publishes: Vec::new(),
         subscribes: Vec::new(),
         serves: Vec::new(),
+        calls: Vec::new(),
     };
     for el in root.elements() {
         match el.name.as_str() {
@@ -156,17 +159,21 @@ fn external_component(
                     c.subscribes.push((topic, ty));
                 }
             }
-            "ros_service_server" => {
+            "ros_service_server" | "ros_service_client" => {
                 let service = el.required(sm, "service_name")?.value.trim().to_string();
                 let ty = el.required(sm, "type")?.value.trim().to_string();
-                c.serves.push((service, ty));
+                if el.name == "ros_service_server" {
+                    c.serves.push((service, ty));
+                } else {
+                    c.calls.push((service, ty));
+                }
             }
-            "ros_service_client" | "ros_action_server" | "ros_action_client" => {
+            "ros_action_server" | "ros_action_client" => {
                 return Err(sm.diag(
                     el.span,
                     format!(
                         "`{name}` cannot be replaced by a process: it declares <{}>, and only \
-                         topics and served services are bridged to processes so far",
+                         topics and services are bridged to processes so far, not actions",
                         el.name
                     ),
                 ));
@@ -183,14 +190,16 @@ fn external_component(
 /// message fields (a message's fields are those its senders give) while nothing in the
 /// model publishes them. Each served service keeps one of its request handlers, disabled
 /// (`cond="false"`), for the response's fields, and gets one that takes a request and
-/// does nothing: the process answers it.
+/// does nothing: the process answers it. Each called service keeps one of its requests
+/// under the transition that never fires, for the request's fields, and gets a response
+/// handler that takes the answer and does nothing: the process gets it.
 fn inert_stub(root: &Element) -> Element {
-    fn handler<'e>(el: &'e Element, alias: &str) -> Option<&'e Element> {
+    fn first<'e>(el: &'e Element, tag: &str, alias: &str) -> Option<&'e Element> {
         el.elements().find_map(|c| {
-            if c.name == "ros_service_handle_request" && c.attr_value("name") == Some(alias) {
+            if c.name == tag && c.attr_value("name") == Some(alias) {
                 Some(c)
             } else {
-                handler(c, alias)
+                first(c, tag, alias)
             }
         })
     }
@@ -212,18 +221,28 @@ fn inert_stub(root: &Element) -> Element {
     stub.attrs = root.attrs.clone();
     stub.set_attr("initial", "external");
     let mut state = Element::new("state", root.span).with_attr("id", "external");
+    let mut requests = Vec::new();
     for c in root.elements() {
         if matches!(
             c.name.as_str(),
-            "datamodel" | "ros_topic_publisher" | "ros_service_server"
+            "datamodel" | "ros_topic_publisher" | "ros_service_server" | "ros_service_client"
         ) {
             stub.push(c.clone());
         }
+        let alias = c.attr_value("name").or(c.attr_value("service_name"));
+        if let ("ros_service_client", Some(alias)) = (c.name.as_str(), alias) {
+            requests.extend(first(root, "ros_service_send_request", alias));
+            state.push(
+                Element::new("ros_service_handle_response", c.span)
+                    .with_attr("name", alias)
+                    .with_attr("target", "external"),
+            );
+        }
         if c.name == "ros_service_server" {
-            let Some(alias) = c.attr_value("name").or(c.attr_value("service_name")) else {
+            let Some(alias) = alias else {
                 continue;
             };
-            if let Some(h) = handler(root, alias) {
+            if let Some(h) = first(root, "ros_service_handle_request", alias) {
                 let mut disabled = h.clone();
                 disabled.set_attr("cond", "false");
                 disabled.set_attr("target", "external");
@@ -239,7 +258,7 @@ fn inert_stub(root: &Element) -> Element {
     let mut never = Element::new("transition", root.span)
         .with_attr("cond", "false")
         .with_attr("target", "external");
-    for p in found {
+    for p in found.into_iter().chain(requests) {
         never.push(p.clone());
     }
     state.push(never);
@@ -250,7 +269,7 @@ fn inert_stub(root: &Element) -> Element {
 /// [`load`], leaving out the node models named in `external` (their `<scxml name>`):
 /// the model runs without their behaviour ([`inert_stub`]), and what each declared is
 /// returned so that a process can take its place. An unknown name, or a node model that
-/// calls a service or takes part in an action, is an error.
+/// takes part in an action, is an error.
 pub fn load_without(
     main_path: &Path,
     external: &[String],
