@@ -114,6 +114,10 @@ fn layout_is_a_monitor_config() {
     let text = String::from_utf8(out.stdout).unwrap();
     // Valid TOML as a whole, with the documented offsets.
     let doc: toml::Table = toml::from_str(&text).unwrap();
+    // The clock of a run at the default speed: model time is wall-clock time, from the
+    // run's first message.
+    assert_eq!(doc["clock"]["speed"].as_float(), Some(1.0));
+    assert_eq!(doc["clock"]["from_first_message"].as_bool(), Some(true));
     let topics = doc["topic"].as_array().unwrap();
     let battery = topics
         .iter()

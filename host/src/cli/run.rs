@@ -41,7 +41,8 @@ pub struct RunArgs {
     /// Model time to run (`100s`, or steps); default: the main file's `max_time`, else 10,000 steps.
     #[arg(long, value_name = "T")]
     pub duration: Option<String>,
-    /// Print each topic's service and payload layout as `hindsight monitor` config (TOML), then exit.
+    /// Print each message's service and payload layout as `hindsight monitor` config (TOML),
+    /// with a `[clock]` for `--speed` (model time from the first message), then exit.
     #[arg(long)]
     pub layout: bool,
     /// A node model (its `<scxml name>`) that a real process plays instead: it is left out
@@ -288,6 +289,12 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         ));
     }
     if args.layout {
+        // The sidecar of this run counts model time from the run's first message.
+        println!(
+            "# `hindsight run --speed {}`: the sidecar's clock counts model time from the \
+             run's first message.\n[clock]\nspeed = {:?}\nfrom_first_message = true\n",
+            args.speed, args.speed
+        );
         print!("{}", layout_toml(&topics, &args.prefix));
         return Ok(());
     }
