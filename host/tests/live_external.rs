@@ -371,3 +371,174 @@ fn a_process_calls_a_service_the_model_serves() {
         "{err}"
     );
 }
+
+/// The layout `hindsight run` uses for one model event, from the library.
+fn layout_of_event(
+    model: &hindsight::sim::CompiledModel,
+    event: &str,
+) -> hindsight::live::publish::TopicLayout {
+    let (all, _) = hindsight::live::publish::layouts(model);
+    all.into_iter()
+        .find(|l| l.event_name == event)
+        .unwrap_or_else(|| panic!("no layout for {event}"))
+}
+
+fn offset(l: &hindsight::live::publish::TopicLayout, field: &str) -> usize {
+    l.fields
+        .iter()
+        .find(|f| f.name == field)
+        .unwrap_or_else(|| panic!("{} has no field {field}: {:?}", l.event_name, l.fields))
+        .offset
+}
+
+/// Plays NavigationComponent for 30 s of the museum at speed 10: accepts every goal, sends
+/// three feedbacks and (with `results`) a success; returns the goals and the run's stderr.
+fn navigation_session(results: bool) -> (Vec<(i64, i64)>, String) {
+    let main = hindsight::robot::load::main_file_of(&museum()).unwrap();
+    let (robot, ext) =
+        hindsight::robot::load::load_without(&main, &["NavigationComponent".to_string()])
+            .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(ext[0].serves_actions.len(), 1);
+    let goal = layout_of_event(
+        &robot.model,
+        "action_NavigationComponent__GoToPoi_goal_handle",
+    );
+    let feedback = layout_of_event(&robot.model, "action_NavigationComponent__GoToPoi_feedback");
+    let result = layout_of_event(&robot.model, "action_NavigationComponent__GoToPoi_result");
+    let (goal_id_at, poi_at) = (offset(&goal, "goal_id"), offset(&goal, "poi_number"));
+    let (fb_goal, fb_status) = (offset(&feedback, "goal_id"), offset(&feedback, "status"));
+    let (res_goal, res_code, res_ok) = (
+        offset(&result, "goal_id"),
+        offset(&result, "code"),
+        offset(&result, "is_ok"),
+    );
+    let (fb_size, fb_seq, res_size, res_seq) = (
+        feedback.size,
+        feedback.seq_offset,
+        result.size,
+        result.seq_offset,
+    );
+
+    let prefix = unique("external-action");
+    let stop = Arc::new(AtomicBool::new(false));
+    let goals = Arc::new(std::sync::Mutex::new(Vec::<(i64, i64)>::new()));
+    let (ready_tx, ready_rx) = std::sync::mpsc::channel();
+    let navigation = {
+        let (prefix, stop, goals) = (prefix.clone(), stop.clone(), goals.clone());
+        std::thread::spawn(move || {
+            let node = node();
+            let svc = |s: &str| {
+                ServiceName::new(&format!("{prefix}/NavigationComponent/GoToPoi{s}")).unwrap()
+            };
+            let server = node
+                .service_builder(&svc(""))
+                .request_response::<[u8], [u8]>()
+                .open_or_create()
+                .unwrap()
+                .server_builder()
+                .initial_max_slice_len(9)
+                .create()
+                .unwrap();
+            let publisher = |s: &str, size: usize| {
+                node.service_builder(&svc(s))
+                    .publish_subscribe::<[u8]>()
+                    .open_or_create()
+                    .unwrap()
+                    .publisher_builder()
+                    .initial_max_slice_len(size)
+                    .create()
+                    .unwrap()
+            };
+            let fb_pub = publisher("/feedback", fb_size);
+            let res_pub = publisher("/result", res_size);
+            ready_tx.send(()).unwrap();
+            let (mut fb_seq_n, mut res_seq_n) = (0u64, 0u64);
+            // The goal being driven to: (goal_id, feedbacks sent, last feedback time).
+            let mut driving: Option<(i64, u32, std::time::Instant)> = None;
+            while !stop.load(Ordering::SeqCst) {
+                while let Some(req) = server.receive().unwrap() {
+                    let p = req.payload();
+                    let gid = i64::from_le_bytes(p[goal_id_at..goal_id_at + 8].try_into().unwrap());
+                    let poi = i64::from_le_bytes(p[poi_at..poi_at + 8].try_into().unwrap());
+                    goals.lock().unwrap().push((gid, poi));
+                    let mut answer = [0u8; 9];
+                    answer[0] = 1; // accepted
+                    let r = req.loan_slice_uninit(9).unwrap();
+                    r.write_from_slice(&answer).send().unwrap();
+                    driving = Some((gid, 0, std::time::Instant::now()));
+                }
+                if let Some((gid, n, last)) = driving {
+                    // A feedback every 50 ms (0.5 s of model time), the result after three.
+                    if last.elapsed() >= Duration::from_millis(50) {
+                        if n < 3 || !results {
+                            let mut b = vec![0u8; fb_size];
+                            b[fb_goal..fb_goal + 8].copy_from_slice(&gid.to_le_bytes());
+                            b[fb_status..fb_status + 8].copy_from_slice(&2i64.to_le_bytes());
+                            b[fb_seq..fb_seq + 8].copy_from_slice(&fb_seq_n.to_le_bytes());
+                            fb_seq_n += 1;
+                            let s = fb_pub.loan_slice_uninit(fb_size).unwrap();
+                            s.write_from_slice(&b).send().unwrap();
+                            driving = Some((gid, n + 1, std::time::Instant::now()));
+                        } else {
+                            let mut b = vec![0u8; res_size];
+                            b[res_goal..res_goal + 8].copy_from_slice(&gid.to_le_bytes());
+                            b[res_code..res_code + 8].copy_from_slice(&4i64.to_le_bytes());
+                            b[res_ok] = 1;
+                            b[res_seq..res_seq + 8].copy_from_slice(&res_seq_n.to_le_bytes());
+                            res_seq_n += 1;
+                            let s = res_pub.loan_slice_uninit(res_size).unwrap();
+                            s.write_from_slice(&b).send().unwrap();
+                            driving = None;
+                        }
+                    }
+                }
+                std::thread::sleep(Duration::from_millis(1));
+            }
+        })
+    };
+    ready_rx.recv().unwrap();
+    let mut run = run_museum(
+        &prefix,
+        &[
+            "--external",
+            "NavigationComponent",
+            "--speed",
+            "10",
+            "--duration",
+            "30s",
+        ],
+    );
+    let (status, err) = finish(&mut run);
+    stop.store(true, Ordering::SeqCst);
+    navigation.join().unwrap();
+    assert!(status.success(), "{err}");
+    let goals = goals.lock().unwrap().clone();
+    (goals, err)
+}
+
+#[test]
+fn a_navigation_process_serves_the_museum_s_action() {
+    let (goals, err) = navigation_session(true);
+    let prefix_line = err
+        .lines()
+        .find(|l| l.starts_with("run: action "))
+        .unwrap_or_else(|| panic!("no action report:\n{err}"))
+        .to_string();
+    // The tree reached a point of interest with the process's result and sent the next goal.
+    assert!(goals.len() >= 2, "goals {goals:?}:\n{err}");
+    assert!(
+        prefix_line.ends_with(&format!(
+            "/NavigationComponent/GoToPoi: {n} goals, {n} answered, 0 unanswered, 0 malformed answers",
+            n = goals.len()
+        )),
+        "{err}"
+    );
+    assert!(err.contains("GoToPoi/result: "), "{err}");
+}
+
+#[test]
+fn without_a_result_the_museum_waits_at_its_first_point_of_interest() {
+    // Feedback only: the skill keeps answering RUNNING and no second goal is sent.
+    let (goals, err) = navigation_session(false);
+    assert_eq!(goals.len(), 1, "goals {goals:?}:\n{err}");
+}

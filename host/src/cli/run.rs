@@ -9,11 +9,11 @@ type Ipc = ipc::Service;
 
 use super::verify::{load_without, ModelArgs};
 use super::CliError;
-use crate::live::inject::{ServiceBridge, ServiceServers, TopicSubscriber};
+use crate::live::inject::{GoalBridge, GoalRoute, ServiceBridge, ServiceServers, TopicSubscriber};
 use crate::live::publish::{
     layout_of, layout_toml, layouts, name_from_ports, TopicLayout, TopicPublisher, WireKind,
 };
-use crate::props::ros::{service_client_event, service_event, topic_event};
+use crate::props::ros::{action_event, service_client_event, service_event, topic_event};
 use crate::sim::{
     EndReason, EventSemantics, Flow, Inbox, Observer, Quiescence, RunConfig, SentMessage, Simulator,
 };
@@ -47,9 +47,9 @@ pub struct RunArgs {
     pub layout: bool,
     /// A node model (its `<scxml name>`) that a real process plays instead: it is left out
     /// of the run, what the process publishes on the node's topics is posted into the
-    /// model, the requests of services the node served go to the process, and the process
-    /// may call the services the node called (repeat for several). Nodes that take part
-    /// in actions cannot be replaced yet.
+    /// model, the requests of services and the goals of actions the node served go to the
+    /// process, and the process may call the services the node called (repeat for
+    /// several). Action clients cannot be replaced yet.
     #[arg(long, value_name = "NAME")]
     pub external: Vec<String>,
 }
@@ -81,8 +81,12 @@ Replacing a component by a process (--external NAME):
   and the process's answer (the response's layout, fields then seq) is posted as the
   server's response. A service it called is served by the run under the same name:
   a process's request (the request's layout) goes to the model's server, and the
-  model's answer comes back. Malformed samples and answers are counted, never posted.
-  Nodes with actions cannot be replaced yet. Example
+  model's answer comes back. An action it served takes goals on the request-response
+  service PREFIX/<action> (request: the goal's layout with goal_id; answer: 1 byte,
+  1 accepted or 0 rejected, then a u64 seq) and the process publishes its feedback
+  and results on PREFIX/<action>/feedback and /result (layouts from --layout; the
+  result's code is 4 succeeded, 5 canceled, 6 aborted). Malformed samples and
+  answers are counted, never posted. Action clients cannot be replaced yet. Example
   (a battery written in Rust that publishes every 1.2 s):
   hindsight run examples/museum-guide --external BatteryComponent --speed 5 &
   cargo run -p hindsight --example battery_component -- --period 1.2s --speed 5
@@ -105,6 +109,7 @@ struct Live<'n> {
     inbound: TopicSubscriber,
     services: ServiceBridge,
     servers: ServiceServers,
+    goals: GoalBridge,
     inbound_error: Option<String>,
     start: Instant,
     /// Wall-clock nanoseconds per model time unit.
@@ -147,6 +152,7 @@ impl Observer for Live<'_> {
             .services
             .forward(msg)
             .and_then(|()| self.servers.answer(msg))
+            .and_then(|()| self.goals.forward(msg))
         {
             self.inbound_error.get_or_insert(e);
         }
@@ -178,6 +184,7 @@ impl Observer for Live<'_> {
         }
         self.services.poll(inbox);
         self.servers.poll(inbox);
+        self.goals.poll(inbox);
     }
 }
 
@@ -189,8 +196,16 @@ fn inbound_layouts(
 ) -> Vec<TopicLayout> {
     let mut inbound = Vec::new();
     for c in external {
-        for (topic, _) in &c.publishes {
-            let event = topic_event(topic);
+        // A served action's feedback and results are topics its process publishes.
+        let action_topics = c.serves_actions.iter().flat_map(|(a, _)| {
+            ["feedback", "result"].map(|part| (action_event(a, part), format!("{a}/{part}")))
+        });
+        for (event, topic) in c
+            .publishes
+            .iter()
+            .map(|(t, _)| (topic_event(t), t.clone()))
+            .chain(action_topics)
+        {
             match topics.iter().position(|l| l.event_name == event) {
                 Some(i) => inbound.push(topics.remove(i)),
                 None => eprintln!(
@@ -265,6 +280,49 @@ fn called_services(
     out
 }
 
+/// The goal routes of the actions the external components serve.
+fn goal_routes(
+    model: &crate::sim::CompiledModel,
+    topics: &[TopicLayout],
+    external: &[crate::robot::load::ExternalComponent],
+) -> Vec<GoalRoute> {
+    let mut out = Vec::new();
+    for c in external {
+        for (action, _) in &c.serves_actions {
+            let goal = topics
+                .iter()
+                .find(|l| l.event_name == action_event(action, "goal_handle"));
+            let with_id = |part: &str| {
+                let e = model.event_id(&action_event(action, part))?;
+                Some((e, model.param_index(e, "goal_id")?))
+            };
+            let goal_id = goal.and_then(|g| model.param_index(g.event, "goal_id"));
+            match (
+                goal,
+                goal_id,
+                with_id("goal_accepted"),
+                with_id("goal_rejected"),
+            ) {
+                (Some(goal), Some(goal_id), Some(accepted), Some(rejected)) => {
+                    out.push(GoalRoute {
+                        path: action.trim_start_matches('/').to_string(),
+                        goal: goal.clone(),
+                        goal_id,
+                        accepted,
+                        rejected,
+                    })
+                }
+                _ => eprintln!(
+                    "warning: --external {}: nothing in the model sends goals to {action}; \
+                     it is not bridged",
+                    c.name
+                ),
+            }
+        }
+    }
+    out
+}
+
 /// Runs `hindsight run`.
 pub fn run(args: &RunArgs) -> Result<(), CliError> {
     iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
@@ -302,6 +360,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let inbound = inbound_layouts(&mut topics, &external);
     let served = bridged_services(&topics, &external);
     let called = called_services(model, &external);
+    let routes = goal_routes(model, &topics, &external);
     let Some(unit_ns) = loaded.unit_ns else {
         return Err(CliError::Input(format!(
             "{}: the model has no time unit; give --time-unit (e.g. 100ms) to pace it",
@@ -325,6 +384,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         .map_err(CliError::Failed)?;
     let servers = ServiceServers::new(&node, model.event_count(), called, &args.prefix)
         .map_err(CliError::Failed)?;
+    let goals = GoalBridge::new(&node, routes, &args.prefix).map_err(CliError::Failed)?;
     let cfg = RunConfig {
         max_time,
         events: loaded.events,
@@ -337,6 +397,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         inbound,
         services,
         servers,
+        goals,
         inbound_error: None,
         start: Instant::now(),
         ns_per_unit: unit_ns as f64 / args.speed,
@@ -373,6 +434,12 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     for st in live.servers.stats() {
         eprintln!(
             "run: serving {}: {} requests from processes, {} answered, {} callers gone, {} malformed",
+            st.service, st.requests, st.answered, st.unanswered, st.malformed
+        );
+    }
+    for st in live.goals.stats() {
+        eprintln!(
+            "run: action {}: {} goals, {} answered, {} unanswered, {} malformed answers",
             st.service, st.requests, st.answered, st.unanswered, st.malformed
         );
     }

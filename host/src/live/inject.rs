@@ -378,3 +378,142 @@ fn prefixed(prefix: &str, path: String) -> String {
         format!("{p}/{path}")
     }
 }
+
+/// One action whose goals go to a process.
+pub struct GoalRoute {
+    /// The request-response service path without prefix (the action's name).
+    pub path: String,
+    /// The layout of the server's goal event (`action_<a>_goal_handle`).
+    pub goal: TopicLayout,
+    /// Index of `goal_id` among the goal event's parameters.
+    pub goal_id: usize,
+    /// `action_<a>_goal_accepted` and the index of its `goal_id`.
+    pub accepted: (crate::sim::EventId, usize),
+    /// `action_<a>_goal_rejected` and the index of its `goal_id`.
+    pub rejected: (crate::sim::EventId, usize),
+}
+
+struct GoalClient {
+    route: GoalRoute,
+    client: RawClient,
+    pending: VecDeque<(Pending, i64)>,
+    seq: u64,
+    stats: ServiceStats,
+}
+
+/// Clients of the actions processes serve: goals out, accepts and rejects into the model.
+pub struct GoalBridge {
+    actions: Vec<GoalClient>,
+}
+
+impl GoalBridge {
+    /// Opens (or creates) one request-response service per route under `prefix`.
+    pub fn new(
+        node: &Node<Ipc>,
+        routes: Vec<GoalRoute>,
+        prefix: &str,
+    ) -> Result<GoalBridge, String> {
+        let mut actions = Vec::new();
+        for route in routes {
+            let svc = prefixed(prefix, route.path.clone());
+            let name = super::service_name(&svc).map_err(|e| e.to_string())?;
+            let client = node
+                .service_builder(&name)
+                .request_response::<[u8], [u8]>()
+                .open_or_create()
+                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?
+                .client_builder()
+                .initial_max_slice_len(route.goal.size)
+                .create()
+                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
+            actions.push(GoalClient {
+                route,
+                client,
+                pending: VecDeque::new(),
+                seq: 0,
+                stats: ServiceStats {
+                    service: svc,
+                    ..ServiceStats::default()
+                },
+            });
+        }
+        Ok(GoalBridge { actions })
+    }
+
+    /// Sends `msg` to its process if it is a goal of a bridged action.
+    pub fn forward(&mut self, msg: &SentMessage<'_>) -> Result<(), String> {
+        if msg.origin() == EXTERNAL {
+            return Ok(());
+        }
+        let Some(a) = self
+            .actions
+            .iter_mut()
+            .find(|a| a.route.goal.event == msg.event())
+        else {
+            return Ok(());
+        };
+        let goal_id = match msg.param(a.route.goal_id) {
+            Some(crate::expr::Value::Int(g)) => g,
+            _ => 0,
+        };
+        let seq = a.seq;
+        a.seq += 1;
+        let layout = &a.route.goal;
+        let pending = a
+            .client
+            .loan_slice_uninit(layout.size)
+            .map_err(|e| format!("iceoryx2: {}: {e:?}", a.stats.service))
+            .and_then(|r| {
+                let mut r = r.write_from_fn(|_| 0u8);
+                layout.encode(msg, seq, r.payload_mut());
+                r.send()
+                    .map_err(|e| format!("iceoryx2: {}: {e:?}", a.stats.service))
+            })?;
+        a.stats.requests += 1;
+        if pending.number_of_server_connections() == 0 {
+            a.stats.unanswered += 1;
+        } else {
+            a.pending.push_back((pending, goal_id));
+        }
+        Ok(())
+    }
+
+    /// Posts each answer that arrived as the server's accept or reject of its goal.
+    pub fn poll(&mut self, inbox: &mut Inbox) {
+        for a in &mut self.actions {
+            let mut k = 0;
+            while k < a.pending.len() {
+                let mut done = false;
+                while let Ok(Some(resp)) = a.pending[k].0.receive() {
+                    let goal_id = a.pending[k].1;
+                    match resp.payload() {
+                        [b @ (0 | 1), _, _, _, _, _, _, _, _] => {
+                            let (event, at) = if *b == 1 {
+                                a.route.accepted
+                            } else {
+                                a.route.rejected
+                            };
+                            inbox.push(event, vec![(at, crate::sim::Scalar::Int(goal_id))]);
+                            a.stats.answered += 1;
+                        }
+                        _ => a.stats.malformed += 1,
+                    }
+                    done = true;
+                }
+                if done || !a.pending[k].0.is_connected() {
+                    if !done {
+                        a.stats.unanswered += 1;
+                    }
+                    a.pending.remove(k);
+                } else {
+                    k += 1;
+                }
+            }
+        }
+    }
+
+    /// What each bridged action's goals did so far.
+    pub fn stats(&self) -> impl Iterator<Item = &ServiceStats> {
+        self.actions.iter().map(|a| &a.stats)
+    }
+}

@@ -54,6 +54,12 @@ pub fn service_client_event(service: &str, client: &str, response: bool) -> Stri
     format!("srv_{}_{part}_client_{client}", ros_name(service))
 }
 
+/// An action's message `part` (`goal_handle`, `goal_accepted`, `feedback`, `result`, ...):
+/// `action_<a>_<part>`.
+pub fn action_event(action: &str, part: &str) -> String {
+    format!("action_{}_{part}", ros_name(action))
+}
+
 /// A ROS name as AS2FM spells it inside event names: no leading `/`, `/` -> `__`.
 fn ros_name(name: &str) -> String {
     name.trim_start_matches('/').replace('/', "__")

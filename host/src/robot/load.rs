@@ -7,6 +7,7 @@ use super::datatypes::read_main_declarations;
 use super::interfaces::Interfaces;
 use super::main_file::{Input, MainFile};
 use super::ros::{self, RosInput};
+use super::types::InterfaceLookup;
 use crate::model::xml::{self, Element};
 use crate::model::{Diagnostic, Diagnostics, ModelSource, SourceMap, TypeDefs};
 use crate::sim::CompiledModel;
@@ -118,6 +119,9 @@ pub struct ExternalComponent {
     pub serves: Vec<(String, String)>,
     /// Services it calls: `(service, ROS type)`; the model answers the process.
     pub calls: Vec<(String, String)>,
+    /// Actions it serves: `(action, ROS type)`; the process takes the goals, publishes
+    /// feedback and results.
+    pub serves_actions: Vec<(String, String)>,
 }
 
 /// Reads a main file and everything it names, lowers the behavior tree and the ROS tags,
@@ -135,7 +139,8 @@ pub fn load_with(main_path: &Path, halts: Halts) -> Result<RobotModel, Diagnosti
 }
 
 /// What a node model declares that a process replacing it must speak, or an error at the
-/// declaration it cannot bridge (topics and services are; actions are not yet).
+/// declaration it cannot bridge (topics, services and served actions are; action clients
+/// are not yet).
 fn external_component(
     sm: &SourceMap,
     root: &Element,
@@ -147,6 +152,7 @@ fn external_component(
         subscribes: Vec::new(),
         serves: Vec::new(),
         calls: Vec::new(),
+        serves_actions: Vec::new(),
     };
     for el in root.elements() {
         match el.name.as_str() {
@@ -168,12 +174,18 @@ fn external_component(
                     c.calls.push((service, ty));
                 }
             }
-            "ros_action_server" | "ros_action_client" => {
+            "ros_action_server" => {
+                let action = el.required(sm, "action_name")?.value.trim().to_string();
+                let ty = el.required(sm, "type")?.value.trim().to_string();
+                c.serves_actions.push((action, ty));
+            }
+            "ros_action_client" => {
                 return Err(sm.diag(
                     el.span,
                     format!(
                         "`{name}` cannot be replaced by a process: it declares <{}>, and only \
-                         topics and services are bridged to processes so far, not actions",
+                         topics, services and served actions are bridged to processes so far, not \
+                         action clients",
                         el.name
                     ),
                 ));
@@ -192,8 +204,11 @@ fn external_component(
 /// (`cond="false"`), for the response's fields, and gets one that takes a request and
 /// does nothing: the process answers it. Each called service keeps one of its requests
 /// under the transition that never fires, for the request's fields, and gets a response
-/// handler that takes the answer and does nothing: the process gets it.
-fn inert_stub(root: &Element) -> Element {
+/// handler that takes the answer and does nothing: the process gets it. Each served
+/// action takes goals and does nothing (its threads are left out), and sends, under the
+/// transition that never fires, an accept, a reject, a feedback and a result whose fields
+/// are the interface's defaults: the process answers and reports instead.
+fn inert_stub(root: &Element, interfaces: &Interfaces) -> Element {
     fn first<'e>(el: &'e Element, tag: &str, alias: &str) -> Option<&'e Element> {
         el.elements().find_map(|c| {
             if c.name == tag && c.attr_value("name") == Some(alias) {
@@ -222,10 +237,15 @@ fn inert_stub(root: &Element) -> Element {
     stub.set_attr("initial", "external");
     let mut state = Element::new("state", root.span).with_attr("id", "external");
     let mut requests = Vec::new();
+    let mut requests_owned = Vec::new();
     for c in root.elements() {
         if matches!(
             c.name.as_str(),
-            "datamodel" | "ros_topic_publisher" | "ros_service_server" | "ros_service_client"
+            "datamodel"
+                | "ros_topic_publisher"
+                | "ros_service_server"
+                | "ros_service_client"
+                | "ros_action_server"
         ) {
             stub.push(c.clone());
         }
@@ -237,6 +257,35 @@ fn inert_stub(root: &Element) -> Element {
                     .with_attr("name", alias)
                     .with_attr("target", "external"),
             );
+        }
+        if let ("ros_action_server", Some(alias)) = (c.name.as_str(), alias) {
+            state.push(
+                Element::new("ros_action_handle_goal", c.span)
+                    .with_attr("name", alias)
+                    .with_attr("target", "external"),
+            );
+            let fields = c
+                .attr_value("type")
+                .and_then(|t| interfaces.action(t.trim()).ok())
+                .unwrap_or_default();
+            let with_fields = |tag: &str, list: &[crate::robot::types::FlatField]| {
+                let mut e = Element::new(tag, c.span)
+                    .with_attr("name", alias)
+                    .with_attr("goal_id", "0");
+                for f in list {
+                    e.push(
+                        Element::new("field", c.span)
+                            .with_attr("name", f.dotted())
+                            .with_attr("expr", f.default.clone()),
+                    );
+                }
+                e
+            };
+            requests_owned.push(with_fields("ros_action_accept_goal", &[]));
+            requests_owned.push(with_fields("ros_action_reject_goal", &[]));
+            requests_owned.push(with_fields("ros_action_feedback", &fields.feedback));
+            requests_owned.push(with_fields("ros_action_succeed", &fields.result));
+            requests_owned.push(with_fields("ros_action_aborted", &fields.result));
         }
         if c.name == "ros_service_server" {
             let Some(alias) = alias else {
@@ -261,6 +310,9 @@ fn inert_stub(root: &Element) -> Element {
     for p in found.into_iter().chain(requests) {
         never.push(p.clone());
     }
+    for p in requests_owned {
+        never.push(p);
+    }
     state.push(never);
     stub.push(state);
     stub
@@ -269,7 +321,7 @@ fn inert_stub(root: &Element) -> Element {
 /// [`load`], leaving out the node models named in `external` (their `<scxml name>`):
 /// the model runs without their behaviour ([`inert_stub`]), and what each declared is
 /// returned so that a process can take its place. An unknown name, or a node model that
-/// takes part in an action, is an error.
+/// is an action client, is an error.
 pub fn load_without(
     main_path: &Path,
     external: &[String],
@@ -324,7 +376,7 @@ fn load_full(
                     Ok(c) => left_out.push(c),
                     Err(d) => errs.push(d),
                 }
-                machines.push(inert_stub(&e));
+                machines.push(inert_stub(&e, &interfaces));
             } else {
                 machines.push(e);
             }
