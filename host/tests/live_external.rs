@@ -542,3 +542,148 @@ fn without_a_result_the_museum_waits_at_its_first_point_of_interest() {
     let (goals, err) = navigation_session(false);
     assert_eq!(goals.len(), 1, "goals {goals:?}:\n{err}");
 }
+
+const MOVER_MAIN: &str = r#"<roaml>
+  <parameters><max_time value="30" unit="s"/></parameters>
+  <node_models>
+    <input type="ros-scxml" src="./mover.scxml"/>
+    <input type="ros-scxml" src="./commander.scxml"/>
+  </node_models>
+  <properties><input type="xml" src="./props.xml"/></properties>
+</roaml>
+"#;
+
+const MOVER: &str = r#"<scxml name="Mover" initial="idle" version="1.0" xmlns="http://www.w3.org/2005/07/scxml">
+  <ros_action_server name="srv" action_name="/mover/move" type="example_interfaces/Fibonacci"/>
+  <ros_topic_publisher topic="/moved" type="std_msgs/Int32"/>
+  <datamodel><data id="gid" type="int32" expr="0"/><data id="order" type="int32" expr="0"/></datamodel>
+  <state id="idle">
+    <ros_action_handle_goal name="srv" target="work">
+      <assign location="gid" expr="_action.goal_id"/>
+      <assign location="order" expr="_goal.order"/>
+    </ros_action_handle_goal>
+  </state>
+  <state id="work">
+    <onentry>
+      <if cond="order &gt; 0">
+        <ros_action_accept_goal name="srv" goal_id="gid"/>
+      <else/>
+        <ros_action_reject_goal name="srv" goal_id="gid"/>
+      </if>
+    </onentry>
+    <transition target="idle" cond="order &gt; 0">
+      <ros_action_succeed name="srv" goal_id="gid"><field name="sequence" expr="[0, 1]"/></ros_action_succeed>
+      <ros_topic_publish name="/moved"><field name="data" expr="order"/></ros_topic_publish>
+    </transition>
+    <transition target="idle" cond="order &lt;= 0"/>
+  </state>
+</scxml>
+"#;
+
+const COMMANDER: &str = r#"<scxml name="Commander" initial="go" version="1.0" xmlns="http://www.w3.org/2005/07/scxml">
+  <ros_action_client name="cl" action_name="/mover/move" type="example_interfaces/Fibonacci"/>
+  <state id="go">
+    <onentry><ros_action_send_goal name="cl"><field name="order" expr="3"/></ros_action_send_goal></onentry>
+    <ros_action_handle_goal_response name="cl" accept="wait" reject="done"/>
+  </state>
+  <state id="wait">
+    <ros_action_handle_success_result name="cl" target="done"/>
+  </state>
+  <state id="done"/>
+</scxml>
+"#;
+
+const MOVER_PROPS: &str = r#"<properties>
+  <ports>
+    <ros_topic topic="/moved" type="std_msgs/Int32"><state_var id="x" type="int32" field="data" expr="0"/></ros_topic>
+  </ports>
+  <guarantees><property id="p" logic="pmtl" expr="historically({x &gt;= 0})"/></guarantees>
+</properties>
+"#;
+
+#[test]
+fn a_process_sends_goals_to_an_action_the_model_serves() {
+    let dir = live_common::scratch("mover");
+    for (name, text) in [
+        ("main.xml", MOVER_MAIN),
+        ("mover.scxml", MOVER),
+        ("commander.scxml", COMMANDER),
+        ("props.xml", MOVER_PROPS),
+    ] {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let prefix = unique("external-action-client");
+    let node = node();
+    let name = ServiceName::new(&format!("{prefix}/mover/move")).unwrap();
+    let client = node
+        .service_builder(&name)
+        .request_response::<[u8], [u8]>()
+        .open_or_create()
+        .unwrap()
+        .client_builder()
+        .initial_max_slice_len(16)
+        .create()
+        .unwrap();
+    let moved_name = ServiceName::new(&format!("{prefix}/moved")).unwrap();
+    let moved = node
+        .service_builder(&moved_name)
+        .publish_subscribe::<[u8]>()
+        .open_or_create()
+        .unwrap()
+        .subscriber_builder()
+        .create()
+        .unwrap();
+    let mut run = Guard(Some(
+        Command::new(env!("CARGO_BIN_EXE_hindsight"))
+            .arg("run")
+            .arg(&dir)
+            .args(["--prefix", &prefix, "--external", "Commander"])
+            .args(["--speed", "10", "--duration", "20s"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap(),
+    ));
+    // Fibonacci goal: order i64, then seq; the answer: accepted byte, then seq.
+    let orders = [3i64, 0, 5];
+    let mut answers = Vec::new();
+    let mut published = Vec::new();
+    let mut pending = None;
+    let mut next = 0;
+    let (status, err) = live_common::finish_polling(&mut run, || {
+        while let Some(s) = moved.receive().unwrap() {
+            published.push(i64::from_le_bytes(s.payload()[0..8].try_into().unwrap()));
+        }
+        if pending.is_none() && next < orders.len() {
+            let mut p = [0u8; 16];
+            p[0..8].copy_from_slice(&orders[next].to_le_bytes());
+            p[8..16].copy_from_slice(&(next as u64).to_le_bytes());
+            let r = client.loan_slice_uninit(16).unwrap();
+            let sent = r.write_from_slice(&p).send().unwrap();
+            if sent.number_of_server_connections() > 0 {
+                pending = Some(sent);
+                next += 1;
+            }
+        }
+        if let Some(p) = &pending {
+            if let Some(resp) = p.receive().unwrap() {
+                let b = resp.payload();
+                assert_eq!(b.len(), 9, "accepted byte + seq");
+                answers.push(b[0]);
+                drop(resp);
+                pending = None;
+            }
+        }
+    });
+    assert!(status.success(), "{err}");
+    // The model's server accepts a positive order and rejects 0; it reports the orders it
+    // carried out on /moved.
+    assert_eq!(answers, vec![1, 0, 1], "{err}");
+    assert_eq!(published, vec![3, 5], "{err}");
+    assert!(
+        err.contains(&format!(
+            "run: serving {prefix}/mover/move: 3 requests from processes, 3 answered"
+        )),
+        "{err}"
+    );
+}

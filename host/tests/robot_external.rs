@@ -136,20 +136,22 @@ fn two_messages_at_one_instant_are_both_posted_in_order() {
 }
 
 #[test]
-fn an_unknown_component_or_an_action_client_is_refused() {
+fn an_unknown_component_is_refused_and_every_kind_of_node_is_described() {
     let e = match load_without(&museum(), &["NoSuchNode".to_string()]) {
         Err(e) => e.to_string(),
         Ok(_) => panic!("an unknown name loads"),
     };
     assert!(e.contains("no node model is called `NoSuchNode`"), "{e}");
     assert!(e.contains("BatteryComponent"), "lists the node models: {e}");
-    let e = match load_without(&museum(), &["GoToPoiActionSkill".to_string()]) {
-        Err(e) => e.to_string(),
-        Ok(_) => panic!("an action client is replaced"),
-    };
-    assert!(
-        e.contains("GoToPoiActionSkill.scxml:") && e.contains("<ros_action_client>"),
-        "{e}"
+    // An action client can be: its process sends the goals.
+    let (_, ext) = load_without(&museum(), &["GoToPoiActionSkill".to_string()])
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        ext[0].calls_actions,
+        vec![(
+            "/NavigationComponent/GoToPoi".to_string(),
+            "navigation_interfaces_dummy/GoToPoi".to_string()
+        )]
     );
     // An action server can be: its threads go, goals go to the process.
     let (_, ext) = load_without(&museum(), &["NavigationComponent".to_string()])

@@ -9,7 +9,9 @@ type Ipc = ipc::Service;
 
 use super::verify::{load_without, ModelArgs};
 use super::CliError;
-use crate::live::inject::{GoalBridge, GoalRoute, ServiceBridge, ServiceServers, TopicSubscriber};
+use crate::live::inject::{
+    Answer, GoalBridge, GoalRoute, ServiceBridge, ServiceServers, TopicSubscriber,
+};
 use crate::live::publish::{
     layout_of, layout_toml, layouts, name_from_ports, TopicLayout, TopicPublisher, WireKind,
 };
@@ -48,8 +50,8 @@ pub struct RunArgs {
     /// A node model (its `<scxml name>`) that a real process plays instead: it is left out
     /// of the run, what the process publishes on the node's topics is posted into the
     /// model, the requests of services and the goals of actions the node served go to the
-    /// process, and the process may call the services the node called (repeat for
-    /// several). Action clients cannot be replaced yet.
+    /// process, and the process may call the services and actions the node called (repeat
+    /// for several).
     #[arg(long, value_name = "NAME")]
     pub external: Vec<String>,
 }
@@ -85,8 +87,11 @@ Replacing a component by a process (--external NAME):
   service PREFIX/<action> (request: the goal's layout with goal_id; answer: 1 byte,
   1 accepted or 0 rejected, then a u64 seq) and the process publishes its feedback
   and results on PREFIX/<action>/feedback and /result (layouts from --layout; the
-  result's code is 4 succeeded, 5 canceled, 6 aborted). Malformed samples and
-  answers are counted, never posted. Action clients cannot be replaced yet. Example
+  result's code is 4 succeeded, 5 canceled, 6 aborted). An action it called is
+  served by the run on PREFIX/<action>: a process's goal (the goal's layout) goes to
+  the model's server and the answer is the same accept byte; feedback and results
+  are on the run's PREFIX/<action>/feedback and /result. Malformed samples and
+  answers are counted, never posted. Example
   (a battery written in Rust that publishes every 1.2 s):
   hindsight run examples/museum-guide --external BatteryComponent --speed 5 &
   cargo run -p hindsight --example battery_component -- --period 1.2s --speed 5
@@ -247,12 +252,12 @@ fn bridged_services(
     out
 }
 
-/// The services the external components call: `(service path, the client's request
-/// layout, the model's answer layout)`.
+/// The services and actions the external components call: `(service or action path, the
+/// client's request or goal layout, how the model's answer is sent back)`.
 fn called_services(
     model: &crate::sim::CompiledModel,
     external: &[crate::robot::load::ExternalComponent],
-) -> Vec<(String, TopicLayout, TopicLayout)> {
+) -> Vec<(String, TopicLayout, Answer)> {
     let mut out = Vec::new();
     let mut warnings = Vec::new();
     for c in external {
@@ -264,10 +269,38 @@ fn called_services(
                 (Some(req), Some(resp)) => out.push((
                     path.clone(),
                     layout_of(model, req, path.clone(), WireKind::Request, &mut warnings),
-                    layout_of(model, resp, path, WireKind::Response, &mut warnings),
+                    Answer::Layout(layout_of(
+                        model,
+                        resp,
+                        path,
+                        WireKind::Response,
+                        &mut warnings,
+                    )),
                 )),
                 _ => eprintln!(
                     "warning: --external {}: nothing in the model serves {service}; it is not \
+                     bridged",
+                    c.name
+                ),
+            }
+        }
+        for (action, _) in &c.calls_actions {
+            let event = |part: &str| {
+                model.event_id(&action_event(action, &format!("{part}_client_{}", c.name)))
+            };
+            let path = action.trim_start_matches('/').to_string();
+            match (
+                event("goal_req"),
+                event("goal_accept"),
+                event("goal_reject"),
+            ) {
+                (Some(goal), Some(accept), Some(reject)) => out.push((
+                    path.clone(),
+                    layout_of(model, goal, path, WireKind::Goal, &mut warnings),
+                    Answer::Goal { accept, reject },
+                )),
+                _ => eprintln!(
+                    "warning: --external {}: nothing in the model serves {action}; it is not \
                      bridged",
                     c.name
                 ),

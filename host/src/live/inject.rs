@@ -253,9 +253,39 @@ impl ServiceBridge {
     }
 }
 
+/// How the model's answer to a process's call becomes the iceoryx2 response.
+pub enum Answer {
+    /// A service's response: the answer event's parameters in this layout.
+    Layout(TopicLayout),
+    /// An action's goal response: one byte, 1 for the `accept` event, 0 for `reject`,
+    /// then a `u64` seq.
+    Goal {
+        /// The handler's accept of the client's goal.
+        accept: crate::sim::EventId,
+        /// The handler's reject of the client's goal.
+        reject: crate::sim::EventId,
+    },
+}
+
+impl Answer {
+    fn size(&self) -> usize {
+        match self {
+            Answer::Layout(l) => l.size,
+            Answer::Goal { .. } => 9,
+        }
+    }
+
+    fn events(&self) -> Vec<crate::sim::EventId> {
+        match self {
+            Answer::Layout(l) => vec![l.event],
+            Answer::Goal { accept, reject } => vec![*accept, *reject],
+        }
+    }
+}
+
 struct Served {
     request: TopicLayout,
-    response: TopicLayout,
+    response: Answer,
     server: RawServer,
     /// Requests posted into the model, oldest first: the model answers in order.
     waiting: VecDeque<Active>,
@@ -263,8 +293,8 @@ struct Served {
     stats: ServiceStats,
 }
 
-/// Servers of the model's services that processes call: requests into the model, its
-/// answers back.
+/// Servers of the model's services and actions that processes call: requests and goals
+/// into the model, its answers back.
 pub struct ServiceServers {
     /// Per event id: the index into `services` if it is a bridged answer to a client.
     by_event: Vec<Option<usize>>,
@@ -272,12 +302,12 @@ pub struct ServiceServers {
 }
 
 impl ServiceServers {
-    /// Opens (or creates) one request-response service per `(service path, the client's
-    /// request layout, the answer's layout)` under `prefix`, with a server each.
+    /// Opens (or creates) one request-response service per `(service or action path, the
+    /// client's request or goal layout, the answer)` under `prefix`, with a server each.
     pub fn new(
         node: &Node<Ipc>,
         event_count: usize,
-        services: Vec<(String, TopicLayout, TopicLayout)>,
+        services: Vec<(String, TopicLayout, Answer)>,
         prefix: &str,
     ) -> Result<ServiceServers, String> {
         let mut by_event = vec![None; event_count];
@@ -291,11 +321,13 @@ impl ServiceServers {
                 .open_or_create()
                 .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?
                 .server_builder()
-                .initial_max_slice_len(response.size)
+                .initial_max_slice_len(response.size())
                 .create()
                 .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
-            if let Some(slot) = by_event.get_mut(response.event.0 as usize) {
-                *slot = Some(out.len());
+            for e in response.events() {
+                if let Some(slot) = by_event.get_mut(e.0 as usize) {
+                    *slot = Some(out.len());
+                }
             }
             out.push(Served {
                 request,
@@ -350,11 +382,18 @@ impl ServiceServers {
             return Ok(());
         }
         let response = &s.response;
-        req.loan_slice_uninit(response.size)
+        req.loan_slice_uninit(response.size())
             .map_err(|e| format!("iceoryx2: {}: {e:?}", s.stats.service))
             .and_then(|r| {
                 let mut r = r.write_from_fn(|_| 0u8);
-                response.encode(msg, seq, r.payload_mut());
+                let out = r.payload_mut();
+                match response {
+                    Answer::Layout(l) => l.encode(msg, seq, out),
+                    Answer::Goal { accept, .. } => {
+                        out[0] = u8::from(msg.event() == *accept);
+                        out[1..9].copy_from_slice(&seq.to_le_bytes());
+                    }
+                }
                 r.send()
                     .map_err(|e| format!("iceoryx2: {}: {e:?}", s.stats.service))
             })?;

@@ -122,6 +122,9 @@ pub struct ExternalComponent {
     /// Actions it serves: `(action, ROS type)`; the process takes the goals, publishes
     /// feedback and results.
     pub serves_actions: Vec<(String, String)>,
+    /// Actions it calls: `(action, ROS type)`; the process sends goals, the model's server
+    /// accepts or rejects them.
+    pub calls_actions: Vec<(String, String)>,
 }
 
 /// Reads a main file and everything it names, lowers the behavior tree and the ROS tags,
@@ -138,9 +141,9 @@ pub fn load_with(main_path: &Path, halts: Halts) -> Result<RobotModel, Diagnosti
     load_full(main_path, &[], halts).map(|(m, _)| m)
 }
 
-/// What a node model declares that a process replacing it must speak, or an error at the
-/// declaration it cannot bridge (topics, services and served actions are; action clients
-/// are not yet).
+/// What a node model declares that a process replacing it must speak (topics, services
+/// and actions, either side), or an error at a declaration without its required
+/// attributes.
 fn external_component(
     sm: &SourceMap,
     root: &Element,
@@ -153,6 +156,7 @@ fn external_component(
         serves: Vec::new(),
         calls: Vec::new(),
         serves_actions: Vec::new(),
+        calls_actions: Vec::new(),
     };
     for el in root.elements() {
         match el.name.as_str() {
@@ -174,21 +178,14 @@ fn external_component(
                     c.calls.push((service, ty));
                 }
             }
-            "ros_action_server" => {
+            "ros_action_server" | "ros_action_client" => {
                 let action = el.required(sm, "action_name")?.value.trim().to_string();
                 let ty = el.required(sm, "type")?.value.trim().to_string();
-                c.serves_actions.push((action, ty));
-            }
-            "ros_action_client" => {
-                return Err(sm.diag(
-                    el.span,
-                    format!(
-                        "`{name}` cannot be replaced by a process: it declares <{}>, and only \
-                         topics, services and served actions are bridged to processes so far, not \
-                         action clients",
-                        el.name
-                    ),
-                ));
+                if el.name == "ros_action_server" {
+                    c.serves_actions.push((action, ty));
+                } else {
+                    c.calls_actions.push((action, ty));
+                }
             }
             _ => {}
         }
@@ -207,7 +204,9 @@ fn external_component(
 /// handler that takes the answer and does nothing: the process gets it. Each served
 /// action takes goals and does nothing (its threads are left out), and sends, under the
 /// transition that never fires, an accept, a reject, a feedback and a result whose fields
-/// are the interface's defaults: the process answers and reports instead.
+/// are the interface's defaults: the process answers and reports instead. Each called
+/// action sends a goal under that transition and takes every answer, feedback and
+/// result, doing nothing: the process sends goals and reads the answers.
 fn inert_stub(root: &Element, interfaces: &Interfaces) -> Element {
     fn first<'e>(el: &'e Element, tag: &str, alias: &str) -> Option<&'e Element> {
         el.elements().find_map(|c| {
@@ -246,6 +245,7 @@ fn inert_stub(root: &Element, interfaces: &Interfaces) -> Element {
                 | "ros_service_server"
                 | "ros_service_client"
                 | "ros_action_server"
+                | "ros_action_client"
         ) {
             stub.push(c.clone());
         }
@@ -257,6 +257,40 @@ fn inert_stub(root: &Element, interfaces: &Interfaces) -> Element {
                     .with_attr("name", alias)
                     .with_attr("target", "external"),
             );
+        }
+        if let ("ros_action_client", Some(alias)) = (c.name.as_str(), alias) {
+            let goal = c
+                .attr_value("type")
+                .and_then(|t| interfaces.action(t.trim()).ok())
+                .unwrap_or_default()
+                .goal;
+            let mut send = Element::new("ros_action_send_goal", c.span).with_attr("name", alias);
+            for f in &goal {
+                send.push(
+                    Element::new("field", c.span)
+                        .with_attr("name", f.dotted())
+                        .with_attr("expr", f.default.clone()),
+                );
+            }
+            requests_owned.push(send);
+            state.push(
+                Element::new("ros_action_handle_goal_response", c.span)
+                    .with_attr("name", alias)
+                    .with_attr("accept", "external")
+                    .with_attr("reject", "external"),
+            );
+            for tag in [
+                "ros_action_handle_feedback",
+                "ros_action_handle_success_result",
+                "ros_action_handle_aborted_result",
+                "ros_action_handle_canceled_result",
+            ] {
+                state.push(
+                    Element::new(tag, c.span)
+                        .with_attr("name", alias)
+                        .with_attr("target", "external"),
+                );
+            }
         }
         if let ("ros_action_server", Some(alias)) = (c.name.as_str(), alias) {
             state.push(
@@ -320,8 +354,7 @@ fn inert_stub(root: &Element, interfaces: &Interfaces) -> Element {
 
 /// [`load`], leaving out the node models named in `external` (their `<scxml name>`):
 /// the model runs without their behaviour ([`inert_stub`]), and what each declared is
-/// returned so that a process can take its place. An unknown name, or a node model that
-/// is an action client, is an error.
+/// returned so that a process can take its place. An unknown name is an error.
 pub fn load_without(
     main_path: &Path,
     external: &[String],
