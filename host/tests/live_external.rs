@@ -3,7 +3,7 @@
 #[path = "live_common/mod.rs"]
 mod live_common;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
@@ -301,68 +301,104 @@ const ADDER_PROPS: &str = r#"<properties>
 </properties>
 "#;
 
-#[test]
-fn a_process_calls_a_service_the_model_serves() {
-    let dir = live_common::scratch("adder");
-    for (name, text) in [
-        ("main.xml", ADDER_MAIN),
-        ("adder.scxml", ADDER),
-        ("asker.scxml", ASKER),
-        ("props.xml", ADDER_PROPS),
-    ] {
+/// Writes a model's files into a fresh scratch folder.
+fn model_dir(tag: &str, files: &[(&str, &str)]) -> PathBuf {
+    let dir = live_common::scratch(tag);
+    for (name, text) in files {
         std::fs::write(dir.join(name), text).unwrap();
     }
-    let prefix = unique("external-client");
+    dir
+}
+
+/// Runs the model in `dir` for 20 s at speed 10 with node `external` played by this test,
+/// which calls `PREFIX/<path>` with each request in turn once the run serves it (`poll`
+/// runs meanwhile); returns the answers and the run's stderr.
+fn call_while_running(
+    dir: &Path,
+    external: &str,
+    prefix: &str,
+    path: &str,
+    requests: &[Vec<u8>],
+    mut poll: impl FnMut(),
+) -> (Vec<Vec<u8>>, String) {
     let node = node();
-    let name = ServiceName::new(&format!("{prefix}/adder/add")).unwrap();
+    let name = ServiceName::new(&format!("{prefix}/{path}")).unwrap();
     let client = node
         .service_builder(&name)
         .request_response::<[u8], [u8]>()
         .open_or_create()
         .unwrap()
         .client_builder()
-        .initial_max_slice_len(24)
+        .initial_max_slice_len(requests.iter().map(Vec::len).max().unwrap_or(8))
         .create()
         .unwrap();
     let mut run = Guard(Some(
         Command::new(env!("CARGO_BIN_EXE_hindsight"))
             .arg("run")
-            .arg(&dir)
-            .args(["--prefix", &prefix, "--external", "Asker"])
+            .arg(dir)
+            .args(["--prefix", prefix, "--external", external])
             .args(["--speed", "10", "--duration", "20s"])
             .stdout(Stdio::null())
             .stderr(Stdio::piped())
             .spawn()
             .unwrap(),
     ));
-    // AddTwoInts request: a i64, b i64, seq u64; response: sum i64, seq u64.
-    let mut sums = Vec::new();
-    let mut asked = 0i64;
+    let mut answers = Vec::new();
+    let mut next = 0;
     let mut pending = None;
     let (status, err) = live_common::finish_polling(&mut run, || {
-        if pending.is_none() && asked < 3 {
-            let mut p = [0u8; 24];
-            p[0..8].copy_from_slice(&(asked * 100).to_le_bytes());
-            p[8..16].copy_from_slice(&7i64.to_le_bytes());
-            p[16..24].copy_from_slice(&(asked as u64).to_le_bytes());
-            let r = client.loan_slice_uninit(24).unwrap();
-            let sent = r.write_from_slice(&p).send().unwrap();
+        poll();
+        if pending.is_none() && next < requests.len() {
+            let r = client.loan_slice_uninit(requests[next].len()).unwrap();
+            let sent = r.write_from_slice(&requests[next]).send().unwrap();
+            // Before the run's server is up nobody answers: ask again.
             if sent.number_of_server_connections() > 0 {
                 pending = Some(sent);
-                asked += 1;
+                next += 1;
             }
         }
         if let Some(p) = &pending {
             if let Some(resp) = p.receive().unwrap() {
-                let b = resp.payload();
-                assert_eq!(b.len(), 16, "sum + seq");
-                sums.push(i64::from_le_bytes(b[0..8].try_into().unwrap()));
+                answers.push(resp.payload().to_vec());
                 drop(resp);
                 pending = None;
             }
         }
     });
     assert!(status.success(), "{err}");
+    (answers, err)
+}
+
+#[test]
+fn a_process_calls_a_service_the_model_serves() {
+    let dir = model_dir(
+        "adder",
+        &[
+            ("main.xml", ADDER_MAIN),
+            ("adder.scxml", ADDER),
+            ("asker.scxml", ASKER),
+            ("props.xml", ADDER_PROPS),
+        ],
+    );
+    let prefix = unique("external-client");
+    // AddTwoInts request: a i64, b i64, seq u64; response: sum i64, seq u64.
+    let requests: Vec<Vec<u8>> = (0..3i64)
+        .map(|k| {
+            let mut p = vec![0u8; 24];
+            p[0..8].copy_from_slice(&(k * 100).to_le_bytes());
+            p[8..16].copy_from_slice(&7i64.to_le_bytes());
+            p[16..24].copy_from_slice(&(k as u64).to_le_bytes());
+            p
+        })
+        .collect();
+    let (answers, err) = call_while_running(&dir, "Asker", &prefix, "adder/add", &requests, || {});
+    let sums: Vec<i64> = answers
+        .iter()
+        .map(|b| {
+            assert_eq!(b.len(), 16, "sum + seq");
+            i64::from_le_bytes(b[0..8].try_into().unwrap())
+        })
+        .collect();
     assert_eq!(sums, vec![7, 107, 207], "{err}");
     assert!(
         err.contains(&format!(
@@ -603,27 +639,17 @@ const MOVER_PROPS: &str = r#"<properties>
 
 #[test]
 fn a_process_sends_goals_to_an_action_the_model_serves() {
-    let dir = live_common::scratch("mover");
-    for (name, text) in [
-        ("main.xml", MOVER_MAIN),
-        ("mover.scxml", MOVER),
-        ("commander.scxml", COMMANDER),
-        ("props.xml", MOVER_PROPS),
-    ] {
-        std::fs::write(dir.join(name), text).unwrap();
-    }
+    let dir = model_dir(
+        "mover",
+        &[
+            ("main.xml", MOVER_MAIN),
+            ("mover.scxml", MOVER),
+            ("commander.scxml", COMMANDER),
+            ("props.xml", MOVER_PROPS),
+        ],
+    );
     let prefix = unique("external-action-client");
     let node = node();
-    let name = ServiceName::new(&format!("{prefix}/mover/move")).unwrap();
-    let client = node
-        .service_builder(&name)
-        .request_response::<[u8], [u8]>()
-        .open_or_create()
-        .unwrap()
-        .client_builder()
-        .initial_max_slice_len(16)
-        .create()
-        .unwrap();
     let moved_name = ServiceName::new(&format!("{prefix}/moved")).unwrap();
     let moved = node
         .service_builder(&moved_name)
@@ -633,52 +659,29 @@ fn a_process_sends_goals_to_an_action_the_model_serves() {
         .subscriber_builder()
         .create()
         .unwrap();
-    let mut run = Guard(Some(
-        Command::new(env!("CARGO_BIN_EXE_hindsight"))
-            .arg("run")
-            .arg(&dir)
-            .args(["--prefix", &prefix, "--external", "Commander"])
-            .args(["--speed", "10", "--duration", "20s"])
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap(),
-    ));
     // Fibonacci goal: order i64, then seq; the answer: accepted byte, then seq.
-    let orders = [3i64, 0, 5];
-    let mut answers = Vec::new();
+    let requests: Vec<Vec<u8>> = [3i64, 0, 5]
+        .iter()
+        .enumerate()
+        .map(|(k, order)| {
+            let mut p = vec![0u8; 16];
+            p[0..8].copy_from_slice(&order.to_le_bytes());
+            p[8..16].copy_from_slice(&(k as u64).to_le_bytes());
+            p
+        })
+        .collect();
     let mut published = Vec::new();
-    let mut pending = None;
-    let mut next = 0;
-    let (status, err) = live_common::finish_polling(&mut run, || {
-        while let Some(s) = moved.receive().unwrap() {
-            published.push(i64::from_le_bytes(s.payload()[0..8].try_into().unwrap()));
-        }
-        if pending.is_none() && next < orders.len() {
-            let mut p = [0u8; 16];
-            p[0..8].copy_from_slice(&orders[next].to_le_bytes());
-            p[8..16].copy_from_slice(&(next as u64).to_le_bytes());
-            let r = client.loan_slice_uninit(16).unwrap();
-            let sent = r.write_from_slice(&p).send().unwrap();
-            if sent.number_of_server_connections() > 0 {
-                pending = Some(sent);
-                next += 1;
+    let (answers, err) =
+        call_while_running(&dir, "Commander", &prefix, "mover/move", &requests, || {
+            while let Some(s) = moved.receive().unwrap() {
+                published.push(i64::from_le_bytes(s.payload()[0..8].try_into().unwrap()));
             }
-        }
-        if let Some(p) = &pending {
-            if let Some(resp) = p.receive().unwrap() {
-                let b = resp.payload();
-                assert_eq!(b.len(), 9, "accepted byte + seq");
-                answers.push(b[0]);
-                drop(resp);
-                pending = None;
-            }
-        }
-    });
-    assert!(status.success(), "{err}");
+        });
     // The model's server accepts a positive order and rejects 0; it reports the orders it
     // carried out on /moved.
-    assert_eq!(answers, vec![1, 0, 1], "{err}");
+    assert!(answers.iter().all(|a| a.len() == 9), "accepted byte + seq");
+    let accepted: Vec<u8> = answers.iter().map(|a| a[0]).collect();
+    assert_eq!(accepted, vec![1, 0, 1], "{err}");
     assert_eq!(published, vec![3, 5], "{err}");
     assert!(
         err.contains(&format!(

@@ -125,20 +125,95 @@ pub struct ServiceStats {
     pub malformed: u64,
 }
 
-struct Bridged {
-    request: TopicLayout,
-    response: TopicLayout,
+/// A client of one request-response service a process serves: requests out in a layout,
+/// answers matched to their requests in order (`T`: what the caller keeps per request).
+struct Outgoing<T> {
     client: RawClient,
-    pending: VecDeque<Pending>,
+    pending: VecDeque<(Pending, T)>,
     seq: u64,
     stats: ServiceStats,
+}
+
+impl<T> Outgoing<T> {
+    /// A client of `prefix/path`, the service opened or created.
+    fn open(node: &Node<Ipc>, prefix: &str, path: String, max_len: usize) -> Result<Self, String> {
+        let svc = prefixed(prefix, path);
+        let name = super::service_name(&svc).map_err(|e| e.to_string())?;
+        let client = node
+            .service_builder(&name)
+            .request_response::<[u8], [u8]>()
+            .open_or_create()
+            .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?
+            .client_builder()
+            .initial_max_slice_len(max_len)
+            .create()
+            .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
+        Ok(Outgoing {
+            client,
+            pending: VecDeque::new(),
+            seq: 0,
+            stats: ServiceStats {
+                service: svc,
+                ..ServiceStats::default()
+            },
+        })
+    }
+
+    /// Sends `msg` in `layout`; without a server it counts as unanswered.
+    fn send(&mut self, layout: &TopicLayout, msg: &SentMessage<'_>, keep: T) -> Result<(), String> {
+        let seq = self.seq;
+        self.seq += 1;
+        let service = &self.stats.service;
+        let pending = self
+            .client
+            .loan_slice_uninit(layout.size)
+            .map_err(|e| format!("iceoryx2: {service}: {e:?}"))
+            .and_then(|r| {
+                let mut r = r.write_from_fn(|_| 0u8);
+                layout.encode(msg, seq, r.payload_mut());
+                r.send().map_err(|e| format!("iceoryx2: {service}: {e:?}"))
+            })?;
+        self.stats.requests += 1;
+        if pending.number_of_server_connections() == 0 {
+            self.stats.unanswered += 1;
+        } else {
+            self.pending.push_back((pending, keep));
+        }
+        Ok(())
+    }
+
+    /// Hands each answer that arrived to `answer` (which says whether it was well formed);
+    /// one answer per request, and a server that went away answers nothing.
+    fn receive(&mut self, mut answer: impl FnMut(&[u8], &T) -> bool) {
+        let mut k = 0;
+        while k < self.pending.len() {
+            let mut done = false;
+            while let Ok(Some(resp)) = self.pending[k].0.receive() {
+                if answer(resp.payload(), &self.pending[k].1) {
+                    self.stats.answered += 1;
+                } else {
+                    self.stats.malformed += 1;
+                }
+                done = true;
+            }
+            if done || !self.pending[k].0.is_connected() {
+                if !done {
+                    self.stats.unanswered += 1;
+                }
+                self.pending.remove(k);
+            } else {
+                k += 1;
+            }
+        }
+    }
 }
 
 /// Clients of the services processes serve: requests out, responses into the model.
 pub struct ServiceBridge {
     /// Per event id: the index into `services` if it is a bridged request.
     by_event: Vec<Option<usize>>,
-    services: Vec<Bridged>,
+    /// `(request layout, response layout, client)`.
+    services: Vec<(TopicLayout, TopicLayout, Outgoing<()>)>,
 }
 
 impl ServiceBridge {
@@ -153,32 +228,11 @@ impl ServiceBridge {
         let mut by_event = vec![None; event_count];
         let mut out = Vec::new();
         for (path, request, response) in services {
-            let svc = prefixed(prefix, path);
-            let name = super::service_name(&svc).map_err(|e| e.to_string())?;
-            let factory = node
-                .service_builder(&name)
-                .request_response::<[u8], [u8]>()
-                .open_or_create()
-                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
-            let client = factory
-                .client_builder()
-                .initial_max_slice_len(request.size)
-                .create()
-                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
+            let client = Outgoing::open(node, prefix, path, request.size)?;
             if let Some(slot) = by_event.get_mut(request.event.0 as usize) {
                 *slot = Some(out.len());
             }
-            out.push(Bridged {
-                request,
-                response,
-                client,
-                pending: VecDeque::new(),
-                seq: 0,
-                stats: ServiceStats {
-                    service: svc,
-                    ..ServiceStats::default()
-                },
-            });
+            out.push((request, response, client));
         }
         Ok(ServiceBridge {
             by_event,
@@ -194,62 +248,26 @@ impl ServiceBridge {
         let Some(Some(i)) = self.by_event.get(msg.event().0 as usize) else {
             return Ok(());
         };
-        let b = &mut self.services[*i];
-        let size = b.request.size;
-        let seq = b.seq;
-        b.seq += 1;
-        let request = &b.request;
-        let pending = b
-            .client
-            .loan_slice_uninit(size)
-            .map_err(|e| format!("iceoryx2: {}: {e:?}", b.stats.service))
-            .and_then(|r| {
-                let mut r = r.write_from_fn(|_| 0u8);
-                request.encode(msg, seq, r.payload_mut());
-                r.send()
-                    .map_err(|e| format!("iceoryx2: {}: {e:?}", b.stats.service))
-            })?;
-        b.stats.requests += 1;
-        if pending.number_of_server_connections() == 0 {
-            b.stats.unanswered += 1;
-        } else {
-            b.pending.push_back(pending);
-        }
-        Ok(())
+        let (request, _, client) = &mut self.services[*i];
+        client.send(request, msg, ())
     }
 
     /// Takes every response that arrived and queues it in `inbox`, oldest request first.
     pub fn poll(&mut self, inbox: &mut Inbox) {
-        for b in &mut self.services {
-            let mut k = 0;
-            while k < b.pending.len() {
-                let mut done = false;
-                while let Ok(Some(resp)) = b.pending[k].receive() {
-                    match b.response.decode(resp.payload()) {
-                        Some((params, _seq)) => {
-                            b.stats.answered += 1;
-                            inbox.push(b.response.event, params);
-                        }
-                        None => b.stats.malformed += 1,
-                    }
-                    done = true;
+        for (_, response, client) in &mut self.services {
+            client.receive(|bytes, ()| match response.decode(bytes) {
+                Some((params, _seq)) => {
+                    inbox.push(response.event, params);
+                    true
                 }
-                // One response per request; a server that went away answers nothing.
-                if done || !b.pending[k].is_connected() {
-                    if !done {
-                        b.stats.unanswered += 1;
-                    }
-                    b.pending.remove(k);
-                } else {
-                    k += 1;
-                }
-            }
+                None => false,
+            });
         }
     }
 
     /// What each bridged service did so far.
     pub fn stats(&self) -> impl Iterator<Item = &ServiceStats> {
-        self.services.iter().map(|b| &b.stats)
+        self.services.iter().map(|s| &s.2.stats)
     }
 }
 
@@ -432,17 +450,10 @@ pub struct GoalRoute {
     pub rejected: (crate::sim::EventId, usize),
 }
 
-struct GoalClient {
-    route: GoalRoute,
-    client: RawClient,
-    pending: VecDeque<(Pending, i64)>,
-    seq: u64,
-    stats: ServiceStats,
-}
-
 /// Clients of the actions processes serve: goals out, accepts and rejects into the model.
 pub struct GoalBridge {
-    actions: Vec<GoalClient>,
+    /// Each route with its client, which keeps each goal's id until its answer.
+    actions: Vec<(GoalRoute, Outgoing<i64>)>,
 }
 
 impl GoalBridge {
@@ -454,27 +465,8 @@ impl GoalBridge {
     ) -> Result<GoalBridge, String> {
         let mut actions = Vec::new();
         for route in routes {
-            let svc = prefixed(prefix, route.path.clone());
-            let name = super::service_name(&svc).map_err(|e| e.to_string())?;
-            let client = node
-                .service_builder(&name)
-                .request_response::<[u8], [u8]>()
-                .open_or_create()
-                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?
-                .client_builder()
-                .initial_max_slice_len(route.goal.size)
-                .create()
-                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
-            actions.push(GoalClient {
-                route,
-                client,
-                pending: VecDeque::new(),
-                seq: 0,
-                stats: ServiceStats {
-                    service: svc,
-                    ..ServiceStats::default()
-                },
-            });
+            let client = Outgoing::open(node, prefix, route.path.clone(), route.goal.size)?;
+            actions.push((route, client));
         }
         Ok(GoalBridge { actions })
     }
@@ -484,75 +476,40 @@ impl GoalBridge {
         if msg.origin() == EXTERNAL {
             return Ok(());
         }
-        let Some(a) = self
+        let Some((route, client)) = self
             .actions
             .iter_mut()
-            .find(|a| a.route.goal.event == msg.event())
+            .find(|(r, _)| r.goal.event == msg.event())
         else {
             return Ok(());
         };
-        let goal_id = match msg.param(a.route.goal_id) {
+        let goal_id = match msg.param(route.goal_id) {
             Some(crate::expr::Value::Int(g)) => g,
             _ => 0,
         };
-        let seq = a.seq;
-        a.seq += 1;
-        let layout = &a.route.goal;
-        let pending = a
-            .client
-            .loan_slice_uninit(layout.size)
-            .map_err(|e| format!("iceoryx2: {}: {e:?}", a.stats.service))
-            .and_then(|r| {
-                let mut r = r.write_from_fn(|_| 0u8);
-                layout.encode(msg, seq, r.payload_mut());
-                r.send()
-                    .map_err(|e| format!("iceoryx2: {}: {e:?}", a.stats.service))
-            })?;
-        a.stats.requests += 1;
-        if pending.number_of_server_connections() == 0 {
-            a.stats.unanswered += 1;
-        } else {
-            a.pending.push_back((pending, goal_id));
-        }
-        Ok(())
+        client.send(&route.goal, msg, goal_id)
     }
 
     /// Posts each answer that arrived as the server's accept or reject of its goal.
     pub fn poll(&mut self, inbox: &mut Inbox) {
-        for a in &mut self.actions {
-            let mut k = 0;
-            while k < a.pending.len() {
-                let mut done = false;
-                while let Ok(Some(resp)) = a.pending[k].0.receive() {
-                    let goal_id = a.pending[k].1;
-                    match resp.payload() {
-                        [b @ (0 | 1), _, _, _, _, _, _, _, _] => {
-                            let (event, at) = if *b == 1 {
-                                a.route.accepted
-                            } else {
-                                a.route.rejected
-                            };
-                            inbox.push(event, vec![(at, crate::sim::Scalar::Int(goal_id))]);
-                            a.stats.answered += 1;
-                        }
-                        _ => a.stats.malformed += 1,
-                    }
-                    done = true;
+        for (route, client) in &mut self.actions {
+            client.receive(|bytes, &goal_id| match bytes {
+                [b @ (0 | 1), _, _, _, _, _, _, _, _] => {
+                    let (event, at) = if *b == 1 {
+                        route.accepted
+                    } else {
+                        route.rejected
+                    };
+                    inbox.push(event, vec![(at, crate::sim::Scalar::Int(goal_id))]);
+                    true
                 }
-                if done || !a.pending[k].0.is_connected() {
-                    if !done {
-                        a.stats.unanswered += 1;
-                    }
-                    a.pending.remove(k);
-                } else {
-                    k += 1;
-                }
-            }
+                _ => false,
+            });
         }
     }
 
     /// What each bridged action's goals did so far.
     pub fn stats(&self) -> impl Iterator<Item = &ServiceStats> {
-        self.actions.iter().map(|a| &a.stats)
+        self.actions.iter().map(|(_, c)| &c.stats)
     }
 }
