@@ -13,7 +13,9 @@
 //! run: guide runs/s over plain runs/s (>= 1 meets the goal). The `sim only` lines run
 //! the simulator without properties, to show where the time goes. The `halts when
 //! needed` line is the guide lowered with `Halts::WhenNeeded` (not the default: it
-//! changes how races at one instant come out, see `hindsight::robot::bt::Halts`).
+//! changes how races at one instant come out, see `hindsight::robot::bt::Halts`). The
+//! `converted` line is the guide's own plain translation (`hindsight convert`, loaded back
+//! as plain SCXML): reading the high-level model natively costs nothing against it.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -60,6 +62,28 @@ impl Case {
             ..RunConfig::default()
         };
         Case { name, loaded, cfg }
+    }
+
+    /// The guide's own plain-SCXML translation: `hindsight convert examples/museum-guide`
+    /// written to a temporary folder and loaded back as plain SCXML, AS2FM's semantics.
+    fn converted() -> Case {
+        let out =
+            std::env::temp_dir().join(format!("hindsight-bench-convert-{}", std::process::id()));
+        hindsight::cli::convert::run(&hindsight::cli::convert::ConvertArgs {
+            model: examples().join("museum-guide"),
+            out: out.clone(),
+        })
+        .unwrap_or_else(|e| panic!("convert: {e:?}"));
+        let args = ModelArgs {
+            model: out.clone(),
+            props: None,
+            time_unit: Some("100ms".into()),
+            events: Some(Events::As2fm),
+        };
+        let loaded = load(&args).unwrap_or_else(|e| panic!("converted guide: {e:?}"));
+        let _ = std::fs::remove_dir_all(&out);
+        let max_time = loaded.default_max_time.or(Some(1002));
+        Case::of("guide converted (plain, as2fm)", loaded, max_time)
     }
 
     /// The guide lowered with `halts`, AS2FM's event semantics.
@@ -146,6 +170,7 @@ fn main() {
             Some(1001),
         ),
         Case::guide_with("guide (halts needed, as2fm)", Halts::WhenNeeded),
+        Case::converted(),
     ];
     let runners: Vec<Runner<'_>> = cases
         .iter()
@@ -214,5 +239,10 @@ fn main() {
         "ratio guide (halts needed) / plain (queues): {:.2}x runs/s, simulator alone {:.2}x",
         rate[4] / rate[2],
         sim_rate[4] / sim_rate[2]
+    );
+    println!(
+        "ratio guide (as2fm) / its own plain translation (convert): {:.2}x runs/s, simulator alone {:.2}x",
+        rate[0] / rate[5],
+        sim_rate[0] / sim_rate[5]
     );
 }
