@@ -249,7 +249,11 @@ fn inert_stub(root: &Element, interfaces: &Interfaces) -> Element {
         ) {
             stub.push(c.clone());
         }
-        let alias = c.attr_value("name").or(c.attr_value("service_name"));
+        // Tags name a declaration by its `name`, else by the service or action name.
+        let alias = c
+            .attr_value("name")
+            .or(c.attr_value("service_name"))
+            .or(c.attr_value("action_name"));
         if let ("ros_service_client", Some(alias)) = (c.name.as_str(), alias) {
             requests.extend(first(root, "ros_service_send_request", alias));
             state.push(
