@@ -69,10 +69,11 @@ enum Command {
     Convert(cli::convert::ConvertArgs),
     /// Monitor a running system on-line: tap iceoryx2 services, judge every sample, report verdicts.
     ///
-    /// Example: `hindsight monitor --props museum.hspec --config museum.toml --record in.jsonl`
+    /// Example: `hindsight monitor --model examples/museum-guide --config museum.toml --record in.jsonl`
     Monitor(cli::monitor::MonitorArgs),
     /// Run one seeded simulation of a model live, paced in wall-clock time, publishing its
-    /// ROS topics over iceoryx2 (e.g. for `hindsight monitor`).
+    /// ROS messages over iceoryx2 (for `hindsight monitor`); real processes can play its
+    /// node models (--external).
     ///
     /// Example: `hindsight run examples/museum-guide --speed 10 --prefix museum`
     Run(cli::run::RunArgs),
