@@ -367,6 +367,26 @@ impl Run<'_, '_> {
         Ok(())
     }
 
+    /// Says `note` about `source` and judges the loss of `count` samples that set `vars`.
+    fn loss(
+        &mut self,
+        time: u64,
+        source: &str,
+        vars: &[String],
+        count: u64,
+        reason: &str,
+        note: String,
+    ) -> Result<(), LiveError> {
+        self.note(format!("{source}: {note}"));
+        self.feed(Input::Loss {
+            time,
+            source: source.to_string(),
+            vars: vars.to_vec(),
+            count,
+            reason: reason.to_string(),
+        })
+    }
+
     fn note(&mut self, msg: String) {
         let _ = writeln!(self.opts.log, "monitor: {msg}");
     }
@@ -454,17 +474,14 @@ impl Run<'_, '_> {
                             (s + modulus - expected) % modulus
                         };
                         tap.stats.lost += lost;
-                        self.note(format!(
-                            "{}: {lost} samples lost (sequence {expected} to {s})",
-                            tap.source
-                        ));
-                        self.feed(Input::Loss {
+                        self.loss(
                             time,
-                            source: tap.source.clone(),
-                            vars: tap.vars.clone(),
-                            count: lost,
-                            reason: "sequence gap".into(),
-                        })?;
+                            &tap.source,
+                            &tap.vars,
+                            lost,
+                            "sequence gap",
+                            format!("{lost} samples lost (sequence {expected} to {s})"),
+                        )?;
                     }
                 }
                 tap.publishers[idx].1 = Some(s);
@@ -483,33 +500,21 @@ impl Run<'_, '_> {
                 }
                 Err(m) => {
                     tap.stats.malformed += 1;
-                    self.note(format!("{}: malformed sample: {m}", tap.source));
-                    self.feed(Input::Loss {
-                        time,
-                        source: tap.source.clone(),
-                        vars: tap.vars.clone(),
-                        count: 1,
-                        reason: format!("malformed: {m}"),
-                    })?;
+                    let reason = format!("malformed: {m}");
+                    let note = format!("malformed sample: {m}");
+                    self.loss(time, &tap.source, &tap.vars, 1, &reason, note)?;
                 }
             }
         }
         if n > 0 && tap.seq.is_none() && n >= tap.sub.buffer_size() {
             // The buffer was full at some moment: the oldest samples may have been overwritten.
             tap.stats.lost += 1;
-            self.note(format!(
-                "{}: buffer of {} samples full, samples may be lost",
-                tap.source,
+            let note = format!(
+                "buffer of {} samples full, samples may be lost",
                 tap.sub.buffer_size()
-            ));
+            );
             let time = self.now();
-            self.feed(Input::Loss {
-                time,
-                source: tap.source.clone(),
-                vars: tap.vars.clone(),
-                count: 1,
-                reason: "buffer full".into(),
-            })?;
+            self.loss(time, &tap.source, &tap.vars, 1, "buffer full", note)?;
         }
         Ok(n > 0)
     }
@@ -546,14 +551,9 @@ impl Run<'_, '_> {
                 }
                 Err(m) => {
                     px.stats.malformed += 1;
-                    self.note(format!("{}: malformed request: {m}", px.source));
-                    self.feed(Input::Loss {
-                        time,
-                        source: px.source.clone(),
-                        vars: px.var_names.clone(),
-                        count: 1,
-                        reason: format!("malformed: {m}"),
-                    })?;
+                    let reason = format!("malformed: {m}");
+                    let note = format!("malformed request: {m}");
+                    self.loss(time, &px.source, &px.var_names, 1, &reason, note)?;
                     // filter cannot judge it, so it does not pass; log forwards it.
                     px.action == Action::Log
                 }
