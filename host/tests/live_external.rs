@@ -10,7 +10,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use iceoryx2::prelude::*;
-use live_common::{example, finish, finish_polling, node, unique, Guard};
+use live_common::{example, finish, finish_polling, node, raw_subscriber, unique, Guard};
 
 fn museum() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-guide")
@@ -85,15 +85,10 @@ fn response_mirror(
     node: &Node<ipc::Service>,
     prefix: &str,
 ) -> iceoryx2::port::subscriber::Subscriber<ipc::Service, [u8], ()> {
-    let name =
-        ServiceName::new(&format!("{prefix}/NotifyUserComponent/StartAlarm/response")).unwrap();
-    node.service_builder(&name)
-        .publish_subscribe::<[u8]>()
-        .open_or_create()
-        .unwrap()
-        .subscriber_builder()
-        .create()
-        .unwrap()
+    raw_subscriber(
+        node,
+        &format!("{prefix}/NotifyUserComponent/StartAlarm/response"),
+    )
 }
 
 fn run_museum(prefix: &str, extra: &[&str]) -> Guard {
@@ -191,15 +186,7 @@ fn without_a_process_the_battery_stays_silent_and_nobody_is_alarmed() {
 fn the_hand_written_battery_replaces_its_model() {
     let prefix = unique("external-example");
     let node = node();
-    let name = ServiceName::new(&format!("{prefix}/BatteryComponent/battery_level")).unwrap();
-    let tap = node
-        .service_builder(&name)
-        .publish_subscribe::<[u8]>()
-        .open_or_create()
-        .unwrap()
-        .subscriber_builder()
-        .create()
-        .unwrap();
+    let tap = raw_subscriber(&node, &format!("{prefix}/BatteryComponent/battery_level"));
     let mut run = run_museum(
         &prefix,
         &[
@@ -650,15 +637,7 @@ fn a_process_sends_goals_to_an_action_the_model_serves() {
     );
     let prefix = unique("external-action-client");
     let node = node();
-    let moved_name = ServiceName::new(&format!("{prefix}/moved")).unwrap();
-    let moved = node
-        .service_builder(&moved_name)
-        .publish_subscribe::<[u8]>()
-        .open_or_create()
-        .unwrap()
-        .subscriber_builder()
-        .create()
-        .unwrap();
+    let moved = raw_subscriber(&node, &format!("{prefix}/moved"));
     // Fibonacci goal: order i64, then seq; the answer: accepted byte, then seq.
     let requests: Vec<Vec<u8>> = [3i64, 0, 5]
         .iter()

@@ -8,7 +8,6 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use iceoryx2::prelude::*;
 use live_common::{example, finish, scratch, unique, Guard};
 
 /// Model time per wall-clock time: a model step of 100 ms takes 20 ms, so the sidecar's
@@ -113,15 +112,10 @@ fn session(tag: &str, duration: &str, battery_period: Option<&str>) -> Session {
     // a component that starts before the system would make the sidecar's time 0 its own
     // first message, before the scheduler's, which poi_response (0.2 s) does not forgive.
     let node = live_common::node();
-    let first = ServiceName::new(&format!("{prefix}/SchedulerComponent/SetPoi/request")).unwrap();
-    let started = node
-        .service_builder(&first)
-        .publish_subscribe::<[u8]>()
-        .open_or_create()
-        .unwrap()
-        .subscriber_builder()
-        .create()
-        .unwrap();
+    let started = live_common::raw_subscriber(
+        &node,
+        &format!("{prefix}/SchedulerComponent/SetPoi/request"),
+    );
     let mut run = Guard(Some(
         hindsight()
             .arg("run")

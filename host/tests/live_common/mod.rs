@@ -284,3 +284,18 @@ pub fn example(name: &str) -> std::path::PathBuf {
     );
     path
 }
+
+/// A subscriber, with iceoryx2's defaults, to the `[u8]` publish-subscribe service `name`
+/// (opened, or created before its publisher exists).
+pub fn raw_subscriber(
+    node: &Node<ipc::Service>,
+    name: &str,
+) -> iceoryx2::port::subscriber::Subscriber<ipc::Service, [u8], ()> {
+    node.service_builder(&ServiceName::new(name).unwrap())
+        .publish_subscribe::<[u8]>()
+        .open_or_create()
+        .unwrap()
+        .subscriber_builder()
+        .create()
+        .unwrap()
+}
