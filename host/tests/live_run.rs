@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use hindsight::live::config::Config;
 use iceoryx2::prelude::*;
-use live_common::{finish, node, unique, Guard};
+use live_common::{finish, finish_polling, node, unique, Guard};
 
 fn museum() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-guide")
@@ -57,14 +57,7 @@ fn battery_level_is_published_once_per_model_second() {
         .unwrap();
     let mut guard = Guard(Some(child));
     let mut got = Vec::new();
-    let (status, err) = loop {
-        drain(&sub, &mut got);
-        if guard.0.as_mut().unwrap().try_wait().unwrap().is_some() {
-            break finish(&mut guard);
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    };
-    drain(&sub, &mut got);
+    let (status, err) = finish_polling(&mut guard, || drain(&sub, &mut got));
     assert!(status.success(), "{err}");
     assert!(err.contains("reached the duration"), "{err}");
     // The battery publishes at t = 0 s, 1 s, ..., 5 s: 100, 99, ..., 95.
