@@ -221,6 +221,10 @@ fn the_hand_written_battery_replaces_its_model() {
     let (status, err) = finish_polling(&mut run, &mut drain);
     assert!(status.success(), "{err}");
     assert!(battery_status.success(), "{battery_err}");
+    assert!(
+        err.contains("run: BatteryComponent is played by a process: publishes /BatteryComponent/battery_level"),
+        "{err}"
+    );
     let want: Vec<(i64, u64)> = (0..8).map(|k| (100 - k as i64, k)).collect();
     assert_eq!(got, want);
     // And the run took them in (all but those published before its subscriber existed).

@@ -224,6 +224,31 @@ fn inbound_layouts(
     inbound
 }
 
+/// What a process playing `c` speaks, for the start of a run.
+fn describe(c: &crate::robot::load::ExternalComponent) -> String {
+    let parts = [
+        ("publishes", &c.publishes),
+        ("subscribes to", &c.subscribes),
+        ("serves", &c.serves),
+        ("calls", &c.calls),
+        ("serves action", &c.serves_actions),
+        ("calls action", &c.calls_actions),
+    ];
+    let said: Vec<String> = parts
+        .iter()
+        .filter(|(_, l)| !l.is_empty())
+        .map(|(verb, l)| {
+            let names: Vec<&str> = l.iter().map(|(n, _)| n.as_str()).collect();
+            format!("{verb} {}", names.join(", "))
+        })
+        .collect();
+    if said.is_empty() {
+        "no ROS interface".to_string()
+    } else {
+        said.join("; ")
+    }
+}
+
 /// The services the external components serve: `(service path, request layout, response
 /// layout)`. Their mirrors stay in `topics`: the run publishes requests and responses.
 fn bridged_services(
@@ -390,6 +415,9 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         return Ok(());
     }
     // The monitor taps what processes publish too: the layout above keeps their topics.
+    for c in &external {
+        eprintln!("run: {} is played by a process: {}", c.name, describe(c));
+    }
     let inbound = inbound_layouts(&mut topics, &external);
     let served = bridged_services(&topics, &external);
     let called = called_services(model, &external);
