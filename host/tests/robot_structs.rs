@@ -354,7 +354,7 @@ fn a_struct_may_name_a_type_declared_after_it_and_literals_nest() {
 }
 
 /// An object literal sent as a parameter takes the parameter's declared type (`<param
-/// type>`); without one, the parameter's type cannot be inferred from the literal.
+/// type>`); without one, the error at the literal says where a struct type can come from.
 #[test]
 fn object_literal_parameters_need_a_declared_type() {
     let dm = r#"<data id="p" type="Point" expr="{x: 1, y: 2}" />"#;
@@ -364,7 +364,9 @@ fn object_literal_parameters_need_a_declared_type() {
         r#"<onentry><send event="e"><param name="q" expr="{x: p.x, y: 3}" /></send></onentry>"#;
     let err = load_err("param-untyped", TYPES, dm, untyped).expect("untyped literal parameter");
     assert!(
-        err.contains("node.ascxml:6:") && err.contains("parameter `q`"),
+        err.contains("node.ascxml:6:48:")
+            && err.contains("struct type of this object literal is not known")
+            && err.contains("a typed parameter"),
         "{err}"
     );
 }

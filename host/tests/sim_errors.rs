@@ -70,6 +70,12 @@ fn undefined_names() {
         "{HEAD}\n<datamodel><data id=\"y\" expr=\"1\"/></datamodel>\n<state id=\"s\"><onentry><assign location=\"y\" expr=\"y + z\"/></onentry></state></scxml>"
     ));
     assert_eq!(e, "3:55: unknown variable `z`");
+    // A sent parameter's type comes from its expression: when that names an unknown
+    // variable, the error says so (not that the type cannot be inferred).
+    let e = error(&format!(
+        "{HEAD}\n<state id=\"s\"><onentry><send event=\"e\" target=\"M\"><param name=\"p\" expr=\"q + 1\"/></send></onentry>\n<transition event=\"e\" target=\"s\"/></state></scxml>"
+    ));
+    assert_eq!(e, "2:73: unknown variable `q`");
 }
 
 #[test]

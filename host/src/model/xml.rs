@@ -141,13 +141,16 @@ impl Element {
     pub fn check_attrs(&self, sm: &SourceMap, allowed: &[&str], out: &mut Vec<Diagnostic>) {
         for a in &self.attrs {
             if !allowed.contains(&a.name.as_str()) && !a.name.starts_with("xmlns") {
+                let expected = if allowed.is_empty() {
+                    "it takes none".to_string()
+                } else {
+                    format!("expected one of: {}", allowed.join(", "))
+                };
                 out.push(sm.diag(
                     a.name_span,
                     format!(
-                        "unknown attribute `{}` on <{}> (expected one of: {})",
-                        a.name,
-                        self.name,
-                        allowed.join(", ")
+                        "unknown attribute `{}` on <{}> ({expected})",
+                        a.name, self.name
                     ),
                 ));
             }

@@ -294,7 +294,12 @@ impl MainFile {
                 continue;
             }
             seen.push((section.to_string(), el.span));
-            el.check_attrs(sm, &[], &mut r.errs);
+            if matches!(
+                section,
+                "parameters" | "data_declarations" | "behavior_tree" | "node_models" | "properties"
+            ) {
+                el.check_attrs(sm, &[], &mut r.errs);
+            }
             match section {
                 "parameters" => params = Some((r.parameters(el), el.span)),
                 "data_declarations" => {

@@ -837,30 +837,7 @@ impl<'s> Builder<'s> {
                     let Some(Some(ast)) = parsed.get(si).and_then(|v| v.get(pi)) else {
                         continue;
                     };
-                    let scope_params: Vec<(String, Option<Ty>)> = match site.event {
-                        Some(e) => self.events[e as usize]
-                            .params
-                            .iter()
-                            .map(|(n, t)| (n.clone(), t.clone()))
-                            .collect(),
-                        None => Vec::new(),
-                    };
-                    let ename = site.event.map(|e| self.events[e as usize].name.clone());
-                    let vars = &self.vars[site.machine as usize];
-                    let abs = |k: u32| k;
-                    let scope = Scope {
-                        vars,
-                        event: match &ename {
-                            Some(n) => EventScope::Event {
-                                name: n,
-                                params: &scope_params,
-                            },
-                            None => EventScope::None,
-                        },
-                        types: &self.types,
-                        abs: &abs,
-                    };
-                    if let Ok(t) = compile(ast, &scope, &mut self.strings, None) {
+                    if let Ok(t) = self.compile_in_site(site, ast) {
                         changed |= self.merge_param(ev, &p.name.name, t.ty);
                     }
                 }
@@ -887,9 +864,16 @@ impl<'s> Builder<'s> {
                     Some(t) => contains_unknown(t),
                 };
                 if bad && reported.insert((ev, p.name.name.clone())) {
-                    // Compile errors in the expression itself are reported with the code.
-                    let infer_failed = parse_expr(&p.expr.text).is_ok();
-                    if infer_failed {
+                    // Syntax errors in the expression itself are reported with the code;
+                    // an expression that parses but does not compile (an unknown
+                    // variable, say) is why the type is unknown: say that instead.
+                    let Ok(ast) = parse_expr(&p.expr.text) else {
+                        continue;
+                    };
+                    if let Err(e) = self.compile_in_site(site, &ast) {
+                        let d = self.expr_diag(&p.expr, &e);
+                        self.errs.push(d);
+                    } else {
                         let msg = format!(
                             "cannot infer the type of parameter `{}` of event `{}`; add <!-- TYPE {}:<type> --> before the <param>",
                             p.name.name, site.send.event.name, p.name.name
@@ -899,6 +883,38 @@ impl<'s> Builder<'s> {
                 }
             }
         }
+    }
+
+    /// Compiles a parameter expression of `site` in its machine's scope (the event's
+    /// parameters as inferred so far), for the error it gives.
+    fn compile_in_site(
+        &mut self,
+        site: &Site<'_>,
+        ast: &crate::expr::ast::Expr,
+    ) -> Result<Typed, CompileError> {
+        let scope_params: Vec<(String, Option<Ty>)> = match site.event {
+            Some(e) => self.events[e as usize]
+                .params
+                .iter()
+                .map(|(n, t)| (n.clone(), t.clone()))
+                .collect(),
+            None => Vec::new(),
+        };
+        let ename = site.event.map(|e| self.events[e as usize].name.clone());
+        let abs = |k: u32| k;
+        let scope = Scope {
+            vars: &self.vars[site.machine as usize],
+            event: match &ename {
+                Some(n) => EventScope::Event {
+                    name: n,
+                    params: &scope_params,
+                },
+                None => EventScope::None,
+            },
+            types: &self.types,
+            abs: &abs,
+        };
+        compile(ast, &scope, &mut self.strings, None)
     }
 
     /// Merges a sent type into a parameter's type; true when it changed.
