@@ -35,7 +35,7 @@ fn model_files(dir: &Path, base: &Path, out: &mut Vec<PathBuf>) {
             model_files(&path, base, out);
         } else if matches!(
             path.extension().and_then(|e| e.to_str()),
-            Some("xml" | "scxml" | "msg" | "srv" | "action")
+            Some("xml" | "scxml" | "ascxml" | "msg" | "srv" | "action" | "jani" | "json")
         ) {
             out.push(rel);
         }
@@ -135,19 +135,21 @@ fn mutate(text: &str, rng: &mut Xoshiro256PlusPlus) -> String {
 /// Whether an error message names a file with a line and column (`file.ext:L:C`).
 fn has_position(message: &str) -> bool {
     message.lines().any(|line| {
-        [".xml:", ".scxml:", ".msg:", ".srv:", ".action:", ".jani:"]
-            .iter()
-            .any(|ext| {
-                line.split(ext).nth(1).is_some_and(|rest| {
-                    let mut parts = rest.splitn(3, ':');
-                    let l = parts.next().unwrap_or("");
-                    let c = parts.next().unwrap_or("");
-                    !l.is_empty()
-                        && l.bytes().all(|b| b.is_ascii_digit())
-                        && !c.is_empty()
-                        && c.bytes().all(|b| b.is_ascii_digit())
-                })
+        [
+            ".xml:", ".scxml:", ".ascxml:", ".msg:", ".srv:", ".action:", ".jani:", ".json:",
+        ]
+        .iter()
+        .any(|ext| {
+            line.split(ext).nth(1).is_some_and(|rest| {
+                let mut parts = rest.splitn(3, ':');
+                let l = parts.next().unwrap_or("");
+                let c = parts.next().unwrap_or("");
+                !l.is_empty()
+                    && l.bytes().all(|b| b.is_ascii_digit())
+                    && !c.is_empty()
+                    && c.bytes().all(|b| b.is_ascii_digit())
             })
+        })
     })
 }
 
@@ -159,37 +161,47 @@ fn position_check_accepts_positions_only() {
     assert!(!has_position("policy.xml:12: unknown node"));
 }
 
-#[test]
-fn mutated_robot_models_are_errors_with_positions_or_run() {
+/// Mutants of the model under `base` (the files under its folders `parts`, all of it
+/// when empty), loaded from `main` (relative to `base`); `favourites` get a share of the
+/// mutants of their own. Panics with every problem found.
+fn fuzz(name: &str, base: &Path, parts: &[&str], main: &str, favourites: &[&str], seed: u64) {
     let count: u64 = std::env::var("HINDSIGHT_ROBOT_MUTANTS")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(400);
-    let base = guide();
+        .unwrap_or(300);
     let mut files = Vec::new();
-    model_files(&base, &base, &mut files);
-    assert!(files.len() > 30, "{files:?}");
-    let dir = std::env::temp_dir().join(format!("hindsight-robot-fuzz-{}", std::process::id()));
+    if parts.is_empty() {
+        model_files(base, base, &mut files);
+    } else {
+        for part in parts {
+            model_files(&base.join(part), base, &mut files);
+        }
+    }
+    assert!(files.len() > 2, "{files:?}");
+    let dir = std::env::temp_dir().join(format!(
+        "hindsight-robot-fuzz-{name}-{}",
+        std::process::id()
+    ));
     let _ = std::fs::remove_dir_all(&dir);
     for rel in &files {
         let to = dir.join(rel);
         std::fs::create_dir_all(to.parent().unwrap()).unwrap();
         std::fs::copy(base.join(rel), &to).unwrap();
     }
-    let main = dir.join("main.xml");
-    // The model, its tree, interfaces and ROS-named properties, as `hindsight verify`
-    // reads them; the unmutated copy loads, so the mutants start from a working model.
+    // The model, its tree, interfaces and properties, as `hindsight verify` reads them;
+    // the unmutated copy loads, so the mutants start from a working model.
     let args = ModelArgs {
-        model: main.clone(),
+        model: dir.join(main),
         props: None,
         time_unit: None,
         events: None,
+        ..ModelArgs::default()
     };
     if let Err(e) = load(&args) {
-        panic!("{e}");
+        panic!("{name}: {e}");
     }
 
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let cfg = RunConfig {
         max_time: 30,
         max_steps: 20_000,
@@ -198,13 +210,12 @@ fn mutated_robot_models_are_errors_with_positions_or_run() {
     };
     let (mut errors, mut loaded, mut unchanged) = (0, 0, 0);
     let mut problems = Vec::new();
+    let mut reported = 0;
     for k in 0..count {
-        // The main file, the tree and the properties get a share; the rest by file.
-        let rel = match rng.next_u32() % 5 {
-            0 => PathBuf::from("main.xml"),
-            1 => PathBuf::from("policy.xml"),
-            2 => PathBuf::from("properties.xml"),
-            _ => files[rng.next_u32() as usize % files.len()].clone(),
+        let slot = rng.next_u32() as usize % (favourites.len() + 2);
+        let rel = match favourites.get(slot) {
+            Some(f) => PathBuf::from(f),
+            None => files[rng.next_u32() as usize % files.len()].clone(),
         };
         let original = std::fs::read_to_string(base.join(&rel)).unwrap();
         let text = mutate(&original, &mut rng);
@@ -230,36 +241,113 @@ fn mutated_robot_models_are_errors_with_positions_or_run() {
                 let absent = message.contains("names no property file");
                 if !has_position(&message) && !absent {
                     problems.push(format!(
-                        "mutant {k} of {}: error without file:line:col: {message}",
+                        "{name} mutant {k} of {}: error without file:line:col: {message}",
                         rel.display()
                     ));
                 }
-                // Errors speak of the user's files, not of the plain SCXML they become.
-                if message.contains("<!-- TYPE") {
+                // Errors speak of the user's files, not of the plain SCXML they become
+                // (`ros_fields__x` is the parameter a message field turns into; JANI
+                // properties are written over those names, so their errors may say them).
+                if message
+                    .lines()
+                    .any(|l| l.contains("ros_fields__") && !l.contains(".jani:"))
+                {
                     problems.push(format!(
-                        "mutant {k} of {}: error about generated SCXML: {message}",
+                        "{name} mutant {k} of {}: error about generated SCXML: {message}",
                         rel.display()
                     ));
                 }
             }
-            Err(_) => problems.push(format!(
-                "mutant {k} of {}: panicked (text kept in {})",
-                rel.display(),
-                dir.join(&rel).display()
-            )),
+            Err(_) => {
+                problems.push(format!(
+                    "{name} mutant {k} of {}: panicked (text kept in {})",
+                    rel.display(),
+                    dir.join(&rel).display()
+                ));
+                break; // keep the mutant on disk to look at
+            }
         }
-        if problems.last().is_some_and(|p| p.contains("panicked")) {
-            break; // keep the mutant on disk to look at
+        if problems.len() > reported {
+            // Keep the mutant beside the restored file, to look at.
+            let keep = dir.join(format!("{}.mutant-{k}", rel.display()));
+            std::fs::write(&keep, &text).unwrap();
+            reported = problems.len();
         }
         std::fs::write(dir.join(&rel), &original).unwrap();
     }
-    println!("{count} mutants: {errors} errors, {loaded} loaded and ran, {unchanged} unchanged");
-    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    println!(
+        "{name}: {count} mutants: {errors} errors, {loaded} loaded and ran, {unchanged} unchanged"
+    );
+    assert!(
+        problems.is_empty(),
+        "{}\n(mutants kept as <file>.mutant-<k> in {})",
+        problems.join("\n"),
+        dir.display()
+    );
     // The mutations reach both outcomes, so the test exercises the error paths and the
     // lowering of models that are still valid.
     assert!(
-        errors > count / 10 && loaded > count / 10,
-        "{errors} / {loaded}"
+        errors > count / 10 && loaded > count / 20,
+        "{name}: {errors} errors, {loaded} loaded"
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn mutated_museum_guides_are_errors_with_positions_or_run() {
+    let base = guide();
+    fuzz(
+        "guide",
+        &base,
+        &[],
+        "main.xml",
+        &["main.xml", "policy.xml", "properties.xml"],
+        5,
+    );
+}
+
+/// AS2FM's own models: actions, blackboard ports, struct declarations, other tree nodes.
+#[test]
+fn mutated_as2fm_models_are_errors_with_positions_or_run() {
+    let Some(as2fm) = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .map(|d| d.join("shared/corpus/as2fm"))
+        .find(|d| d.is_dir())
+    else {
+        panic!("shared/corpus next to the repository");
+    };
+    let cases: [(&str, &str, &[&str]); 4] = [
+        (
+            "examples/tutorial_fetch_and_carry",
+            "main.xml",
+            &["bt_tree.xml", "world.ascxml"],
+        ),
+        (
+            "test_data/grid_robot_blackboard_simple",
+            "main.xml",
+            &["bt.xml"],
+        ),
+        (
+            "test_data/fibonacci_action_example",
+            "main.xml",
+            &["server.ascxml", "client_1.ascxml"],
+        ),
+        (
+            "test_data/data_structs",
+            "main_xml_def.xml",
+            &["my_types.xml", "sender.ascxml"],
+        ),
+    ];
+    for (i, (case, main, favourites)) in cases.iter().enumerate() {
+        let favourites: Vec<String> = favourites.iter().map(|f| format!("{case}/{f}")).collect();
+        let favourites: Vec<&str> = favourites.iter().map(String::as_str).collect();
+        fuzz(
+            case.rsplit('/').next().unwrap(),
+            &as2fm,
+            &[case, "ros_support_interfaces"],
+            &format!("{case}/{main}"),
+            &favourites,
+            100 + i as u64,
+        );
+    }
 }

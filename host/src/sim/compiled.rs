@@ -386,6 +386,11 @@ struct Builder<'s> {
     vars: Vec<Vec<(String, Ty)>>,
     events: Vec<EventB>,
     event_index: HashMap<String, u32>,
+    /// Variables whose declaration was reported as an error: (machine, name). Their uses
+    /// are not reported again as unknown variables.
+    failed_vars: BTreeSet<(u32, String)>,
+    /// The errors a read of a parameter whose type was reported unknown would repeat.
+    failed_params: BTreeSet<String>,
 }
 
 /// Where a send sits: its machine and the event in scope.
@@ -407,12 +412,32 @@ impl<'s> Builder<'s> {
             vars: Vec::new(),
             events: Vec::new(),
             event_index: HashMap::new(),
+            failed_vars: BTreeSet::new(),
+            failed_params: BTreeSet::new(),
         }
     }
 
     fn err(&mut self, span: Span, msg: impl Into<String>) {
         let d = self.src.sources.diag(span, msg);
         self.errs.push(d);
+    }
+
+    /// Reports an expression's compile error in `machine`, unless it only repeats one
+    /// already reported: a use of a variable whose declaration failed, or a read of a
+    /// parameter whose type was reported as unknown where it is sent.
+    fn expr_err(&mut self, machine: u32, src: &SrcExpr, e: &CompileError) {
+        let echo = if e.deferred {
+            self.failed_params.contains(&e.msg)
+        } else {
+            e.msg
+                .strip_prefix("unknown variable `")
+                .and_then(|rest| rest.strip_suffix('`'))
+                .is_some_and(|name| self.failed_vars.contains(&(machine, name.to_string())))
+        };
+        if !echo {
+            let d = self.expr_diag(src, e);
+            self.errs.push(d);
+        }
     }
 
     fn build(
@@ -473,7 +498,12 @@ impl<'s> Builder<'s> {
             })
             .collect();
         if !self.errs.is_empty() {
-            return Err(Diagnostics(self.errs));
+            // A node model lowered into several machines (an action server and its
+            // threads) repeats its errors at the same place: say each once.
+            let mut seen = BTreeSet::new();
+            let mut errs = self.errs;
+            errs.retain(|d| seen.insert((d.path.clone(), d.line, d.column, d.message.clone())));
+            return Err(Diagnostics(errs));
         }
         let mut machine_of_str = vec![u32::MAX; self.strings.len()];
         for (i, m) in machines.iter().enumerate() {
@@ -637,7 +667,10 @@ impl<'s> Builder<'s> {
             let declared = match &d.ty {
                 Some(ann) => match self.resolve(&ann.ty, ann.span) {
                     Some(t) => Some(t),
-                    None => continue,
+                    None => {
+                        self.failed_vars.insert((mi as u32, d.id.name.clone()));
+                        continue;
+                    }
                 },
                 None => None,
             };
@@ -647,10 +680,11 @@ impl<'s> Builder<'s> {
                     self.err(
                         d.span,
                         format!(
-                            "variable `{}` has no type and no value; add <!-- TYPE {}:int32 --> (or its type) before it",
+                            "variable `{}` has no type and no value: give it a type (`type=\"int32\"`, or `<!-- TYPE {}:int32 -->` before it)",
                             d.id.name, d.id.name
                         ),
                     );
+                    self.failed_vars.insert((mi as u32, d.id.name.clone()));
                     continue;
                 }
                 (None, Some(src)) => {
@@ -659,6 +693,7 @@ impl<'s> Builder<'s> {
                         Err(pe) => {
                             let at = self.src.sources.unescaped_offset(src.span, pe.offset);
                             self.err(at, pe.message);
+                            self.failed_vars.insert((mi as u32, d.id.name.clone()));
                             continue;
                         }
                     };
@@ -677,15 +712,17 @@ impl<'s> Builder<'s> {
                             self.err(
                                 d.span,
                                 format!(
-                                    "cannot infer the element type of `{}`; add <!-- TYPE {}:int32[] --> (or its type) before it",
+                                    "cannot infer the element type of `{}` from its value: give it a type (`type=\"int32[]\"`, or `<!-- TYPE {}:int32[] -->` before it)",
                                     d.id.name, d.id.name
                                 ),
                             );
+                            self.failed_vars.insert((mi as u32, d.id.name.clone()));
                             continue;
                         }
                         Err(e) => {
                             let diag = self.expr_diag(src, &e);
                             self.errs.push(diag);
+                            self.failed_vars.insert((mi as u32, d.id.name.clone()));
                             continue;
                         }
                     }
@@ -864,21 +901,28 @@ impl<'s> Builder<'s> {
                     Some(t) => contains_unknown(t),
                 };
                 if bad && reported.insert((ev, p.name.name.clone())) {
-                    // Syntax errors in the expression itself are reported with the code;
-                    // an expression that parses but does not compile (an unknown
-                    // variable, say) is why the type is unknown: say that instead.
-                    let Ok(ast) = parse_expr(&p.expr.text) else {
-                        continue;
-                    };
-                    if let Err(e) = self.compile_in_site(site, &ast) {
-                        let d = self.expr_diag(&p.expr, &e);
-                        self.errs.push(d);
-                    } else {
-                        let msg = format!(
-                            "cannot infer the type of parameter `{}` of event `{}`; add <!-- TYPE {}:<type> --> before the <param>",
-                            p.name.name, site.send.event.name, p.name.name
-                        );
-                        self.err(p.span, msg);
+                    // Why the type is unknown: a syntax error, an expression that does
+                    // not compile (an unknown variable, say), or one whose type says
+                    // nothing (`[]`). Reads of the parameter elsewhere would only echo it.
+                    self.failed_params.insert(format!(
+                        "type of parameter `{}` of event `{}` is not known",
+                        p.name.name, site.send.event.name
+                    ));
+                    match parse_expr(&p.expr.text) {
+                        Err(pe) => {
+                            let at = self.src.sources.unescaped_offset(p.expr.span, pe.offset);
+                            self.err(at, pe.message);
+                        }
+                        Ok(ast) => match self.compile_in_site(site, &ast) {
+                            Err(e) => self.expr_err(site.machine, &p.expr, &e),
+                            Ok(_) => {
+                                let msg = format!(
+                                    "cannot infer the type of parameter `{}` of event `{}` from its value: give the <param> a type (`type=\"int32\"`, or `<!-- TYPE {}:int32 -->` before it)",
+                                    p.name.name, site.send.event.name, p.name.name
+                                );
+                                self.err(p.span, msg);
+                            }
+                        },
                     }
                 }
             }
@@ -1038,8 +1082,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
         match r {
             Ok(t) => Some(t),
             Err(e) => {
-                let d = self.b.expr_diag(src, &e);
-                self.b.errs.push(d);
+                self.b.expr_err(self.mi, src, &e);
                 None
             }
         }
@@ -1082,8 +1125,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
         match r {
             Ok(p) => Some(p),
             Err(e) => {
-                let d = self.b.expr_diag(src, &e);
-                self.b.errs.push(d);
+                self.b.expr_err(self.mi, src, &e);
                 None
             }
         }

@@ -15,7 +15,7 @@ use monitor_core::{valuation, Monitor, Op, Ty, Value, VarKind};
 use super::settle::Settler;
 use crate::expr::Value as SimValue;
 use crate::props::{PortKind, PropertyFile, ANY};
-use crate::sim::{CompiledModel, Flow, MachineId, Observer, SentMessage};
+use crate::sim::{CompiledModel, EventId, Flow, MachineId, Observer, SentMessage};
 use crate::smc::{RunEnd, RunOutcome, Verdict};
 
 /// One port resolved to model ids.
@@ -223,10 +223,7 @@ impl PropertySet {
                         length: *length,
                     },
                     None => {
-                        errors.push(format!(
-                            "{here}: event `{}` has no parameter `{param}`",
-                            p.event
-                        ));
+                        errors.push(format!("{here}: {}", missing_param(model, event, param)));
                         continue;
                     }
                 },
@@ -239,10 +236,7 @@ impl PropertySet {
                         length: false,
                     },
                     None => {
-                        errors.push(format!(
-                            "{here}: event `{}` has no parameter `{param}`",
-                            p.event
-                        ));
+                        errors.push(format!("{here}: {}", missing_param(model, event, param)));
                         continue;
                     }
                 },
@@ -551,6 +545,42 @@ impl Observer for Judge<'_> {
     fn on_time(&mut self, time: u64) -> Flow {
         self.begin();
         self.step(time)
+    }
+}
+
+/// Why `param` cannot be read from `event`: a ROS message field (`ros_fields__a__b`, a
+/// port over a topic or service) is named as the user wrote it, with the fields there are.
+fn missing_param(model: &CompiledModel, event: EventId, param: &str) -> String {
+    let params = model.event_params(event);
+    match param.strip_prefix("ros_fields__") {
+        Some(field) => {
+            let fields: Vec<String> = params
+                .iter()
+                .filter_map(|(n, _)| n.strip_prefix("ros_fields__"))
+                .map(|f| f.replace("__", "."))
+                .collect();
+            format!(
+                "the message has no field `{}` (fields: {})",
+                field.replace("__", "."),
+                if fields.is_empty() {
+                    "none".to_string()
+                } else {
+                    fields.join(", ")
+                }
+            )
+        }
+        None => {
+            let names: Vec<&str> = params.iter().map(|(n, _)| n.as_str()).collect();
+            format!(
+                "event `{}` has no parameter `{param}` (parameters: {})",
+                model.event_name(event),
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            )
+        }
     }
 }
 

@@ -383,16 +383,23 @@ impl Cx<'_> {
             let mut p = Element::new("param", c.span);
             p.set_attr_at("name", fields[fi].param_name(), nspan);
             p.set_attr_at("expr", expr, espan);
+            if fields[fi].scxml_type.ends_with(']') {
+                // An array's element type may not follow from its value (`[]`).
+                p.set_attr("type", fields[fi].scxml_type.clone());
+            }
             given.push((fi, p));
         }
         let mut out: Vec<Element> = given.iter().map(|(_, p)| p.clone()).collect();
         for (i, f) in fields.iter().enumerate() {
             if !given.iter().any(|(g, _)| *g == i) {
-                out.push(
-                    Element::new("param", el.span)
-                        .with_attr("name", f.param_name())
-                        .with_attr("expr", f.default.clone()),
-                );
+                let mut p = Element::new("param", el.span)
+                    .with_attr("name", f.param_name())
+                    .with_attr("expr", f.default.clone());
+                // An empty array literal says nothing of its elements: the interface does.
+                if f.scxml_type.ends_with(']') {
+                    p.set_attr("type", f.scxml_type.clone());
+                }
+                out.push(p);
             }
         }
         out
