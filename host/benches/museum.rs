@@ -62,6 +62,7 @@ impl Case {
             props: None,
             time_unit: None,
             events,
+            ..ModelArgs::default()
         };
         let loaded = match load(&args) {
             Ok(l) => l,
@@ -94,6 +95,7 @@ impl Case {
             props: None,
             time_unit: Some("100ms".into()),
             events: Some(Events::As2fm),
+            ..ModelArgs::default()
         };
         let loaded = load(&args).unwrap_or_else(|e| panic!("converted guide: {e:?}"));
         let _ = std::fs::remove_dir_all(&out);

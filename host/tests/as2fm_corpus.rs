@@ -420,3 +420,65 @@ fn receptive_states_match_as2fm_jani_translation_of_the_museum_guide() {
         "only {checked} (machine, state, event) triples"
     );
 }
+
+/// A property hindsight cannot check (a JANI step bound) stops `verify` with a hint;
+/// `--skip` leaves it out and the others are checked, `--only` keeps one, and a name the
+/// file does not have is an error that lists the names.
+#[test]
+fn verify_skips_and_selects_jani_properties_by_name() {
+    let main = corpus().join("examples/quick_start_battery_monitor/main.xml");
+    let run = |extra: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_hindsight"))
+            .arg("verify")
+            .arg(&main)
+            .args(["--max-runs", "20", "--json", "--threads", "1"])
+            .args(extra)
+            .output()
+            .expect("run hindsight");
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stdout).into_owned(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let names = |stdout: &str| -> Vec<(String, f64)> {
+        let report: serde_json::Value = serde_json::from_str(stdout).unwrap();
+        report["properties"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| {
+                (
+                    p["property"].as_str().unwrap().to_string(),
+                    p["probability"].as_f64().unwrap(),
+                )
+            })
+            .collect()
+    };
+    let (code, _, err) = run(&[]);
+    assert_eq!(code, Some(2));
+    assert!(
+        err.contains("battery_properties.jani:85:25: `step-bounds` are not supported")
+            && err.contains("--skip NAME"),
+        "{err}"
+    );
+    let (code, out, err) = run(&["--skip", "battery_charged"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(
+        names(&out),
+        vec![
+            ("battery_depleted".to_string(), 0.0),
+            ("battery_below_20".to_string(), 0.0),
+            ("battery_alarm_on".to_string(), 1.0),
+        ]
+    );
+    let (code, out, err) = run(&["--only", "battery_alarm_on"]);
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(names(&out), vec![("battery_alarm_on".to_string(), 1.0)]);
+    let (code, _, err) = run(&["--skip", "battery_full"]);
+    assert_eq!(code, Some(2));
+    assert!(
+        err.contains("has no property `battery_full` (properties: battery_depleted, battery_below_20, battery_alarm_on, battery_charged)"),
+        "{err}"
+    );
+}

@@ -203,3 +203,47 @@ fn bad_robot_models_name_file_line_and_column() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// `--only` and `--skip` pick properties of an XML property file by name.
+#[test]
+fn verify_checks_the_properties_named() {
+    let (code, out, err) = hindsight(&[
+        "verify",
+        GUIDE,
+        "--only",
+        "alarm_response",
+        "--only",
+        "absence",
+        "--max-runs",
+        "2",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let report: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let names: Vec<&str> = report["properties"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["property"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["absence", "alarm_response"]);
+    let (code, out, err) = hindsight(&[
+        "verify",
+        GUIDE,
+        "--skip",
+        "absence",
+        "--max-runs",
+        "2",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let report: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(report["properties"].as_array().unwrap().len(), 4);
+    let (code, _, err) = hindsight(&["verify", GUIDE, "--skip", "absense"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("--skip absense: ")
+            && err.contains("has no property `absense` (properties: absence, alarm_response,"),
+        "{err}"
+    );
+}

@@ -87,6 +87,7 @@ fn the_museum_guarantees_compile_for_the_monitor_over_their_port_names() {
         props: None,
         time_unit: None,
         events: None,
+        ..ModelArgs::default()
     })
     .unwrap();
     let names: Vec<&str> = spec.property_names().collect();
@@ -682,6 +683,7 @@ fn a_plain_model_is_monitored_with_its_time_unit_and_without_its_assumptions() {
         props: Some(root().join(props)),
         time_unit: Some("100ms".into()),
         events: None,
+        ..ModelArgs::default()
     })
     .unwrap();
     // The guarantee only: the assumption `tails_thrown` is not monitored.

@@ -154,6 +154,7 @@ fn layout_is_a_monitor_config() {
         props: None,
         time_unit: None,
         events: None,
+        ..hindsight::cli::verify::ModelArgs::default()
     };
     let loaded = hindsight::cli::verify::load(&args).unwrap_or_else(|e| panic!("{e:?}"));
     let spec = loaded.set.compiled();

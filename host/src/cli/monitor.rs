@@ -194,6 +194,7 @@ fn spec_of(args: &MonitorArgs) -> Result<Compiled, CliError> {
         props: args.model_props.clone(),
         time_unit: args.time_unit.clone(),
         events: None,
+        ..ModelArgs::default()
     })
     .map_err(|e| match e {
         CliError::Input(m) if from_props => CliError::Input(format!(

@@ -232,7 +232,7 @@ fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, CliE
 }
 
 /// The model and property arguments every command that loads a model takes.
-#[derive(Debug, clap::Args)]
+#[derive(Debug, Default, clap::Args)]
 pub struct ModelArgs {
     /// The model: a robot main file (`<roaml>` or `<convince_mc_tc>`) or a folder holding
     /// `main.xml`; a folder of plain .scxml machines, a SCAN model.xml, or one .scxml file.
@@ -249,6 +249,14 @@ pub struct ModelArgs {
     /// `as2fm` for robot models and `.jani` property files, `queues` otherwise.
     #[arg(long, value_enum)]
     pub events: Option<Events>,
+    /// Check only this property (by name; repeat for more). The others are not read
+    /// beyond their names, so one that uses something not supported can be left out.
+    #[arg(long = "only", value_name = "NAME")]
+    pub only: Vec<String>,
+    /// Leave this property out (by name; repeat for more), for example a JANI property
+    /// with a step bound.
+    #[arg(long = "skip", value_name = "NAME")]
+    pub skip: Vec<String>,
 }
 
 /// A model with its properties, compiled: everything `validate` checks.
@@ -334,7 +342,7 @@ pub fn load_without(
         Some(p) => p.to_path_buf(),
         None => default_props(model, &compiled)?,
     };
-    let file = read_properties(&props_path, &compiled)?;
+    let file = read_properties(&props_path, &compiled, args)?;
     let set = compile_properties(&file, &compiled, unit_ns)?;
     let events = args
         .events
@@ -354,13 +362,63 @@ pub fn load_without(
 }
 
 /// Reads a property file: JANI (`.jani`) or SCAN XML (with ROS ports and patterns).
-fn read_properties(path: &Path, model: &CompiledModel) -> Result<props::PropertyFile, CliError> {
-    if is_jani(path) {
-        props::jani::parse_file(path, model)
+/// Reads the property file, keeping the guarantees `--only` / `--skip` select.
+fn read_properties(
+    path: &Path,
+    model: &CompiledModel,
+    args: &ModelArgs,
+) -> Result<props::PropertyFile, CliError> {
+    let wanted = |name: &str| {
+        (args.only.is_empty() || args.only.iter().any(|o| o == name))
+            && !args.skip.iter().any(|s| s == name)
+    };
+    let unknown_name = |names: &[String]| {
+        for (option, given) in [("--only", &args.only), ("--skip", &args.skip)] {
+            if let Some(missing) = given.iter().find(|n| !names.contains(n)) {
+                return Err(CliError::Input(format!(
+                    "{option} {missing}: {} has no property `{missing}` (properties: {})",
+                    path.display(),
+                    names.join(", ")
+                )));
+            }
+        }
+        Ok(())
+    };
+    let file = if is_jani(path) {
+        let mut names = Vec::new();
+        if !(args.only.is_empty() && args.skip.is_empty()) {
+            // The names first, so that a misspelt one is reported before any property.
+            props::jani::parse_file_selected(path, model, &mut |name| {
+                names.push(name.to_string());
+                false
+            })
+            .map_err(|d| CliError::Input(d.to_string()))?;
+            unknown_name(&names)?;
+        }
+        props::jani::parse_file_selected(path, model, &mut |name| wanted(name)).map_err(|d| {
+            let text = d.to_string();
+            // A property using what is not supported need not stop the others.
+            let hint = if text.contains("not supported") {
+                "\nhint: --skip NAME leaves a property out, --only NAME checks just that one"
+            } else {
+                ""
+            };
+            CliError::Input(format!("{text}{hint}"))
+        })?
     } else {
-        props::parse_file(path)
+        let mut file = props::parse_file(path).map_err(|d| CliError::Input(d.to_string()))?;
+        let names: Vec<String> = file.guarantees.iter().map(|g| g.id.clone()).collect();
+        unknown_name(&names)?;
+        file.guarantees.retain(|g| wanted(&g.id));
+        file
+    };
+    if file.guarantees.is_empty() && !(args.only.is_empty() && args.skip.is_empty()) {
+        return Err(CliError::Input(format!(
+            "--only/--skip leave no property of {} to check",
+            path.display()
+        )));
     }
-    .map_err(|d| CliError::Input(d.to_string()))
+    Ok(file)
 }
 
 /// Compiles a property file against a model; a bound with a unit on a model without one
@@ -421,7 +479,7 @@ fn load_robot(
             )))
         }
     };
-    let file = read_properties(&props_path, &robot.model)?;
+    let file = read_properties(&props_path, &robot.model, args)?;
     let set = compile_properties(&file, &robot.model, Some(robot.time_unit_ns))?;
     Ok((
         Loaded {

@@ -46,6 +46,17 @@ use crate::sim::{CompiledModel, EventId};
 
 /// Reads the JANI property file at `path` and resolves its variables against `model`.
 pub fn parse_file(path: &Path, model: &CompiledModel) -> Result<PropertyFile, Diagnostics> {
+    parse_file_selected(path, model, &mut |_| true)
+}
+
+/// [`parse_file`] keeping only the properties whose name `keep` accepts; the others are
+/// not read beyond their name (so one using what hindsight does not support, a step
+/// bound say, can be left out). `keep` sees every property's name.
+pub fn parse_file_selected(
+    path: &Path,
+    model: &CompiledModel,
+    keep: &mut dyn FnMut(&str) -> bool,
+) -> Result<PropertyFile, Diagnostics> {
     let fail = |kind| {
         Diagnostics(vec![PropsError {
             path: path.to_path_buf(),
@@ -55,7 +66,7 @@ pub fn parse_file(path: &Path, model: &CompiledModel) -> Result<PropertyFile, Di
     };
     let bytes = std::fs::read(path).map_err(|e| fail(PropsErrorKind::Io(e.to_string())))?;
     let text = String::from_utf8(bytes).map_err(|_| fail(PropsErrorKind::Encoding))?;
-    parse_str(&text, path, model)
+    parse_str_selected(&text, path, model, keep)
 }
 
 /// Reads a JANI property file's text; `path` is only used in errors.
@@ -63,6 +74,16 @@ pub fn parse_str(
     text: &str,
     path: &Path,
     model: &CompiledModel,
+) -> Result<PropertyFile, Diagnostics> {
+    parse_str_selected(text, path, model, &mut |_| true)
+}
+
+/// [`parse_str`] keeping only the properties `keep` accepts (see [`parse_file_selected`]).
+pub fn parse_str_selected(
+    text: &str,
+    path: &Path,
+    model: &CompiledModel,
+    keep: &mut dyn FnMut(&str) -> bool,
 ) -> Result<PropertyFile, Diagnostics> {
     let lines = LineIndex::new(text);
     let root = json::parse(text).map_err(|(offset, message)| {
@@ -83,6 +104,10 @@ pub fn parse_str(
     match root.get("properties").map(|p| &p.value) {
         Some(Json::Array(items)) => {
             for item in items {
+                let name = item.get("name").and_then(Node::as_str);
+                if name.is_some_and(|n| !keep(n)) {
+                    continue;
+                }
                 if let Some(p) = r.property(item) {
                     if let Some(first) = guarantees.iter().find(|g| g.id == p.id) {
                         let first = first.at;
