@@ -35,7 +35,8 @@ enum Command {
     /// (current or tree form, ports over ROS names, patterns) or JANI.
     /// Runs are seeded (run k uses xoshiro256++ stream k) and consumed in run order, so the
     /// same --seed gives the same numbers on any number of threads. A run stops early only
-    /// when every verdict can no longer change.
+    /// when every verdict can no longer change. Progress goes to standard error: a bar on a
+    /// terminal, a line every 30 s on a log (none with --json).
     ///
     /// Example: `hindsight verify examples/museum-scxml --seed 7`
     Verify(cli::verify::VerifyArgs),

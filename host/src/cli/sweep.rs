@@ -1,6 +1,5 @@
 //! `hindsight sweep`: one property's success rate as every time bound in it takes each value of a range.
 
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -421,7 +420,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         keep_failing: 0,
         progress_every: Duration::from_millis(200),
     };
-    let show_progress = !args.json && std::io::stderr().is_terminal();
+    let show_progress = !args.json;
     if !args.json {
         println!("property,bound,successes,failures,unknown,probability,lower,upper");
     }
