@@ -571,3 +571,89 @@ fn with_a_time_unit_bounds_and_sweeps_are_in_seconds() {
     assert_eq!(code, 2);
     assert!(err.contains("150ms"), "{err}");
 }
+
+/// A model that fails at run time (an index out of bounds) stops the study at once with
+/// the failure, file-free as it is, instead of running failing runs forever: without
+/// `--max-runs` the adaptive rule never gets the verdicts it waits for.
+#[test]
+fn a_model_failing_at_run_time_stops_the_study_at_once() {
+    let dir = std::env::temp_dir().join(format!("hindsight-run-error-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/sim/run_error");
+    std::fs::copy(data.join("oob.scxml"), dir.join("oob.scxml")).unwrap();
+    std::fs::write(
+        dir.join("properties.xml"),
+        r#"<properties>
+  <ports>
+    <scxml_event_send event="v" origin="Oob" target="NONE"><state_var id="x" type="int32" expr="0" param="v"/></scxml_event_send>
+  </ports>
+  <guarantees>
+    <property id="small" logic="pmtl" expr="historically {x &lt; 4}"/>
+  </guarantees>
+</properties>"#,
+    )
+    .unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hindsight"))
+        .arg("verify")
+        .arg(&dir)
+        .args(["--threads", "2"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run hindsight");
+    let started = std::time::Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if started.elapsed() > std::time::Duration::from_secs(120) {
+            let _ = child.kill();
+            panic!("the study did not stop at the model's failure");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("the model failed during simulation: run ") && err.contains("index"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// UC3's full museum model (278 machines, 19 guarantees; the reference checker judges all
+/// true in every run): its `battery_level` port is declared int32 over a float32 field,
+/// which is read as a float with a warning (as SCAN does) instead of failing every run.
+#[test]
+fn the_uc3_scale_model_holds_every_guarantee() {
+    let uc3 = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .map(|d| d.join("shared/corpus/uc3-plain"))
+        .find(|d| d.is_dir())
+        .expect("shared/corpus next to the repository");
+    let (code, out, err) = hindsight(&[
+        "verify",
+        uc3.to_str().unwrap(),
+        "--seed",
+        "3",
+        "--max-runs",
+        "12",
+        "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains(
+            "properties.xml:8:7: port `battery_level` is declared int32 but \
+             `ros_fields__percentage` is a float: it is read as a float"
+        ),
+        "{err}"
+    );
+    let report: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let props = report["properties"].as_array().unwrap();
+    assert_eq!(props.len(), 19);
+    for p in props {
+        assert_eq!(p["successes"], 12, "{p}");
+    }
+}

@@ -566,7 +566,7 @@ impl<'m> Runner<'m> {
             time: 0,
         };
         let outcome = if judge.start() == crate::sim::Flow::Stop && judge.error.is_some() {
-            unknown(RunEnd::StepLimit)
+            unknown(RunEnd::Failed)
         } else {
             let out = sim.run(rng, self.run_cfg, &mut judge);
             let end = match &out.end {
@@ -588,7 +588,7 @@ impl<'m> Runner<'m> {
             }
             match end {
                 Some(end) if judge.error.is_none() => judge.outcome(end, out.steps, out.time),
-                _ => unknown(RunEnd::StepLimit),
+                _ => unknown(RunEnd::Failed),
             }
         };
         if let Ok(mut p) = self.pool.lock() {

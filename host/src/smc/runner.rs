@@ -91,6 +91,10 @@ pub enum RunEnd {
     TimeHorizon,
     /// The step limit (`--max-steps`) was reached: the run was cut short.
     StepLimit,
+    /// The model failed (a run-time error, a loop that lets no time pass, a message a
+    /// property cannot read): its verdicts are unknown and the study stops at once, so
+    /// that the failure is reported instead of being run around.
+    Failed,
 }
 
 /// What one run reports to the runner.
@@ -168,6 +172,9 @@ pub struct RunCounts {
     pub time_horizon: u64,
     /// Runs cut short by the step limit.
     pub step_limit: u64,
+    /// Runs in which the model failed (the study stops at the first).
+    #[serde(default)]
+    pub failed: u64,
     /// Simulation steps, summed over runs.
     pub steps: u64,
     /// Model time, summed over runs.
@@ -183,6 +190,7 @@ impl RunCounts {
         self.decided += other.decided;
         self.time_horizon += other.time_horizon;
         self.step_limit += other.step_limit;
+        self.failed += other.failed;
         self.steps += other.steps;
         self.model_time += other.model_time;
     }
@@ -196,6 +204,7 @@ impl RunCounts {
             RunEnd::Decided => self.decided += 1,
             RunEnd::TimeHorizon => self.time_horizon += 1,
             RunEnd::StepLimit => self.step_limit += 1,
+            RunEnd::Failed => self.failed += 1,
         }
         if outcome.assumptions == Verdict::False {
             self.discarded += 1;
@@ -428,6 +437,9 @@ where
             &run,
             |index, outcome| {
                 runs.record(&outcome);
+                if outcome.end == RunEnd::Failed {
+                    return ControlFlow::Break(());
+                }
                 for (i, (rule, tracker)) in rules.iter().zip(trackers.iter_mut()).enumerate() {
                     if tracker.stopped_at.is_some() {
                         continue;
@@ -535,6 +547,9 @@ where
             &run,
             |index, outcome| {
                 counts.runs.record(&outcome);
+                if outcome.end == RunEnd::Failed {
+                    return ControlFlow::Break(());
+                }
                 for i in 0..properties {
                     let Some(verdict) = effective_verdict(&outcome, i) else {
                         continue;

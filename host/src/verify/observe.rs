@@ -77,6 +77,35 @@ fn spec_type(scan: &str) -> Option<&'static str> {
     })
 }
 
+/// The type a state port holds: the declared one (`written`, as the spec language names
+/// it `declared`), except that an integer port
+/// reading a floating-point parameter takes it as a float (with a warning), as SCAN
+/// does: SCAN's port holds the parameter's value whatever type the port declares, and
+/// truncating it would change what the property's comparisons see.
+fn widened(
+    model: &CompiledModel,
+    port: &crate::props::Port,
+    param: &str,
+    (written, declared): (&str, &'static str),
+    file: &str,
+) -> &'static str {
+    let float = model
+        .event_id(&port.event)
+        .and_then(|e| model.param_path(e, param).map(|(i, _)| (e, i)))
+        .and_then(|(e, i)| model.event_params(e).get(i))
+        .is_some_and(|(_, t)| matches!(t, crate::expr::value::Ty::Float));
+    if float && declared.starts_with(['i', 'u']) {
+        eprintln!(
+            "warning: {file}:{}:{}: port `{}` is declared {written} but `{param}` is a \
+             float: it is read as a float (f64), as SCAN reads it",
+            port.at.line, port.at.column, port.id
+        );
+        "f64"
+    } else {
+        declared
+    }
+}
+
 /// A time unit of `ns` nanoseconds as the spec language writes it: `100ms`, `1s`, `7ns`.
 fn unit_text(ns: u64) -> String {
     for (unit, size) in [("s", 1_000_000_000), ("ms", 1_000_000), ("us", 1_000)] {
@@ -129,10 +158,10 @@ impl PropertySet {
                         continue;
                     }
                 },
-                PortKind::State { ty, init, .. } => match spec_type(ty) {
+                PortKind::State { ty, init, param } => match spec_type(ty) {
                     Some(t) => (
                         VarKind::State,
-                        t.to_string(),
+                        widened(model, p, param, (ty, t), &file).to_string(),
                         Some(init.as_str().to_string()),
                     ),
                     None => {
