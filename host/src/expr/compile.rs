@@ -711,46 +711,43 @@ impl Compiler<'_, '_> {
     fn path_code(&mut self, p: Path) -> Typed {
         let at = p.at;
         let ty = p.ty.clone();
-        // Fast paths: a whole variable or parameter.
+        // Fast paths: a whole variable or parameter, one closure per root so that a read
+        // does not test which one it is.
         if p.steps.is_empty() {
-            let (is_var, i) = match p.root {
-                Root::Var(i) => (true, i as usize),
-                Root::Param(i) => (false, i as usize),
-            };
-            macro_rules! slot {
-                ($env:ident) => {
-                    if is_var {
-                        $env.vars.get(i)
-                    } else {
-                        $env.params.get(i)
+            macro_rules! whole {
+                ($slots:ident, $i:expr) => {{
+                    let i = $i as usize;
+                    match ty {
+                        Ty::Bool => Code::Bool(Box::new(move |env| match env.$slots.get(i) {
+                            Some(Cell::Bool(b)) => Ok(*b),
+                            _ => Err(internal(at)),
+                        })),
+                        Ty::Int => Code::Int(Box::new(move |env| match env.$slots.get(i) {
+                            Some(Cell::Int(v)) => Ok(*v),
+                            _ => Err(internal(at)),
+                        })),
+                        Ty::Float => Code::Float(Box::new(move |env| match env.$slots.get(i) {
+                            Some(Cell::Float(v)) => Ok(*v),
+                            Some(Cell::Int(v)) => Ok(*v as f64),
+                            _ => Err(internal(at)),
+                        })),
+                        Ty::Str => Code::Str(Box::new(move |env| match env.$slots.get(i) {
+                            Some(Cell::Str(s)) => Ok(*s),
+                            _ => Err(internal(at)),
+                        })),
+                        _ => Code::Comp(Box::new(move |env, dest| match env.$slots.get(i) {
+                            Some(c) => {
+                                dest.clone_from(c);
+                                Ok(())
+                            }
+                            None => Err(internal(at)),
+                        })),
                     }
-                };
+                }};
             }
-            let code = match ty {
-                Ty::Bool => Code::Bool(Box::new(move |env| match slot!(env) {
-                    Some(Cell::Bool(b)) => Ok(*b),
-                    _ => Err(internal(at)),
-                })),
-                Ty::Int => Code::Int(Box::new(move |env| match slot!(env) {
-                    Some(Cell::Int(v)) => Ok(*v),
-                    _ => Err(internal(at)),
-                })),
-                Ty::Float => Code::Float(Box::new(move |env| match slot!(env) {
-                    Some(Cell::Float(v)) => Ok(*v),
-                    Some(Cell::Int(v)) => Ok(*v as f64),
-                    _ => Err(internal(at)),
-                })),
-                Ty::Str => Code::Str(Box::new(move |env| match slot!(env) {
-                    Some(Cell::Str(s)) => Ok(*s),
-                    _ => Err(internal(at)),
-                })),
-                _ => Code::Comp(Box::new(move |env, dest| match slot!(env) {
-                    Some(c) => {
-                        dest.clone_from(c);
-                        Ok(())
-                    }
-                    None => Err(internal(at)),
-                })),
+            let code = match p.root {
+                Root::Var(i) => whole!(vars, i),
+                Root::Param(i) => whole!(params, i),
             };
             return Typed { ty, code };
         }

@@ -107,10 +107,14 @@ pub(crate) struct StateDef {
     pub eventless: Vec<u32>,
     /// `(event, start, end)` ranges into the machine's `dispatch`, sorted by event.
     pub on_event: Vec<(u32, u32, u32)>,
+    /// Entering the state runs no code and it has no eventless transition: a machine
+    /// that enters it is idle at once.
+    pub idle_on_entry: bool,
 }
 
 impl StateDef {
     /// Transitions on `event`, in document order.
+    #[inline]
     pub fn transitions<'a>(&self, event: u32, dispatch: &'a [u32]) -> &'a [u32] {
         match self.on_event.binary_search_by_key(&event, |&(e, _, _)| e) {
             Ok(i) => {
@@ -1241,7 +1245,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                 span,
             } => {
                 let mut to_end = Vec::new();
-                for (cond, body) in branches {
+                for (k, (cond, body)) in branches.iter().enumerate() {
                     let c = self.bool_code(cond, event);
                     let at = self.emit(
                         Instr::If {
@@ -1251,7 +1255,11 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                         *span,
                     );
                     self.block(body, event);
-                    to_end.push(self.emit(Instr::Jump(0), *span));
+                    // The last branch of an `<if>` without `<else>` ends where the
+                    // `<if>` does: no jump needed.
+                    if k + 1 < branches.len() || !otherwise.is_empty() {
+                        to_end.push(self.emit(Instr::Jump(0), *span));
+                    }
                     let here = self.code.len() as u32;
                     if let Some(Instr::If { else_pc, .. }) = self.code.get_mut(at as usize) {
                         *else_pc = here;
@@ -1403,6 +1411,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                 entry,
                 eventless: Vec::new(),
                 on_event: Vec::new(),
+                idle_on_entry: false,
             });
         }
         let mut trans: Vec<TransDef> = Vec::new();
@@ -1479,6 +1488,14 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                 states[si].on_event.push((e, start, dispatch.len() as u32));
             }
         }
+        for st in &mut states {
+            st.idle_on_entry = st.eventless.is_empty()
+                && matches!(
+                    self.code.get(st.entry as usize),
+                    Some(Instr::CheckEventless)
+                );
+        }
+        thread_jumps(&mut self.code);
         // Datamodel initialisation.
         let vars = self.b.vars[mi as usize].clone();
         let defaults: Vec<Cell> = vars
@@ -1520,6 +1537,34 @@ impl<'b, 's> MachineCompiler<'b, 's> {
             code: self.code,
             code_spans: self.spans,
             n_scratch: self.n_scratch,
+        }
+    }
+}
+
+/// Points every jump (and `<if>`'s else branch) that lands on a jump at that jump's final
+/// target, so that no step goes through a chain of jumps.
+fn thread_jumps(code: &mut [Instr]) {
+    let last_of = |code: &[Instr], mut t: u32| {
+        // A chain visits each instruction at most once (guards against a cycle).
+        for _ in 0..code.len() {
+            match code.get(t as usize) {
+                Some(Instr::Jump(next)) if *next != t => t = *next,
+                _ => break,
+            }
+        }
+        t
+    };
+    for pc in 0..code.len() {
+        let target = match &code[pc] {
+            Instr::Jump(t) => *t,
+            Instr::If { else_pc, .. } => *else_pc,
+            _ => continue,
+        };
+        let last = last_of(code, target);
+        match &mut code[pc] {
+            Instr::Jump(t) => *t = last,
+            Instr::If { else_pc, .. } => *else_pc = last,
+            _ => {}
         }
     }
 }

@@ -861,23 +861,15 @@ impl<'m> Simulator<'m> {
         }
     }
 
-    /// Evaluates the guards of `list` and picks a transition.
+    /// Evaluates the guards of `list` (transitions of machine `m`) and picks one.
     fn select(
         &mut self,
         m: usize,
         def: &MachineDef,
-        event: Option<u32>,
+        list: &[u32],
         rng: &mut dyn Entropy,
         cfg: &RunConfig,
     ) -> Result<Option<u32>, Stop> {
-        let st = match def.states.get(self.ms[m].state as usize) {
-            Some(s) => s,
-            None => return Ok(None),
-        };
-        let list: &[u32] = match event {
-            Some(e) => st.transitions(e, &def.dispatch),
-            None => &st.eventless,
-        };
         if list.is_empty() {
             return Ok(None);
         }
@@ -923,6 +915,16 @@ impl<'m> Simulator<'m> {
         }
     }
 
+    /// The transitions of machine `m` in its current state on `event`, or its eventless
+    /// ones (`None`), in document order.
+    fn candidates<'d>(&self, m: usize, def: &'d MachineDef, event: Option<u32>) -> &'d [u32] {
+        match (def.states.get(self.ms[m].state as usize), event) {
+            (Some(st), Some(e)) => st.transitions(e, &def.dispatch),
+            (Some(st), None) => &st.eventless,
+            (None, _) => &[],
+        }
+    }
+
     /// One step of machine `m`: runs until it communicates once or has nothing to do.
     fn step<O: Observer + ?Sized>(
         &mut self,
@@ -944,7 +946,8 @@ impl<'m> Simulator<'m> {
                         .get(ev as usize)
                         .map_or(StrId(0), |e| e.name_str);
                     self.ms[m].cur_origin = def.name_str;
-                    if let Some(t) = self.select(m, def, Some(ev), rng, cfg)? {
+                    let list = self.candidates(m, def, Some(ev));
+                    if let Some(t) = self.select(m, def, list, rng, cfg)? {
                         self.ms[m].pc = def.trans[t as usize].pc;
                     }
                     internal += 1;
@@ -981,7 +984,8 @@ impl<'m> Simulator<'m> {
                             params: &self.pool[slot as usize].params,
                         },
                     );
-                    if let Some(t) = self.select(m, def, Some(event), rng, cfg)? {
+                    let list = self.candidates(m, def, Some(event));
+                    if let Some(t) = self.select(m, def, list, rng, cfg)? {
                         self.ms[m].pc = def.trans[t as usize].pc;
                     }
                     self.refresh(m);
@@ -1115,18 +1119,25 @@ impl<'m> Simulator<'m> {
                 Instr::Goto(s) => {
                     let r = &mut self.ms[m];
                     r.state = *s;
-                    r.pc = def.states.get(*s as usize).map_or(IDLE, |st| st.entry);
+                    r.pc = match def.states.get(*s as usize) {
+                        // What its entry code would do: check no eventless transition.
+                        Some(st) if st.idle_on_entry => IDLE,
+                        Some(st) => st.entry,
+                        None => IDLE,
+                    };
                 }
-                Instr::CheckEventless => match self.select(m, def, None, rng, cfg)? {
-                    Some(t) => {
-                        internal += 1;
-                        if internal > cfg.max_eventless {
-                            return Err(self.spin(m, SpinKind::EventlessLoop));
+                Instr::CheckEventless => {
+                    match self.select(m, def, self.candidates(m, def, None), rng, cfg)? {
+                        Some(t) => {
+                            internal += 1;
+                            if internal > cfg.max_eventless {
+                                return Err(self.spin(m, SpinKind::EventlessLoop));
+                            }
+                            self.ms[m].pc = def.trans[t as usize].pc;
                         }
-                        self.ms[m].pc = def.trans[t as usize].pc;
+                        None => self.ms[m].pc = IDLE,
                     }
-                    None => self.ms[m].pc = IDLE,
-                },
+                }
                 Instr::Send(sd) => {
                     // A delayed send blocks its machine for the delay (as in SCAN), then sends.
                     if let Some(d) = &sd.delay {
@@ -1334,7 +1345,8 @@ impl<'m> Simulator<'m> {
         let Some(st) = def.states.get(rt.state as usize) else {
             return Ok(None);
         };
-        let has = !st.transitions(e, &def.dispatch).is_empty();
+        let list = st.transitions(e, &def.dispatch);
+        let has = !list.is_empty();
         let origin = self.pool[e as usize].origin;
         {
             let rt = &mut self.ms[m];
@@ -1348,7 +1360,7 @@ impl<'m> Simulator<'m> {
                 .get(origin as usize)
                 .map_or(StrId(0), |d| d.name_str);
         }
-        if let Some(t) = self.select(m, def, Some(e), rng, cfg)? {
+        if let Some(t) = self.select(m, def, list, rng, cfg)? {
             return Ok(Some(Some(t)));
         }
         let discard = may_discard(self.no_discard[m], has, self.ev_flags[e as usize]);
