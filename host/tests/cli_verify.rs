@@ -1,6 +1,8 @@
 //! `hindsight verify` / `validate` end to end: analytic probabilities, assumptions, determinism
 //! across threads, the museum's thresholds, and bad models reported with a position.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -628,11 +630,7 @@ fn a_model_failing_at_run_time_stops_the_study_at_once() {
 /// which is read as a float with a warning (as SCAN does) instead of failing every run.
 #[test]
 fn the_uc3_scale_model_holds_every_guarantee() {
-    let uc3 = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|d| d.join("shared/corpus/uc3-plain"))
-        .find(|d| d.is_dir())
-        .expect("shared/corpus next to the repository");
+    let uc3 = common::corpus("uc3-plain");
     let (code, out, err) = hindsight(&[
         "verify",
         uc3.to_str().unwrap(),

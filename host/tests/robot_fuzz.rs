@@ -7,6 +7,8 @@
 //! the tree, the ROS lowering and the interface reader. `HINDSIGHT_ROBOT_MUTANTS=N` runs
 //! more than the default.
 
+mod common;
+
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
@@ -309,13 +311,7 @@ fn mutated_museum_guides_are_errors_with_positions_or_run() {
 /// AS2FM's own models: actions, blackboard ports, struct declarations, other tree nodes.
 #[test]
 fn mutated_as2fm_models_are_errors_with_positions_or_run() {
-    let Some(as2fm) = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|d| d.join("shared/corpus/as2fm"))
-        .find(|d| d.is_dir())
-    else {
-        panic!("shared/corpus next to the repository");
-    };
+    let as2fm = common::corpus("as2fm");
     let cases: [(&str, &str, &[&str]); 4] = [
         (
             "examples/tutorial_fetch_and_carry",
