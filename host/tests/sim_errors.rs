@@ -235,3 +235,22 @@ fn mutated_expressions_never_panic() {
         }
     }
 }
+
+/// A variable whose declaration is wrong is reported once, at the declaration: its uses
+/// do not add an "unknown variable" each.
+#[test]
+fn a_failed_declaration_is_reported_once() {
+    let text = format!(
+        "{HEAD}\n<datamodel><data id=\"a\" expr=\"[]\"/></datamodel>\n<state id=\"s\"><onentry><assign location=\"a[0]\" expr=\"1\"/><send event=\"e\" target=\"M\"><param name=\"n\" expr=\"a.length\"/></send></onentry>\n<transition event=\"e\" cond=\"a.length &gt; 3\" target=\"s\"/></state></scxml>"
+    );
+    let errs = compile(&[("m.scxml", text.as_str())]).expect_err("rejected");
+    let all: Vec<String> = errs
+        .iter()
+        .map(|d| format!("{}:{}: {}", d.line, d.column, d.message))
+        .collect();
+    assert_eq!(all.len(), 1, "{all:?}");
+    assert!(
+        all[0].starts_with("2:12: cannot infer the element type of `a` from its value"),
+        "{all:?}"
+    );
+}

@@ -141,6 +141,23 @@ pub(crate) struct CompileError {
     /// The error is only that an event parameter's type is not known yet
     /// (type inference of parameters retries these).
     pub deferred: bool,
+    /// The error is only that this variable is not declared (the model compiler stays
+    /// quiet about it when its declaration was already reported as wrong).
+    pub unknown_variable: Option<String>,
+}
+
+/// The message of a read of a parameter whose type is not known: the model compiler
+/// matches it to the parameter's own report.
+pub(crate) fn unknown_param_type(field: &str, event: &str) -> String {
+    format!("type of parameter `{field}` of event `{event}` is not known")
+}
+
+/// An undeclared variable `name` at `at`.
+fn unknown_variable(at: u32, name: &str) -> CompileError {
+    CompileError {
+        unknown_variable: Some(name.to_string()),
+        ..cerr(at, format!("unknown variable `{name}`"))
+    }
 }
 
 fn cerr(at: u32, msg: impl Into<String>) -> CompileError {
@@ -148,6 +165,7 @@ fn cerr(at: u32, msg: impl Into<String>) -> CompileError {
         at,
         msg: msg.into(),
         deferred: false,
+        unknown_variable: None,
     }
 }
 
@@ -393,7 +411,7 @@ impl Compiler<'_, '_> {
                         format!("`_event` cannot be used as a value; {EVENT_FIELDS_HELP}"),
                     )),
                     "Math" => Err(cerr(at, "`Math` cannot be used as a value")),
-                    _ => Err(cerr(at, format!("unknown variable `{name}`"))),
+                    _ => Err(unknown_variable(at, name)),
                 }
             }
             ExprKind::Member(obj, field, fat) => self.member(e, obj, field, *fat),
@@ -682,11 +700,8 @@ impl Compiler<'_, '_> {
                             at: self.abs(at),
                         }),
                         None => Err(CompileError {
-                            at,
-                            msg: format!(
-                                "type of parameter `{field}` of event `{name}` is not known"
-                            ),
                             deferred: true,
+                            ..cerr(at, unknown_param_type(field, name))
                         }),
                     },
                     None => {
@@ -1568,7 +1583,7 @@ pub(crate) fn compile_place(
                 })
             }
             None if name == "_event" => Err(cerr(e.start, "cannot assign to `_event`")),
-            None => Err(cerr(e.start, format!("unknown variable `{name}`"))),
+            None => Err(unknown_variable(e.start, name)),
         },
         ExprKind::Index(arr, idx) => {
             let mut p = compile_place(arr, scope, strings)?;

@@ -11,8 +11,8 @@
 
 use super::ids::{EventId, MachineId, StateId};
 use crate::expr::compile::{
-    compile, compile_as, compile_place, BoolFn, CellFn, Code, CompileError, EventScope, IntFn,
-    Place, Scope, StrFn, Typed,
+    compile, compile_as, compile_place, unknown_param_type, BoolFn, CellFn, Code, CompileError,
+    EventScope, IntFn, Place, Scope, StrFn, Typed,
 };
 use crate::expr::parse_expr;
 use crate::expr::value::{Cell, StrId, Strings, StructDef, Ty, TypeTable};
@@ -433,10 +433,9 @@ impl<'s> Builder<'s> {
         let echo = if e.deferred {
             self.failed_params.contains(&e.msg)
         } else {
-            e.msg
-                .strip_prefix("unknown variable `")
-                .and_then(|rest| rest.strip_suffix('`'))
-                .is_some_and(|name| self.failed_vars.contains(&(machine, name.to_string())))
+            e.unknown_variable
+                .as_ref()
+                .is_some_and(|name| self.failed_vars.contains(&(machine, name.clone())))
         };
         if !echo {
             let d = self.expr_diag(src, e);
@@ -908,10 +907,8 @@ impl<'s> Builder<'s> {
                     // Why the type is unknown: a syntax error, an expression that does
                     // not compile (an unknown variable, say), or one whose type says
                     // nothing (`[]`). Reads of the parameter elsewhere would only echo it.
-                    self.failed_params.insert(format!(
-                        "type of parameter `{}` of event `{}` is not known",
-                        p.name.name, site.send.event.name
-                    ));
+                    self.failed_params
+                        .insert(unknown_param_type(&p.name.name, &site.send.event.name));
                     match parse_expr(&p.expr.text) {
                         Err(pe) => {
                             let at = self.src.sources.unescaped_offset(p.expr.span, pe.offset);
