@@ -9,6 +9,8 @@
 //! variables, applies the ports of a sent message, and steps the monitors. When every
 //! verdict is final ([`super::settle`]) it stops the run.
 
+use std::collections::BTreeSet;
+
 use codegen::{Compiled, DeclInput, FormulaInput, Origin, SpecInput};
 use monitor_core::{valuation, Monitor, Op, Ty, Value, VarKind};
 
@@ -77,10 +79,10 @@ fn spec_type(scan: &str) -> Option<&'static str> {
     })
 }
 
-/// The type a state port holds: the declared one (`written`, as the spec language names
-/// it `declared`), except that an integer port
-/// reading a floating-point parameter takes it as a float (with a warning), as SCAN
-/// does: SCAN's port holds the parameter's value whatever type the port declares, and
+/// The type a state port holds: the declared one (`written` in the file, `declared` as
+/// the spec language names it), except that an integer port reading a floating-point
+/// parameter takes it as a float (with a warning, once per process), as SCAN does:
+/// SCAN's port holds the parameter's value whatever type the port declares, and
 /// truncating it would change what the property's comparisons see.
 fn widened(
     model: &CompiledModel,
@@ -95,11 +97,17 @@ fn widened(
         .and_then(|(e, i)| model.event_params(e).get(i))
         .is_some_and(|(_, t)| matches!(t, crate::expr::value::Ty::Float));
     if float && declared.starts_with(['i', 'u']) {
-        eprintln!(
+        // A sweep compiles the file once per property: say it once.
+        static SAID: std::sync::Mutex<BTreeSet<String>> = std::sync::Mutex::new(BTreeSet::new());
+        let warning = format!(
             "warning: {file}:{}:{}: port `{}` is declared {written} but `{param}` is a \
              float: it is read as a float (f64), as SCAN reads it",
             port.at.line, port.at.column, port.id
         );
+        let mut said = SAID.lock().unwrap_or_else(|e| e.into_inner());
+        if said.insert(warning.clone()) {
+            eprintln!("{warning}");
+        }
         "f64"
     } else {
         declared
