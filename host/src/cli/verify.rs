@@ -385,17 +385,18 @@ fn read_properties(
         Ok(())
     };
     let file = if is_jani(path) {
+        // The reader sees every property's name, skipped or not.
         let mut names = Vec::new();
-        if !(args.only.is_empty() && args.skip.is_empty()) {
-            // The names first, so that a misspelt one is reported before any property.
-            props::jani::parse_file_selected(path, model, &mut |name| {
-                names.push(name.to_string());
-                false
-            })
-            .map_err(|d| CliError::Input(d.to_string()))?;
+        let read = props::jani::parse_file_selected(path, model, &mut |name| {
+            names.push(name.to_string());
+            wanted(name)
+        });
+        // A misspelt name comes before what the properties it kept say (a file that is
+        // not JSON at all names nothing: its own error comes first then).
+        if read.is_ok() || !names.is_empty() {
             unknown_name(&names)?;
         }
-        props::jani::parse_file_selected(path, model, &mut |name| wanted(name)).map_err(|d| {
+        read.map_err(|d| {
             let text = d.to_string();
             // A property using what is not supported need not stop the others.
             let hint = if text.contains("not supported") {

@@ -294,12 +294,6 @@ impl MainFile {
                 continue;
             }
             seen.push((section.to_string(), el.span));
-            if matches!(
-                section,
-                "parameters" | "data_declarations" | "behavior_tree" | "node_models" | "properties"
-            ) {
-                el.check_attrs(sm, &[], &mut r.errs);
-            }
             match section {
                 "parameters" => params = Some((r.parameters(el), el.span)),
                 "data_declarations" => {
@@ -338,14 +332,19 @@ impl MainFile {
                         ],
                     )
                 }
-                other => r.errs.push(sm.diag(
-                    el.span,
-                    format!(
-                        "unknown element <{other}> in <{}> (expected <parameters>, <data_declarations>, <behavior_tree>, <node_models> or <properties>)",
-                        root.name
-                    ),
-                )),
+                other => {
+                    r.errs.push(sm.diag(
+                        el.span,
+                        format!(
+                            "unknown element <{other}> in <{}> (expected <parameters>, <data_declarations>, <behavior_tree>, <node_models> or <properties>)",
+                            root.name
+                        ),
+                    ));
+                    // Its attributes mean nothing here: no error for each of them.
+                    continue;
+                }
             }
+            el.check_attrs(sm, &[], &mut r.errs);
         }
         let params = match params {
             Some((

@@ -383,10 +383,7 @@ impl Cx<'_> {
             let mut p = Element::new("param", c.span);
             p.set_attr_at("name", fields[fi].param_name(), nspan);
             p.set_attr_at("expr", expr, espan);
-            if fields[fi].scxml_type.ends_with(']') {
-                // An array's element type may not follow from its value (`[]`).
-                p.set_attr("type", fields[fi].scxml_type.clone());
-            }
+            typed_if_array(&mut p, &fields[fi]);
             given.push((fi, p));
         }
         let mut out: Vec<Element> = given.iter().map(|(_, p)| p.clone()).collect();
@@ -395,10 +392,7 @@ impl Cx<'_> {
                 let mut p = Element::new("param", el.span)
                     .with_attr("name", f.param_name())
                     .with_attr("expr", f.default.clone());
-                // An empty array literal says nothing of its elements: the interface does.
-                if f.scxml_type.ends_with(']') {
-                    p.set_attr("type", f.scxml_type.clone());
-                }
+                typed_if_array(&mut p, f);
                 out.push(p);
             }
         }
@@ -808,5 +802,13 @@ impl Cx<'_> {
                 one(self.send(el.span, &ev("result"), &handler, ps))
             }
         }
+    }
+}
+
+/// Gives an array field's `<param>` the interface's type: an array's element type need
+/// not follow from its value (`[]`).
+fn typed_if_array(param: &mut Element, field: &FlatField) {
+    if field.scxml_type.ends_with(']') {
+        param.set_attr("type", field.scxml_type.clone());
     }
 }
