@@ -57,6 +57,8 @@ pub(crate) struct Blackboard {
     pub entries: Vec<Entry>,
     /// Machines that read (receive `bt_blackboard_get`), in the order first seen.
     pub readers: Vec<String>,
+    /// Entries whose constants already conflict (reported once, not again per node).
+    pub conflicted: Vec<String>,
 }
 
 impl Blackboard {
@@ -281,12 +283,42 @@ pub(crate) fn type_entries(
         .filter(|n| n.kind == Kind::Control(Control::SetBlackboard))
         .filter_map(set_ports)
         .collect();
+    // The constants written to each entry no port types, in tree order.
+    let mut consts: Vec<(&str, Vec<(&str, Span)>)> = Vec::new();
     for (entry, value) in &sets {
         if let PortValue::Literal(v) = &value.value {
             if !by_ports.contains(entry) {
-                let why = format!("SetBlackboard writing `{}`", v.trim());
-                register(sm, bb, entry, literal_type(v), value.span, &why, errs);
+                match consts.iter_mut().find(|(e, _)| e == entry) {
+                    Some((_, vs)) => vs.push((v, value.span)),
+                    None => consts.push((entry, vec![(v, value.span)])),
+                }
             }
+        }
+    }
+    for (entry, vs) in consts {
+        let kinds: Vec<&str> = vs.iter().map(|(v, _)| literal_type(v)).collect();
+        let numeric = |k: &str| matches!(k, "int32" | "int64" | "float64");
+        // Integers and decimals together make a float; other mixtures are conflicts.
+        let ty = if kinds.iter().all(|k| *k == "int32") {
+            "int32"
+        } else if kinds.iter().all(|k| k.starts_with("int")) {
+            "int64"
+        } else if kinds.iter().all(|k| numeric(k)) {
+            "float64"
+        } else {
+            kinds[0]
+        };
+        let (first, span) = vs[0];
+        let why = format!("SetBlackboard writing `{}`", first.trim());
+        register(sm, bb, entry, ty, span, &why, errs);
+        if let Some(i) = kinds
+            .iter()
+            .position(|k| !(*k == ty || (numeric(k) && numeric(ty))))
+        {
+            let (v, at) = vs[i];
+            let why = format!("SetBlackboard writing `{}`", v.trim());
+            register(sm, bb, entry, kinds[i], at, &why, errs);
+            bb.conflicted.push(entry.to_string());
         }
     }
     loop {
@@ -375,6 +407,7 @@ pub(crate) fn lower_set(
     match &value.value {
         PortValue::Literal(v) => match plugin::check_literal(v, &e.ty) {
             Ok(()) => Some(set_blackboard(ctx, &entry, &plugin::literal_expr(v, &e.ty))),
+            Err(_) if bb.conflicted.contains(&entry) => None,
             Err(m) => {
                 let at = sm.diag(e.span, "");
                 errs.push(sm.diag(

@@ -649,11 +649,22 @@ impl Reader<'_> {
             // (`SetBlackboard::tick` reads it as a string), with braces in AS2FM's model (an
             // output port): either way an entry, private to the SubTree it is in.
             if kind == Kind::Control(Control::SetBlackboard) && a.name == "output_key" {
-                if let PortValue::Literal(v) = &value {
-                    let v = v.trim().to_string();
-                    if is_ident(&v) {
-                        value = self.resolve_bb(&v, self.scopes.len());
-                    }
+                let raw = a.value.trim();
+                let name = blackboard_name(raw).unwrap_or(raw);
+                if !is_ident(name) {
+                    self.err(
+                        a.value_span,
+                        format!("`{raw}` is not a blackboard entry name"),
+                    );
+                    continue;
+                }
+                value = self.resolve_bb(name, self.scopes.len());
+                if let PortValue::Literal(c) = &value {
+                    self.err(
+                        a.value_span,
+                        format!("SetBlackboard writes `{name}`, which the SubTree it is in sets to the constant `{c}`: map it to an entry (`{{...}}`) to write it"),
+                    );
+                    continue;
                 }
             }
             if let PortValue::Blackboard(b) = &value {
