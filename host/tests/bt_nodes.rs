@@ -467,6 +467,12 @@ fn bad_trees_exit_2_with_their_position() {
         "x\"",
         "must be a whole number",
     );
+    refused(
+        "threshold",
+        &v4("<Parallel success_count=\"1\" success_threshold=\"2\">\n<AlwaysSuccess/>\n<AlwaysSuccess/>\n</Parallel>"),
+        "2\"",
+        "the same threshold",
+    );
     // A BT.CPP node hindsight does not support: named as such, with the reason.
     refused(
         "unsupported",

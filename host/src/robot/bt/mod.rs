@@ -310,6 +310,13 @@ fn builtin(
         Control::Parallel => {
             let ok_before = errs.len();
             let mut th = |keys: &[&str], default: i64, what: &str| -> i64 {
+                // BT.CPP 4's name and 3's (AS2FM's) for one threshold: one of them only.
+                if let (Some(_), Some(b)) = (n.port(keys[0]), n.port(keys[1])) {
+                    errs.push(sm.diag(
+                        b.span,
+                        format!("`{}` and `{}` are the same threshold (BehaviorTree.CPP 4's and 3's name): give one", keys[0], keys[1]),
+                    ));
+                }
                 let (v, span) = int_param(sm, n, keys, errs).unwrap_or((default, n.span));
                 let v = if v < 0 { count + v + 1 } else { v };
                 if v < 1 || v > count {
