@@ -147,6 +147,10 @@ fn v4(body: &str) -> String {
 
 /// The machines of `tree` (plugins Attempt and Run) as XML texts, or the errors.
 fn lower(tree: &str) -> Result<Vec<String>, String> {
+    lower_with(tree, Halts::As2fm)
+}
+
+fn lower_with(tree: &str, halts: Halts) -> Result<Vec<String>, String> {
     let mut sm = SourceMap::new();
     let t = sm.add("tree.xml", tree.to_string());
     let plugins = vec![
@@ -160,7 +164,7 @@ fn lower(tree: &str) -> Result<Vec<String>, String> {
             plugins,
             tick_rate_hz: 1.0,
             tick_if_not_running: false,
-            halts: Halts::As2fm,
+            halts,
         },
     )
     .map(|ms| ms.iter().map(write::to_xml).collect())
@@ -259,6 +263,24 @@ fn a_mismatch_halts_the_child_before_answering_as_as2fm_does() {
     let halt = mismatch.find("bt_1001_halt\"").expect("halts the child");
     let answer = mismatch.find("bt_1000_response").expect("then answers");
     assert!(halt < answer, "{check}");
+    // BT.CPP halts the child only if that can change something (`haltChild` while it
+    // runs): with Halts::WhenNeeded a child whose halt never matters is not halted ...
+    let t =
+        v3("<BlackboardCheckInt value_A=\"1\" value_B=\"2\"><AlwaysSuccess/></BlackboardCheckInt>");
+    let ms = lower_with(&t, Halts::WhenNeeded).unwrap();
+    assert!(!ms[1].contains("value_mismatch"), "{}", ms[1]);
+    let exec = ms[1]
+        .split("<state id=\"exec_tick\">")
+        .nth(1)
+        .and_then(|r| r.split("</state>").next())
+        .expect("an exec_tick state");
+    assert!(
+        exec.contains("bt_1000_response") && !exec.contains("_halt"),
+        "{exec}"
+    );
+    // ... and one with halt code still is.
+    let ms = lower_with(&t.replace("AlwaysSuccess", "Run"), Halts::WhenNeeded).unwrap();
+    assert!(ms[1].contains("<state id=\"value_mismatch\">"), "{}", ms[1]);
 }
 
 #[test]
