@@ -1,13 +1,28 @@
-//! The blackboard: one machine holding every `{entry}` the tree names, and the built-in
-//! nodes that use it (SetBlackboard, BlackboardCheckInt).
+//! The blackboard: one machine holding every `{entry}` the tree names, the types of its
+//! entries, and the built-in nodes that use it (SetBlackboard, BlackboardCheckInt /
+//! Double / String / Bool).
 //!
-//! As in AS2FM's translation, a write is `bt_blackboard_set_<entry>` with a `value`
-//! parameter; a read is `bt_blackboard_req`, answered by `bt_blackboard_get` carrying
-//! every entry as a parameter of the same name, sent to every machine that reads.
+//! As in AS2FM's translation (`bt_converter.py`, `generate_blackboard_scxml`), a write
+//! is `bt_blackboard_set_<entry>` with a `value` parameter; a read is
+//! `bt_blackboard_req`, answered by `bt_blackboard_get` carrying every entry as a
+//! parameter of the same name, sent to every machine that reads.
+//!
+//! # Entry types
+//! AS2FM types an entry by the ports that name it (`get_blackboard_variables_from_models`:
+//! every port declaration whose value is `{entry}`, two types being an error), its
+//! SetBlackboard model's ports being `int32`. Here the ports of plugins and of the
+//! BlackboardCheck nodes type an entry first; an entry that only SetBlackboard writes
+//! takes the type of the constants written (AS2FM's literal typing,
+//! `ecmascript_interpretation_functions.py`, `__get_ast_literal_type`: `10` int, `1.5`
+//! float, `true` bool; other text is a string, as BT.CPP keeps it); a copy
+//! (`value="{other}"`) has its source's type. Two types for one entry are an error
+//! naming both places.
 
 use super::build::B;
-use super::control::{status_code, Ctx, FAILURE, RUNNING, SUCCESS};
-use crate::model::source::Span;
+use super::control::{Ctx, HaltEffect, FAILURE, RUNNING, SUCCESS};
+use super::plugin;
+use super::tree::{CheckType, Control, Kind, PortValue, Tree, TreeNode};
+use crate::model::source::{Diagnostic, SourceMap, Span};
 use crate::model::xml::Element;
 
 /// The blackboard machine's name.
@@ -31,6 +46,8 @@ pub(crate) struct Entry {
     pub ty: String,
     /// Where the type was first given.
     pub span: Span,
+    /// What gave it, for errors: "port `x` of plugin `P`", "SetBlackboard writing `1`".
+    pub why: String,
 }
 
 /// The entries and readers collected while lowering the tree.
@@ -40,6 +57,8 @@ pub(crate) struct Blackboard {
     pub entries: Vec<Entry>,
     /// Machines that read (receive `bt_blackboard_get`), in the order first seen.
     pub readers: Vec<String>,
+    /// Entries whose constants already conflict (reported once, not again per node).
+    pub conflicted: Vec<String>,
 }
 
 impl Blackboard {
@@ -136,13 +155,407 @@ pub(crate) fn set_blackboard(ctx: &Ctx, entry: &str, value: &str) -> Element {
     m
 }
 
-/// BlackboardCheckInt: compares `a` and `b` (expressions over `_event.data` when
-/// `reads` is true, after a blackboard read); equal ticks the child and answers as it
-/// does, different answers `mismatch` (SUCCESS, FAILURE or RUNNING; FAILURE by default).
-pub(crate) fn check_int(ctx: &Ctx, a: &str, b_expr: &str, reads: bool, mismatch: &str) -> Element {
+/// The status a tree attribute such as `return_on_mismatch` names: `SUCCESS`,
+/// `FAILURE`, `RUNNING`, or AS2FM's numbers for them (`bt_utils.py`, `BtResponse`: an
+/// `Enum` of `auto()` values, 1 SUCCESS, 2 FAILURE, 3 RUNNING; its
+/// `blackboard_check_int.ascxml` declares `return_on_mismatch` an `int8` port). BT.CPP's
+/// own `NodeStatus` numbers differ (0 IDLE, 1 RUNNING, 2 SUCCESS, 3 FAILURE, 4 SKIPPED;
+/// `test_node.cpp`, `createTestNodeEnums`), but its `convertFromString<NodeStatus>` takes
+/// names only, so a number in a tree can only be AS2FM's.
+pub(crate) fn parse_status(v: &str) -> Result<u8, String> {
+    match v.trim() {
+        "SUCCESS" | "1" => Ok(SUCCESS),
+        "FAILURE" | "2" => Ok(FAILURE),
+        "RUNNING" | "3" => Ok(RUNNING),
+        s @ ("IDLE" | "SKIPPED" | "0" | "4") => Err(format!(
+            "`{s}` is not a status a node can answer: write SUCCESS, FAILURE or RUNNING (or AS2FM's 1, 2, 3)"
+        )),
+        s => Err(format!(
+            "`{s}` is not a status: write SUCCESS, FAILURE or RUNNING (or AS2FM's numbers 1 SUCCESS, 2 FAILURE, 3 RUNNING)"
+        )),
+    }
+}
+
+/// The type AS2FM gives constant `v` (see the module comment), or `string`.
+pub(crate) fn literal_type(v: &str) -> &'static str {
+    let t = v.trim();
+    let digits = t.strip_prefix(['-', '+']).unwrap_or(t);
+    if !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit()) {
+        return if t.parse::<i32>().is_ok() {
+            "int32"
+        } else {
+            "int64"
+        };
+    }
+    let numeric = digits
+        .chars()
+        .next()
+        .is_some_and(|c| c.is_ascii_digit() || c == '.')
+        && digits
+            .chars()
+            .all(|c| c.is_ascii_digit() || matches!(c, '.' | 'e' | 'E' | '-' | '+'));
+    if numeric && t.parse::<f64>().is_ok_and(|f| f.is_finite()) {
+        return "float64";
+    }
+    match t {
+        "true" | "false" => "bool",
+        _ => "string",
+    }
+}
+
+/// Records entry `name` of type `ty` given at `span` by `why`; an error naming both
+/// places if it already has another type.
+pub(crate) fn register(
+    sm: &SourceMap,
+    bb: &mut Blackboard,
+    name: &str,
+    ty: &str,
+    span: Span,
+    why: &str,
+    errs: &mut Vec<Diagnostic>,
+) {
+    match bb.entry(name) {
+        Some(e) if plugin::normalize(&e.ty) != plugin::normalize(ty) => {
+            let at = sm.diag(e.span, "");
+            errs.push(sm.diag(
+                span,
+                format!(
+                    "blackboard entry `{{{name}}}` is used as {ty} here but as {} at {}:{}:{} (here: {why}; there: {})",
+                    e.ty,
+                    at.path.display(),
+                    at.line,
+                    at.column,
+                    e.why
+                ),
+            ));
+        }
+        Some(_) => {}
+        None => bb.entries.push(Entry {
+            name: name.to_string(),
+            ty: ty.to_string(),
+            span,
+            why: why.to_string(),
+        }),
+    }
+}
+
+/// `output_key` and `value` of a SetBlackboard node: the entry written and what.
+fn set_ports(n: &TreeNode) -> Option<(String, &super::tree::Port)> {
+    let key = n.port("output_key")?;
+    let value = n.port("value")?;
+    let entry = match &key.value {
+        PortValue::Literal(v) => v.trim().to_string(),
+        PortValue::Blackboard(b) => b.clone(),
+    };
+    Some((entry, value))
+}
+
+/// Types every entry (see the module comment): ports first, then SetBlackboard's
+/// constants for the entries no port types, then copies, in both directions, until
+/// nothing changes.
+pub(crate) fn type_entries(
+    sm: &SourceMap,
+    tree: &Tree,
+    plugins: &[plugin::Plugin],
+    bb: &mut Blackboard,
+    errs: &mut Vec<Diagnostic>,
+) {
+    for n in &tree.nodes {
+        match n.kind {
+            Kind::Plugin(i) => plugin::check_ports(sm, &plugins[i], n, bb, errs),
+            Kind::Control(Control::BlackboardCheck(t)) => {
+                for p in &n.ports {
+                    if let (true, PortValue::Blackboard(b)) =
+                        (p.key.starts_with("value_"), &p.value)
+                    {
+                        let why = format!("port `{}` of {}", p.key, t.node_name());
+                        register(sm, bb, b, t.port_type(), p.span, &why, errs);
+                    }
+                }
+            }
+            Kind::Control(_) => {}
+        }
+    }
+    let by_ports: Vec<String> = bb.entries.iter().map(|e| e.name.clone()).collect();
+    let sets: Vec<(String, &super::tree::Port)> = tree
+        .nodes
+        .iter()
+        .filter(|n| n.kind == Kind::Control(Control::SetBlackboard))
+        .filter_map(set_ports)
+        .collect();
+    // The constants written to each entry no port types, in tree order.
+    let mut consts: Vec<(&str, Vec<(&str, Span)>)> = Vec::new();
+    for (entry, value) in &sets {
+        if let PortValue::Literal(v) = &value.value {
+            if !by_ports.contains(entry) {
+                match consts.iter_mut().find(|(e, _)| e == entry) {
+                    Some((_, vs)) => vs.push((v, value.span)),
+                    None => consts.push((entry, vec![(v, value.span)])),
+                }
+            }
+        }
+    }
+    for (entry, vs) in consts {
+        let kinds: Vec<&str> = vs.iter().map(|(v, _)| literal_type(v)).collect();
+        let numeric = |k: &str| matches!(k, "int32" | "int64" | "float64");
+        // Integers and decimals together make a float; other mixtures are conflicts.
+        let ty = if kinds.iter().all(|k| *k == "int32") {
+            "int32"
+        } else if kinds.iter().all(|k| k.starts_with("int")) {
+            "int64"
+        } else if kinds.iter().all(|k| numeric(k)) {
+            "float64"
+        } else {
+            kinds[0]
+        };
+        let (first, span) = vs[0];
+        let why = format!("SetBlackboard writing `{}`", first.trim());
+        register(sm, bb, entry, ty, span, &why, errs);
+        if let Some(i) = kinds
+            .iter()
+            .position(|k| !(*k == ty || (numeric(k) && numeric(ty))))
+        {
+            let (v, at) = vs[i];
+            let why = format!("SetBlackboard writing `{}`", v.trim());
+            register(sm, bb, entry, kinds[i], at, &why, errs);
+            bb.conflicted.push(entry.to_string());
+        }
+    }
+    loop {
+        let mut changed = false;
+        for (entry, value) in &sets {
+            let PortValue::Blackboard(src) = &value.value else {
+                continue;
+            };
+            let (d, s) = (bb.entry(entry).cloned(), bb.entry(src).cloned());
+            let why = format!("SetBlackboard copying `{{{src}}}` to `{{{entry}}}`");
+            match (d, s) {
+                (Some(d), None) => {
+                    register(sm, bb, src, &d.ty, value.span, &why, errs);
+                    changed = true;
+                }
+                (None, Some(s)) => {
+                    register(sm, bb, entry, &s.ty, value.span, &why, errs);
+                    changed = true;
+                }
+                _ => {}
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    for (entry, value) in &sets {
+        let PortValue::Blackboard(src) = &value.value else {
+            continue;
+        };
+        if let (Some(d), Some(s)) = (bb.entry(entry), bb.entry(src)) {
+            if plugin::normalize(&d.ty) != plugin::normalize(&s.ty) {
+                let (a, b) = (sm.diag(d.span, ""), sm.diag(s.span, ""));
+                errs.push(sm.diag(
+                    value.span,
+                    format!(
+                        "SetBlackboard copies `{{{src}}}` ({} at {}:{}:{}, {}) to `{{{entry}}}` ({} at {}:{}:{}, {})",
+                        s.ty,
+                        b.path.display(),
+                        b.line,
+                        b.column,
+                        s.why,
+                        d.ty,
+                        a.path.display(),
+                        a.line,
+                        a.column,
+                        d.why
+                    ),
+                ));
+            }
+        }
+    }
+}
+
+/// The entry `n` (a SetBlackboard node) writes, with its type, or an error.
+fn typed_entry(
+    sm: &SourceMap,
+    n: &TreeNode,
+    bb: &Blackboard,
+    errs: &mut Vec<Diagnostic>,
+) -> Option<(String, Entry, super::tree::Port)> {
+    let Some((entry, value)) = set_ports(n) else {
+        errs.push(sm.diag(n.span, "SetBlackboard needs `output_key` and `value`"));
+        return None;
+    };
+    let Some(e) = bb.entry(&entry).cloned() else {
+        errs.push(sm.diag(
+            value.span,
+            format!("blackboard entry `{{{entry}}}` has no type: nothing writes it a constant and no port reads it"),
+        ));
+        return None;
+    };
+    Some((entry, e, value.clone()))
+}
+
+/// SetBlackboard: checks what it writes against the entry's type and builds its machine
+/// (AS2FM's `set_blackboard.ascxml`: on a tick, write and answer SUCCESS).
+pub(crate) fn lower_set(
+    sm: &SourceMap,
+    n: &TreeNode,
+    ctx: &Ctx,
+    bb: &mut Blackboard,
+    errs: &mut Vec<Diagnostic>,
+) -> Option<Element> {
+    let (entry, e, value) = typed_entry(sm, n, bb, errs)?;
+    match &value.value {
+        PortValue::Literal(v) => match plugin::check_literal(v, &e.ty) {
+            Ok(()) => Some(set_blackboard(ctx, &entry, &plugin::literal_expr(v, &e.ty))),
+            Err(_) if bb.conflicted.contains(&entry) => None,
+            Err(m) => {
+                let at = sm.diag(e.span, "");
+                errs.push(sm.diag(
+                    value.span,
+                    format!(
+                        "SetBlackboard writes `{}` to `{{{entry}}}`, which is {} at {}:{}:{} ({}): {m}",
+                        v.trim(),
+                        e.ty,
+                        at.path.display(),
+                        at.line,
+                        at.column,
+                        e.why
+                    ),
+                ));
+                None
+            }
+        },
+        PortValue::Blackboard(src) => {
+            bb.add_reader(&ctx.machine);
+            Some(copy_blackboard(ctx, &entry, src))
+        }
+    }
+}
+
+/// SetBlackboard with `value="{src}"`: reads the blackboard, writes `src`'s value to
+/// `entry`, answers SUCCESS (BT.CPP 4 `SetBlackboardNode::tick`, 3.8 `SetBlackboard::tick`).
+fn copy_blackboard(ctx: &Ctx, entry: &str, src: &str) -> Element {
     let b = &ctx.b;
-    let mismatch = status_code(mismatch).unwrap_or(FAILURE);
     let mut m = b.scxml(&ctx.machine, "idle");
+    m.push(
+        b.state("idle")
+            .with_child(b.tr(
+                Some(&ctx.tick_ev()),
+                None,
+                Some("read_blackboard"),
+                vec![b.send(REQ, MACHINE)],
+            ))
+            .with_child(b.tr(
+                Some(&ctx.halt_ev()),
+                None,
+                Some("idle"),
+                vec![ctx.respond_halted()],
+            )),
+    );
+    let from = format!("_event.data.{src}");
+    m.push(b.state("read_blackboard").with_child(b.tr(
+        Some(GET),
+        None,
+        Some("idle"),
+        vec![
+            b.send_params(&set_event(entry), MACHINE, &[("value", &from)]),
+            ctx.respond(SUCCESS),
+        ],
+    )));
+    m
+}
+
+/// One side of a BlackboardCheck comparison as an expression of type `t`.
+fn check_side(
+    sm: &SourceMap,
+    t: CheckType,
+    n: &TreeNode,
+    key: &str,
+    reads: &mut bool,
+    errs: &mut Vec<Diagnostic>,
+) -> Option<String> {
+    let Some(p) = n.port(key) else {
+        errs.push(sm.diag(n.span, format!("{} needs `{key}`", t.node_name())));
+        return None;
+    };
+    match &p.value {
+        PortValue::Literal(v) => match plugin::check_literal(v, t.port_type()) {
+            Ok(()) => Some(plugin::literal_expr(v, t.port_type())),
+            Err(m) => {
+                errs.push(sm.diag(
+                    p.span,
+                    format!(
+                        "`{key}` of {}: {m} (give a constant of that type or a blackboard entry)",
+                        t.node_name()
+                    ),
+                ));
+                None
+            }
+        },
+        PortValue::Blackboard(b) => {
+            *reads = true;
+            Some(format!("_event.data.{b}"))
+        }
+    }
+}
+
+/// BlackboardCheckInt / Double / String / Bool: checks its ports and builds its machine.
+pub(crate) fn lower_check(
+    sm: &SourceMap,
+    t: CheckType,
+    n: &TreeNode,
+    ctx: &Ctx,
+    bb: &mut Blackboard,
+    errs: &mut Vec<Diagnostic>,
+) -> Option<Element> {
+    let mut reads = false;
+    let a = check_side(sm, t, n, "value_A", &mut reads, errs);
+    let bv = check_side(sm, t, n, "value_B", &mut reads, errs);
+    // BT.CPP's default is FAILURE (`BlackboardPreconditionNode::tick`,
+    // `default_return_status`); AS2FM's model needs the port.
+    let mismatch = match n.port("return_on_mismatch") {
+        None => FAILURE,
+        Some(p) => match &p.value {
+            PortValue::Literal(v) => match parse_status(v) {
+                Ok(s) => s,
+                Err(m) => {
+                    errs.push(sm.diag(p.span, format!("`return_on_mismatch`: {m}")));
+                    return None;
+                }
+            },
+            PortValue::Blackboard(b) => {
+                errs.push(sm.diag(
+                    p.span,
+                    format!("`return_on_mismatch` must be a constant status; a blackboard entry (`{{{b}}}`) is not supported here"),
+                ));
+                return None;
+            }
+        },
+    };
+    let (a, bv) = (a?, bv?);
+    if reads {
+        bb.add_reader(&ctx.machine);
+    }
+    let cond = match t {
+        // BT.CPP 3.8 `blackboard_precondition.h`, `IsSame(const double&, const double&)`:
+        // equal within the float epsilon, 2^-23.
+        CheckType::Double => format!(
+            "({a}) - ({bv}) <= {EPS} && ({bv}) - ({a}) <= {EPS}",
+            EPS = "0.00000011920928955078125"
+        ),
+        _ => format!("({a}) == ({bv})"),
+    };
+    Some(check(ctx, &cond, reads, mismatch))
+}
+
+/// A BlackboardCheck node's machine: on a tick (after a blackboard read when `reads`)
+/// `cond` ticks the child and answers as it does; otherwise the child is halted and the
+/// node answers `mismatch`, as AS2FM's `blackboard_check_int.ascxml` does (its
+/// `value_mismatch` state; BT.CPP halts the child only while it runs, which is what
+/// [`super::Halts::WhenNeeded`] does).
+fn check(ctx: &Ctx, cond: &str, reads: bool, mismatch: u8) -> Element {
+    let b = &ctx.b;
+    let mut m = b.scxml(&ctx.machine, "wait_for_tick");
     let flags = ctx.running_data();
     if !flags.is_empty() {
         let data: Vec<(&str, &str, String)> = flags
@@ -151,72 +564,76 @@ pub(crate) fn check_int(ctx: &Ctx, a: &str, b_expr: &str, reads: bool, mismatch:
             .collect();
         m.push(b.datamodel(&data));
     }
-    let compare = |event: Option<&str>| {
-        vec![
-            b.tr(
-                event,
-                Some(&format!("({a}) == ({b_expr})")),
-                Some("tick_child"),
-                vec![],
-            ),
-            b.tr(event, None, Some("idle"), vec![ctx.respond(mismatch)]),
-        ]
-    };
-    let mut idle = b.state("idle");
-    if reads {
-        idle.push(b.tr(
-            Some(&ctx.tick_ev()),
+    let on_mismatch = if ctx.effect(0) == HaltEffect::Never {
+        b.tr(
             None,
-            Some("read_blackboard"),
-            vec![b.send(REQ, MACHINE)],
-        ));
+            None,
+            Some("wait_for_tick"),
+            vec![ctx.respond(mismatch)],
+        )
     } else {
-        idle.push(b.tr(Some(&ctx.tick_ev()), None, Some("compare"), vec![]));
-    }
+        b.tr(None, None, Some("value_mismatch"), vec![])
+    };
+    let mut w = b.state("wait_for_tick");
+    let exec = if reads {
+        "read_blackboard"
+    } else {
+        "exec_tick"
+    };
+    let send_req = if reads {
+        vec![b.send(REQ, MACHINE)]
+    } else {
+        vec![]
+    };
+    w.push(b.tr(Some(&ctx.tick_ev()), None, Some(exec), send_req));
     for t in ctx.halt_single("halting_child", Vec::new()) {
-        // The idle state here is `idle`, not `wait_for_tick`.
-        idle.push(retarget(t, "wait_for_tick", "idle"));
+        w.push(t);
     }
-    m.push(idle);
+    m.push(w);
     if reads {
+        // The answer carries the entries; compare on it.
         let mut r = b.state("read_blackboard");
-        for t in compare(Some(GET)) {
-            r.push(t);
-        }
+        r.push(b.tr(Some(GET), Some(cond), Some("tick_child"), vec![]));
+        let mut other = on_mismatch.clone();
+        other.set_attr("event", GET);
+        r.push(other);
         m.push(r);
     } else {
-        let mut c = b.state("compare");
-        for t in compare(None) {
-            c.push(t);
-        }
-        m.push(c);
+        m.push(
+            b.state("exec_tick")
+                .with_child(b.tr(None, Some(cond), Some("tick_child"), vec![]))
+                .with_child(on_mismatch),
+        );
     }
-    let mut t = b.state_entry("tick_child", vec![ctx.tick_child(0)]);
-    for s in [SUCCESS, FAILURE, RUNNING] {
-        t.push(b.tr(
-            Some(&ctx.child_resp(0)),
-            Some(&format!("_event.data.status == {s}")),
-            Some("idle"),
-            ctx.marked(0, s, vec![ctx.respond(s)]),
-        ));
-    }
-    m.push(t);
     m.push(
         b.state_entry("halting_child", ctx.halt_child_body(0))
             .with_child(b.tr(
                 Some(&ctx.child_halt_resp(0)),
                 None,
-                Some("idle"),
+                Some("wait_for_tick"),
                 vec![ctx.respond_halted()],
             )),
     );
-    m
-}
-
-/// `t` with target `from` changed to `to`.
-fn retarget(mut t: Element, from: &str, to: &str) -> Element {
-    if t.attr_value("target") == Some(from) {
-        t.set_attr("target", to);
+    let mut t = b.state_entry("tick_child", vec![ctx.tick_child(0)]);
+    for s in [SUCCESS, FAILURE, RUNNING] {
+        t.push(b.tr(
+            Some(&ctx.child_resp(0)),
+            Some(&format!("_event.data.status == {s}")),
+            Some("wait_for_tick"),
+            ctx.marked(0, s, vec![ctx.respond(s)]),
+        ));
     }
-    t
+    m.push(t);
+    if ctx.effect(0) != HaltEffect::Never {
+        m.push(
+            b.state_entry("value_mismatch", ctx.halt_child_body(0))
+                .with_child(b.tr(
+                    Some(&ctx.child_halt_resp(0)),
+                    None,
+                    Some("wait_for_tick"),
+                    vec![ctx.respond(mismatch)],
+                )),
+        );
+    }
+    m
 }

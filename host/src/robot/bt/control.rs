@@ -229,7 +229,7 @@ pub(crate) fn machine(c: Control, ctx: &Ctx, num: &[i64]) -> Element {
         Control::RetryUntilSuccessful => repeat(ctx, num[0], true),
         Control::AlwaysSuccess => constant(ctx, SUCCESS),
         Control::AlwaysFailure => constant(ctx, FAILURE),
-        Control::BlackboardCheckInt | Control::SetBlackboard => {
+        Control::BlackboardCheck(_) | Control::SetBlackboard => {
             unreachable!("blackboard nodes are built in blackboard.rs")
         }
     }

@@ -1,10 +1,13 @@
-//! Behavior trees: a BehaviorTree.cpp (v4) XML tree and its SCXML leaf plugins lowered to
+//! Behavior trees: a BehaviorTree.cpp XML tree and its SCXML leaf plugins lowered to
 //! one machine per tree node, plus the machine that ticks the root and the blackboard.
 //!
 //! # What comes out
 //!
 //! The machines of AS2FM's translation, with its names, so probabilities and traces can
 //! be compared one to one:
+//! Both `BTCPP_format` 3 and 4 are read (`tree.rs`); the machines are the same for both,
+//! AS2FM's, whose node models do not depend on the format.
+//!
 //! - `bt_root_fsm_<tree file stem>` ticks node 1000 (`bt_1000_tick`) at every event of
 //!   the ROS timer `<stem>_tick` (a `<ros_time_rate>` / `<ros_rate_callback>` pair the
 //!   ROS lowering turns into time) and waits for `bt_1000_response`. Without
@@ -14,7 +17,7 @@
 //!   (Sequence, ReactiveSequence, SequenceWithMemory, Fallback, ReactiveFallback,
 //!   Parallel, IfThenElse, Inverter, ForceSuccess, ForceFailure, Repeat,
 //!   RetryUntilSuccessful, AlwaysSuccess, AlwaysFailure, SetBlackboard,
-//!   BlackboardCheckInt) are generated (`control.rs`, `blackboard.rs`); leaves are instances
+//!   BlackboardCheckInt / Double / String / Bool) are generated (`control.rs`, `blackboard.rs`); leaves are instances
 //!   of their plugin (`plugin.rs`) and keep their ROS tags for the ROS lowering.
 //! - `bt_blackboard_fsm` when the tree names `{entries}`.
 //!
@@ -152,23 +155,9 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
     };
     let root_name = root_machine_name(sm, input.tree);
     let mut bb = blackboard::Blackboard::default();
-    // Entry types first (plugins' ports, BlackboardCheckInt's integers), so SetBlackboard
-    // anywhere in the tree knows the type of what it writes.
-    for n in &tree.nodes {
-        match n.kind {
-            Kind::Plugin(i) => plugin::check_ports(sm, &plugins[i], n, &mut bb, &mut errs),
-            Kind::Control(Control::BlackboardCheckInt) => {
-                for p in &n.ports {
-                    if let (true, PortValue::Blackboard(b)) =
-                        (p.key.starts_with("value_"), &p.value)
-                    {
-                        plugin::register(sm, &mut bb, b, "int32", p.span, &mut errs);
-                    }
-                }
-            }
-            Kind::Control(_) => {}
-        }
-    }
+    // Entry types first (plugins' ports, BlackboardCheck's values, SetBlackboard's
+    // constants), so every node knows the type of what it reads and writes.
+    blackboard::type_entries(sm, &tree, &plugins, &mut bb, &mut errs);
     let effects = halt_effects(&tree, &plugins);
     let mut out = Vec::with_capacity(tree.nodes.len() + 2);
     let root_b = B {
@@ -258,10 +247,9 @@ fn halt_effects(tree: &tree::Tree, plugins: &[plugin::Plugin]) -> Vec<HaltEffect
                 Control::Inverter | Control::ForceSuccess | Control::ForceFailure => worst,
                 // Answers its mismatch status without ticking (or halting) its child,
                 // which may still be running then.
-                Control::BlackboardCheckInt => match worst {
-                    HaltEffect::Never => HaltEffect::Never,
-                    _ => HaltEffect::Always,
-                },
+                // Halts its child before answering a mismatch (unless halting it never
+                // changes anything), so when idle its child is idle too.
+                Control::BlackboardCheck(_) => worst,
                 Control::SequenceWithMemory => HaltEffect::Always,
                 Control::Sequence
                 | Control::Fallback
@@ -322,6 +310,13 @@ fn builtin(
         Control::Parallel => {
             let ok_before = errs.len();
             let mut th = |keys: &[&str], default: i64, what: &str| -> i64 {
+                // BT.CPP 4's name and 3's (AS2FM's) for one threshold: one of them only.
+                if let (Some(_), Some(b)) = (n.port(keys[0]), n.port(keys[1])) {
+                    errs.push(sm.diag(
+                        b.span,
+                        format!("`{}` and `{}` are the same threshold (BehaviorTree.CPP 4's and 3's name): give one", keys[0], keys[1]),
+                    ));
+                }
                 let (v, span) = int_param(sm, n, keys, errs).unwrap_or((default, n.span));
                 let v = if v < 0 { count + v + 1 } else { v };
                 if v < 1 || v > count {
@@ -359,87 +354,8 @@ fn builtin(
                 }
             }
         }
-        Control::SetBlackboard => {
-            let (Some(key), Some(value)) = (n.port("output_key"), n.port("value")) else {
-                errs.push(sm.diag(n.span, "SetBlackboard needs `output_key` and `value`"));
-                return None;
-            };
-            let entry = match &key.value {
-                PortValue::Literal(v) => v.trim().to_string(),
-                PortValue::Blackboard(b) => b.clone(),
-            };
-            let Some(ty) = bb.entry(&entry).map(|e| e.ty.clone()) else {
-                errs.push(sm.diag(
-                    key.span,
-                    format!("blackboard entry `{{{entry}}}` has no type: no plugin port uses it"),
-                ));
-                return None;
-            };
-            match &value.value {
-                PortValue::Literal(v) => match plugin::check_literal(v, &ty) {
-                    Ok(()) => Some(blackboard::set_blackboard(
-                        ctx,
-                        &entry,
-                        &plugin::literal_expr(v, &ty),
-                    )),
-                    Err(m) => {
-                        errs.push(sm.diag(value.span, format!("SetBlackboard `{{{entry}}}`: {m}")));
-                        None
-                    }
-                },
-                PortValue::Blackboard(_) => {
-                    errs.push(sm.diag(
-                        value.span,
-                        "SetBlackboard copying one entry to another is not supported",
-                    ));
-                    None
-                }
-            }
-        }
-        Control::BlackboardCheckInt => {
-            let mut reads = false;
-            let mut side = |key: &str, errs: &mut Vec<Diagnostic>| -> Option<String> {
-                let Some(p) = n.port(key) else {
-                    errs.push(sm.diag(n.span, format!("BlackboardCheckInt needs `{key}`")));
-                    return None;
-                };
-                match &p.value {
-                    PortValue::Literal(v) => match v.trim().parse::<i64>() {
-                        Ok(x) => Some(x.to_string()),
-                        Err(_) => {
-                            errs.push(sm.diag(p.span, format!("`{key}` must be a whole number or a blackboard entry, not `{v}`")));
-                            None
-                        }
-                    },
-                    PortValue::Blackboard(b) => {
-                        reads = true;
-                        Some(format!("_event.data.{b}"))
-                    }
-                }
-            };
-            let a = side("value_A", errs);
-            let bv = side("value_B", errs);
-            let mismatch = match n.port("return_on_mismatch").map(|p| &p.value) {
-                None => "FAILURE".to_string(),
-                Some(PortValue::Literal(v)) if control::status_code(v).is_some() => v.clone(),
-                Some(_) => {
-                    let span = n
-                        .port("return_on_mismatch")
-                        .map(|p| p.span)
-                        .unwrap_or(n.span);
-                    errs.push(sm.diag(
-                        span,
-                        "`return_on_mismatch` must be SUCCESS, FAILURE or RUNNING",
-                    ));
-                    return None;
-                }
-            };
-            let (a, bv) = (a?, bv?);
-            if reads {
-                bb.add_reader(&ctx.machine);
-            }
-            Some(blackboard::check_int(ctx, &a, &bv, reads, &mismatch))
-        }
+        Control::SetBlackboard => blackboard::lower_set(sm, n, ctx, bb, errs),
+        Control::BlackboardCheck(t) => blackboard::lower_check(sm, t, n, ctx, bb, errs),
         _ => Some(control::machine(c, ctx, &[])),
     }
 }

@@ -217,44 +217,16 @@ pub(crate) fn check_ports(
                     ));
                 }
             }
-            PortValue::Blackboard(name) => register(sm, bb, name, &decl.ty, p.span, errs),
+            PortValue::Blackboard(name) => {
+                let why = format!("port `{}` of plugin `{}`", p.key, plugin.name);
+                blackboard::register(sm, bb, name, &decl.ty, p.span, &why, errs)
+            }
         }
     }
 }
 
-/// Records blackboard entry `name` of type `ty`; an error if it already has another type.
-pub(crate) fn register(
-    sm: &SourceMap,
-    bb: &mut Blackboard,
-    name: &str,
-    ty: &str,
-    span: Span,
-    errs: &mut Vec<Diagnostic>,
-) {
-    match bb.entry(name) {
-        Some(e) if normalize(&e.ty) != normalize(ty) => {
-            let at = sm.diag(e.span, "");
-            errs.push(sm.diag(
-                span,
-                format!(
-                    "blackboard entry `{{{name}}}` is used as {ty} here but as {} at {}:{}:{}",
-                    e.ty,
-                    at.path.display(),
-                    at.line,
-                    at.column
-                ),
-            ));
-        }
-        Some(_) => {}
-        None => bb.entries.push(blackboard::Entry {
-            name: name.to_string(),
-            ty: ty.to_string(),
-            span,
-        }),
-    }
-}
-
-fn normalize(ty: &str) -> String {
+/// A type written in a comparable form (`int32` and `int32 ` alike).
+pub(crate) fn normalize(ty: &str) -> String {
     match TypeExpr::parse(ty) {
         Ok(t) => format!("{t:?}"),
         Err(_) => ty.trim().to_string(),

@@ -1,4 +1,11 @@
-//! Reads a BehaviorTree.cpp (v4) XML tree into a flat list of nodes, inlining SubTrees.
+//! Reads a BehaviorTree.cpp XML tree (`BTCPP_format` 3 or 4) into a flat list of nodes,
+//! inlining SubTrees.
+//!
+//! The two formats differ in names (3's `SequenceStar` and `SubTreePlus`, 4's
+//! `SequenceWithMemory`) and in how a `<SubTree>` remaps: in format 3 a plain
+//! `<SubTree inner="outer"/>` names the caller's entry `outer` (BT.CPP 3.8's
+//! `gtest_subtree.cpp`, `SubTree.SiblingPorts_Issue_72`), in format 4 `outer` is a
+//! constant and `{outer}` the entry.
 //!
 //! Nodes are numbered in depth-first pre-order from 1000, as AS2FM numbers them, so the
 //! root is always node 1000 and its events are `bt_1000_tick` / `bt_1000_response`.
@@ -31,12 +38,63 @@ pub(crate) enum Control {
     RetryUntilSuccessful,
     AlwaysSuccess,
     AlwaysFailure,
-    BlackboardCheckInt,
+    /// BlackboardCheckInt / Double / String / Bool (BT.CPP 3.8's
+    /// `BlackboardPreconditionNode<T>`, AS2FM's `blackboard_check_int.ascxml`).
+    BlackboardCheck(CheckType),
     SetBlackboard,
 }
 
+/// The value type a BlackboardCheck node compares.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum CheckType {
+    /// `BlackboardCheckInt`: `int32`, the type of AS2FM's model's `value_A`/`value_B` ports.
+    Int,
+    /// `BlackboardCheckDouble`: `float64`, equal within `f32::EPSILON` (BT.CPP 3.8,
+    /// `blackboard_precondition.h`, `IsSame(const double&, const double&)`).
+    Double,
+    /// `BlackboardCheckString`: `string`.
+    String,
+    /// `BlackboardCheckBool`: `bool`.
+    Bool,
+}
+
+impl CheckType {
+    /// The node's name.
+    pub fn node_name(self) -> &'static str {
+        match self {
+            CheckType::Int => "BlackboardCheckInt",
+            CheckType::Double => "BlackboardCheckDouble",
+            CheckType::String => "BlackboardCheckString",
+            CheckType::Bool => "BlackboardCheckBool",
+        }
+    }
+    /// The port type of `value_A` and `value_B`.
+    pub fn port_type(self) -> &'static str {
+        match self {
+            CheckType::Int => "int32",
+            CheckType::Double => "float64",
+            CheckType::String => "string",
+            CheckType::Bool => "bool",
+        }
+    }
+}
+
+/// The `BTCPP_format` of the tree file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub(crate) enum Format {
+    /// `BTCPP_format="3"`: BehaviorTree.CPP 3.8.
+    V3,
+    /// `BTCPP_format="4"`: BehaviorTree.CPP 4.
+    V4,
+    /// No `BTCPP_format`: read as 4 (BT.CPP 4 does), except where 3 and 4 would read
+    /// the same text differently, which is then an error.
+    #[default]
+    Unspecified,
+}
+
 impl Control {
-    /// The built-in node called `name` in a tree.
+    /// The built-in node called `name` in a tree (both formats' names; see
+    /// [`format_name_error`] for the ones one format does not have).
     fn from_name(name: &str) -> Option<Control> {
         Some(match name {
             "Sequence" => Control::Sequence,
@@ -53,7 +111,10 @@ impl Control {
             "RetryUntilSuccessful" | "RetryUntilSuccesful" => Control::RetryUntilSuccessful,
             "AlwaysSuccess" => Control::AlwaysSuccess,
             "AlwaysFailure" => Control::AlwaysFailure,
-            "BlackboardCheckInt" => Control::BlackboardCheckInt,
+            "BlackboardCheckInt" => Control::BlackboardCheck(CheckType::Int),
+            "BlackboardCheckDouble" => Control::BlackboardCheck(CheckType::Double),
+            "BlackboardCheckString" => Control::BlackboardCheck(CheckType::String),
+            "BlackboardCheckBool" => Control::BlackboardCheck(CheckType::Bool),
             "SetBlackboard" => Control::SetBlackboard,
             _ => return None,
         })
@@ -67,7 +128,7 @@ impl Control {
             | Parallel => (1, usize::MAX),
             IfThenElse => (2, 3),
             Inverter | ForceSuccess | ForceFailure | Repeat | RetryUntilSuccessful
-            | BlackboardCheckInt => (1, 1),
+            | BlackboardCheck(_) => (1, 1),
             AlwaysSuccess | AlwaysFailure | SetBlackboard => (0, 0),
         }
     }
@@ -84,7 +145,7 @@ impl Control {
             ],
             Repeat => &["num_cycles"],
             RetryUntilSuccessful => &["num_attempts"],
-            BlackboardCheckInt => &["value_A", "value_B", "return_on_mismatch"],
+            BlackboardCheck(_) => &["value_A", "value_B", "return_on_mismatch"],
             SetBlackboard => &["value", "output_key"],
             _ => &[],
         }
@@ -95,7 +156,7 @@ impl Control {
 const SUPPORTED: &[&str] = &[
     "Sequence",
     "ReactiveSequence",
-    "SequenceWithMemory",
+    "SequenceWithMemory (format 3: SequenceStar)",
     "Fallback",
     "ReactiveFallback",
     "Parallel",
@@ -107,42 +168,110 @@ const SUPPORTED: &[&str] = &[
     "RetryUntilSuccessful",
     "AlwaysSuccess",
     "AlwaysFailure",
-    "BlackboardCheckInt",
     "SetBlackboard",
-    "SubTree",
-];
-
-/// BehaviorTree.cpp's other built-in nodes: named in a clear error.
-const UNSUPPORTED: &[&str] = &[
-    "FallbackWithMemory",
-    "ParallelAll",
-    "WhileDoElse",
-    "Switch2",
-    "Switch3",
-    "Switch4",
-    "Switch5",
-    "Switch6",
-    "ManualSelector",
-    "KeepRunningUntilFailure",
-    "Delay",
-    "Timeout",
-    "RunOnce",
-    "Precondition",
-    "LoopInt",
-    "LoopDouble",
-    "LoopString",
-    "LoopBool",
+    "BlackboardCheckInt",
     "BlackboardCheckDouble",
     "BlackboardCheckString",
-    "UnsetBlackboard",
-    "Script",
-    "ScriptCondition",
-    "Sleep",
-    "WasEntryUpdated",
-    "SkipUnlessUpdated",
-    "WaitValueUpdate",
-    "EntryUpdated",
+    "BlackboardCheckBool",
+    "SubTree",
+    "SubTreePlus (format 3)",
 ];
+
+/// BehaviorTree.CPP's other built-in nodes (the ones its `BehaviorTreeFactory`
+/// registers in 4.10 or 3.8, and the queue nodes its headers ship), each with why
+/// hindsight refuses it. README lists the same.
+pub(crate) const UNSUPPORTED: &[(&str, &str)] = &[
+    (
+        "AsyncSequence",
+        "it answers RUNNING between children to yield; not modelled yet",
+    ),
+    (
+        "AsyncFallback",
+        "it answers RUNNING between children to yield; not modelled yet",
+    ),
+    ("ParallelAll", "no AS2FM model; not modelled yet"),
+    ("WhileDoElse", "no AS2FM model; not modelled yet"),
+    ("TryCatch", "no AS2FM model; not modelled yet"),
+    (
+        "Switch2",
+        "it compares blackboard strings case by case; not modelled yet",
+    ),
+    (
+        "Switch3",
+        "it compares blackboard strings case by case; not modelled yet",
+    ),
+    (
+        "Switch4",
+        "it compares blackboard strings case by case; not modelled yet",
+    ),
+    (
+        "Switch5",
+        "it compares blackboard strings case by case; not modelled yet",
+    ),
+    (
+        "Switch6",
+        "it compares blackboard strings case by case; not modelled yet",
+    ),
+    (
+        "ManualSelector",
+        "it asks a person at a terminal which child to run",
+    ),
+    (
+        "KeepRunningUntilFailure",
+        "no AS2FM model; not modelled yet",
+    ),
+    ("Timeout", "it needs a wall-clock timer inside the tree"),
+    ("Delay", "it needs a wall-clock timer inside the tree"),
+    ("Sleep", "it needs a wall-clock timer inside the tree"),
+    ("RunOnce", "no AS2FM model; not modelled yet"),
+    ("Script", "it runs BT.CPP's script language"),
+    ("ScriptCondition", "it runs BT.CPP's script language"),
+    ("Precondition", "it runs BT.CPP's script language"),
+    (
+        "UnsetBlackboard",
+        "entries in hindsight's blackboard always hold a value",
+    ),
+    ("LoopInt", "it pops from a queue held in the blackboard"),
+    ("LoopDouble", "it pops from a queue held in the blackboard"),
+    ("LoopString", "it pops from a queue held in the blackboard"),
+    ("LoopBool", "it pops from a queue held in the blackboard"),
+    (
+        "ConsumeQueue",
+        "it pops from a queue held in the blackboard",
+    ),
+    (
+        "PopFromQueue",
+        "it pops from a queue held in the blackboard",
+    ),
+    ("QueueSize", "it reads a queue held in the blackboard"),
+    (
+        "WasEntryUpdated",
+        "it needs the blackboard's update counters",
+    ),
+    (
+        "SkipUnlessUpdated",
+        "it needs the blackboard's update counters",
+    ),
+    (
+        "WaitValueUpdate",
+        "it needs the blackboard's update counters",
+    ),
+];
+
+/// Why `name` cannot be used in a tree of format `format` although hindsight knows it:
+/// each format has names the other has not (BT.CPP 4 registers `SequenceStar` only
+/// under `USE_BTCPP3_OLD_NAMES`, and has no `SubTreePlus`).
+fn format_name_error(name: &str, format: Format) -> Option<String> {
+    match (name, format) {
+        ("SequenceStar", Format::V4) => Some(
+            "`SequenceStar` is BehaviorTree.CPP 3's name: in BTCPP_format 4 it is `SequenceWithMemory` (or set BTCPP_format=\"3\")".into(),
+        ),
+        ("SubTreePlus", Format::V4) => Some(
+            "`SubTreePlus` is BehaviorTree.CPP 3's node: in BTCPP_format 4 `SubTree` remaps the same way (or set BTCPP_format=\"3\")".into(),
+        ),
+        _ => None,
+    }
+}
 
 /// What a node is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -224,6 +353,7 @@ struct Reader<'a> {
     nodes: Vec<TreeNode>,
     scopes: Vec<Scope>,
     subtree_count: usize,
+    format: Format,
 }
 
 /// Reads the tree document `root` (already parsed) into a flat tree.
@@ -240,6 +370,7 @@ pub(crate) fn read(
         nodes: Vec::new(),
         scopes: Vec::new(),
         subtree_count: 0,
+        format: Format::Unspecified,
     };
     if root.name != "root" {
         return Err(vec![sm.diag(
@@ -252,11 +383,16 @@ pub(crate) fn read(
     }
     root.check_attrs(sm, &["BTCPP_format", "main_tree_to_execute"], &mut r.errs);
     if let Some(f) = root.attr("BTCPP_format") {
-        if !matches!(f.value.trim(), "3" | "4") {
-            r.err(
-                f.value_span,
-                format!("unsupported BTCPP_format `{}` (expected 4)", f.value),
-            );
+        match f.value.trim() {
+            "3" => r.format = Format::V3,
+            "4" => r.format = Format::V4,
+            other => {
+                r.err(
+                    f.value_span,
+                    format!("unsupported BTCPP_format `{other}` (hindsight reads 3 and 4)"),
+                );
+                return Err(r.errs);
+            }
         }
     }
     let mut order: Vec<&Element> = Vec::new();
@@ -376,8 +512,16 @@ impl Reader<'_> {
         }
     }
 
-    /// Resolves the value `raw` written in the innermost scope.
-    fn resolve(&self, raw: &str) -> PortValue {
+    /// Resolves the value `raw` of port `key` written in the innermost scope: `{name}`
+    /// is an entry, `{=}` (format 3: `=`) the entry called as the port is.
+    fn resolve(&self, key: &str, raw: &str) -> PortValue {
+        let same = match self.format {
+            Format::V3 => raw.trim() == "=" || raw.trim() == "{=}",
+            _ => raw.trim() == "{=}",
+        };
+        if same {
+            return self.resolve_bb(key, self.scopes.len());
+        }
         match blackboard_name(raw) {
             Some(name) => self.resolve_bb(name, self.scopes.len()),
             None => PortValue::Literal(raw.to_string()),
@@ -421,15 +565,23 @@ impl Reader<'_> {
         } else {
             (el.name.clone(), el.span)
         };
+        if let Some(m) = format_name_error(&type_name, self.format) {
+            self.err(type_span, m);
+            return;
+        }
         let kind = match self.plugins.iter().position(|p| p.name == type_name) {
             Some(i) => Kind::Plugin(i),
             None => match Control::from_name(&type_name) {
                 Some(c) => Kind::Control(c),
-                None if UNSUPPORTED.contains(&type_name.as_str()) => {
+                None if UNSUPPORTED.iter().any(|(n, _)| *n == type_name) => {
+                    let why = UNSUPPORTED
+                        .iter()
+                        .find(|(n, _)| *n == type_name)
+                        .map_or("", |(_, w)| *w);
                     self.err(
                         type_span,
                         format!(
-                            "the BehaviorTree.cpp node `{type_name}` is not supported (supported: {})",
+                            "the BehaviorTree.CPP built-in node `{type_name}` is not supported by hindsight: {why} (supported: {})",
                             SUPPORTED.join(", ")
                         ),
                     );
@@ -492,7 +644,29 @@ impl Reader<'_> {
                     continue;
                 }
             }
-            let value = self.resolve(&a.value);
+            let mut value = self.resolve(&a.name, &a.value);
+            // SetBlackboard's `output_key` names an entry without braces in BT.CPP
+            // (`SetBlackboard::tick` reads it as a string), with braces in AS2FM's model (an
+            // output port): either way an entry, private to the SubTree it is in.
+            if kind == Kind::Control(Control::SetBlackboard) && a.name == "output_key" {
+                let raw = a.value.trim();
+                let name = blackboard_name(raw).unwrap_or(raw);
+                if !is_ident(name) {
+                    self.err(
+                        a.value_span,
+                        format!("`{raw}` is not a blackboard entry name"),
+                    );
+                    continue;
+                }
+                value = self.resolve_bb(name, self.scopes.len());
+                if let PortValue::Literal(c) = &value {
+                    self.err(
+                        a.value_span,
+                        format!("SetBlackboard writes `{name}`, which the SubTree it is in sets to the constant `{c}`: map it to an entry (`{{...}}`) to write it"),
+                    );
+                    continue;
+                }
+            }
             if let PortValue::Blackboard(b) = &value {
                 if !is_ident(b) {
                     self.err(
@@ -578,10 +752,27 @@ impl Reader<'_> {
             autoremap: false,
             prefix: String::new(),
         };
+        // Which SubTree this is decides the spelling of its "share every entry" flag and
+        // how a plain value reads (BT.CPP 3.8 `subtree_node.h`: `SubtreeNode` has
+        // `__shared_blackboard` and remaps names, `SubtreePlusNode` has `__autoremap` and
+        // reads `{}` as BT.CPP 4's `SubTree` does with `_autoremap`).
+        let v3_plain = el.name == "SubTree" && self.format == Format::V3;
+        if el.name == "SubTreePlus" && self.format == Format::V4 {
+            if let Some(m) = format_name_error("SubTreePlus", self.format) {
+                self.err(el.span, m);
+            }
+            return;
+        }
+        let flags: &[&str] = match (el.name.as_str(), self.format) {
+            ("SubTreePlus", _) => &["__autoremap"],
+            (_, Format::V3) => &["__shared_blackboard"],
+            (_, Format::V4) => &["_autoremap"],
+            (_, Format::Unspecified) => &["_autoremap", "__shared_blackboard"],
+        };
         for a in &el.attrs {
             match a.name.as_str() {
                 "ID" | "name" | "_description" => {}
-                "_autoremap" | "__shared_blackboard" => match a.value.trim() {
+                n if flags.contains(&n) => match a.value.trim() {
                     "true" | "1" => scope.autoremap = true,
                     "false" | "0" => {}
                     v => self.err(
@@ -589,12 +780,59 @@ impl Reader<'_> {
                         format!("`{}` must be true or false, not `{v}`", a.name),
                     ),
                 },
+                n @ ("_autoremap" | "__autoremap" | "__shared_blackboard") => self.err(
+                    a.name_span,
+                    format!(
+                        "`{n}` is not an attribute of <{}> in this tree's format ({}): use {}",
+                        el.name,
+                        match self.format {
+                            Format::V3 => "BTCPP_format 3",
+                            Format::V4 => "BTCPP_format 4",
+                            Format::Unspecified => "no BTCPP_format, read as 4",
+                        },
+                        flags
+                            .iter()
+                            .map(|f| format!("`{f}`"))
+                            .collect::<Vec<_>>()
+                            .join(" or ")
+                    ),
+                ),
                 n if n.starts_with('_') => self.err(
                     a.name_span,
                     format!("`{n}` (a BehaviorTree.cpp script attribute) is not supported"),
                 ),
+                n if v3_plain => {
+                    // `inner="outer"`: the caller's entry `outer` (braces tolerated).
+                    let raw = a.value.trim();
+                    let name = match raw {
+                        "=" | "{=}" => n,
+                        _ => blackboard_name(raw).unwrap_or(raw),
+                    };
+                    if !is_ident(name) {
+                        self.err(
+                            a.value_span,
+                            format!("`{raw}` is not a blackboard entry name (in BTCPP_format 3 a <SubTree> maps `{n}` to an entry of the caller)"),
+                        );
+                        continue;
+                    }
+                    let v = self.resolve_bb(name, self.scopes.len());
+                    scope.map.insert(n.to_string(), v);
+                }
                 n => {
-                    let v = self.resolve(&a.value);
+                    let raw = a.value.trim();
+                    if self.format == Format::Unspecified
+                        && el.name == "SubTree"
+                        && blackboard_name(raw).is_none()
+                    {
+                        self.err(
+                            a.value_span,
+                            format!(
+                                "`{n}=\"{raw}\"` reads differently in BehaviorTree.CPP 3 (the caller's entry `{raw}`) and 4 (the constant \"{raw}\"): set BTCPP_format on <root>, or write `{{{raw}}}` for the entry"
+                            ),
+                        );
+                        continue;
+                    }
+                    let v = self.resolve(n, &a.value);
                     scope.map.insert(n.to_string(), v);
                 }
             }
