@@ -88,6 +88,7 @@ impl Case {
         hindsight::cli::convert::run(&hindsight::cli::convert::ConvertArgs {
             model: examples().join("museum-guide"),
             out: out.clone(),
+            interfaces: Vec::new(),
         })
         .unwrap_or_else(|e| panic!("convert: {e:?}"));
         let args = ModelArgs {

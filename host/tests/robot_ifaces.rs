@@ -293,8 +293,17 @@ fn unknown_types_list_close_names() {
     assert!(e.ends_with("did you mean geometry_msgs/Twist?"), "{e}");
     let e = ifs.message("Int32").unwrap_err();
     assert!(e.contains("std_msgs/Int32"), "{e}");
+    // An unknown package: no far-fetched names, the places searched instead.
     let e = ifs.action("zzz_pkg/Qqqqqqq").unwrap_err();
-    assert!(e.contains("no close name"), "{e}");
+    assert!(e.contains("no package `zzz_pkg` was found"), "{e}");
+    assert!(!e.contains("did you mean"), "{e}");
+    assert!(e.contains("searched, in this order"), "{e}");
+    // A misspelt package still gets close names.
+    let e = ifs.message("std_msg/Int32").unwrap_err();
+    assert!(
+        e.contains("did you mean") && e.contains("std_msgs/Int32"),
+        "{e}"
+    );
 }
 
 fn temp_dir(name: &str) -> PathBuf {

@@ -7,7 +7,8 @@ use super::sweep::{map_bounds, BoundValue};
 use super::CliError;
 use crate::model::xml::Element;
 use crate::props::{self, PortKind, PropertyFile, ANY};
-use crate::robot::load::{load, main_file_of};
+use crate::robot::interfaces::Search;
+use crate::robot::load::{load_searching, main_file_of};
 use crate::robot::main_file::InputKind;
 use crate::robot::write::{escape_into, to_xml, types_xml};
 
@@ -20,6 +21,9 @@ pub struct ConvertArgs {
     /// The folder to write into (created if missing; files of the same names are replaced).
     #[arg(long, short)]
     pub out: PathBuf,
+    /// A folder of ROS interface packages, searched first (repeat for more); as for `verify`.
+    #[arg(long = "interfaces", value_name = "DIR")]
+    pub interfaces: Vec<PathBuf>,
 }
 
 /// Runs `hindsight convert`.
@@ -31,7 +35,12 @@ pub fn run(args: &ConvertArgs) -> Result<(), CliError> {
             args.model.display()
         ))
     })?;
-    let robot = load(&main).map_err(|d| CliError::Input(d.to_string()))?;
+    let search = Search::from_env(args.interfaces.clone());
+    let (robot, _) =
+        load_searching(&main, &[], &search).map_err(|d| CliError::Input(d.to_string()))?;
+    for w in &robot.warnings {
+        eprintln!("warning: {w}");
+    }
     let out = &args.out;
     std::fs::create_dir_all(out)
         .map_err(|e| CliError::Failed(format!("{}: {e}", out.display())))?;

@@ -30,6 +30,10 @@ pub struct MonitorArgs {
     /// MODEL/properties.xml.
     #[arg(long, value_name = "FILE")]
     pub model_props: Option<PathBuf>,
+    /// With a robot --model: a folder of ROS interface packages, searched first (repeat
+    /// for more); as for `verify`.
+    #[arg(long = "interfaces", value_name = "DIR")]
+    pub interfaces: Vec<PathBuf>,
     /// With a plain SCXML --model: the length of one model time step (`100ms`).
     #[arg(long, value_name = "DURATION")]
     pub time_unit: Option<String>,
@@ -194,6 +198,7 @@ fn spec_of(args: &MonitorArgs) -> Result<Compiled, CliError> {
         props: args.model_props.clone(),
         time_unit: args.time_unit.clone(),
         events: None,
+        interfaces: args.interfaces.clone(),
         ..ModelArgs::default()
     })
     .map_err(|e| match e {

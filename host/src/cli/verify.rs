@@ -257,6 +257,11 @@ pub struct ModelArgs {
     /// with a step bound.
     #[arg(long = "skip", value_name = "NAME")]
     pub skip: Vec<String>,
+    /// A folder of ROS interface packages (DIR/<pkg>/msg/*.msg, or a package itself) for a
+    /// robot model; repeat for more. Searched first, before the folders beside and above
+    /// the model, the sourced ROS workspace (AMENT_PREFIX_PATH) and the built-ins.
+    #[arg(long = "interfaces", value_name = "DIR")]
+    pub interfaces: Vec<PathBuf>,
 }
 
 /// A model with its properties, compiled: everything `validate` checks.
@@ -324,6 +329,14 @@ pub fn load_without(
 ) -> Result<(Loaded, Vec<ExternalComponent>), CliError> {
     if let Some(main) = crate::robot::load::main_file_of(&args.model) {
         return load_robot(args, &main, external);
+    }
+    if let Some(dir) = args.interfaces.first() {
+        return Err(CliError::Input(format!(
+            "--interfaces {}: {} is not a robot model (a main file, or a folder with \
+             main.xml); only a robot model reads ROS interfaces",
+            dir.display(),
+            args.model.display()
+        )));
     }
     if let Some(name) = external.first() {
         return Err(CliError::Input(format!(
@@ -449,8 +462,12 @@ fn load_robot(
     external: &[String],
 ) -> Result<(Loaded, Vec<ExternalComponent>), CliError> {
     use crate::robot::main_file::InputKind;
-    let (robot, external) = crate::robot::load::load_without(main, external)
+    let search = crate::robot::interfaces::Search::from_env(args.interfaces.clone());
+    let (robot, external) = crate::robot::load::load_searching(main, external, &search)
         .map_err(|d| CliError::Input(d.to_string()))?;
+    for w in &robot.warnings {
+        eprintln!("warning: {w}");
+    }
     if let Some(text) = &args.time_unit {
         let given = parse_time_unit(text)?;
         if given != robot.time_unit_ns {

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use super::bt::{self, BtInput, Halts};
 use super::datatypes::read_main_declarations;
-use super::interfaces::Interfaces;
+use super::interfaces::{Interfaces, Search};
 use super::main_file::{Input, MainFile};
 use super::ros::{self, RosInput};
 use super::types::InterfaceLookup;
@@ -28,6 +28,9 @@ pub struct RobotModel {
     /// The run length in model steps: `max_time` plus the step at which the global
     /// timer stops, so that every event due at `max_time` is delivered.
     pub max_time_steps: u64,
+    /// What was read but ignored, as AS2FM ignores it (the main file's
+    /// [`MainFile::warnings`]); a command prints them.
+    pub warnings: Vec<Diagnostic>,
 }
 
 /// The main file a path stands for: the path itself if it is an XML file whose root is
@@ -130,15 +133,23 @@ pub struct ExternalComponent {
 /// Reads a main file and everything it names, lowers the behavior tree and the ROS tags,
 /// and compiles the plain machines. Every error names the user's file, line and column.
 /// Control nodes halt their children as AS2FM's translation does ([`Halts::As2fm`]).
+/// Interfaces are looked for beside and above the model, in the sourced ROS workspace
+/// (`AMENT_PREFIX_PATH`) and among the built-ins ([`super::interfaces::discover`]).
 pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
-    load_full(main_path, &[], Halts::default()).map(|(m, _)| m)
+    load_full(
+        main_path,
+        &[],
+        Halts::default(),
+        &Search::from_env(Vec::new()),
+    )
+    .map(|(m, _)| m)
 }
 
 /// [`load`] with the halting rule of the tree's control nodes chosen:
 /// [`Halts::WhenNeeded`] runs faster, with the same ROS messages under one schedule but
 /// other verdict probabilities where the model races (see [`Halts`]).
 pub fn load_with(main_path: &Path, halts: Halts) -> Result<RobotModel, Diagnostics> {
-    load_full(main_path, &[], halts).map(|(m, _)| m)
+    load_full(main_path, &[], halts, &Search::from_env(Vec::new())).map(|(m, _)| m)
 }
 
 /// What a node model declares that a process replacing it must speak (topics, services
@@ -363,19 +374,35 @@ pub fn load_without(
     main_path: &Path,
     external: &[String],
 ) -> Result<(RobotModel, Vec<ExternalComponent>), Diagnostics> {
-    load_full(main_path, external, Halts::default())
+    load_full(
+        main_path,
+        external,
+        Halts::default(),
+        &Search::from_env(Vec::new()),
+    )
+}
+
+/// [`load_without`] with the interface search given (`--interfaces` folders and the
+/// workspace prefixes; [`Search::from_env`] reads `AMENT_PREFIX_PATH`).
+pub fn load_searching(
+    main_path: &Path,
+    external: &[String],
+    search: &Search,
+) -> Result<(RobotModel, Vec<ExternalComponent>), Diagnostics> {
+    load_full(main_path, external, Halts::default(), search)
 }
 
 fn load_full(
     main_path: &Path,
     external: &[String],
     halts: Halts,
+    search: &Search,
 ) -> Result<(RobotModel, Vec<ExternalComponent>), Diagnostics> {
     let mut sm = SourceMap::new();
     let main = MainFile::read(&mut sm, main_path).map_err(fail)?;
 
     let types = read_main_declarations(&mut sm, &main).map_err(fail)?;
-    let interfaces = Interfaces::discover(&mut sm, main_path, &[]).map_err(fail)?;
+    let interfaces = Interfaces::discover_with(&mut sm, main_path, search).map_err(fail)?;
 
     let mut errs = Vec::new();
     let mut machines = Vec::new();
@@ -468,6 +495,7 @@ fn load_full(
     }
     let model = CompiledModel::compile(src)?;
     let unit = out.time_unit_ns.max(1);
+    let warnings = main.warnings.clone();
     Ok((
         RobotModel {
             main,
@@ -476,6 +504,7 @@ fn load_full(
             model,
             time_unit_ns: unit,
             max_time_steps: max_time_ns / unit + 1,
+            warnings,
         },
         left_out,
     ))

@@ -27,12 +27,27 @@
 //! numbers of `s`, `ms`, `us` or `ns`; decimals (`2.5`, converted exactly) and `min`/`h`
 //! are accepted too. Several property inputs, `xml` and `hspec` ones, and no `<properties>`
 //! at all are extensions (AS2FM wants exactly one `jani`).
-//! Every element and attribute is checked: an unknown one is an error at its position.
+//!
+//! # What is accepted, ignored and refused
+//!
+//! Everything AS2FM's reader accepts is accepted (`RoamlMain` and the `Roaml*` classes of
+//! `jani_generator/scxml_helpers/roaml_model.py`). Where that reader errors, so do we: a
+//! section given twice, an unknown parameter, a child of a section that is not `<input>`,
+//! an unknown input type, a missing `value`, `unit`, `type` or `src`. What it ignores (it
+//! looks sections up by name and reads only the attributes it knows) is ignored here with
+//! a warning at its position ([`MainFile::warnings`]): an unknown element of the root, an
+//! attribute it does not read, text, elements inside a parameter or an `<input>`,
+//! `<mc_parameters>` beside `<parameters>` (AS2FM reads `<parameters>` then). Two are
+//! ignored without a warning: `id` on `<input>` (a label, used by UC3's main files) and
+//! `xmlns` attributes. An unknown name close to one that is read (`<node_model>`, `scr=`)
+//! is an error with "did you mean": a misspelling would otherwise drop a section silently.
 
 use std::path::{Path, PathBuf};
 
 use crate::model::source::{Diagnostic, FileId, SourceMap, Span};
 use crate::model::xml::{self, Element, Node};
+
+use super::main_ignored::{close_to, Notes, PARAMETERS, SECTIONS};
 
 /// The BT tick rate AS2FM uses when `bt_tick_rate` is absent, in Hz.
 pub const DEFAULT_BT_TICK_RATE_HZ: f64 = 1.0;
@@ -223,6 +238,8 @@ pub struct MainFile {
     pub node_models: Vec<Input>,
     /// `<properties>` inputs.
     pub properties: Vec<Input>,
+    /// What was ignored, as AS2FM ignores it (see the module documentation).
+    pub warnings: Vec<Diagnostic>,
 }
 
 impl MainFile {
@@ -270,8 +287,12 @@ impl MainFile {
             sm,
             base,
             errs: Vec::new(),
+            warnings: Vec::new(),
         };
-        root.check_attrs(sm, &[], &mut r.errs);
+        r.attrs(&root, &[]);
+        // AS2FM looks `<mc_parameters>` up only when there is no `<parameters>`
+        // (`RoamlParameters.from_roaml_xml`).
+        let has_parameters = root.elements().any(|e| e.name == "parameters");
         let mut params: Option<(RawParams, Span)> = None;
         let mut seen: Vec<(String, Span)> = Vec::new();
         let mut data_declarations = Vec::new();
@@ -279,6 +300,13 @@ impl MainFile {
         let mut node_models = Vec::new();
         let mut properties = Vec::new();
         for el in r.children(&root) {
+            if el.name == "mc_parameters" && has_parameters {
+                r.warn(
+                    el.span,
+                    "<mc_parameters> is ignored: <parameters> is given, and AS2FM reads only that",
+                );
+                continue;
+            }
             let section = match el.name.as_str() {
                 "parameters" | "mc_parameters" => "parameters",
                 other => other,
@@ -332,19 +360,13 @@ impl MainFile {
                         ],
                     )
                 }
-                other => {
-                    r.errs.push(sm.diag(
-                        el.span,
-                        format!(
-                            "unknown element <{other}> in <{}> (expected <parameters>, <data_declarations>, <behavior_tree>, <node_models> or <properties>)",
-                            root.name
-                        ),
-                    ));
-                    // Its attributes mean nothing here: no error for each of them.
+                _ => {
+                    // AS2FM finds sections by name: any other element is never read.
+                    r.unknown_element(el, &root.name, SECTIONS);
                     continue;
                 }
             }
-            el.check_attrs(sm, &[], &mut r.errs);
+            r.attrs(el, &[]);
         }
         let params = match params {
             Some((
@@ -392,6 +414,7 @@ impl MainFile {
                 behavior_tree,
                 node_models,
                 properties,
+                warnings: r.warnings,
             }),
             _ => Err(r.errs),
         }
@@ -433,18 +456,34 @@ struct Reader<'a> {
     sm: &'a SourceMap,
     base: PathBuf,
     errs: Vec<Diagnostic>,
+    warnings: Vec<Diagnostic>,
+}
+
+impl Notes for Reader<'_> {
+    fn sm(&self) -> &SourceMap {
+        self.sm
+    }
+    fn errs(&mut self) -> &mut Vec<Diagnostic> {
+        &mut self.errs
+    }
+    fn warnings(&mut self) -> &mut Vec<Diagnostic> {
+        &mut self.warnings
+    }
 }
 
 impl<'a> Reader<'a> {
-    /// Child elements; text is an error.
+    /// Child elements. Text is ignored with a warning (AS2FM reads only elements).
     fn children<'e>(&mut self, el: &'e Element) -> Vec<&'e Element> {
         let mut out = Vec::new();
         for n in &el.children {
             match n {
                 Node::Element(e) => out.push(e),
-                Node::Text(span) => self.errs.push(
-                    self.sm
-                        .diag(*span, format!("unexpected text in <{}>", el.name)),
+                Node::Text(span) => self.warn(
+                    *span,
+                    format!(
+                        "text in <{}> is ignored (AS2FM reads only elements)",
+                        el.name
+                    ),
                 ),
                 Node::Comment(..) => {}
             }
@@ -461,26 +500,22 @@ impl<'a> Reader<'a> {
             } else {
                 &["value"]
             };
-            if !matches!(
-                c.name.as_str(),
-                "max_time" | "max_array_size" | "bt_tick_rate" | "bt_tick_if_not_running"
-            ) {
+            if !PARAMETERS.contains(&c.name.as_str()) {
+                // AS2FM refuses an unknown parameter (`_parse_parameters`).
+                let hint = close_to(&c.name, PARAMETERS)
+                    .map(|k| format!("did you mean <{k}>? "))
+                    .unwrap_or_default();
                 self.errs.push(sm.diag(
                     c.span,
                     format!(
-                        "unknown parameter <{}> (expected <max_time>, <max_array_size>, <bt_tick_rate> or <bt_tick_if_not_running>)",
+                        "unknown parameter <{}>; {hint}(expected <max_time>, <max_array_size>, <bt_tick_rate> or <bt_tick_if_not_running>)",
                         c.name
                     ),
                 ));
                 continue;
             }
-            c.check_attrs(sm, allowed, &mut self.errs);
-            for n in &c.children {
-                if let Node::Element(e) = n {
-                    self.errs
-                        .push(sm.diag(e.span, format!("unexpected <{}> in <{}>", e.name, c.name)));
-                }
-            }
+            self.attrs(c, allowed);
+            self.ignored_children(c);
             let value = match c.required(sm, "value") {
                 Ok(a) => a,
                 Err(d) => {
@@ -584,11 +619,8 @@ impl<'a> Reader<'a> {
                 ));
                 continue;
             }
-            c.check_attrs(sm, &["type", "src"], &mut self.errs);
-            if let Some(e) = c.elements().next() {
-                self.errs
-                    .push(sm.diag(e.span, format!("unexpected <{}> in <input>", e.name)));
-            }
+            self.attrs(c, &["type", "src"]);
+            self.ignored_children(c);
             let (ty, src) = match (c.required(sm, "type"), c.required(sm, "src")) {
                 (Ok(t), Ok(s)) => (t, s),
                 (Err(d), _) | (_, Err(d)) => {

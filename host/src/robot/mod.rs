@@ -24,6 +24,7 @@ pub mod datatypes;
 pub mod interfaces;
 pub mod load;
 pub mod main_file;
+mod main_ignored;
 pub mod ros;
 pub mod types;
 pub mod write;

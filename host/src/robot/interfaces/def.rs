@@ -1,0 +1,315 @@
+//! The parsed form of a ROS 2 interface file: kinds, primitive types, fields, constants,
+//! and the normalised text each prints as.
+
+use crate::model::source::{FileId, Span};
+
+/// What an interface file defines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum InterfaceKind {
+    /// A `.msg` file in `msg/`.
+    Message,
+    /// A `.srv` file in `srv/`: request and response.
+    Service,
+    /// An `.action` file in `action/`: goal, result and feedback.
+    Action,
+}
+
+impl InterfaceKind {
+    /// The folder name and the middle word of a full type name: `msg`, `srv`, `action`.
+    pub fn dir(self) -> &'static str {
+        match self {
+            InterfaceKind::Message => "msg",
+            InterfaceKind::Service => "srv",
+            InterfaceKind::Action => "action",
+        }
+    }
+
+    /// The kind whose folder (or middle word) is `s`.
+    pub fn from_dir(s: &str) -> Option<InterfaceKind> {
+        match s {
+            "msg" => Some(InterfaceKind::Message),
+            "srv" => Some(InterfaceKind::Service),
+            "action" => Some(InterfaceKind::Action),
+            _ => None,
+        }
+    }
+
+    /// How many `---`-separated parts a file of this kind has.
+    pub fn parts(self) -> usize {
+        match self {
+            InterfaceKind::Message => 1,
+            InterfaceKind::Service => 2,
+            InterfaceKind::Action => 3,
+        }
+    }
+
+    pub(super) fn noun(self) -> &'static str {
+        match self {
+            InterfaceKind::Message => "message",
+            InterfaceKind::Service => "service",
+            InterfaceKind::Action => "action",
+        }
+    }
+}
+
+/// A ROS 2 primitive type.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Primitive {
+    /// `bool`.
+    Bool,
+    /// `byte` (an octet, read as `uint8`).
+    Byte,
+    /// `char` (read as `uint8`).
+    Char,
+    /// `float32`.
+    Float32,
+    /// `float64`.
+    Float64,
+    /// `int8`.
+    Int8,
+    /// `uint8`.
+    UInt8,
+    /// `int16`.
+    Int16,
+    /// `uint16`.
+    UInt16,
+    /// `int32`.
+    Int32,
+    /// `uint32`.
+    UInt32,
+    /// `int64`.
+    Int64,
+    /// `uint64`.
+    UInt64,
+    /// `string`.
+    String,
+    /// `wstring` (read as `string`).
+    WString,
+}
+
+impl Primitive {
+    /// The primitive called `name` in a `.msg` file.
+    pub fn from_name(name: &str) -> Option<Primitive> {
+        Some(match name {
+            "bool" => Primitive::Bool,
+            "byte" => Primitive::Byte,
+            "char" => Primitive::Char,
+            "float32" => Primitive::Float32,
+            "float64" => Primitive::Float64,
+            "int8" => Primitive::Int8,
+            "uint8" => Primitive::UInt8,
+            "int16" => Primitive::Int16,
+            "uint16" => Primitive::UInt16,
+            "int32" => Primitive::Int32,
+            "uint32" => Primitive::UInt32,
+            "int64" => Primitive::Int64,
+            "uint64" => Primitive::UInt64,
+            "string" => Primitive::String,
+            "wstring" => Primitive::WString,
+            _ => return None,
+        })
+    }
+
+    /// The type as the SCXML reader spells it (`byte`/`char` -> `uint8`, `wstring` -> `string`).
+    pub fn scxml_name(self) -> &'static str {
+        match self {
+            Primitive::Bool => "bool",
+            Primitive::Byte | Primitive::Char | Primitive::UInt8 => "uint8",
+            Primitive::Float32 => "float32",
+            Primitive::Float64 => "float64",
+            Primitive::Int8 => "int8",
+            Primitive::Int16 => "int16",
+            Primitive::UInt16 => "uint16",
+            Primitive::Int32 => "int32",
+            Primitive::UInt32 => "uint32",
+            Primitive::Int64 => "int64",
+            Primitive::UInt64 => "uint64",
+            Primitive::String | Primitive::WString => "string",
+        }
+    }
+
+    /// The value of an unset field of this type, as an ECMAScript literal.
+    pub fn zero(self) -> &'static str {
+        match self {
+            Primitive::Bool => "false",
+            Primitive::Float32 | Primitive::Float64 => "0.0",
+            Primitive::String | Primitive::WString => "''",
+            _ => "0",
+        }
+    }
+
+    pub(super) fn is_string(self) -> bool {
+        matches!(self, Primitive::String | Primitive::WString)
+    }
+
+    /// Inclusive range of an integer type.
+    pub(super) fn int_range(self) -> Option<(i128, i128)> {
+        Some(match self {
+            Primitive::Byte | Primitive::Char | Primitive::UInt8 => (0, u8::MAX as i128),
+            Primitive::Int8 => (i8::MIN as i128, i8::MAX as i128),
+            Primitive::Int16 => (i16::MIN as i128, i16::MAX as i128),
+            Primitive::UInt16 => (0, u16::MAX as i128),
+            Primitive::Int32 => (i32::MIN as i128, i32::MAX as i128),
+            Primitive::UInt32 => (0, u32::MAX as i128),
+            Primitive::Int64 => (i64::MIN as i128, i64::MAX as i128),
+            Primitive::UInt64 => (0, u64::MAX as i128),
+            _ => return None,
+        })
+    }
+}
+
+/// The element type of a field: a primitive or another message.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum BaseType {
+    /// A primitive; `string_bound` is `N` of `string<=N`.
+    Primitive {
+        /// The primitive.
+        prim: Primitive,
+        /// The bound of a bounded string.
+        string_bound: Option<u32>,
+    },
+    /// A message, with its package resolved (`Internal` in package `p` is `p/Internal`).
+    Message {
+        /// The package.
+        package: String,
+        /// The message name.
+        name: String,
+    },
+}
+
+/// Whether and how a field is an array.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ArraySize {
+    /// Not an array.
+    Scalar,
+    /// `T[N]`: exactly `N` elements.
+    Fixed(u32),
+    /// `T[<=N]`: at most `N` elements.
+    Bounded(u32),
+    /// `T[]`.
+    Unbounded,
+}
+
+/// A field's type: element type and array size.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FieldType {
+    /// The element type.
+    pub base: BaseType,
+    /// The array size.
+    pub array: ArraySize,
+}
+
+/// One field of a message.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Field {
+    /// The field name.
+    pub name: String,
+    /// The field type.
+    pub ty: FieldType,
+    /// The default value written after the name, as an ECMAScript literal.
+    pub default: Option<String>,
+    /// Where the type token starts.
+    pub span: Span,
+}
+
+/// A constant (`int8 FAST=1`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Constant {
+    /// The constant's name.
+    pub name: String,
+    /// Its primitive type.
+    pub prim: Primitive,
+    /// Its value as an ECMAScript literal.
+    pub value: String,
+    /// Where the line starts.
+    pub span: Span,
+}
+
+/// One message, or one part of a service or an action.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct MessageDef {
+    /// Fields in declaration order.
+    pub fields: Vec<Field>,
+    /// Constants in declaration order.
+    pub constants: Vec<Constant>,
+}
+
+/// One interface file, parsed.
+///
+/// Invariant: `parts.len() == kind.parts()`.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct InterfaceDef {
+    /// The package (`std_msgs`).
+    pub package: String,
+    /// The type name (`Int32`).
+    pub name: String,
+    /// Message, service or action.
+    pub kind: InterfaceKind,
+    /// The parts: `[message]`, `[request, response]` or `[goal, result, feedback]`.
+    pub parts: Vec<MessageDef>,
+    /// The file it was read from; `None` for a built-in definition.
+    pub file: Option<FileId>,
+}
+
+impl InterfaceDef {
+    /// The full name, `pkg/msg/Type`.
+    pub fn full_name(&self) -> String {
+        format!("{}/{}/{}", self.package, self.kind.dir(), self.name)
+    }
+}
+
+impl Primitive {
+    /// The name as written in a `.msg` file.
+    pub fn msg_name(self) -> &'static str {
+        match self {
+            Primitive::Byte => "byte",
+            Primitive::Char => "char",
+            Primitive::WString => "wstring",
+            Primitive::String => "string",
+            other => other.scxml_name(),
+        }
+    }
+}
+
+impl std::fmt::Display for FieldType {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.base {
+            BaseType::Primitive { prim, string_bound } => {
+                write!(f, "{}", prim.msg_name())?;
+                if let Some(n) = string_bound {
+                    write!(f, "<={n}")?;
+                }
+            }
+            BaseType::Message { package, name } => write!(f, "{package}/{name}")?,
+        }
+        match self.array {
+            ArraySize::Scalar => Ok(()),
+            ArraySize::Fixed(n) => write!(f, "[{n}]"),
+            ArraySize::Bounded(n) => write!(f, "[<={n}]"),
+            ArraySize::Unbounded => write!(f, "[]"),
+        }
+    }
+}
+
+/// The definition in the `.msg`/`.srv`/`.action` format, normalised: constants first, types
+/// with their package, defaults as ECMAScript literals. Reading it back gives the same
+/// definition.
+impl std::fmt::Display for InterfaceDef {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for (i, part) in self.parts.iter().enumerate() {
+            if i > 0 {
+                writeln!(f, "---")?;
+            }
+            for c in &part.constants {
+                writeln!(f, "{} {}={}", c.prim.msg_name(), c.name, c.value)?;
+            }
+            for fl in &part.fields {
+                match &fl.default {
+                    Some(d) => writeln!(f, "{} {} {d}", fl.ty, fl.name)?,
+                    None => writeln!(f, "{} {}", fl.ty, fl.name)?,
+                }
+            }
+        }
+        Ok(())
+    }
+}
