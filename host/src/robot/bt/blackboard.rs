@@ -139,6 +139,21 @@ pub(crate) fn set_blackboard(ctx: &Ctx, entry: &str, value: &str) -> Element {
 /// BlackboardCheckInt: compares `a` and `b` (expressions over `_event.data` when
 /// `reads` is true, after a blackboard read); equal ticks the child and answers as it
 /// does, different answers `mismatch` (SUCCESS, FAILURE or RUNNING; FAILURE by default).
+/// On a mismatch the child is halted before the answer, as AS2FM's
+/// `blackboard_check_int.ascxml` does (its `value_mismatch` state) and BT.CPP's
+/// `BlackboardPreconditionNode::tick` (`haltChild` when the child is RUNNING); with
+/// `Halts::WhenNeeded` only if that can change something.
+fn mismatch_halts(ctx: &Ctx, event: Option<&str>, mismatch: u8) -> Vec<Element> {
+    let b = &ctx.b;
+    let at_once = |cond: Option<&str>| b.tr(event, cond, Some("idle"), vec![ctx.respond(mismatch)]);
+    let go = b.tr(event, None, Some("value_mismatch"), vec![]);
+    match ctx.skip_cond(0) {
+        None => vec![go],
+        Some(c) if c == "true" => vec![at_once(None)],
+        Some(c) => vec![at_once(Some(&c)), go],
+    }
+}
+
 pub(crate) fn check_int(ctx: &Ctx, a: &str, b_expr: &str, reads: bool, mismatch: &str) -> Element {
     let b = &ctx.b;
     let mismatch = status_code(mismatch).unwrap_or(FAILURE);
@@ -152,15 +167,15 @@ pub(crate) fn check_int(ctx: &Ctx, a: &str, b_expr: &str, reads: bool, mismatch:
         m.push(b.datamodel(&data));
     }
     let compare = |event: Option<&str>| {
-        vec![
-            b.tr(
-                event,
-                Some(&format!("({a}) == ({b_expr})")),
-                Some("tick_child"),
-                vec![],
-            ),
-            b.tr(event, None, Some("idle"), vec![ctx.respond(mismatch)]),
-        ]
+        vec![b.tr(
+            event,
+            Some(&format!("({a}) == ({b_expr})")),
+            Some("tick_child"),
+            vec![],
+        )]
+        .into_iter()
+        .chain(mismatch_halts(ctx, event, mismatch))
+        .collect::<Vec<_>>()
     };
     let mut idle = b.state("idle");
     if reads {
@@ -201,6 +216,15 @@ pub(crate) fn check_int(ctx: &Ctx, a: &str, b_expr: &str, reads: bool, mismatch:
         ));
     }
     m.push(t);
+    m.push(
+        b.state_entry("value_mismatch", ctx.halt_child_body(0))
+            .with_child(b.tr(
+                Some(&ctx.child_halt_resp(0)),
+                None,
+                Some("idle"),
+                vec![ctx.respond(mismatch)],
+            )),
+    );
     m.push(
         b.state_entry("halting_child", ctx.halt_child_body(0))
             .with_child(b.tr(

@@ -256,8 +256,8 @@ fn halt_effects(tree: &tree::Tree, plugins: &[plugin::Plugin]) -> Vec<HaltEffect
                 }
                 // No variables: halting one does what halting its child does.
                 Control::Inverter | Control::ForceSuccess | Control::ForceFailure => worst,
-                // Answers its mismatch status without ticking (or halting) its child,
-                // which may still be running then.
+                // On a mismatch it halts its child (when that can matter) and answers
+                // without ticking it; kept `Always` unless the child can never matter.
                 Control::BlackboardCheckInt => match worst {
                     HaltEffect::Never => HaltEffect::Never,
                     _ => HaltEffect::Always,

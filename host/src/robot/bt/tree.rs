@@ -492,7 +492,17 @@ impl Reader<'_> {
                     continue;
                 }
             }
-            let value = self.resolve(&a.value);
+            // SetBlackboard's `output_key` names an entry even without braces, and a
+            // SubTree's remapping applies to it (BT.CPP's `SetBlackboardNode::tick` looks
+            // it up with `getEntry` in the node's own, remapped, blackboard).
+            let value = match blackboard_name(&a.value) {
+                None if a.name == "output_key"
+                    && matches!(kind, Kind::Control(Control::SetBlackboard)) =>
+                {
+                    self.resolve_bb(a.value.trim(), self.scopes.len())
+                }
+                _ => self.resolve(&a.value),
+            };
             if let PortValue::Blackboard(b) = &value {
                 if !is_ident(b) {
                     self.err(
