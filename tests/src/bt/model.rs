@@ -1,0 +1,64 @@
+//! The text of a robot model's behavior-tree half for the lowering harness: one plugin
+//! per scripted leaf type (answers its script; its ticks and halts are messages the
+//! harness observes) and a driver that ticks the root a fixed number of times.
+
+use super::oracle::Scripts;
+
+/// The plugin of leaf type `name`: on its k-th tick it answers `script[k % len]`; a halt
+/// is answered and does not move it.
+pub fn plugin(name: &str, script: &[super::tree::Status]) -> String {
+    let len = script.len();
+    let mut branches = String::new();
+    for (i, s) in script.iter().enumerate() {
+        let head = if i == 0 {
+            format!("<if cond=\"k == {i}\">")
+        } else if i + 1 == len {
+            "<else/>".to_string()
+        } else {
+            format!("<elseif cond=\"k == {i}\"/>")
+        };
+        branches += &format!(
+            "{head}<assign location=\"k\" expr=\"{}\"/><bt_return_status status=\"{}\"/>",
+            (i + 1) % len,
+            s.name()
+        );
+    }
+    if len == 1 {
+        branches = format!("<bt_return_status status=\"{}\"/>", script[0].name());
+    } else {
+        branches += "</if>";
+    }
+    format!(
+        r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="{name}">
+<datamodel><data id="k" type="int32" expr="0"/></datamodel>
+<state id="s">
+<bt_tick target="s">{branches}</bt_tick>
+<bt_halt target="s"><bt_return_halted/></bt_halt>
+</state>
+</ascxml>"#
+    )
+}
+
+/// Every leaf type's plugin: (type name, text).
+pub fn plugins(scripts: &Scripts) -> Vec<(String, String)> {
+    scripts
+        .iter()
+        .map(|(n, s)| (n.clone(), plugin(n, s)))
+        .collect()
+}
+
+/// The machine that stands in for the tree's root machine `name`: ticks node 1000
+/// (machine `root`) `ticks` times, each after the previous answer.
+pub fn driver(name: &str, root: &str, ticks: usize) -> String {
+    format!(
+        r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" name="{name}" initial="go">
+<datamodel><data id="n" type="int32" expr="1"/></datamodel>
+<state id="go">
+<onentry><send event="bt_1000_tick" target="{root}"/></onentry>
+<transition event="bt_1000_response" cond="n &lt; {ticks}" target="go"><assign location="n" expr="n + 1"/></transition>
+<transition event="bt_1000_response" target="done"/>
+</state>
+<state id="done"/>
+</scxml>"#
+    )
+}

@@ -1,0 +1,384 @@
+//! The oracle's own reader of BehaviorTree.CPP XML (formats 3 and 4): a flat node list in
+//! depth-first pre-order with SubTrees inlined, numbered from 1000 as AS2FM numbers them.
+//!
+//! Written independently of hindsight's reader: it uses quick-xml directly and knows the
+//! built-in nodes only through [`NODES`], the one table to extend for a new node kind.
+
+use quick_xml::events::{BytesStart, Event};
+use quick_xml::Reader;
+use std::collections::BTreeMap;
+
+/// A status a node answers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Status {
+    /// SUCCESS.
+    Success,
+    /// FAILURE.
+    Failure,
+    /// RUNNING.
+    Running,
+}
+
+impl Status {
+    /// `SUCCESS`, `FAILURE`, `RUNNING` (or the first letter).
+    pub fn parse(s: &str) -> Option<Status> {
+        match s.trim() {
+            "SUCCESS" | "S" => Some(Status::Success),
+            "FAILURE" | "F" => Some(Status::Failure),
+            "RUNNING" | "R" => Some(Status::Running),
+            _ => None,
+        }
+    }
+    /// The status name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Success => "SUCCESS",
+            Status::Failure => "FAILURE",
+            Status::Running => "RUNNING",
+        }
+    }
+    /// The code AS2FM's translation sends: 1, 2, 3.
+    pub fn code(self) -> i64 {
+        match self {
+            Status::Success => 1,
+            Status::Failure => 2,
+            Status::Running => 3,
+        }
+    }
+}
+
+/// One side of a blackboard comparison.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Operand {
+    /// A number written in the tree.
+    Lit(i64),
+    /// A blackboard entry (after SubTree remapping).
+    Entry(String),
+}
+
+/// What a node is.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A scripted leaf of the named type.
+    Leaf(String),
+    /// `Sequence`.
+    Sequence,
+    /// `ReactiveSequence`.
+    ReactiveSequence,
+    /// `SequenceWithMemory` (format 3: `SequenceStar`).
+    SequenceWithMemory,
+    /// `Fallback`.
+    Fallback,
+    /// `ReactiveFallback`.
+    ReactiveFallback,
+    /// Success and failure thresholds as written (negative counts from the end).
+    Parallel(i64, i64),
+    /// `IfThenElse`.
+    IfThenElse,
+    /// `Inverter`.
+    Inverter,
+    /// `ForceSuccess`.
+    ForceSuccess,
+    /// `ForceFailure`.
+    ForceFailure,
+    /// `Repeat` with `num_cycles`.
+    Repeat(i64),
+    /// `RetryUntilSuccessful` with `num_attempts`.
+    Retry(i64),
+    /// `AlwaysSuccess`.
+    AlwaysSuccess,
+    /// `AlwaysFailure`.
+    AlwaysFailure,
+    /// `SetBlackboard`: the entry and the integer written.
+    SetBlackboard(String, i64),
+    /// `BlackboardCheckInt`: `value_A`, `value_B`, `return_on_mismatch`.
+    CheckInt(Operand, Operand, Status),
+}
+
+/// A node of the flattened tree.
+#[derive(Clone, Debug)]
+pub struct Node {
+    /// 1000, 1001, ... in pre-order.
+    pub id: u32,
+    /// What it is.
+    pub kind: Kind,
+    /// Indices into [`Tree::nodes`].
+    pub children: Vec<usize>,
+}
+
+/// A flattened tree; node 0 is the root.
+#[derive(Clone, Debug, Default)]
+pub struct Tree {
+    /// The nodes, pre-order.
+    pub nodes: Vec<Node>,
+}
+
+/// How many children a kind takes: (least, most).
+type Arity = (usize, usize);
+/// Builds a kind from the node's attributes (already remapped: `{entry}` values name the
+/// caller's entries).
+type Make = fn(&Attrs) -> Result<Kind, String>;
+type Attrs = BTreeMap<String, String>;
+
+const ANY: usize = usize::MAX;
+
+/// Every built-in node the oracle knows: the XML names (format 3 and 4), arity, builder.
+pub const NODES: &[(&[&str], Arity, Make)] = &[
+    (&["Sequence"], (1, ANY), |_| Ok(Kind::Sequence)),
+    (&["ReactiveSequence"], (1, ANY), |_| {
+        Ok(Kind::ReactiveSequence)
+    }),
+    (&["SequenceWithMemory", "SequenceStar"], (1, ANY), |_| {
+        Ok(Kind::SequenceWithMemory)
+    }),
+    (&["Fallback"], (1, ANY), |_| Ok(Kind::Fallback)),
+    (&["ReactiveFallback"], (1, ANY), |_| {
+        Ok(Kind::ReactiveFallback)
+    }),
+    (&["Parallel"], (1, ANY), |a| {
+        Ok(Kind::Parallel(
+            int_or(a, &["success_count", "success_threshold"], -1)?,
+            int_or(a, &["failure_count", "failure_threshold"], 1)?,
+        ))
+    }),
+    (&["IfThenElse"], (2, 3), |_| Ok(Kind::IfThenElse)),
+    (&["Inverter"], (1, 1), |_| Ok(Kind::Inverter)),
+    (&["ForceSuccess"], (1, 1), |_| Ok(Kind::ForceSuccess)),
+    (&["ForceFailure"], (1, 1), |_| Ok(Kind::ForceFailure)),
+    (&["Repeat"], (1, 1), |a| {
+        Ok(Kind::Repeat(int(a, "num_cycles")?))
+    }),
+    (
+        &["RetryUntilSuccessful", "RetryUntilSuccesful"],
+        (1, 1),
+        |a| Ok(Kind::Retry(int(a, "num_attempts")?)),
+    ),
+    (&["AlwaysSuccess"], (0, 0), |_| Ok(Kind::AlwaysSuccess)),
+    (&["AlwaysFailure"], (0, 0), |_| Ok(Kind::AlwaysFailure)),
+    (&["SetBlackboard"], (0, 0), |a| {
+        let key = a
+            .get("output_key")
+            .ok_or("SetBlackboard needs output_key")?;
+        let key = entry(key).unwrap_or(key.trim()).to_string();
+        Ok(Kind::SetBlackboard(key, int(a, "value")?))
+    }),
+    (&["BlackboardCheckInt"], (1, 1), |a| {
+        let mismatch = match a.get("return_on_mismatch") {
+            None => Status::Failure,
+            Some(s) => Status::parse(s).ok_or(format!("bad return_on_mismatch {s}"))?,
+        };
+        Ok(Kind::CheckInt(
+            operand(a, "value_A")?,
+            operand(a, "value_B")?,
+            mismatch,
+        ))
+    }),
+];
+
+fn entry(v: &str) -> Option<&str> {
+    v.trim().strip_prefix('{')?.strip_suffix('}')
+}
+
+fn int(a: &Attrs, k: &str) -> Result<i64, String> {
+    let v = a.get(k).ok_or(format!("missing `{k}`"))?;
+    v.trim()
+        .parse()
+        .map_err(|_| format!("`{k}` is not a number: {v}"))
+}
+
+fn int_or(a: &Attrs, ks: &[&str], d: i64) -> Result<i64, String> {
+    match ks.iter().find(|k| a.contains_key(**k)) {
+        Some(k) => int(a, k),
+        None => Ok(d),
+    }
+}
+
+fn operand(a: &Attrs, k: &str) -> Result<Operand, String> {
+    let v = a.get(k).ok_or(format!("missing `{k}`"))?;
+    Ok(match entry(v) {
+        Some(e) => Operand::Entry(e.to_string()),
+        None => Operand::Lit(v.trim().parse().map_err(|_| format!("`{k}`: {v}"))?),
+    })
+}
+
+/// A bare XML element.
+#[derive(Clone, Debug, Default)]
+struct El {
+    name: String,
+    attrs: Attrs,
+    children: Vec<El>,
+}
+
+fn start(e: &BytesStart<'_>) -> Result<El, String> {
+    let mut el = El {
+        name: e.name().as_ref().to_string(),
+        ..El::default()
+    };
+    for a in e.attributes() {
+        let a = a.map_err(|e| e.to_string())?;
+        let k = a.key.as_ref().to_string();
+        let raw: &str = &a.value;
+        let v = quick_xml::escape::unescape(raw)
+            .map_err(|e| e.to_string())?
+            .into_owned();
+        el.attrs.insert(k, v);
+    }
+    Ok(el)
+}
+
+fn parse_xml(text: &str) -> Result<El, String> {
+    let mut r = Reader::from_str(text);
+    let mut stack = vec![El::default()];
+    loop {
+        match r.read_event().map_err(|e| e.to_string())? {
+            Event::Start(e) => stack.push(start(&e)?),
+            Event::Empty(e) => {
+                let el = start(&e)?;
+                stack.last_mut().expect("document").children.push(el);
+            }
+            Event::End(_) => {
+                let el = stack.pop().expect("balanced");
+                stack.last_mut().ok_or("unbalanced")?.children.push(el);
+            }
+            Event::Eof => break,
+            _ => {}
+        }
+    }
+    let doc = stack.pop().ok_or("empty")?;
+    doc.children.into_iter().next().ok_or("no root".into())
+}
+
+/// Reads a tree: the `main_tree_to_execute`, else the first `<BehaviorTree>`.
+pub fn read(text: &str) -> Result<Tree, String> {
+    let root = parse_xml(text)?;
+    let trees: BTreeMap<&str, &El> = root
+        .children
+        .iter()
+        .filter(|c| c.name == "BehaviorTree")
+        .map(|c| (c.attrs.get("ID").map_or("", |s| s.as_str()), c))
+        .collect();
+    let main = match root.attrs.get("main_tree_to_execute") {
+        Some(id) => *trees.get(id.as_str()).ok_or(format!("no tree {id}"))?,
+        None => root
+            .children
+            .iter()
+            .find(|c| c.name == "BehaviorTree")
+            .ok_or("no <BehaviorTree>")?,
+    };
+    let mut r = Flat {
+        trees,
+        tree: Tree::default(),
+        scopes: vec![Scope::default()],
+        instances: 0,
+    };
+    let body = main.children.first().ok_or("empty <BehaviorTree>")?;
+    r.node(body, None)?;
+    Ok(r.tree)
+}
+
+/// How a SubTree instance names its entries in the caller's terms.
+#[derive(Default)]
+struct Scope {
+    remap: BTreeMap<String, String>,
+    autoremap: bool,
+    prefix: String,
+}
+
+struct Flat<'a> {
+    trees: BTreeMap<&'a str, &'a El>,
+    tree: Tree,
+    scopes: Vec<Scope>,
+    instances: usize,
+}
+
+impl Flat<'_> {
+    /// The global name of entry `e` in the innermost scope.
+    fn global(&self, e: &str, depth: usize) -> String {
+        let s = &self.scopes[depth];
+        if depth == 0 {
+            return e.to_string();
+        }
+        match s.remap.get(e) {
+            Some(outer) => self.global(outer, depth - 1),
+            None if s.autoremap => self.global(e, depth - 1),
+            None => format!("{}{e}", s.prefix),
+        }
+    }
+
+    fn node(&mut self, el: &El, parent: Option<usize>) -> Result<(), String> {
+        if el.name == "SubTree" {
+            return self.subtree(el, parent);
+        }
+        let depth = self.scopes.len() - 1;
+        let mut attrs = el.attrs.clone();
+        for (k, v) in attrs.iter_mut() {
+            if k == "output_key" && entry(v).is_none() {
+                *v = format!("{{{}}}", v.trim());
+            }
+            if let Some(e) = entry(v) {
+                *v = format!("{{{}}}", self.global(e, depth));
+            }
+        }
+        let ty = match el.name.as_str() {
+            "Action" | "Condition" | "Control" | "Decorator" => {
+                attrs.get("ID").cloned().ok_or("node without ID")?
+            }
+            n => n.to_string(),
+        };
+        let kind = match NODES
+            .iter()
+            .find(|(names, _, _)| names.contains(&ty.as_str()))
+        {
+            Some((_, (lo, hi), make)) => {
+                let n = el.children.len();
+                if n < *lo || n > *hi {
+                    return Err(format!("{ty}: {n} children"));
+                }
+                make(&attrs)?
+            }
+            None if el.children.is_empty() => Kind::Leaf(ty),
+            None => return Err(format!("unknown node {ty}")),
+        };
+        let i = self.tree.nodes.len();
+        self.tree.nodes.push(Node {
+            id: 1000 + i as u32,
+            kind,
+            children: Vec::new(),
+        });
+        if let Some(p) = parent {
+            self.tree.nodes[p].children.push(i);
+        }
+        for c in &el.children {
+            self.node(c, Some(i))?;
+        }
+        Ok(())
+    }
+
+    fn subtree(&mut self, el: &El, parent: Option<usize>) -> Result<(), String> {
+        if self.scopes.len() > 16 {
+            return Err("SubTrees nested too deep".into());
+        }
+        let id = el.attrs.get("ID").ok_or("SubTree without ID")?;
+        let body = *self.trees.get(id.as_str()).ok_or(format!("no tree {id}"))?;
+        let mut scope = Scope {
+            prefix: format!("__st{}.", self.instances),
+            ..Scope::default()
+        };
+        self.instances += 1;
+        for (k, v) in &el.attrs {
+            match k.as_str() {
+                "ID" | "name" => {}
+                "_autoremap" => scope.autoremap = v.trim() == "true",
+                _ => {
+                    let outer = entry(v).ok_or(format!("SubTree port {k}={v}: not an entry"))?;
+                    scope.remap.insert(k.clone(), outer.to_string());
+                }
+            }
+        }
+        self.scopes.push(scope);
+        let first = body.children.first().ok_or("empty <BehaviorTree>")?;
+        let r = self.node(first, parent);
+        self.scopes.pop();
+        r
+    }
+}

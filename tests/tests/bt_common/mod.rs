@@ -1,0 +1,203 @@
+//! The lowering harness shared by the BT tests: a tree and leaf scripts lowered by
+//! hindsight in-process, simulated, and observed as the oracle reports them (root status
+//! per tick, leaf ticks and halts in order); plus the comparison with the oracle.
+
+#![allow(dead_code)]
+
+use hindsight::expr::Value;
+use hindsight::model::source::{FileId, SourceMap};
+use hindsight::model::{xml, Diagnostics, ModelSource};
+use hindsight::robot::bt::{self, BtInput, Halts};
+use hindsight::sim::{CompiledModel, Flow, Observer, RunConfig, SentMessage, Simulator};
+use hindsight_tests::bt::model;
+use hindsight_tests::bt::oracle::{self, LeafEvent, Reading, Scripts};
+use hindsight_tests::bt::tree::{self, Kind, Status, Tree};
+use rand_core::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+use std::collections::BTreeSet;
+
+/// Root statuses, one per root tick, and what the leaves received.
+pub type Run = (Vec<Status>, Vec<LeafEvent>);
+
+struct Watch<'a> {
+    leaves: &'a BTreeSet<u32>,
+    statuses: Vec<Status>,
+    log: Vec<LeafEvent>,
+    bad: Option<String>,
+}
+
+impl Observer for Watch<'_> {
+    fn on_send(&mut self, _time: u64, msg: &SentMessage<'_>) -> Flow {
+        let ev = msg.event_name();
+        let Some(rest) = ev.strip_prefix("bt_") else {
+            return Flow::Continue;
+        };
+        let Some((id, what)) = rest.split_once('_') else {
+            return Flow::Continue;
+        };
+        let Ok(id) = id.parse::<u32>() else {
+            return Flow::Continue;
+        };
+        match what {
+            "tick" if self.leaves.contains(&id) => self.log.push(LeafEvent::Tick(id)),
+            "halt" if self.leaves.contains(&id) => self.log.push(LeafEvent::Halt(id)),
+            "response" if id == 1000 && msg.target_name().starts_with("bt_root_fsm") => {
+                let s = match msg.param(0) {
+                    Some(Value::Int(1)) => Status::Success,
+                    Some(Value::Int(2)) => Status::Failure,
+                    Some(Value::Int(3)) => Status::Running,
+                    other => {
+                        self.bad = Some(format!("root answered {other:?}"));
+                        return Flow::Stop;
+                    }
+                };
+                self.statuses.push(s);
+            }
+            _ => {}
+        }
+        Flow::Continue
+    }
+}
+
+/// Lowers `xml` with one plugin per leaf type, ticks the root `ticks` times.
+pub fn lowered(
+    xml_text: &str,
+    scripts: &Scripts,
+    ticks: usize,
+    halts: Halts,
+) -> Result<Run, String> {
+    let tree = tree::read(xml_text)?;
+    let leaves: BTreeSet<u32> = tree
+        .nodes
+        .iter()
+        .filter(|n| matches!(n.kind, Kind::Leaf(_)))
+        .map(|n| n.id)
+        .collect();
+    let mut sm = SourceMap::new();
+    let tree_id = sm.add("t.xml", xml_text.to_string());
+    let plugins = model::plugins(scripts)
+        .into_iter()
+        .map(|(n, text)| sm.add(format!("{n}.ascxml"), text))
+        .collect();
+    let input = BtInput {
+        tree: tree_id,
+        plugins,
+        tick_rate_hz: 1.0,
+        tick_if_not_running: true,
+        halts,
+    };
+    let mut machines = bt::lower(&sm, &input).map_err(|ds| Diagnostics(ds).to_string())?;
+    let root_name = machines[0]
+        .attr_value("name")
+        .unwrap_or_default()
+        .to_string();
+    let node_name = machines[1]
+        .attr_value("name")
+        .unwrap_or_default()
+        .to_string();
+    let drv = sm.add("driver.scxml", model::driver(&root_name, &node_name, ticks));
+    machines[0] = xml::parse(&sm, drv).map_err(|d| d.to_string())?;
+    let mut src = ModelSource {
+        sources: sm,
+        ..ModelSource::default()
+    };
+    let mut errs = Diagnostics::default();
+    for m in &machines {
+        src.add_machine_tree(m, FileId(0), &mut errs);
+    }
+    if !errs.is_empty() {
+        return Err(errs.to_string());
+    }
+    let compiled = CompiledModel::compile(src).map_err(|e| e.to_string())?;
+    let mut w = Watch {
+        leaves: &leaves,
+        statuses: Vec::new(),
+        log: Vec::new(),
+        bad: None,
+    };
+    let cfg = RunConfig {
+        max_steps: 5_000_000,
+        ..RunConfig::default()
+    };
+    Simulator::new(&compiled).run(&mut Xoshiro256PlusPlus::seed_from_u64(1), &cfg, &mut w);
+    if let Some(b) = w.bad {
+        return Err(b);
+    }
+    Ok((w.statuses, w.log))
+}
+
+/// The oracle's run of the same case.
+pub fn reference(
+    xml_text: &str,
+    scripts: &Scripts,
+    ticks: usize,
+    reading: Reading,
+) -> Result<Run, String> {
+    let tree: Tree = tree::read(xml_text)?;
+    oracle::run(&tree, scripts, reading, ticks)
+}
+
+/// Where two runs first differ, or `None`.
+pub fn diff(a: &Run, b: &Run) -> Option<String> {
+    if a.0 != b.0 {
+        return Some(format!("root statuses: {:?} against {:?}", a.0, b.0));
+    }
+    if a.1 != b.1 {
+        let i =
+            a.1.iter()
+                .zip(&b.1)
+                .position(|(x, y)| x != y)
+                .unwrap_or(a.1.len().min(b.1.len()));
+        return Some(format!(
+            "leaf events differ at {i} of {}/{}: {:?} against {:?}\n  all: {:?}\n  all: {:?}",
+            a.1.len(),
+            b.1.len(),
+            a.1.get(i),
+            b.1.get(i),
+            a.1,
+            b.1
+        ));
+    }
+    None
+}
+
+/// Keeps the halts a leaf receives while RUNNING (its last answer): what BT.CPP's
+/// `haltChild` delivers of a log where every reset child is halted.
+pub fn running_halts_only(
+    log: &[LeafEvent],
+    scripts_of: impl Fn(u32, usize) -> Status,
+) -> Vec<LeafEvent> {
+    let mut ticks: std::collections::BTreeMap<u32, usize> = Default::default();
+    let mut running: BTreeSet<u32> = BTreeSet::new();
+    let mut out = Vec::new();
+    for &e in log {
+        match e {
+            LeafEvent::Tick(id) => {
+                let k = ticks.entry(id).or_default();
+                if scripts_of(id, *k) == Status::Running {
+                    running.insert(id);
+                } else {
+                    running.remove(&id);
+                }
+                *k += 1;
+                out.push(e);
+            }
+            LeafEvent::Halt(id) => {
+                if running.remove(&id) {
+                    out.push(e);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// A case in text form for a failure message.
+pub fn show(xml_text: &str, scripts: &Scripts, ticks: usize) -> String {
+    let mut s = format!("ticks = {ticks}\ntree = '''{xml_text}'''\n[scripts]\n");
+    for (k, v) in scripts {
+        let names: Vec<&str> = v.iter().map(|s| s.name()).collect();
+        s += &format!("{k} = {names:?}\n");
+    }
+    s
+}
