@@ -25,30 +25,8 @@ pub(crate) fn ty_name(ty: Ty) -> &'static str {
     }
 }
 
-/// A duration in the largest unit that expresses it exactly (`1s`, `100ms`, `2500ns`).
-pub(crate) fn fmt_ns(ns: u64) -> String {
-    for (unit, n) in [
-        ("min", 60_000_000_000u64),
-        ("s", 1_000_000_000),
-        ("ms", 1_000_000),
-        ("us", 1_000),
-    ] {
-        if ns >= n && ns % n == 0 {
-            return format!("{}{unit}", ns / n);
-        }
-    }
-    format!("{ns}ns")
-}
-
 fn lit_text(t: &TimeLit) -> String {
-    let unit = match t.unit {
-        None => "",
-        Some(TimeUnit::Ns) => "ns",
-        Some(TimeUnit::Us) => "us",
-        Some(TimeUnit::Ms) => "ms",
-        Some(TimeUnit::S) => "s",
-        Some(TimeUnit::Min) => "min",
-    };
+    let unit = t.unit.map_or("", TimeUnit::suffix);
     if t.frac.is_empty() {
         format!("{}{unit}", t.int)
     } else {
@@ -90,7 +68,7 @@ pub(crate) fn lit_ticks(t: &TimeLit, tick_ns: u64) -> Result<u64, String> {
     if denom == 0 || ns_scaled % denom != 0 {
         return Err(format!(
             "`{text}` is not a whole number of ticks (the time unit is {})",
-            fmt_ns(tick_ns)
+            crate::duration::format(tick_ns)
         ));
     }
     u64::try_from(ns_scaled / denom).map_err(|_| too_large())

@@ -53,6 +53,26 @@ struct Source {
     /// `false` for text synthesised from structured input: every position in it
     /// resolves to the origin itself, since its columns do not exist in the file.
     exact: bool,
+    /// A position map, when the text is not a verbatim copy of the file from
+    /// `line`:`col` on (a formula after XML entities, or one generated from a tree):
+    /// sorted by offset, the first at 0. Empty: count forward from `line`:`col`.
+    runs: Vec<PositionRun>,
+}
+
+/// Where a run of a source's text comes from in its file: the map that keeps every
+/// column right when text was unescaped (`&lt;` became `<`) or generated from elements.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PositionRun {
+    /// Byte offset in the text where the run starts.
+    pub offset: u32,
+    /// 1-based line of the run's first character in the file.
+    pub line: u32,
+    /// 1-based column (in characters) of the run's first character in the file.
+    pub col: u32,
+    /// `true` when the run is copied character for character from one line of the file
+    /// (its columns advance with the text); `false` when it was generated from the
+    /// element at `line`:`col`, so every offset in it resolves there.
+    pub exact: bool,
 }
 
 /// The texts that spans point into, with where each starts in its file.
@@ -71,8 +91,27 @@ impl SourceMap {
             line: line.max(1),
             col: col.max(1),
             exact,
+            runs: Vec::new(),
         });
         (self.sources.len() - 1) as u32
+    }
+
+    /// Adds a source whose positions come from the map `runs` (see [`PositionRun`]);
+    /// with no runs, it starts at `line`:`col` like [`SourceMap::add`].
+    pub(crate) fn add_mapped(
+        &mut self,
+        name: &str,
+        text: &str,
+        (line, col): (u32, u32),
+        runs: &[PositionRun],
+    ) -> u32 {
+        let id = self.add(name, text, line, col, true);
+        let mut runs = runs.to_vec();
+        runs.sort_by_key(|r| r.offset);
+        if let Some(src) = self.sources.last_mut() {
+            src.runs = runs;
+        }
+        id
     }
 
     /// The text of source `id`.
@@ -113,7 +152,21 @@ impl SourceMap {
         let line_text = text[line_start..line_end]
             .trim_end_matches('\r')
             .to_string();
-        let loc = if src.exact {
+        let loc = if let Some(run) = run_at(&src.runs, lo) {
+            let col = if run.exact {
+                let from = floor_boundary(text, run.offset as usize).min(lo);
+                run.col
+                    .max(1)
+                    .saturating_add(text[from..lo].chars().count() as u32)
+            } else {
+                run.col.max(1)
+            };
+            Location {
+                file: src.name.clone(),
+                line: run.line.max(1),
+                col,
+            }
+        } else if src.exact {
             let col = if newlines == 0 {
                 src.col.saturating_add(caret_col as u32)
             } else {
@@ -160,6 +213,13 @@ impl SourceMap {
                 .collect(),
         }
     }
+}
+
+/// The run of a position map that byte `at` falls in (the first run for an offset
+/// before it; `None` without a map).
+fn run_at(runs: &[PositionRun], at: usize) -> Option<PositionRun> {
+    let i = runs.partition_point(|r| r.offset as usize <= at);
+    runs.get(i.saturating_sub(1)).copied()
 }
 
 fn floor_boundary(text: &str, mut i: usize) -> usize {

@@ -44,9 +44,11 @@
 //! None: the crate always builds with `std`.
 
 pub mod ast;
+pub mod bounds;
 mod check;
 mod compile;
 pub mod diag;
+pub mod duration;
 pub mod emit_rust;
 mod lower;
 pub mod parse;
@@ -55,7 +57,7 @@ mod spec;
 mod syntax;
 
 pub use compile::{Compiled, PropertyInfo};
-pub use diag::{Diagnostic, Diagnostics, Location, Severity, SourceMap, Span};
+pub use diag::{Diagnostic, Diagnostics, Location, PositionRun, Severity, SourceMap, Span};
 pub use lower::Limits;
 pub use spec::{
     compile_input, compile_spec, Checked, DeclInput, FormulaInput, Measured, Origin, Parsed, Spec,

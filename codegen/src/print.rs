@@ -6,8 +6,9 @@ use monitor_core::layout::{self, SinceKind};
 use monitor_core::{CmpOp, Instr, NumTy, Op, Ty, Value, VarKind};
 
 use crate::ast::{CheckedSpec, Expr, ExprKind, Formula, FormulaKind, Interval, UnaryOp};
-use crate::check::{fmt_ns, ty_name};
+use crate::check::ty_name;
 use crate::compile::Compiled;
+use crate::duration::format as fmt_ns;
 
 fn value(v: &Value, strings: &[String]) -> String {
     match v {

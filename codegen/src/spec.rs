@@ -11,7 +11,7 @@ use monitor_core::VarKind;
 use crate::ast::CheckedSpec;
 use crate::check;
 use crate::compile::Compiled;
-use crate::diag::{Diagnostics, Sink, SourceMap, Span};
+use crate::diag::{Diagnostics, PositionRun, Sink, SourceMap, Span};
 use crate::lower::{self, Limits, Net};
 use crate::parse;
 use crate::syntax::{Ident, Prop, SpecSyntax};
@@ -49,8 +49,14 @@ pub struct FormulaInput {
     pub name: String,
     /// The formula text (already unescaped by the host's XML reader).
     pub text: String,
-    /// Where the formula's first character is: positions inside it are counted from here.
+    /// Where the formula's first character is: positions inside it are counted from here
+    /// when `positions` is empty.
     pub origin: Origin,
+    /// Where each run of `text` comes from in the file, when the text is not a verbatim
+    /// copy of one line from `origin` on: after entities (`&lt;` is one character of
+    /// `text` but four of the file) or for a formula generated from a tree of elements.
+    /// Empty for verbatim text.
+    pub positions: Vec<PositionRun>,
 }
 
 /// A specification given as parts instead of a `.hspec` file.
@@ -178,7 +184,7 @@ impl Spec<Parsed> {
         }
         for f in &input.formulas {
             let o = &f.origin;
-            let id = sources.add(&o.file, &f.text, o.line, o.col, true);
+            let id = sources.add_mapped(&o.file, &f.text, (o.line, o.col), &f.positions);
             if let Some(formula) = parse::parse_formula(&f.text, id, &mut sink) {
                 let span = Span {
                     source: id,

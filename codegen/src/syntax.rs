@@ -16,38 +16,7 @@ pub(crate) struct Ident {
     pub span: Span,
 }
 
-/// A time unit suffix.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum TimeUnit {
-    Ns,
-    Us,
-    Ms,
-    S,
-    Min,
-}
-
-impl TimeUnit {
-    pub fn from_suffix(s: &str) -> Option<TimeUnit> {
-        Some(match s {
-            "ns" => TimeUnit::Ns,
-            "us" => TimeUnit::Us,
-            "ms" => TimeUnit::Ms,
-            "s" => TimeUnit::S,
-            "min" => TimeUnit::Min,
-            _ => return None,
-        })
-    }
-
-    pub fn nanos(self) -> u64 {
-        match self {
-            TimeUnit::Ns => 1,
-            TimeUnit::Us => 1_000,
-            TimeUnit::Ms => 1_000_000,
-            TimeUnit::S => 1_000_000_000,
-            TimeUnit::Min => 60_000_000_000,
-        }
-    }
-}
+pub(crate) use crate::duration::TimeUnit;
 
 /// A time literal as written: `62`, `2.5s`, `100ms`.
 #[derive(Clone, Debug, PartialEq)]

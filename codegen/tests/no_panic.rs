@@ -203,7 +203,12 @@ proptest! {
                 init: Some(init),
                 origin: o.clone(),
             }],
-            formulas: vec![FormulaInput { name: "p".into(), text: f, origin: o }],
+            formulas: vec![FormulaInput {
+                name: "p".into(),
+                text: f,
+                origin: o,
+                positions: Vec::new(),
+            }],
         };
         if let Err(d) = compile_input(&input) {
             let _ = d.to_string();

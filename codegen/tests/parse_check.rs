@@ -1,7 +1,9 @@
 //! Parser and checker behaviour through the public API: precedence, word forms, bounds, units, warnings, errors with positions.
 
 use codegen::ast::{CheckedSpec, FormulaKind, Interval};
-use codegen::{print, DeclInput, Diagnostics, FormulaInput, Origin, Severity, Spec, SpecInput};
+use codegen::{
+    print, DeclInput, Diagnostics, FormulaInput, Origin, PositionRun, Severity, Spec, SpecInput,
+};
 use monitor_core::{Ty, Value, VarKind};
 
 const DECLS: &str = "event a; event b; event c; event d;\n";
@@ -358,6 +360,62 @@ fn origin(line: u32, col: u32) -> Origin {
     }
 }
 
+/// A formula whose text is not a verbatim copy of the file: the position map puts every
+/// problem at its character in the file, after entities and in generated text.
+#[test]
+fn position_maps_keep_columns_right() {
+    let run = |offset, line, col, exact| PositionRun {
+        offset,
+        line,
+        col,
+        exact,
+    };
+    let input = |text: &str, positions: Vec<PositionRun>| SpecInput {
+        decls: vec![DeclInput {
+            kind: VarKind::State,
+            name: "x".into(),
+            type_name: "int".into(),
+            init: None,
+            origin: origin(2, 5),
+        }],
+        formulas: vec![FormulaInput {
+            name: "p".into(),
+            text: text.into(),
+            origin: origin(5, 10),
+            positions,
+        }],
+        ..SpecInput::default()
+    };
+    let first = |input: &SpecInput| {
+        let d = Spec::from_input(input)
+            .and_then(|s| s.check())
+            .expect_err("unknown variable");
+        let e = d.errors().next().expect("an error");
+        (e.line, e.col)
+    };
+    // The file holds `{x &lt; 3} && {nope}` from 5:10: `nope` is at column 25, not at
+    // the 22 that counting the unescaped text forward would give.
+    let text = "{x < 3} && {nope}";
+    let entities = vec![
+        run(0, 5, 10, true),
+        run(3, 5, 13, true),
+        run(4, 5, 17, true),
+    ];
+    assert_eq!(first(&input(text, entities)), (5, 25));
+    assert_eq!(first(&input(text, Vec::new())), (5, 22));
+    // Tree form: `(` and `) && (` generated from elements, the atoms copied from
+    // attributes on other lines.
+    let text = "({x < 3}) && ({nope})";
+    let tree = vec![
+        run(0, 4, 3, false),
+        run(1, 5, 20, true),
+        run(8, 4, 3, false),
+        run(14, 6, 21, true),
+        run(20, 4, 3, false),
+    ];
+    assert_eq!(first(&input(text, tree)), (6, 22));
+}
+
 #[test]
 fn structured_input_reports_at_origins() {
     let input = SpecInput {
@@ -384,16 +442,19 @@ fn structured_input_reports_at_origins() {
                 name: "ok".into(),
                 text: "H({level >= 30} -> !{alarm})".into(),
                 origin: origin(10, 20),
+                positions: Vec::new(),
             },
             FormulaInput {
                 name: "bad".into(),
                 text: "P[0:1s] {level}".into(),
                 origin: origin(12, 30),
+                positions: Vec::new(),
             },
             FormulaInput {
                 name: "bad2".into(),
                 text: "{alarm} &&\n   {nope}".into(),
                 origin: origin(14, 7),
+                positions: Vec::new(),
             },
         ],
     };
@@ -476,6 +537,7 @@ fn untimed_input_takes_tick_counts_and_rejects_units() {
             name: "p".into(),
             text: formula.into(),
             origin: origin(7, 3),
+            positions: Vec::new(),
         }],
     };
     assert!(codegen::compile_input(&input("H(P[:10] {a})")).is_ok());

@@ -34,6 +34,7 @@ fuzz_target!(|data: &[u8]| {
             name: "p".into(),
             text: text.into(),
             origin,
+            positions: Vec::new(),
         }],
     };
     if let Err(d) = codegen::compile_input(&input) {

@@ -176,6 +176,20 @@ fn bad_properties_and_arguments_exit_2() {
     let (code, _, err) = hindsight(&["verify", COIN, bad.to_str().unwrap()]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("p.xml:6:"), "{err}");
+    // A column after entities counts the file's characters: `nope` is at column 58 of
+    // the file; counting the unescaped text forward from the attribute would say 50.
+    std::fs::write(
+        &bad,
+        "<properties>\n<ports>\n<scxml_event_send event=\"heads\" origin=\"coin\" target=\"sink\"><event_var id=\"h\"/></scxml_event_send>\n</ports>\n<guarantees>\n<property id=\"x\" logic=\"pmtl\" expr=\"once {h} &amp;&amp; {nope}\"/>\n</guarantees>\n</properties>\n",
+    )
+    .unwrap();
+    let (code, _, err) = hindsight(&["verify", COIN, bad.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("nope"), "{err}");
+    assert!(
+        err.contains("p.xml:6:58: error: unknown variable `nope`"),
+        "{err}"
+    );
     let (code, _, _) = hindsight(&["verify", COIN, "--confidence", "2"]);
     assert_eq!(code, 2);
     let (code, _, _) = hindsight(&["verify", "no/such/model"]);

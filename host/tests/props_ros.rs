@@ -112,7 +112,7 @@ fn bad_ros_ports_and_patterns_name_their_position() {
             r#"<ports><ros_topic topic="/t" type="t/T"><event_var id="a"/></ros_topic></ports>
 <guarantees><property id="p" pattern="recurrence" event="a" within="1" time_unit="h"/></guarantees>"#,
             "4:72",
-            "one of s, ms, us, ns",
+            "one of ns, us, ms, s or min",
         ),
         (
             r#"<ports><ros_topic topic="/t" type="t/T"><event_var id="a"/></ros_topic></ports>

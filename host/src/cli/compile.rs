@@ -136,22 +136,10 @@ pub fn module_name(spec: &Path) -> String {
     if name.starts_with(|c: char| c.is_ascii_digit()) {
         name.insert_str(0, "m_");
     }
-    if is_keyword(&name) {
+    if codegen::emit_rust::is_rust_keyword(&name) {
         name.push_str("_monitor");
     }
     name
-}
-
-/// Whether `s` is a Rust keyword (strict, reserved or weak enough to break `pub mod s`).
-fn is_keyword(s: &str) -> bool {
-    const KEYWORDS: &[&str] = &[
-        "abstract", "as", "async", "await", "become", "box", "break", "const", "continue", "crate",
-        "do", "dyn", "else", "enum", "extern", "false", "final", "fn", "for", "gen", "if", "impl",
-        "in", "let", "loop", "macro", "match", "mod", "move", "mut", "override", "priv", "pub",
-        "ref", "return", "self", "static", "struct", "super", "trait", "true", "try", "type",
-        "typeof", "unsafe", "unsized", "use", "virtual", "where", "while", "yield",
-    ];
-    KEYWORDS.contains(&s)
 }
 
 #[cfg(test)]

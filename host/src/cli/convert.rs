@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use super::sweep::{map_bounds, BoundValue};
+use super::sweep::BoundValue;
 use super::CliError;
 use crate::model::xml::Element;
 use crate::props::{self, PortKind, PropertyFile, ANY};
@@ -11,6 +11,7 @@ use crate::robot::interfaces::Search;
 use crate::robot::load::{load_searching, main_file_of};
 use crate::robot::main_file::InputKind;
 use crate::robot::write::{escape_into, to_xml, types_xml};
+use codegen::bounds::map_bounds;
 
 /// Arguments of `hindsight convert`.
 #[derive(Debug, clap::Args)]

@@ -227,8 +227,8 @@ pub fn apply(
                 return Err(format!(
                     "the log's ticks are {} long, the spec's are {}: record and replay with \
                      the same unit",
-                    duration_text(*unit_ns),
-                    duration_text(spec.tick_ns())
+                    codegen::duration::format(*unit_ns),
+                    codegen::duration::format(spec.tick_ns())
                 ));
             }
         }
@@ -249,16 +249,6 @@ pub fn parse_log(text: &str, file: &str) -> Result<Vec<(usize, Input)>, String> 
         out.push((i + 1, input));
     }
     Ok(out)
-}
-
-/// `100ms`, `1s`, `250us`, `7ns`.
-fn duration_text(ns: u64) -> String {
-    for (unit, size) in [("s", 1_000_000_000), ("ms", 1_000_000), ("us", 1_000)] {
-        if ns % size == 0 && ns > 0 {
-            return format!("{}{unit}", ns / size);
-        }
-    }
-    format!("{ns}ns")
 }
 
 /// Replays an input log: every verdict line, in order. Errors name `file:line`.

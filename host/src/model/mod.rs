@@ -17,6 +17,7 @@
 //! parses, type-checks and compiles them. All errors are [`Diagnostics`].
 
 pub mod ast;
+pub(crate) mod json;
 mod scxml;
 pub mod source;
 pub mod types;

@@ -162,7 +162,10 @@ fn entity_len(entity: &[u8]) -> Option<u32> {
     Some(resolve_entity(name)?.len_utf8() as u32)
 }
 
-/// The character an XML entity name (without `&` and `;`) stands for.
+/// The character an XML entity name (without `&` and `;`) stands for: the five
+/// predefined entities and character references (`&#65;`, `&#x41;`). `&#0;` is `None`:
+/// U+0000 is not an XML character (XML 1.0, production `Char`). The one entity decoder
+/// of both XML readers (models and property files).
 pub(crate) fn resolve_entity(name: &str) -> Option<char> {
     match name {
         "lt" => Some('<'),
@@ -176,7 +179,7 @@ pub(crate) fn resolve_entity(name: &str) -> Option<char> {
                 Some(hex) => u32::from_str_radix(hex, 16).ok()?,
                 None => num.parse::<u32>().ok()?,
             };
-            char::from_u32(code)
+            char::from_u32(code).filter(|&c| c != '\0')
         }
     }
 }
@@ -345,5 +348,7 @@ mod tests {
         assert_eq!(unescape("a &bogus; b"), Err(2));
         assert_eq!(unescape("a & b"), Err(2));
         assert_eq!(unescape("&#x41;&lt;").unwrap(), "A<");
+        assert_eq!(unescape("a&#0;"), Err(1));
+        assert_eq!(unescape("&#x0;"), Err(0));
     }
 }

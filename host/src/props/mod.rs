@@ -61,7 +61,6 @@
 
 mod error;
 pub mod jani;
-mod json;
 mod read;
 pub mod ros;
 mod source;

@@ -337,8 +337,9 @@ impl<'a> FileReader<'_, 'a> {
             None => "s".to_owned(),
             Some((unit, at)) => {
                 let u = unit.as_str();
-                if !matches!(u, "s" | "ms" | "us" | "ns") {
-                    self.bad_value(at, "time_unit", u, "one of s, ms, us, ns");
+                if codegen::duration::TimeUnit::from_suffix(u).is_none() {
+                    let expected = format!("one of {}", codegen::duration::UNITS_TEXT);
+                    self.bad_value(at, "time_unit", u, &expected);
                 }
                 u.to_owned()
             }

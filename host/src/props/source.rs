@@ -132,6 +132,13 @@ impl SourceText {
         )
     }
 
+    /// The position map: where each run of the text starts (byte offset), its location
+    /// in the file, and whether it is copied character for character (`true`) or
+    /// generated from the element at that location (`false`).
+    pub fn runs(&self) -> impl Iterator<Item = (usize, Location, bool)> + '_ {
+        self.segments.iter().map(|s| (s.offset, s.at, s.exact))
+    }
+
     /// The part of the text between byte offsets `start` and `end` (char boundaries),
     /// keeping its locations.
     pub(crate) fn slice(&self, start: usize, end: usize) -> SourceText {
@@ -234,20 +241,7 @@ pub(crate) fn unescape_attribute(
                 )
             })?;
             let name = &after[..end];
-            let decoded = match name {
-                "lt" => Some('<'),
-                "gt" => Some('>'),
-                "amp" => Some('&'),
-                "apos" => Some('\''),
-                "quot" => Some('"'),
-                _ => name.strip_prefix('#').and_then(|number| {
-                    let value = match number.strip_prefix('x') {
-                        Some(hex) => u32::from_str_radix(hex, 16).ok(),
-                        None => number.parse().ok(),
-                    };
-                    value.and_then(char::from_u32).filter(|&c| c != '\0')
-                }),
-            };
+            let decoded = crate::model::source::resolve_entity(name);
             let decoded = decoded.ok_or_else(|| (at, format!("unknown reference `&{name};`")))?;
             let mut buffer = [0u8; 4];
             out.push_exact(decoded.encode_utf8(&mut buffer), lines.location(at));

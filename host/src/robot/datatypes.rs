@@ -22,6 +22,7 @@
 //! Every type a member names must be declared in one of the files given together.
 
 use super::main_file::{InputKind, MainFile};
+use crate::model::json::{self, Json, Node as JsonNode};
 use crate::model::source::{Diagnostic, FileId, SourceMap, Span};
 use crate::model::types::{TypeDef, TypeDefs, TypeExpr};
 use crate::model::xml::{self, Node};
@@ -220,199 +221,7 @@ fn read_xml(
     }
 }
 
-/// A JSON value with the byte offset where it starts; objects keep their key order.
-#[derive(Clone, Debug, PartialEq)]
-enum Json {
-    Null,
-    Bool(bool),
-    Num(f64),
-    Str(String),
-    Arr(Vec<(Json, usize)>),
-    Obj(Vec<(String, usize, Json, usize)>),
-}
-
-impl Json {
-    fn get(&self, key: &str) -> Option<(&Json, usize)> {
-        match self {
-            Json::Obj(entries) => entries
-                .iter()
-                .find(|(k, _, _, _)| k == key)
-                .map(|(_, _, v, at)| (v, *at)),
-            _ => None,
-        }
-    }
-}
-
-struct JsonParser<'a> {
-    s: &'a [u8],
-    pos: usize,
-}
-
 type JsonError = (usize, String);
-
-impl JsonParser<'_> {
-    fn ws(&mut self) {
-        while self.pos < self.s.len() && self.s[self.pos].is_ascii_whitespace() {
-            self.pos += 1;
-        }
-    }
-
-    fn expect(&mut self, b: u8) -> Result<(), JsonError> {
-        self.ws();
-        if self.s.get(self.pos) == Some(&b) {
-            self.pos += 1;
-            Ok(())
-        } else {
-            Err((self.pos, format!("expected `{}`", b as char)))
-        }
-    }
-
-    fn value(&mut self, depth: usize) -> Result<(Json, usize), JsonError> {
-        self.ws();
-        let at = self.pos;
-        if depth > 128 {
-            return Err((at, "JSON nested too deeply".into()));
-        }
-        let v = match self.s.get(self.pos) {
-            None => return Err((at, "unexpected end of the file".into())),
-            Some(b'{') => {
-                self.pos += 1;
-                let mut entries = Vec::new();
-                self.ws();
-                if self.s.get(self.pos) == Some(&b'}') {
-                    self.pos += 1;
-                } else {
-                    loop {
-                        self.ws();
-                        let kat = self.pos;
-                        let Some(b'"') = self.s.get(self.pos) else {
-                            return Err((kat, "expected a key in double quotes".into()));
-                        };
-                        let k = self.string()?;
-                        self.expect(b':')?;
-                        let (v, vat) = self.value(depth + 1)?;
-                        if entries.iter().any(|(e, _, _, _)| *e == k) {
-                            return Err((kat, format!("key `{k}` appears twice")));
-                        }
-                        entries.push((k, kat, v, vat));
-                        self.ws();
-                        match self.s.get(self.pos) {
-                            Some(b',') => self.pos += 1,
-                            Some(b'}') => {
-                                self.pos += 1;
-                                break;
-                            }
-                            _ => return Err((self.pos, "expected `,` or `}`".into())),
-                        }
-                    }
-                }
-                Json::Obj(entries)
-            }
-            Some(b'[') => {
-                self.pos += 1;
-                let mut items = Vec::new();
-                self.ws();
-                if self.s.get(self.pos) == Some(&b']') {
-                    self.pos += 1;
-                } else {
-                    loop {
-                        items.push(self.value(depth + 1)?);
-                        self.ws();
-                        match self.s.get(self.pos) {
-                            Some(b',') => self.pos += 1,
-                            Some(b']') => {
-                                self.pos += 1;
-                                break;
-                            }
-                            _ => return Err((self.pos, "expected `,` or `]`".into())),
-                        }
-                    }
-                }
-                Json::Arr(items)
-            }
-            Some(b'"') => Json::Str(self.string()?),
-            Some(b't') if self.s[self.pos..].starts_with(b"true") => {
-                self.pos += 4;
-                Json::Bool(true)
-            }
-            Some(b'f') if self.s[self.pos..].starts_with(b"false") => {
-                self.pos += 5;
-                Json::Bool(false)
-            }
-            Some(b'n') if self.s[self.pos..].starts_with(b"null") => {
-                self.pos += 4;
-                Json::Null
-            }
-            Some(b) if *b == b'-' || b.is_ascii_digit() => {
-                let start = self.pos;
-                while self.pos < self.s.len()
-                    && matches!(
-                        self.s[self.pos],
-                        b'0'..=b'9' | b'-' | b'+' | b'.' | b'e' | b'E'
-                    )
-                {
-                    self.pos += 1;
-                }
-                let t = std::str::from_utf8(&self.s[start..self.pos]).unwrap_or("");
-                Json::Num(
-                    t.parse()
-                        .map_err(|_| (start, format!("`{t}` is not a number")))?,
-                )
-            }
-            Some(_) => return Err((at, "expected a JSON value".into())),
-        };
-        Ok((v, at))
-    }
-
-    /// A string starting at the current `"`.
-    fn string(&mut self) -> Result<String, JsonError> {
-        let start = self.pos;
-        self.pos += 1;
-        let mut out = Vec::new();
-        loop {
-            match self.s.get(self.pos) {
-                None => return Err((start, "string is never closed".into())),
-                Some(b'"') => {
-                    self.pos += 1;
-                    break;
-                }
-                Some(b'\\') => {
-                    let esc = self.s.get(self.pos + 1).copied();
-                    self.pos += 2;
-                    let c = match esc {
-                        Some(b'"') => '"',
-                        Some(b'\\') => '\\',
-                        Some(b'/') => '/',
-                        Some(b'n') => '\n',
-                        Some(b't') => '\t',
-                        Some(b'r') => '\r',
-                        Some(b'b') => '\u{8}',
-                        Some(b'f') => '\u{c}',
-                        Some(b'u') => {
-                            let hex = self
-                                .s
-                                .get(self.pos..self.pos + 4)
-                                .and_then(|h| std::str::from_utf8(h).ok())
-                                .and_then(|h| u32::from_str_radix(h, 16).ok())
-                                .and_then(char::from_u32)
-                                .ok_or((self.pos - 2, "bad \\u escape".to_string()))?;
-                            self.pos += 4;
-                            hex
-                        }
-                        _ => return Err((self.pos - 2, "bad escape in string".into())),
-                    };
-                    let mut buf = [0u8; 4];
-                    out.extend_from_slice(c.encode_utf8(&mut buf).as_bytes());
-                }
-                Some(b) => {
-                    out.push(*b);
-                    self.pos += 1;
-                }
-            }
-        }
-        String::from_utf8(out).map_err(|_| (start, "string is not UTF-8".into()))
-    }
-}
 
 fn read_json(
     sm: &SourceMap,
@@ -425,20 +234,16 @@ fn read_json(
         file,
         offset: offset as u32,
     };
-    let mut p = JsonParser {
-        s: text.as_bytes(),
-        pos: 0,
-    };
-    let (root, root_at) = p.value(0).map_err(|(o, m)| vec![sm.diag(at(o), m)])?;
-    p.ws();
-    if p.pos < text.len() {
-        return Err(vec![sm.diag(at(p.pos), "text after the JSON value")]);
-    }
+    let root = json::parse(text).map_err(|(o, m)| vec![sm.diag(at(o), m)])?;
+    let root_at = root.offset;
     let mut errs = Vec::new();
-    let mut structs: Vec<(String, &Json, usize)> = Vec::new();
+    let mut structs: Vec<(String, &JsonNode)> = Vec::new();
     match root.get("title") {
-        Some((Json::Str(t), _)) => structs.push((t.clone(), &root, root_at)),
-        Some((_, o)) => errs.push(sm.diag(at(o), "`title` must be a string")),
+        Some(JsonNode {
+            value: Json::Str(t),
+            ..
+        }) => structs.push((t.clone(), &root)),
+        Some(t) => errs.push(sm.diag(at(t.offset), "`title` must be a string")),
         None if root.get("properties").is_some() => errs.push(sm.diag(
             at(root_at),
             "the top-level object needs a `title`: the name of its struct type",
@@ -446,19 +251,26 @@ fn read_json(
         None => {}
     }
     match root.get("$defs") {
-        Some((Json::Obj(entries), _)) => {
-            for (k, _, v, vat) in entries {
-                structs.push((k.clone(), v, *vat));
+        Some(JsonNode {
+            value: Json::Object(entries),
+            ..
+        }) => {
+            for (k, _, v) in entries {
+                structs.push((k.clone(), v));
             }
         }
-        Some((_, o)) => errs.push(sm.diag(at(o), "`$defs` must be an object")),
+        Some(d) => errs.push(sm.diag(at(d.offset), "`$defs` must be an object")),
         None => {}
     }
-    for (name, obj, oat) in structs {
+    for (name, obj) in structs {
+        let oat = obj.offset;
         match obj.get("type") {
-            Some((Json::Str(t), _)) if t == "object" => {}
-            Some((_, o)) => {
-                errs.push(sm.diag(at(o), format!("`{name}` must have \"type\": \"object\"")));
+            Some(t) if t.as_str() == Some("object") => {}
+            Some(t) => {
+                errs.push(sm.diag(
+                    at(t.offset),
+                    format!("`{name}` must have \"type\": \"object\""),
+                ));
                 continue;
             }
             None => {
@@ -468,18 +280,21 @@ fn read_json(
         }
         let mut fields = Vec::new();
         match obj.get("properties") {
-            Some((Json::Obj(props), _)) => {
-                for (k, _, v, vat) in props {
-                    match json_type(v, *vat) {
+            Some(JsonNode {
+                value: Json::Object(props),
+                ..
+            }) => {
+                for (k, _, v) in props {
+                    match json_type(v) {
                         Ok(t) => {
-                            uses.push((t.clone(), at(*vat)));
+                            uses.push((t.clone(), at(v.offset)));
                             fields.push((k.clone(), t));
                         }
                         Err((o, m)) => errs.push(sm.diag(at(o), m)),
                     }
                 }
             }
-            Some((_, o)) => errs.push(sm.diag(at(o), "`properties` must be an object")),
+            Some(p) => errs.push(sm.diag(at(p.offset), "`properties` must be an object")),
             None => {}
         }
         declare(sm, defs, &name, fields, at(oat), &mut errs);
@@ -492,42 +307,46 @@ fn read_json(
 }
 
 /// The type of one schema property.
-fn json_type(v: &Json, vat: usize) -> Result<TypeExpr, JsonError> {
-    if let Some((r, rat)) = v.get("$ref") {
-        return match r {
-            Json::Str(s) => match s.strip_prefix("#/$defs/") {
+fn json_type(v: &JsonNode) -> Result<TypeExpr, JsonError> {
+    if let Some(r) = v.get("$ref") {
+        return match r.as_str() {
+            Some(s) => match s.strip_prefix("#/$defs/") {
                 Some(n) if !n.is_empty() => Ok(TypeExpr::Named(n.to_string())),
                 _ => Err((
-                    rat,
+                    r.offset,
                     format!("`{s}`: only references to `#/$defs/Name` are supported"),
                 )),
             },
-            _ => Err((rat, "`$ref` must be a string".into())),
+            None => Err((r.offset, "`$ref` must be a string".into())),
         };
     }
-    let (t, tat) = v
-        .get("type")
-        .ok_or((vat, "the property has no \"type\" or \"$ref\"".to_string()))?;
-    let Json::Str(t) = t else {
+    let t = v.get("type").ok_or((
+        v.offset,
+        "the property has no \"type\" or \"$ref\"".to_string(),
+    ))?;
+    let tat = t.offset;
+    let Some(t) = t.as_str() else {
         return Err((tat, "\"type\" must be a string".into()));
     };
     use crate::model::types::BaseType;
-    Ok(match t.as_str() {
+    Ok(match t {
         "string" => TypeExpr::Base(BaseType::Str),
         "boolean" => TypeExpr::Base(BaseType::Bool),
         "integer" => TypeExpr::parse("int32").map_err(|m| (tat, m))?,
         "number" => TypeExpr::parse("float32").map_err(|m| (tat, m))?,
         "array" => {
-            let (items, iat) = v
+            let items = v
                 .get("items")
-                .ok_or((vat, "an array property needs `items`".to_string()))?;
-            let inner = json_type(items, iat)?;
+                .ok_or((v.offset, "an array property needs `items`".to_string()))?;
+            let inner = json_type(items)?;
             let bound = match v.get("maxItems") {
-                Some((Json::Num(n), _)) if *n >= 0.0 && n.fract() == 0.0 && *n <= u32::MAX as f64 => {
-                    Some(*n as u32)
-                }
-                Some((_, o)) => return Err((o, "`maxItems` must be a whole number".into())),
                 None => None,
+                Some(m) => match m.as_f64() {
+                    Some(n) if n >= 0.0 && n.fract() == 0.0 && n <= u32::MAX as f64 => {
+                        Some(n as u32)
+                    }
+                    _ => return Err((m.offset, "`maxItems` must be a whole number".into())),
+                },
             };
             TypeExpr::Array(Box::new(inner), bound)
         }
@@ -546,13 +365,8 @@ fn json_type(v: &Json, vat: usize) -> Result<TypeExpr, JsonError> {
 mod tests {
     use super::*;
 
-    fn parse(s: &str) -> Result<Json, JsonError> {
-        JsonParser {
-            s: s.as_bytes(),
-            pos: 0,
-        }
-        .value(0)
-        .map(|(v, _)| v)
+    fn parse(s: &str) -> Result<JsonNode, JsonError> {
+        json::parse(s)
     }
 
     #[test]
@@ -596,7 +410,7 @@ mod tests {
             match parse(&text) {
                 Ok(v) => {
                     oks += 1;
-                    let _ = json_type(&v, 0);
+                    let _ = json_type(&v);
                 }
                 Err(_) => errs += 1,
             }
@@ -606,23 +420,22 @@ mod tests {
 
     #[test]
     fn json_values() {
-        assert_eq!(parse(" [1, -2.5e1, true, null] ").unwrap(), {
-            Json::Arr(vec![
-                (Json::Num(1.0), 2),
-                (Json::Num(-25.0), 5),
-                (Json::Bool(true), 13),
-                (Json::Null, 19),
-            ])
-        });
+        let v = parse(" [1, -2.5e1, true, null] ").unwrap();
+        let Json::Array(items) = &v.value else {
+            panic!("{v:?}")
+        };
+        let at: Vec<usize> = items.iter().map(|n| n.offset).collect();
+        assert_eq!(at, [2, 5, 13, 19]);
+        assert_eq!(items[1].as_f64(), Some(-25.0));
         let o = parse(r#"{"b": "x\"\u0041", "a": {}}"#).unwrap();
-        let Json::Obj(e) = &o else { panic!() };
+        let Json::Object(e) = &o.value else { panic!() };
         assert_eq!(e[0].0, "b");
-        assert_eq!(e[0].2, Json::Str("x\"A".into()));
+        assert_eq!(e[0].2.as_str(), Some("x\"A"));
         assert_eq!(e[1].0, "a");
         assert_eq!(parse("{\"a\" 1}").unwrap_err().0, 5);
         assert_eq!(parse("[1,").unwrap_err().0, 3);
         assert!(parse("\"abc").is_err());
-        assert!(parse("{\"a\":1,\"a\":2}").is_err());
+        assert_eq!(parse("{\"a\":1,\"a\":2}").unwrap_err().0, 7);
         assert!(parse(&"[".repeat(500)).is_err());
     }
 }

@@ -46,6 +46,7 @@ use std::path::{Path, PathBuf};
 
 use crate::model::source::{Diagnostic, FileId, SourceMap, Span};
 use crate::model::xml::{self, Element, Node};
+use codegen::duration;
 
 use super::main_ignored::{close_to, Notes, PARAMETERS, SECTIONS};
 
@@ -532,7 +533,7 @@ impl<'a> Reader<'a> {
                         Err(_) => {
                             self.errs.push(sm.diag(
                                 c.span,
-                                "<max_time> needs a `unit` (ns, us, ms, s, min or h)",
+                                format!("<max_time> needs a `unit` ({})", duration::UNITS_TEXT),
                             ));
                             continue;
                         }
@@ -541,15 +542,16 @@ impl<'a> Reader<'a> {
                         self.errs.push(sm.diag(c.span, "<max_time> is given twice"));
                         continue;
                     }
-                    match unit_ns(unit.value.trim()) {
+                    match duration::TimeUnit::from_suffix(unit.value.trim()) {
                         None => self.errs.push(sm.diag(
                             unit.value_span,
                             format!(
-                                "unknown time unit `{}` (expected ns, us, ms, s, min or h)",
-                                unit.value
+                                "unknown time unit `{}` (expected {})",
+                                unit.value,
+                                duration::UNITS_TEXT
                             ),
                         )),
-                        Some(scale) => match decimal_times(v, scale) {
+                        Some(unit) => match duration::decimal_times(v, unit.nanos()) {
                             Ok(ns) => p.max_time_ns = Some(Param { value: ns, span }),
                             Err(m) => self.errs.push(sm.diag(span, m)),
                         },
@@ -691,58 +693,6 @@ impl<'a> Reader<'a> {
     }
 }
 
-/// Nanoseconds in one `unit`.
-fn unit_ns(unit: &str) -> Option<u64> {
-    Some(match unit {
-        "ns" => 1,
-        "us" | "µs" => 1_000,
-        "ms" => 1_000_000,
-        "s" | "sec" => 1_000_000_000,
-        "min" => 60_000_000_000,
-        "h" => 3_600_000_000_000,
-        _ => return None,
-    })
-}
-
-/// The decimal `text` (`100`, `2.5`) times `scale`, exactly; an error when it is negative,
-/// not a plain decimal, not a whole number of nanoseconds or too large.
-fn decimal_times(text: &str, scale: u64) -> Result<u64, String> {
-    let (int, frac) = text.split_once('.').unwrap_or((text, ""));
-    let digits = |s: &str| s.bytes().all(|b| b.is_ascii_digit());
-    if (int.is_empty() && frac.is_empty()) || !digits(int) || !digits(frac) {
-        return Err(format!(
-            "`{text}` is not a non-negative decimal number (write `100` or `2.5`)"
-        ));
-    }
-    let frac = frac.trim_end_matches('0');
-    if frac.len() > 19 {
-        return Err(format!("`{text}` has too many decimals"));
-    }
-    let too_big = || format!("`{text}` is too large");
-    let int_v: u128 = if int.is_empty() {
-        0
-    } else {
-        int.parse().map_err(|_| too_big())?
-    };
-    let pow = 10u128.pow(frac.len() as u32);
-    let frac_v: u128 = if frac.is_empty() {
-        0
-    } else {
-        frac.parse().map_err(|_| too_big())?
-    };
-    let num = int_v
-        .checked_mul(pow)
-        .and_then(|v| v.checked_add(frac_v))
-        .and_then(|v| v.checked_mul(scale as u128))
-        .ok_or_else(too_big)?;
-    if num % pow != 0 {
-        return Err(format!(
-            "`{text}` is not a whole number of nanoseconds in this unit"
-        ));
-    }
-    u64::try_from(num / pow).map_err(|_| too_big())
-}
-
 fn tick_rate(text: &str) -> Result<TickRate, String> {
     let bad =
         || format!("bt_tick_rate must be a positive number of ticks per second, not `{text}`");
@@ -791,22 +741,6 @@ fn tick_rate(text: &str) -> Result<TickRate, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn exact_durations() {
-        let s = 1_000_000_000;
-        assert_eq!(decimal_times("100", s), Ok(100 * s));
-        assert_eq!(decimal_times("2.5", s), Ok(2_500_000_000));
-        assert_eq!(decimal_times("0.000000001", s), Ok(1));
-        assert_eq!(decimal_times(".5", 1_000), Ok(500));
-        assert!(decimal_times("1.5", 1).is_err());
-        assert!(decimal_times("-1", s).is_err());
-        assert!(decimal_times("1e3", s).is_err());
-        assert!(decimal_times("", s).is_err());
-        assert!(decimal_times(".", s).is_err());
-        assert!(decimal_times("99999999999999999999999", s).is_err());
-        assert_eq!(decimal_times("2", 3_600_000_000_000), Ok(7_200_000_000_000));
-    }
 
     #[test]
     fn tick_rates() {

@@ -11,7 +11,7 @@
 
 use std::collections::BTreeSet;
 
-use codegen::{Compiled, DeclInput, FormulaInput, Origin, SpecInput};
+use codegen::{Compiled, DeclInput, FormulaInput, Origin, PositionRun, SpecInput};
 use monitor_core::{valuation, Monitor, Op, Ty, Value, VarKind};
 
 use super::settle::Settler;
@@ -114,16 +114,6 @@ fn widened(
     }
 }
 
-/// A time unit of `ns` nanoseconds as the spec language writes it: `100ms`, `1s`, `7ns`.
-fn unit_text(ns: u64) -> String {
-    for (unit, size) in [("s", 1_000_000_000), ("ms", 1_000_000), ("us", 1_000)] {
-        if ns % size == 0 {
-            return format!("{}{unit}", ns / size);
-        }
-    }
-    format!("{ns}ns")
-}
-
 impl PropertySet {
     /// Compiles `props` and resolves its ports against `model`. Every error names the
     /// property file's line and column.
@@ -195,6 +185,16 @@ impl PropertySet {
                 name,
                 text: p.formula.as_str().to_string(),
                 origin: origin(at.line, at.column),
+                positions: p
+                    .formula
+                    .runs()
+                    .map(|(offset, at, exact)| PositionRun {
+                        offset: u32::try_from(offset).unwrap_or(u32::MAX),
+                        line: at.line,
+                        col: at.column,
+                        exact,
+                    })
+                    .collect(),
             }
         };
         let mut formulas: Vec<FormulaInput> = props
@@ -208,7 +208,7 @@ impl PropertySet {
             return Err(errors.join("\n"));
         }
         let compiled = codegen::compile_input(&SpecInput {
-            unit: unit_ns.map(|ns| (unit_text(ns), origin(1, 1))),
+            unit: unit_ns.map(|ns| (codegen::duration::format(ns), origin(1, 1))),
             untimed: unit_ns.is_none(),
             decls,
             formulas,

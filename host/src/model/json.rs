@@ -1,4 +1,5 @@
-//! A small JSON reader that keeps the position of every value, for JANI property files.
+//! The JSON reader that keeps the position of every value: JANI property files and
+//! JSON-schema data declarations (where positions are not needed, serde_json reads).
 //!
 //! It accepts RFC 8259 JSON (objects, arrays, strings with escapes, numbers, `true`,
 //! `false`, `null`) and reports the first syntax error with its byte offset.
@@ -30,6 +31,14 @@ impl Node {
     pub fn get(&self, key: &str) -> Option<&Node> {
         match &self.value {
             Json::Object(members) => members.iter().find(|(k, _, _)| k == key).map(|m| &m.2),
+            _ => None,
+        }
+    }
+
+    /// The number's value, if this is a number.
+    pub fn as_f64(&self) -> Option<f64> {
+        match &self.value {
+            Json::Number(n) => n.parse().ok(),
             _ => None,
         }
     }
@@ -103,6 +112,9 @@ impl Parser<'_> {
                             return Err((self.pos, "expected a member name (a string)".into()));
                         }
                         let key = self.string()?;
+                        if members.iter().any(|(k, _, _)| *k == key) {
+                            return Err((key_at, format!("member `{key}` appears twice")));
+                        }
                         self.ws();
                         self.expect(b':')?;
                         self.ws();

@@ -1,0 +1,187 @@
+//! Durations and time units: the one place that reads `2.5s` and writes `2500ms` back.
+//!
+//! Every reader of a duration uses this module: formula bounds (the parser and the
+//! checker), the main file's `<max_time>`, property files' `time_unit`, `--time-unit`
+//! and sweep bounds on the command line, and the texts the sidecar and `verify` write.
+//!
+//! The accepted units are exactly [`TimeUnit::ALL`]: `ns`, `us`, `ms`, `s`, `min`.
+//! That is the set of AS2FM's main-file reader (`scxml_helpers/roaml_model.py`,
+//! `TIME_MULTIPLIERS`: `s`, `ms`, `us`, `ns`) plus `min`, which formulas have always
+//! accepted. Spellings outside it (`µs`, `sec`, `h`) are errors everywhere, so a
+//! duration that one reader accepts no other reader rejects.
+
+/// A time unit suffix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum TimeUnit {
+    /// Nanoseconds, `ns`.
+    Ns,
+    /// Microseconds, `us`.
+    Us,
+    /// Milliseconds, `ms`.
+    Ms,
+    /// Seconds, `s`.
+    S,
+    /// Minutes, `min`.
+    Min,
+}
+
+/// The accepted units in words, for error messages.
+pub const UNITS_TEXT: &str = "ns, us, ms, s or min";
+
+impl TimeUnit {
+    /// Every unit, smallest first.
+    pub const ALL: [TimeUnit; 5] = [
+        TimeUnit::Ns,
+        TimeUnit::Us,
+        TimeUnit::Ms,
+        TimeUnit::S,
+        TimeUnit::Min,
+    ];
+
+    /// The unit a suffix names (`"ms"`), or `None` for anything else.
+    pub fn from_suffix(s: &str) -> Option<TimeUnit> {
+        TimeUnit::ALL.into_iter().find(|u| u.suffix() == s)
+    }
+
+    /// The suffix as written: `ns`, `us`, `ms`, `s`, `min`.
+    pub fn suffix(self) -> &'static str {
+        match self {
+            TimeUnit::Ns => "ns",
+            TimeUnit::Us => "us",
+            TimeUnit::Ms => "ms",
+            TimeUnit::S => "s",
+            TimeUnit::Min => "min",
+        }
+    }
+
+    /// Nanoseconds in one unit.
+    pub fn nanos(self) -> u64 {
+        match self {
+            TimeUnit::Ns => 1,
+            TimeUnit::Us => 1_000,
+            TimeUnit::Ms => 1_000_000,
+            TimeUnit::S => 1_000_000_000,
+            TimeUnit::Min => 60_000_000_000,
+        }
+    }
+}
+
+/// The decimal `text` (`100`, `2.5`, `.5`) times `scale` nanoseconds, exactly; an error
+/// when it is negative, not a plain decimal, not a whole number of nanoseconds or too
+/// large for `u64`.
+pub fn decimal_times(text: &str, scale: u64) -> Result<u64, String> {
+    let (int, frac) = text.split_once('.').unwrap_or((text, ""));
+    let digits = |s: &str| s.bytes().all(|b| b.is_ascii_digit());
+    if (int.is_empty() && frac.is_empty()) || !digits(int) || !digits(frac) {
+        return Err(format!(
+            "`{text}` is not a non-negative decimal number (write `100` or `2.5`)"
+        ));
+    }
+    let frac = frac.trim_end_matches('0');
+    if frac.len() > 19 {
+        return Err(format!("`{text}` is finer than a nanosecond"));
+    }
+    let too_big = || format!("`{text}` is too large");
+    let int_v: u128 = if int.is_empty() {
+        0
+    } else {
+        int.parse().map_err(|_| too_big())?
+    };
+    let pow = 10u128.pow(frac.len() as u32);
+    let frac_v: u128 = if frac.is_empty() {
+        0
+    } else {
+        frac.parse().map_err(|_| too_big())?
+    };
+    let num = int_v
+        .checked_mul(pow)
+        .and_then(|v| v.checked_add(frac_v))
+        .and_then(|v| v.checked_mul(u128::from(scale)))
+        .ok_or_else(too_big)?;
+    if num % pow != 0 {
+        return Err(format!("`{text}` is finer than a nanosecond"));
+    }
+    u64::try_from(num / pow).map_err(|_| too_big())
+}
+
+/// Splits `2.5ms` into the number `2.5` and the suffix `ms` (after trimming blanks).
+pub fn split(text: &str) -> (&str, &str) {
+    let t = text.trim();
+    let at = t
+        .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .unwrap_or(t.len());
+    t.split_at(at)
+}
+
+/// Parses a duration with its unit (`100ms`, `2.5s`, `1min`) into nanoseconds, exactly.
+pub fn parse(text: &str) -> Result<u64, String> {
+    let (number, suffix) = split(text);
+    let Some(unit) = TimeUnit::from_suffix(suffix) else {
+        return Err(if suffix.is_empty() {
+            format!("`{}` has no time unit ({UNITS_TEXT})", text.trim())
+        } else {
+            format!("unknown time unit `{suffix}` (use {UNITS_TEXT})")
+        });
+    };
+    decimal_times(number, unit.nanos())
+}
+
+/// A duration in the largest unit that expresses it exactly: `1s`, `100ms`, `2500ns`,
+/// `0ns`. [`parse`] reads it back to the same value.
+pub fn format(ns: u64) -> String {
+    for unit in TimeUnit::ALL.into_iter().rev() {
+        let n = unit.nanos();
+        if ns >= n && ns % n == 0 {
+            return format!("{}{}", ns / n, unit.suffix());
+        }
+    }
+    format!("{ns}ns")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_decimals() {
+        let s = 1_000_000_000;
+        assert_eq!(decimal_times("100", s), Ok(100 * s));
+        assert_eq!(decimal_times("2.5", s), Ok(2_500_000_000));
+        assert_eq!(decimal_times("0.000000001", s), Ok(1));
+        assert_eq!(decimal_times(".5", 1_000), Ok(500));
+        assert_eq!(decimal_times("1.50000", 1_000), Ok(1_500));
+        assert!(decimal_times("1.5", 1).is_err());
+        assert!(decimal_times("-1", s).is_err());
+        assert!(decimal_times("1e3", s).is_err());
+        assert!(decimal_times("", s).is_err());
+        assert!(decimal_times(".", s).is_err());
+        assert!(decimal_times("99999999999999999999999", s).is_err());
+    }
+
+    #[test]
+    fn parse_and_format_agree() {
+        assert_eq!(parse("100ms"), Ok(100_000_000));
+        assert_eq!(parse(" 2.5s "), Ok(2_500_000_000));
+        assert_eq!(parse("1.5min"), Ok(90_000_000_000));
+        assert_eq!(parse("7ns"), Ok(7));
+        for bad in ["5", "5µs", "5sec", "5h", "ms", "1.5ns", "-1s"] {
+            assert!(parse(bad).is_err(), "{bad}");
+        }
+        for ns in [
+            0,
+            1,
+            999,
+            1_000,
+            2_500,
+            100_000_000,
+            1_000_000_000,
+            90_000_000_000,
+        ] {
+            assert_eq!(parse(&format(ns)), Ok(ns), "{}", format(ns));
+        }
+        assert_eq!(format(0), "0ns");
+        assert_eq!(format(1_000_000_000), "1s");
+        assert_eq!(format(120_000_000_000), "2min");
+        assert_eq!(format(1_500_000), "1500us");
+    }
+}
