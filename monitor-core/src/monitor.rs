@@ -262,13 +262,17 @@ impl<'a> Monitor<'a> {
     /// 64 nodes; a node's children come before it, so their values at this point
     /// are either in that register or in a word already stored. A network of at
     /// most 64 nodes (most of them) takes a loop without the word bookkeeping.
+    #[inline]
     fn advance(&self, state: &mut [u64], t: u64, verdicts: &mut [bool]) {
         let first_point = rd(state, 0) == 0;
         let vals = self.values_at;
         let nodes = self.program.nodes;
         // Header, atom and value words before `off`; nodes' own words from `off` on.
         let off = self.nodes_at;
-        let (head, body) = state.split_at_mut(off.min(state.len()));
+        // The state length was checked (it covers every node's words): never `None`.
+        let Some((head, body)) = state.split_at_mut_checked(off) else {
+            return;
+        };
         let atom = |head: &[u64], a: u16| {
             rd(head, layout::HEADER_WORDS + a as usize / 64) >> (a % 64) & 1 == 1
         };
@@ -278,7 +282,7 @@ impl<'a> Monitor<'a> {
             for (i, node) in nodes.iter().enumerate() {
                 let now = new;
                 let v = node_step(
-                    node.op,
+                    &node.op,
                     (node.slot as usize).wrapping_sub(off),
                     body,
                     t,
@@ -303,7 +307,7 @@ impl<'a> Monitor<'a> {
                 }
                 let (now, h): (u64, &[u64]) = (new, head);
                 let v = node_step(
-                    node.op,
+                    &node.op,
                     (node.slot as usize).wrapping_sub(off),
                     body,
                     t,
@@ -338,7 +342,7 @@ impl<'a> Monitor<'a> {
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn node_step(
-    op: Op,
+    op: &Op,
     slot: usize,
     words: &mut [u64],
     t: u64,
@@ -347,7 +351,7 @@ fn node_step(
     bit: impl Fn(u16) -> bool,
     own_prev: bool,
 ) -> bool {
-    match op {
+    match *op {
         Op::Const(c) => c,
         Op::Atom(a) => atom(a),
         Op::Not(a) => !bit(a),
