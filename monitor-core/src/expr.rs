@@ -66,8 +66,59 @@ pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> bool {
 
 /// Evaluates a checked atom over `vals`. Errors on a value of the wrong type
 /// (the caller's input) or on integer overflow / division by zero.
+///
+/// The shapes most atoms have (a boolean variable, its negation, a variable
+/// compared with a constant or with another variable) are matched on the code
+/// itself and computed without the stack machine; any surprise (a value of
+/// another type) falls through to the general machine, so errors are the same.
+#[inline]
 pub(crate) fn eval(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, StepError> {
-    let mut stack = [Value::Bool(false); MAX_STACK];
+    match *code {
+        [Instr::Load(n)] => {
+            if let Some(Value::Bool(b)) = vals.get(n as usize) {
+                return Ok(*b);
+            }
+        }
+        [Instr::Load(n), Instr::Not] => {
+            if let Some(Value::Bool(b)) = vals.get(n as usize) {
+                return Ok(!*b);
+            }
+        }
+        [Instr::Load(n), Instr::Push(c), Instr::Cmp(op, _)] => {
+            if let Some(r) = vals.get(n as usize).and_then(|v| compare(op, *v, c)) {
+                return Ok(r);
+            }
+        }
+        [Instr::Push(c), Instr::Load(n), Instr::Cmp(op, _)] => {
+            if let Some(r) = vals.get(n as usize).and_then(|v| compare(op, c, *v)) {
+                return Ok(r);
+            }
+        }
+        [Instr::Load(m), Instr::Load(n), Instr::Cmp(op, _)] => {
+            if let (Some(a), Some(b)) = (vals.get(m as usize), vals.get(n as usize)) {
+                if let Some(r) = compare(op, *a, *b) {
+                    return Ok(r);
+                }
+            }
+        }
+        _ => {}
+    }
+    // The stack never holds more values than the code has instructions: a short
+    // atom gets a short stack to clear.
+    if code.len() <= 8 {
+        eval_stack::<8>(code, vals, atom)
+    } else {
+        eval_stack::<MAX_STACK>(code, vals, atom)
+    }
+}
+
+/// The general stack machine, with room for `D` values.
+fn eval_stack<const D: usize>(
+    code: &[Instr],
+    vals: &[Value],
+    atom: u16,
+) -> Result<bool, StepError> {
+    let mut stack = [Value::Bool(false); D];
     let mut sp = 0usize;
     let arith = StepError::Arithmetic { atom };
     for ins in code {
@@ -115,7 +166,7 @@ pub(crate) fn eval(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, St
 }
 
 fn binary(ins: Instr, a: Value, b: Value) -> Option<Value> {
-    use Value::{Bool, Float, Int, Str};
+    use Value::{Bool, Float, Int};
     Some(match (ins, a, b) {
         (Instr::And, Bool(a), Bool(b)) => Bool(a && b),
         (Instr::Or, Bool(a), Bool(b)) => Bool(a || b),
@@ -129,15 +180,35 @@ fn binary(ins: Instr, a: Value, b: Value) -> Option<Value> {
         (Instr::Mul(_), Float(a), Float(b)) => Float(a * b),
         (Instr::Div(_), Float(a), Float(b)) => Float(a / b),
         (Instr::Rem(_), Float(a), Float(b)) => Float(a % b),
-        (Instr::Cmp(op, _), a, b) => Bool(match (a, b) {
-            (Int(a), Int(b)) => cmp(op, a.partial_cmp(&b)),
-            (Float(a), Float(b)) => cmp(op, a.partial_cmp(&b)),
-            (Bool(a), Bool(b)) => cmp(op, Some(a.cmp(&b))),
-            (Str(a), Str(b)) => cmp(op, Some(a.cmp(&b))),
-            _ => return None,
-        }),
+        (Instr::Cmp(op, _), a, b) => Bool(compare(op, a, b)?),
         _ => return None,
     })
+}
+
+/// `a op b` for two values of the same type; `None` for mixed types.
+#[inline(always)]
+fn compare(op: CmpOp, a: Value, b: Value) -> Option<bool> {
+    use Value::{Bool, Float, Int, Str};
+    Some(match (a, b) {
+        (Int(a), Int(b)) => int_cmp(op, a, b),
+        (Float(a), Float(b)) => cmp(op, a.partial_cmp(&b)),
+        (Bool(a), Bool(b)) => cmp(op, Some(a.cmp(&b))),
+        (Str(a), Str(b)) => cmp(op, Some(a.cmp(&b))),
+        _ => return None,
+    })
+}
+
+/// Integer comparison straight to a flag (the common atom `x op constant`).
+#[inline(always)]
+fn int_cmp(op: CmpOp, a: i64, b: i64) -> bool {
+    match op {
+        CmpOp::Eq => a == b,
+        CmpOp::Ne => a != b,
+        CmpOp::Lt => a < b,
+        CmpOp::Le => a <= b,
+        CmpOp::Gt => a > b,
+        CmpOp::Ge => a >= b,
+    }
 }
 
 fn cmp(op: CmpOp, ord: Option<core::cmp::Ordering>) -> bool {

@@ -2,7 +2,7 @@
 
 use crate::error::{StepError, TableError};
 use crate::expr;
-use crate::layout::{self, SinceKind};
+use crate::layout;
 use crate::program::{Op, Program, Value, VarKind};
 
 /// A [`Program`] that passed every check: it can be stepped without panicking.
@@ -15,6 +15,8 @@ pub struct Monitor<'a> {
     program: Program<'a>,
     state_words: usize,
     values_at: usize,
+    /// First word of the nodes' own state ([`layout::first_node_word`]), decided once.
+    nodes_at: usize,
 }
 
 /// The most nodes, atoms or variables a program may have (ids are `u16`).
@@ -105,6 +107,7 @@ impl<'a> Monitor<'a> {
             program,
             state_words: next_word as usize,
             values_at: layout::HEADER_WORDS + layout::bit_words(p.atoms.len()),
+            nodes_at: layout::first_node_word(p.atoms.len(), p.nodes.len()),
         })
     }
 
@@ -168,21 +171,15 @@ impl<'a> Monitor<'a> {
                 return Err(StepError::VarType { var: i as u16 });
             }
         }
-        let atom_words = self.values_at - layout::HEADER_WORDS;
-        let mut atoms_done = 0usize;
         // Atoms first, into the scratch words: an error leaves the temporal state untouched.
-        for w in 0..atom_words {
+        for (w, chunk) in p.atoms.chunks(64).enumerate() {
             let mut bits = 0u64;
-            for b in 0..64 {
-                let Some(a) = p.atoms.get(atoms_done) else {
-                    break;
-                };
+            for (b, a) in chunk.iter().enumerate() {
                 let range = a.start as usize..a.start as usize + a.len as usize;
                 let code = p.instrs.get(range).unwrap_or(&[]);
-                if expr::eval(code, vars, atoms_done as u16)? {
+                if expr::eval(code, vars, (w * 64 + b) as u16)? {
                     bits |= 1 << b;
                 }
-                atoms_done += 1;
             }
             wr(state, layout::HEADER_WORDS + w, bits);
         }
@@ -260,80 +257,152 @@ impl<'a> Monitor<'a> {
     /// Updates every node; the state length and the time were checked by the caller.
     ///
     /// Every access goes through `get`/`get_mut` (the slots were validated, so the
-    /// fallbacks never run): the step links no panic path into firmware.
+    /// fallbacks never run): the step links no panic path into firmware. The value
+    /// bits of the nodes being updated are built in a register and stored once per
+    /// 64 nodes; a node's children come before it, so their values at this point
+    /// are either in that register or in a word already stored. A network of at
+    /// most 64 nodes (most of them) takes a loop without the word bookkeeping.
+    #[inline]
     fn advance(&self, state: &mut [u64], t: u64, verdicts: &mut [bool]) {
         let first_point = rd(state, 0) == 0;
         let vals = self.values_at;
-        let bit = |state: &[u64], base: usize, i: u16| -> bool {
-            let i = i as usize;
-            rd(state, base + i / 64) >> (i % 64) & 1 == 1
+        let nodes = self.program.nodes;
+        // Header, atom and value words before `off`; nodes' own words from `off` on.
+        let off = self.nodes_at;
+        // The state length was checked (it covers every node's words): never `None`.
+        let Some((head, body)) = state.split_at_mut_checked(off) else {
+            return;
         };
-        for (i, node) in self.program.nodes.iter().enumerate() {
-            let slot = node.slot as usize;
-            let v = match node.op {
-                Op::Const(c) => c,
-                Op::Atom(a) => bit(state, layout::HEADER_WORDS, a),
-                Op::Not(a) => !bit(state, vals, a),
-                Op::And(a, b) => bit(state, vals, a) && bit(state, vals, b),
-                Op::Or(a, b) => bit(state, vals, a) || bit(state, vals, b),
-                Op::Implies(a, b) => !bit(state, vals, a) || bit(state, vals, b),
-                Op::Iff(a, b) => bit(state, vals, a) == bit(state, vals, b),
-                Op::Yesterday(a) => {
-                    let out = !first_point && rd(state, slot) != 0;
-                    wr(state, slot, bit(state, vals, a) as u64);
-                    out
+        let atom = |head: &[u64], a: u16| {
+            rd(head, layout::HEADER_WORDS + a as usize / 64) >> (a % 64) & 1 == 1
+        };
+        if nodes.len() <= 64 {
+            let old = rd(head, vals);
+            let mut new = 0u64;
+            for (i, node) in nodes.iter().enumerate() {
+                let now = new;
+                let v = node_step(
+                    &node.op,
+                    (node.slot as usize).wrapping_sub(off),
+                    body,
+                    t,
+                    first_point,
+                    |a| atom(head, a),
+                    |c| now >> (c & 63) & 1 == 1,
+                    old >> (i & 63) & 1 == 1,
+                );
+                new |= (v as u64) << (i & 63);
+            }
+            wr(head, vals, new);
+        } else {
+            let mut old = rd(head, vals);
+            let mut new = 0u64;
+            let mut base = 0usize;
+            for (i, node) in nodes.iter().enumerate() {
+                if i - base >= 64 {
+                    wr(head, vals + base / 64, new);
+                    base = i;
+                    old = rd(head, vals + base / 64);
+                    new = 0;
                 }
-                Op::WeakYesterday(a) => {
-                    let out = first_point || rd(state, slot) != 0;
-                    wr(state, slot, bit(state, vals, a) as u64);
-                    out
-                }
-                Op::Since { lhs, rhs, lo, hi } => {
-                    let f = bit(state, vals, lhs);
-                    let g = bit(state, vals, rhs);
-                    match layout::since_kind(lo, hi) {
-                        Some(SinceKind::Unbounded) => {
-                            let prev = !first_point && bit(state, vals, i as u16);
-                            g || (f && prev)
-                        }
-                        Some(SinceKind::UpTo(b)) => {
-                            let mut w = rd(state, slot);
-                            if !f {
-                                w = 0;
-                            }
-                            if g {
-                                w = t + 1;
-                            }
-                            wr(state, slot, w);
-                            w != 0 && t.wrapping_sub(w - 1) <= b
-                        }
-                        Some(SinceKind::AtLeast(a)) => {
-                            let mut w = rd(state, slot);
-                            if !f {
-                                w = 0;
-                            }
-                            if g && w == 0 {
-                                w = t + 1;
-                            }
-                            wr(state, slot, w);
-                            w != 0 && t.wrapping_sub(w - 1) >= a
-                        }
-                        Some(SinceKind::Window { lo, hi, cap }) => match state.get_mut(slot..) {
-                            Some(w) => window_step(w, cap as usize, lo, hi, t, f, g),
-                            None => false,
-                        },
-                        // Rejected by `try_new`.
-                        None => false,
-                    }
-                }
-            };
-            let k = vals + i / 64;
-            let w = rd(state, k);
-            wr(state, k, (w & !(1 << (i % 64))) | ((v as u64) << (i % 64)));
+                let (now, h): (u64, &[u64]) = (new, head);
+                let v = node_step(
+                    &node.op,
+                    (node.slot as usize).wrapping_sub(off),
+                    body,
+                    t,
+                    first_point,
+                    |a| atom(h, a),
+                    |c| {
+                        let c = c as usize;
+                        let w = if c >= base {
+                            now >> ((c - base) & 63)
+                        } else {
+                            rd(h, vals + c / 64) >> (c % 64)
+                        };
+                        w & 1 == 1
+                    },
+                    old >> ((i - base) & 63) & 1 == 1,
+                );
+                new |= (v as u64) << ((i - base) & 63);
+            }
+            wr(head, vals + base / 64, new);
         }
-        wr(state, 0, t + 1);
+        wr(head, 0, t + 1);
         for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
-            *out = bit(state, vals, pr.root);
+            let r = pr.root as usize;
+            *out = rd(head, vals + r / 64) >> (r % 64) & 1 == 1;
+        }
+    }
+}
+
+/// One node at one point: its value, given its children's values at this point
+/// (`bit`), the atoms (`atom`) and its own value at the last point (`own_prev`).
+/// `slot` indexes the node's own words in `words`.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn node_step(
+    op: &Op,
+    slot: usize,
+    words: &mut [u64],
+    t: u64,
+    first_point: bool,
+    atom: impl Fn(u16) -> bool,
+    bit: impl Fn(u16) -> bool,
+    own_prev: bool,
+) -> bool {
+    match *op {
+        Op::Const(c) => c,
+        Op::Atom(a) => atom(a),
+        Op::Not(a) => !bit(a),
+        Op::And(a, b) => bit(a) && bit(b),
+        Op::Or(a, b) => bit(a) || bit(b),
+        Op::Implies(a, b) => !bit(a) || bit(b),
+        Op::Iff(a, b) => bit(a) == bit(b),
+        Op::Yesterday(a) => {
+            let out = !first_point && rd(words, slot) != 0;
+            wr(words, slot, bit(a) as u64);
+            out
+        }
+        Op::WeakYesterday(a) => {
+            let out = first_point || rd(words, slot) != 0;
+            wr(words, slot, bit(a) as u64);
+            out
+        }
+        Op::Since { lhs, rhs, lo, hi } => {
+            let f = bit(lhs);
+            let g = bit(rhs);
+            // The kinds of `layout::since_kind`, told apart by the bounds directly
+            // (a window's capacity is only computed when it is needed).
+            match hi {
+                None if lo == 0 => g || (f && !first_point && own_prev),
+                None => {
+                    let mut w = rd(words, slot);
+                    if !f {
+                        w = 0;
+                    }
+                    if g && w == 0 {
+                        w = t + 1;
+                    }
+                    wr(words, slot, w);
+                    w != 0 && t.wrapping_sub(w - 1) >= lo
+                }
+                Some(b) if lo == 0 => {
+                    let mut w = rd(words, slot);
+                    if !f {
+                        w = 0;
+                    }
+                    if g {
+                        w = t + 1;
+                    }
+                    wr(words, slot, w);
+                    w != 0 && t.wrapping_sub(w - 1) <= b
+                }
+                Some(hi) => match words.get_mut(slot..) {
+                    Some(w) => window_step(w, lo, hi, t, f, g),
+                    None => false,
+                },
+            }
         }
     }
 }
@@ -355,23 +424,36 @@ fn wr(w: &mut [u64], i: usize, v: u64) {
 /// `w[0]` packs `head | len << 32`; run `k` is `w[1 + 2k] = first`, `w[2 + 2k] = last`.
 /// Amortised constant work: each run is pushed and expired once, and only the
 /// oldest run decides the verdict (it has the smallest `first`, and every live
-/// run still has `last + hi >= t`).
-fn window_step(w: &mut [u64], cap: usize, lo: u64, hi: u64, t: u64, f: bool, g: bool) -> bool {
-    let next = |k: usize| if k + 1 >= cap { 0 } else { k + 1 };
+/// run still has `last + hi >= t`). The ring's capacity is only needed when a
+/// run expires or a witness arrives; a point interval's is `hi + 1` and any
+/// other's costs a division ([`layout::window_capacity`]), so it is computed then.
+#[inline]
+fn window_step(w: &mut [u64], lo: u64, hi: u64, t: u64, f: bool, g: bool) -> bool {
+    let capacity = || {
+        if lo == hi {
+            hi.saturating_add(1) as usize
+        } else {
+            layout::window_capacity(lo, hi).unwrap_or(1) as usize
+        }
+    };
     let header = rd(w, 0);
     let mut head = (header & 0xffff_ffff) as usize;
     let mut len = (header >> 32) as usize;
     if !f {
         len = 0;
     }
-    while len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
-        head = next(head);
-        len -= 1;
+    if len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
+        let cap = capacity();
+        while len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
+            head = if head + 1 >= cap { 0 } else { head + 1 };
+            len -= 1;
+        }
     }
     if len == 0 {
         head = 0;
     }
     if g {
+        let cap = capacity();
         // Index of the newest run and of the slot after it, without `%` (cap >= 1).
         let mut tail = head + len;
         if tail >= cap {
