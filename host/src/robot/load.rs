@@ -405,7 +405,11 @@ fn load_full(
     let interfaces = Interfaces::discover_with(&mut sm, main_path, search).map_err(fail)?;
 
     let mut errs = Vec::new();
-    let mut machines = Vec::new();
+    // The tree's machines go after the node models, in the order AS2FM collects them
+    // (`generate_plain_scxml_models_and_timers`, jani_generator/scxml_helpers/
+    // top_level_interpreter.py: the node models in main-file order, then `bt_converter`'s
+    // root and plugins): the ROS lowering numbers timers and clients in this order.
+    let mut tree_machines = Vec::new();
     if let Some(tree) = &main.behavior_tree {
         let file_of = |sm: &mut SourceMap, input: &Input| {
             let text = std::fs::read_to_string(&input.path).ok()?;
@@ -423,7 +427,7 @@ fn load_full(
                     halts,
                 };
                 match bt::lower(&sm, &input) {
-                    Ok(ms) => machines.extend(ms),
+                    Ok(ms) => tree_machines = ms,
                     Err(ds) => errs.extend(ds),
                 }
             }
@@ -431,7 +435,7 @@ fn load_full(
         }
     }
     let mut left_out = Vec::new();
-    let from_tree = machines.len();
+    let mut machines = Vec::new();
     for input in &main.node_models {
         if let Some(e) = read_xml(&mut sm, input, &mut errs) {
             let name = e.attr_value("name").unwrap_or("").trim().to_string();
@@ -449,7 +453,7 @@ fn load_full(
     if errs.is_empty() {
         for name in external {
             if !left_out.iter().any(|c| &c.name == name) {
-                let known: Vec<&str> = machines[from_tree..]
+                let known: Vec<&str> = machines
                     .iter()
                     .filter_map(|m| m.attr_value("name"))
                     .collect();
@@ -467,6 +471,7 @@ fn load_full(
         return Err(fail(errs));
     }
 
+    machines.extend(tree_machines);
     let max_time_ns = main.params.max_time_ns.value;
     let max_array_size = main.params.max_array_size_or_default();
     let out = ros::lower(

@@ -3,6 +3,8 @@
 //! Each test file that needs it says `mod common;`; not every file uses every helper.
 #![allow(dead_code)]
 
+pub mod canon;
+
 use std::path::{Path, PathBuf};
 
 /// `shared/corpus`, found next to the repository or a worktree container above it (the

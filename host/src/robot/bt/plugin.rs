@@ -324,9 +324,25 @@ pub(crate) fn instance(
         pending_states: Vec::new(),
     };
     l.block(&mut root);
-    for s in std::mem::take(&mut l.pending_states) {
-        root.push(s);
+    // Each state made to wait for the blackboard comes right after the state it was split
+    // from, as in AS2FM (`ScxmlState._generate_variable_config_retrieval`,
+    // scxml_converter/scxml_entries/scxml_state.py, returns `[state, *new states]`).
+    let mut pending = std::mem::take(&mut l.pending_states);
+    let mut children = Vec::with_capacity(root.children.len() + pending.len());
+    for n in std::mem::take(&mut root.children) {
+        let from = match &n {
+            Node::Element(e) if e.name == "state" => e.attr_value("id").map(String::from),
+            _ => None,
+        };
+        children.push(n);
+        if let Some(id) = from {
+            let (mine, rest): (Vec<_>, Vec<_>) = pending.into_iter().partition(|(p, _)| *p == id);
+            children.extend(mine.into_iter().map(|(_, s)| Node::Element(s)));
+            pending = rest;
+        }
     }
+    children.extend(pending.into_iter().map(|(_, s)| Node::Element(s)));
+    root.children = children;
     if !plugin.has_halt {
         let b = B { at: root.span };
         for s in root.elements_mut() {
@@ -346,7 +362,8 @@ struct Lower<'a> {
     bb: &'a mut Blackboard,
     errs: &'a mut Vec<Diagnostic>,
     /// States made by splitting transitions, added at the end of the machine.
-    pending_states: Vec<Element>,
+    /// States split off to wait for the blackboard, with the id of the state they come from.
+    pending_states: Vec<(String, Element)>,
 }
 
 /// Executable content and transitions that may read the blackboard by being split.
@@ -732,7 +749,7 @@ impl Lower<'_> {
                 None => {}
             }
             get.children = body;
-            new_states.push(b.state(&wait_id).with_child(get));
+            new_states.push((sid.clone(), b.state(&wait_id).with_child(get)));
         }
         self.pending_states.append(&mut new_states);
     }

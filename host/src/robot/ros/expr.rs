@@ -1,6 +1,8 @@
 //! Rewrites the ROS pseudo-variables of a callback (`_msg.x`, `_req.x`, `_goal.x`, ...) into
 //! the event parameters AS2FM's translation sends (`_event.data.ros_fields__x`).
 
+use crate::expr::ast::{Expr, ExprKind};
+use crate::expr::parse_expr;
 use crate::robot::types::FlatField;
 
 /// What the pseudo-variables of one callback refer to.
@@ -26,10 +28,6 @@ const PREFIXES: [&str; 7] = [
     "_wrapped_result",
 ];
 
-fn is_ident(b: u8) -> bool {
-    b.is_ascii_alphanumeric() || b == b'_'
-}
-
 /// Where a pseudo-variable's callback is, for errors.
 fn owner(prefix: &str) -> &'static str {
     match prefix {
@@ -53,57 +51,82 @@ fn match_leaf<'f>(fields: &'f [FlatField], path: &[&str]) -> Option<(&'f FlatFie
 }
 
 /// Rewrites `text`; an error is `(byte offset in text, message)`.
+///
+/// The text is read with the model's own expression parser ([`parse_expr`]); every chain
+/// `prefix.a.b` whose root is a pseudo-variable is replaced, in the text, over the byte
+/// range its syntax tree gives, so the rest of the text stays as the user wrote it. Text
+/// that does not parse is left alone: reading the plain machine reports the syntax error
+/// at its position.
 pub(crate) fn rewrite(text: &str, scope: &Scope) -> Result<String, (usize, String)> {
-    let b = text.as_bytes();
+    let Ok(tree) = parse_expr(text) else {
+        return Ok(text.to_string());
+    };
+    let mut edits: Vec<(usize, usize, String)> = Vec::new();
+    collect(&tree, scope, &mut edits)?;
+    edits.sort_by_key(|e| e.0);
     let mut out = String::with_capacity(text.len() + 16);
-    let mut i = 0;
     let mut last = 0;
-    while i < b.len() {
-        let c = b[i];
-        if c == b'\'' || c == b'"' {
-            // Skip a string literal.
-            i += 1;
-            while i < b.len() && b[i] != c {
-                if b[i] == b'\\' {
-                    i += 1;
-                }
-                i += 1;
-            }
-            i += 1;
-            continue;
-        }
-        if !is_ident(c) || (i > 0 && (is_ident(b[i - 1]) || b[i - 1] == b'.')) {
-            i += 1;
-            continue;
-        }
-        let start = i;
-        while i < b.len() && is_ident(b[i]) {
-            i += 1;
-        }
-        let word = &text[start..i];
-        let Some(&prefix) = PREFIXES.iter().find(|p| **p == word) else {
-            continue;
-        };
-        // The chain `.a.b.c` after the prefix.
-        let mut parts: Vec<(&str, usize)> = Vec::new();
-        let mut j = i;
-        while j + 1 < b.len() && b[j] == b'.' && is_ident(b[j + 1]) {
-            let s = j + 1;
-            j = s;
-            while j < b.len() && is_ident(b[j]) {
-                j += 1;
-            }
-            parts.push((&text[s..j], j));
-        }
-        let names: Vec<&str> = parts.iter().map(|p| p.0).collect();
-        let (replacement, used) = resolve(prefix, &names, scope).map_err(|m| (start, m))?;
-        out.push_str(&text[last..start]);
-        out.push_str(&replacement);
-        last = if used == 0 { i } else { parts[used - 1].1 };
-        i = last;
+    for (from, to, with) in edits {
+        out.push_str(&text[last..from]);
+        out.push_str(&with);
+        last = to;
     }
     out.push_str(&text[last..]);
     Ok(out)
+}
+
+/// The replacements for every pseudo-variable chain in `e`: `(start, end, text)`.
+fn collect(
+    e: &Expr,
+    scope: &Scope,
+    edits: &mut Vec<(usize, usize, String)>,
+) -> Result<(), (usize, String)> {
+    // `root.a.b`: the member nodes from the outermost in, and the root.
+    let mut members: Vec<(&str, &Expr)> = Vec::new();
+    let mut root = e;
+    while let ExprKind::Member(object, name, _) = &root.kind {
+        members.push((name.as_str(), root));
+        root = object;
+    }
+    if let ExprKind::Ident(id) = &root.kind {
+        if let Some(&prefix) = PREFIXES.iter().find(|p| **p == id.as_str()) {
+            members.reverse();
+            let names: Vec<&str> = members.iter().map(|m| m.0).collect();
+            let (with, used) =
+                resolve(prefix, &names, scope).map_err(|m| (root.start as usize, m))?;
+            // The node of the last name used: its range covers the chain from the root and
+            // any parentheses around it, so what is replaced is balanced.
+            let node = if used == 0 { root } else { members[used - 1].1 };
+            edits.push((node.start as usize, node.end as usize, with));
+            return Ok(());
+        }
+    }
+    match &e.kind {
+        ExprKind::Int(_)
+        | ExprKind::Float(_)
+        | ExprKind::Bool(_)
+        | ExprKind::Str(_)
+        | ExprKind::Ident(_) => Ok(()),
+        ExprKind::Array(items) => items.iter().try_for_each(|x| collect(x, scope, edits)),
+        ExprKind::Object(fields) => fields
+            .iter()
+            .try_for_each(|f| collect(&f.value, scope, edits)),
+        ExprKind::Member(object, _, _) => collect(object, scope, edits),
+        ExprKind::Unary(_, x) => collect(x, scope, edits),
+        ExprKind::Index(a, b) | ExprKind::Binary(_, a, b) => {
+            collect(a, scope, edits)?;
+            collect(b, scope, edits)
+        }
+        ExprKind::Call(f, args) => {
+            collect(f, scope, edits)?;
+            args.iter().try_for_each(|x| collect(x, scope, edits))
+        }
+        ExprKind::Cond(c, a, b) => {
+            collect(c, scope, edits)?;
+            collect(a, scope, edits)?;
+            collect(b, scope, edits)
+        }
+    }
 }
 
 /// The replacement for `prefix.names...` and how many names it consumed.
@@ -198,6 +221,18 @@ mod tests {
             "_event.data.ros_fields__data.length > 0 && _event.data.ros_fields__pose__x < '_msg.no'"
         );
         assert_eq!(rewrite("a._msg + x_msg", &scope).unwrap(), "a._msg + x_msg");
+        // Parentheses, indices and calls: the syntax tree says where a chain ends.
+        assert_eq!(
+            rewrite(
+                "(_msg.pose.x) == f(( _msg.pose).y, _msg.data[_msg.pose.x])",
+                &scope
+            )
+            .unwrap(),
+            "_event.data.ros_fields__pose__x == f(_event.data.ros_fields__pose__y, \
+             _event.data.ros_fields__data[_event.data.ros_fields__pose__x])"
+        );
+        // Text that does not parse is left to the reader of the plain machine.
+        assert_eq!(rewrite("_msg.pose.x +", &scope).unwrap(), "_msg.pose.x +");
         let (at, m) = rewrite("1 + _msg.nope", &scope).unwrap_err();
         assert_eq!(at, 4);
         assert!(m.contains("not a field") && m.contains("pose.x"), "{m}");

@@ -1,6 +1,10 @@
 //! The machines the translation adds: service handlers, action handlers and the global timer.
+//!
+//! Each follows the function of AS2FM's converter that generates it (cited beside the code);
+//! like AS2FM's, their sends carry no target until `super::route` gives every send of an
+//! event to the machines with a transition on it (`NONE` when there is none).
 
-use super::{gcd, Cx};
+use super::{gcd, Cx, AUTO_TARGET};
 use crate::model::source::Span;
 use crate::model::xml::Element;
 use crate::robot::types::FlatField;
@@ -62,15 +66,22 @@ fn forward(s: &mut Element, span: Span, fields: &[FlatField]) {
 }
 
 /// A datamodel with one variable per distinct field, then `extra`.
+///
+/// AS2FM joins the groups with Python's dict union (`req_params | res_params` in
+/// `RosServiceHandler.to_scxml`, `goal | feedback | result` in `RosActionHandler.to_scxml`):
+/// a field in two groups keeps the place of its first and the type of its last.
 fn datamodel(span: Span, groups: &[&[FlatField]], extra: &[(&str, &str, &str)]) -> Element {
     let mut dm = Element::new("datamodel", span);
-    let mut seen: Vec<String> = Vec::new();
+    let mut vars: Vec<(String, &FlatField)> = Vec::new();
     for f in groups.iter().flat_map(|g| g.iter()) {
         let p = f.param_name();
-        if !seen.contains(&p) {
-            dm.push(data(span, &p, &f.scxml_type, &f.default));
-            seen.push(p);
+        match vars.iter_mut().find(|(n, _)| *n == p) {
+            Some(v) => v.1 = f,
+            None => vars.push((p, f)),
         }
+    }
+    for (p, f) in &vars {
+        dm.push(data(span, p, &f.scxml_type, &f.default));
     }
     for (id, ty, expr) in extra {
         dm.push(data(span, id, ty, expr));
@@ -102,12 +113,19 @@ fn per_client(
 
 impl Cx<'_> {
     /// `srv_handler_<s>` for every service with a server: one request at a time.
+    ///
+    /// As `RosServiceHandler.to_scxml` (jani_generator/ros_helpers/ros_service_handler.py):
+    /// a datamodel of the request's then the response's fields; state `waiting` with one
+    /// transition per client, in the order the clients were collected, to
+    /// `processing_client_<c>` (copy the request, forward it to the server); then one
+    /// `processing_client_<c>` state per client whose only transition takes the server's
+    /// response back to `waiting` and passes it on to that client.
     pub(super) fn service_handlers(&mut self) -> Vec<Element> {
         let mut out = Vec::new();
         for s in &self.services {
-            let Some(server) = &s.server else {
+            if s.server.is_none() {
                 continue;
-            };
+            }
             let span = s.server_span;
             let key = &s.key;
             let (req, res) = (&s.fields.request, &s.fields.response);
@@ -125,7 +143,7 @@ impl Cx<'_> {
                     &format!("processing_client_{c}"),
                 );
                 take_fields(&mut t, span, req);
-                let mut fwd = send(span, &format!("srv_{key}_request"), server);
+                let mut fwd = send(span, &format!("srv_{key}_request"), AUTO_TARGET);
                 forward(&mut fwd, span, req);
                 t.push(fwd);
                 waiting.push(t);
@@ -133,7 +151,7 @@ impl Cx<'_> {
                     Element::new("state", span).with_attr("id", format!("processing_client_{c}"));
                 let mut t = transition(span, &format!("srv_{key}_response"), "waiting");
                 take_fields(&mut t, span, res);
-                let mut back = send(span, &format!("srv_{key}_response_client_{c}"), c);
+                let mut back = send(span, &format!("srv_{key}_response_client_{c}"), AUTO_TARGET);
                 forward(&mut back, span, res);
                 t.push(back);
                 st.push(t);
@@ -149,12 +167,20 @@ impl Cx<'_> {
     }
 
     /// `action_handler_<a>` for every action with a server; goal ids are client indices.
+    ///
+    /// As `RosActionHandler.to_scxml` (jani_generator/ros_helpers/ros_action_handler.py):
+    /// goal id `i` is the `i`-th client collected; a datamodel of the goal's, feedback's and
+    /// result's fields, then `goal_id` and `code`; state `waiting` with one goal-request
+    /// transition per client, then feedback, then result; state `goal_requested` with
+    /// accepted, then rejected. Each answer copies `code` (results) and `goal_id`, then
+    /// the fields (`_generate_srv_event_transition`), and one `if`/`elseif` on the goal id
+    /// picks the client.
     pub(super) fn action_handlers(&mut self) -> Vec<Element> {
         let mut out = Vec::new();
         for a in &self.actions {
-            let Some(server) = &a.server else {
+            if a.server.is_none() {
                 continue;
-            };
+            }
             let span = a.server_span;
             let key = &a.key;
             let f = &a.fields;
@@ -170,7 +196,7 @@ impl Cx<'_> {
             for (i, c) in a.clients.iter().enumerate() {
                 let mut t = transition(span, &cl("goal_req", c), "goal_requested");
                 take_fields(&mut t, span, &f.goal);
-                let mut s = send(span, &ev("goal_handle"), server);
+                let mut s = send(span, &ev("goal_handle"), AUTO_TARGET);
                 s.push(param(span, "goal_id", &i.to_string()));
                 forward(&mut s, span, &f.goal);
                 t.push(s);
@@ -180,7 +206,7 @@ impl Cx<'_> {
             t.push(assign(span, "goal_id", "_event.data.goal_id"));
             take_fields(&mut t, span, &f.feedback);
             if let Some(iff) = per_client(span, &a.clients, |c| {
-                let mut s = send(span, &cl("feedback_handle", c), c);
+                let mut s = send(span, &cl("feedback_handle", c), AUTO_TARGET);
                 forward(&mut s, span, &f.feedback);
                 vec![s]
             }) {
@@ -192,7 +218,7 @@ impl Cx<'_> {
             t.push(assign(span, "goal_id", "_event.data.goal_id"));
             take_fields(&mut t, span, &f.result);
             if let Some(iff) = per_client(span, &a.clients, |c| {
-                let mut s = send(span, &cl("result_handle", c), c);
+                let mut s = send(span, &cl("result_handle", c), AUTO_TARGET);
                 s.push(param(span, "code", "code"));
                 forward(&mut s, span, &f.result);
                 vec![s]
@@ -208,8 +234,9 @@ impl Cx<'_> {
             ] {
                 let mut t = transition(span, &ev(what), "waiting");
                 t.push(assign(span, "goal_id", "_event.data.goal_id"));
-                if let Some(iff) = per_client(span, &a.clients, |c| vec![send(span, &cl(to, c), c)])
-                {
+                if let Some(iff) = per_client(span, &a.clients, |c| {
+                    vec![send(span, &cl(to, c), AUTO_TARGET)]
+                }) {
                     t.push(iff);
                 }
                 requested.push(t);
@@ -221,6 +248,17 @@ impl Cx<'_> {
     }
 
     /// The global timer (when any timer exists) and the nanoseconds in one time unit.
+    ///
+    /// As `make_global_timer_scxml` (jani_generator/ros_helpers/ros_timer.py): state `idle`
+    /// sends itself `global_timer_tick_event` one time unit later on entry; its first
+    /// transition (while `current_time < max_time`) adds the step, publishes `clock`, then
+    /// has one `if` per timer, in the order the timers were collected, each sending the
+    /// timer's `ros_time_rate.<name>`; its second goes to `timeout`. The timers are
+    /// collected in declaration order over the machines in the order
+    /// `generate_plain_scxml_models_and_timers` (jani_generator/scxml_helpers/
+    /// top_level_interpreter.py) converts them: the node models in main-file order, then
+    /// the behavior tree's root and plugins. So the tree's tick comes after every node
+    /// model's timer of the same instant.
     pub(super) fn global_timer(&mut self, max_time_ns: u64) -> (Option<Element>, u64) {
         let periods: Vec<u64> = self.timers.iter().map(|t| t.period_ns).collect();
         // The coarsest of s, ms, us, ns in which every period and max_time are whole.
@@ -253,12 +291,6 @@ impl Cx<'_> {
             "current_time",
             &format!("current_time + {step}"),
         ));
-        let clock_targets: Vec<String> = self
-            .topics
-            .iter()
-            .find(|t| t.key == "clock")
-            .map(|t| t.subscribers.clone())
-            .unwrap_or_default();
         let per_sec = 1_000_000_000 / unit;
         let (sec, nanosec) = if per_sec == 1 {
             ("current_time".to_string(), "0".to_string())
@@ -268,29 +300,24 @@ impl Cx<'_> {
                 format!("current_time % {per_sec} * {unit}"),
             )
         };
-        let targets = if clock_targets.is_empty() {
-            vec!["NONE".to_string()]
-        } else {
-            clock_targets
-        };
-        for t in &targets {
-            tick.push(
-                send(span, "topic_clock_msg", t)
-                    .with_child(param(span, "ros_fields__sec", &sec))
-                    .with_child(param(span, "ros_fields__nanosec", &nanosec)),
-            );
-        }
+        tick.push(
+            send(span, "topic_clock_msg", AUTO_TARGET)
+                .with_child(param(span, "ros_fields__sec", &sec))
+                .with_child(param(span, "ros_fields__nanosec", &nanosec)),
+        );
         for t in &self.timers {
-            for target in &t.targets {
-                tick.push(
-                    Element::new("if", t.span)
-                        .with_attr(
-                            "cond",
-                            format!("current_time % {} == 0", t.period_ns / unit),
-                        )
-                        .with_child(send(t.span, &format!("ros_time_rate.{}", t.name), target)),
-                );
-            }
+            tick.push(
+                Element::new("if", t.span)
+                    .with_attr(
+                        "cond",
+                        format!("current_time % {} == 0", t.period_ns / unit),
+                    )
+                    .with_child(send(
+                        t.span,
+                        &format!("ros_time_rate.{}", t.name),
+                        AUTO_TARGET,
+                    )),
+            );
         }
         idle.push(tick);
         idle.push(transition(span, "global_timer_tick_event", "timeout"));

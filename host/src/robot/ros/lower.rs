@@ -107,6 +107,10 @@ impl Cx<'_> {
                 other => root.children.push(other.clone()),
             }
         }
+        // AS2FM writes a datamodel only when it has entries (`ScxmlRoot.as_xml`,
+        // scxml_converter/scxml_entries/scxml_root.py).
+        root.children
+            .retain(|n| !matches!(n, Node::Element(e) if e.name == "datamodel" && e.elements().next().is_none()));
         if self.rand_used {
             let data = Element::new("data", src.span)
                 .with_attr("id", "__RAND__")
@@ -135,7 +139,8 @@ impl Cx<'_> {
             }
         }
         self.probabilistic(&mut s);
-        // As AS2FM writes states: `onentry`, `onexit`, then the transitions.
+        // As AS2FM writes states (`ScxmlState.as_xml`, scxml_converter/scxml_entries/
+        // scxml_state.py): `onentry`, `onexit`, then the transitions.
         s.children.sort_by_key(|n| match n {
             Node::Element(e) if e.name == "onentry" => 0,
             Node::Element(e) if e.name == "onexit" => 1,
@@ -145,6 +150,12 @@ impl Cx<'_> {
     }
 
     /// Expands transitions whose children are `<target id prob>` (see the module docs).
+    ///
+    /// As `export_plain_scxml_models` (jani_generator/scxml_helpers/top_level_interpreter.py)
+    /// does: one transition per target, in order, guarded by the transition's condition and
+    /// `lo < __RAND__ && __RAND__ <= hi`; `__RAND__` is added at the end of the datamodel and
+    /// drawn at the end of the state's `onentry`. (A target without `prob` gets no interval
+    /// there; here it shares what the others leave, so that the shares add up to one.)
     fn probabilistic(&mut self, s: &mut Element) {
         let mut uses_rand = false;
         let mut out = Vec::new();
@@ -464,20 +475,11 @@ impl Cx<'_> {
                 };
                 let what = format!("topic `{key}` ({ty})");
                 let params = self.params(el, fields, &what, scope);
+                // A targetless send, as `RosTopicPublish.as_plain_scxml`
+                // (scxml_converter/ascxml_extensions/ros_entries/scxml_ros_topic.py) makes:
+                // `super::route` gives it to every subscriber with a callback.
                 let event = format!("topic_{key}_msg");
-                let subscribers = self
-                    .topics
-                    .iter()
-                    .find(|t| t.key == key)
-                    .map(|t| t.subscribers.clone())
-                    .unwrap_or_default();
-                if subscribers.is_empty() {
-                    return one(self.send(el.span, &event, "NONE", params));
-                }
-                subscribers
-                    .iter()
-                    .map(|s| Node::Element(self.send(el.span, &event, s, params.clone())))
-                    .collect()
+                one(self.send(el.span, &event, super::AUTO_TARGET, params))
             }
             "ros_topic_callback" => {
                 let Some(a) = d.subscribers.iter().find(|a| a.alias == alias) else {
@@ -767,6 +769,10 @@ impl Cx<'_> {
                         format!("action `{key}` has no <ros_action_thread> to start"),
                     );
                 }
+                // AS2FM sends `thread_start` without a target and gives it to every thread
+                // from a `set` (see `super::route`), so no order is its rule; the threads
+                // from last to first is the order of the corpus translations, whose runs
+                // `robot_ros.rs` compares with ours seed by seed.
                 a.threads
                     .iter()
                     .rev()

@@ -106,11 +106,11 @@ pub fn lower(sm: &SourceMap, input: RosInput) -> Result<RosOutput, Vec<Diagnosti
         let m = cx.lower_unit(&input.machines, u);
         out.push(m);
     }
-    route(&mut out);
     out.extend(cx.service_handlers());
     out.extend(cx.action_handlers());
     let (timer, time_unit_ns) = cx.global_timer(input.max_time_ns);
     out.extend(timer);
+    route(&mut out);
     // The order a folder of AS2FM's files (`<name>.scxml`) is read in, so that a seed gives
     // the same run on the lowered model and on AS2FM's translation.
     out.sort_by(|a, b| a.attr_value("name").cmp(&b.attr_value("name")));
@@ -129,6 +129,17 @@ const AUTO_TARGET: &str = "\u{0}auto";
 
 /// Sends written without a target go, as in AS2FM's translation, to every machine with a
 /// transition on that event (one `<send>` each, in machine order), or to `NONE`.
+///
+/// AS2FM's rule: `export_plain_scxml_models` (jani_generator/scxml_helpers/
+/// top_level_interpreter.py) maps each event to the machines with a transition on it, and
+/// `ScxmlSend.add_events_targets` (scxml_converter/scxml_entries/scxml_send.py) replaces
+/// every send of the event by one copy per machine, or one to `NONE`. This covers topics
+/// (a publish is such a send, so its subscribers are the machines with a callback), the
+/// handlers' answers to clients and the global timer's sends. AS2FM keeps those machines
+/// in a Python `set`, whose order changes from one run of the converter to the next
+/// (string hashing is randomised); ours is the order the machines were lowered in (the
+/// node models in main-file order, their action threads, then the tree's, then the
+/// generated handlers and timer), fixed so that a seed always gives the same run.
 fn route(machines: &mut [Element]) {
     let mut handlers: Vec<(String, String)> = Vec::new();
     for m in machines.iter() {
@@ -254,7 +265,6 @@ struct Topic {
     key: String,
     /// Every declaration: (type, type span, publisher?).
     decls: Vec<(String, Span, bool)>,
-    subscribers: Vec<String>,
 }
 
 #[derive(Clone, Debug)]
@@ -283,7 +293,6 @@ struct Timer {
     name: String,
     period_ns: u64,
     span: Span,
-    targets: Vec<String>,
 }
 
 struct Cx<'a> {
@@ -378,16 +387,31 @@ impl Cx<'_> {
                         let Some((rate, rspan)) = self.attr_or_err(el, "rate_hz") else {
                             continue;
                         };
+                        let tname = tname.trim().to_string();
+                        // One timer per name in the whole model, as AS2FM asserts ("Duplicate
+                        // timer name!" in `generate_plain_scxml_models_and_timers`): its
+                        // event `ros_time_rate.<name>` is global.
+                        if let Some(i) = self.timers.iter().position(|t| t.name == tname) {
+                            // Its callbacks are still known, so they give no second error.
+                            d.timers.push((tname.clone(), i));
+                            let at = self.sm.diag(self.timers[i].span, "");
+                            let msg = format!(
+                                "timer `{tname}` is already declared at {}:{}:{} (timer names are global)",
+                                at.path.display(),
+                                at.line,
+                                at.column
+                            );
+                            self.err(el.span, msg);
+                            continue;
+                        }
                         match rate.trim().parse::<f64>() {
                             Ok(r) if r > 0.0 && r.is_finite() && (1e9 / r).round() >= 1.0 => {
                                 self.timers.push(Timer {
-                                    name: tname.trim().to_string(),
+                                    name: tname.clone(),
                                     period_ns: (1e9 / r).round() as u64,
                                     span: rspan,
-                                    targets: Vec::new(),
                                 });
-                                d.timers
-                                    .push((tname.trim().to_string(), self.timers.len() - 1));
+                                d.timers.push((tname, self.timers.len() - 1));
                             }
                             _ => self.err(
                                 rspan,
@@ -535,7 +559,6 @@ impl Cx<'_> {
             None => self.topics.push(Topic {
                 key: key.to_string(),
                 decls: vec![(ty.to_string(), ty_span, publisher)],
-                subscribers: Vec::new(),
             }),
         }
         Some(fields)
@@ -661,7 +684,11 @@ impl Cx<'_> {
         }
     }
 
-    /// Pass 1b: who subscribes, who calls, which machine handles which timer.
+    /// Pass 1b: which machines call a service or send an action goal (the clients the
+    /// handlers serve, numbered in machine order as AS2FM's
+    /// `update_ros_communication_handlers_clients` adds them; AS2FM counts a machine that
+    /// declares a client, we one that sends a request or goal, which is the same in every
+    /// corpus model).
     fn collect_uses(&mut self, machines: &[Element]) {
         for ui in 0..self.units.len() {
             let u = self.units[ui].clone();
@@ -677,20 +704,6 @@ impl Cx<'_> {
                 };
                 let d = &self.machines[u.machine].1;
                 match el.name.as_str() {
-                    "ros_topic_callback" => {
-                        if let Some(k) = find(&d.subscribers, alias) {
-                            let k = k.to_string();
-                            if let Some(t) = self.topics.iter_mut().find(|t| t.key == k) {
-                                push_unique(&mut t.subscribers, &u.name);
-                            }
-                        }
-                    }
-                    "ros_rate_callback" => {
-                        if let Some((_, ti)) = d.timers.iter().find(|t| t.0 == alias.trim()) {
-                            let ti = *ti;
-                            push_unique(&mut self.timers[ti].targets, &u.name);
-                        }
-                    }
                     "ros_service_send_request" => {
                         if let Some(k) = find(&d.srv_clients, alias) {
                             let k = k.to_string();
@@ -714,17 +727,11 @@ impl Cx<'_> {
         // The stack walk visits children in reverse; clients are numbered in machine order.
         let order: Vec<String> = self.units.iter().map(|u| u.name.clone()).collect();
         let rank = |n: &String| order.iter().position(|o| o == n).unwrap_or(usize::MAX);
-        for t in &mut self.topics {
-            t.subscribers.sort_by_key(&rank);
-        }
         for s in &mut self.services {
             s.clients.sort_by_key(&rank);
         }
         for a in &mut self.actions {
             a.clients.sort_by_key(&rank);
-        }
-        for t in &mut self.timers {
-            t.targets.sort_by_key(&rank);
         }
     }
 }
