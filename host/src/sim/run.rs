@@ -511,11 +511,6 @@ impl<'m> Simulator<'m> {
         }
     }
 
-    /// The model being run.
-    pub fn model(&self) -> &'m CompiledModel {
-        self.model
-    }
-
     /// Current model time.
     pub fn time(&self) -> u64 {
         self.time
