@@ -29,11 +29,12 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use hindsight::cli::verify::{load, Events, Loaded, ModelArgs, Runner};
 use hindsight::robot::bt::Halts;
 use hindsight::sim::{EventSemantics, RunConfig, Simulator};
 use hindsight::smc::runner::stream;
+use hindsight::verify::load::{load, LoadOptions, Loaded};
 use hindsight::verify::observe::PropertySet;
+use hindsight::verify::study::Runner;
 
 fn examples() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -53,16 +54,14 @@ impl Case {
     fn new(
         name: &'static str,
         dir: impl AsRef<Path>,
-        events: Option<Events>,
+        events: Option<EventSemantics>,
         max_time: Option<u64>,
     ) -> Case {
         let dir = dir.as_ref();
-        let args = ModelArgs {
+        let args = LoadOptions {
             model: examples().join(dir),
-            props: None,
-            time_unit: None,
             events,
-            ..ModelArgs::default()
+            ..LoadOptions::default()
         };
         let loaded = match load(&args) {
             Ok(l) => l,
@@ -91,12 +90,11 @@ impl Case {
             interfaces: Vec::new(),
         })
         .unwrap_or_else(|e| panic!("convert: {e:?}"));
-        let args = ModelArgs {
+        let args = LoadOptions {
             model: out.clone(),
-            props: None,
-            time_unit: Some("100ms".into()),
-            events: Some(Events::As2fm),
-            ..ModelArgs::default()
+            time_unit_ns: Some(100_000_000),
+            events: Some(EventSemantics::As2fm),
+            ..LoadOptions::default()
         };
         let loaded = load(&args).unwrap_or_else(|e| panic!("converted guide: {e:?}"));
         let _ = std::fs::remove_dir_all(&out);
@@ -206,7 +204,7 @@ fn main() {
         Case::new(
             "guide (robot model, queues)",
             "museum-guide",
-            Some(Events::Queues),
+            Some(EventSemantics::Queues),
             None,
         ),
         Case::new(
@@ -218,7 +216,7 @@ fn main() {
         Case::new(
             "plain (museum-scxml, as2fm)",
             "museum-scxml",
-            Some(Events::As2fm),
+            Some(EventSemantics::As2fm),
             Some(1001),
         ),
         Case::guide_with("guide (halts needed, as2fm)", Halts::WhenNeeded),

@@ -1,4 +1,8 @@
 //! A monitored publisher process that crashes (SIGKILL) and restarts: the sidecar reconnects and reports the gap.
+//!
+//! A `harness = false` target (`host/Cargo.toml`): the same binary is the test and,
+//! with `HINDSIGHT_LIVE_CHILD_SERVICE` set, the publisher process the test starts
+//! and kills, so the publisher is not registered as a test of its own.
 
 mod live_common;
 
@@ -11,15 +15,20 @@ use live_common::*;
 const CHILD_ENV: &str = "HINDSIGHT_LIVE_CHILD_SERVICE";
 const SENT: &str = "HINDSIGHT-CHILD-SENT";
 
-/// Not a check of its own: the publisher process that the restart test starts and kills.
-/// It does nothing unless the test sets `HINDSIGHT_LIVE_CHILD_SERVICE`.
-#[test]
-fn child_publisher_process() {
-    let Ok(svc) = std::env::var(CHILD_ENV) else {
-        return;
-    };
+fn main() {
+    match std::env::var(CHILD_ENV) {
+        Ok(svc) => child_publisher_process(&svc),
+        Err(_) => {
+            a_crashed_publisher_is_picked_up_again_and_the_gap_is_reported();
+            println!("test a_crashed_publisher_is_picked_up_again_and_the_gap_is_reported ... ok");
+        }
+    }
+}
+
+/// The publisher process that the restart test starts and kills: never returns.
+fn child_publisher_process(svc: &str) -> ! {
     let node = node();
-    let p = publisher(&node, &svc);
+    let p = publisher(&node, svc);
     // Every process counts from 0: a new publisher's sequence is its own.
     for i in 0..5u64 {
         send(&p, &battery(70, i));
@@ -32,12 +41,6 @@ fn child_publisher_process() {
 
 fn spawn_publisher(svc: &str) -> Child {
     let mut child = Command::new(std::env::current_exe().unwrap())
-        .args([
-            "child_publisher_process",
-            "--exact",
-            "--nocapture",
-            "--test-threads=1",
-        ])
         .env(CHILD_ENV, svc)
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
@@ -54,7 +57,6 @@ fn spawn_publisher(svc: &str) -> Child {
     panic!("the publisher process ended before sending");
 }
 
-#[test]
 fn a_crashed_publisher_is_picked_up_again_and_the_gap_is_reported() {
     let svc = unique("battery");
     let run = Running::start(&battery_topic(&svc), "restart");

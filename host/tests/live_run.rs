@@ -149,14 +149,11 @@ fn layout_is_a_monitor_config() {
     assert_eq!(alarm_request["event"].as_str(), Some("alarm"));
     // Named after the property file's ports, the whole output is a config for the
     // monitors `verify` compiles from the model's own properties.
-    let args = hindsight::cli::verify::ModelArgs {
+    let args = hindsight::verify::load::LoadOptions {
         model: museum(),
-        props: None,
-        time_unit: None,
-        events: None,
-        ..hindsight::cli::verify::ModelArgs::default()
+        ..Default::default()
     };
-    let loaded = hindsight::cli::verify::load(&args).unwrap_or_else(|e| panic!("{e:?}"));
+    let loaded = hindsight::verify::load::load(&args).unwrap_or_else(|e| panic!("{e}"));
     let spec = loaded.set.compiled();
     let config = Config::parse(&text, "museum.toml", spec).unwrap();
     assert_eq!(config.topics.len(), topics.len());
@@ -206,7 +203,7 @@ fn bool_int_and_float_fields_are_packed_and_strings_left_out() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--speed 0: must be a positive number"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--speed: speed 0: must be a number"));
 
     let node = node();
     let prefix = unique("run-demo");

@@ -4,11 +4,11 @@
 
 use std::path::{Path, PathBuf};
 
-use hindsight::cli::verify::Runner;
 use hindsight::props::{parse_file, PortKind, ANY};
 use hindsight::sim::{CompiledModel, RunConfig};
 use hindsight::smc::runner::stream;
 use hindsight::verify::observe::PropertySet;
+use hindsight::verify::study::Runner;
 
 fn repo(relative: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -12,8 +12,8 @@ mod common;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
-use hindsight::cli::verify::{load, ModelArgs};
 use hindsight::sim::{EventSemantics, RunConfig, Simulator};
+use hindsight::verify::load::{load, LoadOptions};
 use rand_core::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
@@ -192,12 +192,9 @@ fn fuzz(name: &str, base: &Path, parts: &[&str], main: &str, favourites: &[&str]
     }
     // The model, its tree, interfaces and properties, as `hindsight verify` reads them;
     // the unmutated copy loads, so the mutants start from a working model.
-    let args = ModelArgs {
+    let args = LoadOptions {
         model: dir.join(main),
-        props: None,
-        time_unit: None,
-        events: None,
-        ..ModelArgs::default()
+        ..LoadOptions::default()
     };
     if let Err(e) = load(&args) {
         panic!("{name}: {e}");

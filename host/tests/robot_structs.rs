@@ -566,10 +566,10 @@ fn converted_struct_models_read_back_and_run_the_same() {
 /// flattens them (`point__y`); a field the struct does not have is an error.
 #[test]
 fn property_ports_read_struct_fields() {
-    use hindsight::cli::verify::Runner;
     use hindsight::props::parse_str;
     use hindsight::smc::runner::stream;
     use hindsight::verify::observe::PropertySet;
+    use hindsight::verify::study::Runner;
     let m = load_case("data_structs_main_xml_def");
     let props = |px: &str| {
         format!(

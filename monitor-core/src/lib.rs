@@ -31,6 +31,7 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod analysis;
 pub mod error;
 mod expr;
 pub mod layout;

@@ -1,7 +1,7 @@
 //! `hindsight run`: one seeded simulation of a model, paced in wall-clock time, its ROS topics published over iceoryx2.
 
-use std::io::{IsTerminal, Write};
-use std::time::{Duration, Instant};
+use std::io::IsTerminal;
+use std::time::Instant;
 
 use iceoryx2::prelude::*;
 
@@ -12,13 +12,13 @@ use super::CliError;
 use crate::live::inject::{
     Answer, GoalBridge, GoalRoute, ServiceBridge, ServiceServers, TopicSubscriber,
 };
+use crate::live::pace::Paced;
 use crate::live::publish::{
     layout_of, layout_toml, layouts, name_from_ports, TopicLayout, TopicPublisher, WireKind,
 };
+use crate::live::{check_speed, Clock};
 use crate::props::ros::{action_event, service_client_event, service_event, topic_event};
-use crate::sim::{
-    EndReason, EventSemantics, Flow, Inbox, Observer, Quiescence, RunConfig, SentMessage, Simulator,
-};
+use crate::sim::{EndReason, EventSemantics, Quiescence, RunConfig, Simulator};
 
 /// Arguments of `hindsight run`.
 #[derive(Debug, clap::Args)]
@@ -106,92 +106,6 @@ Progress goes to stderr; SIGINT/SIGTERM end the run cleanly (exit 0).
 Plain SCXML models need --time-unit (e.g. 100ms) to be paced.
 
 Exit codes: 0 the run ended (or was stopped); 2 bad model or argument; 1 iceoryx2 failure.";
-
-/// Paces the run in wall-clock time and publishes topic messages.
-struct Live<'n> {
-    node: &'n Node<Ipc>,
-    publisher: TopicPublisher,
-    inbound: TopicSubscriber,
-    services: ServiceBridge,
-    servers: ServiceServers,
-    goals: GoalBridge,
-    inbound_error: Option<String>,
-    start: Instant,
-    /// Wall-clock nanoseconds per model time unit.
-    ns_per_unit: f64,
-    unit_ns: u64,
-    stopped: bool,
-    last_progress: Instant,
-    tty: bool,
-}
-
-impl Live<'_> {
-    fn progress(&mut self, time: u64, force: bool) {
-        if !force && self.last_progress.elapsed() < Duration::from_millis(500) {
-            return;
-        }
-        self.last_progress = Instant::now();
-        let secs = time as f64 * self.unit_ns as f64 / 1e9;
-        let received: u64 = self.inbound.stats().map(|s| s.received).sum();
-        let mut line = format!(
-            "run: model time {secs:.1} s ({time} steps), {} samples published",
-            self.publisher.published()
-        );
-        if self.inbound.stats().next().is_some() {
-            line.push_str(&format!(", {received} received"));
-        }
-        let mut err = std::io::stderr().lock();
-        let _ = if self.tty {
-            write!(err, "\r{line}")
-        } else {
-            writeln!(err, "{line}")
-        };
-        let _ = err.flush();
-    }
-}
-
-impl Observer for Live<'_> {
-    fn on_send(&mut self, time: u64, msg: &SentMessage<'_>) -> Flow {
-        self.publisher.publish(msg);
-        if let Err(e) = self
-            .services
-            .forward(msg)
-            .and_then(|()| self.servers.answer(msg))
-            .and_then(|()| self.goals.forward(msg))
-        {
-            self.inbound_error.get_or_insert(e);
-        }
-        let _ = time;
-        Flow::Continue
-    }
-
-    fn on_time(&mut self, time: u64) -> Flow {
-        let due = self.start + Duration::from_nanos((time as f64 * self.ns_per_unit) as u64);
-        loop {
-            let now = Instant::now();
-            if now >= due {
-                break;
-            }
-            // `wait` also returns on SIGINT/SIGTERM (the node handles them).
-            let step = (due - now).min(Duration::from_millis(200));
-            if self.node.wait(step).is_err() {
-                self.stopped = true;
-                return Flow::Stop;
-            }
-        }
-        self.progress(time, false);
-        Flow::Continue
-    }
-
-    fn inputs(&mut self, _time: u64, inbox: &mut Inbox) {
-        if let Err(e) = self.inbound.poll(inbox) {
-            self.inbound_error.get_or_insert(e);
-        }
-        self.services.poll(inbox);
-        self.servers.poll(inbox);
-        self.goals.poll(inbox);
-    }
-}
 
 /// The layouts of the topics the external components publish, taken out of `topics` (the
 /// run does not publish them: their processes do).
@@ -384,12 +298,7 @@ fn goal_routes(
 /// Runs `hindsight run`.
 pub fn run(args: &RunArgs) -> Result<(), CliError> {
     iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
-    if !(args.speed.is_finite() && args.speed > 0.0) {
-        return Err(CliError::Input(format!(
-            "--speed {}: must be a positive number",
-            args.speed
-        )));
-    }
+    check_speed(args.speed).map_err(|m| CliError::Input(format!("--speed: {m}")))?;
     let (loaded, external) = load_without(&args.input, &args.external)?;
     let model = &loaded.model;
     let (mut topics, warnings) = layouts(model);
@@ -452,7 +361,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         quiescence: Quiescence::AdvanceTime,
         ..RunConfig::default()
     };
-    let mut live = Live {
+    let mut live = Paced {
         node: &node,
         publisher,
         inbound,
@@ -460,8 +369,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         servers,
         goals,
         inbound_error: None,
-        start: Instant::now(),
-        ns_per_unit: unit_ns as f64 / args.speed,
+        clock: Clock::with_speed(unit_ns, args.speed),
         unit_ns,
         stopped: false,
         last_progress: Instant::now(),

@@ -1,20 +1,19 @@
 //! `hindsight verify`: estimate each guarantee's probability on a plain SCXML model.
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::time::Duration;
 
-use rand_xoshiro::Xoshiro256PlusPlus;
 use serde::Serialize;
 
 use super::CliError;
-use crate::props;
 use crate::robot::load::ExternalComponent;
-use crate::sim::{CompiledModel, EndReason, EventSemantics, RunConfig, Simulator};
+use crate::sim::{CompiledModel, EventSemantics, RunConfig, Simulator};
 use crate::smc::progress::TerminalProgress;
 use crate::smc::stats::{RuleConfig, RuleKind};
-use crate::smc::{run_study, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
+use crate::smc::{StudyConfig, StudyResult};
+use crate::verify::load::{LoadOptions, Loaded};
 use crate::verify::observe::{Judge, PropertySet};
+use crate::verify::study::Runner;
 
 /// The stopping rule, as named on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -46,21 +45,6 @@ impl From<Events> for EventSemantics {
             Events::As2fm => EventSemantics::As2fm,
         }
     }
-}
-
-/// The event semantics for a property file when none is asked for: AS2FM's for a JANI
-/// property file (the model is then AS2FM's plain SCXML), SCAN's queues otherwise.
-pub fn default_events(props_path: &Path) -> EventSemantics {
-    if is_jani(props_path) {
-        EventSemantics::As2fm
-    } else {
-        EventSemantics::Queues
-    }
-}
-
-fn is_jani(path: &Path) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("jani"))
 }
 
 /// Arguments of `hindsight verify`.
@@ -199,38 +183,6 @@ pub struct Report {
     pub properties: Vec<PropertyReport>,
 }
 
-/// Finds the property file for a model when none is given.
-fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, CliError> {
-    if let Some(p) = compiled.properties_path() {
-        return Ok(p.to_path_buf());
-    }
-    let dir = if model.is_dir() {
-        model.to_path_buf()
-    } else {
-        model.parent().map(Path::to_path_buf).unwrap_or_default()
-    };
-    let p = dir.join("properties.xml");
-    if p.is_file() {
-        return Ok(p);
-    }
-    // A folder with exactly one JANI file (AS2FM's models keep their properties there).
-    let mut jani: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .map(|rd| {
-            rd.filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.is_file() && is_jani(p))
-                .collect()
-        })
-        .unwrap_or_default();
-    if jani.len() == 1 {
-        return Ok(jani.remove(0));
-    }
-    Err(CliError::Input(format!(
-        "{}: no property file given and none found (looked for {} and a single .jani file)",
-        model.display(),
-        p.display()
-    )))
-}
-
 /// The model and property arguments every command that loads a model takes.
 #[derive(Debug, Default, clap::Args)]
 pub struct ModelArgs {
@@ -264,24 +216,22 @@ pub struct ModelArgs {
     pub interfaces: Vec<PathBuf>,
 }
 
-/// A model with its properties, compiled: everything `validate` checks.
-pub struct Loaded {
-    /// The simulator's model.
-    pub model: CompiledModel,
-    /// The property file as read.
-    pub file: props::PropertyFile,
-    /// Its guarantees and assumptions, compiled and resolved against the model.
-    pub set: PropertySet,
-    /// Where the properties came from.
-    pub props_path: PathBuf,
-    /// The length of one model time step in nanoseconds, when known.
-    pub unit_ns: Option<u64>,
-    /// The run length the model asks for (a robot main file's `max_time`), in steps.
-    pub default_max_time: Option<u64>,
-    /// How sends are delivered.
-    pub events: EventSemantics,
+impl ModelArgs {
+    /// The library's load options for these arguments (`--time-unit` parsed).
+    pub fn options(&self) -> Result<LoadOptions, CliError> {
+        Ok(LoadOptions {
+            model: self.model.clone(),
+            props: self.props.clone(),
+            time_unit_ns: self.time_unit.as_deref().map(parse_time_unit).transpose()?,
+            events: self.events.map(Into::into),
+            only: self.only.clone(),
+            skip: self.skip.clone(),
+            interfaces: self.interfaces.clone(),
+        })
+    }
 }
 
+/// `--max-time` on a loaded model (a command-line reading, so it lives here).
 impl Loaded {
     /// `--max-time`: model steps, or a duration when the model has a time unit; by
     /// default the main file's `max_time`, else 10,000 steps.
@@ -315,206 +265,20 @@ fn parse_time_unit(text: &str) -> Result<u64, CliError> {
     }
 }
 
-/// Loads the model and its properties: a robot model (a main file, or a folder holding
-/// `main.xml`) through the robot pipeline, anything else as plain SCXML.
+/// [`crate::verify::load::load`] with the command line's arguments.
 pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
-    load_without(args, &[]).map(|(l, _)| l)
+    crate::verify::load::load(&args.options()?).map_err(CliError::Input)
 }
 
-/// [`load`] without the robot model's node models named in `external`, which processes
-/// play instead (`hindsight run --external`); what each declared comes back with it.
+/// [`crate::verify::load::load_without`] with the command line's arguments.
 pub fn load_without(
     args: &ModelArgs,
     external: &[String],
 ) -> Result<(Loaded, Vec<ExternalComponent>), CliError> {
-    if let Some(main) = crate::robot::load::main_file_of(&args.model) {
-        return load_robot(args, &main, external);
-    }
-    if let Some(dir) = args.interfaces.first() {
-        return Err(CliError::Input(format!(
-            "--interfaces {}: {} is not a robot model (a main file, or a folder with \
-             main.xml); only a robot model reads ROS interfaces",
-            dir.display(),
-            args.model.display()
-        )));
-    }
-    if let Some(name) = external.first() {
-        return Err(CliError::Input(format!(
-            "--external {name}: {} is not a robot model (a main file, or a folder with \
-             main.xml); only a robot model's node models can be replaced by processes",
-            args.model.display()
-        )));
-    }
-    let model = &args.model;
-    let unit_ns = args.time_unit.as_deref().map(parse_time_unit).transpose()?;
-    let compiled = CompiledModel::load(model).map_err(|d| CliError::Input(d.to_string()))?;
-    for w in compiled.warnings() {
-        eprintln!("warning: {w}");
-    }
-    let props_path = match &args.props {
-        Some(p) => p.to_path_buf(),
-        None => default_props(model, &compiled)?,
-    };
-    let file = read_properties(&props_path, &compiled, args)?;
-    let set = compile_properties(&file, &compiled, unit_ns)?;
-    let events = args
-        .events
-        .map_or_else(|| default_events(&props_path), Into::into);
-    Ok((
-        Loaded {
-            model: compiled,
-            file,
-            set,
-            props_path,
-            unit_ns,
-            default_max_time: None,
-            events,
-        },
-        Vec::new(),
-    ))
+    crate::verify::load::load_without(&args.options()?, external).map_err(CliError::Input)
 }
 
-/// Reads a property file: JANI (`.jani`) or SCAN XML (with ROS ports and patterns).
-/// Reads the property file, keeping the guarantees `--only` / `--skip` select.
-fn read_properties(
-    path: &Path,
-    model: &CompiledModel,
-    args: &ModelArgs,
-) -> Result<props::PropertyFile, CliError> {
-    let wanted = |name: &str| {
-        (args.only.is_empty() || args.only.iter().any(|o| o == name))
-            && !args.skip.iter().any(|s| s == name)
-    };
-    let unknown_name = |names: &[String]| {
-        for (option, given) in [("--only", &args.only), ("--skip", &args.skip)] {
-            if let Some(missing) = given.iter().find(|n| !names.contains(n)) {
-                return Err(CliError::Input(format!(
-                    "{option} {missing}: {} has no property `{missing}` (properties: {})",
-                    path.display(),
-                    names.join(", ")
-                )));
-            }
-        }
-        Ok(())
-    };
-    let file = if is_jani(path) {
-        // The reader sees every property's name, skipped or not.
-        let mut names = Vec::new();
-        let read = props::jani::parse_file_selected(path, model, &mut |name| {
-            names.push(name.to_string());
-            wanted(name)
-        });
-        // A misspelt name comes before what the properties it kept say (a file that is
-        // not JSON at all names nothing: its own error comes first then).
-        if read.is_ok() || !names.is_empty() {
-            unknown_name(&names)?;
-        }
-        read.map_err(|d| {
-            let text = d.to_string();
-            // A property using what is not supported need not stop the others.
-            let hint = if text.contains("not supported") {
-                "\nhint: --skip NAME leaves a property out, --only NAME checks just that one"
-            } else {
-                ""
-            };
-            CliError::Input(format!("{text}{hint}"))
-        })?
-    } else {
-        let mut file = props::parse_file(path).map_err(|d| CliError::Input(d.to_string()))?;
-        let names: Vec<String> = file.guarantees.iter().map(|g| g.id.clone()).collect();
-        unknown_name(&names)?;
-        file.guarantees.retain(|g| wanted(&g.id));
-        file
-    };
-    if file.guarantees.is_empty() && !(args.only.is_empty() && args.skip.is_empty()) {
-        return Err(CliError::Input(format!(
-            "--only/--skip leave no property of {} to check",
-            path.display()
-        )));
-    }
-    Ok(file)
-}
-
-/// Compiles a property file against a model; a bound with a unit on a model without one
-/// gets a hint.
-fn compile_properties(
-    file: &props::PropertyFile,
-    model: &CompiledModel,
-    unit_ns: Option<u64>,
-) -> Result<PropertySet, CliError> {
-    PropertySet::with_unit(file, model, unit_ns).map_err(|e| {
-        if unit_ns.is_none() && e.contains("no known duration") {
-            CliError::Input(format!(
-                "{e}\nhint: give the length of one model step with --time-unit (for example \
-                 --time-unit 100ms)"
-            ))
-        } else {
-            CliError::Input(e)
-        }
-    })
-}
-
-/// Loads a robot model: the main file and everything it names, lowered and compiled; the
-/// properties are the file given, else the first one the main file names.
-fn load_robot(
-    args: &ModelArgs,
-    main: &Path,
-    external: &[String],
-) -> Result<(Loaded, Vec<ExternalComponent>), CliError> {
-    use crate::robot::main_file::InputKind;
-    let search = crate::robot::interfaces::Search::from_env(args.interfaces.clone());
-    let (robot, external) = crate::robot::load::load_searching(main, external, &search)
-        .map_err(|d| CliError::Input(d.to_string()))?;
-    for w in &robot.warnings {
-        eprintln!("warning: {w}");
-    }
-    if let Some(text) = &args.time_unit {
-        let given = parse_time_unit(text)?;
-        if given != robot.time_unit_ns {
-            return Err(CliError::Input(format!(
-                "--time-unit {text}: {} steps by {}, from its timers and max_time",
-                main.display(),
-                super::sweep::BoundValue::Nanos(robot.time_unit_ns).display()
-            )));
-        }
-    }
-    let props_path = match (&args.props, robot.main.properties.first()) {
-        (Some(p), _) => p.clone(),
-        (None, Some(input)) => {
-            if input.kind == InputKind::Hspec {
-                return Err(CliError::Input(format!(
-                    "{}: an .hspec file names no messages of the model; write the \
-                     properties over ROS names (XML) or give them on the command line",
-                    input.path.display()
-                )));
-            }
-            input.path.clone()
-        }
-        (None, None) => {
-            return Err(CliError::Input(format!(
-                "{}: the main file names no property file; give one after the model",
-                main.display()
-            )))
-        }
-    };
-    let file = read_properties(&props_path, &robot.model, args)?;
-    let set = compile_properties(&file, &robot.model, Some(robot.time_unit_ns))?;
-    Ok((
-        Loaded {
-            model: robot.model,
-            file,
-            set,
-            props_path,
-            unit_ns: Some(robot.time_unit_ns),
-            default_max_time: Some(robot.max_time_steps),
-            // The lowering is AS2FM's translation; its sends mean what AS2FM's JANI means.
-            events: args.events.map_or(EventSemantics::As2fm, Into::into),
-        },
-        external,
-    ))
-}
-
-/// Runs a study of `set` on `model`: the function `verify` and `sweep` share.
+/// [`crate::verify::study::study`], its failure a bad-input error.
 pub fn study(
     model: &CompiledModel,
     set: &PropertySet,
@@ -523,107 +287,8 @@ pub fn study(
     rule: &RuleConfig,
     show_progress: bool,
 ) -> Result<StudyResult, CliError> {
-    let rules = set
-        .guarantee_names()
-        .iter()
-        .map(|_| rule.build())
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| CliError::Input(format!("statistics: {e}")))?;
-    let runner = Runner::new(model, set, run_cfg);
-    let mut bar = if show_progress {
-        TerminalProgress::stderr()
-    } else {
-        TerminalProgress::hidden()
-    };
-    let result = run_study(study_cfg, &rules, |k, rng| runner.run(k, rng), &mut |p| {
-        bar.update(p)
-    });
-    runner.finish()?;
-    Ok(result)
-}
-
-/// Runs one simulation with its judge: the run function every study shares.
-///
-/// Simulators and judges are pooled and reused across runs (no allocation per step);
-/// the first model failure (a spin, a run-time error) is kept and ends the study.
-pub struct Runner<'m> {
-    model: &'m CompiledModel,
-    set: &'m PropertySet,
-    run_cfg: &'m RunConfig,
-    pool: Mutex<Vec<(Simulator<'m>, Judge<'m>)>>,
-    failure: Mutex<Option<String>>,
-}
-
-impl<'m> Runner<'m> {
-    /// A runner for `model` judged by `set`.
-    pub fn new(model: &'m CompiledModel, set: &'m PropertySet, run_cfg: &'m RunConfig) -> Self {
-        Runner {
-            model,
-            set,
-            run_cfg,
-            pool: Mutex::new(Vec::new()),
-            failure: Mutex::new(None),
-        }
-    }
-
-    /// Run `k` with its stream.
-    pub fn run(&self, k: u64, rng: &mut Xoshiro256PlusPlus) -> RunOutcome {
-        let popped = self.pool.lock().ok().and_then(|mut p| p.pop());
-        let (mut sim, mut judge) = match popped {
-            Some(pair) => pair,
-            None => (
-                Simulator::new(self.model),
-                Judge::new(self.set).expect("validated program"),
-            ),
-        };
-        let unknown = |end| RunOutcome {
-            verdicts: Vec::new(),
-            assumptions: Verdict::Unknown,
-            end,
-            steps: 0,
-            time: 0,
-        };
-        let outcome = if judge.start() == crate::sim::Flow::Stop && judge.error.is_some() {
-            unknown(RunEnd::Failed)
-        } else {
-            let out = sim.run(rng, self.run_cfg, &mut judge);
-            let end = match &out.end {
-                EndReason::Quiescent => Some(RunEnd::Quiescent),
-                EndReason::MaxTime => Some(RunEnd::TimeHorizon),
-                EndReason::MaxSteps => Some(RunEnd::StepLimit),
-                EndReason::Stopped => Some(RunEnd::Decided),
-                EndReason::Spin(s) => {
-                    record(&self.failure, format!("run {k}: {s}"));
-                    None
-                }
-                EndReason::Error(e) => {
-                    record(&self.failure, format!("run {k}: {e}"));
-                    None
-                }
-            };
-            if let Some(err) = &judge.error {
-                record(&self.failure, format!("run {k}: {err}"));
-            }
-            match end {
-                Some(end) if judge.error.is_none() => judge.outcome(end, out.steps, out.time),
-                _ => unknown(RunEnd::Failed),
-            }
-        };
-        if let Ok(mut p) = self.pool.lock() {
-            p.push((sim, judge));
-        }
-        outcome
-    }
-
-    /// The first model failure any run met, as a bad-input error.
-    pub fn finish(self) -> Result<(), CliError> {
-        match self.failure.into_inner().ok().flatten() {
-            Some(msg) => Err(CliError::Input(format!(
-                "the model failed during simulation: {msg}"
-            ))),
-            None => Ok(()),
-        }
-    }
+    crate::verify::study::study(model, set, run_cfg, study_cfg, rule, show_progress)
+        .map_err(CliError::Input)
 }
 
 /// FNV-1a over bytes: a stable fingerprint so `merge` can refuse mixed studies.
@@ -682,7 +347,7 @@ fn run_shard_cli(
         |k, rng| runner.run(k, rng),
         &mut |p| bar.update(p),
     );
-    runner.finish()?;
+    runner.finish().map_err(CliError::Input)?;
     let json = part.to_json();
     match &args.partial {
         Some(p) => std::fs::write(p, json)
@@ -817,12 +482,6 @@ fn save_failing(
         }
     }
     Ok(())
-}
-
-fn record(slot: &Mutex<Option<String>>, msg: String) {
-    if let Ok(mut s) = slot.lock() {
-        s.get_or_insert(msg);
-    }
 }
 
 /// Runs `hindsight verify`.

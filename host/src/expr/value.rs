@@ -86,11 +86,6 @@ pub enum Ty {
 }
 
 impl Ty {
-    /// True for `Bool`, `Int`, `Float` and `Str`.
-    pub fn is_scalar(&self) -> bool {
-        matches!(self, Ty::Bool | Ty::Int | Ty::Float | Ty::Str)
-    }
-
     /// True for `Int` and `Float`.
     pub fn is_numeric(&self) -> bool {
         matches!(self, Ty::Int | Ty::Float)

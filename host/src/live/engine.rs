@@ -5,7 +5,7 @@
 //!
 //! # Verdicts
 //! - `true` / `false`: the monitor's verdict, and it can no longer change
-//!   (decided by [`crate::verify::settle::Settler`]);
+//!   (decided by [`monitor_core::analysis::settle`]);
 //! - `currently_true` / `currently_false`: the verdict at this point, which later points may change;
 //! - `unknown`: a sample that a property reads was lost (or malformed) recently.
 //!
@@ -20,9 +20,7 @@
 //! Unaffected properties are never disturbed.
 
 use codegen::Compiled;
-use monitor_core::{valuation, Instr, Monitor, Op, StepError, Value};
-
-use crate::verify::settle::Settler;
+use monitor_core::{analysis, valuation, Monitor, StepError, Value};
 
 /// A property's verdict as the sidecar reports it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -88,7 +86,8 @@ pub struct Change {
 struct Slot {
     state: Vec<u64>,
     verdicts: Vec<bool>,
-    settler: Settler,
+    /// Per node, its final value as of the last point ([`analysis::settle`]).
+    finals: Vec<Option<bool>>,
 }
 
 /// The monitors of one spec with the loss rule applied.
@@ -120,27 +119,11 @@ impl<'c> Engine<'c> {
         let mut horizon = Vec::with_capacity(n);
         for p in program.props {
             let mut vars = Vec::new();
-            let mut h = 0u64;
-            for node in &program.nodes[p.first as usize..=p.root as usize] {
-                match node.op {
-                    Op::Atom(a) => {
-                        let atom = program.atoms[a as usize];
-                        let code = &program.instrs
-                            [atom.start as usize..atom.start as usize + atom.len as usize];
-                        for i in code {
-                            if let Instr::Load(v) = i {
-                                vars.push(*v as usize);
-                            }
-                        }
-                    }
-                    Op::Since { lo, hi, .. } => h = h.max(lo).max(hi.unwrap_or(0)),
-                    _ => {}
-                }
-            }
+            analysis::for_each_read(&program, p, |v| vars.push(v as usize));
             vars.sort_unstable();
             vars.dedup();
             prop_vars.push(vars);
-            horizon.push(h.max(1));
+            horizon.push(analysis::horizon(&program, p).max(1));
         }
         let slot = Self::fresh(&monitor);
         Ok(Engine {
@@ -161,18 +144,13 @@ impl<'c> Engine<'c> {
         Slot {
             state: vec![0; monitor.state_words()],
             verdicts: vec![false; monitor.properties()],
-            settler: Settler::new(monitor),
+            finals: vec![None; monitor.program().nodes.len()],
         }
     }
 
     /// The number of properties.
     pub fn properties(&self) -> usize {
         self.last.len()
-    }
-
-    /// The variables property `prop` reads.
-    pub fn property_vars(&self, prop: usize) -> &[usize] {
-        &self.prop_vars[prop]
     }
 
     /// The last reported verdict of every property (`None` before the first point).
@@ -216,7 +194,13 @@ impl<'c> Engine<'c> {
             // Cannot fail: state sizes, the time and every type were checked.
             self.monitor
                 .try_step(&mut s.state, time, &self.vals, &mut s.verdicts)?;
-            s.settler.update(&self.monitor, &s.state);
+            let m = &self.monitor;
+            let st = &s.state;
+            analysis::settle(
+                m.program(),
+                |n| m.node_value(st, n).unwrap_or(false),
+                &mut s.finals,
+            );
         }
         self.last_time = Some(time);
         self.report(time, event, out);
@@ -228,7 +212,10 @@ impl<'c> Engine<'c> {
             return Verdict::Unknown;
         }
         let s = &self.slots[self.prop_slot[prop]];
-        match (s.settler.property(&self.monitor, prop), s.verdicts[prop]) {
+        match (
+            analysis::settled(self.monitor.program(), &s.finals, prop),
+            s.verdicts[prop],
+        ) {
             (Some(true), _) => Verdict::True,
             (Some(false), _) => Verdict::False,
             (None, true) => Verdict::CurrentlyTrue,

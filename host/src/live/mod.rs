@@ -14,6 +14,7 @@
 //! - [`engine`]: five-valued verdicts and the loss rule (see its docs).
 //! - [`record`]: the verdict line and input log formats; replay.
 //! - [`bench`]: throughput and added latency against a plain subscriber.
+//! - [`pace`]: `hindsight run`'s observer, pacing a simulation on the same [`Clock`].
 //!
 //! Taps never slow a publisher: the services keep iceoryx2's safe overflow, so a
 //! full tap buffer drops the tap's oldest sample. Lost samples are found from a
@@ -21,9 +22,11 @@
 //! drain that found the buffer full (a conservative "may have lost").
 
 pub mod bench;
+mod clock;
 pub mod config;
 pub mod engine;
 pub mod inject;
+pub mod pace;
 pub mod publish;
 pub mod record;
 
@@ -42,6 +45,7 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 use monitor_core::Value;
 
+pub use clock::{check_speed, Clock, SPEED_RANGE};
 use config::{Action, Config, Layout};
 use engine::{Change, Engine};
 use record::Input;
@@ -49,85 +53,6 @@ use record::Input;
 type Ipc = ipc::Service;
 type Req = ActiveRequest<Ipc, [u8], (), [u8], ()>;
 type Pending = PendingResponse<Ipc, [u8], (), [u8], ()>;
-
-/// A monotonic clock quantised to the spec's time unit: ticks of model time since the
-/// sidecar started.
-///
-/// The monitored system may run `speed` times faster than real time (`hindsight run
-/// --speed S`); the clock then counts model time, `ticks = elapsed * speed / tick`, so
-/// the spec's bounds keep meaning model time. The speed is kept exactly to a millionth
-/// (an integer ratio), so the arithmetic is exact and never decreases.
-#[derive(Clone, Copy, Debug)]
-pub struct Clock {
-    start: Instant,
-    tick_ns: u64,
-    /// Millionths of the speed: model nanoseconds per 10^6 wall-clock nanoseconds.
-    speed_micros: u64,
-}
-
-/// The slowest and fastest speeds a [`Clock`] takes.
-pub const SPEED_RANGE: (f64, f64) = (1e-6, 1e9);
-
-/// Checks a speed for [`Clock::with_speed`]: finite, within [`SPEED_RANGE`].
-pub fn check_speed(speed: f64) -> Result<f64, String> {
-    if speed.is_finite() && speed >= SPEED_RANGE.0 && speed <= SPEED_RANGE.1 {
-        Ok(speed)
-    } else {
-        Err(format!(
-            "speed {speed}: must be a number from {} to {} (1: real time)",
-            SPEED_RANGE.0, SPEED_RANGE.1
-        ))
-    }
-}
-
-impl Clock {
-    /// A real-time clock starting now with ticks of `tick_ns` nanoseconds.
-    pub fn new(tick_ns: u64) -> Self {
-        Self::with_speed(tick_ns, 1.0)
-    }
-
-    /// A clock starting now that counts ticks of `tick_ns` nanoseconds of model time in a
-    /// system running `speed` times faster than real time (rounded to a millionth and
-    /// clamped to [`SPEED_RANGE`]; see [`check_speed`]).
-    pub fn with_speed(tick_ns: u64, speed: f64) -> Self {
-        let speed = if speed.is_nan() {
-            1.0
-        } else {
-            speed.clamp(SPEED_RANGE.0, SPEED_RANGE.1)
-        };
-        Clock {
-            start: Instant::now(),
-            tick_ns: tick_ns.max(1),
-            speed_micros: (speed * 1e6).round() as u64,
-        }
-    }
-
-    /// Restarts the clock so that now is tick 0 and later instants are rounded to the
-    /// nearest tick instead of truncated: it starts half a tick of wall-clock time ago.
-    /// A system that steps on whole ticks from now on is stamped on whole ticks despite
-    /// up to half a tick of scheduling jitter either way.
-    pub fn anchor_now(&mut self) {
-        let half_tick_wall_ns =
-            (self.tick_ns as u128 * 1_000_000 / (2 * self.speed_micros.max(1) as u128)) as u64;
-        let now = Instant::now();
-        self.start = now
-            .checked_sub(Duration::from_nanos(half_tick_wall_ns))
-            .unwrap_or(now);
-    }
-
-    /// Whole ticks elapsed since the start (never decreases).
-    pub fn now(&self) -> u64 {
-        self.ticks(self.start.elapsed())
-    }
-
-    /// Whole ticks of model time in `elapsed` wall-clock time:
-    /// `floor(elapsed * speed / tick)`, saturating.
-    pub fn ticks(&self, elapsed: Duration) -> u64 {
-        let model_ns = elapsed.as_nanos().saturating_mul(self.speed_micros as u128);
-        let t = model_ns / (self.tick_ns as u128 * 1_000_000);
-        u64::try_from(t).unwrap_or(u64::MAX)
-    }
-}
 
 /// Counts for one tapped topic or proxied service.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -879,58 +804,5 @@ impl Sidecar {
             verdict_lines: run.lines,
             probed: run.probed,
         })
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn clock_counts_model_time_at_any_speed() {
-        let ms = Duration::from_millis;
-        // Real time, 100 ms ticks: whole ticks, rounded down.
-        let c = Clock::new(100_000_000);
-        assert_eq!(c.ticks(ms(0)), 0);
-        assert_eq!(c.ticks(ms(99)), 0);
-        assert_eq!(c.ticks(ms(100)), 1);
-        assert_eq!(c.ticks(ms(2_550)), 25);
-        // Ten times faster: 10 ms of wall-clock time is one 100 ms tick of model time.
-        let c = Clock::with_speed(100_000_000, 10.0);
-        assert_eq!(c.ticks(ms(9)), 0);
-        assert_eq!(c.ticks(ms(10)), 1);
-        assert_eq!(c.ticks(ms(1_000)), 100);
-        // Slower than real time, exactly at the boundaries (no floating rounding).
-        let c = Clock::with_speed(100_000_000, 0.1);
-        assert_eq!(c.ticks(Duration::from_nanos(999_999_999)), 0);
-        assert_eq!(c.ticks(ms(1_000)), 1);
-        let c = Clock::with_speed(1_000_000, 2.5);
-        assert_eq!(c.ticks(Duration::from_nanos(399_999)), 0);
-        assert_eq!(c.ticks(Duration::from_nanos(400_000)), 1);
-        assert_eq!(c.ticks(ms(4)), 10);
-        // Saturates instead of wrapping.
-        let c = Clock::with_speed(1, SPEED_RANGE.1);
-        assert_eq!(c.ticks(Duration::MAX), u64::MAX);
-    }
-
-    #[test]
-    fn clock_ticks_never_decrease() {
-        let c = Clock::with_speed(100_000_000, 3.7);
-        let mut last = 0;
-        for ns in (0..5_000_000_000u64).step_by(7_777_777) {
-            let t = c.ticks(Duration::from_nanos(ns));
-            assert!(t >= last);
-            last = t;
-        }
-        assert_eq!(last, 184); // floor(4.9933 s * 3.7 / 0.1 s), the last time taken
-    }
-
-    #[test]
-    fn speeds_are_checked() {
-        assert_eq!(check_speed(1.0), Ok(1.0));
-        assert_eq!(check_speed(10.0), Ok(10.0));
-        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e-7, 1e10] {
-            assert!(check_speed(bad).is_err(), "{bad}");
-        }
     }
 }

@@ -59,6 +59,15 @@ impl WireTy {
         }
     }
 
+    /// The sidecar's field type of the same bytes.
+    pub fn field_ty(self) -> super::config::FieldTy {
+        match self {
+            WireTy::Bool => super::config::FieldTy::Bool,
+            WireTy::I64 => super::config::FieldTy::I64,
+            WireTy::F64 => super::config::FieldTy::F64,
+        }
+    }
+
     /// The name the sidecar's config uses.
     pub fn name(self) -> &'static str {
         match self {
@@ -183,22 +192,20 @@ impl TopicLayout {
 
     /// Reads a payload written in this layout (by [`Self::encode`] or a process that
     /// speaks it): the parameters it sets and its `seq`; `None` if it is not exactly
-    /// [`Self::size`] bytes or a `bool` byte is neither 0 nor 1.
+    /// [`Self::size`] bytes or a field holds no valid value. Fields are read by the
+    /// sidecar's own reader ([`super::config::FieldTy::read`]), so `run` and `monitor`
+    /// accept the same payloads (a `bool` byte is 0 or 1, a float is finite).
     pub fn decode(&self, buf: &[u8]) -> Option<(Vec<(usize, Scalar)>, u64)> {
         if buf.len() != self.size {
             return None;
         }
         let mut out = Vec::with_capacity(self.fields.len());
         for f in &self.fields {
-            let at = buf.get(f.offset..f.offset + f.ty.size())?;
-            let v = match f.ty {
-                WireTy::Bool => match at[0] {
-                    0 => Scalar::Bool(false),
-                    1 => Scalar::Bool(true),
-                    _ => return None,
-                },
-                WireTy::I64 => Scalar::Int(i64::from_le_bytes(at.try_into().ok()?)),
-                WireTy::F64 => Scalar::Float(f64::from_le_bytes(at.try_into().ok()?)),
+            let v = match f.ty.field_ty().read(buf, f.offset)? {
+                monitor_core::Value::Bool(b) => Scalar::Bool(b),
+                monitor_core::Value::Int(i) => Scalar::Int(i),
+                monitor_core::Value::Float(x) => Scalar::Float(x),
+                monitor_core::Value::Str(_) => return None,
             };
             out.push((f.param, v));
         }
@@ -549,5 +556,9 @@ mod tests {
         assert!(layout.decode(&buf[..24]).is_none(), "short");
         buf[0] = 2;
         assert!(layout.decode(&buf).is_none(), "a bool byte of 2");
+        // The sidecar's rule for floats: a NaN is no value.
+        buf[0] = 1;
+        buf[9..17].copy_from_slice(&f64::NAN.to_le_bytes());
+        assert!(layout.decode(&buf).is_none(), "a NaN");
     }
 }

@@ -53,11 +53,6 @@ impl TerminalProgress {
         }
     }
 
-    /// Whether anything is drawn.
-    pub fn is_visible(&self) -> bool {
-        self.bar.is_some() || self.log.is_some()
-    }
-
     /// Shows one report; clears the bar after the final one.
     pub fn update(&mut self, progress: &Progress<'_>) {
         if let Some(last) = &mut self.log {

@@ -1,5 +1,6 @@
 //! Statistical model checking glue: properties observed on simulated runs, judged by monitors.
 
+pub mod load;
 pub mod observe;
 pub mod record;
-pub mod settle;
+pub mod study;

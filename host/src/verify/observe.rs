@@ -7,14 +7,13 @@
 //! [`Judge`] then observes one run: at every point DESIGN.md section 2 defines (the
 //! initial state, every send, every receive, every time advance) it clears the event
 //! variables, applies the ports of a sent message, and steps the monitors. When every
-//! verdict is final ([`super::settle`]) it stops the run.
+//! verdict is final ([`monitor_core::analysis::settle`]) it stops the run.
 
 use std::collections::BTreeSet;
 
 use codegen::{Compiled, DeclInput, FormulaInput, Origin, PositionRun, SpecInput};
-use monitor_core::{valuation, Monitor, Op, Ty, Value, VarKind};
+use monitor_core::{analysis, valuation, Monitor, Ty, Value, VarKind};
 
-use super::settle::Settler;
 use crate::expr::Value as SimValue;
 use crate::props::{PortKind, PropertyFile, ANY};
 use crate::sim::{CompiledModel, EventId, Flow, MachineId, Observer, SentMessage};
@@ -330,7 +329,8 @@ pub struct Judge<'a> {
     state: Vec<u64>,
     vals: Vec<Value>,
     verdicts: Vec<bool>,
-    settler: Settler,
+    /// Per node, its final value as of the last point ([`analysis::settle`]).
+    finals: Vec<Option<bool>>,
     /// The first error (a payload of the wrong type, a timestamp going back).
     pub error: Option<String>,
     decided: bool,
@@ -350,14 +350,10 @@ impl<'a> Judge<'a> {
         let vars = monitor.program().vars;
         let mut vals = vec![Value::Bool(false); vars.len()];
         valuation::init(vars, &mut vals);
-        let repeat_is_noop = monitor
-            .program()
-            .nodes
-            .iter()
-            .all(|n| !matches!(n.op, Op::Yesterday(_) | Op::WeakYesterday(_)));
+        let repeat_is_noop = analysis::repeat_is_noop(monitor.program());
         Ok(Judge {
             set,
-            settler: Settler::new(&monitor),
+            finals: vec![None; monitor.program().nodes.len()],
             state: vec![0; monitor.state_words()],
             verdicts: vec![false; monitor.properties()],
             monitor,
@@ -418,9 +414,14 @@ impl<'a> Judge<'a> {
             self.error = Some(format!("monitor step at time {time}: {e}"));
             return Flow::Stop;
         }
-        self.settler.update(&self.monitor, &self.state);
-        let all =
-            (0..self.verdicts.len()).all(|p| self.settler.property(&self.monitor, p).is_some());
+        let (m, st) = (&self.monitor, &self.state);
+        analysis::settle(
+            m.program(),
+            |n| m.node_value(st, n).unwrap_or(false),
+            &mut self.finals,
+        );
+        let all = (0..self.verdicts.len())
+            .all(|p| analysis::settled(m.program(), &self.finals, p).is_some());
         if all {
             self.decided = true;
             return Flow::Stop;
@@ -492,7 +493,7 @@ impl<'a> Judge<'a> {
     pub fn outcome(&self, end: RunEnd, steps: u64, time: u64) -> RunOutcome {
         let g = self.set.guarantees.len();
         let judged = |p: usize| -> Verdict {
-            match self.settler.property(&self.monitor, p) {
+            match analysis::settled(self.monitor.program(), &self.finals, p) {
                 Some(v) => v.into(),
                 // A run cut short is judged only where the verdict was already final.
                 None if end == RunEnd::StepLimit => Verdict::Unknown,
@@ -624,7 +625,7 @@ fn missing_param(model: &CompiledModel, event: EventId, param: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::same_values;
-    use monitor_core::{valuation, Monitor, Op, Value};
+    use monitor_core::{analysis, valuation, Monitor, Value};
 
     /// The fact [`super::Judge`] relies on to skip repeated points: without `Y` / `Z`, a
     /// step at the same time with the same values leaves the state bit for bit unchanged.
@@ -653,11 +654,7 @@ mod tests {
             let src = format!("event p;\nevent q;\nstate n: i64 = 0;\nproperty f = {f};\n");
             let c = codegen::compile_spec(&src, "t.hspec").unwrap();
             let m = Monitor::try_new(c.program()).unwrap();
-            assert!(m
-                .program()
-                .nodes
-                .iter()
-                .all(|n| !matches!(n.op, Op::Yesterday(_) | Op::WeakYesterday(_))));
+            assert!(analysis::repeat_is_noop(m.program()));
             for _ in 0..40 {
                 let mut st = vec![0; m.state_words()];
                 let mut vals = vec![Value::Bool(false); c.program().vars.len()];

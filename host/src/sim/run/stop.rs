@@ -1,0 +1,76 @@
+//! How a run stops on a model error: a diagnostic at the failing instruction, or a spin report.
+
+use super::*;
+
+impl Simulator<'_> {
+    pub(super) fn diag_error(&self, m: usize, pc: Option<usize>, e: EvalError) -> Stop {
+        let def = &self.model.machines[m];
+        let span = if e.at != 0 {
+            Span {
+                file: def.file,
+                offset: e.at,
+            }
+        } else {
+            pc.and_then(|p| def.code_spans.get(p).copied())
+                .unwrap_or(Span {
+                    file: def.file,
+                    offset: 0,
+                })
+        };
+        Stop::End(EndReason::Error(RunError {
+            machine: MachineId(m as u32),
+            time: self.time,
+            diagnostic: self.model.sources.diag(span, e.message()),
+        }))
+    }
+
+    pub(super) fn spin(&self, m: usize, kind: SpinKind) -> Stop {
+        let def = &self.model.machines[m];
+        let s = self.ms[m].state;
+        let state_name = def
+            .states
+            .get(s as usize)
+            .map_or(String::new(), |st| st.name.clone());
+        let span = def
+            .states
+            .get(s as usize)
+            .map(|st| st.span)
+            .unwrap_or(Span {
+                file: def.file,
+                offset: 0,
+            });
+        Stop::End(EndReason::Spin(SpinReport {
+            kind,
+            machine: MachineId(m as u32),
+            state: StateId(s),
+            machine_name: def.name.clone(),
+            state_name: state_name.clone(),
+            location: self
+                .model
+                .sources
+                .diag(span, format!("state `{state_name}`")),
+        }))
+    }
+
+    pub(super) fn internal(&self, m: usize, pc: u32) -> Stop {
+        self.diag_error(
+            m,
+            Some(pc as usize),
+            EvalError {
+                at: 0,
+                kind: EvalErrorKind::Internal,
+            },
+        )
+    }
+
+    pub(super) fn too_long(&self, m: usize, pc: u32, bound: u32) -> Stop {
+        self.diag_error(
+            m,
+            Some(pc as usize),
+            EvalError {
+                at: 0,
+                kind: EvalErrorKind::TooLong { bound },
+            },
+        )
+    }
+}

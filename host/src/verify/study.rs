@@ -1,0 +1,132 @@
+//! Running a study: simulated runs judged by the monitors, under a stopping rule.
+//!
+//! [`Runner`] runs one simulation with its [`Judge`] (the function every study
+//! shares: `verify`, `sweep`, shards, the benches); [`study`] hands it to
+//! [`crate::smc::run_study`] with one stopping rule per guarantee.
+
+use std::sync::Mutex;
+
+use rand_xoshiro::Xoshiro256PlusPlus;
+
+use super::observe::{Judge, PropertySet};
+use crate::sim::{CompiledModel, EndReason, RunConfig, Simulator};
+use crate::smc::progress::TerminalProgress;
+use crate::smc::stats::RuleConfig;
+use crate::smc::{run_study, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
+
+/// Runs a study of `set` on `model`: the function `verify` and `sweep` share.
+pub fn study(
+    model: &CompiledModel,
+    set: &PropertySet,
+    run_cfg: &RunConfig,
+    study_cfg: &StudyConfig,
+    rule: &RuleConfig,
+    show_progress: bool,
+) -> Result<StudyResult, String> {
+    let rules = set
+        .guarantee_names()
+        .iter()
+        .map(|_| rule.build())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| format!("statistics: {e}"))?;
+    let runner = Runner::new(model, set, run_cfg);
+    let mut bar = if show_progress {
+        TerminalProgress::stderr()
+    } else {
+        TerminalProgress::hidden()
+    };
+    let result = run_study(study_cfg, &rules, |k, rng| runner.run(k, rng), &mut |p| {
+        bar.update(p)
+    });
+    runner.finish()?;
+    Ok(result)
+}
+
+/// Runs one simulation with its judge: the run function every study shares.
+///
+/// Simulators and judges are pooled and reused across runs (no allocation per step);
+/// the first model failure (a spin, a run-time error) is kept and ends the study.
+pub struct Runner<'m> {
+    model: &'m CompiledModel,
+    set: &'m PropertySet,
+    run_cfg: &'m RunConfig,
+    pool: Mutex<Vec<(Simulator<'m>, Judge<'m>)>>,
+    failure: Mutex<Option<String>>,
+}
+
+impl<'m> Runner<'m> {
+    /// A runner for `model` judged by `set`.
+    pub fn new(model: &'m CompiledModel, set: &'m PropertySet, run_cfg: &'m RunConfig) -> Self {
+        Runner {
+            model,
+            set,
+            run_cfg,
+            pool: Mutex::new(Vec::new()),
+            failure: Mutex::new(None),
+        }
+    }
+
+    /// Run `k` with its stream.
+    pub fn run(&self, k: u64, rng: &mut Xoshiro256PlusPlus) -> RunOutcome {
+        let popped = self.pool.lock().ok().and_then(|mut p| p.pop());
+        let (mut sim, mut judge) = match popped {
+            Some(pair) => pair,
+            None => (
+                Simulator::new(self.model),
+                Judge::new(self.set).expect("validated program"),
+            ),
+        };
+        let unknown = |end| RunOutcome {
+            verdicts: Vec::new(),
+            assumptions: Verdict::Unknown,
+            end,
+            steps: 0,
+            time: 0,
+        };
+        let outcome = if judge.start() == crate::sim::Flow::Stop && judge.error.is_some() {
+            unknown(RunEnd::Failed)
+        } else {
+            let out = sim.run(rng, self.run_cfg, &mut judge);
+            let end = match &out.end {
+                EndReason::Quiescent => Some(RunEnd::Quiescent),
+                EndReason::MaxTime => Some(RunEnd::TimeHorizon),
+                EndReason::MaxSteps => Some(RunEnd::StepLimit),
+                EndReason::Stopped => Some(RunEnd::Decided),
+                EndReason::Spin(s) => {
+                    record(&self.failure, format!("run {k}: {s}"));
+                    None
+                }
+                EndReason::Error(e) => {
+                    record(&self.failure, format!("run {k}: {e}"));
+                    None
+                }
+            };
+            if let Some(err) = &judge.error {
+                record(&self.failure, format!("run {k}: {err}"));
+            }
+            match end {
+                Some(end) if judge.error.is_none() => judge.outcome(end, out.steps, out.time),
+                _ => unknown(RunEnd::Failed),
+            }
+        };
+        if let Ok(mut p) = self.pool.lock() {
+            p.push((sim, judge));
+        }
+        outcome
+    }
+
+    /// The first model failure any run met, as a bad-input error.
+    pub fn finish(self) -> Result<(), String> {
+        match self.failure.into_inner().ok().flatten() {
+            Some(msg) => Err(format!("the model failed during simulation: {msg}")),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Keeps the first failure.
+fn record(slot: &Mutex<Option<String>>, msg: String) {
+    if let Ok(mut s) = slot.lock() {
+        s.get_or_insert(msg);
+    }
+}
