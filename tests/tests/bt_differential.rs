@@ -49,7 +49,7 @@ const FEATURES: &[&str] = &[
     "<SubTreePlus",
     "__shared_blackboard=\"true\"",
     "__autoremap=\"true\"",
-    "_autoremap=\"true\"",
+    " _autoremap=\"true\"",
     "d0=\"d0\"",
     "<BlackboardCheckDouble",
     "<BlackboardCheckString",
