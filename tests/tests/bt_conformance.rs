@@ -143,7 +143,7 @@ fn check_expected(c: &Case, xml: &str, run: &Run, who: &str) -> Option<String> {
 #[test]
 fn btcpp_unit_tests_hold_in_the_oracle_and_the_lowering() {
     let cases = load("bt/btcpp");
-    assert!(cases.len() >= 20, "{} cases", cases.len());
+    assert!(cases.len() >= 98, "{} cases", cases.len());
     let mut fails = Vec::new();
     let mut lowering_agrees = 0;
     for (file, c) in &cases {

@@ -1,5 +1,7 @@
 //! The oracle's two readings, node by node where AS2FM's models and BehaviorTree.CPP
-//! disagree (and one where they agree), with the leaf ticks and halts each gives.
+//! disagree (and one where they agree), with the leaf ticks and halts each gives; and the
+//! blackboard rules the random trees lean on (typed checks, status numbers, copies,
+//! format-3 SubTree mapping).
 
 use hindsight_tests::bt::oracle::{run, LeafEvent, Reading, Scripts};
 use hindsight_tests::bt::tree::{read, Status};
@@ -103,4 +105,83 @@ fn subtree_remapping_reaches_the_callers_entries() {
     let xml2 = xml.replace("value=\"2\"", "value=\"3\"");
     let tree = read(&xml2).expect("tree");
     assert_eq!(run(&tree, &s, Reading::As2fm, 1).expect("run").0, [F]);
+}
+
+/// A whole document, AS2FM's reading: the root's statuses.
+fn doc(xml: &str, scripts: &[(&str, &[Status])], ticks: usize) -> Vec<Status> {
+    let tree = read(xml).expect("tree");
+    let s: Scripts = scripts
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_vec()))
+        .collect();
+    run(&tree, &s, Reading::As2fm, ticks).expect("run").0
+}
+
+#[test]
+fn blackboard_checks_compare_by_type_with_the_float_epsilon() {
+    // v3.8 `IsSame(double, double)`: within 2^-23; Int, String, Bool exactly.
+    let check = |tag: &str, set: &str, b: &str| {
+        let body = format!(
+            "<Sequence><SetBlackboard output_key=\"e\" value=\"{set}\"/><BlackboardCheck{tag} value_A=\"{{e}}\" value_B=\"{b}\" return_on_mismatch=\"3\"><A/></BlackboardCheck{tag}></Sequence>"
+        );
+        go(&body, &[("A", &[S])], 1, Reading::As2fm).0[0]
+    };
+    assert_eq!(check("Double", "1.5", "1.50000005"), S);
+    assert_eq!(check("Double", "1.5", "1.5000005"), R);
+    assert_eq!(check("Int", "2", "2"), S);
+    assert_eq!(check("Int", "2", "3"), R);
+    assert_eq!(check("String", "a", "a"), S);
+    assert_eq!(check("String", "a", "b"), R);
+    assert_eq!(check("Bool", "true", "true"), S);
+    assert_eq!(check("Bool", "true", "false"), R);
+}
+
+#[test]
+fn return_on_mismatch_takes_as2fms_numbers() {
+    let with = |m: &str| {
+        let body = format!("<BlackboardCheckInt value_A=\"1\" value_B=\"2\" return_on_mismatch=\"{m}\"><A/></BlackboardCheckInt>");
+        go(&body, &[("A", &[S])], 1, Reading::As2fm).0[0]
+    };
+    assert_eq!([with("1"), with("2"), with("3")], [S, F, R]);
+    assert_eq!(
+        [with("SUCCESS"), with("FAILURE"), with("RUNNING")],
+        [S, F, R]
+    );
+}
+
+#[test]
+fn set_blackboard_copies_an_entry() {
+    let body = "<Sequence><SetBlackboard output_key=\"a\" value=\"7\"/><SetBlackboard output_key=\"b\" value=\"{a}\"/><SetBlackboard output_key=\"a\" value=\"8\"/>\
+<BlackboardCheckInt value_A=\"{b}\" value_B=\"7\" return_on_mismatch=\"FAILURE\"><A/></BlackboardCheckInt></Sequence>";
+    assert_eq!(go(body, &[("A", &[S])], 1, Reading::As2fm).0, [S]);
+}
+
+#[test]
+fn format_3_subtrees_map_by_name_share_or_keep_entries_private() {
+    // The SubTree writes `y`; the caller then checks its `x`.
+    let main = |attrs: &str, tag: &str| {
+        format!(
+            "<root BTCPP_format=\"3\" main_tree_to_execute=\"M\"><BehaviorTree ID=\"M\"><Sequence>\
+<SetBlackboard output_key=\"x\" value=\"1\"/><SetBlackboard output_key=\"y\" value=\"1\"/><{tag} ID=\"S\" {attrs}/>\
+<BlackboardCheckInt value_A=\"{{x}}\" value_B=\"5\" return_on_mismatch=\"FAILURE\"><A/></BlackboardCheckInt></Sequence></BehaviorTree>\
+<BehaviorTree ID=\"S\"><SetBlackboard output_key=\"y\" value=\"5\"/></BehaviorTree></root>"
+        )
+    };
+    let sc: &[(&str, &[Status])] = &[("A", &[S])];
+    // `y="x"`: the SubTree's `y` is the caller's `x` (format 3 maps by name).
+    assert_eq!(doc(&main("y=\"x\"", "SubTree"), sc, 1), [S]);
+    // Not mapped: its `y` is its own; the caller's `x` stays 1.
+    assert_eq!(doc(&main("", "SubTree"), sc, 1), [F]);
+    // Shared: its `y` is the caller's `y`, not `x`.
+    assert_eq!(
+        doc(&main("__shared_blackboard=\"true\"", "SubTree"), sc, 1),
+        [F]
+    );
+    // SubTreePlus maps `{x}`.
+    assert_eq!(doc(&main("y=\"{x}\"", "SubTreePlus"), sc, 1), [S]);
+    // Shared, then checked on `y`: the SubTree's write is the caller's.
+    let shared = main("__shared_blackboard=\"true\"", "SubTree").replace("{x}", "{y}");
+    assert_eq!(doc(&shared, sc, 1), [S]);
+    let private = main("", "SubTree").replace("{x}", "{y}");
+    assert_eq!(doc(&private, sc, 1), [F]);
 }

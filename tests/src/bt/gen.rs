@@ -1,6 +1,8 @@
 //! Seeded random behavior trees and leaf scripts for the differential test: every node
-//! kind the oracle knows, mixed at random depth and width, SubTrees with remapping, and
-//! blackboard writes and reads of two integer entries.
+//! kind the oracle knows, mixed at random depth and width, in `BTCPP_format` 3 and 4;
+//! SubTrees remapped, shared or keeping an entry private; blackboard writes (constants
+//! and copies) and reads of int, double, string and bool entries; leaves with and
+//! without `<bt_halt>`; counts of -1.
 
 use super::oracle::Scripts;
 use super::tree::Status;
@@ -24,7 +26,13 @@ struct G<'r, R: Rng> {
     budget: i64,
     /// SubTree definitions written so far (a tree only uses earlier ones).
     subtrees: Vec<String>,
+    /// `BTCPP_format="3"`: v3 names and SubTree mapping.
+    v3: bool,
 }
+
+/// The int entries. `p0` is never remapped: inside a SubTree it is the instance's own
+/// (unless the whole blackboard is shared), which each SubTree body writes first.
+const INTS: [&str; 3] = ["k0", "k1", "p0"];
 
 impl<R: Rng> G<'_, R> {
     fn below(&mut self, n: u64) -> u64 {
@@ -39,25 +47,82 @@ impl<R: Rng> G<'_, R> {
         }
     }
 
-    fn leaf(&mut self) -> String {
-        let name = format!("L{}", self.scripts.len());
+    /// A fresh leaf type; `N...` types have no `<bt_halt>` (see `model::plugin`). With
+    /// `stop`, its script ends with it or RUNNING, so a count of -1 above it ends.
+    fn leaf_with(&mut self, stop: Option<Status>) -> String {
+        let tag = if self.below(4) == 0 { "N" } else { "L" };
+        let name = format!("{tag}{}", self.scripts.len());
         let len = 1 + self.below(4) as usize;
-        let script = (0..len).map(|_| self.status()).collect();
+        let mut script: Vec<Status> = (0..len).map(|_| self.status()).collect();
+        if let Some(st) = stop {
+            script[len - 1] = if self.below(3) == 0 {
+                Status::Running
+            } else {
+                st
+            };
+        }
         self.scripts.insert(name.clone(), script);
         format!("<{name}/>")
+    }
+
+    fn leaf(&mut self) -> String {
+        self.leaf_with(None)
+    }
+
+    fn pick<'s>(&mut self, xs: &[&'s str]) -> &'s str {
+        xs[self.below(xs.len() as u64) as usize]
+    }
+
+    /// A write: an int constant or copy, or a constant of another type.
+    fn set(&mut self) -> String {
+        let (key, value) = match self.below(7) {
+            0 => ("d0", self.pick(&["0.5", "1.5", "1.50000005"]).to_string()),
+            1 => ("s0", self.pick(&["a", "b"]).to_string()),
+            2 => ("b0", self.pick(&["true", "false"]).to_string()),
+            3 => (self.int_entry(), format!("{{{}}}", self.int_entry())),
+            _ => (self.int_entry(), self.below(3).to_string()),
+        };
+        format!("<SetBlackboard output_key=\"{key}\" value=\"{value}\"/>")
+    }
+
+    fn int_entry(&mut self) -> &'static str {
+        INTS[self.below(3) as usize]
+    }
+
+    /// A BlackboardCheck of some type over `child`.
+    fn check(&mut self, child: String) -> String {
+        let (tag, a, b) = match self.below(6) {
+            0 => (
+                "Double",
+                "d0",
+                self.pick(&["0.5", "1.5", "1.50000005", "{d0}"]).to_string(),
+            ),
+            1 => ("String", "s0", self.pick(&["a", "b", "{s0}"]).to_string()),
+            2 => ("Bool", "b0", self.pick(&["true", "false"]).to_string()),
+            _ => {
+                let a = self.int_entry();
+                let b = if self.below(2) == 0 {
+                    format!("{{{}}}", self.int_entry())
+                } else {
+                    self.below(3).to_string()
+                };
+                ("Int", a, b)
+            }
+        };
+        let st = self.status();
+        let m = if self.below(2) == 0 {
+            st.name().to_string()
+        } else {
+            st.code().to_string()
+        };
+        format!(
+            "<BlackboardCheck{tag} value_A=\"{{{a}}}\" value_B=\"{b}\" return_on_mismatch=\"{m}\">{child}</BlackboardCheck{tag}>"
+        )
     }
 
     fn children(&mut self, depth: u32, lo: u64, hi: u64) -> String {
         let n = lo + self.below(hi - lo + 1);
         (0..n).map(|_| self.node(depth + 1)).collect()
-    }
-
-    fn entry(&mut self) -> &'static str {
-        if self.below(2) == 0 {
-            "k0"
-        } else {
-            "k1"
-        }
     }
 
     fn node(&mut self, depth: u32) -> String {
@@ -66,11 +131,7 @@ impl<R: Rng> G<'_, R> {
             return match self.below(12) {
                 0 => "<AlwaysSuccess/>".into(),
                 1 => "<AlwaysFailure/>".into(),
-                2 => format!(
-                    "<SetBlackboard output_key=\"{}\" value=\"{}\"/>",
-                    self.entry(),
-                    self.below(3)
-                ),
+                2 => self.set(),
                 3 if !self.subtrees.is_empty() => self.subtree_ref(),
                 _ => self.leaf(),
             };
@@ -87,10 +148,11 @@ impl<R: Rng> G<'_, R> {
                 self.children(depth, 1, 3)
             ),
             6 | 7 => {
-                let tag = if self.below(2) == 0 {
-                    "SequenceWithMemory"
-                } else {
+                // BT.CPP 4 knows `SequenceStar` only under USE_BTCPP3_OLD_NAMES.
+                let tag = if self.v3 {
                     "SequenceStar"
+                } else {
+                    "SequenceWithMemory"
                 };
                 format!("<{tag}>{}</{tag}>", self.children(depth, 1, 4))
             }
@@ -106,48 +168,83 @@ impl<R: Rng> G<'_, R> {
                 };
                 let (s, f) = (th(self), th(self));
                 let kids: String = (0..n).map(|_| self.node(depth + 1)).collect();
-                format!("<Parallel success_count=\"{s}\" failure_count=\"{f}\">{kids}</Parallel>")
+                let (sn, fna) = if self.v3 {
+                    ("success_threshold", "failure_threshold")
+                } else {
+                    ("success_count", "failure_count")
+                };
+                format!("<Parallel {sn}=\"{s}\" {fna}=\"{f}\">{kids}</Parallel>")
             }
             9 => format!("<IfThenElse>{}</IfThenElse>", self.children(depth, 2, 3)),
             10 => format!("<Inverter>{}</Inverter>", self.node(depth + 1)),
             11 => format!("<ForceSuccess>{}</ForceSuccess>", self.node(depth + 1)),
             12 => format!("<ForceFailure>{}</ForceFailure>", self.node(depth + 1)),
-            13 => format!(
-                "<Repeat num_cycles=\"{}\">{}</Repeat>",
-                self.below(4),
-                self.node(depth + 1)
-            ),
-            14 | 15 => format!(
-                "<RetryUntilSuccessful num_attempts=\"{}\">{}</RetryUntilSuccessful>",
-                self.below(4),
-                self.node(depth + 1)
-            ),
-            16 => {
-                let a = self.entry();
-                let b = if self.below(2) == 0 {
-                    format!("{{{}}}", self.entry())
+            13..=15 => {
+                let (tag, port, stop) = if self.below(3) == 0 {
+                    ("Repeat", "num_cycles", Status::Failure)
                 } else {
-                    self.below(3).to_string()
+                    let t = if self.v3 && self.below(2) == 0 {
+                        "RetryUntilSuccesful"
+                    } else {
+                        "RetryUntilSuccessful"
+                    };
+                    (t, "num_attempts", Status::Success)
                 };
-                let m = self.status().name();
-                format!(
-                    "<BlackboardCheckInt value_A=\"{{{a}}}\" value_B=\"{b}\" return_on_mismatch=\"{m}\">{}</BlackboardCheckInt>",
-                    self.node(depth + 1)
-                )
+                // -1: without end, over a leaf whose script stops it.
+                let (count, child) = if self.below(5) == 0 {
+                    (-1, self.leaf_with(Some(stop)))
+                } else {
+                    (self.below(4) as i64, self.node(depth + 1))
+                };
+                format!("<{tag} {port}=\"{count}\">{child}</{tag}>")
+            }
+            16 => {
+                let child = self.node(depth + 1);
+                self.check(child)
             }
             _ if !self.subtrees.is_empty() => self.subtree_ref(),
             _ => self.leaf(),
         }
     }
 
+    /// A SubTree instance: the whole blackboard shared, every entry but `p0` remapped
+    /// (as itself, or `k0` and `k1` swapped). Format 3 spells it `__shared_blackboard`
+    /// and maps by name, or uses `SubTreePlus` (`__autoremap`, `{entry}` values).
     fn subtree_ref(&mut self) -> String {
         let i = self.below(self.subtrees.len() as u64);
-        let remap = match self.below(3) {
-            0 => "_autoremap=\"true\"",
-            1 => "k0=\"{k0}\" k1=\"{k1}\"",
-            _ => "k0=\"{k1}\" k1=\"{k0}\"",
+        let plus = self.v3 && self.below(3) == 0;
+        let (tag, flag, braced) = match (self.v3, plus) {
+            (true, false) => ("SubTree", "__shared_blackboard", false),
+            (true, true) => ("SubTreePlus", "__autoremap", true),
+            _ => ("SubTree", "_autoremap", true),
         };
-        format!("<SubTree ID=\"S{i}\" {remap}/>")
+        let v = |e: &str| {
+            if braced {
+                format!("{{{e}}}")
+            } else {
+                e.to_string()
+            }
+        };
+        let remap = match self.below(3) {
+            0 => format!("{flag}=\"true\""),
+            1 => format!(
+                "k0=\"{}\" k1=\"{}\" d0=\"{}\" s0=\"{}\" b0=\"{}\"",
+                v("k0"),
+                v("k1"),
+                v("d0"),
+                v("s0"),
+                v("b0")
+            ),
+            _ => format!(
+                "k0=\"{}\" k1=\"{}\" d0=\"{}\" s0=\"{}\" b0=\"{}\"",
+                v("k1"),
+                v("k0"),
+                v("d0"),
+                v("s0"),
+                v("b0")
+            ),
+        };
+        format!("<{tag} ID=\"S{i}\" {remap}/>")
     }
 }
 
@@ -158,22 +255,30 @@ pub fn case<R: Rng>(rng: &mut R, size: i64) -> Case {
         scripts: Scripts::new(),
         budget: 0,
         subtrees: Vec::new(),
+        v3: false,
     };
+    g.v3 = g.below(3) == 0;
     let n_sub = g.below(3);
     let mut defs = String::new();
     for i in 0..n_sub {
         g.budget = size / 3;
+        let p0 = g.below(3);
         let body = g.node(1);
-        defs += &format!("<BehaviorTree ID=\"S{i}\">{body}</BehaviorTree>");
+        // The instance's own `p0` written before anything reads it.
+        defs += &format!(
+            "<BehaviorTree ID=\"S{i}\"><Sequence><SetBlackboard output_key=\"p0\" value=\"{p0}\"/>{body}</Sequence></BehaviorTree>"
+        );
         g.subtrees.push(format!("S{i}"));
     }
     g.budget = size;
     let body = g.node(0);
-    // Both entries written first and read once, so each has a value and a type.
+    let format = if g.v3 { 3 } else { 4 };
+    // Every entry written first, so each has a value and a type.
     let xml = format!(
-        "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\"><BehaviorTree ID=\"Main\"><Sequence>\
+        "<root BTCPP_format=\"{format}\" main_tree_to_execute=\"Main\"><BehaviorTree ID=\"Main\"><Sequence>\
 <SetBlackboard output_key=\"k0\" value=\"0\"/><SetBlackboard output_key=\"k1\" value=\"1\"/>\
-<ForceSuccess><BlackboardCheckInt value_A=\"{{k0}}\" value_B=\"{{k1}}\" return_on_mismatch=\"SUCCESS\"><AlwaysSuccess/></BlackboardCheckInt></ForceSuccess>\
+<SetBlackboard output_key=\"p0\" value=\"2\"/><SetBlackboard output_key=\"d0\" value=\"1.5\"/>\
+<SetBlackboard output_key=\"s0\" value=\"a\"/><SetBlackboard output_key=\"b0\" value=\"true\"/>\
 {body}</Sequence></BehaviorTree>{defs}</root>"
     );
     let ticks = 4 + g.below(7) as usize;

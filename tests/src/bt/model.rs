@@ -4,8 +4,17 @@
 
 use super::oracle::Scripts;
 
+/// Whether leaf type `name`'s plugin has a `<bt_halt>`: all but `N0`, `N1`, ... The
+/// lowering under `Halts::WhenNeeded` sends such a leaf no halt at all (its halt changes
+/// nothing), so a comparison drops the halts the oracle gives it.
+pub fn has_halt(name: &str) -> bool {
+    let b = name.as_bytes();
+    !(b.len() > 1 && b[0] == b'N' && b[1].is_ascii_digit())
+}
+
 /// The plugin of leaf type `name`: on its k-th tick it answers `script[k % len]`; a halt
-/// is answered and does not move it.
+/// is answered and does not move it. A type named `N<digit>...` has no `<bt_halt>` ([`has_halt`]), as older
+/// AS2FM plugins have none (the lowering answers their halts in every state).
 pub fn plugin(name: &str, script: &[super::tree::Status]) -> String {
     let len = script.len();
     let mut branches = String::new();
@@ -28,13 +37,17 @@ pub fn plugin(name: &str, script: &[super::tree::Status]) -> String {
     } else {
         branches += "</if>";
     }
+    let halt = if !has_halt(name) {
+        ""
+    } else {
+        "<bt_halt target=\"s\"><bt_return_halted/></bt_halt>\n"
+    };
     format!(
         r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="{name}">
 <datamodel><data id="k" type="int32" expr="0"/></datamodel>
 <state id="s">
 <bt_tick target="s">{branches}</bt_tick>
-<bt_halt target="s"><bt_return_halted/></bt_halt>
-</state>
+{halt}</state>
 </ascxml>"#
     )
 }

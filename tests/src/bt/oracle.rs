@@ -6,7 +6,7 @@
 //! BT.CPP v4.10 (`src/controls/*.cpp`, `src/decorators/*.cpp`, `control_node.cpp`,
 //! `decorator_node.cpp`) and AS2FM's `*.ascxml` node models.
 
-use super::tree::{Kind, Operand, Status, Tree};
+use super::tree::{CheckType, Kind, Operand, Status, Tree};
 use std::collections::BTreeMap;
 
 /// Whose rules the oracle follows where AS2FM and BT.CPP differ.
@@ -50,7 +50,8 @@ pub struct Oracle<'t> {
     counts: Vec<(i64, i64)>,
     /// Ticks each leaf instance received.
     leaf_ticks: Vec<usize>,
-    bb: BTreeMap<String, i64>,
+    /// Entries as the text written (BT.CPP converts where a port reads).
+    bb: BTreeMap<String, String>,
     /// Every tick and halt leaves received, in order.
     pub log: Vec<LeafEvent>,
 }
@@ -91,15 +92,42 @@ impl<'t> Oracle<'t> {
         self.tree.nodes[n].children.len()
     }
 
-    fn value(&self, o: &Operand) -> Result<i64, String> {
+    fn value(&self, o: &Operand) -> Result<String, String> {
         match o {
-            Operand::Lit(v) => Ok(*v),
+            Operand::Lit(v) => Ok(v.clone()),
             Operand::Entry(e) => self
                 .bb
                 .get(e)
-                .copied()
+                .cloned()
                 .ok_or(format!("blackboard entry {e} read before written")),
         }
+    }
+
+    /// v3.8 `blackboard_precondition.h`: both sides converted to the node's type
+    /// (`convertFromString`), then `IsSame` -- `==`, for doubles `|a - b| <= EPS` with
+    /// `EPS` the float epsilon.
+    fn same(&self, ty: CheckType, a: &Operand, b: &Operand) -> Result<bool, String> {
+        let (a, b) = (self.value(a)?, self.value(b)?);
+        let bad = |v: &str| format!("`{v}` is not a {ty:?}");
+        Ok(match ty {
+            CheckType::Int => {
+                let p = |v: &str| v.trim().parse::<i64>().map_err(|_| bad(v));
+                p(&a)? == p(&b)?
+            }
+            CheckType::Double => {
+                let p = |v: &str| v.trim().parse::<f64>().map_err(|_| bad(v));
+                (p(&a)? - p(&b)?).abs() <= f64::from(f32::EPSILON)
+            }
+            CheckType::String => a == b,
+            CheckType::Bool => {
+                let p = |v: &str| match v.trim() {
+                    "true" | "True" | "1" => Ok(true),
+                    "false" | "False" | "0" => Ok(false),
+                    _ => Err(bad(v)),
+                };
+                p(&a)? == p(&b)?
+            }
+        })
     }
 
     /// `TreeNode::executeTick`: the node's tick, its answer kept as its status.
@@ -190,16 +218,18 @@ impl<'t> Oracle<'t> {
             &Kind::Retry(max) => self.repeat(n, max, Failure),
             Kind::AlwaysSuccess => Ok(Success),
             Kind::AlwaysFailure => Ok(Failure),
+            // v4 `SetBlackboardNode::tick`: a `{other}` value copies that entry.
             Kind::SetBlackboard(key, v) => {
-                self.bb.insert(key.clone(), *v);
+                let v = self.value(v)?;
+                self.bb.insert(key.clone(), v);
                 Ok(Success)
             }
-            Kind::CheckInt(a, b, mismatch) => {
+            Kind::Check(ty, a, b, mismatch) => {
                 let mismatch = *mismatch;
                 let c = self.child(n, 0);
                 // v3.8 `BlackboardPreconditionNode::tick`; AS2FM's
                 // `blackboard_check_int.ascxml` halts the child on a mismatch.
-                if self.value(a)? == self.value(b)? {
+                if self.same(*ty, a, b)? {
                     self.tick(c)
                 } else {
                     self.halt_child(c);
@@ -377,7 +407,13 @@ impl<'t> Oracle<'t> {
         };
         let c = self.child(n, 0);
         let halts = self.reading == Reading::Btcpp || again == Status::Success;
+        let mut spins = 0;
         while max == -1 || self.idx[n] < max {
+            // -1 repeats without end: a child that never stops would hang BT.CPP too.
+            spins += 1;
+            if spins > 10_000 {
+                return Err("a Repeat/Retry of -1 never stops within one tick".into());
+            }
             let s = self.tick(c)?;
             if s == Status::Running {
                 return Ok(Status::Running);

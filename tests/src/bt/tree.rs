@@ -47,13 +47,27 @@ impl Status {
     }
 }
 
-/// One side of a blackboard comparison.
+/// One side of a blackboard comparison, or the value SetBlackboard writes.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Operand {
-    /// A number written in the tree.
-    Lit(i64),
+    /// Text written in the tree (BT.CPP keeps a SetBlackboard value as a string and
+    /// converts it where a port reads it: `convertFromString`).
+    Lit(String),
     /// A blackboard entry (after SubTree remapping).
     Entry(String),
+}
+
+/// Which `BlackboardCheck*` node: the type both sides are read as.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CheckType {
+    /// `BlackboardCheckInt`.
+    Int,
+    /// `BlackboardCheckDouble`: equal within `f32::EPSILON`.
+    Double,
+    /// `BlackboardCheckString`.
+    String,
+    /// `BlackboardCheckBool`.
+    Bool,
 }
 
 /// What a node is.
@@ -89,10 +103,11 @@ pub enum Kind {
     AlwaysSuccess,
     /// `AlwaysFailure`.
     AlwaysFailure,
-    /// `SetBlackboard`: the entry and the integer written.
-    SetBlackboard(String, i64),
-    /// `BlackboardCheckInt`: `value_A`, `value_B`, `return_on_mismatch`.
-    CheckInt(Operand, Operand, Status),
+    /// `SetBlackboard`: the entry and the text written, or the entry copied.
+    SetBlackboard(String, Operand),
+    /// `BlackboardCheckInt/Double/String/Bool`: `value_A`, `value_B`,
+    /// `return_on_mismatch`.
+    Check(CheckType, Operand, Operand, Status),
 }
 
 /// A node of the flattened tree.
@@ -160,18 +175,19 @@ pub const NODES: &[(&[&str], Arity, Make)] = &[
             .get("output_key")
             .ok_or("SetBlackboard needs output_key")?;
         let key = entry(key).unwrap_or(key.trim()).to_string();
-        Ok(Kind::SetBlackboard(key, int(a, "value")?))
+        Ok(Kind::SetBlackboard(key, operand(a, "value")?))
     }),
     (&["BlackboardCheckInt"], (1, 1), |a| {
-        let mismatch = match a.get("return_on_mismatch") {
-            None => Status::Failure,
-            Some(s) => Status::parse(s).ok_or(format!("bad return_on_mismatch {s}"))?,
-        };
-        Ok(Kind::CheckInt(
-            operand(a, "value_A")?,
-            operand(a, "value_B")?,
-            mismatch,
-        ))
+        check(a, CheckType::Int)
+    }),
+    (&["BlackboardCheckDouble"], (1, 1), |a| {
+        check(a, CheckType::Double)
+    }),
+    (&["BlackboardCheckString"], (1, 1), |a| {
+        check(a, CheckType::String)
+    }),
+    (&["BlackboardCheckBool"], (1, 1), |a| {
+        check(a, CheckType::Bool)
     }),
 ];
 
@@ -197,8 +213,27 @@ fn operand(a: &Attrs, k: &str) -> Result<Operand, String> {
     let v = a.get(k).ok_or(format!("missing `{k}`"))?;
     Ok(match entry(v) {
         Some(e) => Operand::Entry(e.to_string()),
-        None => Operand::Lit(v.trim().parse().map_err(|_| format!("`{k}`: {v}"))?),
+        None => Operand::Lit(v.trim().to_string()),
     })
+}
+
+/// A `BlackboardCheck*` node. `return_on_mismatch` defaults to FAILURE (v3.8
+/// `BlackboardPreconditionNode::tick`, `default_return_status`); besides the names it
+/// takes AS2FM's numbers 1, 2, 3 (`bt_utils.py`, `BtResponse`).
+fn check(a: &Attrs, ty: CheckType) -> Result<Kind, String> {
+    let mismatch = match a.get("return_on_mismatch").map(|s| s.trim()) {
+        None => Status::Failure,
+        Some("1") => Status::Success,
+        Some("2") => Status::Failure,
+        Some("3") => Status::Running,
+        Some(s) => Status::parse(s).ok_or(format!("bad return_on_mismatch {s}"))?,
+    };
+    Ok(Kind::Check(
+        ty,
+        operand(a, "value_A")?,
+        operand(a, "value_B")?,
+        mismatch,
+    ))
 }
 
 /// A bare XML element.
@@ -265,7 +300,9 @@ pub fn read(text: &str) -> Result<Tree, String> {
             .find(|c| c.name == "BehaviorTree")
             .ok_or("no <BehaviorTree>")?,
     };
+    let v3 = root.attrs.get("BTCPP_format").map(|f| f.trim()) == Some("3");
     let mut r = Flat {
+        v3,
         trees,
         tree: Tree::default(),
         scopes: vec![Scope::default()],
@@ -285,6 +322,8 @@ struct Scope {
 }
 
 struct Flat<'a> {
+    /// `BTCPP_format="3"`: a plain `<SubTree>` maps names to the caller's names.
+    v3: bool,
     trees: BTreeMap<&'a str, &'a El>,
     tree: Tree,
     scopes: Vec<Scope>,
@@ -306,7 +345,7 @@ impl Flat<'_> {
     }
 
     fn node(&mut self, el: &El, parent: Option<usize>) -> Result<(), String> {
-        if el.name == "SubTree" {
+        if el.name == "SubTree" || (self.v3 && el.name == "SubTreePlus") {
             return self.subtree(el, parent);
         }
         let depth = self.scopes.len() - 1;
@@ -365,12 +404,25 @@ impl Flat<'_> {
             ..Scope::default()
         };
         self.instances += 1;
+        // v4 `SubTree`: `_autoremap`, `{outer}` values. v3.8 (`xml_parsing.cpp`,
+        // `XMLParser::Pimpl::recursivelyCreateTree`): a plain `SubTree` shares everything
+        // with `__shared_blackboard` and maps `inner="outer"` by name; `SubTreePlus` has
+        // `__autoremap` and `{outer}` values.
+        let (flag, by_name) = match (self.v3, el.name.as_str()) {
+            (true, "SubTree") => ("__shared_blackboard", true),
+            (true, _) => ("__autoremap", false),
+            (false, _) => ("_autoremap", false),
+        };
         for (k, v) in &el.attrs {
             match k.as_str() {
                 "ID" | "name" => {}
-                "_autoremap" => scope.autoremap = v.trim() == "true",
+                f if f == flag => scope.autoremap = matches!(v.trim(), "true" | "1"),
                 _ => {
-                    let outer = entry(v).ok_or(format!("SubTree port {k}={v}: not an entry"))?;
+                    let outer = match entry(v) {
+                        Some(e) => e,
+                        None if by_name => v.trim(),
+                        None => return Err(format!("SubTree port {k}={v}: not an entry")),
+                    };
                     scope.remap.insert(k.clone(), outer.to_string());
                 }
             }
