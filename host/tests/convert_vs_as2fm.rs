@@ -82,7 +82,7 @@ const FALLBACK: &str = "the answers of the child in `tick_children` come in anot
     than AS2FM's fallback.ascxml / reactive_fallback.ascxml write them (RUNNING, SUCCESS, \
     FAILURE; and ReactiveFallback's variables `running_child` before `success_child`): the \
     conditions exclude each other (one status each), so no run changes; the node \
-    generators are host/src/robot/bt/control.rs's";
+    generators are host/src/robot/bt/sequences.rs's";
 
 /// The differences that remain: (case, machine, why). A machine `*` is a case we refuse.
 const KNOWN: &[(&str, &str, &str)] = &[
