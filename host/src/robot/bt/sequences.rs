@@ -40,15 +40,29 @@ pub(super) fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
             "seq_failure"
         }
     };
-    on_child_status(ctx, &mut t, idx, cont, "tick_children", || {
-        vec![b.assign(idx, &format!("{idx} + 1"))]
-    });
-    on_child_status(ctx, &mut t, idx, stop, "reset_children", || {
-        vec![b.assign(idx, "0"), b.assign(flag(stop), "true")]
-    });
-    on_child_status(ctx, &mut t, idx, RUNNING, "wait_for_tick", || {
-        vec![ctx.respond(RUNNING)]
-    });
+    // The child's answers in each model's order, state `tick_children`: AS2FM's
+    // sequence.ascxml SUCCESS, FAILURE, RUNNING; fallback.ascxml RUNNING, SUCCESS,
+    // FAILURE (one status each, so the order changes no run, only the text).
+    let order = if cont == SUCCESS {
+        [cont, stop, RUNNING]
+    } else {
+        [RUNNING, stop, cont]
+    };
+    for s in order {
+        if s == cont {
+            on_child_status(ctx, &mut t, idx, cont, "tick_children", || {
+                vec![b.assign(idx, &format!("{idx} + 1"))]
+            });
+        } else if s == stop {
+            on_child_status(ctx, &mut t, idx, stop, "reset_children", || {
+                vec![b.assign(idx, "0"), b.assign(flag(stop), "true")]
+            });
+        } else {
+            on_child_status(ctx, &mut t, idx, RUNNING, "wait_for_tick", || {
+                vec![ctx.respond(RUNNING)]
+            });
+        }
+    }
     t.push(b.tr(
         None,
         Some(&format!("{idx} == children_count")),
@@ -174,7 +188,14 @@ pub(super) fn reactive(ctx: &Ctx, seq: bool) -> Element {
                 Some(&ctx.halt_ev()),
                 None,
                 Some("reset_children"),
-                vec![b.assign(idx, "0"), b.assign(stop_child, "-1")],
+                // The variable a halt resets is each model's, state `wait_for_tick`:
+                // AS2FM's reactive_sequence.ascxml `failed_child`,
+                // reactive_fallback.ascxml `running_child`. Either is already -1 or
+                // unread until set again, so no run changes.
+                vec![
+                    b.assign(idx, "0"),
+                    b.assign(if seq { stop_child } else { "running_child" }, "-1"),
+                ],
             )),
     );
     let finish = vec![
@@ -202,18 +223,32 @@ pub(super) fn reactive(ctx: &Ctx, seq: bool) -> Element {
     );
     let mut t = b.state_entry("tick_children", vec![guard]);
     let n = ctx.children.len();
-    on_child_status(ctx, &mut t, idx, cont, "tick_children", || {
-        vec![
-            b.assign(count, &format!("{count} + 1")),
-            b.assign(idx, &format!("{idx} + 1")),
-        ]
-    });
-    on_child_status(ctx, &mut t, idx, stop, "reset_children", || {
-        vec![b.assign(stop_child, idx), b.assign(idx, "0")]
-    });
-    on_child_status(ctx, &mut t, idx, RUNNING, "reset_other_children", || {
-        vec![b.assign("running_child", idx), b.assign(idx, "0")]
-    });
+    // The child's answers in each model's order, state `tick_children`: AS2FM's
+    // reactive_sequence.ascxml SUCCESS, FAILURE, RUNNING; reactive_fallback.ascxml
+    // RUNNING, FAILURE, SUCCESS.
+    let order = if seq {
+        [cont, stop, RUNNING]
+    } else {
+        [RUNNING, cont, stop]
+    };
+    for s in order {
+        if s == cont {
+            on_child_status(ctx, &mut t, idx, cont, "tick_children", || {
+                vec![
+                    b.assign(count, &format!("{count} + 1")),
+                    b.assign(idx, &format!("{idx} + 1")),
+                ]
+            });
+        } else if s == stop {
+            on_child_status(ctx, &mut t, idx, stop, "reset_children", || {
+                vec![b.assign(stop_child, idx), b.assign(idx, "0")]
+            });
+        } else {
+            on_child_status(ctx, &mut t, idx, RUNNING, "reset_other_children", || {
+                vec![b.assign("running_child", idx), b.assign(idx, "0")]
+            });
+        }
+    }
     t.push(b.tr(
         None,
         Some(&format!("{count} == children_count")),
