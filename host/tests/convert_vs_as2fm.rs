@@ -77,13 +77,6 @@ const STRUCTS: &str = "AS2FM flattens a struct-typed variable into one variable 
 const ARRAY_PARAM: &str = "hindsight writes the interface's type on a `<param>` of an array \
     field (`type=\"int32[]\"`), so that an empty array literal has an element type when the \
     plain file is read back; AS2FM's plain file leaves it out";
-/// Why a Fallback or ReactiveFallback differs.
-const FALLBACK: &str = "the answers of the child in `tick_children` come in another order \
-    than AS2FM's fallback.ascxml / reactive_fallback.ascxml write them (RUNNING, SUCCESS, \
-    FAILURE; and ReactiveFallback's variables `running_child` before `success_child`): the \
-    conditions exclude each other (one status each), so no run changes; the node \
-    generators are host/src/robot/bt/control.rs's";
-
 /// The differences that remain: (case, machine, why). A machine `*` is a case we refuse.
 const KNOWN: &[(&str, &str, &str)] = &[
     ("array_of_data_structs_main", "receiver", STRUCTS),
@@ -107,51 +100,13 @@ const KNOWN: &[(&str, &str, &str)] = &[
         "fibonacci_thread_0",
         ARRAY_PARAM,
     ),
-    (
-        "grid_robot_blackboard_simple_main",
-        "BT_plugin_1000_control_loop",
-        FALLBACK,
-    ),
     ("overarching_tutorial_main_locations", "world", STRUCTS),
-    (
-        "robot_navigation_with_bt_main",
-        "BT_plugin_1000_ReactiveFallback",
-        FALLBACK,
-    ),
     (
         "string_msg_comparison_main",
         "*",
         "it publishes example_interfaces/String on a topic it subscribes as \
          nested_interfaces/Internal and reads `_msg.data`, which the subscribed type does not \
          have; AS2FM accepts it, hindsight reports both at their positions",
-    ),
-    (
-        "uc1_docking_main",
-        "BT_plugin_1000_perform_docking",
-        FALLBACK,
-    ),
-    (
-        "uc1_docking_main_with_problem",
-        "BT_plugin_1000_perform_docking",
-        FALLBACK,
-    ),
-    ("uc2_assembly_main", "BT_plugin_1001_Fallback", FALLBACK),
-    (
-        "uc3_museum_guide_main",
-        "BT_plugin_1001_ReactiveFallback",
-        FALLBACK,
-    ),
-    ("uc3_museum_guide_main", "BT_plugin_1004_Fallback", FALLBACK),
-    (
-        "uc3_museum_guide_main",
-        "BT_plugin_1015_ReactiveFallback",
-        FALLBACK,
-    ),
-    ("bt_fallback", "BT_plugin_1000_Fallback", FALLBACK),
-    (
-        "bt_reactive_fallback",
-        "BT_plugin_1000_root_sequence",
-        FALLBACK,
     ),
 ];
 

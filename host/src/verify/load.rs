@@ -255,8 +255,8 @@ fn load_robot(
 ) -> Result<(Loaded, Vec<ExternalComponent>), String> {
     use crate::robot::main_file::InputKind;
     let search = crate::robot::interfaces::Search::from_env(opts.interfaces.clone());
-    let (robot, external) = crate::robot::load::load_searching(main, external, &search)
-        .map_err(|d| d.to_string())?;
+    let (robot, external) =
+        crate::robot::load::load_searching(main, external, &search).map_err(|d| d.to_string())?;
     for w in &robot.warnings {
         eprintln!("warning: {w}");
     }

@@ -17,8 +17,9 @@
 //!   (Sequence, ReactiveSequence, SequenceWithMemory, Fallback, ReactiveFallback,
 //!   Parallel, IfThenElse, Inverter, ForceSuccess, ForceFailure, Repeat,
 //!   RetryUntilSuccessful, AlwaysSuccess, AlwaysFailure, SetBlackboard,
-//!   BlackboardCheckInt / Double / String / Bool) are generated (`control.rs`, `blackboard.rs`); leaves are instances
-//!   of their plugin (`plugin.rs`) and keep their ROS tags for the ROS lowering.
+//!   BlackboardCheckInt / Double / String / Bool) are generated (`control.rs` and the
+//!   files it dispatches to, `blackboard.rs`); leaves are instances of their plugin
+//!   (`plugin.rs`) and keep their ROS tags for the ROS lowering.
 //! - `bt_blackboard_fsm` when the tree names `{entries}`.
 //!
 //! A parent ticks a child with `bt_<id>_tick`; the child answers `bt_<id>_response` with
@@ -32,7 +33,10 @@
 mod blackboard;
 mod build;
 mod control;
+mod decorators;
+mod parallel;
 mod plugin;
+mod sequences;
 mod tree;
 
 use crate::model::source::{Diagnostic, FileId, SourceMap};
