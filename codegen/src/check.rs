@@ -36,16 +36,7 @@ fn lit_text(t: &TimeLit) -> String {
 
 /// `value * unit_ns`, exactly, as `(numerator, scale)`: the duration is `numerator / scale` ns.
 fn scaled_ns(t: &TimeLit, unit_ns: u64) -> Option<(u128, u128)> {
-    let frac = t.frac.trim_end_matches('0');
-    let scale = 10u128.checked_pow(u32::try_from(frac.len()).ok()?)?;
-    let int: u128 = t.int.parse().ok()?;
-    let frac_v: u128 = if frac.is_empty() {
-        0
-    } else {
-        frac.parse().ok()?
-    };
-    let numer = int.checked_mul(scale)?.checked_add(frac_v)?;
-    Some((numer.checked_mul(unit_ns as u128)?, scale))
+    crate::duration::scaled_decimal(&t.int, &t.frac, unit_ns)
 }
 
 /// Converts a bound end to ticks of `tick_ns` exactly.

@@ -66,6 +66,26 @@ impl TimeUnit {
     }
 }
 
+/// The decimal `int.frac` (digits only; an empty `int` is 0) times `scale`, exactly, as
+/// `(numerator, denominator)`: the value is `numerator / denominator`, the denominator
+/// `10^k` for the fraction's `k` significant digits. `None` when it overflows `u128`.
+/// [`decimal_times`] and the formula checker's bounds in ticks both compute with it.
+pub fn scaled_decimal(int: &str, frac: &str, scale: u64) -> Option<(u128, u128)> {
+    let frac = frac.trim_end_matches('0');
+    let pow = 10u128.checked_pow(u32::try_from(frac.len()).ok()?)?;
+    let int_v: u128 = if int.is_empty() { 0 } else { int.parse().ok()? };
+    let frac_v: u128 = if frac.is_empty() {
+        0
+    } else {
+        frac.parse().ok()?
+    };
+    let num = int_v
+        .checked_mul(pow)?
+        .checked_add(frac_v)?
+        .checked_mul(u128::from(scale))?;
+    Some((num, pow))
+}
+
 /// The decimal `text` (`100`, `2.5`, `.5`) times `scale` nanoseconds, exactly; an error
 /// when it is negative, not a plain decimal, not a whole number of nanoseconds or too
 /// large for `u64`.
@@ -77,27 +97,11 @@ pub fn decimal_times(text: &str, scale: u64) -> Result<u64, String> {
             "`{text}` is not a non-negative decimal number (write `100` or `2.5`)"
         ));
     }
-    let frac = frac.trim_end_matches('0');
-    if frac.len() > 19 {
+    if frac.trim_end_matches('0').len() > 19 {
         return Err(format!("`{text}` is finer than a nanosecond"));
     }
     let too_big = || format!("`{text}` is too large");
-    let int_v: u128 = if int.is_empty() {
-        0
-    } else {
-        int.parse().map_err(|_| too_big())?
-    };
-    let pow = 10u128.pow(frac.len() as u32);
-    let frac_v: u128 = if frac.is_empty() {
-        0
-    } else {
-        frac.parse().map_err(|_| too_big())?
-    };
-    let num = int_v
-        .checked_mul(pow)
-        .and_then(|v| v.checked_add(frac_v))
-        .and_then(|v| v.checked_mul(u128::from(scale)))
-        .ok_or_else(too_big)?;
+    let (num, pow) = scaled_decimal(int, frac, scale).ok_or_else(too_big)?;
     if num % pow != 0 {
         return Err(format!("`{text}` is finer than a nanosecond"));
     }
