@@ -2,6 +2,7 @@
 
 use super::source::{Diagnostic, FileId, SourceMap, Span};
 use super::xml::{self, Node};
+pub use codegen::scalar::Scalar;
 
 /// A base (scalar) type as written in a model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -16,111 +17,10 @@ pub enum BaseType {
     Str,
 }
 
-/// A scalar type by name: the one table of scalar type names (`int32`, `float64`,
-/// `string`, ...) that models, property files, the properties' spec language and the
-/// sidecar's layouts share.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Scalar {
-    /// `bool` / `boolean`; spec `bool`.
-    Bool,
-    /// `int8`; spec `i8`.
-    I8,
-    /// `int16`; spec `i16`.
-    I16,
-    /// `int32` / `int`; spec `i32`.
-    I32,
-    /// `int64`; spec `i64`.
-    I64,
-    /// `uint8`; spec `u8`.
-    U8,
-    /// `uint16`; spec `u16`.
-    U16,
-    /// `uint32`; spec `u32`.
-    U32,
-    /// `uint64`; spec `u64`.
-    U64,
-    /// `float32` / `float`; spec `f32`.
-    F32,
-    /// `float64` / `double`; spec `f64`.
-    F64,
-    /// `string`; spec `string`.
-    Str,
-}
-
-impl Scalar {
-    /// Every scalar.
-    pub const ALL: [Scalar; 12] = [
-        Scalar::Bool,
-        Scalar::I8,
-        Scalar::I16,
-        Scalar::I32,
-        Scalar::I64,
-        Scalar::U8,
-        Scalar::U16,
-        Scalar::U32,
-        Scalar::U64,
-        Scalar::F32,
-        Scalar::F64,
-        Scalar::Str,
-    ];
-
-    /// The scalar a model or property file names: `bool`, `boolean`, `int`, `int8` ...
-    /// `int64`, `uint8` ... `uint64`, `float`, `float32`, `double`, `float64`, `string`.
-    pub fn from_name(name: &str) -> Option<Scalar> {
-        Some(match name {
-            "boolean" => Scalar::Bool,
-            "int" => Scalar::I32,
-            "float" => Scalar::F32,
-            "double" => Scalar::F64,
-            _ => return Scalar::ALL.into_iter().find(|s| s.name() == name),
-        })
-    }
-
-    /// The scalar the spec language (and a sidecar layout) names: `bool`, `i8` ...
-    /// `u64`, `f32`, `f64`, `string`.
-    pub fn from_spec_name(name: &str) -> Option<Scalar> {
-        Scalar::ALL.into_iter().find(|s| s.spec_name() == name)
-    }
-
-    /// The name as a model writes it: `bool`, `int8`, ..., `float64`, `string`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Scalar::Bool => "bool",
-            Scalar::I8 => "int8",
-            Scalar::I16 => "int16",
-            Scalar::I32 => "int32",
-            Scalar::I64 => "int64",
-            Scalar::U8 => "uint8",
-            Scalar::U16 => "uint16",
-            Scalar::U32 => "uint32",
-            Scalar::U64 => "uint64",
-            Scalar::F32 => "float32",
-            Scalar::F64 => "float64",
-            Scalar::Str => "string",
-        }
-    }
-
-    /// The name in the spec language: `bool`, `i8`, ..., `f64`, `string`.
-    pub fn spec_name(self) -> &'static str {
-        match self {
-            Scalar::Bool => "bool",
-            Scalar::I8 => "i8",
-            Scalar::I16 => "i16",
-            Scalar::I32 => "i32",
-            Scalar::I64 => "i64",
-            Scalar::U8 => "u8",
-            Scalar::U16 => "u16",
-            Scalar::U32 => "u32",
-            Scalar::U64 => "u64",
-            Scalar::F32 => "f32",
-            Scalar::F64 => "f64",
-            Scalar::Str => "string",
-        }
-    }
-
-    /// How the simulator stores it.
-    pub fn base(self) -> BaseType {
-        match self {
+/// How the simulator stores a scalar.
+impl From<Scalar> for BaseType {
+    fn from(s: Scalar) -> BaseType {
+        match s {
             Scalar::Bool => BaseType::Bool,
             Scalar::I8
             | Scalar::I16
@@ -161,7 +61,7 @@ impl TypeExpr {
         let base = base.trim();
         // The shared scalar names, then the spellings only SCXML data declarations accept.
         let mut ty = match (Scalar::from_name(base), base) {
-            (Some(scalar), _) => TypeExpr::Base(scalar.base()),
+            (Some(scalar), _) => TypeExpr::Base(scalar.into()),
             (None, "integer") => TypeExpr::Base(BaseType::Int),
             (None, "f64" | "f32") => TypeExpr::Base(BaseType::Float),
             (None, "URI" | "str") => TypeExpr::Base(BaseType::Str),
@@ -376,20 +276,19 @@ mod tests {
     use super::*;
 
     #[test]
-    fn one_scalar_table() {
+    fn scalar_names_parse_to_their_base_type() {
         for s in Scalar::ALL {
-            assert_eq!(Scalar::from_name(s.name()), Some(s));
-            assert_eq!(Scalar::from_spec_name(s.spec_name()), Some(s));
-            assert_eq!(TypeExpr::parse(s.name()), Ok(TypeExpr::Base(s.base())));
+            assert_eq!(TypeExpr::parse(s.name()), Ok(TypeExpr::Base(s.into())));
         }
-        assert_eq!(Scalar::from_name("int"), Some(Scalar::I32));
-        assert_eq!(Scalar::from_name("double"), Some(Scalar::F64));
-        assert_eq!(Scalar::from_name("integer"), None);
+        assert_eq!(TypeExpr::parse("int"), Ok(TypeExpr::Base(BaseType::Int)));
         assert_eq!(
             TypeExpr::parse("integer"),
             Ok(TypeExpr::Base(BaseType::Int))
         );
-        assert_eq!(Scalar::from_spec_name("int32"), None);
+        assert_eq!(
+            TypeExpr::parse("double"),
+            Ok(TypeExpr::Base(BaseType::Float))
+        );
     }
 
     #[test]

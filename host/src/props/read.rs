@@ -24,7 +24,7 @@ pub(super) enum Ty {
 impl Ty {
     fn of(declared: &str) -> Option<Ty> {
         use crate::model::types::{BaseType, Scalar};
-        Some(match Scalar::from_name(declared)?.base() {
+        Some(match BaseType::from(Scalar::from_name(declared)?) {
             BaseType::Bool => Ty::Bool,
             BaseType::Int => Ty::Int,
             BaseType::Float => Ty::Float,
