@@ -36,16 +36,7 @@ fn lit_text(t: &TimeLit) -> String {
 
 /// `value * unit_ns`, exactly, as `(numerator, scale)`: the duration is `numerator / scale` ns.
 fn scaled_ns(t: &TimeLit, unit_ns: u64) -> Option<(u128, u128)> {
-    let frac = t.frac.trim_end_matches('0');
-    let scale = 10u128.checked_pow(u32::try_from(frac.len()).ok()?)?;
-    let int: u128 = t.int.parse().ok()?;
-    let frac_v: u128 = if frac.is_empty() {
-        0
-    } else {
-        frac.parse().ok()?
-    };
-    let numer = int.checked_mul(scale)?.checked_add(frac_v)?;
-    Some((numer.checked_mul(unit_ns as u128)?, scale))
+    crate::duration::scaled_decimal(&t.int, &t.frac, unit_ns)
 }
 
 /// Converts a bound end to ticks of `tick_ns` exactly.
@@ -98,21 +89,31 @@ fn unit_ns(t: &TimeLit) -> Result<u64, String> {
 
 /// Resolves a declared type name to its run-time type and, for integers, its range.
 fn resolve_type(name: &str) -> Option<(Ty, Option<(i128, i128)>)> {
-    let int = |lo: i128, hi: i128| Some((Ty::Int, Some((lo, hi))));
+    use crate::scalar::Scalar;
     match name {
-        "bool" => Some((Ty::Bool, None)),
-        "int" | "i64" => int(i64::MIN as i128, i64::MAX as i128),
-        "i8" => int(i8::MIN as i128, i8::MAX as i128),
-        "i16" => int(i16::MIN as i128, i16::MAX as i128),
-        "i32" => int(i32::MIN as i128, i32::MAX as i128),
-        "u8" => int(0, u8::MAX as i128),
-        "u16" => int(0, u16::MAX as i128),
-        "u32" => int(0, u32::MAX as i128),
-        // Stored as i64: the upper half of u64 is out of reach.
-        "u64" => int(0, i64::MAX as i128),
-        "float" | "f32" | "f64" => Some((Ty::Float, None)),
-        "string" => Some((Ty::Str, None)),
-        _ => None,
+        "int" => Some((Ty::Int, Some((i64::MIN.into(), i64::MAX.into())))),
+        "float" => Some((Ty::Float, None)),
+        _ => {
+            let scalar = Scalar::from_spec_name(name)?;
+            let ty = match scalar {
+                Scalar::Bool => Ty::Bool,
+                Scalar::F32 | Scalar::F64 => Ty::Float,
+                Scalar::Str => Ty::Str,
+                Scalar::I8
+                | Scalar::I16
+                | Scalar::I32
+                | Scalar::I64
+                | Scalar::U8
+                | Scalar::U16
+                | Scalar::U32
+                | Scalar::U64 => Ty::Int,
+            };
+            // Stored as i64: the upper half of u64 is out of reach.
+            let range = scalar
+                .int_range()
+                .map(|(lo, hi)| (lo, hi.min(i64::MAX.into())));
+            Some((ty, range))
+        }
     }
 }
 

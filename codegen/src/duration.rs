@@ -66,6 +66,26 @@ impl TimeUnit {
     }
 }
 
+/// The decimal `int.frac` (digits only; an empty `int` is 0) times `scale`, exactly, as
+/// `(numerator, denominator)`: the value is `numerator / denominator`, the denominator
+/// `10^k` for the fraction's `k` significant digits. `None` when it overflows `u128`.
+/// [`decimal_times`] and the formula checker's bounds in ticks both compute with it.
+pub fn scaled_decimal(int: &str, frac: &str, scale: u64) -> Option<(u128, u128)> {
+    let frac = frac.trim_end_matches('0');
+    let pow = 10u128.checked_pow(u32::try_from(frac.len()).ok()?)?;
+    let int_v: u128 = if int.is_empty() { 0 } else { int.parse().ok()? };
+    let frac_v: u128 = if frac.is_empty() {
+        0
+    } else {
+        frac.parse().ok()?
+    };
+    let num = int_v
+        .checked_mul(pow)?
+        .checked_add(frac_v)?
+        .checked_mul(u128::from(scale))?;
+    Some((num, pow))
+}
+
 /// The decimal `text` (`100`, `2.5`, `.5`) times `scale` nanoseconds, exactly; an error
 /// when it is negative, not a plain decimal, not a whole number of nanoseconds or too
 /// large for `u64`.
@@ -77,27 +97,11 @@ pub fn decimal_times(text: &str, scale: u64) -> Result<u64, String> {
             "`{text}` is not a non-negative decimal number (write `100` or `2.5`)"
         ));
     }
-    let frac = frac.trim_end_matches('0');
-    if frac.len() > 19 {
+    if frac.trim_end_matches('0').len() > 19 {
         return Err(format!("`{text}` is finer than a nanosecond"));
     }
     let too_big = || format!("`{text}` is too large");
-    let int_v: u128 = if int.is_empty() {
-        0
-    } else {
-        int.parse().map_err(|_| too_big())?
-    };
-    let pow = 10u128.pow(frac.len() as u32);
-    let frac_v: u128 = if frac.is_empty() {
-        0
-    } else {
-        frac.parse().map_err(|_| too_big())?
-    };
-    let num = int_v
-        .checked_mul(pow)
-        .and_then(|v| v.checked_add(frac_v))
-        .and_then(|v| v.checked_mul(u128::from(scale)))
-        .ok_or_else(too_big)?;
+    let (num, pow) = scaled_decimal(int, frac, scale).ok_or_else(too_big)?;
     if num % pow != 0 {
         return Err(format!("`{text}` is finer than a nanosecond"));
     }
@@ -138,9 +142,76 @@ pub fn format(ns: u64) -> String {
     format!("{ns}ns")
 }
 
+/// A duration in seconds, as the command line and the reports write one: `0.1s`, `6.2s`,
+/// `2s`, exact to the nanosecond.
+pub fn seconds(ns: u64) -> String {
+    let s = format!("{}.{:09}", ns / 1_000_000_000, ns % 1_000_000_000);
+    format!("{}s", s.trim_end_matches('0').trim_end_matches('.'))
+}
+
+/// A length as the command line writes one (`--max-time`, sweep bounds): a plain
+/// integer counts model steps, a number with a unit is a duration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum StepsOrDuration {
+    /// A plain integer: model time steps.
+    Steps(u64),
+    /// A duration with a unit, in nanoseconds.
+    Nanos(u64),
+}
+
+/// Parses `62` (steps) or `6.2s`, `100ms`, `1.5min` (a duration, exactly).
+pub fn parse_steps_or_duration(text: &str) -> Result<StepsOrDuration, String> {
+    let t = text.trim();
+    let (num, unit) = split(t);
+    let bad =
+        || format!("`{t}` is not a number of steps or a duration (write `62`, `6.2s` or `100ms`)");
+    if num.is_empty() || num.starts_with('.') || num.ends_with('.') {
+        return Err(bad());
+    }
+    let (int, frac) = num.split_once('.').unwrap_or((num, ""));
+    if frac.contains('.') {
+        return Err(bad());
+    }
+    if unit.is_empty() {
+        if frac.is_empty() {
+            return int
+                .parse()
+                .map(StepsOrDuration::Steps)
+                .map_err(|_| format!("`{t}` is too large"));
+        }
+        return Err(format!(
+            "`{t}` has a fraction but no time unit ({UNITS_TEXT})"
+        ));
+    }
+    parse(t).map(StepsOrDuration::Nanos)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn steps_or_durations() {
+        use StepsOrDuration::{Nanos, Steps};
+        assert_eq!(parse_steps_or_duration("62"), Ok(Steps(62)));
+        assert_eq!(parse_steps_or_duration(" 6.2s"), Ok(Nanos(6_200_000_000)));
+        assert_eq!(parse_steps_or_duration("1.5min"), Ok(Nanos(90_000_000_000)));
+        let err = |t| parse_steps_or_duration(t).unwrap_err();
+        assert!(
+            err("2.5").contains("fraction but no time unit"),
+            "{}",
+            err("2.5")
+        );
+        assert!(err("s").contains("not a number of steps"));
+        assert!(err("1.2.3s").contains("not a number of steps"));
+        assert!(err("3parsecs").contains("unknown time unit `parsecs`"));
+        assert!(err("99999999999999999999").contains("too large"));
+        assert!(err("0.5ns").contains("finer than a nanosecond"));
+        assert_eq!(seconds(6_200_000_000), "6.2s");
+        assert_eq!(seconds(2_000_000_000), "2s");
+        assert_eq!(seconds(100_000_000), "0.1s");
+        assert_eq!(seconds(0), "0s");
+    }
 
     #[test]
     fn exact_decimals() {

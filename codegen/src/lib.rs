@@ -53,6 +53,7 @@ pub mod emit_rust;
 mod lower;
 pub mod parse;
 pub mod print;
+pub mod scalar;
 mod spec;
 mod syntax;
 

@@ -576,16 +576,28 @@ fn with_a_time_unit_bounds_and_sweeps_are_in_seconds() {
     let (code, _, err) = hindsight(&["verify", "examples/museum-scxml", props]);
     assert_eq!(code, 2);
     assert!(err.contains("properties.xml"), "{err}");
-    let (code, _, err) = hindsight(&[
-        "verify",
-        "examples/museum-scxml",
-        "--time-unit",
-        "100ms",
-        "--max-time",
-        "150ms",
-    ]);
-    assert_eq!(code, 2);
-    assert!(err.contains("150ms"), "{err}");
+    // The units are codegen's everywhere: `sec` is rejected with the list of units.
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &["--time-unit", "100ms", "--max-time", "150ms"],
+            "--max-time: 150ms is not a whole number of model steps of 100ms",
+        ),
+        (
+            &["--time-unit", "1sec"],
+            "--time-unit 1sec: unknown time unit `sec` (use ns, us, ms, s or min)",
+        ),
+        (
+            &["--time-unit", "100ms", "--max-time", "2.5"],
+            "`2.5` has a fraction but no time unit",
+        ),
+    ];
+    for (flags, want) in cases {
+        let mut args = vec!["verify", "examples/museum-scxml"];
+        args.extend_from_slice(flags);
+        let (code, _, err) = hindsight(&args);
+        assert_eq!(code, 2, "{flags:?}");
+        assert!(err.contains(want), "{flags:?}: {err}");
+    }
 }
 
 /// A model that fails at run time (an index out of bounds) stops the study at once with

@@ -500,7 +500,7 @@ fn main_file_errors_point_at_the_input() {
         (
             "inexact",
             "<roaml><parameters>\n<max_time value=\"1.5\" unit=\"ns\"/></parameters></roaml>",
-            ":2:18: `1.5` is not a whole number of nanoseconds",
+            ":2:18: `1.5` is finer than a nanosecond",
         ),
         (
             "nounit",

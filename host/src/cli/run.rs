@@ -342,7 +342,9 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
             "warning: the model has no ROS topics (events `topic_*_msg`); nothing is published"
         );
     }
-    let max_time = loaded.max_time(args.duration.as_deref())?;
+    let max_time = loaded
+        .max_time(args.duration.as_deref())
+        .map_err(|m| CliError::Input(format!("--duration: {m}")))?;
     let node = NodeBuilder::new()
         .signal_handling_mode(SignalHandlingMode::HandleTerminationRequests)
         .create::<Ipc>()

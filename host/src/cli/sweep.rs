@@ -101,27 +101,15 @@ pub enum BoundValue {
 }
 
 impl BoundValue {
-    /// Parses `62`, `6.2s`, `100ms`, `1.5min`, `250us`, `10ns`.
+    /// Parses `62`, `6.2s`, `100ms`, `1.5min`, `250us`, `10ns`
+    /// ([`codegen::duration::parse_steps_or_duration`]).
     pub fn parse(text: &str) -> Result<BoundValue, String> {
-        let t = text.trim();
-        let (num, unit) = codegen::duration::split(t);
-        let bad = || format!("bad bound `{text}` (expected e.g. `62`, `6.2s`, `100ms`)");
-        if num.is_empty() || num.starts_with('.') || num.ends_with('.') {
-            return Err(bad());
+        use codegen::duration::StepsOrDuration;
+        match codegen::duration::parse_steps_or_duration(text) {
+            Ok(StepsOrDuration::Steps(v)) => Ok(BoundValue::Units(v)),
+            Ok(StepsOrDuration::Nanos(v)) => Ok(BoundValue::Nanos(v)),
+            Err(m) => Err(format!("bad bound: {m}")),
         }
-        let (int, frac) = num.split_once('.').unwrap_or((num, ""));
-        if frac.contains('.') {
-            return Err(bad());
-        }
-        if unit.is_empty() {
-            if frac.is_empty() {
-                return int.parse().map(BoundValue::Units).map_err(|_| bad());
-            }
-            return Err(format!("bound `{text}` has a fraction but no unit"));
-        }
-        codegen::duration::parse(t)
-            .map(BoundValue::Nanos)
-            .map_err(|m| format!("bad bound: {m}"))
     }
 
     /// The default step for a range starting at `text`: one unit of its last digit.
@@ -179,10 +167,7 @@ impl BoundValue {
     pub fn display(self) -> String {
         match self {
             BoundValue::Units(v) => v.to_string(),
-            BoundValue::Nanos(v) => {
-                let s = format!("{}.{:09}", v / 1_000_000_000, v % 1_000_000_000);
-                format!("{}s", s.trim_end_matches('0').trim_end_matches('.'))
-            }
+            BoundValue::Nanos(v) => codegen::duration::seconds(v),
         }
     }
 }
@@ -354,7 +339,9 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         return finish(args, &values, curves);
     }
     let run_cfg = RunConfig {
-        max_time: loaded.max_time(args.max_time.as_deref())?,
+        max_time: loaded
+            .max_time(args.max_time.as_deref())
+            .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
         events: loaded.events,
         ..RunConfig::default()
     };

@@ -231,37 +231,14 @@ impl ModelArgs {
     }
 }
 
-/// `--max-time` on a loaded model (a command-line reading, so it lives here).
-impl Loaded {
-    /// `--max-time`: model steps, or a duration when the model has a time unit; by
-    /// default the main file's `max_time`, else 10,000 steps.
-    pub fn max_time(&self, arg: Option<&str>) -> Result<u64, CliError> {
-        let Some(text) = arg else {
-            return Ok(self.default_max_time.unwrap_or(10_000));
-        };
-        match super::sweep::BoundValue::parse(text).map_err(CliError::Input)? {
-            super::sweep::BoundValue::Units(v) => Ok(v),
-            super::sweep::BoundValue::Nanos(ns) => match self.unit_ns {
-                Some(unit) if ns % unit == 0 => Ok(ns / unit),
-                Some(unit) => Err(CliError::Input(format!(
-                    "--max-time {text} is not a whole number of model steps of {unit} ns"
-                ))),
-                None => Err(CliError::Input(format!(
-                    "--max-time {text}: the model has no time unit (give --time-unit, or \
-                     --max-time in steps)"
-                ))),
-            },
-        }
-    }
-}
-
 /// Parses `--time-unit`: a positive duration with a unit (`100ms`, `1s`).
 fn parse_time_unit(text: &str) -> Result<u64, CliError> {
-    match super::sweep::BoundValue::parse(text) {
-        Ok(super::sweep::BoundValue::Nanos(ns)) if ns > 0 => Ok(ns),
-        _ => Err(CliError::Input(format!(
-            "--time-unit {text}: expected a positive duration with a unit (100ms, 1s, 50us)"
+    match codegen::duration::parse(text) {
+        Ok(ns) if ns > 0 => Ok(ns),
+        Ok(_) => Err(CliError::Input(format!(
+            "--time-unit {text}: expected a positive duration (100ms, 1s, 50us)"
         ))),
+        Err(m) => Err(CliError::Input(format!("--time-unit {text}: {m}"))),
     }
 }
 
@@ -432,7 +409,9 @@ pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
     let loaded = load(&args.input)?;
     let (model, set) = (&loaded.model, &loaded.set);
     let run_cfg = RunConfig {
-        max_time: loaded.max_time(args.max_time.as_deref())?,
+        max_time: loaded
+            .max_time(args.max_time.as_deref())
+            .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
         max_steps: args.max_steps,
         events: loaded.events,
         ..RunConfig::default()
@@ -500,7 +479,9 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         precision: args.precision,
     };
     let run_cfg = RunConfig {
-        max_time: loaded.max_time(args.max_time.as_deref())?,
+        max_time: loaded
+            .max_time(args.max_time.as_deref())
+            .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
         max_steps: args.max_steps,
         events: loaded.events,
         ..RunConfig::default()

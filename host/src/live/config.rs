@@ -71,20 +71,22 @@ pub enum FieldTy {
 }
 
 impl FieldTy {
+    /// The layout type the spec language names (`i32`, `f64`, ...; not `string`).
     fn parse(s: &str) -> Option<FieldTy> {
-        Some(match s {
-            "bool" => FieldTy::Bool,
-            "i8" => FieldTy::I8,
-            "i16" => FieldTy::I16,
-            "i32" => FieldTy::I32,
-            "i64" => FieldTy::I64,
-            "u8" => FieldTy::U8,
-            "u16" => FieldTy::U16,
-            "u32" => FieldTy::U32,
-            "u64" => FieldTy::U64,
-            "f32" => FieldTy::F32,
-            "f64" => FieldTy::F64,
-            _ => return None,
+        use crate::model::types::Scalar;
+        Some(match Scalar::from_spec_name(s)? {
+            Scalar::Bool => FieldTy::Bool,
+            Scalar::I8 => FieldTy::I8,
+            Scalar::I16 => FieldTy::I16,
+            Scalar::I32 => FieldTy::I32,
+            Scalar::I64 => FieldTy::I64,
+            Scalar::U8 => FieldTy::U8,
+            Scalar::U16 => FieldTy::U16,
+            Scalar::U32 => FieldTy::U32,
+            Scalar::U64 => FieldTy::U64,
+            Scalar::F32 => FieldTy::F32,
+            Scalar::F64 => FieldTy::F64,
+            Scalar::Str => return None,
         })
     }
 

@@ -2,6 +2,7 @@
 
 use super::source::{Diagnostic, FileId, SourceMap, Span};
 use super::xml::{self, Node};
+pub use codegen::scalar::Scalar;
 
 /// A base (scalar) type as written in a model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -14,6 +15,25 @@ pub enum BaseType {
     Float,
     /// `string` / `URI`: interned strings.
     Str,
+}
+
+/// How the simulator stores a scalar.
+impl From<Scalar> for BaseType {
+    fn from(s: Scalar) -> BaseType {
+        match s {
+            Scalar::Bool => BaseType::Bool,
+            Scalar::I8
+            | Scalar::I16
+            | Scalar::I32
+            | Scalar::I64
+            | Scalar::U8
+            | Scalar::U16
+            | Scalar::U32
+            | Scalar::U64 => BaseType::Int,
+            Scalar::F32 | Scalar::F64 => BaseType::Float,
+            Scalar::Str => BaseType::Str,
+        }
+    }
 }
 
 /// A type expression: a base type, a named type from `types.xml`, or an array of either.
@@ -39,16 +59,14 @@ impl TypeExpr {
             None => (text, ""),
         };
         let base = base.trim();
-        let mut ty = match base {
-            "bool" | "boolean" => TypeExpr::Base(BaseType::Bool),
-            "int" | "int8" | "int16" | "int32" | "int64" | "uint8" | "uint16" | "uint32"
-            | "uint64" | "integer" => TypeExpr::Base(BaseType::Int),
-            "float" | "float32" | "float64" | "double" | "f64" | "f32" => {
-                TypeExpr::Base(BaseType::Float)
-            }
-            "string" | "URI" | "str" => TypeExpr::Base(BaseType::Str),
-            "" => return Err(format!("missing type name in `{text}`")),
-            name => {
+        // The shared scalar names, then the spellings only SCXML data declarations accept.
+        let mut ty = match (Scalar::from_name(base), base) {
+            (Some(scalar), _) => TypeExpr::Base(scalar.into()),
+            (None, "integer") => TypeExpr::Base(BaseType::Int),
+            (None, "f64" | "f32") => TypeExpr::Base(BaseType::Float),
+            (None, "URI" | "str") => TypeExpr::Base(BaseType::Str),
+            (None, "") => return Err(format!("missing type name in `{text}`")),
+            (None, name) => {
                 if name
                     .chars()
                     .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '/' || c == ':')
@@ -256,6 +274,22 @@ pub(crate) fn parse_type_comment(text: &str) -> Option<(String, Result<TypeExpr,
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn scalar_names_parse_to_their_base_type() {
+        for s in Scalar::ALL {
+            assert_eq!(TypeExpr::parse(s.name()), Ok(TypeExpr::Base(s.into())));
+        }
+        assert_eq!(TypeExpr::parse("int"), Ok(TypeExpr::Base(BaseType::Int)));
+        assert_eq!(
+            TypeExpr::parse("integer"),
+            Ok(TypeExpr::Base(BaseType::Int))
+        );
+        assert_eq!(
+            TypeExpr::parse("double"),
+            Ok(TypeExpr::Base(BaseType::Float))
+        );
+    }
 
     #[test]
     fn type_expressions() {

@@ -23,13 +23,12 @@ pub(super) enum Ty {
 
 impl Ty {
     fn of(declared: &str) -> Option<Ty> {
-        Some(match declared {
-            "bool" | "boolean" => Ty::Bool,
-            "int" | "int8" | "int16" | "int32" | "int64" | "uint8" | "uint16" | "uint32"
-            | "uint64" => Ty::Int,
-            "float" | "double" | "float32" | "float64" => Ty::Float,
-            "string" => Ty::Str,
-            _ => return None,
+        use crate::model::types::{BaseType, Scalar};
+        Some(match BaseType::from(Scalar::from_name(declared)?) {
+            BaseType::Bool => Ty::Bool,
+            BaseType::Int => Ty::Int,
+            BaseType::Float => Ty::Float,
+            BaseType::Str => Ty::Str,
         })
     }
 

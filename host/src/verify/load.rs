@@ -53,12 +53,6 @@ fn is_jani(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("jani"))
 }
 
-/// A duration in seconds as the command line writes one (`0.1s`).
-fn seconds(ns: u64) -> String {
-    let s = format!("{}.{:09}", ns / 1_000_000_000, ns % 1_000_000_000);
-    format!("{}s", s.trim_end_matches('0').trim_end_matches('.'))
-}
-
 /// Finds the property file for a model when none is given.
 fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, String> {
     if let Some(p) = compiled.properties_path() {
@@ -107,6 +101,34 @@ pub struct Loaded {
     pub default_max_time: Option<u64>,
     /// How sends are delivered.
     pub events: EventSemantics,
+}
+
+impl Loaded {
+    /// The run length in model steps: `arg` is model steps (`500`), or a duration
+    /// (`100s`) when the model has a time unit; by default the main file's `max_time`,
+    /// else 10,000 steps. The caller names its flag in front of an error.
+    pub fn max_time(&self, arg: Option<&str>) -> Result<u64, String> {
+        use codegen::duration::StepsOrDuration;
+        let Some(text) = arg else {
+            return Ok(self.default_max_time.unwrap_or(10_000));
+        };
+        match codegen::duration::parse_steps_or_duration(text)? {
+            StepsOrDuration::Steps(v) => Ok(v),
+            StepsOrDuration::Nanos(ns) => match self.unit_ns {
+                Some(unit) if ns % unit == 0 => Ok(ns / unit),
+                Some(unit) => Err(format!(
+                    "{} is not a whole number of model steps of {}",
+                    text.trim(),
+                    codegen::duration::format(unit)
+                )),
+                None => Err(format!(
+                    "{} is a duration but the model has no time unit (give --time-unit, \
+                     or the length in steps)",
+                    text.trim()
+                )),
+            },
+        }
+    }
 }
 
 /// Loads the model and its properties: a robot model (a main file, or a folder holding
@@ -264,9 +286,9 @@ fn load_robot(
         if given != robot.time_unit_ns {
             return Err(format!(
                 "--time-unit {}: {} steps by {}, from its timers and max_time",
-                seconds(given),
+                codegen::duration::seconds(given),
                 main.display(),
-                seconds(robot.time_unit_ns)
+                codegen::duration::seconds(robot.time_unit_ns)
             ));
         }
     }

@@ -61,21 +61,7 @@ pub struct PropertySet {
 
 /// Maps a SCAN port type to a spec type name.
 fn spec_type(scan: &str) -> Option<&'static str> {
-    Some(match scan {
-        "bool" | "boolean" => "bool",
-        "int" | "int32" => "i32",
-        "int8" => "i8",
-        "int16" => "i16",
-        "int64" => "i64",
-        "uint8" => "u8",
-        "uint16" => "u16",
-        "uint32" => "u32",
-        "uint64" => "u64",
-        "float" | "float32" => "f32",
-        "double" | "float64" => "f64",
-        "string" => "string",
-        _ => return None,
-    })
+    crate::model::types::Scalar::from_name(scan).map(crate::model::types::Scalar::spec_name)
 }
 
 /// The type a state port holds: the declared one (`written` in the file, `declared` as

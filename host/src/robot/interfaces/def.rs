@@ -2,6 +2,7 @@
 //! and the normalised text each prints as.
 
 use crate::model::source::{FileId, Span};
+use crate::model::types::Scalar;
 
 /// What an interface file defines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -110,22 +111,28 @@ impl Primitive {
         })
     }
 
+    /// The scalar the SCXML reader takes it as (`byte`/`char` -> `uint8`, `wstring` ->
+    /// `string`).
+    pub fn scalar(self) -> Scalar {
+        match self {
+            Primitive::Bool => Scalar::Bool,
+            Primitive::Byte | Primitive::Char | Primitive::UInt8 => Scalar::U8,
+            Primitive::Float32 => Scalar::F32,
+            Primitive::Float64 => Scalar::F64,
+            Primitive::Int8 => Scalar::I8,
+            Primitive::Int16 => Scalar::I16,
+            Primitive::UInt16 => Scalar::U16,
+            Primitive::Int32 => Scalar::I32,
+            Primitive::UInt32 => Scalar::U32,
+            Primitive::Int64 => Scalar::I64,
+            Primitive::UInt64 => Scalar::U64,
+            Primitive::String | Primitive::WString => Scalar::Str,
+        }
+    }
+
     /// The type as the SCXML reader spells it (`byte`/`char` -> `uint8`, `wstring` -> `string`).
     pub fn scxml_name(self) -> &'static str {
-        match self {
-            Primitive::Bool => "bool",
-            Primitive::Byte | Primitive::Char | Primitive::UInt8 => "uint8",
-            Primitive::Float32 => "float32",
-            Primitive::Float64 => "float64",
-            Primitive::Int8 => "int8",
-            Primitive::Int16 => "int16",
-            Primitive::UInt16 => "uint16",
-            Primitive::Int32 => "int32",
-            Primitive::UInt32 => "uint32",
-            Primitive::Int64 => "int64",
-            Primitive::UInt64 => "uint64",
-            Primitive::String | Primitive::WString => "string",
-        }
+        self.scalar().name()
     }
 
     /// The value of an unset field of this type, as an ECMAScript literal.
