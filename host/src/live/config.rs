@@ -43,69 +43,44 @@ use monitor_core::{Ty, Value, VarKind};
 use serde::Deserialize;
 use toml::Spanned;
 
-/// The type of one payload field (little-endian, no padding assumed).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FieldTy {
-    /// One byte, 0 or 1 (any other byte makes the sample malformed).
-    Bool,
-    /// Signed integers.
-    I8,
-    /// Signed 16-bit.
-    I16,
-    /// Signed 32-bit.
-    I32,
-    /// Signed 64-bit.
-    I64,
-    /// Unsigned 8-bit.
-    U8,
-    /// Unsigned 16-bit.
-    U16,
-    /// Unsigned 32-bit.
-    U32,
-    /// Unsigned 64-bit (a value above `i64::MAX` makes the sample malformed).
-    U64,
-    /// IEEE single (a NaN or infinity makes the sample malformed).
-    F32,
-    /// IEEE double (a NaN or infinity makes the sample malformed).
-    F64,
+/// The type of one payload field (little-endian, no padding assumed): a scalar of the
+/// one table of type names ([`codegen::scalar::Scalar`]), never `string` (a layout
+/// reads fixed-size fields only). A bool is one byte, 0 or 1; a `u64` above `i64::MAX`,
+/// a NaN or an infinity makes the sample malformed.
+pub type FieldTy = crate::model::types::Scalar;
+
+/// Parses a layout's field type (the spec language's names: `i32`, `f64`, ...; not
+/// `string`).
+fn parse_field_ty(s: &str) -> Option<FieldTy> {
+    FieldTy::from_spec_name(s).filter(|t| *t != FieldTy::Str)
 }
 
-impl FieldTy {
-    /// The layout type the spec language names (`i32`, `f64`, ...; not `string`).
-    fn parse(s: &str) -> Option<FieldTy> {
-        use crate::model::types::Scalar;
-        Some(match Scalar::from_spec_name(s)? {
-            Scalar::Bool => FieldTy::Bool,
-            Scalar::I8 => FieldTy::I8,
-            Scalar::I16 => FieldTy::I16,
-            Scalar::I32 => FieldTy::I32,
-            Scalar::I64 => FieldTy::I64,
-            Scalar::U8 => FieldTy::U8,
-            Scalar::U16 => FieldTy::U16,
-            Scalar::U32 => FieldTy::U32,
-            Scalar::U64 => FieldTy::U64,
-            Scalar::F32 => FieldTy::F32,
-            Scalar::F64 => FieldTy::F64,
-            Scalar::Str => return None,
-        })
-    }
+/// A payload field's size and decoding.
+pub trait Wire: Copy {
+    /// Size in bytes (0 for `string`, which no layout holds).
+    fn size(self) -> usize;
+    /// Whether it holds an integer.
+    fn is_int(self) -> bool;
+    /// Reads the field at `offset`; `None` when out of range or not a valid value.
+    fn read(self, bytes: &[u8], offset: usize) -> Option<Value>;
+}
 
-    /// Size in bytes.
-    pub fn size(self) -> usize {
+impl Wire for FieldTy {
+    fn size(self) -> usize {
         match self {
             FieldTy::Bool | FieldTy::I8 | FieldTy::U8 => 1,
             FieldTy::I16 | FieldTy::U16 => 2,
             FieldTy::I32 | FieldTy::U32 | FieldTy::F32 => 4,
             FieldTy::I64 | FieldTy::U64 | FieldTy::F64 => 8,
+            FieldTy::Str => 0,
         }
     }
 
     fn is_int(self) -> bool {
-        !matches!(self, FieldTy::Bool | FieldTy::F32 | FieldTy::F64)
+        self.int_range().is_some()
     }
 
-    /// Reads the field at `offset`; `None` when out of range or not a valid value.
-    pub fn read(self, bytes: &[u8], offset: usize) -> Option<Value> {
+    fn read(self, bytes: &[u8], offset: usize) -> Option<Value> {
         let b = bytes.get(offset..offset.checked_add(self.size())?)?;
         let mut w = [0u8; 8];
         w[..b.len()].copy_from_slice(b);
@@ -136,6 +111,7 @@ impl FieldTy {
                 }
                 Value::Float(f)
             }
+            FieldTy::Str => return None,
         })
     }
 }
@@ -436,7 +412,7 @@ impl Checker<'_> {
                 );
                 continue;
             };
-            let Some(ty) = FieldTy::parse(f.ty.get_ref()) else {
+            let Some(ty) = parse_field_ty(f.ty.get_ref()) else {
                 self.err(
                     f.ty.span(),
                     format!(
@@ -519,7 +495,7 @@ impl Config {
             names.push((service.clone(), t.service.span()));
             let layout = c.layout(&t.size, &t.event, &t.field);
             let seq = t.seq.as_ref().and_then(|s| {
-                let ty = FieldTy::parse(s.ty.get_ref()).filter(|t| {
+                let ty = parse_field_ty(s.ty.get_ref()).filter(|t| {
                     matches!(t, FieldTy::U8 | FieldTy::U16 | FieldTy::U32 | FieldTy::U64)
                 });
                 let Some(ty) = ty else {

@@ -46,7 +46,7 @@ use iceoryx2::prelude::*;
 use monitor_core::Value;
 
 pub use clock::{check_speed, Clock, SPEED_RANGE};
-use config::{Action, Config, Layout};
+use config::{Action, Config, Layout, Wire};
 use engine::{Change, Engine};
 use record::Input;
 

@@ -35,6 +35,7 @@ use iceoryx2::prelude::*;
 type Ipc = ipc::Service;
 type RawPublisher = Publisher<Ipc, [u8], ()>;
 
+use super::config::Wire as _;
 use crate::expr::{Ty, Value};
 use crate::props::{Port, PortKind};
 use crate::sim::{CompiledModel, EventId, Flow, Observer, Scalar, SentMessage};
@@ -193,7 +194,7 @@ impl TopicLayout {
     /// Reads a payload written in this layout (by [`Self::encode`] or a process that
     /// speaks it): the parameters it sets and its `seq`; `None` if it is not exactly
     /// [`Self::size`] bytes or a field holds no valid value. Fields are read by the
-    /// sidecar's own reader ([`super::config::FieldTy::read`]), so `run` and `monitor`
+    /// sidecar's own reader ([`super::config::Wire::read`]), so `run` and `monitor`
     /// accept the same payloads (a `bool` byte is 0 or 1, a float is finite).
     pub fn decode(&self, buf: &[u8]) -> Option<(Vec<(usize, Scalar)>, u64)> {
         if buf.len() != self.size {

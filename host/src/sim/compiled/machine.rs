@@ -1,6 +1,7 @@
 //! One machine's executable content compiled to flat instructions with closures, and its listing.
 
 use super::*;
+use crate::expr::ast::Expr;
 
 pub(super) struct MachineCompiler<'b, 's> {
     b: &'b mut Builder<'s>,
@@ -34,8 +35,14 @@ impl<'b, 's> MachineCompiler<'b, 's> {
         self.code.len() as u32 - 1
     }
 
-    /// Parses and compiles `src` in the scope of this machine and `event`.
-    fn typed(&mut self, src: &SrcExpr, event: Option<u32>, expect: Option<&Ty>) -> Option<Typed> {
+    /// Parses `src` and hands its syntax tree to `compile` in the scope of this machine
+    /// and `event`; a parse or compile error is reported at its file position.
+    fn scoped<T>(
+        &mut self,
+        src: &SrcExpr,
+        event: Option<u32>,
+        compile: impl FnOnce(&Expr, &Scope<'_>, &mut Strings) -> Result<T, CompileError>,
+    ) -> Option<T> {
         let ast = match parse_expr(&src.text) {
             Ok(a) => a,
             Err(pe) => {
@@ -60,10 +67,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                 types: &self.b.types,
                 abs: &abs,
             };
-            match expect {
-                Some(t) => compile_as(&ast, &scope, &mut self.b.strings, t, "the expression"),
-                None => compile(&ast, &scope, &mut self.b.strings, None),
-            }
+            compile(&ast, &scope, &mut self.b.strings)
         };
         match r {
             Ok(t) => Some(t),
@@ -74,6 +78,14 @@ impl<'b, 's> MachineCompiler<'b, 's> {
         }
     }
 
+    /// Parses and compiles `src` in the scope of this machine and `event`.
+    fn typed(&mut self, src: &SrcExpr, event: Option<u32>, expect: Option<&Ty>) -> Option<Typed> {
+        self.scoped(src, event, |ast, scope, strings| match expect {
+            Some(t) => compile_as(ast, scope, strings, t, "the expression"),
+            None => compile(ast, scope, strings, None),
+        })
+    }
+
     fn bool_code(&mut self, src: &SrcExpr, event: Option<u32>) -> Option<BoolFn> {
         match self.typed(src, event, Some(&Ty::Bool))?.code {
             Code::Bool(f) => Some(f),
@@ -82,39 +94,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
     }
 
     fn place(&mut self, src: &SrcExpr, event: Option<u32>) -> Option<Place> {
-        let ast = match parse_expr(&src.text) {
-            Ok(a) => a,
-            Err(pe) => {
-                let at = self.b.src.sources.unescaped_offset(src.span, pe.offset);
-                self.b.err(at, pe.message);
-                return None;
-            }
-        };
-        let r = {
-            let sources = &self.b.src.sources;
-            let span = src.span;
-            let abs = move |k: u32| sources.unescaped_offset(span, k).offset;
-            let scope = Scope {
-                vars: &self.b.vars[self.mi as usize],
-                event: match event {
-                    Some(e) => EventScope::Event {
-                        name: &self.events[e as usize].0,
-                        params: &self.events[e as usize].1,
-                    },
-                    None => EventScope::None,
-                },
-                types: &self.b.types,
-                abs: &abs,
-            };
-            compile_place(&ast, &scope, &mut self.b.strings)
-        };
-        match r {
-            Ok(p) => Some(p),
-            Err(e) => {
-                self.b.expr_err(self.mi, src, &e);
-                None
-            }
-        }
+        self.scoped(src, event, compile_place)
     }
 
     fn block(&mut self, execs: &[Exec], event: Option<u32>) {
