@@ -167,18 +167,33 @@ fn merge_rejects_incomplete_or_foreign_shards() {
     let study = study(5, 300);
     let parts = shards(&study, 3);
     assert_eq!(merge(&[], 0), Err(ShardError::Empty));
+    // Every missing shard is named, not only the first.
     assert_eq!(
-        merge(&parts[..2], 0),
-        Err(ShardError::Missing(Shard { index: 2, count: 3 }))
+        merge(&parts[1..2], 0),
+        Err(ShardError::Missing(vec![
+            Shard { index: 0, count: 3 },
+            Shard { index: 2, count: 3 }
+        ]))
     );
+    let err = merge(&parts[..2], 0).unwrap_err().to_string();
+    assert!(err.starts_with("shard 2/3 is missing: run each"), "{err}");
+    // A shard re-run by the batch system is identical: counted once.
     let twice = [
         parts[0].clone(),
         parts[1].clone(),
         parts[1].clone(),
         parts[2].clone(),
     ];
+    assert_eq!(merge(&twice, 0), merge(&parts, 0));
     assert_eq!(
-        merge(&twice, 0),
+        hindsight::smc::shard::duplicates(&twice),
+        vec![(Shard { index: 1, count: 3 }, vec![1, 2])]
+    );
+    // Two different copies of one shard are an error.
+    let mut differ = twice.clone();
+    differ[2].runs.discarded += 1;
+    assert_eq!(
+        merge(&differ, 0),
         Err(ShardError::Duplicate(Shard { index: 1, count: 3 }))
     );
 

@@ -97,8 +97,9 @@ pub struct VerifyArgs {
     /// Kubernetes indexed jobs) can run them anywhere.
     #[arg(long, value_name = "I/N", requires = "runs")]
     pub shard: Option<crate::smc::shard::Shard>,
-    /// Size of the fixed study that --shard slices.
-    #[arg(long, value_name = "N")]
+    /// Run a fixed-size study of N runs: no early stop, the rule only gives the interval
+    /// (the same numbers as its shards merged). With --shard, the size of the study it slices.
+    #[arg(long, value_name = "N", conflicts_with = "save_failing")]
     pub runs: Option<u64>,
     /// File for the partial result of --shard.
     #[arg(long, value_name = "FILE")]
@@ -291,7 +292,7 @@ fn run_shard_cli(
     rule: &RuleConfig,
     shard: crate::smc::shard::Shard,
     runs: u64,
-) -> Result<(), CliError> {
+) -> Result<crate::smc::shard::PartialResult, CliError> {
     use crate::smc::shard::{run_shard, FixedStudy, PropertySpec};
     let props_text = std::fs::read(props_path).unwrap_or_default();
     let model_desc = format!(
@@ -325,13 +326,7 @@ fn run_shard_cli(
         &mut |p| bar.update(p),
     );
     runner.finish().map_err(CliError::Input)?;
-    let json = part.to_json();
-    match &args.partial {
-        Some(p) => std::fs::write(p, json)
-            .map_err(|e| CliError::Failed(format!("{}: {e}", p.display())))?,
-        None => println!("{json}"),
-    }
-    Ok(())
+    Ok(part)
 }
 
 /// Arguments of `hindsight merge`.
@@ -347,7 +342,7 @@ pub struct MergeArgs {
 
 /// Runs `hindsight merge`: checks the parts cover one study exactly once, then reports it.
 pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
-    use crate::smc::shard::{merge, PartialResult};
+    use crate::smc::shard::{duplicates, merge, PartialResult, Shard, ShardError};
     let mut parts = Vec::new();
     for p in &args.parts {
         let text = super::read_file(p)?;
@@ -356,8 +351,41 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
                 .map_err(|e| CliError::Input(format!("{}: {e}", p.display())))?,
         );
     }
-    let m = merge(&parts, 0).map_err(|e| CliError::Input(format!("merge: {e}")))?;
-    let report = Report {
+    // Name the files of a shard in every message about it.
+    let files_of = |shard: Shard| -> String {
+        let names: Vec<String> = args
+            .parts
+            .iter()
+            .zip(&parts)
+            .filter(|(_, p)| p.shard.index == shard.index)
+            .map(|(f, _)| f.display().to_string())
+            .collect();
+        names.join(", ")
+    };
+    let m = merge(&parts, 0).map_err(|e| {
+        let shard = match &e {
+            ShardError::Mismatch { shard, .. }
+            | ShardError::Duplicate(shard)
+            | ShardError::Range(shard) => Some(*shard),
+            _ => None,
+        };
+        match shard {
+            Some(s) => CliError::Input(format!("merge: {e} ({})", files_of(s))),
+            None => CliError::Input(format!("merge: {e}")),
+        }
+    })?;
+    for (shard, _) in duplicates(&parts) {
+        eprintln!(
+            "merge: shard {shard} is given more than once, identical ({}): counted once",
+            files_of(shard)
+        );
+    }
+    print_report(&merged_report(&m), args.json)
+}
+
+/// The report of a merged fixed-size study (`merge`, and `verify --runs R` alone).
+fn merged_report(m: &crate::smc::shard::MergedResult) -> Report {
+    Report {
         model: m.study.model.clone(),
         properties_file: m.study.properties_fingerprint.clone(),
         seed: m.study.seed,
@@ -377,8 +405,7 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
             .iter()
             .map(|p| PropertyReport::new(&p.id, &p.estimate, &p.interval, &p.counts))
             .collect(),
-    };
-    print_report(&report, args.json)
+    }
 }
 
 /// Arguments of `hindsight trace`.
@@ -493,10 +520,30 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         keep_failing: args.save_failing,
         progress_every: Duration::from_millis(200),
     };
-    if let (Some(shard), Some(runs)) = (args.shard, args.runs) {
-        return run_shard_cli(
+    if let Some(runs) = args.runs {
+        // A fixed-size study: one shard of it, or all of it (shard 0/1) reported as
+        // `merge` reports the shards of one, so both give the same numbers.
+        let shard = args.shard.unwrap_or(crate::smc::shard::Shard::WHOLE);
+        let part = run_shard_cli(
             args, model, set, props_path, &run_cfg, &study_cfg, &rule, shard, runs,
-        );
+        )?;
+        if args.shard.is_some() {
+            let json = part.to_json();
+            return match &args.partial {
+                Some(p) => std::fs::write(p, json)
+                    .map_err(|e| CliError::Failed(format!("{}: {e}", p.display()))),
+                None => {
+                    println!("{json}");
+                    Ok(())
+                }
+            };
+        }
+        let m = crate::smc::shard::merge(&[part], 0)
+            .map_err(|e| CliError::Input(format!("--runs: {e}")))?;
+        let mut report = merged_report(&m);
+        report.model = args.input.model.display().to_string();
+        report.properties_file = props_path.display().to_string();
+        return print_report(&report, args.json);
     }
     let result = study(model, set, &run_cfg, &study_cfg, &rule, !args.json)?;
     if args.save_failing > 0 {

@@ -94,10 +94,11 @@ pub enum ShardError {
         /// The shard whose value differs from the first one's.
         shard: Shard,
     },
-    /// The same shard given twice.
+    /// The same shard given twice with different contents (a shard re-run gives the same
+    /// counts, so an identical copy is counted once instead).
     Duplicate(Shard),
-    /// A shard of the study is missing.
-    Missing(Shard),
+    /// Shards of the study are missing (every one, in index order).
+    Missing(Vec<Shard>),
     /// A partial result whose run range is not its shard's.
     Range(Shard),
     /// A property's rule is invalid.
@@ -120,8 +121,25 @@ impl fmt::Display for ShardError {
                 f,
                 "shard {shard} belongs to another study: its `{field}` differs"
             ),
-            ShardError::Duplicate(shard) => write!(f, "shard {shard} is given more than once"),
-            ShardError::Missing(shard) => write!(f, "shard {shard} is missing"),
+            ShardError::Duplicate(shard) => write!(
+                f,
+                "shard {shard} is given twice with different counts (a re-run of a shard \
+                 gives the same counts: one of them is from another build or settings)"
+            ),
+            ShardError::Missing(shards) => {
+                let list: Vec<String> = shards.iter().map(Shard::to_string).collect();
+                let (noun, verb) = if shards.len() == 1 {
+                    ("shard", "is")
+                } else {
+                    ("shards", "are")
+                };
+                write!(
+                    f,
+                    "{noun} {} {verb} missing: run each with the same `verify ... --runs R \
+                     --shard I/N` and merge again with every part",
+                    list.join(", ")
+                )
+            }
             ShardError::Range(shard) => {
                 write!(f, "shard {shard} does not cover its own range of runs")
             }
@@ -294,10 +312,24 @@ pub struct MergedResult {
     pub runs: RunCounts,
 }
 
+/// The shards given more than once among `parts`, each with the positions (in `parts`)
+/// of its copies, in shard order.
+pub fn duplicates(parts: &[PartialResult]) -> Vec<(Shard, Vec<usize>)> {
+    let mut at: BTreeMap<u64, (Shard, Vec<usize>)> = BTreeMap::new();
+    for (k, part) in parts.iter().enumerate() {
+        at.entry(part.shard.index)
+            .or_insert_with(|| (part.shard, Vec::new()))
+            .1
+            .push(k);
+    }
+    at.into_values().filter(|(_, ks)| ks.len() > 1).collect()
+}
+
 /// Merges the partial results of one study: they must share format, seed, study size,
-/// fingerprints and properties, have the same shard count, and cover every shard exactly
-/// once, each on its own range. Failing-run lists are merged in index order and cut to
-/// `keep_failing` per property.
+/// fingerprints and properties, have the same shard count, and cover every shard, each on
+/// its own range. A shard given twice counts once when both copies are identical (a
+/// batch system that re-ran a finished shard); see [`duplicates`] to report them.
+/// Failing-run lists are merged in index order and cut to `keep_failing` per property.
 pub fn merge(parts: &[PartialResult], keep_failing: usize) -> Result<MergedResult, ShardError> {
     let first = parts.first().ok_or(ShardError::Empty)?;
     let count = first.shard.count;
@@ -346,15 +378,18 @@ pub fn merge(parts: &[PartialResult], keep_failing: usize) -> Result<MergedResul
         {
             return Err(ShardError::Range(shard));
         }
-        if by_index.insert(shard.index, part).is_some() {
-            return Err(ShardError::Duplicate(shard));
+        if let Some(before) = by_index.insert(shard.index, part) {
+            if before != part {
+                return Err(ShardError::Duplicate(shard));
+            }
         }
     }
-    if let Some(missing) = (0..count).find(|i| !by_index.contains_key(i)) {
-        return Err(ShardError::Missing(Shard {
-            index: missing,
-            count,
-        }));
+    let missing: Vec<Shard> = (0..count)
+        .filter(|i| !by_index.contains_key(i))
+        .map(|index| Shard { index, count })
+        .collect();
+    if !missing.is_empty() {
+        return Err(ShardError::Missing(missing));
     }
 
     let study = first.study.clone();
