@@ -46,6 +46,13 @@ pub struct MonitorArgs {
     /// Verdict JSON lines to this file instead of standard output.
     #[arg(short, long, value_name = "FILE")]
     pub output: Option<PathBuf>,
+    /// Serve a live page of the verdicts at ADDR (PORT, :PORT or HOST:PORT; a bare port
+    /// listens on loopback only): open http://ADDR/ in a browser to watch every
+    /// property's verdict and its timeline as verdicts arrive. The verdict output is
+    /// written first and is complete whatever the page does. Port 0 picks a free port;
+    /// the address is printed on standard error.
+    #[arg(long, value_name = "ADDR", conflicts_with_all = ["replay", "bench"])]
+    pub serve: Option<String>,
     /// Write every judged input (samples, requests, heartbeats, losses) as JSON lines, for `--replay`.
     #[arg(long, value_name = "LOG")]
     pub record: Option<PathBuf>,
@@ -147,6 +154,8 @@ Config example (see `hindsight::live::config` for every key):
 Examples:
   hindsight monitor --props museum.hspec --config museum.toml --record in.jsonl -o verdicts.jsonl
   hindsight monitor --props museum.hspec --replay in.jsonl     # the same verdicts, off-line
+  hindsight monitor --props museum.hspec --config museum.toml --serve 8080
+      # and open http://127.0.0.1:8080/ : every verdict and its timeline, live
   hindsight monitor --bench
 The museum end to end, ten times faster than real time (two shells):
   hindsight run examples/museum-guide --layout > museum.toml
@@ -260,6 +269,13 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         print!("{r}");
         return Ok(());
     }
+    // A bad address is refused before anything is loaded.
+    let serve_addr = args
+        .serve
+        .as_deref()
+        .map(live::serve::parse_addr)
+        .transpose()
+        .map_err(|m| CliError::Input(format!("--serve: {m}")))?;
     let spec = spec_of(args)?;
     let mut out: Box<dyn Write + Send> = match &args.output {
         Some(p) => create(p)?,
@@ -286,6 +302,17 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
     if let Some(s) = args.speed {
         config.speed =
             live::check_speed(s).map_err(|m| CliError::Input(format!("--speed: {m}")))?;
+    }
+    if let Some(addr) = serve_addr {
+        let title = args
+            .model
+            .as_ref()
+            .or(args.props.as_ref())
+            .map_or_else(String::new, |p| p.display().to_string());
+        let server = live::serve::serve(addr, live::serve::page(&title, &spec))
+            .map_err(|e| CliError::Failed(format!("--serve {addr}: {e}")))?;
+        eprintln!("monitor: live page at http://{}/", server.addr);
+        out = Box::new(live::serve::Tee::new(out, server.hub));
     }
     let mut opts = Options {
         verdicts: out,

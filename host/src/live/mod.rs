@@ -15,6 +15,7 @@
 //! - [`record`]: the verdict line and input log formats; replay.
 //! - [`bench`]: throughput and added latency against a plain subscriber.
 //! - [`pace`]: `hindsight run`'s observer, pacing a simulation on the same [`Clock`].
+//! - [`serve`]: the live page (`--serve`): verdict lines streamed to a browser.
 //!
 //! Taps never slow a publisher: the services keep iceoryx2's safe overflow, so a
 //! full tap buffer drops the tap's oldest sample. Lost samples are found from a
@@ -29,6 +30,7 @@ pub mod inject;
 pub mod pace;
 pub mod publish;
 pub mod record;
+pub mod serve;
 
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};

@@ -1,0 +1,354 @@
+//! The sidecar's live page (`hindsight monitor --serve ADDR`): a small HTTP/1.1 server on
+//! its own threads that serves one self-contained page and streams every verdict line to
+//! it as server-sent events, as the monitor writes them.
+//!
+//! The verdict output itself is untouched: [`Tee`] writes every byte to the file (or
+//! standard output) first and only then hands complete lines to the [`Hub`], so a slow or
+//! absent browser can neither lose nor delay a verdict line, and stopping the monitor
+//! flushes the file as before. Hand-written on `std::net` (two routes and an event
+//! stream need no framework, and no async runtime beside the sidecar's loop).
+
+use std::collections::VecDeque;
+use std::io::{BufRead, BufReader, Write};
+use std::net::{SocketAddr, TcpListener, TcpStream, ToSocketAddrs};
+use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+/// Lines the page can get on (re)connecting; older ones are only in the verdict file.
+pub const HISTORY: usize = 100_000;
+
+/// One published verdict line: its sequence number (the event id) and when it was
+/// published (milliseconds since the Unix epoch, for the page's delay figure).
+#[derive(Clone, Debug)]
+struct Published {
+    id: u64,
+    sent_ms: u64,
+    line: Arc<str>,
+}
+
+#[derive(Default)]
+struct HubState {
+    history: VecDeque<Published>,
+    next_id: u64,
+    subscribers: Vec<Sender<Published>>,
+}
+
+/// Where verdict lines meet the page's connections.
+#[derive(Default)]
+pub struct Hub {
+    state: Mutex<HubState>,
+}
+
+impl Hub {
+    /// Publishes one verdict line (without its newline) to every connection.
+    pub fn publish(&self, line: &str) {
+        let Ok(mut s) = self.state.lock() else {
+            return;
+        };
+        let p = Published {
+            id: s.next_id,
+            sent_ms: now_ms(),
+            line: line.into(),
+        };
+        s.next_id += 1;
+        if s.history.len() == HISTORY {
+            s.history.pop_front();
+        }
+        s.history.push_back(p.clone());
+        // A connection that is gone drops its receiver: forget it.
+        s.subscribers.retain(|tx| tx.send(p.clone()).is_ok());
+    }
+
+    /// The lines after `last_id` (all with `None`) and a receiver of the later ones.
+    fn subscribe(&self, last_id: Option<u64>) -> (Vec<Published>, Receiver<Published>) {
+        let (tx, rx) = channel();
+        let Ok(mut s) = self.state.lock() else {
+            return (Vec::new(), rx);
+        };
+        let past = s
+            .history
+            .iter()
+            .filter(|p| last_id.is_none_or(|l| p.id > l))
+            .cloned()
+            .collect();
+        s.subscribers.push(tx);
+        (past, rx)
+    }
+
+    /// Every line still held, newline-terminated.
+    fn all_lines(&self) -> String {
+        let Ok(s) = self.state.lock() else {
+            return String::new();
+        };
+        let mut out = String::new();
+        for p in &s.history {
+            out.push_str(&p.line);
+            out.push('\n');
+        }
+        out
+    }
+}
+
+fn now_ms() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_millis() as u64)
+}
+
+/// A writer that passes every byte to `inner` and then each complete line to a [`Hub`].
+pub struct Tee {
+    inner: Box<dyn Write + Send>,
+    hub: Arc<Hub>,
+    partial: Vec<u8>,
+}
+
+impl Tee {
+    /// Writes to `inner`, publishing lines to `hub`.
+    pub fn new(inner: Box<dyn Write + Send>, hub: Arc<Hub>) -> Tee {
+        Tee {
+            inner,
+            hub,
+            partial: Vec::new(),
+        }
+    }
+}
+
+impl Write for Tee {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        // The file first: what reaches the page is always already in the output.
+        let n = self.inner.write(buf)?;
+        let mut rest = &buf[..n];
+        while let Some(i) = rest.iter().position(|&b| b == b'\n') {
+            self.partial.extend_from_slice(&rest[..i]);
+            self.hub.publish(&String::from_utf8_lossy(&self.partial));
+            self.partial.clear();
+            rest = &rest[i + 1..];
+        }
+        self.partial.extend_from_slice(rest);
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+/// The live page for `spec`: its properties in order (a row each before any verdict),
+/// the unit that turns ticks into seconds, and `title` (e.g. the model's path).
+pub fn page(title: &str, spec: &codegen::Compiled) -> String {
+    let names: Vec<&str> = spec.property_names().collect();
+    let data = serde_json::json!({ "properties": names, "unit_ns": spec.tick_ns() });
+    // `<` escaped so no name can close the script element.
+    let data = data.to_string().replace('<', "\\u003c");
+    let title = title
+        .replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;");
+    include_str!("page.html")
+        .replace("__TITLE__", &title)
+        .replace("__SPEC__", &data)
+}
+
+/// Resolves `--serve ADDR`: a bare port (`8080`) or `:8080` means loopback, so the page
+/// is not offered to the network unless an address says so (`0.0.0.0:8080`).
+pub fn parse_addr(text: &str) -> Result<SocketAddr, String> {
+    let t = text.trim();
+    let full = if t.parse::<u16>().is_ok() {
+        format!("127.0.0.1:{t}")
+    } else if let Some(port) = t.strip_prefix(':') {
+        format!("127.0.0.1:{port}")
+    } else {
+        t.to_string()
+    };
+    full.to_socket_addrs()
+        .map_err(|e| format!("`{text}`: {e} (expected PORT, :PORT or HOST:PORT)"))?
+        .next()
+        .ok_or_else(|| format!("`{text}`: no address"))
+}
+
+/// The page's server: bound, accepting on its own thread.
+pub struct Server {
+    /// Where it listens (with the port the system chose for port 0).
+    pub addr: SocketAddr,
+    /// The verdict lines it streams.
+    pub hub: Arc<Hub>,
+}
+
+/// Binds `addr` and serves `page` at `/`, the event stream at `/events` and every line
+/// held at `/verdicts.jsonl`, each connection on its own thread.
+pub fn serve(addr: SocketAddr, page: String) -> std::io::Result<Server> {
+    let listener = TcpListener::bind(addr)?;
+    let addr = listener.local_addr()?;
+    let hub = Arc::new(Hub::default());
+    let page: Arc<str> = page.into();
+    let h = hub.clone();
+    std::thread::Builder::new()
+        .name("serve".into())
+        .spawn(move || {
+            for stream in listener.incoming().flatten() {
+                let (hub, page) = (h.clone(), page.clone());
+                let _ = std::thread::Builder::new()
+                    .name("serve-conn".into())
+                    .spawn(move || {
+                        let _ = connection(stream, &hub, &page);
+                    });
+            }
+        })?;
+    Ok(Server { addr, hub })
+}
+
+/// The request line's path and the `Last-Event-ID` header, if any.
+fn read_request(stream: &TcpStream) -> std::io::Result<Option<(String, String, Option<u64>)>> {
+    stream.set_read_timeout(Some(Duration::from_secs(5)))?;
+    let mut r = BufReader::new(stream.try_clone()?);
+    let mut first = String::new();
+    if r.read_line(&mut first)? == 0 {
+        return Ok(None);
+    }
+    let mut parts = first.split_whitespace();
+    let (Some(method), Some(target)) = (parts.next(), parts.next()) else {
+        return Ok(None);
+    };
+    let mut last_id = None;
+    // Headers until the empty line; at most 100 of them.
+    for _ in 0..100 {
+        let mut h = String::new();
+        if r.read_line(&mut h)? == 0 || h.trim().is_empty() {
+            break;
+        }
+        if let Some((k, v)) = h.split_once(':') {
+            if k.trim().eq_ignore_ascii_case("last-event-id") {
+                last_id = v.trim().parse().ok();
+            }
+        }
+    }
+    let path = target.split('?').next().unwrap_or("/").to_string();
+    Ok(Some((method.to_string(), path, last_id)))
+}
+
+fn respond(mut s: &TcpStream, status: &str, ty: &str, body: &[u8]) -> std::io::Result<()> {
+    write!(
+        s,
+        "HTTP/1.1 {status}\r\nContent-Type: {ty}\r\nContent-Length: {}\r\n\
+         Cache-Control: no-store\r\nConnection: close\r\n\r\n",
+        body.len()
+    )?;
+    s.write_all(body)?;
+    s.flush()
+}
+
+fn connection(stream: TcpStream, hub: &Hub, page: &str) -> std::io::Result<()> {
+    let Some((method, path, last_id)) = read_request(&stream)? else {
+        return Ok(());
+    };
+    if method != "GET" && method != "HEAD" {
+        return respond(
+            &stream,
+            "405 Method Not Allowed",
+            "text/plain",
+            b"GET only\n",
+        );
+    }
+    match path.as_str() {
+        "/" | "/index.html" => respond(
+            &stream,
+            "200 OK",
+            "text/html; charset=utf-8",
+            page.as_bytes(),
+        ),
+        "/verdicts.jsonl" => respond(
+            &stream,
+            "200 OK",
+            "application/x-ndjson",
+            hub.all_lines().as_bytes(),
+        ),
+        "/events" => events(stream, hub, last_id),
+        _ => respond(&stream, "404 Not Found", "text/plain", b"not found\n"),
+    }
+}
+
+/// One event: `id` for a reconnect's `Last-Event-ID`, data `{"sent_ms":..,"verdict":LINE}`.
+fn event(p: &Published) -> String {
+    format!(
+        "id: {}\ndata: {{\"sent_ms\":{},\"verdict\":{}}}\n\n",
+        p.id, p.sent_ms, p.line
+    )
+}
+
+fn events(mut stream: TcpStream, hub: &Hub, last_id: Option<u64>) -> std::io::Result<()> {
+    stream.set_read_timeout(None)?;
+    write!(
+        stream,
+        "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\n\
+         Connection: keep-alive\r\n\r\nretry: 1000\n\n"
+    )?;
+    let (past, rx) = hub.subscribe(last_id);
+    let mut batch = String::new();
+    for p in &past {
+        batch.push_str(&event(p));
+    }
+    stream.write_all(batch.as_bytes())?;
+    stream.flush()?;
+    loop {
+        match rx.recv_timeout(Duration::from_secs(15)) {
+            Ok(p) => {
+                let mut text = event(&p);
+                // Whatever else is queued goes in the same write.
+                while let Ok(more) = rx.try_recv() {
+                    text.push_str(&event(&more));
+                }
+                stream.write_all(text.as_bytes())?;
+                stream.flush()?;
+            }
+            // A comment keeps proxies from closing an idle stream, and finds a gone peer.
+            Err(RecvTimeoutError::Timeout) => {
+                stream.write_all(b": idle\n\n")?;
+                stream.flush()?;
+            }
+            Err(RecvTimeoutError::Disconnected) => return Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn addresses_default_to_loopback() {
+        assert_eq!(parse_addr("8080").unwrap().to_string(), "127.0.0.1:8080");
+        assert_eq!(parse_addr(":0").unwrap().to_string(), "127.0.0.1:0");
+        assert_eq!(parse_addr("0.0.0.0:9").unwrap().to_string(), "0.0.0.0:9");
+        assert!(parse_addr("nowhere").unwrap_err().contains("expected PORT"));
+    }
+
+    #[test]
+    fn the_tee_writes_through_and_publishes_whole_lines() {
+        let hub = Arc::new(Hub::default());
+        let file = Arc::new(Mutex::new(Vec::new()));
+        struct Shared(Arc<Mutex<Vec<u8>>>);
+        impl Write for Shared {
+            fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+                self.0.lock().unwrap().extend_from_slice(b);
+                Ok(b.len())
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                Ok(())
+            }
+        }
+        let mut tee = Tee::new(Box::new(Shared(file.clone())), hub.clone());
+        let (_, rx) = hub.subscribe(None);
+        tee.write_all(b"{\"a\":1}\n{\"b\"").unwrap();
+        assert_eq!(hub.all_lines(), "{\"a\":1}\n");
+        tee.write_all(b":2}\n").unwrap();
+        assert_eq!(hub.all_lines(), "{\"a\":1}\n{\"b\":2}\n");
+        assert_eq!(&*file.lock().unwrap(), b"{\"a\":1}\n{\"b\":2}\n");
+        let got: Vec<u64> = rx.try_iter().map(|p| p.id).collect();
+        assert_eq!(got, vec![0, 1]);
+        // A reconnect after id 0 gets only what followed.
+        let (past, _) = hub.subscribe(Some(0));
+        assert_eq!(past.len(), 1);
+        assert!(event(&past[0]).starts_with("id: 1\ndata: {\"sent_ms\":"));
+    }
+}

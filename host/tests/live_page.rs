@@ -1,0 +1,193 @@
+//! The sidecar's live page (`monitor --serve`): a browser connected while the museum runs
+//! sees the verdicts arrive, the page's lines are the verdict file's, and stopping the
+//! monitor loses no verdict line. The browser is headless Chromium (installed by
+//! `.ci/run`); without it, and outside CI, the browser part is skipped with a note.
+
+#[path = "live_common/mod.rs"]
+mod live_common;
+
+mod browser;
+
+use std::io::{Read, Write};
+use std::net::TcpStream;
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use browser::{chromium, shot_path, Browser};
+use live_common::{finish, scratch, unique, Guard};
+
+fn hindsight() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_hindsight"))
+}
+
+fn museum() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-guide")
+}
+
+/// A plain GET, status line and all, for the server's own routes.
+fn get(addr: &str, path: &str) -> String {
+    let mut s = TcpStream::connect(addr).unwrap();
+    write!(s, "GET {path} HTTP/1.1\r\nHost: {addr}\r\n\r\n").unwrap();
+    let mut text = String::new();
+    s.read_to_string(&mut text).unwrap();
+    text
+}
+
+/// What the page shows: verdict lines received, and each row's property and verdict.
+const PAGE_STATE: &str = "JSON.stringify({lines: +document.getElementById('lines').textContent, \
+    errors: +document.getElementById('errors').textContent, \
+    median: +document.getElementById('delay-median').textContent, \
+    max: +document.getElementById('delay-max').textContent, \
+    rows: Array.from(document.querySelectorAll('tr[data-property]')).map(function (r) { \
+      return [r.getAttribute('data-property'), r.getAttribute('data-verdict')]; })})";
+
+#[test]
+fn the_live_page_shows_the_verdicts_as_they_arrive() {
+    let dir = scratch("live-page");
+    let prefix = unique("live-page");
+    let layout = hindsight()
+        .arg("run")
+        .arg(museum())
+        .args(["--layout", "--prefix", &prefix])
+        .output()
+        .unwrap();
+    assert!(layout.status.success());
+    let config = dir.join("museum.toml");
+    std::fs::write(&config, &layout.stdout).unwrap();
+    let verdicts = dir.join("verdicts.jsonl");
+    let err_path = dir.join("monitor.err");
+    let mut monitor = Guard(Some(
+        hindsight()
+            .arg("monitor")
+            .arg("--model")
+            .arg(museum())
+            .arg("--config")
+            .arg(&config)
+            .args(["--speed", "10", "--from-first-message", "--serve", ":0"])
+            .arg("-o")
+            .arg(&verdicts)
+            .stdout(Stdio::null())
+            .stderr(std::fs::File::create(&err_path).unwrap())
+            .spawn()
+            .unwrap(),
+    ));
+    let t = Instant::now();
+    let addr = loop {
+        let log = std::fs::read_to_string(&err_path).unwrap_or_default();
+        if log.contains("monitor: ready") {
+            let at = log.find("live page at http://").expect(&log) + "live page at http://".len();
+            break log[at..at + log[at..].find('/').unwrap()].to_string();
+        }
+        assert!(t.elapsed() < Duration::from_secs(30), "never ready: {log}");
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    // Loopback unless told otherwise.
+    assert!(addr.starts_with("127.0.0.1:"), "{addr}");
+    let page = get(&addr, "/");
+    assert!(page.starts_with("HTTP/1.1 200 OK"), "{page}");
+    for p in ["battery_recurrence", "alarm_response", "poi_response"] {
+        assert!(page.contains(p), "{p} not on the page");
+    }
+    assert!(!page.contains("http://") && !page.contains("https://"));
+    assert!(get(&addr, "/nothing").starts_with("HTTP/1.1 404"));
+
+    // The browser connects before the system starts, and stays while it runs.
+    let mut browser = chromium().map(|c| {
+        let mut b = Browser::start(&c, &dir.join("profile"));
+        b.open(&format!("http://{addr}/"));
+        b.wait_for(
+            "document.getElementById('status').textContent === 'live'",
+            Duration::from_secs(30),
+        );
+        b
+    });
+    let run = hindsight()
+        .arg("run")
+        .arg(museum())
+        .args(["--prefix", &prefix, "--seed", "2", "--speed", "10"])
+        .args(["--duration", "60s"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .output()
+        .unwrap();
+    assert!(run.status.success());
+    let served_body = |addr: &str| {
+        let t = get(addr, "/verdicts.jsonl");
+        t[t.find("\r\n\r\n").unwrap() + 4..].to_string()
+    };
+    // The page catches up with every line served so far.
+    let so_far = served_body(&addr).lines().count();
+    assert!(so_far >= 5, "{so_far} verdict lines");
+    let state = browser.as_mut().map(|b| {
+        b.wait_for(
+            &format!("+document.getElementById('lines').textContent >= {so_far}"),
+            Duration::from_secs(30),
+        );
+        let state: serde_json::Value =
+            serde_json::from_str(b.eval(PAGE_STATE).as_str().unwrap()).unwrap();
+        b.screenshot(&shot_path("live-page.png"));
+        state
+    });
+    let served = served_body(&addr);
+
+    // Stopping loses no line: everything served is in the file, and the file is whole.
+    let pid = monitor.0.as_ref().unwrap().id().to_string();
+    assert!(Command::new("kill")
+        .args(["-TERM", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let (status, _) = finish(&mut monitor);
+    assert!(status.success());
+    let file = std::fs::read_to_string(&verdicts).unwrap();
+    assert!(file.starts_with(&served), "served lines are not the file's");
+    let lines: Vec<serde_json::Value> = file
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+
+    let (Some(state), Some(b)) = (state, browser) else {
+        return;
+    };
+    assert!(b.errors.is_empty(), "page errors: {:?}", b.errors);
+    assert_eq!(state["errors"], 0, "{state}");
+    // Nothing but the page and its event stream was fetched.
+    for u in &b.requests {
+        assert!(u.starts_with(&format!("http://{addr}/")), "fetched {u}");
+    }
+    let shown = state["lines"].as_u64().unwrap() as usize;
+    assert!(
+        shown >= so_far && shown <= lines.len(),
+        "{shown} of {}",
+        lines.len()
+    );
+    // Each row shows the last verdict of its property among the lines the page had.
+    for row in state["rows"].as_array().unwrap() {
+        let p = row[0].as_str().unwrap();
+        let last = lines[..shown].iter().rev().find(|w| w["property"] == p);
+        assert_eq!(
+            row[1].as_str(),
+            last.and_then(|l| l["verdict"].as_str()),
+            "{p}: {state}"
+        );
+    }
+    println!(
+        "verdict to page: median {} ms, max {} ms over {shown} lines",
+        state["median"], state["max"]
+    );
+    assert!(state["max"].as_u64().unwrap() < 5_000, "{state}");
+}
+
+#[test]
+fn a_bad_serve_address_exits_2() {
+    let out = hindsight()
+        .args(["monitor", "--model"])
+        .arg(museum())
+        .args(["--config", "nothing.toml", "--serve", "nowhere"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--serve"), "{err}");
+}
