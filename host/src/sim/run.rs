@@ -141,8 +141,6 @@ impl std::fmt::Debug for Simulator<'_> {
     }
 }
 
-/// Unbiased uniform integer in `0..n` (`n > 0`), Lemire's multiply-and-reject
-/// (the division is only needed in the rare case the low half is small).
 /// The expression environment of machine `m`: its variables and its current event.
 /// A function over the two fields (not a method) so callers may hold other fields mutably.
 fn env<'s>(
@@ -168,6 +166,13 @@ fn env<'s>(
     }
 }
 
+/// Machine `m`'s scratch cell `sc` (`None` only if the compiled model is inconsistent).
+/// A function over the field, like [`env`], so callers may borrow the others meanwhile.
+#[inline]
+fn scratch_cell(scratch: &mut [Vec<Cell>], m: usize, sc: u32) -> Option<&mut Cell> {
+    scratch.get_mut(m).and_then(|v| v.get_mut(sc as usize))
+}
+
 /// Evaluates a send's parameter expressions into `out` (the message's cells), stopping at
 /// the first error.
 fn eval_params(sd: &SendDef, env: &mut Env<'_>, out: &mut [Cell]) -> Result<(), EvalError> {
@@ -179,6 +184,8 @@ fn eval_params(sd: &SendDef, env: &mut Env<'_>, out: &mut [Cell]) -> Result<(), 
     Ok(())
 }
 
+/// Unbiased uniform integer in `0..n` (`n > 0`), Lemire's multiply-and-reject
+/// (the division is only needed in the rare case the low half is small).
 fn below(rng: &mut dyn Entropy, n: u32) -> u32 {
     let n = n as u64;
     let mut m = (rng.next_u64() as u128) * (n as u128);
@@ -435,11 +442,7 @@ impl<'m> Simulator<'m> {
                 }
             }
             for (slot, f, bound, span, sc) in &def.init {
-                let Some(scratch) = self
-                    .scratch
-                    .get_mut(m)
-                    .and_then(|v| v.get_mut(*sc as usize))
-                else {
+                let Some(scratch) = scratch_cell(&mut self.scratch, m, *sc) else {
                     continue;
                 };
                 let res = {
@@ -727,11 +730,7 @@ impl<'m> Simulator<'m> {
                     bound,
                     scratch: sc,
                 } => {
-                    let Some(scratch) = self
-                        .scratch
-                        .get_mut(m)
-                        .and_then(|v| v.get_mut(*sc as usize))
-                    else {
+                    let Some(scratch) = scratch_cell(&mut self.scratch, m, *sc) else {
                         return Err(self.internal(m, pc));
                     };
                     let res = {
@@ -764,11 +763,7 @@ impl<'m> Simulator<'m> {
                     value,
                     scratch: sc,
                 } => {
-                    let Some(scratch) = self
-                        .scratch
-                        .get_mut(m)
-                        .and_then(|v| v.get_mut(*sc as usize))
-                    else {
+                    let Some(scratch) = scratch_cell(&mut self.scratch, m, *sc) else {
                         return Err(self.internal(m, pc));
                     };
                     let res = {
@@ -809,11 +804,7 @@ impl<'m> Simulator<'m> {
                     value,
                     scratch: sc,
                 } => {
-                    let Some(scratch) = self
-                        .scratch
-                        .get_mut(m)
-                        .and_then(|v| v.get_mut(*sc as usize))
-                    else {
+                    let Some(scratch) = scratch_cell(&mut self.scratch, m, *sc) else {
                         return Err(self.internal(m, pc));
                     };
                     let mut has = false;

@@ -42,16 +42,7 @@ impl Simulator<'_> {
                 let s = &self.pool[slot as usize];
                 (s.event, s.origin, s.target)
             };
-            let r = &mut self.ms[m];
-            r.cur = slot;
-            r.cur_event = model
-                .events
-                .get(event as usize)
-                .map_or(StrId(0), |e| e.name_str);
-            r.cur_origin = model
-                .machines
-                .get(origin as usize)
-                .map_or(StrId(0), |d| d.name_str);
+            self.take_current(m, slot, event, origin);
             self.steps += 1;
             self.instant_steps += 1;
             let flow = obs.on_receive(
@@ -73,6 +64,23 @@ impl Simulator<'_> {
         }
         self.refresh(m);
         Ok(Some(Flow::Continue))
+    }
+
+    /// Makes the message in pool slot `slot` (event `event`, from machine `origin`)
+    /// machine `m`'s current one: what `_event` and its name and origin read.
+    #[inline]
+    fn take_current(&mut self, m: usize, slot: u32, event: u32, origin: u32) {
+        let model = self.model;
+        let r = &mut self.ms[m];
+        r.cur = slot;
+        r.cur_event = model
+            .events
+            .get(event as usize)
+            .map_or(StrId(0), |e| e.name_str);
+        r.cur_origin = model
+            .machines
+            .get(origin as usize)
+            .map_or(StrId(0), |d| d.name_str);
     }
 
     /// Whether a blocked machine's send (or awaited rendezvous) can go on now.
@@ -116,18 +124,7 @@ impl Simulator<'_> {
         let list = st.transitions(e, &def.dispatch);
         let has = !list.is_empty();
         let origin = self.pool[e as usize].origin;
-        {
-            let rt = &mut self.ms[m];
-            rt.cur = e;
-            rt.cur_event = model
-                .events
-                .get(e as usize)
-                .map_or(StrId(0), |d| d.name_str);
-            rt.cur_origin = model
-                .machines
-                .get(origin as usize)
-                .map_or(StrId(0), |d| d.name_str);
-        }
+        self.take_current(m, e, e, origin);
         if let Some(t) = self.select(m, def, list, rng, cfg)? {
             return Ok(Some(Some(t)));
         }
