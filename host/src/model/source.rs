@@ -2,10 +2,23 @@
 //!
 //! The model reader keeps the text of every file it read in a [`SourceMap`];
 //! parsed items carry a [`Span`] (file + byte offset). Line and column are
-//! computed only when a [`Diagnostic`] is made, so spans cost 8 bytes.
+//! computed only when a [`Diagnostic`] is made, so spans cost 8 bytes. Lines,
+//! columns, the diagnostic and its rendering are codegen's ([`codegen::diag`]),
+//! the one source foundation of every reader.
 
-use std::fmt;
 use std::path::{Path, PathBuf};
+
+use codegen::diag::LineIndex;
+
+/// An error (or warning) about a model is the project's one diagnostic (line 0: about a
+/// whole file, such as a missing one); one or more of them, [`Diagnostics`], are the
+/// error type of loading and compiling a model.
+pub use codegen::diag::{Diagnostic, Diagnostics};
+
+/// A diagnostic about the whole file at `path` (no line or column).
+pub fn about_file(path: impl AsRef<Path>, message: impl Into<String>) -> Diagnostic {
+    Diagnostic::about_file(path.as_ref().display().to_string(), message.into())
+}
 
 /// Index of a file in a [`SourceMap`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -35,7 +48,7 @@ impl Span {
 pub struct SourceFile {
     path: PathBuf,
     text: String,
-    line_starts: Vec<u32>,
+    lines: LineIndex,
 }
 
 impl SourceFile {
@@ -51,18 +64,7 @@ impl SourceFile {
 
     /// 1-based line and column (in characters) of a byte offset.
     pub fn line_col(&self, offset: u32) -> (u32, u32) {
-        let offset = offset.min(self.text.len() as u32);
-        let line = match self.line_starts.binary_search(&offset) {
-            Ok(i) => i,
-            Err(i) => i.saturating_sub(1),
-        };
-        let start = self.line_starts.get(line).copied().unwrap_or(0) as usize;
-        let mut end = offset as usize;
-        while end > start && !self.text.is_char_boundary(end) {
-            end -= 1;
-        }
-        let column = self.text.get(start..end).map_or(0, |s| s.chars().count());
-        (line as u32 + 1, column as u32 + 1)
+        self.lines.line_col(&self.text, offset as usize)
     }
 }
 
@@ -80,16 +82,10 @@ impl SourceMap {
 
     /// Adds a file's text and returns its id.
     pub fn add(&mut self, path: impl Into<PathBuf>, text: String) -> FileId {
-        let mut line_starts = vec![0u32];
-        for (i, b) in text.bytes().enumerate() {
-            if b == b'\n' {
-                line_starts.push(i as u32 + 1);
-            }
-        }
         self.files.push(SourceFile {
             path: path.into(),
+            lines: LineIndex::new(&text),
             text,
-            line_starts,
         });
         FileId(self.files.len() as u32 - 1)
     }
@@ -107,21 +103,14 @@ impl SourceMap {
     /// A diagnostic at `span` with `message`.
     pub fn diag(&self, span: Span, message: impl Into<String>) -> Diagnostic {
         match self.file(span.file) {
-            Some(f) => {
-                let (line, column) = f.line_col(span.offset);
-                Diagnostic {
-                    path: f.path.clone(),
-                    line,
-                    column,
-                    message: message.into(),
-                }
-            }
-            None => Diagnostic {
-                path: PathBuf::from("<unknown>"),
-                line: 0,
-                column: 0,
-                message: message.into(),
-            },
+            Some(f) => Diagnostic::in_text(
+                f.path.display().to_string(),
+                &f.text,
+                &f.lines,
+                span.offset as usize,
+                message.into(),
+            ),
+            None => about_file("<unknown>", message),
         }
     }
 
@@ -209,100 +198,6 @@ pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, usize> {
     Ok(std::borrow::Cow::Owned(out))
 }
 
-/// An error (or warning) about a model, at a file, line and column.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Diagnostic {
-    /// The file.
-    pub path: PathBuf,
-    /// 1-based line (0 when there is no position, e.g. a missing file).
-    pub line: u32,
-    /// 1-based column in characters (0 when there is no position).
-    pub column: u32,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl Diagnostic {
-    /// A diagnostic about a whole file (no line or column).
-    pub fn file(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
-        Diagnostic {
-            path: path.into(),
-            line: 0,
-            column: 0,
-            message: message.into(),
-        }
-    }
-}
-
-impl fmt::Display for Diagnostic {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.line == 0 {
-            write!(f, "{}: {}", self.path.display(), self.message)
-        } else {
-            write!(
-                f,
-                "{}:{}:{}: {}",
-                self.path.display(),
-                self.line,
-                self.column,
-                self.message
-            )
-        }
-    }
-}
-
-impl std::error::Error for Diagnostic {}
-
-/// One or more [`Diagnostic`]s: the error type of loading and compiling a model.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Diagnostics(pub Vec<Diagnostic>);
-
-impl Diagnostics {
-    /// True when there is no diagnostic.
-    pub fn is_empty(&self) -> bool {
-        self.0.is_empty()
-    }
-
-    /// The diagnostics in the order they were found.
-    pub fn iter(&self) -> std::slice::Iter<'_, Diagnostic> {
-        self.0.iter()
-    }
-
-    /// Adds one diagnostic.
-    pub fn push(&mut self, d: Diagnostic) {
-        self.0.push(d);
-    }
-
-    /// `Ok(v)` when empty, `Err(self)` otherwise.
-    pub fn into_result<T>(self, v: T) -> Result<T, Diagnostics> {
-        if self.0.is_empty() {
-            Ok(v)
-        } else {
-            Err(self)
-        }
-    }
-}
-
-impl From<Diagnostic> for Diagnostics {
-    fn from(d: Diagnostic) -> Self {
-        Diagnostics(vec![d])
-    }
-}
-
-impl fmt::Display for Diagnostics {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, d) in self.0.iter().enumerate() {
-            if i > 0 {
-                writeln!(f)?;
-            }
-            write!(f, "{d}")?;
-        }
-        Ok(())
-    }
-}
-
-impl std::error::Error for Diagnostics {}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -312,14 +207,14 @@ mod tests {
         let mut sm = SourceMap::new();
         let f = sm.add("a.scxml", "ab\ncdé\nx".to_string());
         let d = sm.diag(Span { file: f, offset: 0 }, "m");
-        assert_eq!((d.line, d.column), (1, 1));
+        assert_eq!((d.line, d.col), (1, 1));
         let d = sm.diag(Span { file: f, offset: 4 }, "m");
-        assert_eq!((d.line, d.column), (2, 2));
+        assert_eq!((d.line, d.col), (2, 2));
         let d = sm.diag(Span { file: f, offset: 7 }, "m");
-        assert_eq!((d.line, d.column), (2, 4));
+        assert_eq!((d.line, d.col), (2, 4));
         let d = sm.diag(Span { file: f, offset: 8 }, "m");
-        assert_eq!((d.line, d.column), (3, 1));
-        assert_eq!(d.to_string(), "a.scxml:3:1: m");
+        assert_eq!((d.line, d.col), (3, 1));
+        assert_eq!(d.to_string(), "a.scxml:3:1: m\n    x\n    ^");
     }
 
     #[test]
