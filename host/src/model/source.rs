@@ -122,21 +122,20 @@ impl SourceMap {
         let Some(f) = self.file(span.file) else {
             return span;
         };
-        let raw = f.text.as_bytes();
-        let mut raw_pos = span.offset as usize;
+        let raw = f.text.as_str();
+        let mut raw_pos = floor_boundary(raw, span.offset as usize);
         let mut out = 0u32;
         while out < k && raw_pos < raw.len() {
-            if raw[raw_pos] == b'&' {
-                if let Some(len) = raw[raw_pos..].iter().take(12).position(|&b| b == b';') {
-                    let entity = &raw[raw_pos..raw_pos + len + 1];
-                    let produced = entity_len(entity).unwrap_or(1);
-                    out += produced;
-                    raw_pos += len + 1;
-                    continue;
+            let rest = &raw[raw_pos..];
+            let (produced, consumed) = match reference(rest) {
+                Some(Ok((c, consumed))) => (c.len_utf8(), consumed),
+                _ => {
+                    let c = rest.chars().next().map_or(1, char::len_utf8);
+                    (c, c)
                 }
-            }
-            raw_pos += 1;
-            out += 1;
+            };
+            out = out.saturating_add(produced as u32);
+            raw_pos += consumed;
         }
         Span {
             file: span.file,
@@ -145,10 +144,33 @@ impl SourceMap {
     }
 }
 
-/// UTF-8 length of the character an entity such as `&amp;` or `&#x41;` stands for.
-fn entity_len(entity: &[u8]) -> Option<u32> {
-    let name = std::str::from_utf8(entity.get(1..entity.len() - 1)?).ok()?;
-    Some(resolve_entity(name)?.len_utf8() as u32)
+fn floor_boundary(text: &str, mut i: usize) -> usize {
+    i = i.min(text.len());
+    while !text.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
+
+/// The reference at the start of `rest`, when it starts with `&`: the character it
+/// stands for and the bytes it takes (`&lt;` is 4), or what is wrong with it; `None`
+/// when `rest` does not start with `&`. The one scanner of references, used by both
+/// XML readers (attribute values of models and of property files) and by
+/// [`SourceMap::unescaped_offset`]; names are decoded by [`resolve_entity`].
+pub(crate) fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
+    let after = rest.strip_prefix('&')?;
+    // A name longer than any entity or reasonable character reference is taken as a
+    // stray `&`, so the message does not quote half a line.
+    let Some(end) = after.find(';').filter(|&end| end <= 12) else {
+        return Some(Err(
+            "`&` that does not start a reference (write `&amp;`)".to_owned()
+        ));
+    };
+    let name = &after[..end];
+    Some(match resolve_entity(name) {
+        Some(c) => Ok((c, end + 2)),
+        None => Err(format!("unknown reference `&{name};`")),
+    })
 }
 
 /// The character an XML entity name (without `&` and `;`) stands for: the five
@@ -179,22 +201,19 @@ pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, usize> {
         return Ok(std::borrow::Cow::Borrowed(raw));
     }
     let mut out = String::with_capacity(raw.len());
-    let mut rest = raw;
     let mut pos = 0usize;
-    while let Some(i) = rest.find('&') {
-        out.push_str(&rest[..i]);
-        let after = &rest[i + 1..];
-        let Some(end) = after.find(';') else {
-            return Err(pos + i);
-        };
-        let Some(c) = resolve_entity(&after[..end]) else {
-            return Err(pos + i);
-        };
-        out.push(c);
-        pos += i + end + 2;
-        rest = &after[end + 1..];
+    while let Some(i) = raw[pos..].find('&') {
+        out.push_str(&raw[pos..pos + i]);
+        pos += i;
+        match reference(&raw[pos..]) {
+            Some(Ok((c, consumed))) => {
+                out.push(c);
+                pos += consumed;
+            }
+            _ => return Err(pos),
+        }
     }
-    out.push_str(rest);
+    out.push_str(&raw[pos..]);
     Ok(std::borrow::Cow::Owned(out))
 }
 
@@ -245,5 +264,15 @@ mod tests {
         assert_eq!(unescape("&#x41;&lt;").unwrap(), "A<");
         assert_eq!(unescape("a&#0;"), Err(1));
         assert_eq!(unescape("&#x0;"), Err(0));
+        assert_eq!(unescape("x &#233;!").unwrap(), "x é!");
+        assert_eq!(
+            reference("&nbsp; b"),
+            Some(Err("unknown reference `&nbsp;`".to_owned()))
+        );
+        assert_eq!(reference("&amp;&lt;"), Some(Ok(('&', 5))));
+        assert!(
+            matches!(reference("&a b c d e f g h i;"), Some(Err(m)) if m.contains("write `&amp;`"))
+        );
+        assert_eq!(reference("a"), None);
     }
 }

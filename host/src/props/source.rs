@@ -217,19 +217,10 @@ pub(crate) fn unescape_attribute(
     let mut rest = raw;
     let mut at = offset;
     while !rest.is_empty() {
-        if let Some(after) = rest.strip_prefix('&') {
-            let end = after.find(';').filter(|&end| end <= 12).ok_or_else(|| {
-                (
-                    at,
-                    "`&` that does not start a reference (write `&amp;`)".to_owned(),
-                )
-            })?;
-            let name = &after[..end];
-            let decoded = crate::model::source::resolve_entity(name);
-            let decoded = decoded.ok_or_else(|| (at, format!("unknown reference `&{name};`")))?;
+        if let Some(decoded) = crate::model::source::reference(rest) {
+            let (decoded, consumed) = decoded.map_err(|message| (at, message))?;
             let mut buffer = [0u8; 4];
             out.push_exact(decoded.encode_utf8(&mut buffer), lines.location(at));
-            let consumed = end + 2;
             rest = &rest[consumed..];
             at += consumed;
             continue;
