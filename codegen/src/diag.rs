@@ -1,13 +1,25 @@
-//! Diagnostics: spans into sources, errors and warnings rendered as `file:line:col: error: message` with a caret line.
+//! Diagnostics of every reader in the project: positions in source text and one rendering, `file:line:col: message` with the source line and a caret.
 //!
-//! Every parsed node keeps a [`Span`]: a byte range in one source of a
-//! [`SourceMap`]. A source is either a whole `.hspec` file (line 1, column 1)
-//! or a piece of text that starts somewhere inside another file, such as a
-//! formula taken from an XML attribute: its [`crate::Origin`] gives the file,
+//! This module is the source foundation that the host's readers (models, robot
+//! models, property files) share with the formula compiler, so positions are
+//! computed and problems are printed in one place:
+//!
+//! - [`LineIndex`] turns a byte offset of a text into a 1-based line and a column
+//!   counted in characters, and gives the line's text for the caret;
+//! - [`PositionRun`]s map text that is not a verbatim copy of its file (a formula
+//!   after XML entities, one generated from a tree of elements) back to the file
+//!   ([`locate_in_runs`]);
+//! - [`Diagnostic`] is one located problem, its payload a message or a structured
+//!   kind (the property reader's), rendered the same way whatever the payload;
+//!   [`Diagnostics`] collects them in the order found.
+//!
+//! Inside the compiler every parsed node keeps a [`Span`]: a byte range in one
+//! source of a [`SourceMap`]. A source is either a whole `.hspec` file (line 1,
+//! column 1) or a piece of text that starts somewhere inside another file, such as
+//! a formula taken from an XML attribute: its [`crate::Origin`] gives the file,
 //! line and column of its first character, so positions point into that file.
-//!
-//! Passes collect problems instead of stopping at the first one and hand back
-//! a [`Diagnostics`]: located, already rendered, independent of the sources.
+//! Passes collect problems instead of stopping at the first one and hand back a
+//! [`Diagnostics`]: located, already rendered, independent of the sources.
 
 use std::fmt;
 
@@ -132,7 +144,7 @@ impl SourceMap {
     }
 
     /// Location plus the source line, the caret's 0-based character column in it and its length.
-    fn resolve(&self, span: Span) -> (Location, Option<(String, usize, usize)>) {
+    fn resolve(&self, span: Span) -> (Location, Option<Snippet>) {
         let Some(src) = self.sources.get(span.source as usize) else {
             let loc = Location {
                 file: "<unknown>".into(),
@@ -143,83 +155,157 @@ impl SourceMap {
         };
         let text = src.text.as_str();
         let lo = floor_boundary(text, span.lo as usize);
-        let hi = floor_boundary(text, (span.hi as usize).max(lo));
-        let line_start = text[..lo].rfind('\n').map_or(0, |p| p + 1);
-        let line_end = text[lo..].find('\n').map_or(text.len(), |p| lo + p);
-        let newlines = text[..lo].matches('\n').count() as u32;
-        let caret_col = text[line_start..lo].chars().count();
-        let caret_len = text[lo..hi.min(line_end)].chars().count().max(1);
-        let line_text = text[line_start..line_end]
-            .trim_end_matches('\r')
-            .to_string();
-        let loc = if let Some(run) = run_at(&src.runs, lo) {
-            let col = if run.exact {
-                let from = floor_boundary(text, run.offset as usize).min(lo);
-                run.col
-                    .max(1)
-                    .saturating_add(text[from..lo].chars().count() as u32)
-            } else {
-                run.col.max(1)
-            };
-            Location {
-                file: src.name.clone(),
-                line: run.line.max(1),
-                col,
-            }
+        let snippet = Snippet::of(text, lo, span.hi as usize);
+        let (line, col) = if let Some(at) = locate_in_runs(text, &src.runs, lo) {
+            at
         } else if src.exact {
+            let newlines = text[..lo].matches('\n').count() as u32;
             let col = if newlines == 0 {
-                src.col.saturating_add(caret_col as u32)
+                src.col.saturating_add(snippet.caret_col as u32)
             } else {
-                caret_col as u32 + 1
+                snippet.caret_col as u32 + 1
             };
-            Location {
-                file: src.name.clone(),
-                line: src.line.saturating_add(newlines),
-                col,
-            }
+            (src.line.saturating_add(newlines), col)
         } else {
-            Location {
-                file: src.name.clone(),
-                line: src.line,
-                col: src.col,
-            }
+            (src.line, src.col)
         };
-        (loc, Some((line_text, caret_col, caret_len)))
+        let loc = Location {
+            file: src.name.clone(),
+            line,
+            col,
+        };
+        (loc, Some(snippet))
     }
 
     /// Renders one problem at `span`.
     pub(crate) fn diagnostic(&self, severity: Severity, span: Span, message: String) -> Diagnostic {
         let (loc, snippet) = self.resolve(span);
-        let (source_line, caret_col, caret_len) = snippet.unwrap_or_default();
+        let snippet = snippet.unwrap_or_default();
         Diagnostic {
             severity,
             message,
             file: loc.file,
             line: loc.line,
             col: loc.col,
-            source_line,
-            caret_col,
-            caret_len,
+            source_line: snippet.line,
+            caret_col: snippet.caret_col,
+            caret_len: snippet.caret_len,
         }
     }
 
     /// Renders every collected problem.
     pub(crate) fn render(&self, sink: Sink) -> Diagnostics {
-        Diagnostics {
-            items: sink
-                .items
+        Diagnostics(
+            sink.items
                 .into_iter()
                 .map(|r| self.diagnostic(r.severity, r.span, r.message))
                 .collect(),
-        }
+        )
     }
 }
 
-/// The run of a position map that byte `at` falls in (the first run for an offset
-/// before it; `None` without a map).
-fn run_at(runs: &[PositionRun], at: usize) -> Option<PositionRun> {
+/// The file position (line, column) of byte `at` of `text`, whose position map is
+/// `runs` (sorted by offset; an offset before the first run counts in the first run);
+/// `None` without a map. The one reading of a [`PositionRun`] map: the compiler's
+/// sources and the property reader's formulas both resolve through it.
+pub fn locate_in_runs(text: &str, runs: &[PositionRun], at: usize) -> Option<(u32, u32)> {
     let i = runs.partition_point(|r| r.offset as usize <= at);
-    runs.get(i.saturating_sub(1)).copied()
+    let run = runs.get(i.saturating_sub(1))?;
+    if !run.exact {
+        return Some((run.line.max(1), run.col.max(1)));
+    }
+    let at = floor_boundary(text, at);
+    let from = floor_boundary(text, run.offset as usize).min(at);
+    let chars = u32::try_from(text[from..at].chars().count()).unwrap_or(u32::MAX);
+    Some((run.line.max(1), run.col.max(1).saturating_add(chars)))
+}
+
+/// Where lines start in a text, to turn byte offsets into 1-based lines and columns
+/// counted in characters (a tab counts as one), and to find a line's text for the
+/// caret. Holds only the offsets, so the owner of the text keeps it.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct LineIndex {
+    starts: Vec<u32>,
+}
+
+impl LineIndex {
+    /// The index of `text`.
+    pub fn new(text: &str) -> LineIndex {
+        let mut starts = vec![0u32];
+        starts.extend(
+            text.bytes()
+                .enumerate()
+                .filter(|&(_, b)| b == b'\n')
+                .map(|(i, _)| u32::try_from(i + 1).unwrap_or(u32::MAX)),
+        );
+        LineIndex { starts }
+    }
+
+    /// 1-based line and column of byte `offset` of `text` (the indexed text), clamped
+    /// to the text; an offset inside a multi-byte character counts as that character.
+    pub fn line_col(&self, text: &str, offset: usize) -> (u32, u32) {
+        let offset = floor_boundary(text, offset);
+        let line = self
+            .starts
+            .partition_point(|&s| s as usize <= offset)
+            .saturating_sub(1);
+        let start = self.starts.get(line).map_or(0, |&s| s as usize).min(offset);
+        let column = text.get(start..offset).map_or(0, |s| s.chars().count());
+        (
+            u32::try_from(line + 1).unwrap_or(u32::MAX),
+            u32::try_from(column + 1).unwrap_or(u32::MAX),
+        )
+    }
+
+    /// Byte offset where 1-based line `line` starts, if the text has it.
+    pub fn line_start(&self, line: u32) -> Option<usize> {
+        let i = usize::try_from(line).ok()?.checked_sub(1)?;
+        self.starts.get(i).map(|&s| s as usize)
+    }
+}
+
+/// The source line a diagnostic shows, and where its carets go.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Snippet {
+    /// The line's text (no line break).
+    pub line: String,
+    /// 0-based character column of the first caret.
+    pub caret_col: usize,
+    /// Number of carets (at least 1).
+    pub caret_len: usize,
+}
+
+impl Snippet {
+    /// The line of `text` holding byte `lo`, with carets under `lo..hi` (cut at the
+    /// line's end).
+    pub fn of(text: &str, lo: usize, hi: usize) -> Snippet {
+        let lo = floor_boundary(text, lo);
+        let hi = floor_boundary(text, hi.max(lo));
+        let line_start = text[..lo].rfind('\n').map_or(0, |p| p + 1);
+        let line_end = text[lo..].find('\n').map_or(text.len(), |p| lo + p);
+        Snippet {
+            line: text[line_start..line_end]
+                .trim_end_matches('\r')
+                .to_string(),
+            caret_col: text[line_start..lo].chars().count(),
+            caret_len: text[lo..hi.min(line_end)].chars().count().max(1),
+        }
+    }
+
+    /// The caret at 1-based `line` and character column `col` of `text`, as `index`
+    /// (of `text`) finds them (empty when the text has no such line).
+    pub fn at_line_col(text: &str, index: &LineIndex, line: u32, col: u32) -> Snippet {
+        let Some(start) = index.line_start(line).filter(|&s| s <= text.len()) else {
+            return Snippet::default();
+        };
+        let rest = &text[start..];
+        let skip = col.saturating_sub(1) as usize;
+        let lo = rest
+            .char_indices()
+            .nth(skip)
+            .map_or(rest.find('\n').unwrap_or(rest.len()), |(i, _)| i);
+        Snippet::of(text, start + lo, start + lo)
+    }
 }
 
 fn floor_boundary(text: &str, mut i: usize) -> usize {
@@ -248,20 +334,26 @@ impl fmt::Display for Severity {
     }
 }
 
-/// One located problem.
+/// One located problem. Its payload `message` is a sentence (no trailing period) or a
+/// structured kind that displays as one (the property reader's `PropsErrorKind`, which
+/// callers match on); the position and its rendering are the same for every payload.
+///
+/// Rendered as `file:line:col: message` (`file:line:col: warning: message` for a
+/// warning), followed by the source line and a caret line when the source is known,
+/// and as `file: message` for a problem about a whole file (`line == 0`).
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Diagnostic {
+pub struct Diagnostic<M = String> {
     /// Error or warning.
     pub severity: Severity,
-    /// What is wrong, in one sentence (no trailing period).
-    pub message: String,
+    /// What is wrong.
+    pub message: M,
     /// The file the problem is in.
     pub file: String,
-    /// 1-based line.
+    /// 1-based line (0 for a problem about the whole file, such as a missing file).
     pub line: u32,
-    /// 1-based column, in characters.
+    /// 1-based column, in characters (0 when `line` is).
     pub col: u32,
-    /// The line of source text the problem is on (may be empty when unknown).
+    /// The line of source text the problem is on (empty when unknown).
     pub source_line: String,
     /// 0-based character column of the caret in `source_line`.
     pub caret_col: usize,
@@ -269,13 +361,78 @@ pub struct Diagnostic {
     pub caret_len: usize,
 }
 
-impl fmt::Display for Diagnostic {
+impl<M> Diagnostic<M> {
+    /// An error at `line`:`col` of `file`, with no source line.
+    pub fn error(file: impl Into<String>, (line, col): (u32, u32), message: M) -> Self {
+        Diagnostic {
+            severity: Severity::Error,
+            message,
+            file: file.into(),
+            line,
+            col,
+            source_line: String::new(),
+            caret_col: 0,
+            caret_len: 1,
+        }
+    }
+
+    /// An error about the whole file `file` (it cannot be read, it is missing, ...).
+    pub fn about_file(file: impl Into<String>, message: M) -> Self {
+        Self::error(file, (0, 0), message)
+    }
+
+    /// An error at byte `offset` of `text`, the whole text of `file` indexed by
+    /// `index`: the position and the caret both come from the offset.
+    pub fn in_text(
+        file: impl Into<String>,
+        text: &str,
+        index: &LineIndex,
+        offset: usize,
+        message: M,
+    ) -> Self {
+        Self::error(file, index.line_col(text, offset), message)
+            .with_snippet(Snippet::of(text, offset, offset))
+    }
+
+    /// The same problem showing `snippet` under its first line.
+    pub fn with_snippet(mut self, snippet: Snippet) -> Self {
+        self.source_line = snippet.line;
+        self.caret_col = snippet.caret_col;
+        self.caret_len = snippet.caret_len;
+        self
+    }
+
+    /// The same problem as a warning.
+    pub fn warning(mut self) -> Self {
+        self.severity = Severity::Warning;
+        self
+    }
+
+    /// The same problem with its payload turned by `f` (a kind into its message).
+    pub fn map<N>(self, f: impl FnOnce(M) -> N) -> Diagnostic<N> {
+        Diagnostic {
+            severity: self.severity,
+            message: f(self.message),
+            file: self.file,
+            line: self.line,
+            col: self.col,
+            source_line: self.source_line,
+            caret_col: self.caret_col,
+            caret_len: self.caret_len,
+        }
+    }
+}
+
+impl<M: fmt::Display> fmt::Display for Diagnostic<M> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{}:{}:{}: {}: {}",
-            self.file, self.line, self.col, self.severity, self.message
-        )?;
+        if self.line == 0 {
+            return write!(f, "{}: {}", self.file, self.message);
+        }
+        write!(f, "{}:{}:{}: ", self.file, self.line, self.col)?;
+        if self.severity == Severity::Warning {
+            write!(f, "{}: ", self.severity)?;
+        }
+        write!(f, "{}", self.message)?;
         if self.source_line.is_empty() {
             return Ok(());
         }
@@ -295,13 +452,19 @@ impl fmt::Display for Diagnostic {
     }
 }
 
+impl<M: fmt::Display + fmt::Debug> std::error::Error for Diagnostic<M> {}
+
 /// Every problem a pass found, errors and warnings, in the order found.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Diagnostics {
-    items: Vec<Diagnostic>,
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Diagnostics<M = String>(pub Vec<Diagnostic<M>>);
+
+impl<M> Default for Diagnostics<M> {
+    fn default() -> Self {
+        Diagnostics(Vec::new())
+    }
 }
 
-impl Diagnostics {
+impl<M> Diagnostics<M> {
     /// No diagnostics.
     pub fn new() -> Self {
         Self::default()
@@ -309,45 +472,69 @@ impl Diagnostics {
 
     /// `true` when at least one item is an error.
     pub fn has_errors(&self) -> bool {
-        self.items.iter().any(|d| d.severity == Severity::Error)
+        self.0.iter().any(|d| d.severity == Severity::Error)
     }
 
     /// Number of items (errors and warnings).
     pub fn len(&self) -> usize {
-        self.items.len()
+        self.0.len()
     }
 
     /// `true` when there is nothing to report.
     pub fn is_empty(&self) -> bool {
-        self.items.is_empty()
+        self.0.is_empty()
     }
 
     /// All items, in the order found.
-    pub fn iter(&self) -> std::slice::Iter<'_, Diagnostic> {
-        self.items.iter()
+    pub fn iter(&self) -> std::slice::Iter<'_, Diagnostic<M>> {
+        self.0.iter()
     }
 
     /// Only the errors.
-    pub fn errors(&self) -> impl Iterator<Item = &Diagnostic> {
-        self.items.iter().filter(|d| d.severity == Severity::Error)
+    pub fn errors(&self) -> impl Iterator<Item = &Diagnostic<M>> {
+        self.0.iter().filter(|d| d.severity == Severity::Error)
     }
 
     /// Only the warnings.
-    pub fn warnings(&self) -> impl Iterator<Item = &Diagnostic> {
-        self.items
-            .iter()
-            .filter(|d| d.severity == Severity::Warning)
+    pub fn warnings(&self) -> impl Iterator<Item = &Diagnostic<M>> {
+        self.0.iter().filter(|d| d.severity == Severity::Warning)
+    }
+
+    /// Adds one item.
+    pub fn push(&mut self, d: Diagnostic<M>) {
+        self.0.push(d);
     }
 
     /// Appends every item of `other`.
-    pub fn extend(&mut self, other: Diagnostics) {
-        self.items.extend(other.items);
+    pub fn extend(&mut self, other: Diagnostics<M>) {
+        self.0.extend(other.0);
+    }
+
+    /// `Ok(v)` when empty, `Err(self)` otherwise.
+    pub fn into_result<T>(self, v: T) -> Result<T, Diagnostics<M>> {
+        if self.0.is_empty() {
+            Ok(v)
+        } else {
+            Err(self)
+        }
     }
 }
 
-impl fmt::Display for Diagnostics {
+impl<M> From<Vec<Diagnostic<M>>> for Diagnostics<M> {
+    fn from(items: Vec<Diagnostic<M>>) -> Self {
+        Diagnostics(items)
+    }
+}
+
+impl<M> From<Diagnostic<M>> for Diagnostics<M> {
+    fn from(d: Diagnostic<M>) -> Self {
+        Diagnostics(vec![d])
+    }
+}
+
+impl<M: fmt::Display> fmt::Display for Diagnostics<M> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, d) in self.items.iter().enumerate() {
+        for (i, d) in self.0.iter().enumerate() {
             if i > 0 {
                 writeln!(f)?;
             }
@@ -357,21 +544,21 @@ impl fmt::Display for Diagnostics {
     }
 }
 
-impl std::error::Error for Diagnostics {}
+impl<M: fmt::Display + fmt::Debug> std::error::Error for Diagnostics<M> {}
 
-impl IntoIterator for Diagnostics {
-    type Item = Diagnostic;
-    type IntoIter = std::vec::IntoIter<Diagnostic>;
+impl<M> IntoIterator for Diagnostics<M> {
+    type Item = Diagnostic<M>;
+    type IntoIter = std::vec::IntoIter<Diagnostic<M>>;
     fn into_iter(self) -> Self::IntoIter {
-        self.items.into_iter()
+        self.0.into_iter()
     }
 }
 
-impl<'a> IntoIterator for &'a Diagnostics {
-    type Item = &'a Diagnostic;
-    type IntoIter = std::slice::Iter<'a, Diagnostic>;
+impl<'a, M> IntoIterator for &'a Diagnostics<M> {
+    type Item = &'a Diagnostic<M>;
+    type IntoIter = std::slice::Iter<'a, Diagnostic<M>>;
     fn into_iter(self) -> Self::IntoIter {
-        self.items.iter()
+        self.0.iter()
     }
 }
 
@@ -411,5 +598,85 @@ impl Sink {
     /// `true` when an error was recorded.
     pub fn has_errors(&self) -> bool {
         self.items.iter().any(|r| r.severity == Severity::Error)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_and_character_columns() {
+        let text = "ab\ncdé\nx";
+        let index = LineIndex::new(text);
+        assert_eq!(index.line_col(text, 0), (1, 1));
+        assert_eq!(index.line_col(text, 4), (2, 2));
+        // After the two-byte `é`, and inside it (counts as the character).
+        assert_eq!(index.line_col(text, 7), (2, 4));
+        assert_eq!(index.line_col(text, 6), (2, 3));
+        assert_eq!(index.line_col(text, 8), (3, 1));
+        assert_eq!(index.line_col(text, 99), (3, 2));
+        assert_eq!(index.line_start(3), Some(8));
+        assert_eq!(index.line_start(4), None);
+        assert_eq!(index.line_start(0), None);
+    }
+
+    #[test]
+    fn one_rendering_for_every_payload() {
+        let text = "<a>\n  <b x=\"1\"/>\r\n</a>";
+        let index = LineIndex::new(text);
+        let at = text.find("x=").unwrap();
+        let d = Diagnostic::in_text("m.xml", text, &index, at, "bad `x`");
+        assert_eq!(
+            d.to_string(),
+            "m.xml:2:6: bad `x`\n      <b x=\"1\"/>\n         ^"
+        );
+        let w = d.clone().warning();
+        assert!(w.to_string().starts_with("m.xml:2:6: warning: bad `x`\n"));
+        // A caret found from a line and column gives the same snippet.
+        let by_line = Snippet::at_line_col(text, &index, 2, 6);
+        assert_eq!(by_line, Snippet::of(text, at, at));
+        assert_eq!(Snippet::at_line_col(text, &index, 9, 1), Snippet::default());
+        let whole: Diagnostic = Diagnostic::about_file("m.xml", "cannot read".into());
+        assert_eq!(whole.to_string(), "m.xml: cannot read");
+        let kind = d.map(|m| m.len());
+        assert_eq!(kind.message, 7);
+        assert_eq!((kind.line, kind.col), (2, 6));
+    }
+
+    #[test]
+    fn runs_map_offsets_back_to_the_file() {
+        // `a &lt; b` unescaped to `a < b`: the run after the entity starts at column 11.
+        let runs = [
+            PositionRun {
+                offset: 0,
+                line: 4,
+                col: 3,
+                exact: true,
+            },
+            PositionRun {
+                offset: 2,
+                line: 4,
+                col: 5,
+                exact: true,
+            },
+            PositionRun {
+                offset: 3,
+                line: 4,
+                col: 9,
+                exact: true,
+            },
+            PositionRun {
+                offset: 5,
+                line: 7,
+                col: 1,
+                exact: false,
+            },
+        ];
+        let text = "a < b and";
+        assert_eq!(locate_in_runs(text, &runs, 0), Some((4, 3)));
+        assert_eq!(locate_in_runs(text, &runs, 4), Some((4, 10)));
+        assert_eq!(locate_in_runs(text, &runs, 8), Some((7, 1)));
+        assert_eq!(locate_in_runs(text, &[], 1), None);
     }
 }

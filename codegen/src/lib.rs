@@ -36,8 +36,9 @@
 //! - Custom [`Limits`], or the checked AST: walk the stages of [`Spec`] yourself.
 //!
 //! Every failure is a [`Diagnostics`] value that prints as
-//! `file:line:col: error: message` with the source line and a caret line; no
-//! input string makes any stage panic.
+//! `file:line:col: message` (`warning: ` before the message of a warning) with the
+//! source line and a caret line, the rendering of every reader of the project
+//! ([`diag`]); no input string makes any stage panic.
 //!
 //! # Crate features
 //!
@@ -58,7 +59,9 @@ mod spec;
 mod syntax;
 
 pub use compile::{Compiled, PropertyInfo};
-pub use diag::{Diagnostic, Diagnostics, Location, PositionRun, Severity, SourceMap, Span};
+pub use diag::{
+    Diagnostic, Diagnostics, LineIndex, Location, PositionRun, Severity, Snippet, SourceMap, Span,
+};
 pub use lower::Limits;
 pub use spec::{
     compile_input, compile_spec, Checked, DeclInput, FormulaInput, Measured, Origin, Parsed, Spec,

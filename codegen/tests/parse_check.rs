@@ -345,7 +345,7 @@ fn diagnostics_render_with_source_line_and_carets() {
         .expect_err("unknown variable");
     assert_eq!(
         d.to_string(),
-        "r.hspec:3:10: error: unknown variable `zz`\n    \t{a} && {zz};\n    \t        ^^"
+        "r.hspec:3:10: unknown variable `zz`\n    \t{a} && {zz};\n    \t        ^^"
     );
     assert!(d.has_errors());
     let e: &dyn std::error::Error = &d;

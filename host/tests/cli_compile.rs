@@ -150,7 +150,7 @@ fn bad_spec_exits_2_with_position() {
         assert!(out.stdout.is_empty(), "--emit {emit}: nothing on stdout");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(
-            err.contains("bad.hspec:3:20: error"),
+            err.contains("bad.hspec:3:20: expected"),
             "--emit {emit}: {err}"
         );
         assert!(

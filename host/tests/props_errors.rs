@@ -5,7 +5,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use hindsight::props::{parse_file, parse_str, Location, PropsError, PropsErrorKind};
+use hindsight::props::{location, parse_file, parse_str, Location, PropsError, PropsErrorKind};
 
 fn errors(text: &str) -> Vec<PropsError> {
     match parse_str(text, Path::new("props.xml")) {
@@ -20,8 +20,8 @@ fn single(text: &str) -> (Location, PropsErrorKind) {
     let mut all = errors(text);
     assert_eq!(all.len(), 1, "{all:?}");
     let error = all.remove(0);
-    assert_eq!(error.path, Path::new("props.xml"));
-    (error.at, error.kind)
+    assert_eq!(error.file, "props.xml");
+    (location(&error), error.message)
 }
 
 const PORT: &str =
@@ -154,7 +154,7 @@ fn missing_attributes() {
     let all = errors(&text);
     let found: Vec<(Location, PropsErrorKind)> = all
         .into_iter()
-        .map(|error| (error.at, error.kind))
+        .map(|error| (location(&error), error.message))
         .collect();
     assert_eq!(
         found,
@@ -195,8 +195,10 @@ fn bad_values_and_duplicates() {
         &format!("  {PORT}\n  <scxml_event_send event=\"f\" origin=\"a\" target=\"b\"><state_var id=\"ev\" param=\"q\" type=\"int33\" expr=\"0\"/></scxml_event_send>"),
         "  <property id=\"p\" logic=\"ltl\" expr=\"true\"/>\n  <property id=\"p\" expr=\"{ev}\"/>",
     );
-    let found: Vec<(Location, PropsErrorKind)> =
-        errors(&text).into_iter().map(|e| (e.at, e.kind)).collect();
+    let found: Vec<(Location, PropsErrorKind)> = errors(&text)
+        .into_iter()
+        .map(|e| (location(&e), e.message))
+        .collect();
     assert_eq!(found.len(), 3, "{found:?}");
     assert_eq!(found[0].0, Location::new(4, 82));
     assert!(
@@ -348,11 +350,11 @@ fn tree_form_errors() {
         let text = tree(body);
         let found = errors(&text);
         let first = &found[0];
-        assert_eq!(first.at, at, "{body}: {found:?}");
+        assert_eq!(location(first), at, "{body}: {found:?}");
         assert!(
-            first.kind.to_string().starts_with(message),
+            first.message.to_string().starts_with(message),
             "{body}: `{}`",
-            first.kind
+            first.message
         );
         assert!(first
             .to_string()
@@ -368,7 +370,7 @@ fn tree_form_port_errors() {
 </ports></properties>"#;
     let found: Vec<(Location, String)> = errors(text)
         .into_iter()
-        .map(|e| (e.at, e.kind.to_string()))
+        .map(|e| (location(&e), e.message.to_string()))
         .collect();
     assert_eq!(
         found,
@@ -397,14 +399,14 @@ fn files_that_cannot_be_read() {
     std::fs::create_dir_all(&dir).expect("temp dir");
     let missing = dir.join("missing.xml");
     let error = parse_file(&missing).expect_err("no such file");
-    assert!(matches!(error.0[0].kind, PropsErrorKind::Io(_)));
-    assert_eq!(error.0[0].path, missing);
+    assert!(matches!(error.0[0].message, PropsErrorKind::Io(_)));
+    assert_eq!(error.0[0].file, missing.display().to_string());
 
     let latin1 = dir.join("latin1.xml");
     std::fs::write(&latin1, b"<properties>\n  <!-- caf\xe9 -->\n</properties>").expect("write");
     let error = parse_file(&latin1).expect_err("not UTF-8");
-    assert_eq!(error.0[0].kind, PropsErrorKind::Encoding);
-    assert_eq!(error.0[0].at, Location::new(2, 11));
+    assert_eq!(error.0[0].message, PropsErrorKind::Encoding);
+    assert_eq!(location(&error.0[0]), Location::new(2, 11));
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
 
@@ -447,8 +449,8 @@ fn damaged_corpus_files_never_panic() {
             let lines = text.lines().count().max(1) as u32;
             if let Err(diagnostics) = parse_str(&text, &path) {
                 for error in diagnostics.0 {
-                    assert!(error.at.line >= 1 && error.at.line <= lines + 1, "{error}");
-                    assert!(error.at.column >= 1, "{error}");
+                    assert!(error.line >= 1 && error.line <= lines + 1, "{error}");
+                    assert!(error.col >= 1, "{error}");
                 }
             }
         }

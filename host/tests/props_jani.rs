@@ -120,10 +120,16 @@ fn array_elements_lengths_and_string_characters_are_ports() {
 #[test]
 fn errors_name_file_line_and_column() {
     let e = read("{\"properties\": [\n  {\"name\": 1}\n]}").unwrap_err();
-    assert_eq!(e, "p.jani:2:3: a property needs a string `name`");
+    assert_eq!(
+        e,
+        "p.jani:2:3: a property needs a string `name`\n      {\"name\": 1}\n      ^"
+    );
 
     let e = read("{\"properties\": [\n  {\"name\" \"x\"}]}").unwrap_err();
-    assert_eq!(e, "p.jani:2:11: malformed JSON: expected `:`");
+    assert_eq!(
+        e,
+        "p.jani:2:11: malformed JSON: expected `:`\n      {\"name\" \"x\"}]}\n              ^"
+    );
 
     let text = prop("p", r#"{"op": "F", "exp": "nope"}"#);
     let e = read(&text).unwrap_err();
@@ -143,7 +149,12 @@ fn errors_name_file_line_and_column() {
     );
 
     let e = read(&prop("p", r#"{"op": "F", "exp": 3}"#)).unwrap_err();
-    assert_eq!(e, "p.jani:2:54: a state formula must be boolean");
+    assert_eq!(
+        e.lines().next(),
+        Some("p.jani:2:54: a state formula must be boolean")
+    );
+    // The caret stands under the 54th character of the line shown.
+    assert_eq!(e.lines().nth(2).map(|l| l.len()), Some(4 + 54));
 
     let e = read(&prop("p", r#"{"op": "X", "exp": true}"#)).unwrap_err();
     assert!(e.contains("path operator `X` is not supported"), "{e}");
@@ -153,7 +164,12 @@ fn errors_name_file_line_and_column() {
   {"name": "a", "expression": {"op": "Pmin", "exp": {"op": "F", "exp": "u1"}}},
   {"name": "b", "expression": {"op": "Pmax", "exp": {"op": "G", "exp": "u2"}}}]}"#;
     let e = read(two).unwrap_err();
-    assert_eq!(e.lines().count(), 2, "{e}");
+    let heads: Vec<&str> = e.lines().filter(|l| l.starts_with("p.jani:")).collect();
+    assert_eq!(heads.len(), 2, "{e}");
+    assert!(
+        heads[0].starts_with("p.jani:2:") && heads[1].starts_with("p.jani:3:"),
+        "{e}"
+    );
 }
 
 #[test]

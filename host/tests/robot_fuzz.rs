@@ -247,10 +247,10 @@ fn fuzz(name: &str, base: &Path, parts: &[&str], main: &str, favourites: &[&str]
                 // Errors speak of the user's files, not of the plain SCXML they become
                 // (`ros_fields__x` is the parameter a message field turns into; JANI
                 // properties are written over those names, so their errors may say them).
-                if message
-                    .lines()
-                    .any(|l| l.contains("ros_fields__") && !l.contains(".jani:"))
-                {
+                // Lines indented by four spaces quote the user's file under a diagnostic.
+                if message.lines().any(|l| {
+                    !l.starts_with("    ") && l.contains("ros_fields__") && !l.contains(".jani:")
+                }) {
                     problems.push(format!(
                         "{name} mutant {k} of {}: error about generated SCXML: {message}",
                         rel.display()

@@ -401,7 +401,7 @@ fn every_main_file_reads() {
                 "{missing:?}"
             );
             let line = if main.ends_with("main.xml") { 35 } else { 22 };
-            assert_eq!((missing[0].line, missing[0].column), (line, 33));
+            assert_eq!((missing[0].line, missing[0].col), (line, 33));
             assert_eq!(MainFile::read(&mut sm, main).unwrap_err(), missing);
             m
         } else {
@@ -443,7 +443,7 @@ fn every_main_file_reads() {
     assert_eq!(uc3.node_models.len(), 17);
     assert_eq!(uc3.properties[0].kind, InputKind::Jani);
     let d = sm.diag(uc3.properties[0].span, "here");
-    assert_eq!((d.line, d.column), (38, 33));
+    assert_eq!((d.line, d.col), (38, 33));
 
     let uc2 = MainFile::read(
         &mut sm,

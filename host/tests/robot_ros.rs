@@ -765,10 +765,10 @@ fn museum_high_level_reports_its_bug_and_matches_the_example_when_fixed() {
     assert_eq!(errs.0.len(), 1, "{errs}");
     let d = &errs.0[0];
     assert!(
-        d.path.ends_with("Components/NavigationComponent.scxml"),
+        Path::new(&d.file).ends_with("Components/NavigationComponent.scxml"),
         "{d}"
     );
-    assert_eq!((d.line, d.column), (91, 30), "{d}");
+    assert_eq!((d.line, d.col), (91, 30), "{d}");
     assert!(d.message.contains("_event.data.thread_id"), "{d}");
 
     let (sm, out) = museum_simpar(true);

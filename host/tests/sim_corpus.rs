@@ -82,15 +82,15 @@ fn museum_reports_the_event_thread_id_bug() {
     assert_eq!(err.0.len(), 1, "{err}");
     let d = &err.0[0];
     assert!(
-        d.path.ends_with("model_scxml/NavigationComponent.scxml"),
+        Path::new(&d.file).ends_with("model_scxml/NavigationComponent.scxml"),
         "{d}"
     );
-    assert_eq!((d.line, d.column), (20, 30), "{d}");
+    assert_eq!((d.line, d.col), (20, 30), "{d}");
     assert_eq!(
         d.message,
         "`_event` has no field `thread_id` (did you mean `_event.data.thread_id`?)"
     );
-    let text = std::fs::read_to_string(&d.path).unwrap();
+    let text = std::fs::read_to_string(&d.file).unwrap();
     let line = text.lines().nth(19).unwrap();
     assert!(line[29..].starts_with("thread_id == 0"), "{line}");
 }

@@ -13,8 +13,8 @@ fn compile(files: &[(&str, &str)]) -> Result<CompiledModel, Diagnostics> {
 fn error(text: &str) -> String {
     let errs = compile(&[("m.scxml", text)]).expect_err("model should be rejected");
     let d = errs.iter().next().unwrap();
-    assert_eq!(d.path.to_str(), Some("m.scxml"));
-    format!("{}:{}: {}", d.line, d.column, d.message)
+    assert_eq!(d.file, "m.scxml");
+    format!("{}:{}: {}", d.line, d.col, d.message)
 }
 
 const HEAD: &str = r#"<scxml name="M" initial="s" xmlns="http://www.w3.org/2005/07/scxml">"#;
@@ -108,7 +108,7 @@ fn params_must_agree_across_senders() {
     let b = r#"<scxml name="B" initial="s"><state id="s"><onentry><send event="e" target="B"><param name="p" expr="1"/></send></onentry><transition event="e" target="s"/></state></scxml>"#;
     let errs = compile(&[("a.scxml", a), ("b.scxml", b)]).unwrap_err();
     let d = errs.iter().next().unwrap();
-    assert_eq!(d.path.to_str(), Some("b.scxml"));
+    assert_eq!(d.file, "b.scxml");
     assert!(d.message.contains("int but string is expected"), "{d}");
 }
 
@@ -246,7 +246,7 @@ fn a_failed_declaration_is_reported_once() {
     let errs = compile(&[("m.scxml", text.as_str())]).expect_err("rejected");
     let all: Vec<String> = errs
         .iter()
-        .map(|d| format!("{}:{}: {}", d.line, d.column, d.message))
+        .map(|d| format!("{}:{}: {}", d.line, d.col, d.message))
         .collect();
     assert_eq!(all.len(), 1, "{all:?}");
     assert!(

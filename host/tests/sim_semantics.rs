@@ -264,7 +264,7 @@ fn eventless_loop_is_reported_with_machine_and_state() {
             assert_eq!(s.kind, SpinKind::EventlessLoop);
             assert_eq!(s.machine_name, "Spinner");
             assert_eq!(s.state_name, "loop");
-            assert!(s.location.path.ends_with("spinner.scxml"));
+            assert!(s.location.file.ends_with("spinner.scxml"));
             assert_eq!(s.location.line, 6, "the state's tag: {s}");
             assert!(s.to_string().contains("machine `Spinner` in state `loop`"));
         }
@@ -404,8 +404,8 @@ fn run_time_errors_point_at_the_expression() {
     match out.end {
         EndReason::Error(e) => {
             let d = &e.diagnostic;
-            assert!(d.path.ends_with("oob.scxml"));
-            assert_eq!((d.line, d.column), (10, 61), "the index `i`: {d}");
+            assert!(Path::new(&d.file).ends_with("oob.scxml"));
+            assert_eq!((d.line, d.col), (10, 61), "the index `i`: {d}");
             assert!(
                 d.message.contains("index 3 out of bounds (length 3)"),
                 "{d}"
@@ -498,7 +498,7 @@ fn scan_main_file_lists_processes_types_and_properties() {
     let err = hindsight::model::load(&dir.join("bad_model.xml")).unwrap_err();
     let msgs: Vec<String> = err
         .iter()
-        .map(|d| format!("{}:{}: {}", d.line, d.column, d.message))
+        .map(|d| format!("{}:{}: {}", d.line, d.col, d.message))
         .collect();
     assert_eq!(msgs.len(), 2, "{msgs:?}");
     assert!(

@@ -24,7 +24,7 @@ pub mod types;
 pub mod xml;
 
 pub use ast::Machine;
-pub use source::{Diagnostic, Diagnostics, FileId, SourceMap, Span};
+pub use source::{about_file, Diagnostic, Diagnostics, FileId, SourceMap, Span};
 pub use types::{BaseType, TypeDef, TypeDefs, TypeExpr};
 
 use std::path::{Path, PathBuf};
@@ -84,10 +84,7 @@ impl ModelSource {
                     m.name.span,
                     format!(
                         "machine name `{}` is used twice (also at {}:{}:{})",
-                        m.name.name,
-                        at.path.display(),
-                        at.line,
-                        at.column
+                        m.name.name, at.file, at.line, at.col
                     ),
                 ));
             }
@@ -102,7 +99,7 @@ impl ModelSource {
                     errs.0.extend(ds);
                 }
             }
-            Err(e) => errs.push(Diagnostic::file(
+            Err(e) => errs.push(crate::model::about_file(
                 path,
                 format!("cannot read types file: {e}"),
             )),
@@ -131,7 +128,10 @@ fn read_scxml_file(m: &mut ModelSource, path: &Path, errs: &mut Diagnostics) {
             let id = m.sources.add(path, text);
             m.add_machine(id, errs);
         }
-        Err(e) => errs.push(Diagnostic::file(path, format!("cannot read file: {e}"))),
+        Err(e) => errs.push(crate::model::about_file(
+            path,
+            format!("cannot read file: {e}"),
+        )),
     }
 }
 
@@ -139,7 +139,10 @@ fn collect_scxml(dir: &Path, out: &mut Vec<PathBuf>, errs: &mut Diagnostics, dep
     let entries = match std::fs::read_dir(dir) {
         Ok(e) => e,
         Err(e) => {
-            errs.push(Diagnostic::file(dir, format!("cannot read folder: {e}")));
+            errs.push(crate::model::about_file(
+                dir,
+                format!("cannot read folder: {e}"),
+            ));
             return;
         }
     };
@@ -163,7 +166,10 @@ pub fn load_dir(dir: &Path) -> Result<ModelSource, Diagnostics> {
     let mut files = Vec::new();
     collect_scxml(dir, &mut files, &mut errs, 0);
     if files.is_empty() && errs.is_empty() {
-        errs.push(Diagnostic::file(dir, "no .scxml file in this folder"));
+        errs.push(crate::model::about_file(
+            dir,
+            "no .scxml file in this folder",
+        ));
     }
     let types = dir.join("types.xml");
     if types.is_file() {
@@ -185,7 +191,7 @@ pub fn load_spec(path: &Path) -> Result<ModelSource, Diagnostics> {
     let mut m = ModelSource::default();
     let mut errs = Diagnostics::default();
     let text = std::fs::read_to_string(path)
-        .map_err(|e| Diagnostic::file(path, format!("cannot read file: {e}")))?;
+        .map_err(|e| crate::model::about_file(path, format!("cannot read file: {e}")))?;
     let spec_id = m.sources.add(path, text);
     let root = xml::parse(&m.sources, spec_id)?;
     let base = path.parent().unwrap_or(Path::new("."));

@@ -763,9 +763,9 @@ mod tests {
         let text = "<scxml name=\"M\">\n  <state id=\"a\" bogus=\"1\">\n    <parallel/>\n  </state>\n</scxml>";
         let errs = read(text).unwrap_err();
         assert_eq!(errs.len(), 2, "{errs:?}");
-        assert_eq!((errs[0].line, errs[0].column), (2, 17));
+        assert_eq!((errs[0].line, errs[0].col), (2, 17));
         assert!(errs[0].message.contains("bogus"));
-        assert_eq!((errs[1].line, errs[1].column), (3, 5));
+        assert_eq!((errs[1].line, errs[1].col), (3, 5));
     }
 
     #[test]

@@ -2,10 +2,23 @@
 //!
 //! The model reader keeps the text of every file it read in a [`SourceMap`];
 //! parsed items carry a [`Span`] (file + byte offset). Line and column are
-//! computed only when a [`Diagnostic`] is made, so spans cost 8 bytes.
+//! computed only when a [`Diagnostic`] is made, so spans cost 8 bytes. Lines,
+//! columns, the diagnostic and its rendering are codegen's ([`codegen::diag`]),
+//! the one source foundation of every reader.
 
-use std::fmt;
 use std::path::{Path, PathBuf};
+
+use codegen::diag::LineIndex;
+
+/// An error (or warning) about a model is the project's one diagnostic (line 0: about a
+/// whole file, such as a missing one); one or more of them, [`Diagnostics`], are the
+/// error type of loading and compiling a model.
+pub use codegen::diag::{Diagnostic, Diagnostics};
+
+/// A diagnostic about the whole file at `path` (no line or column).
+pub fn about_file(path: impl AsRef<Path>, message: impl Into<String>) -> Diagnostic {
+    Diagnostic::about_file(path.as_ref().display().to_string(), message.into())
+}
 
 /// Index of a file in a [`SourceMap`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -35,7 +48,7 @@ impl Span {
 pub struct SourceFile {
     path: PathBuf,
     text: String,
-    line_starts: Vec<u32>,
+    lines: LineIndex,
 }
 
 impl SourceFile {
@@ -51,18 +64,7 @@ impl SourceFile {
 
     /// 1-based line and column (in characters) of a byte offset.
     pub fn line_col(&self, offset: u32) -> (u32, u32) {
-        let offset = offset.min(self.text.len() as u32);
-        let line = match self.line_starts.binary_search(&offset) {
-            Ok(i) => i,
-            Err(i) => i.saturating_sub(1),
-        };
-        let start = self.line_starts.get(line).copied().unwrap_or(0) as usize;
-        let mut end = offset as usize;
-        while end > start && !self.text.is_char_boundary(end) {
-            end -= 1;
-        }
-        let column = self.text.get(start..end).map_or(0, |s| s.chars().count());
-        (line as u32 + 1, column as u32 + 1)
+        self.lines.line_col(&self.text, offset as usize)
     }
 }
 
@@ -80,16 +82,10 @@ impl SourceMap {
 
     /// Adds a file's text and returns its id.
     pub fn add(&mut self, path: impl Into<PathBuf>, text: String) -> FileId {
-        let mut line_starts = vec![0u32];
-        for (i, b) in text.bytes().enumerate() {
-            if b == b'\n' {
-                line_starts.push(i as u32 + 1);
-            }
-        }
         self.files.push(SourceFile {
             path: path.into(),
+            lines: LineIndex::new(&text),
             text,
-            line_starts,
         });
         FileId(self.files.len() as u32 - 1)
     }
@@ -107,21 +103,14 @@ impl SourceMap {
     /// A diagnostic at `span` with `message`.
     pub fn diag(&self, span: Span, message: impl Into<String>) -> Diagnostic {
         match self.file(span.file) {
-            Some(f) => {
-                let (line, column) = f.line_col(span.offset);
-                Diagnostic {
-                    path: f.path.clone(),
-                    line,
-                    column,
-                    message: message.into(),
-                }
-            }
-            None => Diagnostic {
-                path: PathBuf::from("<unknown>"),
-                line: 0,
-                column: 0,
-                message: message.into(),
-            },
+            Some(f) => Diagnostic::in_text(
+                f.path.display().to_string(),
+                &f.text,
+                &f.lines,
+                span.offset as usize,
+                message.into(),
+            ),
+            None => about_file("<unknown>", message),
         }
     }
 
@@ -133,21 +122,20 @@ impl SourceMap {
         let Some(f) = self.file(span.file) else {
             return span;
         };
-        let raw = f.text.as_bytes();
-        let mut raw_pos = span.offset as usize;
+        let raw = f.text.as_str();
+        let mut raw_pos = floor_boundary(raw, span.offset as usize);
         let mut out = 0u32;
         while out < k && raw_pos < raw.len() {
-            if raw[raw_pos] == b'&' {
-                if let Some(len) = raw[raw_pos..].iter().take(12).position(|&b| b == b';') {
-                    let entity = &raw[raw_pos..raw_pos + len + 1];
-                    let produced = entity_len(entity).unwrap_or(1);
-                    out += produced;
-                    raw_pos += len + 1;
-                    continue;
+            let rest = &raw[raw_pos..];
+            let (produced, consumed) = match reference(rest) {
+                Some(Ok((c, consumed))) => (c.len_utf8(), consumed),
+                _ => {
+                    let c = rest.chars().next().map_or(1, char::len_utf8);
+                    (c, c)
                 }
-            }
-            raw_pos += 1;
-            out += 1;
+            };
+            out = out.saturating_add(produced as u32);
+            raw_pos += consumed;
         }
         Span {
             file: span.file,
@@ -156,10 +144,33 @@ impl SourceMap {
     }
 }
 
-/// UTF-8 length of the character an entity such as `&amp;` or `&#x41;` stands for.
-fn entity_len(entity: &[u8]) -> Option<u32> {
-    let name = std::str::from_utf8(entity.get(1..entity.len() - 1)?).ok()?;
-    Some(resolve_entity(name)?.len_utf8() as u32)
+fn floor_boundary(text: &str, mut i: usize) -> usize {
+    i = i.min(text.len());
+    while !text.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
+
+/// The reference at the start of `rest`, when it starts with `&`: the character it
+/// stands for and the bytes it takes (`&lt;` is 4), or what is wrong with it; `None`
+/// when `rest` does not start with `&`. The one scanner of references, used by both
+/// XML readers (attribute values of models and of property files) and by
+/// [`SourceMap::unescaped_offset`]; names are decoded by [`resolve_entity`].
+pub(crate) fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
+    let after = rest.strip_prefix('&')?;
+    // A name longer than any entity or reasonable character reference is taken as a
+    // stray `&`, so the message does not quote half a line.
+    let Some(end) = after.find(';').filter(|&end| end <= 12) else {
+        return Some(Err(
+            "`&` that does not start a reference (write `&amp;`)".to_owned()
+        ));
+    };
+    let name = &after[..end];
+    Some(match resolve_entity(name) {
+        Some(c) => Ok((c, end + 2)),
+        None => Err(format!("unknown reference `&{name};`")),
+    })
 }
 
 /// The character an XML entity name (without `&` and `;`) stands for: the five
@@ -190,118 +201,21 @@ pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, usize> {
         return Ok(std::borrow::Cow::Borrowed(raw));
     }
     let mut out = String::with_capacity(raw.len());
-    let mut rest = raw;
     let mut pos = 0usize;
-    while let Some(i) = rest.find('&') {
-        out.push_str(&rest[..i]);
-        let after = &rest[i + 1..];
-        let Some(end) = after.find(';') else {
-            return Err(pos + i);
-        };
-        let Some(c) = resolve_entity(&after[..end]) else {
-            return Err(pos + i);
-        };
-        out.push(c);
-        pos += i + end + 2;
-        rest = &after[end + 1..];
+    while let Some(i) = raw[pos..].find('&') {
+        out.push_str(&raw[pos..pos + i]);
+        pos += i;
+        match reference(&raw[pos..]) {
+            Some(Ok((c, consumed))) => {
+                out.push(c);
+                pos += consumed;
+            }
+            _ => return Err(pos),
+        }
     }
-    out.push_str(rest);
+    out.push_str(&raw[pos..]);
     Ok(std::borrow::Cow::Owned(out))
 }
-
-/// An error (or warning) about a model, at a file, line and column.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Diagnostic {
-    /// The file.
-    pub path: PathBuf,
-    /// 1-based line (0 when there is no position, e.g. a missing file).
-    pub line: u32,
-    /// 1-based column in characters (0 when there is no position).
-    pub column: u32,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl Diagnostic {
-    /// A diagnostic about a whole file (no line or column).
-    pub fn file(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
-        Diagnostic {
-            path: path.into(),
-            line: 0,
-            column: 0,
-            message: message.into(),
-        }
-    }
-}
-
-impl fmt::Display for Diagnostic {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.line == 0 {
-            write!(f, "{}: {}", self.path.display(), self.message)
-        } else {
-            write!(
-                f,
-                "{}:{}:{}: {}",
-                self.path.display(),
-                self.line,
-                self.column,
-                self.message
-            )
-        }
-    }
-}
-
-impl std::error::Error for Diagnostic {}
-
-/// One or more [`Diagnostic`]s: the error type of loading and compiling a model.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Diagnostics(pub Vec<Diagnostic>);
-
-impl Diagnostics {
-    /// True when there is no diagnostic.
-    pub fn is_empty(&self) -> bool {
-        self.0.is_empty()
-    }
-
-    /// The diagnostics in the order they were found.
-    pub fn iter(&self) -> std::slice::Iter<'_, Diagnostic> {
-        self.0.iter()
-    }
-
-    /// Adds one diagnostic.
-    pub fn push(&mut self, d: Diagnostic) {
-        self.0.push(d);
-    }
-
-    /// `Ok(v)` when empty, `Err(self)` otherwise.
-    pub fn into_result<T>(self, v: T) -> Result<T, Diagnostics> {
-        if self.0.is_empty() {
-            Ok(v)
-        } else {
-            Err(self)
-        }
-    }
-}
-
-impl From<Diagnostic> for Diagnostics {
-    fn from(d: Diagnostic) -> Self {
-        Diagnostics(vec![d])
-    }
-}
-
-impl fmt::Display for Diagnostics {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, d) in self.0.iter().enumerate() {
-            if i > 0 {
-                writeln!(f)?;
-            }
-            write!(f, "{d}")?;
-        }
-        Ok(())
-    }
-}
-
-impl std::error::Error for Diagnostics {}
 
 #[cfg(test)]
 mod tests {
@@ -312,14 +226,14 @@ mod tests {
         let mut sm = SourceMap::new();
         let f = sm.add("a.scxml", "ab\ncdé\nx".to_string());
         let d = sm.diag(Span { file: f, offset: 0 }, "m");
-        assert_eq!((d.line, d.column), (1, 1));
+        assert_eq!((d.line, d.col), (1, 1));
         let d = sm.diag(Span { file: f, offset: 4 }, "m");
-        assert_eq!((d.line, d.column), (2, 2));
+        assert_eq!((d.line, d.col), (2, 2));
         let d = sm.diag(Span { file: f, offset: 7 }, "m");
-        assert_eq!((d.line, d.column), (2, 4));
+        assert_eq!((d.line, d.col), (2, 4));
         let d = sm.diag(Span { file: f, offset: 8 }, "m");
-        assert_eq!((d.line, d.column), (3, 1));
-        assert_eq!(d.to_string(), "a.scxml:3:1: m");
+        assert_eq!((d.line, d.col), (3, 1));
+        assert_eq!(d.to_string(), "a.scxml:3:1: m\n    x\n    ^");
     }
 
     #[test]
@@ -350,5 +264,15 @@ mod tests {
         assert_eq!(unescape("&#x41;&lt;").unwrap(), "A<");
         assert_eq!(unescape("a&#0;"), Err(1));
         assert_eq!(unescape("&#x0;"), Err(0));
+        assert_eq!(unescape("x &#233;!").unwrap(), "x é!");
+        assert_eq!(
+            reference("&nbsp; b"),
+            Some(Err("unknown reference `&nbsp;`".to_owned()))
+        );
+        assert_eq!(reference("&amp;&lt;"), Some(Ok(('&', 5))));
+        assert!(
+            matches!(reference("&a b c d e f g h i;"), Some(Err(m)) if m.contains("write `&amp;`"))
+        );
+        assert_eq!(reference("a"), None);
     }
 }

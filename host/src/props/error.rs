@@ -1,9 +1,12 @@
 //! Errors of property files: every one carries the file, line and column it is about.
+//!
+//! A [`PropsError`] is the project's one diagnostic ([`codegen::diag::Diagnostic`])
+//! with a [`PropsErrorKind`] as its payload, so callers can match on what is wrong
+//! while positions and rendering stay codegen's.
 
 use std::fmt;
-use std::path::PathBuf;
 
-use super::source::Location;
+use super::source::{LineIndex, Location};
 
 /// What is wrong, without the position.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -164,46 +167,25 @@ impl fmt::Display for PropsErrorKind {
     }
 }
 
-/// One error in a property file.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct PropsError {
-    /// The file, as given.
-    pub path: PathBuf,
-    /// Where in the file.
-    pub at: Location,
-    /// What is wrong.
-    pub kind: PropsErrorKind,
-}
-
-impl fmt::Display for PropsError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}:{}: {}", self.path.display(), self.at, self.kind)
-    }
-}
-
-impl std::error::Error for PropsError {}
+/// One error in a property file: file, line, column, source line and caret, and the
+/// kind of problem as its `message`.
+pub type PropsError = codegen::diag::Diagnostic<PropsErrorKind>;
 
 /// Every error found in a property file (at least one), in file order.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct Diagnostics(pub Vec<PropsError>);
+pub type Diagnostics = codegen::diag::Diagnostics<PropsErrorKind>;
 
-impl Diagnostics {
-    /// The errors.
-    pub fn errors(&self) -> &[PropsError] {
-        &self.0
-    }
+/// An error at `at` of the file `path` whose text `lines` indexes, showing its line.
+pub(crate) fn error_at(
+    path: &std::path::Path,
+    lines: &LineIndex<'_>,
+    at: Location,
+    kind: PropsErrorKind,
+) -> PropsError {
+    PropsError::error(path.display().to_string(), (at.line, at.column), kind)
+        .with_snippet(lines.snippet(at))
 }
 
-impl fmt::Display for Diagnostics {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, error) in self.0.iter().enumerate() {
-            if i > 0 {
-                writeln!(f)?;
-            }
-            write!(f, "{error}")?;
-        }
-        Ok(())
-    }
+/// Where a property error is, as a [`Location`].
+pub fn location(error: &PropsError) -> Location {
+    Location::new(error.line, error.col)
 }
-
-impl std::error::Error for Diagnostics {}

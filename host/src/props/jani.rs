@@ -61,11 +61,11 @@ pub fn parse_file_selected(
     keep: &mut dyn FnMut(&str) -> bool,
 ) -> Result<PropertyFile, Diagnostics> {
     let fail = |kind| {
-        Diagnostics(vec![PropsError {
-            path: path.to_path_buf(),
-            at: Location::new(1, 1),
+        Diagnostics::from(vec![PropsError::error(
+            path.display().to_string(),
+            (1, 1),
             kind,
-        }])
+        )])
     };
     let bytes = std::fs::read(path).map_err(|e| fail(PropsErrorKind::Io(e.to_string())))?;
     let text = String::from_utf8(bytes).map_err(|_| fail(PropsErrorKind::Encoding))?;
@@ -90,11 +90,12 @@ pub fn parse_str_selected(
 ) -> Result<PropertyFile, Diagnostics> {
     let lines = LineIndex::new(text);
     let root = json::parse(text).map_err(|(offset, message)| {
-        Diagnostics(vec![PropsError {
-            path: path.to_path_buf(),
-            at: lines.location(offset),
-            kind: PropsErrorKind::Json(message),
-        }])
+        Diagnostics::from(vec![super::error::error_at(
+            path,
+            &lines,
+            lines.location(offset),
+            PropsErrorKind::Json(message),
+        )])
     })?;
     let mut r = Reader {
         path,
@@ -132,9 +133,9 @@ pub fn parse_str_selected(
     }
     if !r.errors.is_empty() {
         let mut errors = r.errors;
-        errors.sort_by_key(|e| e.at);
+        errors.sort_by_key(|e| (e.line, e.col));
         errors.dedup();
-        return Err(Diagnostics(errors));
+        return Err(Diagnostics::from(errors));
     }
     Ok(PropertyFile {
         path: path.to_path_buf(),
@@ -165,11 +166,8 @@ impl Reader<'_, '_> {
 
     fn error(&mut self, offset: usize, kind: PropsErrorKind) {
         let at = self.at(offset);
-        self.errors.push(PropsError {
-            path: self.path.to_path_buf(),
-            at,
-            kind,
-        });
+        self.errors
+            .push(super::error::error_at(self.path, self.lines, at, kind));
     }
 
     fn jani(&mut self, offset: usize, message: impl Into<String>) {

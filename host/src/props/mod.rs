@@ -68,7 +68,7 @@ mod xml;
 
 use std::path::{Path, PathBuf};
 
-pub use error::{Diagnostics, PropsError, PropsErrorKind};
+pub use error::{location, Diagnostics, PropsError, PropsErrorKind};
 pub use source::{Location, SourceText};
 
 /// A property file, read and checked.
@@ -161,12 +161,12 @@ impl PropertyFile {
 
 /// Reads and checks the property file at `path`.
 pub fn parse_file(path: &Path) -> Result<PropertyFile, Diagnostics> {
-    let fail = |at, kind| {
-        Diagnostics(vec![PropsError {
-            path: path.to_path_buf(),
-            at,
+    let fail = |at: Location, kind| {
+        Diagnostics::from(vec![PropsError::error(
+            path.display().to_string(),
+            (at.line, at.column),
             kind,
-        }])
+        )])
     };
     let bytes = std::fs::read(path)
         .map_err(|error| fail(Location::new(1, 1), PropsErrorKind::Io(error.to_string())))?;
@@ -185,21 +185,16 @@ pub fn parse_file(path: &Path) -> Result<PropertyFile, Diagnostics> {
 /// Reads and checks a property file's text; `path` is only used in errors.
 pub fn parse_str(text: &str, path: &Path) -> Result<PropertyFile, Diagnostics> {
     let lines = source::LineIndex::new(text);
-    let root = xml::parse_document(text, &lines).map_err(|(at, kind)| {
-        Diagnostics(vec![PropsError {
-            path: path.to_path_buf(),
-            at,
-            kind,
-        }])
-    })?;
+    let root = xml::parse_document(text, &lines)
+        .map_err(|(at, kind)| Diagnostics::from(vec![error::error_at(path, &lines, at, kind)]))?;
     let mut reader = read::FileReader::new(path, &lines);
     let file = reader.read(&root);
     let mut errors = reader.into_errors();
     if errors.is_empty() {
         Ok(file)
     } else {
-        errors.sort_by_key(|error| error.at);
+        errors.sort_by_key(|error| (error.line, error.col));
         errors.dedup();
-        Err(Diagnostics(errors))
+        Err(Diagnostics::from(errors))
     }
 }

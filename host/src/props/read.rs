@@ -79,11 +79,8 @@ impl<'p, 'a> FileReader<'p, 'a> {
     }
 
     pub(super) fn error(&mut self, at: Location, kind: PropsErrorKind) {
-        self.errors.push(PropsError {
-            path: self.path.to_path_buf(),
-            at,
-            kind,
-        });
+        self.errors
+            .push(super::error::error_at(self.path, self.lines, at, kind));
     }
 
     /// Reports unknown attributes and text content; returns nothing.

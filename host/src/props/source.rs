@@ -1,8 +1,11 @@
 //! Source positions for property files: [`Location`] (line, column), a line index over a
 //! file's text, and [`SourceText`], a piece of text (formula, initial value) that maps
-//! each of its offsets back to where it came from in the file.
+//! each of its offsets back to where it came from in the file. Lines, columns and the
+//! position map are codegen's ([`codegen::diag`]), the one source foundation.
 
 use std::fmt;
+
+use codegen::diag::{locate_in_runs, PositionRun, Snippet};
 
 /// A position in a file: 1-based line and column, columns counted in characters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -26,34 +29,32 @@ impl fmt::Display for Location {
     }
 }
 
-/// Byte offsets of line starts, to turn byte offsets into [`Location`]s.
+/// A file's text with its line index ([`codegen::diag::LineIndex`]), to turn byte
+/// offsets into [`Location`]s and locations into carets.
 #[derive(Clone, Debug)]
 pub(crate) struct LineIndex<'a> {
     text: &'a str,
-    starts: Vec<usize>,
+    index: codegen::diag::LineIndex,
 }
 
 impl<'a> LineIndex<'a> {
     pub(crate) fn new(text: &'a str) -> LineIndex<'a> {
-        let mut starts = vec![0];
-        starts.extend(text.match_indices('\n').map(|(i, _)| i + 1));
-        LineIndex { text, starts }
+        LineIndex {
+            text,
+            index: codegen::diag::LineIndex::new(text),
+        }
     }
 
     /// The location of byte `offset` (clamped to the text; a position inside a multi-byte
     /// character counts as that character).
     pub(crate) fn location(&self, offset: usize) -> Location {
-        let offset = offset.min(self.text.len());
-        let line = self.starts.partition_point(|&start| start <= offset) - 1;
-        let start = self.starts[line];
-        let column = self.text.as_bytes()[start..offset]
-            .iter()
-            .filter(|&&b| (b as i8) >= -0x40)
-            .count();
-        Location::new(
-            u32::try_from(line + 1).unwrap_or(u32::MAX),
-            u32::try_from(column + 1).unwrap_or(u32::MAX),
-        )
+        let (line, column) = self.index.line_col(self.text, offset);
+        Location::new(line, column)
+    }
+
+    /// The source line and caret of location `at`.
+    pub(crate) fn snippet(&self, at: Location) -> Snippet {
+        Snippet::at_line_col(self.text, &self.index, at.line, at.column)
     }
 
     /// The byte offset of `slice` in the indexed text, if it is a sub-slice of it.
@@ -64,28 +65,29 @@ impl<'a> LineIndex<'a> {
     }
 }
 
-/// Where a run of a [`SourceText`] comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-struct Segment {
-    /// Byte offset in the text where the run starts.
-    offset: usize,
-    /// Location of the run's first character in the file.
-    at: Location,
-    /// Whether the run is copied from the file character for character on one line (its
-    /// columns advance with the text); otherwise it was generated from the element at
-    /// `at`, and every offset in it maps to `at`.
-    exact: bool,
-}
-
 /// Text taken from (or generated from) a file, that maps each byte offset back to a
-/// [`Location`] in the file, for error messages.
+/// [`Location`] in the file, for error messages: the text and its position map
+/// ([`PositionRun`]s), the map codegen reads a formula's positions from.
 ///
-/// Invariant: segments are sorted by offset and the first starts at 0 (unless the text
+/// Invariant: runs are sorted by offset and the first starts at 0 (unless the text
 /// is empty).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SourceText {
     text: String,
-    segments: Vec<Segment>,
+    runs: Vec<PositionRun>,
+}
+
+fn run(offset: usize, at: Location, exact: bool) -> PositionRun {
+    PositionRun {
+        offset: u32::try_from(offset).unwrap_or(u32::MAX),
+        line: at.line,
+        col: at.column,
+        exact,
+    }
+}
+
+fn run_location(run: &PositionRun) -> Location {
+    Location::new(run.line, run.col)
 }
 
 impl SourceText {
@@ -99,7 +101,7 @@ impl SourceText {
     pub(crate) fn empty() -> SourceText {
         SourceText {
             text: String::new(),
-            segments: Vec::new(),
+            runs: Vec::new(),
         }
     }
 
@@ -111,32 +113,17 @@ impl SourceText {
     /// The file location of the character at byte `offset` of the text (offsets past the
     /// end map to just after the last character).
     pub fn location(&self, offset: usize) -> Location {
-        let index = self.segments.partition_point(|s| s.offset <= offset);
-        let Some(segment) = index.checked_sub(1).map(|i| self.segments[i]) else {
-            return self.segments.first().map_or(Location::new(1, 1), |s| s.at);
-        };
-        if !segment.exact {
-            return segment.at;
+        match locate_in_runs(&self.text, &self.runs, offset) {
+            Some((line, column)) => Location::new(line, column),
+            None => Location::new(1, 1),
         }
-        let end = offset.min(self.text.len());
-        let chars = self.text.as_bytes()[segment.offset.min(end)..end]
-            .iter()
-            .filter(|&&b| (b as i8) >= -0x40)
-            .count();
-        Location::new(
-            segment.at.line,
-            segment
-                .at
-                .column
-                .saturating_add(u32::try_from(chars).unwrap_or(u32::MAX)),
-        )
     }
 
     /// The position map: where each run of the text starts (byte offset), its location
-    /// in the file, and whether it is copied character for character (`true`) or
-    /// generated from the element at that location (`false`).
-    pub fn runs(&self) -> impl Iterator<Item = (usize, Location, bool)> + '_ {
-        self.segments.iter().map(|s| (s.offset, s.at, s.exact))
+    /// in the file, and whether it is copied character for character (`exact`) or
+    /// generated from the element at that location.
+    pub fn runs(&self) -> &[PositionRun] {
+        &self.runs
     }
 
     /// The part of the text between byte offsets `start` and `end` (char boundaries),
@@ -146,26 +133,24 @@ impl SourceText {
         let start = start.min(end);
         let mut out = SourceText {
             text: self.text[start..end].to_owned(),
-            segments: Vec::new(),
+            runs: Vec::new(),
         };
-        for (i, segment) in self.segments.iter().enumerate() {
-            let segment_end = self
-                .segments
+        for (i, r) in self.runs.iter().enumerate() {
+            let run_end = self
+                .runs
                 .get(i + 1)
-                .map_or(self.text.len(), |next| next.offset);
-            if segment_end <= start || segment.offset >= end {
+                .map_or(self.text.len(), |next| next.offset as usize);
+            let offset = r.offset as usize;
+            if run_end <= start || offset >= end {
                 continue;
             }
-            let from = segment.offset.max(start);
-            out.segments.push(Segment {
-                offset: from - start,
-                at: if segment.exact {
-                    self.location(from)
-                } else {
-                    segment.at
-                },
-                exact: segment.exact,
-            });
+            let from = offset.max(start);
+            let at = if r.exact {
+                self.location(from)
+            } else {
+                run_location(r)
+            };
+            out.runs.push(run(from - start, at, r.exact));
         }
         out
     }
@@ -182,11 +167,11 @@ impl SourceText {
 
     /// Appends another source text, keeping its locations.
     pub(crate) fn push_source(&mut self, other: &SourceText) {
-        let base = self.text.len();
+        let base = u32::try_from(self.text.len()).unwrap_or(u32::MAX);
         self.text.push_str(&other.text);
-        self.segments.extend(other.segments.iter().map(|s| Segment {
-            offset: s.offset + base,
-            ..*s
+        self.runs.extend(other.runs.iter().map(|r| PositionRun {
+            offset: r.offset.saturating_add(base),
+            ..*r
         }));
     }
 
@@ -194,21 +179,20 @@ impl SourceText {
         if text.is_empty() {
             return;
         }
-        let segment = Segment {
-            offset: self.text.len(),
-            at,
-            exact,
-        };
-        // Merge with the previous segment when it simply continues it.
-        let continues = self.segments.last().is_some_and(|last| {
+        // Merge with the previous run when it simply continues it.
+        let continues = self.runs.last().is_some_and(|last| {
             exact
                 && last.exact
-                && last.at.line == at.line
-                && self.text[last.offset..].chars().count() as u64 + u64::from(last.at.column)
+                && last.line == at.line
+                && self
+                    .text
+                    .get(last.offset as usize..)
+                    .map_or(0, |t| t.chars().count()) as u64
+                    + u64::from(last.col)
                     == u64::from(at.column)
         });
         if !continues {
-            self.segments.push(segment);
+            self.runs.push(run(self.text.len(), at, exact));
         }
         self.text.push_str(text);
     }
@@ -233,19 +217,10 @@ pub(crate) fn unescape_attribute(
     let mut rest = raw;
     let mut at = offset;
     while !rest.is_empty() {
-        if let Some(after) = rest.strip_prefix('&') {
-            let end = after.find(';').filter(|&end| end <= 12).ok_or_else(|| {
-                (
-                    at,
-                    "`&` that does not start a reference (write `&amp;`)".to_owned(),
-                )
-            })?;
-            let name = &after[..end];
-            let decoded = crate::model::source::resolve_entity(name);
-            let decoded = decoded.ok_or_else(|| (at, format!("unknown reference `&{name};`")))?;
+        if let Some(decoded) = crate::model::source::reference(rest) {
+            let (decoded, consumed) = decoded.map_err(|message| (at, message))?;
             let mut buffer = [0u8; 4];
             out.push_exact(decoded.encode_utf8(&mut buffer), lines.location(at));
-            let consumed = end + 2;
             rest = &rest[consumed..];
             at += consumed;
             continue;

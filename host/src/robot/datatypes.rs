@@ -51,7 +51,7 @@ pub fn read_data_declarations(
         let text = match std::fs::read_to_string(path) {
             Ok(t) => t,
             Err(e) => {
-                errs.push(Diagnostic::file(*path, format!("cannot read: {e}")));
+                errs.push(crate::model::about_file(*path, format!("cannot read: {e}")));
                 continue;
             }
         };

@@ -104,7 +104,7 @@ fn read_xml(sm: &mut SourceMap, input: &Input, errs: &mut Vec<Diagnostic>) -> Op
 }
 
 fn fail(ds: Vec<Diagnostic>) -> Diagnostics {
-    Diagnostics(ds)
+    Diagnostics::from(ds)
 }
 
 /// A node model left out of the model because a real process plays it
@@ -457,7 +457,7 @@ fn load_full(
                     .iter()
                     .filter_map(|m| m.attr_value("name"))
                     .collect();
-                errs.push(Diagnostic::file(
+                errs.push(crate::model::about_file(
                     main_path,
                     format!(
                         "--external {name}: no node model is called `{name}` (node models: {})",

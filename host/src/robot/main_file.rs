@@ -260,7 +260,7 @@ impl MainFile {
     /// that replaces some of them, such as the properties).
     pub fn parse(sm: &mut SourceMap, path: &Path) -> Result<MainFile, Vec<Diagnostic>> {
         let text = std::fs::read_to_string(path)
-            .map_err(|e| vec![Diagnostic::file(path, format!("cannot read: {e}"))])?;
+            .map_err(|e| vec![crate::model::about_file(path, format!("cannot read: {e}"))])?;
         let file = sm.add(path, text);
         MainFile::parse_file(sm, file, path)
     }

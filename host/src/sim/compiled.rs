@@ -496,8 +496,8 @@ impl<'s> Builder<'s> {
             // threads) repeats its errors at the same place: say each once.
             let mut seen = BTreeSet::new();
             let mut errs = self.errs;
-            errs.retain(|d| seen.insert((d.path.clone(), d.line, d.column, d.message.clone())));
-            return Err(Diagnostics(errs));
+            errs.retain(|d| seen.insert((d.file.clone(), d.line, d.col, d.message.clone())));
+            return Err(Diagnostics::from(errs));
         }
         let mut machine_of_str = vec![u32::MAX; self.strings.len()];
         for (i, m) in machines.iter().enumerate() {

@@ -198,8 +198,10 @@ fn below(rng: &mut dyn Entropy, n: u32) -> u32 {
     (m >> 64) as u32
 }
 
+/// Why a run stops early: a run-time error or a spin, boxed so that the `Result`s of
+/// the step functions stay small (the diagnostic inside carries its source line).
 enum Stop {
-    End(EndReason),
+    End(Box<EndReason>),
 }
 
 /// Evaluates `code`: a scalar is returned, an array or struct is written into `scratch`.
@@ -463,7 +465,7 @@ impl<'m> Simulator<'m> {
                 let scratch = &self.scratch[m][*sc as usize];
                 if let (Some(b), Cell::List(v)) = (bound, scratch) {
                     if v.len() > *b as usize {
-                        return Err(Stop::End(EndReason::Error(RunError {
+                        return Err(Stop::End(Box::new(EndReason::Error(RunError {
                             machine: MachineId(m as u32),
                             time: 0,
                             diagnostic: model.sources.diag(
@@ -473,7 +475,7 @@ impl<'m> Simulator<'m> {
                                     v.len()
                                 ),
                             ),
-                        })));
+                        }))));
                     }
                 }
                 if let Some(dst) = self.ms[m].vars.get_mut(*slot as usize) {
@@ -511,7 +513,8 @@ impl<'m> Simulator<'m> {
     ) -> RunOutcome {
         let rng: &mut dyn Entropy = rng;
         let end = match self.run_inner(rng, cfg, obs) {
-            Ok(e) | Err(Stop::End(e)) => e,
+            Ok(e) => e,
+            Err(Stop::End(e)) => *e,
         };
         RunOutcome {
             end,

@@ -11,7 +11,7 @@
 
 use std::collections::BTreeSet;
 
-use codegen::{Compiled, DeclInput, FormulaInput, Origin, PositionRun, SpecInput};
+use codegen::{Compiled, DeclInput, FormulaInput, Origin, SpecInput};
 use monitor_core::{analysis, valuation, Monitor, Ty, Value, VarKind};
 
 use crate::expr::Value as SimValue;
@@ -170,16 +170,7 @@ impl PropertySet {
                 name,
                 text: p.formula.as_str().to_string(),
                 origin: origin(at.line, at.column),
-                positions: p
-                    .formula
-                    .runs()
-                    .map(|(offset, at, exact)| PositionRun {
-                        offset: u32::try_from(offset).unwrap_or(u32::MAX),
-                        line: at.line,
-                        col: at.column,
-                        exact,
-                    })
-                    .collect(),
+                positions: p.formula.runs().to_vec(),
             }
         };
         let mut formulas: Vec<FormulaInput> = props

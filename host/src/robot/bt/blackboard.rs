@@ -222,9 +222,9 @@ pub(crate) fn register(
                 format!(
                     "blackboard entry `{{{name}}}` is used as {ty} here but as {} at {}:{}:{} (here: {why}; there: {})",
                     e.ty,
-                    at.path.display(),
+                    at.file,
                     at.line,
-                    at.column,
+                    at.col,
                     e.why
                 ),
             ));
@@ -357,14 +357,14 @@ pub(crate) fn type_entries(
                     format!(
                         "SetBlackboard copies `{{{src}}}` ({} at {}:{}:{}, {}) to `{{{entry}}}` ({} at {}:{}:{}, {})",
                         s.ty,
-                        b.path.display(),
+                        b.file,
                         b.line,
-                        b.column,
+                        b.col,
                         s.why,
                         d.ty,
-                        a.path.display(),
+                        a.file,
                         a.line,
-                        a.column,
+                        a.col,
                         d.why
                     ),
                 ));
@@ -416,9 +416,9 @@ pub(crate) fn lower_set(
                         "SetBlackboard writes `{}` to `{{{entry}}}`, which is {} at {}:{}:{} ({}): {m}",
                         v.trim(),
                         e.ty,
-                        at.path.display(),
+                        at.file,
                         at.line,
-                        at.column,
+                        at.col,
                         e.why
                     ),
                 ));

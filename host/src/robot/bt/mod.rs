@@ -128,10 +128,7 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
                         p.root.span,
                         format!(
                             "two plugins are called `{}` (the other is {}:{}:{})",
-                            p.name,
-                            at.path.display(),
-                            at.line,
-                            at.column
+                            p.name, at.file, at.line, at.col
                         ),
                     ));
                 }

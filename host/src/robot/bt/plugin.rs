@@ -395,10 +395,7 @@ impl Lower<'_> {
                 self.node.span,
                 format!(
                     "node needs port `{key}`: plugin `{}` reads it at {}:{}:{}",
-                    self.plugin.name,
-                    at.path.display(),
-                    at.line,
-                    at.column
+                    self.plugin.name, at.file, at.line, at.col
                 ),
             );
             return None;
@@ -705,10 +702,7 @@ impl Lower<'_> {
                     self.node.span,
                     format!(
                         "node needs port `{k}`: plugin `{}` writes it at {}:{}:{}",
-                        self.plugin.name,
-                        at.path.display(),
-                        at.line,
-                        at.column
+                        self.plugin.name, at.file, at.line, at.col
                     ),
                 );
                 return None;

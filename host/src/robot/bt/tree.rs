@@ -406,7 +406,7 @@ pub(crate) fn read(
                         el.span,
                         format!(
                             "BehaviorTree `{id}` is defined twice (also at {}:{})",
-                            at.line, at.column
+                            at.line, at.col
                         ),
                     );
                 }

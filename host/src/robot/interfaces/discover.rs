@@ -113,7 +113,7 @@ impl Interfaces {
         };
         for path in &search.dirs {
             if !path.is_dir() {
-                errs.push(Diagnostic::file(
+                errs.push(crate::model::about_file(
                     path,
                     "--interfaces: the interface folder does not exist or is not a folder",
                 ));
@@ -274,7 +274,7 @@ impl Interfaces {
                 let text = match std::fs::read_to_string(&path) {
                     Ok(t) => t,
                     Err(e) => {
-                        errs.push(Diagnostic::file(&path, format!("cannot read: {e}")));
+                        errs.push(crate::model::about_file(&path, format!("cannot read: {e}")));
                         continue;
                     }
                 };

@@ -113,7 +113,7 @@ impl Interfaces {
     ) -> Result<(), Vec<Diagnostic>> {
         let file = sm.add(path, text);
         if !parse::valid_type_name(name) {
-            return Err(vec![Diagnostic::file(
+            return Err(vec![crate::model::about_file(
                 path,
                 format!("`{name}` is not a valid interface name (it must start with an upper-case letter and have only letters and digits)"),
             )]);
@@ -163,7 +163,10 @@ impl Interfaces {
                     if let Some(m) = msg {
                         let d = match def.file {
                             Some(_) => sm.diag(f.span, m),
-                            None => Diagnostic::file(format!("<built-in {}>", def.full_name()), m),
+                            None => crate::model::about_file(
+                                format!("<built-in {}>", def.full_name()),
+                                m,
+                            ),
                         };
                         errs.push(d);
                     }

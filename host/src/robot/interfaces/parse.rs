@@ -19,7 +19,7 @@ pub fn parse_interface(
     kind: InterfaceKind,
 ) -> Result<InterfaceDef, Vec<Diagnostic>> {
     let Some(src) = sm.file(file) else {
-        return Err(vec![Diagnostic::file(
+        return Err(vec![crate::model::about_file(
             "<unknown>",
             "internal error: interface file not in the source map",
         )]);

@@ -397,9 +397,9 @@ impl Cx<'_> {
                             let at = self.sm.diag(self.timers[i].span, "");
                             let msg = format!(
                                 "timer `{tname}` is already declared at {}:{}:{} (timer names are global)",
-                                at.path.display(),
+                                at.file,
                                 at.line,
-                                at.column
+                                at.col
                             );
                             self.err(el.span, msg);
                             continue;
@@ -439,9 +439,9 @@ impl Cx<'_> {
                                         el.span,
                                         format!(
                                             "service `{sname}` already has a server, `{other}` ({}:{}:{})",
-                                            at.path.display(),
+                                            at.file,
                                             at.line,
-                                            at.column
+                                            at.col
                                         ),
                                     );
                                 }
@@ -662,9 +662,9 @@ impl Cx<'_> {
                             if *publisher { "published" } else { "subscribed" },
                             ty.trim(),
                             pty.trim(),
-                            at.path.display(),
+                            at.file,
                             at.line,
-                            at.column
+                            at.col
                         ),
                     ));
                 }

@@ -137,9 +137,9 @@ impl std::fmt::Display for SpinReport {
         write!(
             f,
             "{}:{}:{}: machine `{}` in state `{}` {what}",
-            self.location.path.display(),
+            self.location.file,
             self.location.line,
-            self.location.column,
+            self.location.col,
             self.machine_name,
             self.state_name
         )

@@ -92,7 +92,7 @@ impl Simulator<'_> {
                             file: def.file,
                             offset: 0,
                         });
-                        return Err(Stop::End(EndReason::Error(RunError {
+                        return Err(Stop::End(Box::new(EndReason::Error(RunError {
                             machine: MachineId(m as u32),
                             time: self.time,
                             diagnostic: model.sources.diag(
@@ -102,7 +102,7 @@ impl Simulator<'_> {
                                     model.strings.get(s)
                                 ),
                             ),
-                        })));
+                        }))));
                     }
                 }
             }

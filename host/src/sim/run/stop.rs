@@ -17,11 +17,11 @@ impl Simulator<'_> {
                     offset: 0,
                 })
         };
-        Stop::End(EndReason::Error(RunError {
+        Stop::End(Box::new(EndReason::Error(RunError {
             machine: MachineId(m as u32),
             time: self.time,
             diagnostic: self.model.sources.diag(span, e.message()),
-        }))
+        })))
     }
 
     pub(super) fn spin(&self, m: usize, kind: SpinKind) -> Stop {
@@ -39,7 +39,7 @@ impl Simulator<'_> {
                 file: def.file,
                 offset: 0,
             });
-        Stop::End(EndReason::Spin(SpinReport {
+        Stop::End(Box::new(EndReason::Spin(SpinReport {
             kind,
             machine: MachineId(m as u32),
             state: StateId(s),
@@ -49,7 +49,7 @@ impl Simulator<'_> {
                 .model
                 .sources
                 .diag(span, format!("state `{state_name}`")),
-        }))
+        })))
     }
 
     pub(super) fn internal(&self, m: usize, pc: u32) -> Stop {
