@@ -369,22 +369,12 @@ impl<'a, const N: usize> Monitor<'a, N> {
     }
 
     /// The atoms of this point through [`Monitor::atom_plan`], into the scratch
-    /// words; the first word (all of them for at most 64 atoms) is returned.
+    /// words 64 at a time (a program with more than 64 atoms or nodes); the first
+    /// word is returned.
     #[inline(always)]
     fn planned_atoms(&self, state: &mut [u64], vars: &[Value]) -> Result<u64, StepError> {
         let p = &self.program;
         let steps = self.atom_plan.get(..p.atoms.len()).unwrap_or(&[]);
-        if self.small {
-            let mut bits = 0u64;
-            for (k, a) in steps.iter().enumerate() {
-                bits |= (a.eval(p.instrs, vars, k)? as u64) << (k & 63);
-            }
-            // No scratch word without atoms: the value word comes next.
-            if !p.atoms.is_empty() {
-                wr(state, layout::HEADER_WORDS, bits);
-            }
-            return Ok(bits);
-        }
         for (w, chunk) in steps.chunks(64).enumerate() {
             let mut bits = 0u64;
             for (b, a) in chunk.iter().enumerate() {
