@@ -25,6 +25,9 @@ pub use cases::{spec, FORMULAS};
 
 use monitor_core::{Monitor, Value};
 
+/// Plan room of the benchmarked interpreter (`Monitor<'_, PLAN>`): nodes and atoms.
+pub const PLAN: usize = 64;
+
 /// Seed of the benchmark traces (any non-zero value works; this one is fixed).
 pub const SEED: u64 = 0x9E37_79B9_7F4A_7C15;
 
@@ -168,9 +171,30 @@ impl Interpreted {
 
     /// Runs [`Monitor::try_step`] over `trace` from a fresh state, each verdict to
     /// `sink`: atoms are computed by the interpreter from the variables' values.
+    /// The monitor is planned ([`PLAN`] entries, every bench formula fits).
     #[inline(never)]
     pub fn run(&self, trace: &Trace, sink: &mut impl FnMut(bool)) -> Result<(), RunError> {
-        let monitor = self.monitor()?;
+        self.run_with::<PLAN>(trace, sink)
+    }
+
+    /// [`Interpreted::run`] with an unplanned monitor (`Monitor<'_>`, as built by
+    /// [`Monitor::try_new`]).
+    #[inline(never)]
+    pub fn run_unplanned(
+        &self,
+        trace: &Trace,
+        sink: &mut impl FnMut(bool),
+    ) -> Result<(), RunError> {
+        self.run_with::<0>(trace, sink)
+    }
+
+    #[inline(always)]
+    fn run_with<const N: usize>(
+        &self,
+        trace: &Trace,
+        sink: &mut impl FnMut(bool),
+    ) -> Result<(), RunError> {
+        let monitor = self.monitor::<N>()?;
         let mut state = vec![0u64; monitor.state_words()];
         monitor.reset(&mut state).map_err(|e| error_at(0, &e))?;
         let mut verdict = [false];
@@ -189,7 +213,7 @@ impl Interpreted {
     /// the atoms, so this measures the temporal network alone.
     #[inline(never)]
     pub fn run_atoms(&self, trace: &Trace, sink: &mut impl FnMut(bool)) -> Result<(), RunError> {
-        let monitor = self.monitor()?;
+        let monitor = self.monitor::<PLAN>()?;
         let mut state = vec![0u64; monitor.state_words()];
         monitor.reset(&mut state).map_err(|e| error_at(0, &e))?;
         // Atom k is the k-th distinct atom of the formula, in compile order.
@@ -208,8 +232,8 @@ impl Interpreted {
         Ok(())
     }
 
-    fn monitor(&self) -> Result<Monitor<'_>, RunError> {
-        Monitor::try_new(self.compiled.program()).map_err(|e| error_at(0, &e))
+    fn monitor<const N: usize>(&self) -> Result<Monitor<'_, N>, RunError> {
+        Monitor::try_new_planned(self.compiled.program()).map_err(|e| error_at(0, &e))
     }
 
     /// For each atom, the trace bit it reads (0: `p`, 1: `q`, 2: `r`): every atom of

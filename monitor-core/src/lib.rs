@@ -11,6 +11,9 @@
 //!    or [`table::Table::from_bytes`] (feature `postcard`) decodes one from bytes.
 //! 2. **Validate**: [`Monitor::try_new`] checks every index, type, bound and
 //!    state slot once, so that stepping cannot panic or misbehave.
+//!    [`Monitor::try_new_planned`] also decides once what each node and atom
+//!    does at every point, into a plan of `N` entries held in a `Monitor<'_, N>`
+//!    (faster steps, same results; `plan.rs`).
 //! 3. **Allocate state**: [`Monitor::state_words`] `u64` words, owned by the
 //!    caller (a `static`, the stack, a `Vec` on the host); [`Monitor::reset`].
 //! 4. **Step**: [`Monitor::try_step`] once per trace point with the variables'
@@ -36,6 +39,7 @@ pub mod error;
 mod expr;
 pub mod layout;
 mod monitor;
+mod plan;
 pub mod program;
 #[cfg(feature = "postcard")]
 pub mod table;

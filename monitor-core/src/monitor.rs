@@ -3,20 +3,37 @@
 use crate::error::{StepError, TableError};
 use crate::expr;
 use crate::layout;
-use crate::program::{Op, Program, Value, VarKind};
+use crate::plan::{self, AtomStep, Kind, Step};
+use crate::program::{Atom, Instr, Op, Program, Value, VarKind};
 
 /// A [`Program`] that passed every check: it can be stepped without panicking.
 ///
 /// Build one with [`Monitor::try_new`]; allocate `state_words()` words (statically
 /// or on the stack), [`Monitor::reset`] them, then call [`Monitor::try_step`]
 /// once per point.
+///
+/// `N` is the room for a plan (`plan.rs`): a `Monitor<'_, N>` built with
+/// [`Monitor::try_new_planned`] decides each node's kind, children, state slot
+/// and window capacity and each atom's shape once, for programs of at most `N`
+/// nodes and `N` atoms, and steps faster. It holds `N` entries of 32 bytes and
+/// `N` of 16 (const generics: no allocation); the default `N = 0` plans nothing
+/// and holds nothing more.
 #[derive(Clone, Copy, Debug)]
-pub struct Monitor<'a> {
+pub struct Monitor<'a, const N: usize = 0> {
     program: Program<'a>,
     state_words: usize,
     values_at: usize,
     /// First word of the nodes' own state ([`layout::first_node_word`]), decided once.
     nodes_at: usize,
+    /// At most 64 atoms and 64 nodes, decided once: the atoms and the node values
+    /// of a point each fit one register ([`Monitor::advance_small`]).
+    small: bool,
+    /// Whether `plan` and `atom_plan` hold the program (at most `N` nodes and atoms).
+    planned: bool,
+    /// Node `i`'s plan, for `i < program.nodes.len()` when `planned`.
+    plan: [Step; N],
+    /// Atom `k`'s plan, for `k < program.atoms.len()` when `planned`.
+    atom_plan: [AtomStep; N],
 }
 
 /// The most nodes, atoms or variables a program may have (ids are `u16`).
@@ -25,6 +42,14 @@ pub const MAX_IDS: usize = u16::MAX as usize;
 impl<'a> Monitor<'a> {
     /// Checks every invariant of `program`: indices, types, bounds, state slots.
     pub fn try_new(program: Program<'a>) -> Result<Self, TableError> {
+        Self::try_new_planned(program)
+    }
+}
+
+impl<'a, const N: usize> Monitor<'a, N> {
+    /// [`Monitor::try_new`], and the plan of a program of at most `N` nodes and
+    /// `N` atoms (a larger one is stepped unplanned, with the same results).
+    pub fn try_new_planned(program: Program<'a>) -> Result<Self, TableError> {
         let p = &program;
         if p.vars.len() > MAX_IDS
             || p.atoms.len() > MAX_IDS
@@ -103,12 +128,32 @@ impl<'a> Monitor<'a> {
                 prop: p.props.len() as u16,
             });
         }
-        Ok(Monitor {
+        let nodes_at = layout::first_node_word(p.atoms.len(), p.nodes.len());
+        let mut monitor = Monitor {
             program,
             state_words: next_word as usize,
             values_at: layout::HEADER_WORDS + layout::bit_words(p.atoms.len()),
-            nodes_at: layout::first_node_word(p.atoms.len(), p.nodes.len()),
-        })
+            nodes_at,
+            small: p.atoms.len() <= 64 && p.nodes.len() <= 64,
+            planned: false,
+            plan: [Step::NONE; N],
+            atom_plan: [AtomStep::NONE; N],
+        };
+        if N > 0 {
+            monitor.planned = plan::build(
+                &program,
+                nodes_at,
+                &mut monitor.plan,
+                &mut monitor.atom_plan,
+            );
+        }
+        Ok(monitor)
+    }
+
+    /// Whether this monitor steps through its plan: `N > 0` and the program has
+    /// at most `N` nodes and `N` atoms (see [`Monitor::try_new_planned`]).
+    pub fn is_planned(&self) -> bool {
+        N > 0 && self.planned
     }
 
     /// The program this monitor runs.
@@ -171,16 +216,27 @@ impl<'a> Monitor<'a> {
                 return Err(StepError::VarType { var: i as u16 });
             }
         }
-        // Atoms first, into the scratch words: an error leaves the temporal state untouched.
-        for (w, chunk) in p.atoms.chunks(64).enumerate() {
-            let mut bits = 0u64;
-            for (b, a) in chunk.iter().enumerate() {
-                let range = a.start as usize..a.start as usize + a.len as usize;
-                let code = p.instrs.get(range).unwrap_or(&[]);
-                if expr::eval(code, vars, (w * 64 + b) as u16)? {
-                    bits |= 1 << b;
-                }
+        // Atoms first: an error leaves the temporal state untouched.
+        if N > 0 && self.planned {
+            if self.small {
+                return self.step_planned_small(state, time, vars, verdicts);
             }
+            let bits = self.planned_atoms(state, vars)?;
+            self.advance_planned(state, time, bits, verdicts);
+            return Ok(());
+        }
+        if self.small {
+            let bits = atom_word(p.atoms, p.instrs, vars, 0)?;
+            // No scratch word without atoms: the value word comes next.
+            if !p.atoms.is_empty() {
+                wr(state, layout::HEADER_WORDS, bits);
+            }
+            self.advance_small(state, time, bits, verdicts);
+            return Ok(());
+        }
+        // Into the scratch words, 64 atoms at a time.
+        for (w, chunk) in p.atoms.chunks(64).enumerate() {
+            let bits = atom_word(chunk, p.instrs, vars, w * 64)?;
             wr(state, layout::HEADER_WORDS + w, bits);
         }
         self.advance(state, time, verdicts);
@@ -207,7 +263,15 @@ impl<'a> Monitor<'a> {
         for (k, a) in atoms.iter().enumerate() {
             wr(state, layout::HEADER_WORDS + k, *a);
         }
-        self.advance(state, time, verdicts);
+        if N > 0 && self.planned {
+            let bits = atoms.first().copied().unwrap_or(0);
+            self.advance_planned(state, time, bits, verdicts);
+        } else if self.small {
+            let bits = atoms.first().copied().unwrap_or(0);
+            self.advance_small(state, time, bits, verdicts);
+        } else {
+            self.advance(state, time, verdicts);
+        }
         Ok(())
     }
 
@@ -252,6 +316,181 @@ impl<'a> Monitor<'a> {
     /// The timestamp of the last point, `None` before the first point.
     pub fn last_time(&self, state: &[u64]) -> Option<u64> {
         state.first().and_then(|t| t.checked_sub(1))
+    }
+
+    /// The planned step of a program of at most 64 atoms and 64 nodes, after the
+    /// checks: atoms and node values each in one register, the plan in order.
+    #[inline(always)]
+    fn step_planned_small(
+        &self,
+        state: &mut [u64],
+        t: u64,
+        vars: &[Value],
+        verdicts: &mut [bool],
+    ) -> Result<(), StepError> {
+        let p = &self.program;
+        let mut atoms = 0u64;
+        let atom_plan = self.atom_plan.get(..p.atoms.len()).unwrap_or(&[]);
+        for (k, a) in atom_plan.iter().enumerate() {
+            atoms |= (a.eval(p.instrs, vars, k)? as u64) << (k & 63);
+        }
+        let (off, vals) = (self.nodes_at, self.values_at);
+        // The state length was checked (it covers every node's words): never `None`.
+        let Some((head, body)) = state.split_at_mut_checked(off) else {
+            return Ok(());
+        };
+        // No scratch word without atoms: the value word comes next.
+        if !p.atoms.is_empty() {
+            wr(head, layout::HEADER_WORDS, atoms);
+        }
+        let first_point = rd(head, 0) == 0;
+        let old = rd(head, vals);
+        let mut new = 0u64;
+        let plan = self.plan.get(..p.nodes.len()).unwrap_or(&[]);
+        for (i, s) in plan.iter().enumerate() {
+            let now = new;
+            let v = exec(
+                s,
+                body,
+                t,
+                first_point,
+                |a| atoms >> (a & 63) & 1 == 1,
+                |c| now >> (c & 63) & 1 == 1,
+                old >> (i & 63) & 1 == 1,
+            );
+            new |= (v as u64) << (i & 63);
+        }
+        wr(head, vals, new);
+        wr(head, 0, t + 1);
+        for (out, pr) in verdicts.iter_mut().zip(p.props) {
+            *out = new >> (pr.root & 63) & 1 == 1;
+        }
+        Ok(())
+    }
+
+    /// The atoms of this point through [`Monitor::atom_plan`], into the scratch
+    /// words 64 at a time (a program with more than 64 atoms or nodes); the first
+    /// word is returned.
+    #[inline(always)]
+    fn planned_atoms(&self, state: &mut [u64], vars: &[Value]) -> Result<u64, StepError> {
+        let p = &self.program;
+        let steps = self.atom_plan.get(..p.atoms.len()).unwrap_or(&[]);
+        for (w, chunk) in steps.chunks(64).enumerate() {
+            let mut bits = 0u64;
+            for (b, a) in chunk.iter().enumerate() {
+                bits |= (a.eval(p.instrs, vars, w * 64 + b)? as u64) << (b & 63);
+            }
+            wr(state, layout::HEADER_WORDS + w, bits);
+        }
+        Ok(rd(state, layout::HEADER_WORDS))
+    }
+
+    /// [`Monitor::advance`] over the plan; `atoms` is the first atom word (all
+    /// of them for a small program, which keeps its node values in one register).
+    #[inline(always)]
+    fn advance_planned(&self, state: &mut [u64], t: u64, atoms: u64, verdicts: &mut [bool]) {
+        let off = self.nodes_at;
+        let vals = self.values_at;
+        let steps = self.plan.get(..self.program.nodes.len()).unwrap_or(&[]);
+        // The state length was checked (it covers every node's words): never `None`.
+        let Some((head, body)) = state.split_at_mut_checked(off) else {
+            return;
+        };
+        let first_point = rd(head, 0) == 0;
+        if self.small {
+            let old = rd(head, vals);
+            let mut new = 0u64;
+            for (i, s) in steps.iter().enumerate() {
+                let now = new;
+                let v = exec(
+                    s,
+                    body,
+                    t,
+                    first_point,
+                    |a| atoms >> (a & 63) & 1 == 1,
+                    |c| now >> (c & 63) & 1 == 1,
+                    old >> (i & 63) & 1 == 1,
+                );
+                new |= (v as u64) << (i & 63);
+            }
+            wr(head, vals, new);
+            wr(head, 0, t + 1);
+            for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
+                *out = new >> (pr.root & 63) & 1 == 1;
+            }
+            return;
+        }
+        let mut old = rd(head, vals);
+        let mut new = 0u64;
+        let mut base = 0usize;
+        for (i, s) in steps.iter().enumerate() {
+            if i - base >= 64 {
+                wr(head, vals + base / 64, new);
+                base = i;
+                old = rd(head, vals + base / 64);
+                new = 0;
+            }
+            let (now, h): (u64, &[u64]) = (new, head);
+            let v = exec(
+                s,
+                body,
+                t,
+                first_point,
+                |a| rd(h, layout::HEADER_WORDS + a as usize / 64) >> (a % 64) & 1 == 1,
+                |c| {
+                    let c = c as usize;
+                    let w = if c >= base {
+                        now >> ((c - base) & 63)
+                    } else {
+                        rd(h, vals + c / 64) >> (c % 64)
+                    };
+                    w & 1 == 1
+                },
+                old >> ((i - base) & 63) & 1 == 1,
+            );
+            new |= (v as u64) << ((i - base) & 63);
+        }
+        wr(head, vals + base / 64, new);
+        wr(head, 0, t + 1);
+        for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
+            let r = pr.root as usize;
+            *out = rd(head, vals + r / 64) >> (r % 64) & 1 == 1;
+        }
+    }
+
+    /// [`Monitor::advance`] for a program of at most 64 atoms and 64 nodes, with
+    /// this point's atoms in `atoms`: the node values are built in one register,
+    /// stored once, and the verdicts are read from it.
+    #[inline(always)]
+    fn advance_small(&self, state: &mut [u64], t: u64, atoms: u64, verdicts: &mut [bool]) {
+        let off = self.nodes_at;
+        let vals = self.values_at;
+        // The state length was checked (it covers every node's words): never `None`.
+        let Some((head, body)) = state.split_at_mut_checked(off) else {
+            return;
+        };
+        let first_point = rd(head, 0) == 0;
+        let old = rd(head, vals);
+        let mut new = 0u64;
+        for (i, node) in self.program.nodes.iter().enumerate() {
+            let now = new;
+            let v = node_step(
+                &node.op,
+                (node.slot as usize).wrapping_sub(off),
+                body,
+                t,
+                first_point,
+                |a| atoms >> (a & 63) & 1 == 1,
+                |c| now >> (c & 63) & 1 == 1,
+                old >> (i & 63) & 1 == 1,
+            );
+            new |= (v as u64) << (i & 63);
+        }
+        wr(head, vals, new);
+        wr(head, 0, t + 1);
+        for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
+            *out = new >> (pr.root & 63) & 1 == 1;
+        }
     }
 
     /// Updates every node; the state length and the time were checked by the caller.
@@ -336,6 +575,107 @@ impl<'a> Monitor<'a> {
     }
 }
 
+/// The bits of up to 64 atoms (`chunk`, the first being atom `base`) at this point.
+///
+/// A boolean variable (one `Load`, the most common atom) is read directly; any other
+/// atom, or a value of another type, goes through [`expr::eval`], so results and
+/// errors are those of the general machine.
+#[inline(always)]
+fn atom_word(
+    chunk: &[Atom],
+    instrs: &[Instr],
+    vars: &[Value],
+    base: usize,
+) -> Result<u64, StepError> {
+    let mut bits = 0u64;
+    for (b, a) in chunk.iter().enumerate() {
+        let start = a.start as usize;
+        let v = match (a.len, instrs.get(start)) {
+            (1, Some(Instr::Load(n))) => match vars.get(*n as usize) {
+                Some(Value::Bool(v)) => *v,
+                _ => general_atom(instrs, start, a.len, vars, base + b)?,
+            },
+            _ => general_atom(instrs, start, a.len, vars, base + b)?,
+        };
+        bits |= (v as u64) << (b & 63);
+    }
+    Ok(bits)
+}
+
+/// Atom number `atom`, `len` instructions from `start`, through the atom machine.
+#[inline(never)]
+fn general_atom(
+    instrs: &[Instr],
+    start: usize,
+    len: u16,
+    vars: &[Value],
+    atom: usize,
+) -> Result<bool, StepError> {
+    let code = instrs.get(start..start + len as usize).unwrap_or(&[]);
+    expr::eval(code, vars, atom as u16)
+}
+
+/// One planned node at one point, as [`node_step`] computes it from the node's [`Op`].
+#[inline(always)]
+fn exec(
+    s: &Step,
+    words: &mut [u64],
+    t: u64,
+    first_point: bool,
+    atom: impl Fn(u16) -> bool,
+    bit: impl Fn(u16) -> bool,
+    own_prev: bool,
+) -> bool {
+    let slot = s.slot as usize;
+    match s.kind {
+        Kind::False => false,
+        Kind::True => true,
+        Kind::Atom => atom(s.a),
+        Kind::Not => !bit(s.a),
+        Kind::And => bit(s.a) & bit(s.b),
+        Kind::Or => bit(s.a) | bit(s.b),
+        Kind::Implies => !bit(s.a) | bit(s.b),
+        Kind::Iff => bit(s.a) == bit(s.b),
+        Kind::Yesterday => {
+            let out = !first_point && rd(words, slot) != 0;
+            wr(words, slot, bit(s.a) as u64);
+            out
+        }
+        Kind::WeakYesterday => {
+            let out = first_point || rd(words, slot) != 0;
+            wr(words, slot, bit(s.a) as u64);
+            out
+        }
+        Kind::Since => bit(s.b) | (bit(s.a) & !first_point & own_prev),
+        Kind::SinceAtLeast => {
+            let mut w = rd(words, slot);
+            if !bit(s.a) {
+                w = 0;
+            }
+            if bit(s.b) && w == 0 {
+                w = t + 1;
+            }
+            wr(words, slot, w);
+            w != 0 && t.wrapping_sub(w - 1) >= s.lo
+        }
+        Kind::SinceUpTo => {
+            let mut w = rd(words, slot);
+            if !bit(s.a) {
+                w = 0;
+            }
+            if bit(s.b) {
+                w = t + 1;
+            }
+            wr(words, slot, w);
+            w != 0 && t.wrapping_sub(w - 1) <= s.hi
+        }
+        Kind::SinceWindow => match words.get_mut(slot..) {
+            Some(w) => window_step(w, s.lo, s.hi, t, bit(s.a), bit(s.b), || s.cap as usize),
+            None => false,
+        },
+    }
+}
+
 /// One node at one point: its value, given its children's values at this point
 /// (`bit`), the atoms (`atom`) and its own value at the last point (`own_prev`).
 /// `slot` indexes the node's own words in `words`.
@@ -399,7 +739,15 @@ fn node_step(
                     w != 0 && t.wrapping_sub(w - 1) <= b
                 }
                 Some(hi) => match words.get_mut(slot..) {
-                    Some(w) => window_step(w, lo, hi, t, f, g),
+                    // A point interval's capacity is `hi + 1`; any other's costs a
+                    // division ([`layout::window_capacity`]), done only when needed.
+                    Some(w) => window_step(w, lo, hi, t, f, g, || {
+                        if lo == hi {
+                            hi.saturating_add(1) as usize
+                        } else {
+                            layout::window_capacity(lo, hi).unwrap_or(1) as usize
+                        }
+                    }),
                     None => false,
                 },
             }
@@ -424,18 +772,18 @@ fn wr(w: &mut [u64], i: usize, v: u64) {
 /// `w[0]` packs `head | len << 32`; run `k` is `w[1 + 2k] = first`, `w[2 + 2k] = last`.
 /// Amortised constant work: each run is pushed and expired once, and only the
 /// oldest run decides the verdict (it has the smallest `first`, and every live
-/// run still has `last + hi >= t`). The ring's capacity is only needed when a
-/// run expires or a witness arrives; a point interval's is `hi + 1` and any
-/// other's costs a division ([`layout::window_capacity`]), so it is computed then.
+/// run still has `last + hi >= t`). The ring's capacity (`capacity`, at least 1)
+/// is only asked for when a run expires or a witness arrives.
 #[inline]
-fn window_step(w: &mut [u64], lo: u64, hi: u64, t: u64, f: bool, g: bool) -> bool {
-    let capacity = || {
-        if lo == hi {
-            hi.saturating_add(1) as usize
-        } else {
-            layout::window_capacity(lo, hi).unwrap_or(1) as usize
-        }
-    };
+fn window_step(
+    w: &mut [u64],
+    lo: u64,
+    hi: u64,
+    t: u64,
+    f: bool,
+    g: bool,
+    capacity: impl Fn() -> usize,
+) -> bool {
     let header = rd(w, 0);
     let mut head = (header & 0xffff_ffff) as usize;
     let mut len = (header >> 32) as usize;
