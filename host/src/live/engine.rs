@@ -93,7 +93,8 @@ struct Slot {
 /// The monitors of one spec with the loss rule applied.
 #[derive(Debug)]
 pub struct Engine<'c> {
-    monitor: Monitor<'c>,
+    /// Planned for up to 256 nodes and atoms (a larger spec is stepped unplanned).
+    monitor: Monitor<'c, 256>,
     vals: Vec<Value>,
     slots: Vec<Slot>,
     prop_slot: Vec<usize>,
@@ -110,7 +111,7 @@ impl<'c> Engine<'c> {
     /// otherwise only changes (and every property's first verdict).
     pub fn new(spec: &'c Compiled, every_point: bool) -> Result<Self, String> {
         let program = spec.program();
-        let monitor = Monitor::try_new(program)
+        let monitor = Monitor::try_new_planned(program)
             .map_err(|e| format!("internal: compiled program rejected: {e}"))?;
         let mut vals = vec![Value::Bool(false); program.vars.len()];
         valuation::init(program.vars, &mut vals);
@@ -140,7 +141,7 @@ impl<'c> Engine<'c> {
         })
     }
 
-    fn fresh(monitor: &Monitor<'_>) -> Slot {
+    fn fresh<const N: usize>(monitor: &Monitor<'_, N>) -> Slot {
         Slot {
             state: vec![0; monitor.state_words()],
             verdicts: vec![false; monitor.properties()],

@@ -302,7 +302,9 @@ impl PropertySet {
 /// Judges one run: an [`Observer`] stepping the monitors at every point.
 pub struct Judge<'a> {
     set: &'a PropertySet,
-    monitor: Monitor<'a>,
+    /// Planned for up to 256 nodes and atoms (what does not depend on the point is
+    /// decided once per run; a larger spec is stepped unplanned, with the same results).
+    monitor: Monitor<'a, 256>,
     state: Vec<u64>,
     vals: Vec<Value>,
     verdicts: Vec<bool>,
@@ -322,7 +324,7 @@ pub struct Judge<'a> {
 impl<'a> Judge<'a> {
     /// A judge for `set`, before the run's initial point.
     pub fn new(set: &'a PropertySet) -> Result<Judge<'a>, String> {
-        let monitor = Monitor::try_new(set.compiled.program())
+        let monitor = Monitor::try_new_planned(set.compiled.program())
             .map_err(|e| format!("internal: compiled program rejected: {e}"))?;
         let vars = monitor.program().vars;
         let mut vals = vec![Value::Bool(false); vars.len()];
