@@ -2,50 +2,325 @@
 //!
 //! The wire format is `(TABLE_VERSION: u32, Program)` in postcard encoding: the
 //! host writes it with `postcard::to_allocvec(&(TABLE_VERSION, program))`
-//! (`codegen` does this); [`Table::from_bytes`] reads it back without
-//! allocating, borrowing names and strings from the bytes, and runs every
-//! check of [`Monitor::try_new`] before handing out a monitor.
+//! (`codegen` does this). Two loaders read it back without allocating,
+//! borrowing names and strings from the bytes, and run every check of
+//! [`Monitor::try_new`] before handing out a program:
+//!
+//! - [`Store`]: one array per vector, each sized exactly for one table
+//!   (const parameters), filled in place: the RAM of the decoded program and
+//!   nothing more, and a decode that keeps one element on the stack at a time.
+//!   For firmware: put the `Store` in a `static` and call [`Store::load`].
+//! - [`Table`]: `heapless` vectors of one capacity `N`, returned by value, for
+//!   hosts that do not know the table's shape in advance.
+//!
+//! Both read the program as a stream: the header, then each vector as its
+//! length and its elements one at a time ([`read_program`]), never the whole
+//! program as one serde value (which would build it in stack temporaries).
 
 use heapless::Vec;
 use serde::Deserialize;
 
 use crate::error::TableError;
 use crate::monitor::Monitor;
-use crate::program::{Atom, Instr, Node, Program, Property, Var};
+use crate::program::{Atom, Instr, Node, Op, Program, Property, Ty, Value, Var, VarKind};
 
 /// Version of the table wire format; bump on any change to the program types.
 pub const TABLE_VERSION: u32 = 1;
 
+/// One postcard value from the front of `rest`, advancing it.
+fn take<'a, T: Deserialize<'a>>(rest: &mut &'a [u8]) -> Result<T, TableError> {
+    let (value, tail) = postcard::take_from_bytes::<T>(rest).map_err(|_| TableError::Decode)?;
+    *rest = tail;
+    Ok(value)
+}
+
+/// One postcard sequence (length, then elements) from the front of `rest`,
+/// handing element `i` to `put(i, element)`; `put` returns `false` when there
+/// is no room for it, which is a [`TableError::Decode`] like any other corrupt input.
+fn take_seq<'a, T: Deserialize<'a>>(
+    rest: &mut &'a [u8],
+    mut put: impl FnMut(usize, T) -> bool,
+) -> Result<usize, TableError> {
+    // postcard writes a sequence length as a varint `usize`; for lengths below
+    // 2^32 its bytes are those of a varint `u32` (postcard's wire spec, "varint").
+    let len = take::<u32>(rest)? as usize;
+    for i in 0..len {
+        let element = take::<T>(rest)?;
+        if !put(i, element) {
+            return Err(TableError::Decode);
+        }
+    }
+    Ok(len)
+}
+
+/// Where [`read_program`] puts each element of a table, as it reads it.
+///
+/// Each method gets the element's index and the element, and returns `false`
+/// when it has no room for it.
+pub trait Sink<'a> {
+    /// The program's `tick_ns`.
+    fn tick_ns(&mut self, tick_ns: u64);
+    /// Variable `i`.
+    fn var(&mut self, i: usize, v: Var<'a>) -> bool;
+    /// String constant `i`.
+    fn string(&mut self, i: usize, s: &'a str) -> bool;
+    /// Instruction `i`.
+    fn instr(&mut self, i: usize, ins: Instr) -> bool;
+    /// Atom `i`.
+    fn atom(&mut self, i: usize, a: Atom) -> bool;
+    /// Node `i`.
+    fn node(&mut self, i: usize, n: Node) -> bool;
+    /// Property `i`.
+    fn prop(&mut self, i: usize, p: Property<'a>) -> bool;
+}
+
+/// The number of elements of each vector of a decoded program.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counts {
+    /// Variables.
+    pub vars: usize,
+    /// String constants.
+    pub strings: usize,
+    /// Instructions.
+    pub instrs: usize,
+    /// Atoms.
+    pub atoms: usize,
+    /// Nodes.
+    pub nodes: usize,
+    /// Properties.
+    pub props: usize,
+}
+
+/// Reads a whole table from `bytes` into `sink`, element by element: the
+/// version, then the program's fields in declaration order (postcard encodes a
+/// struct as its fields in order, a sequence as a varint length and its
+/// elements). Corrupt, truncated or trailing bytes, a foreign version or an
+/// element the sink has no room for give an error; nothing is validated
+/// beyond the encoding (that is [`Monitor::try_new`]'s job).
+pub fn read_program<'a>(bytes: &'a [u8], sink: &mut impl Sink<'a>) -> Result<Counts, TableError> {
+    let mut rest = bytes;
+    let version = take::<u32>(&mut rest)?;
+    if version != TABLE_VERSION {
+        return Err(TableError::Version { found: version });
+    }
+    sink.tick_ns(take::<u64>(&mut rest)?);
+    let counts = Counts {
+        vars: take_seq(&mut rest, |i, v| sink.var(i, v))?,
+        strings: take_seq(&mut rest, |i, s| sink.string(i, s))?,
+        instrs: take_seq(&mut rest, |i, ins| sink.instr(i, ins))?,
+        atoms: take_seq(&mut rest, |i, a| sink.atom(i, a))?,
+        nodes: take_seq(&mut rest, |i, n| sink.node(i, n))?,
+        props: take_seq(&mut rest, |i, p| sink.prop(i, p))?,
+    };
+    if !rest.is_empty() {
+        return Err(TableError::Decode);
+    }
+    Ok(counts)
+}
+
+/// Places `value` at `slots[i]`; `false` when there is no such slot.
+fn put<T>(slots: &mut [T], i: usize, value: T) -> bool {
+    match slots.get_mut(i) {
+        Some(slot) => {
+            *slot = value;
+            true
+        }
+        None => false,
+    }
+}
+
+/// Storage for one decoded program, every vector an array of exactly the
+/// size its table needs: `V` variables, `S` strings, `I` instructions, `A`
+/// atoms, `N` nodes and `P` properties. [`Store::new`] is `const`, so the
+/// store can live in a `static`; [`Store::load`] decodes into it in place.
+#[derive(Debug)]
+pub struct Store<
+    'a,
+    const V: usize,
+    const S: usize,
+    const I: usize,
+    const A: usize,
+    const N: usize,
+    const P: usize,
+> {
+    tick_ns: u64,
+    vars: [Var<'a>; V],
+    strings: [&'a str; S],
+    instrs: [Instr; I],
+    atoms: [Atom; A],
+    nodes: [Node; N],
+    props: [Property<'a>; P],
+    counts: Counts,
+}
+
+impl<
+        'a,
+        const V: usize,
+        const S: usize,
+        const I: usize,
+        const A: usize,
+        const N: usize,
+        const P: usize,
+    > Store<'a, V, S, I, A, N, P>
+{
+    /// An empty store (every slot a placeholder, no program loaded).
+    pub const fn new() -> Self {
+        const VAR: Var<'static> = Var {
+            name: "",
+            ty: Ty::Bool,
+            kind: VarKind::Event,
+            init: Value::Bool(false),
+        };
+        const PROP: Property<'static> = Property {
+            name: "",
+            first: 0,
+            root: 0,
+        };
+        Store {
+            tick_ns: 0,
+            vars: [VAR; V],
+            strings: [""; S],
+            instrs: [Instr::Not; I],
+            atoms: [Atom { start: 0, len: 0 }; A],
+            nodes: [Node {
+                op: Op::Const(false),
+                slot: 0,
+            }; N],
+            props: [PROP; P],
+            counts: Counts {
+                vars: 0,
+                strings: 0,
+                instrs: 0,
+                atoms: 0,
+                nodes: 0,
+                props: 0,
+            },
+        }
+    }
+
+    /// Decodes `bytes` into this store, in place, and validates the program
+    /// with [`Monitor::try_new`]. A table with more elements of some kind than
+    /// the store's arrays hold is a [`TableError::Decode`]. After an error,
+    /// [`Store::program`] shows whatever was decoded, unvalidated.
+    pub fn load(&mut self, bytes: &'a [u8]) -> Result<Monitor<'_>, TableError> {
+        self.counts = Counts::default();
+        self.counts = read_program(bytes, self)?;
+        Monitor::try_new(self.program())
+    }
+
+    /// The loaded program (empty before [`Store::load`]).
+    pub fn program(&self) -> Program<'_> {
+        let c = &self.counts;
+        Program {
+            tick_ns: self.tick_ns,
+            vars: self.vars.get(..c.vars).unwrap_or(&[]),
+            strings: self.strings.get(..c.strings).unwrap_or(&[]),
+            instrs: self.instrs.get(..c.instrs).unwrap_or(&[]),
+            atoms: self.atoms.get(..c.atoms).unwrap_or(&[]),
+            nodes: self.nodes.get(..c.nodes).unwrap_or(&[]),
+            props: self.props.get(..c.props).unwrap_or(&[]),
+        }
+    }
+}
+
+impl<
+        'a,
+        const V: usize,
+        const S: usize,
+        const I: usize,
+        const A: usize,
+        const N: usize,
+        const P: usize,
+    > Default for Store<'a, V, S, I, A, N, P>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<
+        'a,
+        const V: usize,
+        const S: usize,
+        const I: usize,
+        const A: usize,
+        const N: usize,
+        const P: usize,
+    > Sink<'a> for Store<'a, V, S, I, A, N, P>
+{
+    fn tick_ns(&mut self, tick_ns: u64) {
+        self.tick_ns = tick_ns;
+    }
+    fn var(&mut self, i: usize, v: Var<'a>) -> bool {
+        put(&mut self.vars, i, v)
+    }
+    fn string(&mut self, i: usize, s: &'a str) -> bool {
+        put(&mut self.strings, i, s)
+    }
+    fn instr(&mut self, i: usize, ins: Instr) -> bool {
+        put(&mut self.instrs, i, ins)
+    }
+    fn atom(&mut self, i: usize, a: Atom) -> bool {
+        put(&mut self.atoms, i, a)
+    }
+    fn node(&mut self, i: usize, n: Node) -> bool {
+        put(&mut self.nodes, i, n)
+    }
+    fn prop(&mut self, i: usize, p: Property<'a>) -> bool {
+        put(&mut self.props, i, p)
+    }
+}
+
 /// A deserialised program in fixed-capacity vectors of at most `N` elements each.
-#[derive(Debug, Deserialize)]
+#[derive(Debug)]
 pub struct Table<'a, const N: usize> {
     tick_ns: u64,
-    #[serde(borrow)]
     vars: Vec<Var<'a>, N>,
-    #[serde(borrow)]
     strings: Vec<&'a str, N>,
     instrs: Vec<Instr, N>,
     atoms: Vec<Atom, N>,
     nodes: Vec<Node, N>,
-    #[serde(borrow)]
     props: Vec<Property<'a>, N>,
+}
+
+impl<'a, const N: usize> Sink<'a> for Table<'a, N> {
+    fn tick_ns(&mut self, tick_ns: u64) {
+        self.tick_ns = tick_ns;
+    }
+    fn var(&mut self, _: usize, v: Var<'a>) -> bool {
+        self.vars.push(v).is_ok()
+    }
+    fn string(&mut self, _: usize, s: &'a str) -> bool {
+        self.strings.push(s).is_ok()
+    }
+    fn instr(&mut self, _: usize, ins: Instr) -> bool {
+        self.instrs.push(ins).is_ok()
+    }
+    fn atom(&mut self, _: usize, a: Atom) -> bool {
+        self.atoms.push(a).is_ok()
+    }
+    fn node(&mut self, _: usize, n: Node) -> bool {
+        self.nodes.push(n).is_ok()
+    }
+    fn prop(&mut self, _: usize, p: Property<'a>) -> bool {
+        self.props.push(p).is_ok()
+    }
 }
 
 impl<'a, const N: usize> Table<'a, N> {
     /// Decodes and validates a table. Corrupt or truncated bytes, trailing bytes,
     /// a foreign version or a table larger than `N` give an error, never a panic.
     pub fn from_bytes(bytes: &'a [u8]) -> Result<Self, TableError> {
-        let (version, rest) =
-            postcard::take_from_bytes::<u32>(bytes).map_err(|_| TableError::Decode)?;
-        if version != TABLE_VERSION {
-            return Err(TableError::Version { found: version });
-        }
-        // A vector longer than `N` fails to decode like any other corrupt input.
-        let (table, rest) =
-            postcard::take_from_bytes::<Self>(rest).map_err(|_| TableError::Decode)?;
-        if !rest.is_empty() {
-            return Err(TableError::Decode);
-        }
+        let mut table = Table {
+            tick_ns: 0,
+            vars: Vec::new(),
+            strings: Vec::new(),
+            instrs: Vec::new(),
+            atoms: Vec::new(),
+            nodes: Vec::new(),
+            props: Vec::new(),
+        };
+        read_program(bytes, &mut table)?;
         Monitor::try_new(table.program())?;
         Ok(table)
     }

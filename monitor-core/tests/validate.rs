@@ -3,8 +3,10 @@
 mod common;
 
 use common::{program, since_nodes, Rng, ATOMS, INSTRS, PROPS, VARS};
-use monitor_core::table::{Table, TABLE_VERSION};
-use monitor_core::{Atom, Instr, Monitor, Node, Op, Program, Property, TableError};
+use monitor_core::table::{Store, Table, TABLE_VERSION};
+use monitor_core::{
+    Atom, CmpOp, Instr, Monitor, Node, NumTy, Op, Program, Property, TableError, Ty, Value,
+};
 
 #[test]
 fn bad_nodes_are_rejected() {
@@ -129,6 +131,129 @@ fn tables_round_trip_and_corruption_is_an_error() {
             let mut out = vec![false; m.properties()];
             let vals: Vec<_> = t.program().vars.iter().map(|v| v.init).collect();
             let _ = m.try_step(&mut state, 1, &vals, &mut out);
+        }
+    }
+}
+
+/// `Store` decodes into arrays of exactly the table's size: the same program
+/// as `Table`, and one element too many of any kind is a decode error.
+#[test]
+fn a_store_of_the_exact_size_loads_the_table_in_place() {
+    let nodes = since_nodes(2, Some(4));
+    let bytes = table_bytes(&nodes);
+    let mut store = Store::<2, 0, 2, 2, 3, 1>::new();
+    let m = store.load(&bytes).unwrap();
+    assert_eq!(*m.program(), program(&nodes));
+    assert_eq!(store.program(), program(&nodes));
+    // One slot short in each array in turn.
+    assert_eq!(
+        Store::<1, 0, 2, 2, 3, 1>::new().load(&bytes).unwrap_err(),
+        TableError::Decode
+    );
+    assert_eq!(
+        Store::<2, 0, 1, 2, 3, 1>::new().load(&bytes).unwrap_err(),
+        TableError::Decode
+    );
+    assert_eq!(
+        Store::<2, 0, 2, 1, 3, 1>::new().load(&bytes).unwrap_err(),
+        TableError::Decode
+    );
+    assert_eq!(
+        Store::<2, 0, 2, 2, 2, 1>::new().load(&bytes).unwrap_err(),
+        TableError::Decode
+    );
+    assert_eq!(
+        Store::<2, 0, 2, 2, 3, 0>::new().load(&bytes).unwrap_err(),
+        TableError::Decode
+    );
+    // Every truncation is an error, and a store can be loaded again after one.
+    let mut store = Store::<2, 0, 2, 2, 3, 1>::new();
+    for cut in 0..bytes.len() {
+        assert!(store.load(&bytes[..cut]).is_err(), "cut at {cut}");
+    }
+    assert!(store.load(&bytes).is_ok());
+    // A store validates like `Monitor::try_new`.
+    let mut bad = nodes;
+    bad[2].slot += 1;
+    assert_eq!(
+        store.load(&table_bytes(&bad)).unwrap_err(),
+        TableError::Layout { node: 2 }
+    );
+}
+
+/// An atom that needs floating point or integer division: accepted when
+/// monitor-core is built with `float` / `int-div` (the default), rejected on
+/// load with `TableError::Feature` when built without (scripts/test runs this
+/// file both ways).
+#[test]
+fn atoms_beyond_the_build_s_features_are_rejected_on_load() {
+    let nodes = since_nodes(0, None);
+    let float_cmp = [
+        Instr::Push(Value::Float(1.5)),
+        Instr::Push(Value::Float(2.5)),
+        Instr::Cmp(CmpOp::Lt, Ty::Float),
+        Instr::Load(1),
+    ];
+    let int_to_float = [
+        Instr::Push(Value::Int(3)),
+        Instr::ToFloat,
+        Instr::Push(Value::Float(2.5)),
+        Instr::Cmp(CmpOp::Gt, Ty::Float),
+        Instr::Load(1),
+    ];
+    let int_div = [
+        Instr::Push(Value::Int(7)),
+        Instr::Push(Value::Int(2)),
+        Instr::Div(NumTy::Int),
+        Instr::Push(Value::Int(3)),
+        Instr::Cmp(CmpOp::Eq, Ty::Int),
+        Instr::Load(1),
+    ];
+    let int_only = [
+        Instr::Push(Value::Int(7)),
+        Instr::Push(Value::Int(2)),
+        Instr::Mul(NumTy::Int),
+        Instr::Push(Value::Int(14)),
+        Instr::Cmp(CmpOp::Eq, Ty::Int),
+        Instr::Load(1),
+    ];
+    let cases: [(&[Instr], bool); 4] = [
+        (&float_cmp, cfg!(feature = "float")),
+        (&int_to_float, cfg!(feature = "float")),
+        (&int_div, cfg!(feature = "int-div")),
+        (&int_only, true),
+    ];
+    for (code, accepted) in cases {
+        let n = code.len() as u16;
+        let atoms = [
+            Atom {
+                start: 0,
+                len: n - 1,
+            },
+            Atom {
+                start: n - 1,
+                len: 1,
+            },
+        ];
+        let p = Program {
+            instrs: code,
+            atoms: &atoms,
+            ..program(&nodes)
+        };
+        match Monitor::try_new(p) {
+            Ok(m) => {
+                assert!(accepted, "{code:?} accepted");
+                // The atom is true: 1.5 < 2.5, 3.0 > 2.5, 7 / 2 == 3, 7 * 2 == 14.
+                let mut state = vec![0u64; m.state_words()];
+                let mut out = [false];
+                m.try_step(&mut state, 0, &[Value::Bool(false); 2], &mut out)
+                    .unwrap();
+                assert_eq!(m.node_value(&state, 0), Some(true), "{code:?}");
+            }
+            Err(e) => {
+                assert!(!accepted, "{code:?} rejected: {e}");
+                assert_eq!(e, TableError::Feature { atom: 0 });
+            }
         }
     }
 }

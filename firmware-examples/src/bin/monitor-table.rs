@@ -4,8 +4,7 @@
 
 use cortex_m_rt::entry;
 use firmware::{end_of_setup, fail, finish, log_start, step_point, VerdictLog};
-use monitor_core::table::Table;
-use monitor_core::Value;
+use monitor_core::{Monitor, Value};
 use museum_spec::trace::Reader;
 
 mod info {
@@ -16,41 +15,31 @@ mod info {
 static TABLE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/table.postcard"));
 static TRACE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/trace.bin"));
 
-type MonitorTable = Table<'static, { info::CAPACITY }>;
-
-/// Decodes and validates the embedded table into a `static`. Decoding moves
-/// the table by value a few times: doing it in a frame of its own keeps that
-/// transient stack out of the replay.
+/// Decodes the embedded table into a `static` store of exactly its size,
+/// element by element (no temporary copy of the program on the stack), and
+/// validates it.
 #[inline(never)]
-fn load() -> &'static MonitorTable {
-    let table = match MonitorTable::from_bytes(TABLE) {
-        Ok(t) => t,
-        Err(e) => {
-            defmt::error!("table rejected: {}", e);
-            fail("table")
-        }
+fn load() -> Monitor<'static> {
+    let Some(store) = cortex_m::singleton!(: info::Store = info::Store::new()) else {
+        fail("table loaded twice")
     };
-    match cortex_m::singleton!(: MonitorTable = table) {
-        Some(t) => t,
-        None => fail("table loaded twice"),
-    }
-}
-
-#[entry]
-fn main() -> ! {
-    let table = load();
-    defmt::info!(
-        "table bytes={=usize} decoded_bytes={=usize}",
-        TABLE.len(),
-        core::mem::size_of::<MonitorTable>()
-    );
-    let monitor = match table.monitor() {
+    match store.load(TABLE) {
         Ok(m) => m,
         Err(e) => {
             defmt::error!("table rejected: {}", e);
             fail("table")
         }
-    };
+    }
+}
+
+#[entry]
+fn main() -> ! {
+    let monitor = load();
+    defmt::info!(
+        "table bytes={=usize} decoded_bytes={=usize}",
+        TABLE.len(),
+        core::mem::size_of::<info::Store>()
+    );
     let mut trace = match Reader::new(TRACE, monitor.program().vars.len()) {
         Ok(r) => r,
         Err(_) => fail("trace header"),

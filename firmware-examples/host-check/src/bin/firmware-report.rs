@@ -1,7 +1,8 @@
 //! Prints the firmware size report: flash and RAM with and without the monitor, state bytes per property, stack high-water mark in QEMU, panic paths below the monitor step.
 //!
-//! Usage: `firmware-report` (images from `$FIRMWARE_DIR` or the firmware
-//! project's release output). Exits non-zero when an image is missing, fails
+//! Usage: `firmware-report` (images of `$FIRMWARE_TARGET`, default
+//! thumbv7em-none-eabihf, from `$FIRMWARE_DIR` or the firmware project's
+//! release output for that target). Exits non-zero when an image is missing, fails
 //! in QEMU, or a measurement cannot be made.
 
 use std::collections::BTreeMap;
@@ -27,6 +28,11 @@ fn main() -> ExitCode {
 }
 
 fn report() -> Result<(), String> {
+    let board = host_check::board()?;
+    println!(
+        "==== {} ({}, QEMU machine {})",
+        board.target, board.core, board.machine
+    );
     let mut sizes = BTreeMap::new();
     let mut stacks = BTreeMap::new();
     let mut tables = Vec::new();
@@ -124,7 +130,10 @@ fn report() -> Result<(), String> {
     );
 
     println!();
-    println!("== Stack high-water mark (bytes; QEMU mps2-an386, cortex-m-rt paint-stack)");
+    println!(
+        "== Stack high-water mark (bytes; QEMU {}, cortex-m-rt paint-stack)",
+        board.machine
+    );
     println!(
         "{:<16} {:>6} {:>7} {:>7}   (set-up: decode and validate the program; replay: from then on, live frames included)",
         "image", "peak", "set-up", "replay"
