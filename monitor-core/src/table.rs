@@ -6,12 +6,14 @@
 //! borrowing names and strings from the bytes, and run every check of
 //! [`Monitor::try_new`] before handing out a program:
 //!
-//! - [`Store`]: one array per vector, each sized exactly for one table
-//!   (const parameters), filled in place: the RAM of the decoded program and
-//!   nothing more, and a decode that keeps one element on the stack at a time.
-//!   For firmware: put the `Store` in a `static` and call [`Store::load`].
-//! - [`Table`]: `heapless` vectors of one capacity `N`, returned by value, for
-//!   hosts that do not know the table's shape in advance.
+//! - [`Store`]: one `heapless` vector per program vector, each with its own
+//!   capacity (const parameters: build scripts size them exactly for one
+//!   table), filled in place: the RAM of the decoded program and nothing
+//!   more, and a decode that keeps one element on the stack at a time. For
+//!   firmware: put the `Store` in a `static` and call [`Store::load`].
+//! - [`Table`]: a `Store` with one capacity `N` for every vector, returned by
+//!   value from [`Store::from_bytes`], for hosts that do not know the table's
+//!   shape in advance.
 //!
 //! Both read the program as a stream: the header, then each vector as its
 //! length and its elements one at a time ([`read_program`]), never the whole
@@ -22,7 +24,7 @@ use serde::Deserialize;
 
 use crate::error::TableError;
 use crate::monitor::Monitor;
-use crate::program::{Atom, Instr, Node, Op, Program, Property, Ty, Value, Var, VarKind};
+use crate::program::{Atom, Instr, Node, Program, Property, Var};
 
 /// Version of the table wire format; bump on any change to the program types.
 pub const TABLE_VERSION: u32 = 1;
@@ -118,21 +120,12 @@ pub fn read_program<'a>(bytes: &'a [u8], sink: &mut impl Sink<'a>) -> Result<Cou
     Ok(counts)
 }
 
-/// Places `value` at `slots[i]`; `false` when there is no such slot.
-fn put<T>(slots: &mut [T], i: usize, value: T) -> bool {
-    match slots.get_mut(i) {
-        Some(slot) => {
-            *slot = value;
-            true
-        }
-        None => false,
-    }
-}
-
-/// Storage for one decoded program, every vector an array of exactly the
-/// size its table needs: `V` variables, `S` strings, `I` instructions, `A`
-/// atoms, `N` nodes and `P` properties. [`Store::new`] is `const`, so the
-/// store can live in a `static`; [`Store::load`] decodes into it in place.
+/// Storage for one decoded program: `heapless` vectors with room for `V`
+/// variables, `S` strings, `I` instructions, `A` atoms, `N` nodes and `P`
+/// properties. [`Store::new`] is `const` and leaves the room uninitialised, so
+/// a store can live in a `static` with no image in flash; [`Store::load`]
+/// decodes into it in place. With each capacity exactly what one table needs,
+/// the store is the RAM of the decoded program and nothing more.
 #[derive(Debug)]
 pub struct Store<
     'a,
@@ -144,14 +137,17 @@ pub struct Store<
     const P: usize,
 > {
     tick_ns: u64,
-    vars: [Var<'a>; V],
-    strings: [&'a str; S],
-    instrs: [Instr; I],
-    atoms: [Atom; A],
-    nodes: [Node; N],
-    props: [Property<'a>; P],
-    counts: Counts,
+    vars: Vec<Var<'a>, V>,
+    strings: Vec<&'a str, S>,
+    instrs: Vec<Instr, I>,
+    atoms: Vec<Atom, A>,
+    nodes: Vec<Node, N>,
+    props: Vec<Property<'a>, P>,
 }
+
+/// A store with one capacity `N` for every vector, for hosts that do not know
+/// a table's shape in advance ([`Store::from_bytes`]).
+pub type Table<'a, const N: usize> = Store<'a, N, N, N, N, N, N>;
 
 impl<
         'a,
@@ -163,63 +159,59 @@ impl<
         const P: usize,
     > Store<'a, V, S, I, A, N, P>
 {
-    /// An empty store (every slot a placeholder, no program loaded).
+    /// An empty store.
     pub const fn new() -> Self {
-        const VAR: Var<'static> = Var {
-            name: "",
-            ty: Ty::Bool,
-            kind: VarKind::Event,
-            init: Value::Bool(false),
-        };
-        const PROP: Property<'static> = Property {
-            name: "",
-            first: 0,
-            root: 0,
-        };
         Store {
             tick_ns: 0,
-            vars: [VAR; V],
-            strings: [""; S],
-            instrs: [Instr::Not; I],
-            atoms: [Atom { start: 0, len: 0 }; A],
-            nodes: [Node {
-                op: Op::Const(false),
-                slot: 0,
-            }; N],
-            props: [PROP; P],
-            counts: Counts {
-                vars: 0,
-                strings: 0,
-                instrs: 0,
-                atoms: 0,
-                nodes: 0,
-                props: 0,
-            },
+            vars: Vec::new(),
+            strings: Vec::new(),
+            instrs: Vec::new(),
+            atoms: Vec::new(),
+            nodes: Vec::new(),
+            props: Vec::new(),
         }
     }
 
     /// Decodes `bytes` into this store, in place, and validates the program
-    /// with [`Monitor::try_new`]. A table with more elements of some kind than
-    /// the store's arrays hold is a [`TableError::Decode`]. After an error,
-    /// [`Store::program`] shows whatever was decoded, unvalidated.
+    /// with [`Monitor::try_new`]. Corrupt or truncated bytes, trailing bytes,
+    /// a foreign version or more elements of some kind than the store has room
+    /// for give an error, never a panic. After an error, [`Store::program`]
+    /// shows whatever was decoded, unvalidated.
     pub fn load(&mut self, bytes: &'a [u8]) -> Result<Monitor<'_>, TableError> {
-        self.counts = Counts::default();
-        self.counts = read_program(bytes, self)?;
+        self.vars.clear();
+        self.strings.clear();
+        self.instrs.clear();
+        self.atoms.clear();
+        self.nodes.clear();
+        self.props.clear();
+        read_program(bytes, self)?;
         Monitor::try_new(self.program())
     }
 
-    /// The loaded program (empty before [`Store::load`]).
+    /// Decodes and validates a table into a new store, returned by value (on
+    /// a host; firmware should [`Store::load`] into a `static` instead).
+    pub fn from_bytes(bytes: &'a [u8]) -> Result<Self, TableError> {
+        let mut store = Self::new();
+        store.load(bytes)?;
+        Ok(store)
+    }
+
+    /// The program, borrowed from this store (empty before [`Store::load`]).
     pub fn program(&self) -> Program<'_> {
-        let c = &self.counts;
         Program {
             tick_ns: self.tick_ns,
-            vars: self.vars.get(..c.vars).unwrap_or(&[]),
-            strings: self.strings.get(..c.strings).unwrap_or(&[]),
-            instrs: self.instrs.get(..c.instrs).unwrap_or(&[]),
-            atoms: self.atoms.get(..c.atoms).unwrap_or(&[]),
-            nodes: self.nodes.get(..c.nodes).unwrap_or(&[]),
-            props: self.props.get(..c.props).unwrap_or(&[]),
+            vars: &self.vars,
+            strings: &self.strings,
+            instrs: &self.instrs,
+            atoms: &self.atoms,
+            nodes: &self.nodes,
+            props: &self.props,
         }
+    }
+
+    /// The validated monitor for this store's program.
+    pub fn monitor(&self) -> Result<Monitor<'_>, TableError> {
+        Monitor::try_new(self.program())
     }
 }
 
@@ -251,42 +243,6 @@ impl<
     fn tick_ns(&mut self, tick_ns: u64) {
         self.tick_ns = tick_ns;
     }
-    fn var(&mut self, i: usize, v: Var<'a>) -> bool {
-        put(&mut self.vars, i, v)
-    }
-    fn string(&mut self, i: usize, s: &'a str) -> bool {
-        put(&mut self.strings, i, s)
-    }
-    fn instr(&mut self, i: usize, ins: Instr) -> bool {
-        put(&mut self.instrs, i, ins)
-    }
-    fn atom(&mut self, i: usize, a: Atom) -> bool {
-        put(&mut self.atoms, i, a)
-    }
-    fn node(&mut self, i: usize, n: Node) -> bool {
-        put(&mut self.nodes, i, n)
-    }
-    fn prop(&mut self, i: usize, p: Property<'a>) -> bool {
-        put(&mut self.props, i, p)
-    }
-}
-
-/// A deserialised program in fixed-capacity vectors of at most `N` elements each.
-#[derive(Debug)]
-pub struct Table<'a, const N: usize> {
-    tick_ns: u64,
-    vars: Vec<Var<'a>, N>,
-    strings: Vec<&'a str, N>,
-    instrs: Vec<Instr, N>,
-    atoms: Vec<Atom, N>,
-    nodes: Vec<Node, N>,
-    props: Vec<Property<'a>, N>,
-}
-
-impl<'a, const N: usize> Sink<'a> for Table<'a, N> {
-    fn tick_ns(&mut self, tick_ns: u64) {
-        self.tick_ns = tick_ns;
-    }
     fn var(&mut self, _: usize, v: Var<'a>) -> bool {
         self.vars.push(v).is_ok()
     }
@@ -304,42 +260,5 @@ impl<'a, const N: usize> Sink<'a> for Table<'a, N> {
     }
     fn prop(&mut self, _: usize, p: Property<'a>) -> bool {
         self.props.push(p).is_ok()
-    }
-}
-
-impl<'a, const N: usize> Table<'a, N> {
-    /// Decodes and validates a table. Corrupt or truncated bytes, trailing bytes,
-    /// a foreign version or a table larger than `N` give an error, never a panic.
-    pub fn from_bytes(bytes: &'a [u8]) -> Result<Self, TableError> {
-        let mut table = Table {
-            tick_ns: 0,
-            vars: Vec::new(),
-            strings: Vec::new(),
-            instrs: Vec::new(),
-            atoms: Vec::new(),
-            nodes: Vec::new(),
-            props: Vec::new(),
-        };
-        read_program(bytes, &mut table)?;
-        Monitor::try_new(table.program())?;
-        Ok(table)
-    }
-
-    /// The program, borrowed from this table.
-    pub fn program(&self) -> Program<'_> {
-        Program {
-            tick_ns: self.tick_ns,
-            vars: &self.vars,
-            strings: &self.strings,
-            instrs: &self.instrs,
-            atoms: &self.atoms,
-            nodes: &self.nodes,
-            props: &self.props,
-        }
-    }
-
-    /// The validated monitor for this table.
-    pub fn monitor(&self) -> Result<Monitor<'_>, TableError> {
-        Monitor::try_new(self.program())
     }
 }

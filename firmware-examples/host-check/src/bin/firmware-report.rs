@@ -155,11 +155,23 @@ fn report() -> Result<(), String> {
             f.starts_with("__") || f.starts_with("compiler_builtins::") || f.as_str() == "fmod"
         });
         let own: Vec<&str> = own.iter().map(|s| s.as_str()).collect();
+        let (float_div, other): (Vec<&String>, Vec<&String>) = builtins
+            .iter()
+            .partition(|f| callgraph::is_soft_float_or_division(f));
         println!(
-            "{name}: the step reaches {} and {} compiler-builtins routines (soft f64, fmod, 64-bit division)",
+            "{name}: the step reaches {} and {} compiler-builtins routines",
             own.join(", "),
             builtins.len()
         );
+        let list = |v: &[&String]| {
+            if v.is_empty() {
+                "none".to_string()
+            } else {
+                v.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ")
+            }
+        };
+        println!("  soft-float or 64-bit division: {}", list(&float_div));
+        println!("  other builtins: {}", list(&other));
         if r.panic_calls.is_empty() {
             println!("  no panic entry point is reachable");
         }
