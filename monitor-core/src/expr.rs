@@ -50,7 +50,9 @@ pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> bool {
             return false;
         }
         for (k, want) in pops.iter().enumerate() {
-            if stack[sp - pops.len() + k] != *want {
+            // `get`, not indexing: no bounds-check panic (and its message
+            // formatting) in a firmware image that loads tables.
+            if stack.get(sp - pops.len() + k) != Some(want) {
                 return false;
             }
         }
@@ -58,7 +60,10 @@ pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> bool {
         if sp >= MAX_STACK {
             return false;
         }
-        stack[sp] = push;
+        let Some(slot) = stack.get_mut(sp) else {
+            return false;
+        };
+        *slot = push;
         sp += 1;
     }
     sp == 1 && stack[0] == Ty::Bool

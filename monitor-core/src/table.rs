@@ -17,42 +17,247 @@
 //!
 //! Both read the program as a stream: the header, then each vector as its
 //! length and its elements one at a time ([`read_program`]), never the whole
-//! program as one serde value (which would build it in stack temporaries).
+//! program as one value (which serde would build in stack temporaries), and
+//! with a reader of postcard's encoding written for these types rather than
+//! serde's generic one (a fraction of its code size).
 
 use heapless::Vec;
-use serde::Deserialize;
 
 use crate::error::TableError;
 use crate::monitor::Monitor;
-use crate::program::{Atom, Instr, Node, Program, Property, Var};
+use crate::program::{
+    Atom, CmpOp, Instr, Node, NumTy, Op, Program, Property, Ty, Value, Var, VarKind,
+};
 
 /// Version of the table wire format; bump on any change to the program types.
 pub const TABLE_VERSION: u32 = 1;
 
-/// One postcard value from the front of `rest`, advancing it.
-fn take<'a, T: Deserialize<'a>>(rest: &mut &'a [u8]) -> Result<T, TableError> {
-    let (value, tail) = postcard::take_from_bytes::<T>(rest).map_err(|_| TableError::Decode)?;
-    *rest = tail;
-    Ok(value)
+/// A cursor over table bytes that reads postcard's encoding of the program
+/// types directly, without serde: the decoder of a firmware image is then a
+/// few small functions instead of serde's generic visitors (several KiB).
+///
+/// The rules, from postcard's wire format (its `spec/` and
+/// `postcard::de::deserializer::Deserializer`, read for the rules only):
+/// - `u16`/`u32`/`u64` (and lengths, `usize`) are unsigned LEB128 varints of
+///   at most 3/5/10 bytes whose last byte may not carry bits beyond the type
+///   (`try_take_varint_u*`); `i64` is the varint of its zigzag encoding;
+/// - `bool` is one byte, 0 or 1; `f64` 8 bytes little-endian; `Option` a
+///   byte 0 (None) or 1 followed by the value;
+/// - `&str` a varint length and that many bytes of UTF-8;
+/// - an enum the varint `u32` index of its variant (in declaration order,
+///   as serde derives it) followed by the variant's fields; a struct or tuple
+///   its fields in order; a sequence a varint length and its elements.
+///
+/// Each `program.rs` type's derived `Serialize` writes exactly this;
+/// `tests/validate.rs` checks the reader against postcard on every variant.
+struct Reader<'a> {
+    rest: &'a [u8],
 }
 
-/// One postcard sequence (length, then elements) from the front of `rest`,
-/// handing element `i` to `put(i, element)`; `put` returns `false` when there
-/// is no room for it, which is a [`TableError::Decode`] like any other corrupt input.
-fn take_seq<'a, T: Deserialize<'a>>(
-    rest: &mut &'a [u8],
-    mut put: impl FnMut(usize, T) -> bool,
-) -> Result<usize, TableError> {
-    // postcard writes a sequence length as a varint `usize`; for lengths below
-    // 2^32 its bytes are those of a varint `u32` (postcard's wire spec, "varint").
-    let len = take::<u32>(rest)? as usize;
-    for i in 0..len {
-        let element = take::<T>(rest)?;
-        if !put(i, element) {
-            return Err(TableError::Decode);
+impl<'a> Reader<'a> {
+    fn byte(&mut self) -> Result<u8, TableError> {
+        let (&b, rest) = self.rest.split_first().ok_or(TableError::Decode)?;
+        self.rest = rest;
+        Ok(b)
+    }
+
+    /// A varint of a type of `bits` bits (16, 32 or 64).
+    fn varint(&mut self, bits: u32) -> Result<u64, TableError> {
+        let max_bytes = bits.div_ceil(7);
+        let mut out = 0u64;
+        for i in 0..max_bytes {
+            let b = self.byte()?;
+            let low = (b & 0x7f) as u64;
+            if i == max_bytes - 1 && (b & 0x80 != 0 || low >> (bits - 7 * i) != 0) {
+                return Err(TableError::Decode);
+            }
+            out |= low << (7 * i);
+            if b & 0x80 == 0 {
+                return Ok(out);
+            }
+        }
+        Err(TableError::Decode)
+    }
+
+    fn u16(&mut self) -> Result<u16, TableError> {
+        Ok(self.varint(16)? as u16)
+    }
+
+    fn u32(&mut self) -> Result<u32, TableError> {
+        Ok(self.varint(32)? as u32)
+    }
+
+    fn u64(&mut self) -> Result<u64, TableError> {
+        self.varint(64)
+    }
+
+    fn i64(&mut self) -> Result<i64, TableError> {
+        let z = self.varint(64)?;
+        Ok((z >> 1) as i64 ^ -((z & 1) as i64))
+    }
+
+    fn bool(&mut self) -> Result<bool, TableError> {
+        match self.byte()? {
+            0 => Ok(false),
+            1 => Ok(true),
+            _ => Err(TableError::Decode),
         }
     }
-    Ok(len)
+
+    fn f64(&mut self) -> Result<f64, TableError> {
+        let (bytes, rest) = self
+            .rest
+            .split_first_chunk::<8>()
+            .ok_or(TableError::Decode)?;
+        self.rest = rest;
+        Ok(f64::from_le_bytes(*bytes))
+    }
+
+    fn str(&mut self) -> Result<&'a str, TableError> {
+        let len = self.varint(usize::BITS)? as usize;
+        let (bytes, rest) = self.rest.split_at_checked(len).ok_or(TableError::Decode)?;
+        self.rest = rest;
+        core::str::from_utf8(bytes).map_err(|_| TableError::Decode)
+    }
+
+    /// A variant index (postcard writes it as a varint `u32`).
+    fn variant(&mut self) -> Result<u32, TableError> {
+        self.u32()
+    }
+
+    fn value(&mut self) -> Result<Value, TableError> {
+        Ok(match self.variant()? {
+            0 => Value::Bool(self.bool()?),
+            1 => Value::Int(self.i64()?),
+            2 => Value::Float(self.f64()?),
+            3 => Value::Str(self.u32()?),
+            _ => return Err(TableError::Decode),
+        })
+    }
+
+    fn ty(&mut self) -> Result<Ty, TableError> {
+        Ok(match self.variant()? {
+            0 => Ty::Bool,
+            1 => Ty::Int,
+            2 => Ty::Float,
+            3 => Ty::Str,
+            _ => return Err(TableError::Decode),
+        })
+    }
+
+    fn num_ty(&mut self) -> Result<NumTy, TableError> {
+        Ok(match self.variant()? {
+            0 => NumTy::Int,
+            1 => NumTy::Float,
+            _ => return Err(TableError::Decode),
+        })
+    }
+
+    fn cmp_op(&mut self) -> Result<CmpOp, TableError> {
+        Ok(match self.variant()? {
+            0 => CmpOp::Eq,
+            1 => CmpOp::Ne,
+            2 => CmpOp::Lt,
+            3 => CmpOp::Le,
+            4 => CmpOp::Gt,
+            5 => CmpOp::Ge,
+            _ => return Err(TableError::Decode),
+        })
+    }
+
+    fn var(&mut self) -> Result<Var<'a>, TableError> {
+        Ok(Var {
+            name: self.str()?,
+            ty: self.ty()?,
+            kind: match self.variant()? {
+                0 => VarKind::Event,
+                1 => VarKind::State,
+                _ => return Err(TableError::Decode),
+            },
+            init: self.value()?,
+        })
+    }
+
+    fn instr(&mut self) -> Result<Instr, TableError> {
+        Ok(match self.variant()? {
+            0 => Instr::Push(self.value()?),
+            1 => Instr::Load(self.u16()?),
+            2 => Instr::Not,
+            3 => Instr::And,
+            4 => Instr::Or,
+            5 => Instr::Neg(self.num_ty()?),
+            6 => Instr::Add(self.num_ty()?),
+            7 => Instr::Sub(self.num_ty()?),
+            8 => Instr::Mul(self.num_ty()?),
+            9 => Instr::Div(self.num_ty()?),
+            10 => Instr::Rem(self.num_ty()?),
+            11 => Instr::Cmp(self.cmp_op()?, self.ty()?),
+            12 => Instr::ToFloat,
+            _ => return Err(TableError::Decode),
+        })
+    }
+
+    fn atom(&mut self) -> Result<Atom, TableError> {
+        Ok(Atom {
+            start: self.u16()?,
+            len: self.u16()?,
+        })
+    }
+
+    fn node(&mut self) -> Result<Node, TableError> {
+        let op = match self.variant()? {
+            0 => Op::Const(self.bool()?),
+            1 => Op::Atom(self.u16()?),
+            2 => Op::Not(self.u16()?),
+            3 => Op::And(self.u16()?, self.u16()?),
+            4 => Op::Or(self.u16()?, self.u16()?),
+            5 => Op::Implies(self.u16()?, self.u16()?),
+            6 => Op::Iff(self.u16()?, self.u16()?),
+            7 => Op::Yesterday(self.u16()?),
+            8 => Op::WeakYesterday(self.u16()?),
+            9 => Op::Since {
+                lhs: self.u16()?,
+                rhs: self.u16()?,
+                lo: self.u64()?,
+                hi: match self.byte()? {
+                    0 => None,
+                    1 => Some(self.u64()?),
+                    _ => return Err(TableError::Decode),
+                },
+            },
+            _ => return Err(TableError::Decode),
+        };
+        Ok(Node {
+            op,
+            slot: self.u32()?,
+        })
+    }
+
+    fn prop(&mut self) -> Result<Property<'a>, TableError> {
+        Ok(Property {
+            name: self.str()?,
+            first: self.u16()?,
+            root: self.u16()?,
+        })
+    }
+
+    /// A sequence: its length, then each element read by `read` and handed
+    /// to `put(i, element)`, which returns `false` when it has no room (a
+    /// [`TableError::Decode`] like any other corrupt input).
+    fn seq<T>(
+        &mut self,
+        read: impl Fn(&mut Self) -> Result<T, TableError>,
+        mut put: impl FnMut(usize, T) -> bool,
+    ) -> Result<usize, TableError> {
+        let len = self.varint(usize::BITS)? as usize;
+        for i in 0..len {
+            let element = read(self)?;
+            if !put(i, element) {
+                return Err(TableError::Decode);
+            }
+        }
+        Ok(len)
+    }
 }
 
 /// Where [`read_program`] puts each element of a table, as it reads it.
@@ -100,21 +305,21 @@ pub struct Counts {
 /// element the sink has no room for give an error; nothing is validated
 /// beyond the encoding (that is [`Monitor::try_new`]'s job).
 pub fn read_program<'a>(bytes: &'a [u8], sink: &mut impl Sink<'a>) -> Result<Counts, TableError> {
-    let mut rest = bytes;
-    let version = take::<u32>(&mut rest)?;
+    let mut r = Reader { rest: bytes };
+    let version = r.u32()?;
     if version != TABLE_VERSION {
         return Err(TableError::Version { found: version });
     }
-    sink.tick_ns(take::<u64>(&mut rest)?);
+    sink.tick_ns(r.u64()?);
     let counts = Counts {
-        vars: take_seq(&mut rest, |i, v| sink.var(i, v))?,
-        strings: take_seq(&mut rest, |i, s| sink.string(i, s))?,
-        instrs: take_seq(&mut rest, |i, ins| sink.instr(i, ins))?,
-        atoms: take_seq(&mut rest, |i, a| sink.atom(i, a))?,
-        nodes: take_seq(&mut rest, |i, n| sink.node(i, n))?,
-        props: take_seq(&mut rest, |i, p| sink.prop(i, p))?,
+        vars: r.seq(Reader::var, |i, v| sink.var(i, v))?,
+        strings: r.seq(Reader::str, |i, s| sink.string(i, s))?,
+        instrs: r.seq(Reader::instr, |i, ins| sink.instr(i, ins))?,
+        atoms: r.seq(Reader::atom, |i, a| sink.atom(i, a))?,
+        nodes: r.seq(Reader::node, |i, n| sink.node(i, n))?,
+        props: r.seq(Reader::prop, |i, p| sink.prop(i, p))?,
     };
-    if !rest.is_empty() {
+    if !r.rest.is_empty() {
         return Err(TableError::Decode);
     }
     Ok(counts)

@@ -3,9 +3,10 @@
 mod common;
 
 use common::{program, since_nodes, Rng, ATOMS, INSTRS, PROPS, VARS};
-use monitor_core::table::{Store, Table, TABLE_VERSION};
+use monitor_core::table::{read_program, Sink, Store, Table, TABLE_VERSION};
 use monitor_core::{
-    Atom, CmpOp, Instr, Monitor, Node, NumTy, Op, Program, Property, TableError, Ty, Value,
+    Atom, CmpOp, Instr, Monitor, Node, NumTy, Op, Program, Property, TableError, Ty, Value, Var,
+    VarKind,
 };
 
 #[test]
@@ -257,4 +258,207 @@ fn atoms_beyond_the_build_s_features_are_rejected_on_load() {
             }
         }
     }
+}
+
+/// Collects everything `read_program` hands out.
+#[derive(Default)]
+struct Collect<'a> {
+    tick_ns: u64,
+    vars: Vec<Var<'a>>,
+    strings: Vec<&'a str>,
+    instrs: Vec<Instr>,
+    atoms: Vec<Atom>,
+    nodes: Vec<Node>,
+    props: Vec<Property<'a>>,
+}
+
+impl<'a> Sink<'a> for Collect<'a> {
+    fn tick_ns(&mut self, tick_ns: u64) {
+        self.tick_ns = tick_ns;
+    }
+    fn var(&mut self, _: usize, v: Var<'a>) -> bool {
+        self.vars.push(v);
+        true
+    }
+    fn string(&mut self, _: usize, s: &'a str) -> bool {
+        self.strings.push(s);
+        true
+    }
+    fn instr(&mut self, _: usize, ins: Instr) -> bool {
+        self.instrs.push(ins);
+        true
+    }
+    fn atom(&mut self, _: usize, a: Atom) -> bool {
+        self.atoms.push(a);
+        true
+    }
+    fn node(&mut self, _: usize, n: Node) -> bool {
+        self.nodes.push(n);
+        true
+    }
+    fn prop(&mut self, _: usize, p: Property<'a>) -> bool {
+        self.props.push(p);
+        true
+    }
+}
+
+/// The table reader reads back what postcard writes for every variant of
+/// every program type and for the extremes of every integer (it is not
+/// validated here: `read_program` only decodes).
+#[test]
+fn the_table_reader_reads_what_postcard_writes() {
+    let ints = [0, 1, -1, 63, -64, 64, i64::MAX, i64::MIN, 300, -301];
+    let big = [
+        0,
+        1,
+        127,
+        128,
+        16_383,
+        16_384,
+        u64::from(u32::MAX),
+        u64::MAX,
+    ];
+    let mut instrs = vec![
+        Instr::Push(Value::Bool(true)),
+        Instr::Push(Value::Bool(false)),
+        Instr::Push(Value::Float(-2.5)),
+        Instr::Push(Value::Float(f64::INFINITY)),
+        Instr::Push(Value::Str(0)),
+        Instr::Push(Value::Str(u32::MAX)),
+        Instr::Load(0),
+        Instr::Load(u16::MAX),
+        Instr::Not,
+        Instr::And,
+        Instr::Or,
+        Instr::ToFloat,
+    ];
+    instrs.extend(ints.map(|i| Instr::Push(Value::Int(i))));
+    for t in [NumTy::Int, NumTy::Float] {
+        instrs.extend([
+            Instr::Neg(t),
+            Instr::Add(t),
+            Instr::Sub(t),
+            Instr::Mul(t),
+            Instr::Div(t),
+            Instr::Rem(t),
+        ]);
+    }
+    for op in [
+        CmpOp::Eq,
+        CmpOp::Ne,
+        CmpOp::Lt,
+        CmpOp::Le,
+        CmpOp::Gt,
+        CmpOp::Ge,
+    ] {
+        for ty in [Ty::Bool, Ty::Int, Ty::Float, Ty::Str] {
+            instrs.push(Instr::Cmp(op, ty));
+        }
+    }
+    let mut ops = vec![
+        Op::Const(true),
+        Op::Const(false),
+        Op::Atom(7),
+        Op::Not(1),
+        Op::And(1, 2),
+        Op::Or(3, u16::MAX),
+        Op::Implies(128, 129),
+        Op::Iff(0, 0),
+        Op::Yesterday(5),
+        Op::WeakYesterday(6),
+    ];
+    for lo in big {
+        for hi in [None, Some(lo), Some(u64::MAX)] {
+            ops.push(Op::Since {
+                lhs: 1,
+                rhs: 2,
+                lo,
+                hi,
+            });
+        }
+    }
+    let nodes: Vec<Node> = ops
+        .iter()
+        .zip([0, 1, 127, 128, u32::MAX].iter().cycle())
+        .map(|(&op, &slot)| Node { op, slot })
+        .collect();
+    let vars = [
+        Var {
+            name: "",
+            ty: Ty::Bool,
+            kind: VarKind::Event,
+            init: Value::Bool(false),
+        },
+        Var {
+            name: "höhe",
+            ty: Ty::Float,
+            kind: VarKind::State,
+            init: Value::Float(1e-300),
+        },
+        Var {
+            name: "n",
+            ty: Ty::Int,
+            kind: VarKind::State,
+            init: Value::Int(i64::MIN),
+        },
+        Var {
+            name: "s",
+            ty: Ty::Str,
+            kind: VarKind::State,
+            init: Value::Str(3),
+        },
+    ];
+    let strings = ["a", "", "ünïcode ✓"];
+    let atoms = [
+        Atom { start: 0, len: 1 },
+        Atom {
+            start: u16::MAX,
+            len: 200,
+        },
+    ];
+    let props = [
+        Property {
+            name: "p",
+            first: 0,
+            root: u16::MAX,
+        },
+        Property {
+            name: "q",
+            first: 300,
+            root: 2,
+        },
+    ];
+    let program = Program {
+        tick_ns: u64::MAX,
+        vars: &vars,
+        strings: &strings,
+        instrs: &instrs,
+        atoms: &atoms,
+        nodes: &nodes,
+        props: &props,
+    };
+    let bytes = postcard::to_allocvec(&(TABLE_VERSION, program)).unwrap();
+    let mut got = Collect::default();
+    let counts = read_program(&bytes, &mut got).unwrap();
+    let back = Program {
+        tick_ns: got.tick_ns,
+        vars: &got.vars,
+        strings: &got.strings,
+        instrs: &got.instrs,
+        atoms: &got.atoms,
+        nodes: &got.nodes,
+        props: &got.props,
+    };
+    assert_eq!(back, program);
+    assert_eq!(counts.instrs, instrs.len());
+    // Every truncation fails, and so does a varint past its type's width.
+    for cut in 0..bytes.len() {
+        assert!(read_program(&bytes[..cut], &mut Collect::default()).is_err());
+    }
+    let mut wide = postcard::to_allocvec(&TABLE_VERSION).unwrap();
+    wide.extend([0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0x02]);
+    assert_eq!(
+        read_program(&wide, &mut Collect::default()).unwrap_err(),
+        TableError::Decode
+    );
 }
