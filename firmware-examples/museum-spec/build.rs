@@ -4,6 +4,8 @@
 //! - `museum.rs`: the generated monitor, module `museum` (`codegen::emit_rust`).
 //! - `museum.postcard`: the same program as a postcard table
 //!   (`Compiled::to_table_bytes`, read by `monitor_core::table::Table`).
+//! - `final.postcard`: `final.hspec` as a postcard table, properties whose
+//!   verdicts all become final on the run (for `monitor-final`).
 //! - `museum_data.rs`: the spec's shape as the compiler reports it (variable
 //!   and property counts, formulas, state bytes in total and per property),
 //!   the trace as a `static` array of points, and `input`, which fills the
@@ -25,6 +27,8 @@ use codegen::Compiled;
 use monitor_core::{Ty, Value, VarKind};
 
 const SPEC: &str = "museum.hspec";
+/// Properties that all become final on the run: `monitor-final`'s table.
+const FINAL_SPEC: &str = "final.hspec";
 const TRACE: &str = "museum-run0.csv";
 
 fn main() -> ExitCode {
@@ -40,6 +44,7 @@ fn main() -> ExitCode {
 fn run() -> Result<(), String> {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed={SPEC}");
+    println!("cargo:rerun-if-changed={FINAL_SPEC}");
     println!("cargo:rerun-if-changed={TRACE}");
     let out = PathBuf::from(std::env::var_os("OUT_DIR").ok_or("OUT_DIR is not set")?);
     let read = |f: &str| fs::read_to_string(f).map_err(|e| format!("{f}: {e}"));
@@ -53,6 +58,21 @@ fn run() -> Result<(), String> {
 
     write(&out.join("museum.rs"), source.as_bytes())?;
     write(&out.join("museum.postcard"), &compiled.to_table_bytes())?;
+    let finals =
+        codegen::compile_spec(&read(FINAL_SPEC)?, FINAL_SPEC).map_err(|d| d.to_string())?;
+    let final_program = finals.program();
+    let (ours, theirs) = (program.vars, final_program.vars);
+    if ours.len() != theirs.len()
+        || ours
+            .iter()
+            .zip(theirs.iter())
+            .any(|(a, b)| (a.name, a.ty) != (b.name, b.ty))
+    {
+        return Err(format!(
+            "{FINAL_SPEC}: declare the variables of {SPEC}, in its order (the trace's columns)"
+        ));
+    }
+    write(&out.join("final.postcard"), &finals.to_table_bytes())?;
     write(
         &out.join("museum_data.rs"),
         data(&compiled, &points).as_bytes(),

@@ -18,6 +18,10 @@
 //! - `verdict prop=<p> point=<i> time=<t> value=<bool>`: property `p`'s
 //!   verdict at point `i` (0-based) differs from its verdict at point `i-1`,
 //!   or `i` is the first point
+//! - `final point=<i> time=<t>` (table images): after point `i` every
+//!   property's verdict is final ([`Finality`]): no later point can change
+//!   one, so the image stops stepping and the `done` line follows with
+//!   `points=<i+1>`
 //! - `done points=<N> stack=<bytes> setup_stack=<bytes> replay_stack=<bytes>`:
 //!   stack high-water marks of the whole run, of the set-up (decoding and
 //!   validating the program) and of the replay (from [`end_of_setup`] on,
@@ -29,6 +33,7 @@ use core::panic::PanicInfo;
 
 use cortex_m_rt as _;
 use defmt_semihosting as _;
+use monitor_core::analysis::{settle, settled};
 use monitor_core::{Monitor, StepError, Value};
 
 // Provides the single-core critical section that defmt-semihosting needs.
@@ -94,6 +99,127 @@ pub fn step_point(
     verdicts: &mut [bool],
 ) -> Result<(), StepError> {
     monitor.try_step(state, time, vars, verdicts)
+}
+
+/// Tells when every property's verdict is final, by the host's own finality
+/// analysis ([`monitor_core::analysis::settle`]) over the node values after
+/// each point: from then on no point can change a verdict, so stepping on is
+/// wasted work. `N` is the program's node count (one slot per node).
+pub struct Finality<const N: usize> {
+    finals: [Option<bool>; N],
+}
+
+impl<const N: usize> Default for Finality<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> Finality<N> {
+    /// Nothing known to be final yet.
+    pub const fn new() -> Self {
+        Finality { finals: [None; N] }
+    }
+
+    /// After a step: whether every property's verdict is now final.
+    pub fn all_final(&mut self, monitor: &Monitor<'_>, state: &[u64]) -> bool {
+        let program = monitor.program();
+        settle(
+            program,
+            |n| monitor.node_value(state, n).unwrap_or(false),
+            &mut self.finals,
+        );
+        (0..monitor.properties()).all(|p| settled(program, &self.finals, p).is_some())
+    }
+}
+
+/// The `main` of an image that decodes a postcard table embedded by build.rs
+/// and replays the embedded trace through it, stopping once every verdict is
+/// final. `$name` is the image's name in its log, `$table` the table file in
+/// `OUT_DIR` and `$info` the `<name>_info.rs` that build.rs sized for it.
+#[macro_export]
+macro_rules! table_image {
+    ($name:literal, $table:literal, $info:literal) => {
+        mod info {
+            //! Sizes of the embedded table, computed by build.rs.
+            include!(concat!(env!("OUT_DIR"), "/", $info));
+        }
+
+        static TABLE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/", $table));
+        static TRACE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/trace.bin"));
+
+        /// Decodes the embedded table into a `static` store of exactly its
+        /// size, element by element (no copy of the program on the stack),
+        /// and validates it.
+        #[inline(never)]
+        fn load() -> monitor_core::Monitor<'static> {
+            // The static starts uninitialised (no image of it in flash) and
+            // the empty store is written into it, not built on the stack.
+            let Some(slot) = ::cortex_m::singleton!(
+                : ::core::mem::MaybeUninit<info::Store> = ::core::mem::MaybeUninit::uninit()
+            ) else {
+                $crate::fail("table loaded twice")
+            };
+            let store = slot.write(info::Store::new());
+            match store.load(TABLE) {
+                Ok(m) => m,
+                Err(e) => {
+                    defmt::error!("table rejected: {}", e);
+                    $crate::fail("table")
+                }
+            }
+        }
+
+        #[cortex_m_rt::entry]
+        fn main() -> ! {
+            let monitor = load();
+            defmt::info!(
+                "table bytes={=usize} decoded_bytes={=usize}",
+                TABLE.len(),
+                ::core::mem::size_of::<info::Store>()
+            );
+            let nvars = monitor.program().vars.len();
+            let mut trace = match museum_spec::trace::Reader::new(TRACE, nvars) {
+                Ok(r) => r,
+                Err(_) => $crate::fail("trace header"),
+            };
+            let mut state = [0u64; info::STATE_WORDS];
+            if let Err(e) = monitor.reset(&mut state) {
+                defmt::error!("state: {}", e);
+                $crate::fail("state")
+            }
+            $crate::log_start($name, &monitor, trace.points());
+            let setup_stack = $crate::end_of_setup();
+            // Variables start at their declared values; each point then gives all of them.
+            let mut values = [monitor_core::Value::Bool(false); info::VARS];
+            monitor_core::valuation::init(monitor.program().vars, &mut values);
+            let mut log = $crate::VerdictLog::<{ info::PROPS }>::new();
+            let mut finality = $crate::Finality::<{ info::NODES }>::new();
+            let mut verdicts = [false; info::PROPS];
+            loop {
+                let time = match trace.next_point(&mut values) {
+                    Ok(Some(t)) => t,
+                    Ok(None) => break,
+                    Err(_) => $crate::fail("trace point"),
+                };
+                if let Err(e) = $crate::step_point(&monitor, &mut state, time, &values, &mut verdicts)
+                {
+                    defmt::error!("step at time {=u64}: {}", time, e);
+                    $crate::fail("step")
+                }
+                log.record(time, &verdicts);
+                if finality.all_final(&monitor, &state) {
+                    defmt::info!(
+                        "final point={=u32} time={=u64}",
+                        log.points().saturating_sub(1),
+                        time
+                    );
+                    break;
+                }
+            }
+            $crate::finish(log.points(), setup_stack)
+        }
+    };
 }
 
 /// Remembers the last verdict of each of `P` properties and logs every change.

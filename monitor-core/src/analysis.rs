@@ -1,4 +1,4 @@
-//! Static and per-point analyses of a [`Program`]: finality, repeat-idempotence, reads and horizon.
+//! Static and per-point analyses of a [`Program`]: finality, repeat-idempotence, reads, horizon and arithmetic.
 //!
 //! These are facts about the semantics of the network, so they live beside it:
 //! every function here matches [`Op`] exhaustively, and a new operator does not
@@ -11,12 +11,14 @@
 //!   values) always leaves the state unchanged, so a caller may skip the repeat.
 //! - [`for_each_read`]: the variables a property's atoms load.
 //! - [`horizon`]: the largest time bound in a property's formula.
+//! - [`arithmetic`]: whether the atoms need floating point or integer division
+//!   (the `float` / `int-div` features of this crate).
 //!
 //! The conformance tests (`tests/tests/analysis.rs`) check [`settle`] and
 //! [`repeat_is_noop`] against the reference oracle on the corpus and on random
 //! formulas.
 
-use crate::program::{Instr, NodeId, Op, Program, Property};
+use crate::program::{Instr, NodeId, NumTy, Op, Program, Property, Ty, Var};
 
 /// The final value of one node, if its value can no longer change, from its
 /// operation, its value `now` after the last point and its children's finality.
@@ -179,4 +181,43 @@ pub fn horizon(program: &Program<'_>, prop: &Property<'_>) -> u64 {
         })
         .max()
         .unwrap_or(0)
+}
+
+/// What a program's atoms compute beyond booleans, comparisons and integer
+/// `+ - *`: each is a feature of this crate that a firmware build may leave out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Arithmetic {
+    /// Some instruction loads, pushes, computes or compares a float (feature `float`).
+    pub float: bool,
+    /// Some instruction divides integers, `/` or `%` (feature `int-div`).
+    pub int_div: bool,
+}
+
+/// Scans every instruction of `program` for floats and integer division.
+pub fn arithmetic(program: &Program<'_>) -> Arithmetic {
+    program
+        .instrs
+        .iter()
+        .map(|ins| instr_arithmetic(ins, program.vars))
+        .fold(Arithmetic::default(), |a, b| Arithmetic {
+            float: a.float || b.float,
+            int_div: a.int_div || b.int_div,
+        })
+}
+
+/// What one instruction needs, over variables `vars`.
+pub(crate) fn instr_arithmetic(ins: &Instr, vars: &[Var<'_>]) -> Arithmetic {
+    let float = match *ins {
+        Instr::Push(v) => v.ty() == Ty::Float,
+        Instr::Load(n) => vars.get(n as usize).is_some_and(|v| v.ty == Ty::Float),
+        Instr::Neg(t) | Instr::Add(t) | Instr::Sub(t) | Instr::Mul(t) => t == NumTy::Float,
+        Instr::Div(t) | Instr::Rem(t) => t == NumTy::Float,
+        Instr::Cmp(_, ty) => ty == Ty::Float,
+        Instr::ToFloat => true,
+        Instr::Not | Instr::And | Instr::Or => false,
+    };
+    Arithmetic {
+        float,
+        int_div: matches!(ins, Instr::Div(NumTy::Int) | Instr::Rem(NumTy::Int)),
+    }
 }

@@ -30,6 +30,9 @@ impl defmt::Format for TableError {
             TableError::Version { found } => defmt::write!(f, "table: version {=u32}", found),
             TableError::Var { var } => defmt::write!(f, "table: variable {=u16}", var),
             TableError::Atom { atom } => defmt::write!(f, "table: atom {=u16}", atom),
+            TableError::Feature { atom } => {
+                defmt::write!(f, "table: atom {=u16} needs float or int-div", atom)
+            }
             TableError::Node { node } => defmt::write!(f, "table: node {=u16}", node),
             TableError::Layout { node } => defmt::write!(f, "table: layout of node {=u16}", node),
             TableError::Property { prop } => defmt::write!(f, "table: property {=u16}", prop),

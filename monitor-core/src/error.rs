@@ -23,6 +23,12 @@ pub enum TableError {
         /// Index of the atom.
         atom: u16,
     },
+    /// An atom needs what this build of monitor-core left out: floating point
+    /// (feature `float`) or integer division (feature `int-div`).
+    Feature {
+        /// Index of the atom.
+        atom: u16,
+    },
     /// A node refers to a later node, a node outside its property, or a missing atom.
     Node {
         /// Index of the node.
@@ -88,6 +94,10 @@ impl fmt::Display for TableError {
             TableError::Version { found } => write!(f, "unsupported table version {found}"),
             TableError::Var { var } => write!(f, "variable {var}: bad type or initial value"),
             TableError::Atom { atom } => write!(f, "atom {atom}: invalid bytecode"),
+            TableError::Feature { atom } => write!(
+                f,
+                "atom {atom}: needs floating point or integer division, which this build leaves out (monitor-core features `float`, `int-div`)"
+            ),
             TableError::Node { node } => write!(f, "node {node}: invalid operand"),
             TableError::Layout { node } => write!(f, "node {node}: invalid bounds or state slot"),
             TableError::Property { prop } => write!(f, "property {prop}: invalid node range"),

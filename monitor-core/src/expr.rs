@@ -50,7 +50,9 @@ pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> bool {
             return false;
         }
         for (k, want) in pops.iter().enumerate() {
-            if stack[sp - pops.len() + k] != *want {
+            // `get`, not indexing: no bounds-check panic (and its message
+            // formatting) in a firmware image that loads tables.
+            if stack.get(sp - pops.len() + k) != Some(want) {
                 return false;
             }
         }
@@ -58,10 +60,24 @@ pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> bool {
         if sp >= MAX_STACK {
             return false;
         }
-        stack[sp] = push;
+        let Some(slot) = stack.get_mut(sp) else {
+            return false;
+        };
+        *slot = push;
         sp += 1;
     }
     sp == 1 && stack[0] == Ty::Bool
+}
+
+/// Whether this build evaluates `code`: without feature `float` no
+/// instruction may touch a float (load, push, compute or compare one), without
+/// feature `int-div` none may divide integers. Checked on load, so that the
+/// step never meets what the build left out.
+pub(crate) fn enabled(code: &[Instr], vars: &[Var<'_>]) -> bool {
+    code.iter().all(|ins| {
+        let needs = crate::analysis::instr_arithmetic(ins, vars);
+        (cfg!(feature = "float") || !needs.float) && (cfg!(feature = "int-div") || !needs.int_div)
+    })
 }
 
 /// Evaluates a checked atom over `vals`. Errors on a value of the wrong type
@@ -137,7 +153,9 @@ fn eval_stack<const D: usize>(
                 match (*ins, a) {
                     (Instr::Not, Value::Bool(a)) => Value::Bool(!a),
                     (Instr::Neg(_), Value::Int(a)) => Value::Int(a.checked_neg().ok_or(arith)?),
+                    #[cfg(feature = "float")]
                     (Instr::Neg(_), Value::Float(a)) => Value::Float(-a),
+                    #[cfg(feature = "float")]
                     (Instr::ToFloat, Value::Int(a)) => Value::Float(a as f64),
                     _ => return Err(arith),
                 }
@@ -166,19 +184,28 @@ fn eval_stack<const D: usize>(
 }
 
 fn binary(ins: Instr, a: Value, b: Value) -> Option<Value> {
-    use Value::{Bool, Float, Int};
+    #[cfg(feature = "float")]
+    use Value::Float;
+    use Value::{Bool, Int};
     Some(match (ins, a, b) {
         (Instr::And, Bool(a), Bool(b)) => Bool(a && b),
         (Instr::Or, Bool(a), Bool(b)) => Bool(a || b),
         (Instr::Add(_), Int(a), Int(b)) => Int(a.checked_add(b)?),
         (Instr::Sub(_), Int(a), Int(b)) => Int(a.checked_sub(b)?),
         (Instr::Mul(_), Int(a), Int(b)) => Int(a.checked_mul(b)?),
+        #[cfg(feature = "int-div")]
         (Instr::Div(_), Int(a), Int(b)) => Int(a.checked_div(b)?),
+        #[cfg(feature = "int-div")]
         (Instr::Rem(_), Int(a), Int(b)) => Int(a.checked_rem(b)?),
+        #[cfg(feature = "float")]
         (Instr::Add(_), Float(a), Float(b)) => Float(a + b),
+        #[cfg(feature = "float")]
         (Instr::Sub(_), Float(a), Float(b)) => Float(a - b),
+        #[cfg(feature = "float")]
         (Instr::Mul(_), Float(a), Float(b)) => Float(a * b),
+        #[cfg(feature = "float")]
         (Instr::Div(_), Float(a), Float(b)) => Float(a / b),
+        #[cfg(feature = "float")]
         (Instr::Rem(_), Float(a), Float(b)) => Float(a % b),
         (Instr::Cmp(op, _), a, b) => Bool(compare(op, a, b)?),
         _ => return None,
@@ -188,9 +215,12 @@ fn binary(ins: Instr, a: Value, b: Value) -> Option<Value> {
 /// `a op b` for two values of the same type; `None` for mixed types.
 #[inline(always)]
 fn compare(op: CmpOp, a: Value, b: Value) -> Option<bool> {
-    use Value::{Bool, Float, Int, Str};
+    #[cfg(feature = "float")]
+    use Value::Float;
+    use Value::{Bool, Int, Str};
     Some(match (a, b) {
         (Int(a), Int(b)) => int_cmp(op, a, b),
+        #[cfg(feature = "float")]
         (Float(a), Float(b)) => cmp(op, a.partial_cmp(&b)),
         (Bool(a), Bool(b)) => cmp(op, Some(a.cmp(&b))),
         (Str(a), Str(b)) => cmp(op, Some(a.cmp(&b))),

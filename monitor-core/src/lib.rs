@@ -31,6 +31,11 @@
 //! - `serde`: `Serialize`/`Deserialize` for every program type.
 //! - `postcard`: [`table::Table`], a validated postcard loader (implies `serde`).
 //! - `defmt`: `defmt::Format` for the error types.
+//! - `float` (default): atoms over `float` values. Without it a program with a
+//!   float atom is rejected ([`TableError::Feature`]) and no soft-float routine
+//!   is linked into the step.
+//! - `int-div` (default): integer `/` and `%` in atoms (64-bit division, a
+//!   library routine on 32-bit cores); without it such a program is rejected.
 #![no_std]
 #![forbid(unsafe_code)]
 

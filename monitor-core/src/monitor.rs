@@ -73,6 +73,9 @@ impl<'a, const N: usize> Monitor<'a, N> {
             if !expr::check(code, p.vars) {
                 return Err(err);
             }
+            if !expr::enabled(code, p.vars) {
+                return Err(TableError::Feature { atom: i as u16 });
+            }
         }
         let mut next_word = layout::first_node_word(p.atoms.len(), p.nodes.len()) as u64;
         let mut prop_of_next = 0usize;

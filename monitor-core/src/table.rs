@@ -2,55 +2,406 @@
 //!
 //! The wire format is `(TABLE_VERSION: u32, Program)` in postcard encoding: the
 //! host writes it with `postcard::to_allocvec(&(TABLE_VERSION, program))`
-//! (`codegen` does this); [`Table::from_bytes`] reads it back without
-//! allocating, borrowing names and strings from the bytes, and runs every
-//! check of [`Monitor::try_new`] before handing out a monitor.
+//! (`codegen` does this). Two loaders read it back without allocating,
+//! borrowing names and strings from the bytes, and run every check of
+//! [`Monitor::try_new`] before handing out a program:
+//!
+//! - [`Store`]: one `heapless` vector per program vector, each with its own
+//!   capacity (const parameters: build scripts size them exactly for one
+//!   table), filled in place: the RAM of the decoded program and nothing
+//!   more, and a decode that keeps one element on the stack at a time. For
+//!   firmware: put the `Store` in a `static` and call [`Store::load`].
+//! - [`Table`]: a `Store` with one capacity `N` for every vector, returned by
+//!   value from [`Store::from_bytes`], for hosts that do not know the table's
+//!   shape in advance.
+//!
+//! Both read the program as a stream: the header, then each vector as its
+//! length and its elements one at a time ([`read_program`]), never the whole
+//! program as one value (which serde would build in stack temporaries), and
+//! with a reader of postcard's encoding written for these types rather than
+//! serde's generic one (a fraction of its code size).
 
 use heapless::Vec;
-use serde::Deserialize;
 
 use crate::error::TableError;
 use crate::monitor::Monitor;
-use crate::program::{Atom, Instr, Node, Program, Property, Var};
+use crate::program::{
+    Atom, CmpOp, Instr, Node, NumTy, Op, Program, Property, Ty, Value, Var, VarKind,
+};
 
 /// Version of the table wire format; bump on any change to the program types.
 pub const TABLE_VERSION: u32 = 1;
 
-/// A deserialised program in fixed-capacity vectors of at most `N` elements each.
-#[derive(Debug, Deserialize)]
-pub struct Table<'a, const N: usize> {
-    tick_ns: u64,
-    #[serde(borrow)]
-    vars: Vec<Var<'a>, N>,
-    #[serde(borrow)]
-    strings: Vec<&'a str, N>,
-    instrs: Vec<Instr, N>,
-    atoms: Vec<Atom, N>,
-    nodes: Vec<Node, N>,
-    #[serde(borrow)]
-    props: Vec<Property<'a>, N>,
+/// A cursor over table bytes that reads postcard's encoding of the program
+/// types directly, without serde: the decoder of a firmware image is then a
+/// few small functions instead of serde's generic visitors (several KiB).
+///
+/// The rules, from postcard's wire format (its `spec/` and
+/// `postcard::de::deserializer::Deserializer`, read for the rules only):
+/// - `u16`/`u32`/`u64` (and lengths, `usize`) are unsigned LEB128 varints of
+///   at most 3/5/10 bytes whose last byte may not carry bits beyond the type
+///   (`try_take_varint_u*`); `i64` is the varint of its zigzag encoding;
+/// - `bool` is one byte, 0 or 1; `f64` 8 bytes little-endian; `Option` a
+///   byte 0 (None) or 1 followed by the value;
+/// - `&str` a varint length and that many bytes of UTF-8;
+/// - an enum the varint `u32` index of its variant (in declaration order,
+///   as serde derives it) followed by the variant's fields; a struct or tuple
+///   its fields in order; a sequence a varint length and its elements.
+///
+/// Each `program.rs` type's derived `Serialize` writes exactly this;
+/// `tests/validate.rs` checks the reader against postcard on every variant.
+struct Reader<'a> {
+    rest: &'a [u8],
 }
 
-impl<'a, const N: usize> Table<'a, N> {
-    /// Decodes and validates a table. Corrupt or truncated bytes, trailing bytes,
-    /// a foreign version or a table larger than `N` give an error, never a panic.
-    pub fn from_bytes(bytes: &'a [u8]) -> Result<Self, TableError> {
-        let (version, rest) =
-            postcard::take_from_bytes::<u32>(bytes).map_err(|_| TableError::Decode)?;
-        if version != TABLE_VERSION {
-            return Err(TableError::Version { found: version });
-        }
-        // A vector longer than `N` fails to decode like any other corrupt input.
-        let (table, rest) =
-            postcard::take_from_bytes::<Self>(rest).map_err(|_| TableError::Decode)?;
-        if !rest.is_empty() {
-            return Err(TableError::Decode);
-        }
-        Monitor::try_new(table.program())?;
-        Ok(table)
+impl<'a> Reader<'a> {
+    fn byte(&mut self) -> Result<u8, TableError> {
+        let (&b, rest) = self.rest.split_first().ok_or(TableError::Decode)?;
+        self.rest = rest;
+        Ok(b)
     }
 
-    /// The program, borrowed from this table.
+    /// A varint of a type of `bits` bits (16, 32 or 64).
+    fn varint(&mut self, bits: u32) -> Result<u64, TableError> {
+        let max_bytes = bits.div_ceil(7);
+        let mut out = 0u64;
+        for i in 0..max_bytes {
+            let b = self.byte()?;
+            let low = (b & 0x7f) as u64;
+            if i == max_bytes - 1 && (b & 0x80 != 0 || low >> (bits - 7 * i) != 0) {
+                return Err(TableError::Decode);
+            }
+            out |= low << (7 * i);
+            if b & 0x80 == 0 {
+                return Ok(out);
+            }
+        }
+        Err(TableError::Decode)
+    }
+
+    fn u16(&mut self) -> Result<u16, TableError> {
+        Ok(self.varint(16)? as u16)
+    }
+
+    fn u32(&mut self) -> Result<u32, TableError> {
+        Ok(self.varint(32)? as u32)
+    }
+
+    fn u64(&mut self) -> Result<u64, TableError> {
+        self.varint(64)
+    }
+
+    fn i64(&mut self) -> Result<i64, TableError> {
+        let z = self.varint(64)?;
+        Ok((z >> 1) as i64 ^ -((z & 1) as i64))
+    }
+
+    fn bool(&mut self) -> Result<bool, TableError> {
+        match self.byte()? {
+            0 => Ok(false),
+            1 => Ok(true),
+            _ => Err(TableError::Decode),
+        }
+    }
+
+    fn f64(&mut self) -> Result<f64, TableError> {
+        let (bytes, rest) = self
+            .rest
+            .split_first_chunk::<8>()
+            .ok_or(TableError::Decode)?;
+        self.rest = rest;
+        Ok(f64::from_le_bytes(*bytes))
+    }
+
+    fn str(&mut self) -> Result<&'a str, TableError> {
+        let len = self.varint(usize::BITS)? as usize;
+        let (bytes, rest) = self.rest.split_at_checked(len).ok_or(TableError::Decode)?;
+        self.rest = rest;
+        core::str::from_utf8(bytes).map_err(|_| TableError::Decode)
+    }
+
+    /// A variant index (postcard writes it as a varint `u32`).
+    fn variant(&mut self) -> Result<u32, TableError> {
+        self.u32()
+    }
+
+    fn value(&mut self) -> Result<Value, TableError> {
+        Ok(match self.variant()? {
+            0 => Value::Bool(self.bool()?),
+            1 => Value::Int(self.i64()?),
+            2 => Value::Float(self.f64()?),
+            3 => Value::Str(self.u32()?),
+            _ => return Err(TableError::Decode),
+        })
+    }
+
+    fn ty(&mut self) -> Result<Ty, TableError> {
+        Ok(match self.variant()? {
+            0 => Ty::Bool,
+            1 => Ty::Int,
+            2 => Ty::Float,
+            3 => Ty::Str,
+            _ => return Err(TableError::Decode),
+        })
+    }
+
+    fn num_ty(&mut self) -> Result<NumTy, TableError> {
+        Ok(match self.variant()? {
+            0 => NumTy::Int,
+            1 => NumTy::Float,
+            _ => return Err(TableError::Decode),
+        })
+    }
+
+    fn cmp_op(&mut self) -> Result<CmpOp, TableError> {
+        Ok(match self.variant()? {
+            0 => CmpOp::Eq,
+            1 => CmpOp::Ne,
+            2 => CmpOp::Lt,
+            3 => CmpOp::Le,
+            4 => CmpOp::Gt,
+            5 => CmpOp::Ge,
+            _ => return Err(TableError::Decode),
+        })
+    }
+
+    fn var(&mut self) -> Result<Var<'a>, TableError> {
+        Ok(Var {
+            name: self.str()?,
+            ty: self.ty()?,
+            kind: match self.variant()? {
+                0 => VarKind::Event,
+                1 => VarKind::State,
+                _ => return Err(TableError::Decode),
+            },
+            init: self.value()?,
+        })
+    }
+
+    fn instr(&mut self) -> Result<Instr, TableError> {
+        Ok(match self.variant()? {
+            0 => Instr::Push(self.value()?),
+            1 => Instr::Load(self.u16()?),
+            2 => Instr::Not,
+            3 => Instr::And,
+            4 => Instr::Or,
+            5 => Instr::Neg(self.num_ty()?),
+            6 => Instr::Add(self.num_ty()?),
+            7 => Instr::Sub(self.num_ty()?),
+            8 => Instr::Mul(self.num_ty()?),
+            9 => Instr::Div(self.num_ty()?),
+            10 => Instr::Rem(self.num_ty()?),
+            11 => Instr::Cmp(self.cmp_op()?, self.ty()?),
+            12 => Instr::ToFloat,
+            _ => return Err(TableError::Decode),
+        })
+    }
+
+    fn atom(&mut self) -> Result<Atom, TableError> {
+        Ok(Atom {
+            start: self.u16()?,
+            len: self.u16()?,
+        })
+    }
+
+    fn node(&mut self) -> Result<Node, TableError> {
+        let op = match self.variant()? {
+            0 => Op::Const(self.bool()?),
+            1 => Op::Atom(self.u16()?),
+            2 => Op::Not(self.u16()?),
+            3 => Op::And(self.u16()?, self.u16()?),
+            4 => Op::Or(self.u16()?, self.u16()?),
+            5 => Op::Implies(self.u16()?, self.u16()?),
+            6 => Op::Iff(self.u16()?, self.u16()?),
+            7 => Op::Yesterday(self.u16()?),
+            8 => Op::WeakYesterday(self.u16()?),
+            9 => Op::Since {
+                lhs: self.u16()?,
+                rhs: self.u16()?,
+                lo: self.u64()?,
+                hi: match self.byte()? {
+                    0 => None,
+                    1 => Some(self.u64()?),
+                    _ => return Err(TableError::Decode),
+                },
+            },
+            _ => return Err(TableError::Decode),
+        };
+        Ok(Node {
+            op,
+            slot: self.u32()?,
+        })
+    }
+
+    fn prop(&mut self) -> Result<Property<'a>, TableError> {
+        Ok(Property {
+            name: self.str()?,
+            first: self.u16()?,
+            root: self.u16()?,
+        })
+    }
+
+    /// A sequence: its length, then each element read by `read` and handed
+    /// to `put(i, element)`, which returns `false` when it has no room (a
+    /// [`TableError::Decode`] like any other corrupt input).
+    fn seq<T>(
+        &mut self,
+        read: impl Fn(&mut Self) -> Result<T, TableError>,
+        mut put: impl FnMut(usize, T) -> bool,
+    ) -> Result<usize, TableError> {
+        let len = self.varint(usize::BITS)? as usize;
+        for i in 0..len {
+            let element = read(self)?;
+            if !put(i, element) {
+                return Err(TableError::Decode);
+            }
+        }
+        Ok(len)
+    }
+}
+
+/// Where [`read_program`] puts each element of a table, as it reads it.
+///
+/// Each method gets the element's index and the element, and returns `false`
+/// when it has no room for it.
+pub trait Sink<'a> {
+    /// The program's `tick_ns`.
+    fn tick_ns(&mut self, tick_ns: u64);
+    /// Variable `i`.
+    fn var(&mut self, i: usize, v: Var<'a>) -> bool;
+    /// String constant `i`.
+    fn string(&mut self, i: usize, s: &'a str) -> bool;
+    /// Instruction `i`.
+    fn instr(&mut self, i: usize, ins: Instr) -> bool;
+    /// Atom `i`.
+    fn atom(&mut self, i: usize, a: Atom) -> bool;
+    /// Node `i`.
+    fn node(&mut self, i: usize, n: Node) -> bool;
+    /// Property `i`.
+    fn prop(&mut self, i: usize, p: Property<'a>) -> bool;
+}
+
+/// The number of elements of each vector of a decoded program.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Counts {
+    /// Variables.
+    pub vars: usize,
+    /// String constants.
+    pub strings: usize,
+    /// Instructions.
+    pub instrs: usize,
+    /// Atoms.
+    pub atoms: usize,
+    /// Nodes.
+    pub nodes: usize,
+    /// Properties.
+    pub props: usize,
+}
+
+/// Reads a whole table from `bytes` into `sink`, element by element: the
+/// version, then the program's fields in declaration order (postcard encodes a
+/// struct as its fields in order, a sequence as a varint length and its
+/// elements). Corrupt, truncated or trailing bytes, a foreign version or an
+/// element the sink has no room for give an error; nothing is validated
+/// beyond the encoding (that is [`Monitor::try_new`]'s job).
+pub fn read_program<'a>(bytes: &'a [u8], sink: &mut impl Sink<'a>) -> Result<Counts, TableError> {
+    let mut r = Reader { rest: bytes };
+    let version = r.u32()?;
+    if version != TABLE_VERSION {
+        return Err(TableError::Version { found: version });
+    }
+    sink.tick_ns(r.u64()?);
+    let counts = Counts {
+        vars: r.seq(Reader::var, |i, v| sink.var(i, v))?,
+        strings: r.seq(Reader::str, |i, s| sink.string(i, s))?,
+        instrs: r.seq(Reader::instr, |i, ins| sink.instr(i, ins))?,
+        atoms: r.seq(Reader::atom, |i, a| sink.atom(i, a))?,
+        nodes: r.seq(Reader::node, |i, n| sink.node(i, n))?,
+        props: r.seq(Reader::prop, |i, p| sink.prop(i, p))?,
+    };
+    if !r.rest.is_empty() {
+        return Err(TableError::Decode);
+    }
+    Ok(counts)
+}
+
+/// Storage for one decoded program: `heapless` vectors with room for `V`
+/// variables, `S` strings, `I` instructions, `A` atoms, `N` nodes and `P`
+/// properties. [`Store::new`] is `const` and leaves the room uninitialised, so
+/// a store can live in a `static` with no image in flash; [`Store::load`]
+/// decodes into it in place. With each capacity exactly what one table needs,
+/// the store is the RAM of the decoded program and nothing more.
+#[derive(Debug)]
+pub struct Store<
+    'a,
+    const V: usize,
+    const S: usize,
+    const I: usize,
+    const A: usize,
+    const N: usize,
+    const P: usize,
+> {
+    tick_ns: u64,
+    vars: Vec<Var<'a>, V>,
+    strings: Vec<&'a str, S>,
+    instrs: Vec<Instr, I>,
+    atoms: Vec<Atom, A>,
+    nodes: Vec<Node, N>,
+    props: Vec<Property<'a>, P>,
+}
+
+/// A store with one capacity `N` for every vector, for hosts that do not know
+/// a table's shape in advance ([`Store::from_bytes`]).
+pub type Table<'a, const N: usize> = Store<'a, N, N, N, N, N, N>;
+
+impl<
+        'a,
+        const V: usize,
+        const S: usize,
+        const I: usize,
+        const A: usize,
+        const N: usize,
+        const P: usize,
+    > Store<'a, V, S, I, A, N, P>
+{
+    /// An empty store.
+    pub const fn new() -> Self {
+        Store {
+            tick_ns: 0,
+            vars: Vec::new(),
+            strings: Vec::new(),
+            instrs: Vec::new(),
+            atoms: Vec::new(),
+            nodes: Vec::new(),
+            props: Vec::new(),
+        }
+    }
+
+    /// Decodes `bytes` into this store, in place, and validates the program
+    /// with [`Monitor::try_new`]. Corrupt or truncated bytes, trailing bytes,
+    /// a foreign version or more elements of some kind than the store has room
+    /// for give an error, never a panic. After an error, [`Store::program`]
+    /// shows whatever was decoded, unvalidated.
+    pub fn load(&mut self, bytes: &'a [u8]) -> Result<Monitor<'_>, TableError> {
+        self.vars.clear();
+        self.strings.clear();
+        self.instrs.clear();
+        self.atoms.clear();
+        self.nodes.clear();
+        self.props.clear();
+        read_program(bytes, self)?;
+        Monitor::try_new(self.program())
+    }
+
+    /// Decodes and validates a table into a new store, returned by value (on
+    /// a host; firmware should [`Store::load`] into a `static` instead).
+    pub fn from_bytes(bytes: &'a [u8]) -> Result<Self, TableError> {
+        let mut store = Self::new();
+        store.load(bytes)?;
+        Ok(store)
+    }
+
+    /// The program, borrowed from this store (empty before [`Store::load`]).
     pub fn program(&self) -> Program<'_> {
         Program {
             tick_ns: self.tick_ns,
@@ -63,8 +414,56 @@ impl<'a, const N: usize> Table<'a, N> {
         }
     }
 
-    /// The validated monitor for this table.
+    /// The validated monitor for this store's program.
     pub fn monitor(&self) -> Result<Monitor<'_>, TableError> {
         Monitor::try_new(self.program())
+    }
+}
+
+impl<
+        'a,
+        const V: usize,
+        const S: usize,
+        const I: usize,
+        const A: usize,
+        const N: usize,
+        const P: usize,
+    > Default for Store<'a, V, S, I, A, N, P>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<
+        'a,
+        const V: usize,
+        const S: usize,
+        const I: usize,
+        const A: usize,
+        const N: usize,
+        const P: usize,
+    > Sink<'a> for Store<'a, V, S, I, A, N, P>
+{
+    fn tick_ns(&mut self, tick_ns: u64) {
+        self.tick_ns = tick_ns;
+    }
+    fn var(&mut self, _: usize, v: Var<'a>) -> bool {
+        self.vars.push(v).is_ok()
+    }
+    fn string(&mut self, _: usize, s: &'a str) -> bool {
+        self.strings.push(s).is_ok()
+    }
+    fn instr(&mut self, _: usize, ins: Instr) -> bool {
+        self.instrs.push(ins).is_ok()
+    }
+    fn atom(&mut self, _: usize, a: Atom) -> bool {
+        self.atoms.push(a).is_ok()
+    }
+    fn node(&mut self, _: usize, n: Node) -> bool {
+        self.nodes.push(n).is_ok()
+    }
+    fn prop(&mut self, _: usize, p: Property<'a>) -> bool {
+        self.props.push(p).is_ok()
     }
 }

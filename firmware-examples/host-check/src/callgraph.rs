@@ -221,6 +221,38 @@ pub fn location_at(elf: &object::File<'_>, addr: u64) -> Option<Location> {
     })
 }
 
+/// Whether `name` is a compiler-builtins routine (or libm's `fmod`) for
+/// soft floating point or 64-bit division: what an integer-only spec's step
+/// must not reach on a core without an FPU or a 64-bit divider. Other
+/// builtins (`memcpy`, 64-bit shifts and multiplies) are not counted.
+pub fn is_soft_float_or_division(name: &str) -> bool {
+    let n = name.rsplit("::").next().unwrap_or(name);
+    // ARM EABI names: __aeabi_d* (f64), __aeabi_f* (f32), __aeabi_[u]ldivmod,
+    // __aeabi_[u]idiv*, conversions to and from floats (*2d, *2f, d2*, f2*).
+    let aeabi = n.strip_prefix("__aeabi_").is_some_and(|r| {
+        r.starts_with('d')
+            || r.starts_with('f')
+            || r.contains("div")
+            || r.ends_with("2d")
+            || r.ends_with("2f")
+    });
+    // Generic compiler-builtins names: __adddf3, __divdi3, __udivmoddi4, ...
+    let generic = n.starts_with("__")
+        && (n.ends_with("df3")
+            || n.ends_with("sf3")
+            || n.contains("div")
+            || n.contains("mod")
+            || n.contains("float"));
+    aeabi
+        || generic
+        || n == "fmod"
+        || name.contains("::float::")
+        || name.contains("libm_math")
+        || name.contains("div_rem")
+        || name.contains("::int::udiv")
+        || name.contains("::int::sdiv")
+}
+
 /// The rustup `llvm-tools` binary `name` (`rustup component add llvm-tools`).
 pub fn llvm_tool(name: &str) -> Result<PathBuf, String> {
     let out = |args: &[&str]| -> Result<String, String> {
@@ -278,6 +310,34 @@ pub fn analyse(image: &Path, root: &str) -> Result<PanicReport, String> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn soft_float_and_division_routines_are_told_apart_from_other_builtins() {
+        for name in [
+            "__aeabi_dadd",
+            "__aeabi_fmul",
+            "__aeabi_uldivmod",
+            "__aeabi_l2d",
+            "__adddf3",
+            "__udivmoddi4",
+            "fmod",
+            "compiler_builtins::float::div::__divdf3",
+            "compiler_builtins::int::specialized_div_rem::u64_div_rem",
+            "compiler_builtins::math::libm_math::fmod::fmod",
+        ] {
+            assert!(super::is_soft_float_or_division(name), "{name}");
+        }
+        for name in [
+            "__aeabi_memcpy",
+            "__aeabi_memclr8",
+            "__aeabi_llsl",
+            "__aeabi_lmul",
+            "compiler_builtins::mem::memcpy",
+            "__muldi3",
+        ] {
+            assert!(!super::is_soft_float_or_division(name), "{name}");
+        }
+    }
+
     use super::*;
 
     const DIS: &str = "

@@ -2,7 +2,7 @@
 
 use object::{Object, ObjectSection, SectionFlags};
 
-/// Start of RAM on mps2-an386 (memory.x); allocated sections below it are in flash.
+/// Start of RAM on mps2-an386 and on microbit (memory-*.x); allocated sections below it are in flash.
 pub const RAM_ORIGIN: u64 = 0x2000_0000;
 
 /// `SHF_ALLOC`: the section occupies memory on the target.

@@ -3,8 +3,9 @@
 //! # Pipeline
 //!
 //! 1. [`qemu::run`] boots an image on `qemu-system-arm` (machine
-//!    `mps2-an386`, Cortex-M4F) with semihosting, under a time limit, and
-//!    returns the raw defmt stream and the exit status.
+//!    `mps2-an386` for the Cortex-M4F build, `microbit` for the Cortex-M0
+//!    one: [`BOARDS`], chosen by `$FIRMWARE_TARGET`) with semihosting, under
+//!    a time limit, and returns the raw defmt stream and the exit status.
 //! 2. [`log::decode`] turns the stream into messages with the image's defmt
 //!    table (`defmt-decoder`); [`log::Log::parse`] reads the firmware's log
 //!    lines (see the firmware crate's docs for the format).
@@ -73,12 +74,62 @@ pub const STEPS: [(&str, &str); 2] = [
     ("monitor-table", "firmware::step_point"),
 ];
 
-/// Where the images are: `$FIRMWARE_DIR`, else the firmware project's release output.
+/// A target the firmware is built for and the QEMU board that runs it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Board {
+    /// Rust target triple.
+    pub target: &'static str,
+    /// The core, for the report.
+    pub core: &'static str,
+    /// QEMU's `-machine`.
+    pub machine: &'static str,
+    /// QEMU's `-cpu`, when the machine's default is not the one.
+    pub cpu: Option<&'static str>,
+}
+
+/// Every target the firmware is built for (`scripts/firmware` builds and checks each).
+pub const BOARDS: [Board; 2] = [
+    Board {
+        target: "thumbv7em-none-eabihf",
+        core: "Cortex-M4F",
+        machine: "mps2-an386",
+        cpu: Some("cortex-m4"),
+    },
+    Board {
+        target: "thumbv6m-none-eabi",
+        core: "Cortex-M0",
+        machine: "microbit",
+        cpu: None,
+    },
+];
+
+/// The board of `$FIRMWARE_TARGET` (a target triple of [`BOARDS`]), else the first.
+pub fn board() -> Result<Board, String> {
+    match std::env::var("FIRMWARE_TARGET") {
+        Ok(t) => BOARDS
+            .iter()
+            .copied()
+            .find(|b| b.target == t)
+            .ok_or_else(|| {
+                format!(
+                    "FIRMWARE_TARGET={t}: not one of {:?}",
+                    BOARDS.map(|b| b.target)
+                )
+            }),
+        Err(_) => Ok(BOARDS[0]),
+    }
+}
+
+/// Where the images are: `$FIRMWARE_DIR`, else the firmware project's release output for [`board`].
 pub fn image_dir() -> PathBuf {
     match std::env::var_os("FIRMWARE_DIR") {
         Some(d) => PathBuf::from(d),
         None => {
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/thumbv7em-none-eabihf/release")
+            let target = board().map(|b| b.target).unwrap_or(BOARDS[0].target);
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../target")
+                .join(target)
+                .join("release")
         }
     }
 }

@@ -1,4 +1,4 @@
-//! Decoding a firmware's defmt stream and reading its log lines (`start`, `property`, `verdict`, `done`, `error`).
+//! Decoding a firmware's defmt stream and reading its log lines (`start`, `property`, `verdict`, `final`, `done`, `error`).
 
 use defmt_decoder::{DecodeError, Table};
 
@@ -53,6 +53,15 @@ pub struct Change {
     pub value: bool,
 }
 
+/// The `final` line: every verdict is final after `point`, and the image stopped stepping.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Final {
+    /// The last point stepped, from 0.
+    pub point: u32,
+    /// Its timestamp.
+    pub time: u64,
+}
+
 /// The `done` line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Done {
@@ -77,6 +86,8 @@ pub struct Log {
     pub properties: Vec<String>,
     /// Every `verdict` line, in order.
     pub changes: Vec<Change>,
+    /// The `final` line, if any.
+    pub finality: Option<Final>,
     /// The `done` line, if any.
     pub done: Option<Done>,
     /// Every `error` line.
@@ -125,6 +136,12 @@ impl Log {
                     time: field(line, "time")?,
                     value: field(line, "value")?,
                 }),
+                Some("final") => {
+                    log.finality = Some(Final {
+                        point: field(line, "point")?,
+                        time: field(line, "time")?,
+                    })
+                }
                 Some("done") => {
                     log.done = Some(Done {
                         points: field(line, "points")?,
@@ -155,6 +172,7 @@ mod tests {
             "verdict prop=0 point=0 time=0 value=true",
             "verdict prop=1 point=2 time=7 value=false",
             "replayed events=1 level_sum=3",
+            "final point=2 time=7",
             "done points=3 stack=412 setup_stack=412 replay_stack=300",
         ];
         let log = Log::parse(lines.iter().map(|s| s.to_string()).collect()).unwrap();
@@ -186,8 +204,9 @@ mod tests {
                 replay_stack: 300
             })
         );
+        assert_eq!(log.finality, Some(Final { point: 2, time: 7 }));
         assert!(log.errors.is_empty());
-        assert_eq!(log.messages.len(), 7);
+        assert_eq!(log.messages.len(), 8);
     }
 
     #[test]

@@ -22,28 +22,31 @@ pub struct Run {
     pub elapsed: Duration,
 }
 
-/// The QEMU command line for `image`: Cortex-M4F on `mps2-an386`, semihosting on, no display.
-pub fn command(image: &Path) -> Command {
+/// The QEMU command line for `image` on the board of `$FIRMWARE_TARGET`
+/// ([`crate::board`]): semihosting on, no display.
+pub fn command(image: &Path) -> Result<Command, String> {
+    let board = crate::board()?;
     let mut cmd = Command::new(QEMU);
+    if let Some(cpu) = board.cpu {
+        cmd.args(["-cpu", cpu]);
+    }
     cmd.args([
-        "-cpu",
-        "cortex-m4",
         "-machine",
-        "mps2-an386",
+        board.machine,
         "-nographic",
         "-semihosting-config",
         "enable=on,target=native",
         "-kernel",
     ])
     .arg(image);
-    cmd
+    Ok(cmd)
 }
 
 /// Boots `image` and waits for it to exit; an image still running after
 /// `timeout` is killed and reported as an error.
 pub fn run(image: &Path, timeout: Duration) -> Result<Run, String> {
     let start = Instant::now();
-    let mut child = command(image)
+    let mut child = command(image)?
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())

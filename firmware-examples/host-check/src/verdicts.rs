@@ -1,5 +1,6 @@
 //! The host interpreter's verdicts over a trace, and the point-for-point comparison with a firmware's verdict changes.
 
+use monitor_core::analysis::{settle, settled};
 use monitor_core::table::Table;
 use monitor_core::{Monitor, Program, Value};
 use museum_spec::trace::Reader;
@@ -20,6 +21,11 @@ pub struct Expected {
     pub props: usize,
     /// Monitor state size in bytes.
     pub state_bytes: usize,
+    /// The first point after which every verdict is final
+    /// (`monitor_core::analysis::settle`), where a table image stops stepping;
+    /// `None` when some verdict can still change at the end, or for an image
+    /// that does not stop (the generated monitor).
+    pub final_point: Option<usize>,
 }
 
 /// Runs `monitor_core::Monitor` on this machine over `points`.
@@ -35,7 +41,10 @@ pub fn host_run<'v>(
         verdicts: Vec::new(),
         props: monitor.properties(),
         state_bytes: monitor.state_bytes(),
+        final_point: None,
     };
+    let program = monitor.program();
+    let mut finals = vec![None; program.nodes.len()];
     for (time, values) in points {
         let mut verdicts = vec![false; monitor.properties()];
         monitor
@@ -43,6 +52,16 @@ pub fn host_run<'v>(
             .map_err(|e| format!("point {}: {e}", expected.times.len()))?;
         expected.times.push(time);
         expected.verdicts.push(verdicts);
+        if expected.final_point.is_none() {
+            settle(
+                program,
+                |n| monitor.node_value(&state, n).unwrap_or(false),
+                &mut finals,
+            );
+            if (0..monitor.properties()).all(|p| settled(program, &finals, p).is_some()) {
+                expected.final_point = Some(expected.times.len() - 1);
+            }
+        }
     }
     Ok(expected)
 }
@@ -57,6 +76,8 @@ pub fn static_expected() -> Result<Expected, String> {
         .map(|p| (p.time, p.values.to_vec()));
     let mut expected = with_table(museum_spec::TABLE, points.collect())?;
     expected.state_bytes = museum_spec::museum::STATE_BYTES;
+    // The generated monitor replays every point.
+    expected.final_point = None;
     Ok(expected)
 }
 
@@ -142,8 +163,9 @@ pub fn replay_changes(log: &Log, props: usize, points: usize) -> Result<Vec<Vec<
 }
 
 /// Checks a firmware log against the host's verdicts: the same number of
-/// properties and points, every change at the right timestamp, and the same
-/// verdict for every property at every point.
+/// properties and points, every change at the right timestamp, the same
+/// verdict for every property at every point stepped, and a `final` line
+/// exactly where the host finds every verdict final (the image then stops).
 pub fn compare(expected: &Expected, log: &Log) -> Result<(), String> {
     if !log.errors.is_empty() {
         return Err(format!("the firmware logged errors: {:?}", log.errors));
@@ -152,7 +174,7 @@ pub fn compare(expected: &Expected, log: &Log) -> Result<(), String> {
     let done = log
         .done
         .ok_or("no `done` line: the replay did not finish")?;
-    let n = expected.times.len();
+    let all = expected.times.len();
     if start.props != expected.props {
         return Err(format!(
             "{} properties, the host has {}",
@@ -165,9 +187,20 @@ pub fn compare(expected: &Expected, log: &Log) -> Result<(), String> {
             start.state_bytes, expected.state_bytes
         ));
     }
-    if start.points as usize != n || done.points as usize != n {
+    let logged = log.finality.map(|f| (f.point as usize, f.time));
+    let host = expected
+        .final_point
+        .map(|i| (i, expected.times.get(i).copied().unwrap_or(0)));
+    if logged != host {
         return Err(format!(
-            "announced {} and replayed {} points, the trace has {n}",
+            "every verdict final after (point, time) {logged:?}, the host says {host:?}"
+        ));
+    }
+    // Stepped: up to the final point, else the whole trace.
+    let n = expected.final_point.map_or(all, |i| i + 1);
+    if start.points as usize != all || done.points as usize != n {
+        return Err(format!(
+            "announced {} and replayed {} points, the trace has {all} and the host expects {n} stepped",
             start.points, done.points
         ));
     }
@@ -192,7 +225,7 @@ pub fn compare(expected: &Expected, log: &Log) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::log::{Change, Done, Start};
+    use crate::log::{Change, Done, Final, Start};
 
     fn log_of(changes: &[(usize, u32, u64, bool)], points: u32) -> Log {
         Log {
@@ -227,6 +260,7 @@ mod tests {
             verdicts: verdicts.iter().map(|v| v.to_vec()).collect(),
             props: 2,
             state_bytes: 8,
+            final_point: None,
         }
     }
 
@@ -264,6 +298,35 @@ mod tests {
         assert!(compare(&expected(&[[true, false]]), &log).is_err());
         let log = log_of(&[(0, 0, 0, true), (1, 0, 0, false)], 2);
         assert!(compare(&expected(&[[true, false]]), &log).is_err());
+    }
+
+    #[test]
+    fn a_replay_stops_exactly_where_the_host_finds_every_verdict_final() {
+        let verdicts = [[true, false], [true, true], [true, true]];
+        let mut e = expected(&verdicts);
+        e.final_point = Some(1);
+        // Announced 3 points, stepped 2, `final` after point 1 (time 10).
+        let mut log = log_of(&[(0, 0, 0, true), (1, 0, 0, false), (1, 1, 10, true)], 3);
+        log.done.as_mut().unwrap().points = 2;
+        log.finality = Some(Final { point: 1, time: 10 });
+        assert_eq!(compare(&e, &log), Ok(()));
+        // A stop one point late or early, at the wrong time, or missing.
+        let mut late = log.clone();
+        late.finality = Some(Final { point: 2, time: 20 });
+        assert!(compare(&e, &late).is_err());
+        let mut wrong_time = log.clone();
+        wrong_time.finality = Some(Final { point: 1, time: 11 });
+        assert!(compare(&e, &wrong_time).is_err());
+        let mut missing = log.clone();
+        missing.finality = None;
+        assert!(compare(&e, &missing).is_err());
+        // Stepping past the final point is a mismatch too.
+        let mut on = log.clone();
+        on.done.as_mut().unwrap().points = 3;
+        assert!(compare(&e, &on).is_err());
+        // And a `final` line where the host expects none.
+        e.final_point = None;
+        assert!(compare(&e, &log).is_err());
     }
 
     #[test]

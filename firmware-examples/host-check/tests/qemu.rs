@@ -48,6 +48,33 @@ fn monitor_table_verdicts_equal_the_host_interpreter() {
 }
 
 #[test]
+fn monitor_table_steps_the_whole_museum_run() {
+    // No museum verdict is final before the end: the table image replays every point.
+    let (table, trace) = table_inputs().unwrap();
+    let expected = table_expected(&table, &trace).unwrap();
+    if table == museum_spec::TABLE {
+        assert_eq!(expected.final_point, None);
+    }
+}
+
+#[test]
+fn monitor_final_stops_where_every_verdict_becomes_final() {
+    let expected = table_expected(museum_spec::FINAL_TABLE, &museum_spec::trace_bytes()).unwrap();
+    // final.hspec's verdicts are all final at the run's first alarm, well before its end.
+    let alarm = museum_spec::VAR_NAMES
+        .iter()
+        .position(|n| *n == "alarm")
+        .unwrap();
+    let first_alarm = museum_spec::TRACE
+        .iter()
+        .position(|p| p.values[alarm] == monitor_core::Value::Bool(true))
+        .unwrap();
+    assert_eq!(expected.final_point, Some(first_alarm));
+    assert!(first_alarm + 1 < museum_spec::TRACE_LEN);
+    check("monitor-final", &expected);
+}
+
+#[test]
 fn baselines_replay_the_whole_trace() {
     for name in ["baseline", "baseline-bytes"] {
         let log = run(name);

@@ -13,6 +13,8 @@
 //!   stepped by [`step`]; what `monitor-static` links.
 //! - [`TABLE`]: the same program as a postcard table, what `monitor-table`
 //!   decodes at run time and what the host interpreter runs.
+//! - [`FINAL_TABLE`]: `final.hspec` as a postcard table, properties that
+//!   all become final during the run, what `monitor-final` decodes.
 //! - [`TRACE`]: the run as a `static` array of points, one per CSV row.
 //! - The compiler's figures: [`STATE_BYTES`], [`PROPERTY_STATE_BYTES`],
 //!   [`FORMULAS`].
@@ -41,6 +43,10 @@ include!(concat!(env!("OUT_DIR"), "/museum_data.rs"));
 
 /// The postcard table of the compiled spec (`monitor_core::table::Table::from_bytes` reads it).
 pub static TABLE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/museum.postcard"));
+
+/// The postcard table of `final.hspec`: the same variables, properties whose
+/// verdicts all become final during the run (`monitor-final` stops there).
+pub static FINAL_TABLE: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/final.postcard"));
 
 /// One point of a replayed trace.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,7 +1,8 @@
 //! Prints the firmware size report: flash and RAM with and without the monitor, state bytes per property, stack high-water mark in QEMU, panic paths below the monitor step.
 //!
-//! Usage: `firmware-report` (images from `$FIRMWARE_DIR` or the firmware
-//! project's release output). Exits non-zero when an image is missing, fails
+//! Usage: `firmware-report` (images of `$FIRMWARE_TARGET`, default
+//! thumbv7em-none-eabihf, from `$FIRMWARE_DIR` or the firmware project's
+//! release output for that target). Exits non-zero when an image is missing, fails
 //! in QEMU, or a measurement cannot be made.
 
 use std::collections::BTreeMap;
@@ -27,6 +28,11 @@ fn main() -> ExitCode {
 }
 
 fn report() -> Result<(), String> {
+    let board = host_check::board()?;
+    println!(
+        "==== {} ({}, QEMU machine {})",
+        board.target, board.core, board.machine
+    );
     let mut sizes = BTreeMap::new();
     let mut stacks = BTreeMap::new();
     let mut tables = Vec::new();
@@ -124,7 +130,10 @@ fn report() -> Result<(), String> {
     );
 
     println!();
-    println!("== Stack high-water mark (bytes; QEMU mps2-an386, cortex-m-rt paint-stack)");
+    println!(
+        "== Stack high-water mark (bytes; QEMU {}, cortex-m-rt paint-stack)",
+        board.machine
+    );
     println!(
         "{:<16} {:>6} {:>7} {:>7}   (set-up: decode and validate the program; replay: from then on, live frames included)",
         "image", "peak", "set-up", "replay"
@@ -146,11 +155,23 @@ fn report() -> Result<(), String> {
             f.starts_with("__") || f.starts_with("compiler_builtins::") || f.as_str() == "fmod"
         });
         let own: Vec<&str> = own.iter().map(|s| s.as_str()).collect();
+        let (float_div, other): (Vec<&String>, Vec<&String>) = builtins
+            .iter()
+            .partition(|f| callgraph::is_soft_float_or_division(f));
         println!(
-            "{name}: the step reaches {} and {} compiler-builtins routines (soft f64, fmod, 64-bit division)",
+            "{name}: the step reaches {} and {} compiler-builtins routines",
             own.join(", "),
             builtins.len()
         );
+        let list = |v: &[&String]| {
+            if v.is_empty() {
+                "none".to_string()
+            } else {
+                v.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ")
+            }
+        };
+        println!("  soft-float or 64-bit division: {}", list(&float_div));
+        println!("  other builtins: {}", list(&other));
         if r.panic_calls.is_empty() {
             println!("  no panic entry point is reachable");
         }
