@@ -1,0 +1,427 @@
+// hindsight report: draws each failing run as a timeline (plain JavaScript and SVG, inline).
+// Lanes: the messages (sends above, receives below), one per property variable (numbers
+// as steps, booleans and text as bands), one per verdict (true green, false red, the first
+// false point marked and linked to its formula). Wheel or buttons zoom, dragging pans,
+// hover shows a point's state, a click pins it, arrow keys step point by point.
+// Many points per pixel are merged, so a long run draws as fast as its width allows.
+// The page counts its own script errors in <body data-errors> and how many timelines
+// it drew in <body data-rendered> (read by the browser test).
+"use strict";
+(function () {
+  var body = document.body;
+  var errors = 0;
+  function countError() {
+    errors += 1;
+    body.setAttribute("data-errors", String(errors));
+  }
+  window.addEventListener("error", countError);
+  window.addEventListener("unhandledrejection", countError);
+
+  var LABEL = 180, LANE = 22, AXIS = 24, PAD = 4, RIGHT = 12;
+  var GREEN = "#59a14f", RED = "#d62728", MIXED = "#e69f00";
+
+  function esc(s) {
+    return String(s).replace(/&/g, "&amp;").replace(/</g, "&lt;")
+      .replace(/>/g, "&gt;").replace(/"/g, "&quot;");
+  }
+  function num(v) {
+    var s = v.toFixed(6).replace(/0+$/, "").replace(/\.$/, "");
+    return s === "-0" ? "0" : s;
+  }
+  function anchor(name) {
+    return String(name).replace(/[^A-Za-z0-9_-]/g, "_");
+  }
+  // First index whose time is >= t.
+  function lower(times, t) {
+    var lo = 0, hi = times.length;
+    while (lo < hi) {
+      var mid = (lo + hi) >> 1;
+      if (times[mid] < t) lo = mid + 1; else hi = mid;
+    }
+    return lo;
+  }
+  // First index whose time is > t.
+  function upper(times, t) {
+    var lo = 0, hi = times.length;
+    while (lo < hi) {
+      var mid = (lo + hi) >> 1;
+      if (times[mid] <= t) lo = mid + 1; else hi = mid;
+    }
+    return lo;
+  }
+  function niceStep(span, ticks) {
+    var raw = Math.max(span / ticks, 1e-12);
+    var mag = Math.pow(10, Math.floor(Math.log10(raw)));
+    var m = raw / mag;
+    return (m <= 1 ? 1 : m <= 2 ? 2 : m <= 5 ? 5 : 10) * mag;
+  }
+
+  function lanesOf(run) {
+    var lanes = [{ kind: "messages", name: "messages" }];
+    run.vars.forEach(function (name, i) {
+      var col = run.values[i];
+      var kind = "bool", min = Infinity, max = -Infinity;
+      for (var k = 0; k < col.length; k++) {
+        var v = col[k];
+        if (typeof v === "number") {
+          if (kind === "bool") kind = "num";
+          if (v < min) min = v;
+          if (v > max) max = v;
+        } else if (typeof v !== "boolean") {
+          kind = "text";
+          break;
+        }
+      }
+      if (kind === "num" && col.some(function (v) { return typeof v !== "number"; })) kind = "text";
+      lanes.push({ kind: kind, name: name, get: function (k) { return col[k]; }, min: min, max: max });
+    });
+    run.verdict_names.forEach(function (name, j) {
+      var col = run.verdicts[j];
+      lanes.push({
+        kind: "verdict", name: name, first: col.indexOf("0"),
+        get: function (k) { return col.charCodeAt(k) === 49; }
+      });
+    });
+    return lanes;
+  }
+
+  function Timeline(el, run, tools, state) {
+    this.el = el;
+    this.run = run;
+    this.tools = tools;
+    this.state = state;
+    this.n = run.time.length;
+    this.t0 = this.n ? run.time[0] : 0;
+    this.tEnd = this.n ? run.time[this.n - 1] : 1;
+    if (this.tEnd <= this.t0) this.tEnd = this.t0 + 1;
+    this.view = [this.t0, this.tEnd];
+    this.sel = -1;
+    this.pinned = false;
+    this.lanes = lanesOf(run);
+    this.height = AXIS + this.lanes.length * LANE + PAD;
+    this.measure();
+    this.bind();
+    this.draw();
+  }
+
+  // The drawing width, read once per draw (reading layout per point would be slow).
+  Timeline.prototype.measure = function () {
+    this.w = Math.max(this.el.clientWidth || 0, 400);
+  };
+  Timeline.prototype.width = function () {
+    return this.w;
+  };
+  Timeline.prototype.x = function (t) {
+    var w = this.width() - LABEL - RIGHT;
+    return LABEL + (t - this.view[0]) / (this.view[1] - this.view[0]) * w;
+  };
+  Timeline.prototype.t = function (x) {
+    var w = this.width() - LABEL - RIGHT;
+    return this.view[0] + (x - LABEL) / w * (this.view[1] - this.view[0]);
+  };
+  Timeline.prototype.timeText = function (t) {
+    var s = this.run.step_seconds;
+    return s ? num(t * s) + " s" : String(t);
+  };
+
+  // Bands of equal value; sub-pixel stretches merge into one band of colour `mixed`.
+  Timeline.prototype.bands = function (lane, y, h, colour, mixed, lo, hi) {
+    var out = [], cur = null, time = this.run.time, self = this;
+    var L = LABEL, R = this.width() - RIGHT;
+    function flush() {
+      if (!cur) return;
+      var c = cur.mixed ? mixed : colour(cur.v);
+      if (c) {
+        var w = Math.max(cur.x1 - cur.x0, 1.5);
+        out.push('<rect x="' + cur.x0.toFixed(1) + '" y="' + y + '" width="' + w.toFixed(1) +
+          '" height="' + h + '" fill="' + c + '"/>');
+      }
+      if (lane.kind === "text" && !cur.mixed && cur.x1 - cur.x0 > 8 * String(cur.v).length) {
+        out.push('<text class="tick" x="' + (cur.x0 + 3).toFixed(1) + '" y="' + (y + h - 5) + '">' +
+          esc(cur.v) + "</text>");
+      }
+    }
+    for (var k = lo; k < hi; k++) {
+      var v = lane.get(k);
+      var xa = Math.max(self.x(time[k]), L);
+      var xb = Math.min(self.x(k + 1 < self.n ? time[k + 1] : self.tEnd), R);
+      if (xb < L || xa > R) continue;
+      if (cur && cur.v === v && !cur.mixed) {
+        cur.x1 = Math.max(cur.x1, xb);
+      } else if (cur && cur.x1 - cur.x0 < 1 && xb - cur.x0 < 2) {
+        cur.mixed = true;
+        cur.x1 = Math.max(cur.x1, xb);
+      } else {
+        flush();
+        cur = { v: v, x0: xa, x1: xb, mixed: false };
+      }
+    }
+    flush();
+    return out.join("");
+  };
+
+  // A number lane as a step line; points sharing a pixel draw their range as one stroke.
+  Timeline.prototype.steps = function (lane, y, h, lo, hi) {
+    var time = this.run.time, span = lane.max - lane.min, d = "", last = null;
+    var ymin = 0, ymax = 0, ylast = 0, R = this.width() - RIGHT;
+    function Y(v) {
+      return span > 0 ? y + h - 2 - (v - lane.min) / span * (h - 4) : y + h / 2;
+    }
+    for (var k = lo; k < hi; k++) {
+      var px = Math.round(Math.min(Math.max(this.x(time[k]), LABEL), R));
+      var yy = Y(lane.get(k));
+      if (px === last) {
+        ymin = Math.min(ymin, yy);
+        ymax = Math.max(ymax, yy);
+        ylast = yy;
+        continue;
+      }
+      if (last === null) d = "M" + px + " " + yy.toFixed(1);
+      else d += "V" + ymin.toFixed(1) + "V" + ymax.toFixed(1) + "V" + ylast.toFixed(1) + "H" + px;
+      last = px;
+      ymin = ymax = ylast = yy;
+    }
+    if (last === null) return "";
+    d += "V" + ymin.toFixed(1) + "V" + ymax.toFixed(1) + "V" + ylast.toFixed(1) + "H" +
+      Math.round(Math.min(this.x(this.tEnd), R));
+    return '<path d="' + d + '" fill="none" stroke="#0072b2" stroke-width="1.5"/>';
+  };
+
+  // Message ticks: sends in the upper half, receives in the lower; one per pixel and kind.
+  Timeline.prototype.ticks = function (y, h, lo, hi) {
+    var time = this.run.time, step = this.run.step, seen = {}, d = ["", ""];
+    var send = this.run.names.indexOf("send"), receive = this.run.names.indexOf("receive");
+    for (var k = lo; k < hi; k++) {
+      var s = step[k] === send ? 0 : step[k] === receive ? 1 : -1;
+      if (s < 0) continue;
+      var px = Math.round(this.x(time[k]));
+      if (px < LABEL || px > this.width() - RIGHT) continue;
+      var key = px * 2 + s;
+      if (seen[key]) continue;
+      seen[key] = true;
+      var y0 = y + 2 + s * (h / 2 - 1);
+      d[s] += "M" + px + " " + y0.toFixed(1) + "v" + (h / 2 - 3).toFixed(1);
+    }
+    return '<path d="' + d[0] + '" stroke="#0072b2"/><path d="' + d[1] + '" stroke="#d55e00"/>';
+  };
+
+  Timeline.prototype.axis = function () {
+    var s = this.run.step_seconds || 1, out = [];
+    var a = this.view[0] * s, b = this.view[1] * s;
+    var step = niceStep(b - a, Math.max(2, Math.floor((this.width() - LABEL) / 90)));
+    for (var v = Math.ceil(a / step) * step; v <= b + step * 1e-9; v += step) {
+      var x = this.x(v / s).toFixed(1);
+      out.push('<line x1="' + x + '" x2="' + x + '" y1="' + (AXIS - 4) + '" y2="' + this.height +
+        '" stroke="#eee"/><text class="tick" x="' + x + '" y="' + (AXIS - 8) +
+        '" text-anchor="middle">' + num(v) + "</text>");
+    }
+    out.push('<text class="tick" x="4" y="' + (AXIS - 8) + '">time (' +
+      (this.run.step_seconds ? "s" : "steps") + ")</text>");
+    return out.join("");
+  };
+
+  Timeline.prototype.draw = function () {
+    this.measure();
+    var W = this.width(), time = this.run.time, self = this;
+    var lo = Math.max(lower(time, this.view[0]) - 1, 0);
+    var hi = Math.min(upper(time, this.view[1]) + 1, this.n);
+    var parts = ['<svg width="' + W + '" height="' + this.height + '">', this.axis()];
+    this.lanes.forEach(function (lane, i) {
+      var y = AXIS + i * LANE, h = LANE - 6;
+      parts.push('<rect x="0" y="' + y + '" width="' + W + '" height="' + (LANE - 2) + '" fill="' +
+        (i % 2 ? "#fff" : "#f6f6f6") + '"/>');
+      var label = esc(lane.name);
+      if (lane.kind === "num") label += " (" + num(lane.min) + " to " + num(lane.max) + ")";
+      if (lane.kind === "verdict") {
+        label = '<a href="#prop-' + anchor(lane.name) + '">' + label + "</a>";
+      }
+      parts.push('<text class="lbl' + (lane.kind === "verdict" ? " verdict" : "") + '" x="4" y="' +
+        (y + h - 2) + '">' + label + "</text>");
+      var yb = y + 2;
+      if (lane.kind === "messages") parts.push(self.ticks(yb, h, lo, hi));
+      else if (lane.kind === "num") parts.push(self.steps(lane, yb, h, lo, hi));
+      else if (lane.kind === "bool") {
+        var blue = "#0072b2";
+        parts.push(self.bands(lane, yb + 3, h - 6, function (v) { return v ? blue : null; }, blue, lo, hi));
+      } else if (lane.kind === "text") {
+        var pal = ["#dbe9f6", "#fde7d0"], seen = {}, n = 0;
+        parts.push(self.bands(lane, yb, h, function (v) {
+          if (!(v in seen)) seen[v] = pal[n++ % 2];
+          return seen[v];
+        }, "#bbb", lo, hi));
+      } else {
+        parts.push(self.bands(lane, yb, h, function (v) { return v ? GREEN : RED; }, MIXED, lo, hi));
+        if (lane.first >= 0) {
+          var ft = time[lane.first], fx = self.x(ft);
+          if (fx >= LABEL - 1 && fx <= W - RIGHT + 1) {
+            parts.push('<a href="#prop-' + anchor(lane.name) + '"><g class="ff-mark" data-property="' +
+              esc(lane.name) + '" data-time="' + ft + '" data-point="' + lane.first + '"><line x1="' +
+              fx.toFixed(1) + '" x2="' + fx.toFixed(1) + '" y1="' + AXIS + '" y2="' + (y + LANE) +
+              '" stroke="' + RED + '" stroke-dasharray="3 2"/><path d="M' + fx.toFixed(1) + " " + y +
+              "l-5 -6h10z" + '" fill="' + RED + '"/><title>' + esc(lane.name) + " is false from t = " +
+              self.timeText(ft) + " (point " + lane.first + ")</title></g></a>");
+          }
+        }
+      }
+    });
+    if (this.sel >= 0) {
+      var sx = this.x(time[this.sel]);
+      if (sx >= LABEL && sx <= W - RIGHT) {
+        parts.push('<line class="cursor" x1="' + sx.toFixed(1) + '" x2="' + sx.toFixed(1) + '" y1="' +
+          AXIS + '" y2="' + this.height + '" stroke="#333" stroke-width="' + (this.pinned ? 2 : 1) + '"/>');
+      }
+    }
+    parts.push("</svg>");
+    this.el.innerHTML = parts.join("");
+    var view = this.tools && this.tools.querySelector(".view");
+    if (view) {
+      view.textContent = "showing " + this.timeText(this.view[0]) + " to " + this.timeText(this.view[1]) +
+        " (points " + lower(time, this.view[0]) + " to " + Math.max(upper(time, this.view[1]) - 1, 0) +
+        " of " + this.n + ")";
+    }
+  };
+
+  Timeline.prototype.showState = function () {
+    var r = this.run, k = this.sel, nm = r.names;
+    if (k < 0 || !this.state) return;
+    var rows = [["point", k + " of " + this.n + (this.pinned ? " (pinned)" : "")],
+      ["time", this.timeText(r.time[k])], ["step", nm[r.step[k]]]];
+    if (nm[r.event[k]]) {
+      rows.push(["message", nm[r.event[k]] + ": " + nm[r.origin[k]] + " \u2192 " + nm[r.target[k]]]);
+    }
+    if (r.params[k]) rows.push(["parameters", r.params[k]]);
+    var html = "<table><tbody>";
+    rows.forEach(function (row) {
+      html += "<tr><th>" + esc(row[0]) + "</th><td>" + esc(row[1]) + "</td></tr>";
+    });
+    r.vars.forEach(function (name, i) {
+      html += "<tr><th>" + esc(name) + "</th><td>" + esc(r.values[i][k]) + "</td></tr>";
+    });
+    r.verdict_names.forEach(function (name, j) {
+      var ok = r.verdicts[j].charCodeAt(k) === 49;
+      html += '<tr><th><a href="#prop-' + anchor(name) + '">' + esc(name) + '</a></th><td class="' +
+        (ok ? "t" : "f") + '">' + (ok ? "true" : "false") + "</td></tr>";
+    });
+    this.state.innerHTML = html + "</tbody></table>";
+  };
+
+  Timeline.prototype.select = function (k, pin) {
+    if (this.n === 0) return;
+    this.sel = Math.min(Math.max(k, 0), this.n - 1);
+    this.pinned = pin;
+    var t = this.run.time[this.sel], span = this.view[1] - this.view[0];
+    if (t < this.view[0] || t > this.view[1]) this.setView(t - span / 2, t + span / 2);
+    this.draw();
+    this.showState();
+  };
+  Timeline.prototype.at = function (x) {
+    return Math.max(upper(this.run.time, this.t(x)) - 1, 0);
+  };
+  Timeline.prototype.setView = function (a, b) {
+    var full = this.tEnd - this.t0, span = Math.min(Math.max(b - a, 1), full);
+    a = Math.min(Math.max(a, this.t0), this.tEnd - span);
+    this.view = [a, a + span];
+  };
+  Timeline.prototype.zoom = function (factor, around) {
+    var a = this.view[0], b = this.view[1];
+    if (around === undefined) around = (a + b) / 2;
+    this.setView(around - (around - a) * factor, around + (b - around) * factor);
+    this.draw();
+  };
+  // Zooms to a twentieth of the run (at least 20 steps) around point k and pins it.
+  Timeline.prototype.focusPoint = function (k) {
+    if (this.n === 0) return;
+    k = Math.min(Math.max(k, 0), this.n - 1);
+    var t = this.run.time[k], span = Math.max((this.tEnd - this.t0) / 20, 20);
+    this.setView(t - span / 2, t + span / 2);
+    this.select(k, true);
+  };
+  Timeline.prototype.toFirstFalse = function () {
+    var run = this.run, want = run.property, best = -1;
+    this.lanes.forEach(function (l) {
+      if (l.kind === "verdict" && l.first >= 0 && (best < 0 || l.name === want)) best = l.first;
+    });
+    if (best >= 0) this.focusPoint(best);
+  };
+
+  Timeline.prototype.bind = function () {
+    var self = this, el = this.el, drag = null;
+    function localX(e) { return e.clientX - el.getBoundingClientRect().left; }
+    el.addEventListener("wheel", function (e) {
+      e.preventDefault();
+      self.zoom(e.deltaY > 0 ? 1.25 : 0.8, self.t(localX(e)));
+    }, { passive: false });
+    el.addEventListener("mousedown", function (e) {
+      drag = { x: localX(e), view: self.view.slice(), moved: false };
+    });
+    window.addEventListener("mouseup", function (e) {
+      if (!drag) return;
+      var d = drag;
+      drag = null;
+      if (!d.moved && e.target && el.contains(e.target) && localX(e) >= LABEL) {
+        var k = self.at(localX(e));
+        self.select(k, !(self.pinned && k === self.sel));
+      }
+    });
+    el.addEventListener("mousemove", function (e) {
+      var x = localX(e);
+      if (drag) {
+        var dx = x - drag.x;
+        if (Math.abs(dx) > 3) drag.moved = true;
+        if (drag.moved) {
+          var per = (drag.view[1] - drag.view[0]) / (self.width() - LABEL - RIGHT);
+          self.setView(drag.view[0] - dx * per, drag.view[1] - dx * per);
+          self.draw();
+        }
+      } else if (!self.pinned && x >= LABEL) {
+        self.select(self.at(x), false);
+      }
+    });
+    el.addEventListener("keydown", function (e) {
+      if (e.key === "ArrowRight" || e.key === "ArrowLeft") {
+        e.preventDefault();
+        self.select(self.sel + (e.key === "ArrowRight" ? 1 : -1), true);
+      } else if (e.key === "+" || e.key === "=") self.zoom(0.8);
+      else if (e.key === "-") self.zoom(1.25);
+    });
+    if (this.tools) {
+      this.tools.addEventListener("click", function (e) {
+        var act = e.target && e.target.getAttribute("data-act");
+        if (act === "fit") { self.setView(self.t0, self.tEnd); self.draw(); }
+        else if (act === "in") self.zoom(0.5);
+        else if (act === "out") self.zoom(2);
+        else if (act === "false") self.toFirstFalse();
+      });
+    }
+    window.addEventListener("resize", function () { self.draw(); });
+  };
+
+  var start = performance.now();
+  var runs = JSON.parse(document.getElementById("hindsight-runs").textContent);
+  var drawn = 0;
+  runs.forEach(function (run, i) {
+    var el = document.getElementById("timeline-" + i);
+    if (!el) return;
+    var section = document.getElementById("run-" + i);
+    var tl = new Timeline(el, run, section && section.querySelector(".tools"),
+      document.getElementById("state-" + i));
+    el.hindsightTimeline = tl;
+    drawn += 1;
+  });
+  // `#run-I-point-K` (the first false points link there) selects point K of run I.
+  function fromHash() {
+    var m = /^#run-(\d+)-point-(\d+)$/.exec(window.location.hash);
+    var el = m && document.getElementById("timeline-" + m[1]);
+    if (el && el.hindsightTimeline) {
+      el.hindsightTimeline.focusPoint(Number(m[2]));
+      el.scrollIntoView();
+    }
+  }
+  window.addEventListener("hashchange", fromHash);
+  fromHash();
+  var now = performance.now();
+  body.setAttribute("data-rendered", String(drawn));
+  // Milliseconds drawing the timelines, and from navigation start to here (page parsed).
+  body.setAttribute("data-render-ms", (now - start).toFixed(1));
+  body.setAttribute("data-ready-ms", now.toFixed(1));
+})();
