@@ -56,6 +56,16 @@
     return (m <= 1 ? 1 : m <= 2 ? 2 : m <= 5 ? 5 : 10) * mag;
   }
 
+  // The points where get(k) differs from the point before (and point 0): a lane is drawn
+  // from these, so its cost is its number of changes, not the run's number of points.
+  function changes(n, get) {
+    var out = [];
+    for (var k = 0; k < n; k++) {
+      if (k === 0 || get(k) !== get(k - 1)) out.push(k);
+    }
+    return out;
+  }
+
   function lanesOf(run) {
     var lanes = [{ kind: "messages", name: "messages" }];
     run.vars.forEach(function (name, i) {
@@ -73,14 +83,13 @@
         }
       }
       if (kind === "num" && col.some(function (v) { return typeof v !== "number"; })) kind = "text";
-      lanes.push({ kind: kind, name: name, get: function (k) { return col[k]; }, min: min, max: max });
+      var get = function (k) { return col[k]; };
+      lanes.push({ kind: kind, name: name, get: get, min: min, max: max, ch: changes(col.length, get) });
     });
     run.verdict_names.forEach(function (name, j) {
       var col = run.verdicts[j];
-      lanes.push({
-        kind: "verdict", name: name, first: col.indexOf("0"),
-        get: function (k) { return col.charCodeAt(k) === 49; }
-      });
+      var get = function (k) { return col.charCodeAt(k) === 49; };
+      lanes.push({ kind: "verdict", name: name, first: col.indexOf("0"), get: get, ch: changes(col.length, get) });
     });
     return lanes;
   }
@@ -98,10 +107,20 @@
     this.sel = -1;
     this.pinned = false;
     this.lanes = lanesOf(run);
+    // Sends and receives before each point, so a pixel asks "any message here?" in O(log n).
+    var names = run.names, send = names.indexOf("send"), receive = names.indexOf("receive");
+    this.sends = new Int32Array(this.n + 1);
+    this.receives = new Int32Array(this.n + 1);
+    for (var k = 0; k < this.n; k++) {
+      this.sends[k + 1] = this.sends[k] + (run.step[k] === send ? 1 : 0);
+      this.receives[k + 1] = this.receives[k] + (run.step[k] === receive ? 1 : 0);
+    }
     this.height = AXIS + this.lanes.length * LANE + PAD;
     this.measure();
     this.bind();
+    var t = performance.now();
     this.draw();
+    this.drawMs = performance.now() - t;
   }
 
   // The drawing width, read once per draw (reading layout per point would be slow).
@@ -141,10 +160,12 @@
           esc(cur.v) + "</text>");
       }
     }
-    for (var k = lo; k < hi; k++) {
+    var ch = lane.ch;
+    for (var j = Math.max(upper(ch, lo) - 1, 0); j < ch.length && ch[j] < hi; j++) {
+      var k = ch[j], next = j + 1 < ch.length ? ch[j + 1] : self.n;
       var v = lane.get(k);
       var xa = Math.max(self.x(time[k]), L);
-      var xb = Math.min(self.x(k + 1 < self.n ? time[k + 1] : self.tEnd), R);
+      var xb = Math.min(self.x(next < self.n ? time[next] : self.tEnd), R);
       if (xb < L || xa > R) continue;
       if (cur && cur.v === v && !cur.mixed) {
         cur.x1 = Math.max(cur.x1, xb);
@@ -167,7 +188,9 @@
     function Y(v) {
       return span > 0 ? y + h - 2 - (v - lane.min) / span * (h - 4) : y + h / 2;
     }
-    for (var k = lo; k < hi; k++) {
+    var ch = lane.ch;
+    for (var j = Math.max(upper(ch, lo) - 1, 0); j < ch.length && ch[j] < hi; j++) {
+      var k = ch[j];
       var px = Math.round(Math.min(Math.max(this.x(time[k]), LABEL), R));
       var yy = Y(lane.get(k));
       if (px === last) {
@@ -191,6 +214,20 @@
   Timeline.prototype.ticks = function (y, h, lo, hi) {
     var time = this.run.time, step = this.run.step, seen = {}, d = ["", ""];
     var send = this.run.names.indexOf("send"), receive = this.run.names.indexOf("receive");
+    var R = this.width() - RIGHT;
+    if (hi - lo > 2 * (R - LABEL)) {
+      // More points than pixels: ask each pixel whether it holds a send or a receive.
+      var counts = [this.sends, this.receives];
+      for (var p = LABEL; p <= R; p++) {
+        var a = lower(time, this.t(p - 0.5)), b = lower(time, this.t(p + 0.5));
+        for (var c = 0; c < 2; c++) {
+          if (counts[c][b] > counts[c][a]) {
+            d[c] += "M" + p + " " + (y + 2 + c * (h / 2 - 1)).toFixed(1) + "v" + (h / 2 - 3).toFixed(1);
+          }
+        }
+      }
+      return '<path d="' + d[0] + '" stroke="#0072b2"/><path d="' + d[1] + '" stroke="#d55e00"/>';
+    }
     for (var k = lo; k < hi; k++) {
       var s = step[k] === send ? 0 : step[k] === receive ? 1 : -1;
       if (s < 0) continue;
@@ -398,7 +435,7 @@
 
   var start = performance.now();
   var runs = JSON.parse(document.getElementById("hindsight-runs").textContent);
-  var drawn = 0;
+  var drawn = 0, drawMs = 0;
   runs.forEach(function (run, i) {
     var el = document.getElementById("timeline-" + i);
     if (!el) return;
@@ -407,6 +444,7 @@
       document.getElementById("state-" + i));
     el.hindsightTimeline = tl;
     drawn += 1;
+    drawMs = Math.max(drawMs, tl.drawMs);
   });
   // `#run-I-point-K` (the first false points link there) selects point K of run I.
   function fromHash() {
@@ -421,7 +459,9 @@
   fromHash();
   var now = performance.now();
   body.setAttribute("data-rendered", String(drawn));
-  // Milliseconds drawing the timelines, and from navigation start to here (page parsed).
+  // Milliseconds reading and drawing the timelines, the longest single draw (what a zoom
+  // or pan at that view costs), and from navigation start to here (page parsed).
   body.setAttribute("data-render-ms", (now - start).toFixed(1));
+  body.setAttribute("data-draw-ms", drawMs.toFixed(1));
   body.setAttribute("data-ready-ms", now.toFixed(1));
 })();
