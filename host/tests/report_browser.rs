@@ -221,6 +221,60 @@ fn the_museum_report_renders_in_chromium_without_errors_or_fetches() {
         "{state}"
     );
     assert!(dom.contains("class=\"cursor\""), "cursor drawn");
+    // The behavior tree at that point: every node the run's messages name, each with the
+    // status its last tick, answer or halt before the point gives.
+    let want = bt_statuses(&csv, due_point);
+    assert!(want.len() > 10, "{want:?}");
+    let distinct: std::collections::BTreeSet<&String> = want.values().collect();
+    assert!(distinct.len() >= 2, "{want:?}");
+    let tree = &dom[dom.find("<div class=\"bt\">").expect("tree drawn")..];
+    let tree = &tree[..tree.find("</svg>").unwrap()];
+    assert_eq!(tree.matches("class=\"bt-node\"").count(), want.len());
+    for (id, status) in &want {
+        let marker = format!("class=\"bt-node\" data-node=\"{id}\"");
+        assert_eq!(
+            attr_in_tag(tree, &marker, "data-status").as_deref(),
+            Some(status.as_str()),
+            "node {id}"
+        );
+    }
+}
+
+/// Each behavior-tree node's status at `point`, read from the run's CSV: the last
+/// `bt_<id>_tick` (ticked), `bt_<id>_response` (its status: 1 success, 2 failure,
+/// 3 running) or `bt_<id>_halt` (idle) sent up to that point.
+fn bt_statuses(csv: &str, point: usize) -> std::collections::BTreeMap<String, String> {
+    let mut out = std::collections::BTreeMap::new();
+    for (k, line) in csv.lines().skip(1).enumerate() {
+        let cells: Vec<&str> = line.split(',').collect();
+        if cells[1] != "send" {
+            continue;
+        }
+        let Some(rest) = cells[2].strip_prefix("bt_") else {
+            continue;
+        };
+        let Some((id, kind)) = rest.split_once('_') else {
+            continue;
+        };
+        let status = match kind {
+            "tick" => "ticked".to_string(),
+            "halt" => "idle".to_string(),
+            "response" => match cells[5].trim_start_matches("status=") {
+                "1" => "success".into(),
+                "2" => "failure".into(),
+                "3" => "running".into(),
+                other => panic!("status {other}"),
+            },
+            _ => continue,
+        };
+        let entry = out
+            .entry(id.to_string())
+            .or_insert_with(|| "idle".to_string());
+        if k <= point {
+            *entry = status;
+        }
+    }
+    out
 }
 
 #[test]

@@ -109,7 +109,8 @@ pub fn page(data: &ReportData) -> String {
              variable and verdict. Wheel or the buttons zoom the time axis, dragging pans, \
              hovering shows a point's state, a click pins it, the arrow keys step from point \
              to point (several points may share a time). A red mark is where a property \
-             first turned false; its name links to the formula.</p>"
+             first turned false; its name links to the formula. For a robot model, the \
+             behavior tree below shows each node's status at the selected point.</p>"
         );
     }
     for (i, r) in data.runs.iter().enumerate() {

@@ -121,6 +121,13 @@
     var t = performance.now();
     this.draw();
     this.drawMs = performance.now() - t;
+    this.tree = new Tree(run);
+    if (this.tree.count > 0 && state) {
+      this.treeEl = document.createElement("div");
+      this.treeEl.className = "bt";
+      state.parentNode.insertBefore(this.treeEl, state.nextSibling);
+      this.drawTree();
+    }
   }
 
   // The drawing width, read once per draw (reading layout per point would be slow).
@@ -342,6 +349,118 @@
     this.state.innerHTML = html + "</tbody></table>";
   };
 
+  // The behavior tree of a robot model, read from the run's own messages: the lowering
+  // names each node's machine BT_plugin_<id>_<type>, a parent sends bt_<id>_tick and
+  // bt_<id>_halt, the node answers bt_<id>_response with status 1 SUCCESS, 2 FAILURE,
+  // 3 RUNNING (host/src/robot/bt/control.rs). A node's status at a point is its last
+  // such message: ticked (waiting for its answer), its answer, or idle after a halt.
+  var BT_STATUS = { 1: "success", 2: "failure", 3: "running" };
+  var BT_FILL = { idle: "#eeeeee", ticked: "#fff3b0", success: "#8fd694", failure: "#f08a8a", running: "#f6c26b" };
+  var BT_MARK = { Sequence: "\u2192", ReactiveSequence: "R\u2192", SequenceWithMemory: "M\u2192",
+    Fallback: "?", ReactiveFallback: "R?", Parallel: "\u21c9", Inverter: "!" };
+
+  function Tree(run) {
+    var ev = [], self = this;
+    run.names.forEach(function (name, i) {
+      var m = /^bt_(\d+)_(tick|response|halt)$/.exec(name);
+      if (m) ev[i] = { id: m[1], kind: m[2] };
+    });
+    var send = run.names.indexOf("send"), nodes = {}, order = [];
+    function node(id) {
+      if (!nodes[id]) {
+        nodes[id] = { id: id, type: "?", children: [], parent: null, at: [], status: [] };
+        order.push(id);
+      }
+      return nodes[id];
+    }
+    for (var k = 0; k < run.time.length; k++) {
+      var e = ev[run.event[k]];
+      if (!e || run.step[k] !== send) continue;
+      var n = node(e.id);
+      if (e.kind === "response") {
+        var st = /(?:^|;)status=(\d+)/.exec(run.params[k]);
+        n.at.push(k);
+        n.status.push(st && BT_STATUS[st[1]] || "ticked");
+        continue;
+      }
+      var tm = /^BT_plugin_\d+_(.+)$/.exec(run.names[run.target[k]]);
+      if (tm) n.type = tm[1];
+      var pm = /^BT_plugin_(\d+)_/.exec(run.names[run.origin[k]]);
+      if (pm && n.parent === null) {
+        n.parent = pm[1];
+        node(pm[1]).children.push(e.id);
+      }
+      n.at.push(k);
+      n.status.push(e.kind === "tick" ? "ticked" : "idle");
+    }
+    this.nodes = nodes;
+    this.roots = order.filter(function (id) { return nodes[id].parent === null; }).sort();
+    order.forEach(function (id) {
+      nodes[id].children.sort(function (a, b) { return Number(a) - Number(b); });
+    });
+    this.count = order.length;
+    // Layout: leaves in order left to right, a parent centred over its children.
+    var slot = 0, depth = 0;
+    function place(id, d) {
+      var n = nodes[id];
+      n.depth = d;
+      depth = Math.max(depth, d);
+      if (n.children.length === 0) {
+        n.x = slot++;
+      } else {
+        n.children.forEach(function (c) { place(c, d + 1); });
+        n.x = (nodes[n.children[0]].x + nodes[n.children[n.children.length - 1]].x) / 2;
+      }
+    }
+    this.roots.forEach(function (r) { place(r, 0); });
+    this.slots = slot;
+    this.depth = depth;
+    this.statusAt = function (id, k) {
+      var n = self.nodes[id], i = upper(n.at, k) - 1;
+      return i < 0 ? "idle" : n.status[i];
+    };
+  }
+
+  Tree.prototype.svg = function (k) {
+    var BW = 124, BH = 34, GX = 10, GY = 30, nodes = this.nodes, self = this;
+    var W = this.slots * (BW + GX) + GX, H = (this.depth + 1) * (BH + GY) + GY;
+    var out = ['<svg width="' + W + '" height="' + H + '">'];
+    function cx(n) { return GX + n.x * (BW + GX) + BW / 2; }
+    function cy(n) { return GY + n.depth * (BH + GY); }
+    Object.keys(nodes).forEach(function (id) {
+      var n = nodes[id];
+      n.children.forEach(function (c) {
+        var m = nodes[c];
+        out.push('<path d="M' + cx(n) + " " + (cy(n) + BH) + "V" + (cy(n) + BH + GY / 2) + "H" + cx(m) +
+          "V" + cy(m) + '" fill="none" stroke="#888"/>');
+      });
+    });
+    Object.keys(nodes).forEach(function (id) {
+      var n = nodes[id], st = self.statusAt(id, k), mark = BT_MARK[n.type];
+      var label = mark ? mark + " " + n.type : n.type;
+      if (label.length > 21) label = label.slice(0, 20) + "\u2026";
+      var control = n.children.length > 0;
+      out.push('<g class="bt-node" data-node="' + esc(id) + '" data-status="' + st + '"><rect x="' +
+        (cx(n) - BW / 2) + '" y="' + cy(n) + '" width="' + BW + '" height="' + BH + '" rx="' +
+        (control ? 2 : 10) + '" fill="' + BT_FILL[st] + '" stroke="#555"/><text class="lbl" x="' + cx(n) +
+        '" y="' + (cy(n) + 14) + '" text-anchor="middle">' + esc(label) +
+        '</text><text class="tick" x="' + cx(n) + '" y="' + (cy(n) + 27) + '" text-anchor="middle">' +
+        st + " (" + esc(id) + ")</text><title>" + esc(n.type + " " + id + ": " + st) + "</title></g>");
+    });
+    out.push("</svg>");
+    return out.join("");
+  };
+
+  Timeline.prototype.drawTree = function () {
+    if (!this.tree || this.tree.count === 0 || !this.treeEl) return;
+    var k = Math.max(this.sel, 0);
+    this.treeEl.innerHTML = "<p><b>Behavior tree</b> at point " + k + " (t = " +
+      this.timeText(this.run.time[k] || 0) + "): " +
+      Object.keys(BT_FILL).map(function (s) {
+        return '<span class="bt-key" style="background:' + BT_FILL[s] + '">' + s + "</span>";
+      }).join(" ") + "</p>" + this.tree.svg(k);
+  };
+
   Timeline.prototype.select = function (k, pin) {
     if (this.n === 0) return;
     this.sel = Math.min(Math.max(k, 0), this.n - 1);
@@ -350,6 +469,7 @@
     if (t < this.view[0] || t > this.view[1]) this.setView(t - span / 2, t + span / 2);
     this.draw();
     this.showState();
+    this.drawTree();
   };
   Timeline.prototype.at = function (x) {
     return Math.max(upper(this.run.time, this.t(x)) - 1, 0);
