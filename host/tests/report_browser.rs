@@ -61,7 +61,7 @@ fn chromium(browser: &Path, url: &str, extra: &[String], profile: &Path) -> (Str
             "--disable-component-update",
             "--disable-sync",
             "--hide-scrollbars",
-            "--window-size=1400,2200",
+            "--window-size=1400,3400",
             "--host-resolver-rules=MAP * ~NOTFOUND",
             "--enable-logging=stderr",
             "--v=0",
@@ -221,6 +221,25 @@ fn the_museum_report_renders_in_chromium_without_errors_or_fetches() {
         "{state}"
     );
     assert!(dom.contains("class=\"cursor\""), "cursor drawn");
+    // The messages around it as a sequence chart, the last send at or before it marked.
+    let last_send = csv
+        .lines()
+        .skip(1)
+        .take(due_point + 1)
+        .enumerate()
+        .filter(|(_, l)| l.split(',').nth(1) == Some("send"))
+        .map(|(k, _)| k)
+        .last()
+        .unwrap();
+    let seq = &dom[dom
+        .find("<div class=\"seq\">")
+        .expect("sequence chart drawn")..];
+    let seq = &seq[..seq.find("</svg>").unwrap()];
+    assert_eq!(seq.matches("<g class=\"seq-msg").count(), 40);
+    assert_eq!(
+        attr_in_tag(seq, "class=\"seq-msg selected\"", "data-point"),
+        Some(last_send.to_string())
+    );
     // The behavior tree at that point: every node the run's messages name, each with the
     // status its last tick, answer or halt before the point gives.
     let want = bt_statuses(&csv, due_point);

@@ -97,6 +97,36 @@ fn a_museum_study_page_shows_every_property_and_where_the_failing_run_turned_fal
 }
 
 #[test]
+fn a_passing_study_page_has_every_property_and_no_failing_run() {
+    let dir = scratch("passing");
+    let out = dir.join("report.html");
+    let (code, _, err) = hindsight(&[
+        "verify",
+        "examples/museum-guide",
+        "--max-runs",
+        "2",
+        "--report",
+        &out.display().to_string(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let html = std::fs::read_to_string(&out).unwrap();
+    for name in [
+        "absence",
+        "alarm_response",
+        "battery_recurrence",
+        "poi_response",
+        "visitors_recurrence",
+    ] {
+        let row = property_row(&html, name);
+        assert!(row.contains("<td class=\"prob\">1.0000</td>"), "{row}");
+        assert!(row.contains("as compiled"), "{row}");
+    }
+    assert!(!html.contains("Failing runs"));
+    assert!(html.contains("id=\"hindsight-runs\">[]</script>"));
+    assert_eq!(external_refs(&html), Vec::<String>::new());
+}
+
+#[test]
 fn a_sweep_page_draws_the_curves_and_names_the_thresholds() {
     let dir = scratch("sweep");
     let out = dir.join("sweep.html");

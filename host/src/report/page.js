@@ -121,11 +121,23 @@
     var t = performance.now();
     this.draw();
     this.drawMs = performance.now() - t;
+    this.sendIdx = [];
+    var sendName = run.names.indexOf("send");
+    for (var p = 0; p < this.n; p++) {
+      if (run.step[p] === sendName) this.sendIdx.push(p);
+    }
+    if (state && this.sendIdx.length > 0) {
+      this.seqEl = document.createElement("div");
+      this.seqEl.className = "seq";
+      state.parentNode.insertBefore(this.seqEl, state.nextSibling);
+      this.drawSequence();
+    }
     this.tree = new Tree(run);
     if (this.tree.count > 0 && state) {
       this.treeEl = document.createElement("div");
       this.treeEl.className = "bt";
-      state.parentNode.insertBefore(this.treeEl, state.nextSibling);
+      var after = this.seqEl || state;
+      after.parentNode.insertBefore(this.treeEl, after.nextSibling);
       this.drawTree();
     }
   }
@@ -451,6 +463,54 @@
     return out.join("");
   };
 
+  // The messages around the selected point as a sequence chart: one lifeline per machine
+  // that sends or receives in the window, one arrow per send (SEQ_AROUND before and
+  // after the selection), the send at or before the selection highlighted.
+  var SEQ_AROUND = 20;
+  Timeline.prototype.drawSequence = function () {
+    if (!this.seqEl) return;
+    var r = this.run, nm = r.names, send = nm.indexOf("send"), k = Math.max(this.sel, 0);
+    var at = upper(this.sendIdx, k) - 1;
+    var from = Math.max(at - SEQ_AROUND + 1, 0), to = Math.min(at + SEQ_AROUND + 1, this.sendIdx.length);
+    var rows = this.sendIdx.slice(from, to), lanes = [], col = {};
+    rows.forEach(function (p) {
+      [r.origin[p], r.target[p]].forEach(function (m) {
+        if (!(m in col)) { col[m] = lanes.length; lanes.push(m); }
+      });
+    });
+    if (send < 0 || rows.length === 0) { this.seqEl.innerHTML = ""; return; }
+    var CW = 150, RH = 20, TOP = 34, W = lanes.length * CW + 20, H = TOP + rows.length * RH + 10;
+    function lx(m) { return 10 + col[m] * CW + CW / 2; }
+    var out = ['<svg width="' + W + '" height="' + H + '">'];
+    lanes.forEach(function (m) {
+      var name = nm[m], short = name.length > 22 ? name.slice(0, 21) + "\u2026" : name;
+      out.push('<text class="lbl" x="' + lx(m) + '" y="14" text-anchor="middle">' + esc(short) +
+        "<title>" + esc(name) + '</title></text><line x1="' + lx(m) + '" x2="' + lx(m) + '" y1="' + 20 +
+        '" y2="' + H + '" stroke="#bbb" stroke-dasharray="4 3"/>');
+    });
+    var self = this;
+    rows.forEach(function (p, i) {
+      var y = TOP + i * RH + RH / 2, x1 = lx(r.origin[p]), x2 = lx(r.target[p]);
+      var mine = from + i === at, dir = x2 >= x1 ? 1 : -1;
+      if (mine) {
+        out.push('<rect x="0" y="' + (y - RH / 2) + '" width="' + W + '" height="' + RH + '" fill="#fff3b0"/>');
+      }
+      var line = x1 === x2
+        ? '<path d="M' + x1 + " " + (y - 4) + "h18v8h-14" + '" fill="none" stroke="#333"/>'
+        : '<line x1="' + x1 + '" x2="' + (x2 - dir * 6) + '" y1="' + y + '" y2="' + y + '" stroke="#333"/>' +
+          '<path d="M' + x2 + " " + y + "l" + (-dir * 7) + " -4v8z" + '" fill="#333"/>';
+      var label = nm[r.event[p]] + (r.params[p] ? " (" + r.params[p] + ")" : "");
+      if (label.length > 60) label = label.slice(0, 59) + "\u2026";
+      out.push('<g class="seq-msg' + (mine ? " selected" : "") + '" data-point="' + p + '">' + line +
+        '<text class="tick" x="' + (Math.min(x1, x2) + 4) + '" y="' + (y - 3) + '">' + esc(label) +
+        "</text><title>point " + p + ", t = " + esc(self.timeText(r.time[p])) + ": " + esc(nm[r.event[p]]) +
+        " " + esc(nm[r.origin[p]]) + " \u2192 " + esc(nm[r.target[p]]) + "</title></g>");
+    });
+    out.push("</svg>");
+    this.seqEl.innerHTML = "<p><b>Messages</b> around point " + k + " (" + rows.length +
+      " sends; the highlighted one is the last at or before the point)</p>" + out.join("");
+  };
+
   Timeline.prototype.drawTree = function () {
     if (!this.tree || this.tree.count === 0 || !this.treeEl) return;
     var k = Math.max(this.sel, 0);
@@ -469,6 +529,7 @@
     if (t < this.view[0] || t > this.view[1]) this.setView(t - span / 2, t + span / 2);
     this.draw();
     this.showState();
+    this.drawSequence();
     this.drawTree();
   };
   Timeline.prototype.at = function (x) {
