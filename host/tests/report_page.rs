@@ -211,3 +211,32 @@ fn bad_report_inputs_name_the_file_and_line() {
     assert!(err.contains("nothing to show"), "{err}");
     assert!(!std::path::Path::new(&out).exists());
 }
+
+#[test]
+fn an_online_sweep_names_its_recorded_runs() {
+    // What `sweep --online a.jsonl --online b.jsonl --json` prints, in model units.
+    let dir = scratch("online");
+    let json = dir.join("online.json");
+    std::fs::write(
+        &json,
+        r#"{"runs": 2, "logs": ["a.jsonl", "b.jsonl"], "confidence": 0.95, "properties": [
+            {"property": "p", "threshold": "3", "points": [
+                {"bound": "2", "successes": 0, "failures": 2, "unknown": 0, "probability": 0.0, "lower": 0.0, "upper": 0.84},
+                {"bound": "3", "successes": 2, "failures": 0, "unknown": 0, "probability": 1.0, "lower": 0.16, "upper": 1.0}]}]}"#,
+    )
+    .unwrap();
+    let out = dir.join("r.html");
+    let (code, _, err) = hindsight(&[
+        "report",
+        "--sweep",
+        &json.display().to_string(),
+        "-o",
+        &out.display().to_string(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let html = std::fs::read_to_string(&out).unwrap();
+    assert!(html.contains("(2 recorded runs)"), "title");
+    assert!(html.contains("bound (model time units)"));
+    assert!(html.contains("<td class=\"threshold\">3</td>"));
+    assert_eq!(html.matches("<circle").count(), 2);
+}

@@ -458,33 +458,31 @@ fn finish(
         Some(BoundValue::Nanos(_)) => "bound (s)",
         _ => "bound (model time units)",
     };
-    {
-        let doc = if args.online.is_empty() {
-            serde_json::json!({
-                "runs": args.runs,
-                "seed": args.seed,
-                "confidence": args.confidence,
-                "properties": curves,
-            })
-        } else {
-            let logs: Vec<String> = args
-                .online
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect();
-            serde_json::json!({
-                "runs": logs.len(),
-                "logs": logs,
-                "confidence": args.confidence,
-                "properties": curves,
-            })
-        };
-        if let Some(path) = &args.report {
-            super::report::from_sweep(path, &args.input.model, &doc)?;
-        }
-        if args.json {
-            println!("{doc}");
-        }
+    let doc = if args.online.is_empty() {
+        serde_json::json!({
+            "runs": args.runs,
+            "seed": args.seed,
+            "confidence": args.confidence,
+            "properties": curves,
+        })
+    } else {
+        let logs: Vec<String> = args
+            .online
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        serde_json::json!({
+            "runs": logs.len(),
+            "logs": logs,
+            "confidence": args.confidence,
+            "properties": curves,
+        })
+    };
+    if let Some(path) = &args.report {
+        super::report::from_sweep(path, &args.input.model, &doc)?;
+    }
+    if args.json {
+        println!("{doc}");
     }
     if !args.json {
         for c in &curves {

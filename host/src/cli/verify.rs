@@ -520,9 +520,10 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         );
     }
     let result = study(model, set, &run_cfg, &study_cfg, &rule, !args.json)?;
-    let failing = match args.save_failing > 0 || args.report.is_some() {
-        true => save_failing(args, model, set, &run_cfg, &result)?,
-        false => Vec::new(),
+    let failing = if args.save_failing > 0 || args.report.is_some() {
+        save_failing(args, model, set, &run_cfg, &result)?
+    } else {
+        Vec::new()
     };
     let mut report = report(args, props_path, set, &result);
     if let Some(unit) = loaded.unit_ns {

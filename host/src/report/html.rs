@@ -276,9 +276,9 @@ fn sweep(o: &mut String, i: usize, s: &Sweep) {
             }
         })
         .collect();
-    let what = match (s.runs, s.logs.len()) {
-        (Some(r), _) => format!("{r} runs each"),
-        (None, n) => format!("{n} recorded run{}", if n == 1 { "" } else { "s" }),
+    let what = match (s.logs.len(), s.runs) {
+        (0, Some(r)) => format!("{r} runs each"),
+        (n, _) => format!("{n} recorded run{}", if n == 1 { "" } else { "s" }),
     };
     let x_label = if seconds {
         "bound (s)"
