@@ -5,6 +5,7 @@ pub mod expr;
 pub mod live;
 pub mod model;
 pub mod props;
+pub mod report;
 pub mod robot;
 pub mod sim;
 pub mod smc;

@@ -53,6 +53,10 @@ enum Command {
     ///
     /// Example: `hindsight sweep examples/museum-guide --from 0.1s --to 7s --svg sweep.svg`
     Sweep(cli::sweep::SweepArgs),
+    /// Write one self-contained HTML page from a study's JSON, sweeps' JSON and failing runs.
+    ///
+    /// Example: `hindsight report --study study.json failing-runs/ -o report.html`
+    Report(cli::report::ReportArgs),
     /// Combine the partial results of `verify --shard I/N --runs R` into one report.
     ///
     /// Example: `hindsight merge part-0.json part-1.json`
@@ -95,6 +99,7 @@ fn main() -> ExitCode {
         Command::Verify(a) => cli::verify::run(a),
         Command::Validate(a) => cli::verify::validate(a),
         Command::Sweep(a) => cli::sweep::run(a),
+        Command::Report(a) => cli::report::run(a),
         Command::Merge(a) => cli::verify::merge(a),
         Command::Trace(a) => cli::verify::trace(a),
         Command::Convert(a) => cli::convert::run(a),

@@ -3,8 +3,8 @@
 pub mod compile;
 pub mod convert;
 pub mod monitor;
-pub mod plot;
 pub mod replay;
+pub mod report;
 pub mod run;
 pub mod sweep;
 pub mod verify;

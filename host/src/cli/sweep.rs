@@ -4,9 +4,10 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use super::verify::{load, study};
-use super::{plot, CliError};
+use super::CliError;
 use crate::live::{self, engine::Verdict};
 use crate::props::{self, SourceText};
+use crate::report::plot;
 use crate::sim::RunConfig;
 use crate::smc::runner::{widened_interval, PropertyCounts};
 use crate::smc::stats::{RuleConfig, RuleKind};
@@ -79,6 +80,10 @@ pub struct SweepArgs {
     /// Print one JSON object instead of CSV and the threshold summary.
     #[arg(long)]
     pub json: bool,
+    /// Also write one self-contained HTML page with the curves, their intervals and
+    /// thresholds, and every bound's counts (see `hindsight report --help`).
+    #[arg(long, value_name = "FILE")]
+    pub report: Option<PathBuf>,
     /// On-line: judge input logs recorded by `hindsight monitor --record` instead of
     /// simulating; each log is one run (repeat for several). Their variables are the
     /// property file's port ids and their times ticks of the model's time unit, as
@@ -453,29 +458,33 @@ fn finish(
         Some(BoundValue::Nanos(_)) => "bound (s)",
         _ => "bound (model time units)",
     };
-    if args.json {
-        let doc = if args.online.is_empty() {
-            serde_json::json!({
-                "runs": args.runs,
-                "seed": args.seed,
-                "confidence": args.confidence,
-                "properties": curves,
-            })
-        } else {
-            let logs: Vec<String> = args
-                .online
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect();
-            serde_json::json!({
-                "runs": logs.len(),
-                "logs": logs,
-                "confidence": args.confidence,
-                "properties": curves,
-            })
-        };
-        println!("{doc}");
+    let doc = if args.online.is_empty() {
+        serde_json::json!({
+            "runs": args.runs,
+            "seed": args.seed,
+            "confidence": args.confidence,
+            "properties": curves,
+        })
     } else {
+        let logs: Vec<String> = args
+            .online
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        serde_json::json!({
+            "runs": logs.len(),
+            "logs": logs,
+            "confidence": args.confidence,
+            "properties": curves,
+        })
+    };
+    if let Some(path) = &args.report {
+        super::report::from_sweep(path, &args.input.model, &doc)?;
+    }
+    if args.json {
+        println!("{doc}");
+    }
+    if !args.json {
         for c in &curves {
             match &c.threshold {
                 Some(t) => eprintln!("{}: every run succeeds from bound {t} on", c.property),

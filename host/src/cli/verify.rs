@@ -104,6 +104,11 @@ pub struct VerifyArgs {
     /// File for the partial result of --shard.
     #[arg(long, value_name = "FILE")]
     pub partial: Option<PathBuf>,
+    /// Also write one self-contained HTML page (see `hindsight report --help`): settings,
+    /// formulas, probabilities and the failing runs as timelines (those of --save-failing,
+    /// else one per property).
+    #[arg(long, value_name = "FILE", conflicts_with = "shard")]
+    pub report: Option<PathBuf>,
 }
 
 /// One property's line of the report.
@@ -469,25 +474,38 @@ fn replay_csv(
     Ok(rec.csv)
 }
 
-/// Replays each kept failing run (run k is stream k of the seed) and writes its CSV.
+/// Replays each kept failing run (run k is stream k of the seed) and, with
+/// --save-failing, writes its CSV.
 fn save_failing(
     args: &VerifyArgs,
     model: &CompiledModel,
     set: &PropertySet,
     run_cfg: &RunConfig,
     result: &StudyResult,
-) -> Result<(), CliError> {
+) -> Result<Vec<super::report::Failing>, CliError> {
     let io = |e: std::io::Error| CliError::Failed(format!("{}: {e}", args.out.display()));
-    std::fs::create_dir_all(&args.out).map_err(io)?;
+    if args.save_failing > 0 {
+        std::fs::create_dir_all(&args.out).map_err(io)?;
+    }
+    let mut kept = Vec::new();
     for (name, p) in set.guarantee_names().iter().zip(&result.properties) {
         for &k in &p.failing_runs {
             let csv = replay_csv(model, set, run_cfg, args.seed, k)?;
             let path = args.out.join(format!("{name}-run{k}.csv"));
-            std::fs::write(&path, csv).map_err(io)?;
-            eprintln!("wrote {}", path.display());
+            if args.save_failing > 0 {
+                std::fs::write(&path, &csv).map_err(io)?;
+                eprintln!("wrote {}", path.display());
+            }
+            let file = path.display().to_string();
+            kept.push(super::report::Failing {
+                property: name.clone(),
+                run: k,
+                file,
+                csv,
+            });
         }
     }
-    Ok(())
+    Ok(kept)
 }
 
 /// Runs `hindsight verify`.
@@ -517,7 +535,10 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         seed: args.seed,
         threads: args.threads,
         max_runs: args.max_runs,
-        keep_failing: args.save_failing,
+        keep_failing: match args.report {
+            Some(_) => args.save_failing.max(1),
+            None => args.save_failing,
+        },
         progress_every: Duration::from_millis(200),
     };
     if let Some(runs) = args.runs {
@@ -546,13 +567,25 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         return print_report(&report, args.json);
     }
     let result = study(model, set, &run_cfg, &study_cfg, &rule, !args.json)?;
-    if args.save_failing > 0 {
-        save_failing(args, model, set, &run_cfg, &result)?;
-    }
+    let failing = if args.save_failing > 0 || args.report.is_some() {
+        save_failing(args, model, set, &run_cfg, &result)?
+    } else {
+        Vec::new()
+    };
     let mut report = report(args, props_path, set, &result);
     if let Some(unit) = loaded.unit_ns {
         report.step_seconds = Some(unit as f64 / 1e9);
         report.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
+    }
+    if let Some(path) = &args.report {
+        let settings = [
+            ("rule", format!("{:?}", rule.kind).to_lowercase()),
+            ("run length in steps", run_cfg.max_time.to_string()),
+            ("step limit", args.max_steps.to_string()),
+            ("events", format!("{:?}", run_cfg.events).to_lowercase()),
+        ];
+        let settings = settings.map(|(k, v)| (k.to_string(), v)).to_vec();
+        super::report::from_verify(path, &report, &loaded, settings, &failing)?;
     }
     print_report(&report, args.json)
 }

@@ -1,4 +1,4 @@
-//! An SVG chart of success rate against a time bound, one curve per property: the picture `hindsight sweep --svg` writes.
+//! An SVG chart of success rate against a time bound, one curve per property: the picture `hindsight sweep --svg` writes and reports show.
 
 use std::fmt::Write;
 
@@ -78,6 +78,21 @@ fn label(v: f64) -> String {
 /// The SVG document: rate (0 to 1) against bound, with interval bars, thresholds as dashed
 /// vertical lines, and a legend naming each property and its threshold.
 pub fn svg(title: &str, x_label: &str, curves: &[Curve]) -> String {
+    chart(
+        title,
+        x_label,
+        curves,
+        r#" xmlns="http://www.w3.org/2000/svg""#,
+    )
+}
+
+/// The same chart as an element to put inside an HTML page (no namespace attribute: the
+/// HTML parser gives `<svg>` its namespace, and the page names no URL).
+pub fn svg_element(title: &str, x_label: &str, curves: &[Curve]) -> String {
+    chart(title, x_label, curves, "")
+}
+
+fn chart(title: &str, x_label: &str, curves: &[Curve], xmlns: &str) -> String {
     let xs = curves.iter().flat_map(|c| c.points.iter().map(|p| p.x));
     let (mut lo, mut hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
         (a.min(x), b.max(x))
@@ -95,7 +110,7 @@ pub fn svg(title: &str, x_label: &str, curves: &[Curve]) -> String {
     let mut o = String::new();
     let _ = writeln!(
         o,
-        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{W}" height="{H}" viewBox="0 0 {W} {H}" font-family="sans-serif" font-size="12">"#
+        r#"<svg{xmlns} class="chart" width="{W}" height="{H}" viewBox="0 0 {W} {H}" font-family="sans-serif" font-size="12">"#
     );
     let _ = writeln!(o, r#"<rect width="{W}" height="{H}" fill="white"/>"#);
     let _ = writeln!(
@@ -268,6 +283,9 @@ mod tests {
         assert!(!s.contains("a<b"));
         assert!(s.contains("threshold 1.5"));
         assert!(s.contains("no threshold in range"));
+        assert!(s.contains("xmlns="));
+        let e = svg_element("t", "x", &[curve("c", None)]);
+        assert!(e.starts_with("<svg class=") && !e.contains("http"), "{e}");
         assert_eq!(s.matches("stroke-dasharray").count(), 1);
     }
 

@@ -1,0 +1,210 @@
+//! `hindsight report` (a page from the files `verify --json`, `sweep --json` and
+//! `--save-failing` write) and the `--report FILE` of `verify` and `sweep`.
+
+use std::path::{Path, PathBuf};
+
+use super::CliError;
+use crate::report::{self, ReportData, Run, Study, Sweep};
+use crate::verify::load::Loaded;
+
+/// Arguments of `hindsight report`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "\
+Reads what the other commands write and makes one self-contained HTML page (styles,
+script, charts and data inline; nothing is fetched when it is opened):
+  --study FILE   the JSON of `verify --json` or `merge --json`: settings, how runs ended,
+                 each property's probability, interval and runs; formulas are read from
+                 the property file it names when that file is an XML file found here
+  --sweep FILE   the JSON of `sweep --json` (repeatable): success rate against the bound,
+                 with intervals and thresholds
+  RUNS           CSV files of `verify --save-failing` or `trace`, or folders of them: each
+                 is drawn as a timeline (a file named PROPERTY-runK.csv is linked to PROPERTY)
+
+`verify --report FILE` and `sweep --report FILE` write the same page straight from the
+study in memory, with each formula as written and as compiled.
+
+Examples:
+  hindsight verify examples/museum-guide --json --save-failing 2 --out runs > study.json
+  hindsight report --study study.json runs -o report.html")]
+pub struct ReportArgs {
+    /// Failing runs: CSV files written by `verify --save-failing` or `trace`, or folders of them.
+    pub runs: Vec<PathBuf>,
+    /// A study as `verify --json` (or `merge --json`) prints it.
+    #[arg(long, value_name = "FILE")]
+    pub study: Option<PathBuf>,
+    /// A sweep as `sweep --json` prints it (repeat for several).
+    #[arg(long = "sweep", value_name = "FILE")]
+    pub sweeps: Vec<PathBuf>,
+    /// The HTML file to write.
+    #[arg(short, long, value_name = "FILE")]
+    pub output: PathBuf,
+    /// The page's title (default: the study's model).
+    #[arg(long)]
+    pub title: Option<String>,
+    /// The length of one model step (`100ms`), to show the runs' times in seconds when
+    /// no study gives it.
+    #[arg(long, value_name = "DURATION")]
+    pub time_unit: Option<String>,
+}
+
+fn read_json<T: serde::de::DeserializeOwned>(path: &Path, what: &str) -> Result<T, CliError> {
+    let text = super::read_file(path)?;
+    serde_json::from_str(&text).map_err(|e| {
+        CliError::Input(format!(
+            "{}:{}:{}: not the JSON of {what}: {e}",
+            path.display(),
+            e.line().max(1),
+            e.column().max(1)
+        ))
+    })
+}
+
+/// The CSV files among `paths` (a folder stands for its `.csv` files, by name).
+fn run_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, CliError> {
+    let mut out = Vec::new();
+    for p in paths {
+        if p.is_dir() {
+            let mut files: Vec<PathBuf> = std::fs::read_dir(p)
+                .map_err(|e| CliError::Input(format!("{}: cannot read: {e}", p.display())))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|f| f.extension().is_some_and(|x| x == "csv"))
+                .collect();
+            files.sort();
+            out.extend(files);
+        } else {
+            out.push(p.clone());
+        }
+    }
+    Ok(out)
+}
+
+/// Runs `hindsight report`.
+pub fn run(args: &ReportArgs) -> Result<(), CliError> {
+    if args.study.is_none() && args.sweeps.is_empty() && args.runs.is_empty() {
+        return Err(CliError::Input(
+            "report: nothing to show: give --study, --sweep or failing runs (see --help)".into(),
+        ));
+    }
+    let mut data = ReportData::default();
+    if let Some(path) = &args.study {
+        let mut study: Study = read_json(path, "`verify --json`")?;
+        formulas_from_file(&mut study);
+        data.study = Some(study);
+    }
+    for path in &args.sweeps {
+        let mut sweep: Sweep = read_json(path, "`sweep --json`")?;
+        sweep.title = path.display().to_string();
+        data.sweeps.push(sweep);
+    }
+    let step_seconds = match &args.time_unit {
+        Some(t) => Some(
+            codegen::duration::parse(t)
+                .map_err(|m| CliError::Input(format!("--time-unit {t}: {m}")))? as f64
+                / 1e9,
+        ),
+        None => data.study.as_ref().and_then(|s| s.step_seconds),
+    };
+    for path in run_files(&args.runs)? {
+        let text = super::read_file(&path)?;
+        let mut run = Run::from_csv(&path.display().to_string(), &text).map_err(CliError::Input)?;
+        run.step_seconds = step_seconds;
+        data.runs.push(run);
+    }
+    data.title = match (&args.title, &data.study) {
+        (Some(t), _) => t.clone(),
+        (None, Some(s)) => format!("hindsight report: {}", s.model),
+        (None, None) => "hindsight report".into(),
+    };
+    write(&args.output, &data)
+}
+
+/// Fills formulas from the study's property file, when it is SCAN XML that reads.
+fn formulas_from_file(study: &mut Study) {
+    let path = Path::new(&study.properties_file);
+    if study.properties.iter().all(|p| p.formula.is_some())
+        || path.extension().is_none_or(|e| e != "xml")
+        || !path.is_file()
+    {
+        return;
+    }
+    match crate::props::parse_file(path) {
+        Ok(file) => {
+            for p in &mut study.properties {
+                if let Some(g) = file.guarantees.iter().find(|g| g.id == p.property) {
+                    p.formula
+                        .get_or_insert_with(|| g.formula.as_str().to_string());
+                }
+            }
+        }
+        Err(e) => eprintln!("warning: formulas not shown: {e}"),
+    }
+}
+
+fn write(path: &Path, data: &ReportData) -> Result<(), CliError> {
+    std::fs::write(path, report::render(data))
+        .map_err(|e| CliError::Failed(format!("{}: cannot write: {e}", path.display())))?;
+    eprintln!("wrote {}", path.display());
+    Ok(())
+}
+
+/// One failing run replayed by `verify`: its property, run index, file name and CSV.
+pub struct Failing {
+    /// The property it was kept for.
+    pub property: String,
+    /// Its index in the study.
+    pub run: u64,
+    /// The file it was written to, or would be.
+    pub file: String,
+    /// The CSV text.
+    pub csv: String,
+}
+
+/// `verify --report FILE`: the study in memory (`report` is what `--json` prints), each
+/// formula as written and as compiled, and the failing runs replayed.
+pub fn from_verify(
+    path: &Path,
+    report: &impl serde::Serialize,
+    loaded: &Loaded,
+    settings: Vec<(String, String)>,
+    failing: &[Failing],
+) -> Result<(), CliError> {
+    let bad = |e: serde_json::Error| CliError::Failed(format!("report: {e}"));
+    let mut study: Study =
+        serde_json::from_value(serde_json::to_value(report).map_err(bad)?).map_err(bad)?;
+    study.settings = settings;
+    let checked = loaded.set.compiled().checked();
+    for p in &mut study.properties {
+        if let Some(g) = loaded.file.guarantees.iter().find(|g| g.id == p.property) {
+            p.formula = Some(g.formula.as_str().to_string());
+        }
+        if let Some(def) = checked.properties.iter().find(|d| d.name == p.property) {
+            p.compiled = Some(codegen::print::formula(&def.formula, checked));
+        }
+    }
+    let mut data = ReportData {
+        title: format!("hindsight verify: {}", study.model),
+        ..ReportData::default()
+    };
+    for f in failing {
+        let mut run = Run::from_csv(&f.file, &f.csv).map_err(CliError::Failed)?;
+        run.property = Some(f.property.clone());
+        run.run = Some(f.run);
+        run.step_seconds = study.step_seconds;
+        data.runs.push(run);
+    }
+    data.study = Some(study);
+    write(path, &data)
+}
+
+/// `sweep --report FILE`: `doc` is what `sweep --json` prints.
+pub fn from_sweep(path: &Path, model: &Path, doc: &serde_json::Value) -> Result<(), CliError> {
+    let mut sweep: Sweep = serde_json::from_value(doc.clone())
+        .map_err(|e| CliError::Failed(format!("report: {e}")))?;
+    sweep.title = model.display().to_string();
+    let data = ReportData {
+        title: format!("hindsight sweep: {}", model.display()),
+        sweeps: vec![sweep],
+        ..ReportData::default()
+    };
+    write(path, &data)
+}

@@ -1,0 +1,648 @@
+// hindsight report: draws each failing run as a timeline (plain JavaScript and SVG, inline).
+// Lanes: the messages (sends above, receives below), one per property variable (numbers
+// as steps, booleans and text as bands), one per verdict (true green, false red, the first
+// false point marked and linked to its formula). Wheel or buttons zoom, dragging pans,
+// hover shows a point's state, a click pins it, arrow keys step point by point.
+// Many points per pixel are merged, so a long run draws as fast as its width allows.
+// The page counts its own script errors in <body data-errors> and how many timelines
+// it drew in <body data-rendered> (read by the browser test).
+"use strict";
+(function () {
+  var body = document.body;
+  var errors = 0;
+  function countError() {
+    errors += 1;
+    body.setAttribute("data-errors", String(errors));
+  }
+  window.addEventListener("error", countError);
+  window.addEventListener("unhandledrejection", countError);
+
+  var LABEL = 180, LANE = 22, AXIS = 24, PAD = 4, RIGHT = 12;
+  var GREEN = "#59a14f", RED = "#d62728", MIXED = "#e69f00";
+
+  function esc(s) {
+    return String(s).replace(/&/g, "&amp;").replace(/</g, "&lt;")
+      .replace(/>/g, "&gt;").replace(/"/g, "&quot;");
+  }
+  function num(v) {
+    var s = v.toFixed(6).replace(/0+$/, "").replace(/\.$/, "");
+    return s === "-0" ? "0" : s;
+  }
+  function anchor(name) {
+    return String(name).replace(/[^A-Za-z0-9_-]/g, "_");
+  }
+  // First index whose time is >= t.
+  function lower(times, t) {
+    var lo = 0, hi = times.length;
+    while (lo < hi) {
+      var mid = (lo + hi) >> 1;
+      if (times[mid] < t) lo = mid + 1; else hi = mid;
+    }
+    return lo;
+  }
+  // First index whose time is > t.
+  function upper(times, t) {
+    var lo = 0, hi = times.length;
+    while (lo < hi) {
+      var mid = (lo + hi) >> 1;
+      if (times[mid] <= t) lo = mid + 1; else hi = mid;
+    }
+    return lo;
+  }
+  function niceStep(span, ticks) {
+    var raw = Math.max(span / ticks, 1e-12);
+    var mag = Math.pow(10, Math.floor(Math.log10(raw)));
+    var m = raw / mag;
+    return (m <= 1 ? 1 : m <= 2 ? 2 : m <= 5 ? 5 : 10) * mag;
+  }
+
+  // The points where get(k) differs from the point before (and point 0): a lane is drawn
+  // from these, so its cost is its number of changes, not the run's number of points.
+  function changes(n, get) {
+    var out = [];
+    for (var k = 0; k < n; k++) {
+      if (k === 0 || get(k) !== get(k - 1)) out.push(k);
+    }
+    return out;
+  }
+
+  function lanesOf(run) {
+    var lanes = [{ kind: "messages", name: "messages" }];
+    run.vars.forEach(function (name, i) {
+      var col = run.values[i];
+      var kind = "bool", min = Infinity, max = -Infinity;
+      for (var k = 0; k < col.length; k++) {
+        var v = col[k];
+        if (typeof v === "number") {
+          if (kind === "bool") kind = "num";
+          if (v < min) min = v;
+          if (v > max) max = v;
+        } else if (typeof v !== "boolean") {
+          kind = "text";
+          break;
+        }
+      }
+      if (kind === "num" && col.some(function (v) { return typeof v !== "number"; })) kind = "text";
+      var get = function (k) { return col[k]; };
+      lanes.push({ kind: kind, name: name, get: get, min: min, max: max, ch: changes(col.length, get) });
+    });
+    run.verdict_names.forEach(function (name, j) {
+      var col = run.verdicts[j];
+      var get = function (k) { return col.charCodeAt(k) === 49; };
+      lanes.push({ kind: "verdict", name: name, first: col.indexOf("0"), get: get, ch: changes(col.length, get) });
+    });
+    return lanes;
+  }
+
+  function Timeline(el, run, tools, state) {
+    this.el = el;
+    this.run = run;
+    this.tools = tools;
+    this.state = state;
+    this.n = run.time.length;
+    this.t0 = this.n ? run.time[0] : 0;
+    this.tEnd = this.n ? run.time[this.n - 1] : 1;
+    if (this.tEnd <= this.t0) this.tEnd = this.t0 + 1;
+    this.view = [this.t0, this.tEnd];
+    this.sel = -1;
+    this.pinned = false;
+    this.lanes = lanesOf(run);
+    // Sends and receives before each point, so a pixel asks "any message here?" in O(log n).
+    var names = run.names, send = names.indexOf("send"), receive = names.indexOf("receive");
+    this.sends = new Int32Array(this.n + 1);
+    this.receives = new Int32Array(this.n + 1);
+    for (var k = 0; k < this.n; k++) {
+      this.sends[k + 1] = this.sends[k] + (run.step[k] === send ? 1 : 0);
+      this.receives[k + 1] = this.receives[k] + (run.step[k] === receive ? 1 : 0);
+    }
+    this.height = AXIS + this.lanes.length * LANE + PAD;
+    this.measure();
+    this.bind();
+    var t = performance.now();
+    this.draw();
+    this.drawMs = performance.now() - t;
+    this.sendIdx = [];
+    var sendName = run.names.indexOf("send");
+    for (var p = 0; p < this.n; p++) {
+      if (run.step[p] === sendName) this.sendIdx.push(p);
+    }
+    if (state && this.sendIdx.length > 0) {
+      this.seqEl = document.createElement("div");
+      this.seqEl.className = "seq";
+      state.parentNode.insertBefore(this.seqEl, state.nextSibling);
+      this.drawSequence();
+    }
+    this.tree = new Tree(run);
+    if (this.tree.count > 0 && state) {
+      this.treeEl = document.createElement("div");
+      this.treeEl.className = "bt";
+      var after = this.seqEl || state;
+      after.parentNode.insertBefore(this.treeEl, after.nextSibling);
+      this.drawTree();
+    }
+  }
+
+  // The drawing width, read once per draw (reading layout per point would be slow).
+  Timeline.prototype.measure = function () {
+    this.w = Math.max(this.el.clientWidth || 0, 400);
+  };
+  Timeline.prototype.width = function () {
+    return this.w;
+  };
+  Timeline.prototype.x = function (t) {
+    var w = this.width() - LABEL - RIGHT;
+    return LABEL + (t - this.view[0]) / (this.view[1] - this.view[0]) * w;
+  };
+  Timeline.prototype.t = function (x) {
+    var w = this.width() - LABEL - RIGHT;
+    return this.view[0] + (x - LABEL) / w * (this.view[1] - this.view[0]);
+  };
+  Timeline.prototype.timeText = function (t) {
+    var s = this.run.step_seconds;
+    return s ? num(t * s) + " s" : String(t);
+  };
+
+  // Bands of equal value; sub-pixel stretches merge into one band of colour `mixed`.
+  Timeline.prototype.bands = function (lane, y, h, colour, mixed, lo, hi) {
+    var out = [], cur = null, time = this.run.time, self = this;
+    var L = LABEL, R = this.width() - RIGHT;
+    function flush() {
+      if (!cur) return;
+      var c = cur.mixed ? mixed : colour(cur.v);
+      if (c) {
+        var w = Math.max(cur.x1 - cur.x0, 1.5);
+        out.push('<rect x="' + cur.x0.toFixed(1) + '" y="' + y + '" width="' + w.toFixed(1) +
+          '" height="' + h + '" fill="' + c + '"/>');
+      }
+      if (lane.kind === "text" && !cur.mixed && cur.x1 - cur.x0 > 8 * String(cur.v).length) {
+        out.push('<text class="tick" x="' + (cur.x0 + 3).toFixed(1) + '" y="' + (y + h - 5) + '">' +
+          esc(cur.v) + "</text>");
+      }
+    }
+    var ch = lane.ch;
+    for (var j = Math.max(upper(ch, lo) - 1, 0); j < ch.length && ch[j] < hi; j++) {
+      var k = ch[j], next = j + 1 < ch.length ? ch[j + 1] : self.n;
+      var v = lane.get(k);
+      var xa = Math.max(self.x(time[k]), L);
+      var xb = Math.min(self.x(next < self.n ? time[next] : self.tEnd), R);
+      if (xb < L || xa > R) continue;
+      if (cur && cur.v === v && !cur.mixed) {
+        cur.x1 = Math.max(cur.x1, xb);
+      } else if (cur && cur.x1 - cur.x0 < 1 && xb - cur.x0 < 2) {
+        cur.mixed = true;
+        cur.x1 = Math.max(cur.x1, xb);
+      } else {
+        flush();
+        cur = { v: v, x0: xa, x1: xb, mixed: false };
+      }
+    }
+    flush();
+    return out.join("");
+  };
+
+  // A number lane as a step line; points sharing a pixel draw their range as one stroke.
+  Timeline.prototype.steps = function (lane, y, h, lo, hi) {
+    var time = this.run.time, span = lane.max - lane.min, d = "", last = null;
+    var ymin = 0, ymax = 0, ylast = 0, R = this.width() - RIGHT;
+    function Y(v) {
+      return span > 0 ? y + h - 2 - (v - lane.min) / span * (h - 4) : y + h / 2;
+    }
+    var ch = lane.ch;
+    for (var j = Math.max(upper(ch, lo) - 1, 0); j < ch.length && ch[j] < hi; j++) {
+      var k = ch[j];
+      var px = Math.round(Math.min(Math.max(this.x(time[k]), LABEL), R));
+      var yy = Y(lane.get(k));
+      if (px === last) {
+        ymin = Math.min(ymin, yy);
+        ymax = Math.max(ymax, yy);
+        ylast = yy;
+        continue;
+      }
+      if (last === null) d = "M" + px + " " + yy.toFixed(1);
+      else d += "V" + ymin.toFixed(1) + "V" + ymax.toFixed(1) + "V" + ylast.toFixed(1) + "H" + px;
+      last = px;
+      ymin = ymax = ylast = yy;
+    }
+    if (last === null) return "";
+    d += "V" + ymin.toFixed(1) + "V" + ymax.toFixed(1) + "V" + ylast.toFixed(1) + "H" +
+      Math.round(Math.min(this.x(this.tEnd), R));
+    return '<path d="' + d + '" fill="none" stroke="#0072b2" stroke-width="1.5"/>';
+  };
+
+  // Message ticks: sends in the upper half, receives in the lower; one per pixel and kind.
+  Timeline.prototype.ticks = function (y, h, lo, hi) {
+    var time = this.run.time, step = this.run.step, seen = {}, d = ["", ""];
+    var send = this.run.names.indexOf("send"), receive = this.run.names.indexOf("receive");
+    var R = this.width() - RIGHT;
+    if (hi - lo > 2 * (R - LABEL)) {
+      // More points than pixels: ask each pixel whether it holds a send or a receive.
+      var counts = [this.sends, this.receives];
+      for (var p = LABEL; p <= R; p++) {
+        var a = lower(time, this.t(p - 0.5)), b = lower(time, this.t(p + 0.5));
+        for (var c = 0; c < 2; c++) {
+          if (counts[c][b] > counts[c][a]) {
+            d[c] += "M" + p + " " + (y + 2 + c * (h / 2 - 1)).toFixed(1) + "v" + (h / 2 - 3).toFixed(1);
+          }
+        }
+      }
+      return '<path d="' + d[0] + '" stroke="#0072b2"/><path d="' + d[1] + '" stroke="#d55e00"/>';
+    }
+    for (var k = lo; k < hi; k++) {
+      var s = step[k] === send ? 0 : step[k] === receive ? 1 : -1;
+      if (s < 0) continue;
+      var px = Math.round(this.x(time[k]));
+      if (px < LABEL || px > this.width() - RIGHT) continue;
+      var key = px * 2 + s;
+      if (seen[key]) continue;
+      seen[key] = true;
+      var y0 = y + 2 + s * (h / 2 - 1);
+      d[s] += "M" + px + " " + y0.toFixed(1) + "v" + (h / 2 - 3).toFixed(1);
+    }
+    return '<path d="' + d[0] + '" stroke="#0072b2"/><path d="' + d[1] + '" stroke="#d55e00"/>';
+  };
+
+  Timeline.prototype.axis = function () {
+    var s = this.run.step_seconds || 1, out = [];
+    var a = this.view[0] * s, b = this.view[1] * s;
+    var step = niceStep(b - a, Math.max(2, Math.floor((this.width() - LABEL) / 90)));
+    for (var v = Math.ceil(a / step) * step; v <= b + step * 1e-9; v += step) {
+      var x = this.x(v / s).toFixed(1);
+      out.push('<line x1="' + x + '" x2="' + x + '" y1="' + (AXIS - 4) + '" y2="' + this.height +
+        '" stroke="#eee"/><text class="tick" x="' + x + '" y="' + (AXIS - 8) +
+        '" text-anchor="middle">' + num(v) + "</text>");
+    }
+    out.push('<text class="tick" x="4" y="' + (AXIS - 8) + '">time (' +
+      (this.run.step_seconds ? "s" : "steps") + ")</text>");
+    return out.join("");
+  };
+
+  Timeline.prototype.draw = function () {
+    this.measure();
+    var W = this.width(), time = this.run.time, self = this;
+    var lo = Math.max(lower(time, this.view[0]) - 1, 0);
+    var hi = Math.min(upper(time, this.view[1]) + 1, this.n);
+    var parts = ['<svg width="' + W + '" height="' + this.height + '">', this.axis()];
+    this.lanes.forEach(function (lane, i) {
+      var y = AXIS + i * LANE, h = LANE - 6;
+      parts.push('<rect x="0" y="' + y + '" width="' + W + '" height="' + (LANE - 2) + '" fill="' +
+        (i % 2 ? "#fff" : "#f6f6f6") + '"/>');
+      var label = esc(lane.name);
+      if (lane.kind === "num") label += " (" + num(lane.min) + " to " + num(lane.max) + ")";
+      if (lane.kind === "verdict") {
+        label = '<a href="#prop-' + anchor(lane.name) + '">' + label + "</a>";
+      }
+      parts.push('<text class="lbl' + (lane.kind === "verdict" ? " verdict" : "") + '" x="4" y="' +
+        (y + h - 2) + '">' + label + "</text>");
+      var yb = y + 2;
+      if (lane.kind === "messages") parts.push(self.ticks(yb, h, lo, hi));
+      else if (lane.kind === "num") parts.push(self.steps(lane, yb, h, lo, hi));
+      else if (lane.kind === "bool") {
+        var blue = "#0072b2";
+        parts.push(self.bands(lane, yb + 3, h - 6, function (v) { return v ? blue : null; }, blue, lo, hi));
+      } else if (lane.kind === "text") {
+        var pal = ["#dbe9f6", "#fde7d0"], seen = {}, n = 0;
+        parts.push(self.bands(lane, yb, h, function (v) {
+          if (!(v in seen)) seen[v] = pal[n++ % 2];
+          return seen[v];
+        }, "#bbb", lo, hi));
+      } else {
+        parts.push(self.bands(lane, yb, h, function (v) { return v ? GREEN : RED; }, MIXED, lo, hi));
+        if (lane.first >= 0) {
+          var ft = time[lane.first], fx = self.x(ft);
+          if (fx >= LABEL - 1 && fx <= W - RIGHT + 1) {
+            parts.push('<a href="#prop-' + anchor(lane.name) + '"><g class="ff-mark" data-property="' +
+              esc(lane.name) + '" data-time="' + ft + '" data-point="' + lane.first + '"><line x1="' +
+              fx.toFixed(1) + '" x2="' + fx.toFixed(1) + '" y1="' + AXIS + '" y2="' + (y + LANE) +
+              '" stroke="' + RED + '" stroke-dasharray="3 2"/><path d="M' + fx.toFixed(1) + " " + y +
+              "l-5 -6h10z" + '" fill="' + RED + '"/><title>' + esc(lane.name) + " is false from t = " +
+              self.timeText(ft) + " (point " + lane.first + ")</title></g></a>");
+          }
+        }
+      }
+    });
+    if (this.sel >= 0) {
+      var sx = this.x(time[this.sel]);
+      if (sx >= LABEL && sx <= W - RIGHT) {
+        parts.push('<line class="cursor" x1="' + sx.toFixed(1) + '" x2="' + sx.toFixed(1) + '" y1="' +
+          AXIS + '" y2="' + this.height + '" stroke="#333" stroke-width="' + (this.pinned ? 2 : 1) + '"/>');
+      }
+    }
+    parts.push("</svg>");
+    this.el.innerHTML = parts.join("");
+    var view = this.tools && this.tools.querySelector(".view");
+    if (view) {
+      view.textContent = "showing " + this.timeText(this.view[0]) + " to " + this.timeText(this.view[1]) +
+        " (points " + lower(time, this.view[0]) + " to " + Math.max(upper(time, this.view[1]) - 1, 0) +
+        " of " + this.n + ")";
+    }
+  };
+
+  Timeline.prototype.showState = function () {
+    var r = this.run, k = this.sel, nm = r.names;
+    if (k < 0 || !this.state) return;
+    var rows = [["point", k + " of " + this.n + (this.pinned ? " (pinned)" : "")],
+      ["time", this.timeText(r.time[k])], ["step", nm[r.step[k]]]];
+    if (nm[r.event[k]]) {
+      rows.push(["message", nm[r.event[k]] + ": " + nm[r.origin[k]] + " \u2192 " + nm[r.target[k]]]);
+    }
+    if (r.params[k]) rows.push(["parameters", r.params[k]]);
+    var html = "<table><tbody>";
+    rows.forEach(function (row) {
+      html += "<tr><th>" + esc(row[0]) + "</th><td>" + esc(row[1]) + "</td></tr>";
+    });
+    r.vars.forEach(function (name, i) {
+      html += "<tr><th>" + esc(name) + "</th><td>" + esc(r.values[i][k]) + "</td></tr>";
+    });
+    r.verdict_names.forEach(function (name, j) {
+      var ok = r.verdicts[j].charCodeAt(k) === 49;
+      html += '<tr><th><a href="#prop-' + anchor(name) + '">' + esc(name) + '</a></th><td class="' +
+        (ok ? "t" : "f") + '">' + (ok ? "true" : "false") + "</td></tr>";
+    });
+    this.state.innerHTML = html + "</tbody></table>";
+  };
+
+  // The behavior tree of a robot model, read from the run's own messages: the lowering
+  // names each node's machine BT_plugin_<id>_<type>, a parent sends bt_<id>_tick and
+  // bt_<id>_halt, the node answers bt_<id>_response with status 1 SUCCESS, 2 FAILURE,
+  // 3 RUNNING (host/src/robot/bt/control.rs). A node's status at a point is its last
+  // such message: ticked (waiting for its answer), its answer, or idle after a halt.
+  var BT_STATUS = { 1: "success", 2: "failure", 3: "running" };
+  var BT_FILL = { idle: "#eeeeee", ticked: "#fff3b0", success: "#8fd694", failure: "#f08a8a", running: "#f6c26b" };
+  var BT_MARK = { Sequence: "\u2192", ReactiveSequence: "R\u2192", SequenceWithMemory: "M\u2192",
+    Fallback: "?", ReactiveFallback: "R?", Parallel: "\u21c9", Inverter: "!" };
+
+  function Tree(run) {
+    var ev = [], self = this;
+    run.names.forEach(function (name, i) {
+      var m = /^bt_(\d+)_(tick|response|halt)$/.exec(name);
+      if (m) ev[i] = { id: m[1], kind: m[2] };
+    });
+    var send = run.names.indexOf("send"), nodes = {}, order = [];
+    function node(id) {
+      if (!nodes[id]) {
+        nodes[id] = { id: id, type: "?", children: [], parent: null, at: [], status: [] };
+        order.push(id);
+      }
+      return nodes[id];
+    }
+    for (var k = 0; k < run.time.length; k++) {
+      var e = ev[run.event[k]];
+      if (!e || run.step[k] !== send) continue;
+      var n = node(e.id);
+      if (e.kind === "response") {
+        var st = /(?:^|;)status=(\d+)/.exec(run.params[k]);
+        n.at.push(k);
+        n.status.push(st && BT_STATUS[st[1]] || "ticked");
+        continue;
+      }
+      var tm = /^BT_plugin_\d+_(.+)$/.exec(run.names[run.target[k]]);
+      if (tm) n.type = tm[1];
+      var pm = /^BT_plugin_(\d+)_/.exec(run.names[run.origin[k]]);
+      if (pm && n.parent === null) {
+        n.parent = pm[1];
+        node(pm[1]).children.push(e.id);
+      }
+      n.at.push(k);
+      n.status.push(e.kind === "tick" ? "ticked" : "idle");
+    }
+    this.nodes = nodes;
+    this.roots = order.filter(function (id) { return nodes[id].parent === null; }).sort();
+    order.forEach(function (id) {
+      nodes[id].children.sort(function (a, b) { return Number(a) - Number(b); });
+    });
+    this.count = order.length;
+    // Layout: leaves in order left to right, a parent centred over its children.
+    var slot = 0, depth = 0;
+    function place(id, d) {
+      var n = nodes[id];
+      n.depth = d;
+      depth = Math.max(depth, d);
+      if (n.children.length === 0) {
+        n.x = slot++;
+      } else {
+        n.children.forEach(function (c) { place(c, d + 1); });
+        n.x = (nodes[n.children[0]].x + nodes[n.children[n.children.length - 1]].x) / 2;
+      }
+    }
+    this.roots.forEach(function (r) { place(r, 0); });
+    this.slots = slot;
+    this.depth = depth;
+    this.statusAt = function (id, k) {
+      var n = self.nodes[id], i = upper(n.at, k) - 1;
+      return i < 0 ? "idle" : n.status[i];
+    };
+  }
+
+  Tree.prototype.svg = function (k) {
+    var BW = 124, BH = 34, GX = 10, GY = 30, nodes = this.nodes, self = this;
+    var W = this.slots * (BW + GX) + GX, H = (this.depth + 1) * (BH + GY) + GY;
+    var out = ['<svg width="' + W + '" height="' + H + '">'];
+    function cx(n) { return GX + n.x * (BW + GX) + BW / 2; }
+    function cy(n) { return GY + n.depth * (BH + GY); }
+    Object.keys(nodes).forEach(function (id) {
+      var n = nodes[id];
+      n.children.forEach(function (c) {
+        var m = nodes[c];
+        out.push('<path d="M' + cx(n) + " " + (cy(n) + BH) + "V" + (cy(n) + BH + GY / 2) + "H" + cx(m) +
+          "V" + cy(m) + '" fill="none" stroke="#888"/>');
+      });
+    });
+    Object.keys(nodes).forEach(function (id) {
+      var n = nodes[id], st = self.statusAt(id, k), mark = BT_MARK[n.type];
+      var label = mark ? mark + " " + n.type : n.type;
+      if (label.length > 21) label = label.slice(0, 20) + "\u2026";
+      var control = n.children.length > 0;
+      out.push('<g class="bt-node" data-node="' + esc(id) + '" data-status="' + st + '"><rect x="' +
+        (cx(n) - BW / 2) + '" y="' + cy(n) + '" width="' + BW + '" height="' + BH + '" rx="' +
+        (control ? 2 : 10) + '" fill="' + BT_FILL[st] + '" stroke="#555"/><text class="lbl" x="' + cx(n) +
+        '" y="' + (cy(n) + 14) + '" text-anchor="middle">' + esc(label) +
+        '</text><text class="tick" x="' + cx(n) + '" y="' + (cy(n) + 27) + '" text-anchor="middle">' +
+        st + " (" + esc(id) + ")</text><title>" + esc(n.type + " " + id + ": " + st) + "</title></g>");
+    });
+    out.push("</svg>");
+    return out.join("");
+  };
+
+  // The messages around the selected point as a sequence chart: one lifeline per machine
+  // that sends or receives in the window, one arrow per send (SEQ_AROUND before and
+  // after the selection), the send at or before the selection highlighted.
+  var SEQ_AROUND = 20;
+  Timeline.prototype.drawSequence = function () {
+    if (!this.seqEl) return;
+    var r = this.run, nm = r.names, send = nm.indexOf("send"), k = Math.max(this.sel, 0);
+    var at = upper(this.sendIdx, k) - 1;
+    var from = Math.max(at - SEQ_AROUND + 1, 0), to = Math.min(at + SEQ_AROUND + 1, this.sendIdx.length);
+    var rows = this.sendIdx.slice(from, to), lanes = [], col = {};
+    rows.forEach(function (p) {
+      [r.origin[p], r.target[p]].forEach(function (m) {
+        if (!(m in col)) { col[m] = lanes.length; lanes.push(m); }
+      });
+    });
+    if (send < 0 || rows.length === 0) { this.seqEl.innerHTML = ""; return; }
+    var CW = 150, RH = 20, TOP = 34, W = lanes.length * CW + 20, H = TOP + rows.length * RH + 10;
+    function lx(m) { return 10 + col[m] * CW + CW / 2; }
+    var out = ['<svg width="' + W + '" height="' + H + '">'];
+    lanes.forEach(function (m) {
+      var name = nm[m], short = name.length > 22 ? name.slice(0, 21) + "\u2026" : name;
+      out.push('<text class="lbl" x="' + lx(m) + '" y="14" text-anchor="middle">' + esc(short) +
+        "<title>" + esc(name) + '</title></text><line x1="' + lx(m) + '" x2="' + lx(m) + '" y1="' + 20 +
+        '" y2="' + H + '" stroke="#bbb" stroke-dasharray="4 3"/>');
+    });
+    var self = this;
+    rows.forEach(function (p, i) {
+      var y = TOP + i * RH + RH / 2, x1 = lx(r.origin[p]), x2 = lx(r.target[p]);
+      var mine = from + i === at, dir = x2 >= x1 ? 1 : -1;
+      if (mine) {
+        out.push('<rect x="0" y="' + (y - RH / 2) + '" width="' + W + '" height="' + RH + '" fill="#fff3b0"/>');
+      }
+      var line = x1 === x2
+        ? '<path d="M' + x1 + " " + (y - 4) + "h18v8h-14" + '" fill="none" stroke="#333"/>'
+        : '<line x1="' + x1 + '" x2="' + (x2 - dir * 6) + '" y1="' + y + '" y2="' + y + '" stroke="#333"/>' +
+          '<path d="M' + x2 + " " + y + "l" + (-dir * 7) + " -4v8z" + '" fill="#333"/>';
+      var label = nm[r.event[p]] + (r.params[p] ? " (" + r.params[p] + ")" : "");
+      if (label.length > 60) label = label.slice(0, 59) + "\u2026";
+      out.push('<g class="seq-msg' + (mine ? " selected" : "") + '" data-point="' + p + '">' + line +
+        '<text class="tick" x="' + (Math.min(x1, x2) + 4) + '" y="' + (y - 3) + '">' + esc(label) +
+        "</text><title>point " + p + ", t = " + esc(self.timeText(r.time[p])) + ": " + esc(nm[r.event[p]]) +
+        " " + esc(nm[r.origin[p]]) + " \u2192 " + esc(nm[r.target[p]]) + "</title></g>");
+    });
+    out.push("</svg>");
+    this.seqEl.innerHTML = "<p><b>Messages</b> around point " + k + " (" + rows.length +
+      " sends; the highlighted one is the last at or before the point)</p>" + out.join("");
+  };
+
+  Timeline.prototype.drawTree = function () {
+    if (!this.tree || this.tree.count === 0 || !this.treeEl) return;
+    var k = Math.max(this.sel, 0);
+    this.treeEl.innerHTML = "<p><b>Behavior tree</b> at point " + k + " (t = " +
+      this.timeText(this.run.time[k] || 0) + "): " +
+      Object.keys(BT_FILL).map(function (s) {
+        return '<span class="bt-key" style="background:' + BT_FILL[s] + '">' + s + "</span>";
+      }).join(" ") + "</p>" + this.tree.svg(k);
+  };
+
+  Timeline.prototype.select = function (k, pin) {
+    if (this.n === 0) return;
+    this.sel = Math.min(Math.max(k, 0), this.n - 1);
+    this.pinned = pin;
+    var t = this.run.time[this.sel], span = this.view[1] - this.view[0];
+    if (t < this.view[0] || t > this.view[1]) this.setView(t - span / 2, t + span / 2);
+    this.draw();
+    this.showState();
+    this.drawSequence();
+    this.drawTree();
+  };
+  Timeline.prototype.at = function (x) {
+    return Math.max(upper(this.run.time, this.t(x)) - 1, 0);
+  };
+  Timeline.prototype.setView = function (a, b) {
+    var full = this.tEnd - this.t0, span = Math.min(Math.max(b - a, 1), full);
+    a = Math.min(Math.max(a, this.t0), this.tEnd - span);
+    this.view = [a, a + span];
+  };
+  Timeline.prototype.zoom = function (factor, around) {
+    var a = this.view[0], b = this.view[1];
+    if (around === undefined) around = (a + b) / 2;
+    this.setView(around - (around - a) * factor, around + (b - around) * factor);
+    this.draw();
+  };
+  // Zooms to a twentieth of the run (at least 20 steps) around point k and pins it.
+  Timeline.prototype.focusPoint = function (k) {
+    if (this.n === 0) return;
+    k = Math.min(Math.max(k, 0), this.n - 1);
+    var t = this.run.time[k], span = Math.max((this.tEnd - this.t0) / 20, 20);
+    this.setView(t - span / 2, t + span / 2);
+    this.select(k, true);
+  };
+  Timeline.prototype.toFirstFalse = function () {
+    var run = this.run, want = run.property, best = -1;
+    this.lanes.forEach(function (l) {
+      if (l.kind === "verdict" && l.first >= 0 && (best < 0 || l.name === want)) best = l.first;
+    });
+    if (best >= 0) this.focusPoint(best);
+  };
+
+  Timeline.prototype.bind = function () {
+    var self = this, el = this.el, drag = null;
+    function localX(e) { return e.clientX - el.getBoundingClientRect().left; }
+    el.addEventListener("wheel", function (e) {
+      e.preventDefault();
+      self.zoom(e.deltaY > 0 ? 1.25 : 0.8, self.t(localX(e)));
+    }, { passive: false });
+    el.addEventListener("mousedown", function (e) {
+      drag = { x: localX(e), view: self.view.slice(), moved: false };
+    });
+    window.addEventListener("mouseup", function (e) {
+      if (!drag) return;
+      var d = drag;
+      drag = null;
+      if (!d.moved && e.target && el.contains(e.target) && localX(e) >= LABEL) {
+        var k = self.at(localX(e));
+        self.select(k, !(self.pinned && k === self.sel));
+      }
+    });
+    el.addEventListener("mousemove", function (e) {
+      var x = localX(e);
+      if (drag) {
+        var dx = x - drag.x;
+        if (Math.abs(dx) > 3) drag.moved = true;
+        if (drag.moved) {
+          var per = (drag.view[1] - drag.view[0]) / (self.width() - LABEL - RIGHT);
+          self.setView(drag.view[0] - dx * per, drag.view[1] - dx * per);
+          self.draw();
+        }
+      } else if (!self.pinned && x >= LABEL) {
+        self.select(self.at(x), false);
+      }
+    });
+    el.addEventListener("keydown", function (e) {
+      if (e.key === "ArrowRight" || e.key === "ArrowLeft") {
+        e.preventDefault();
+        self.select(self.sel + (e.key === "ArrowRight" ? 1 : -1), true);
+      } else if (e.key === "+" || e.key === "=") self.zoom(0.8);
+      else if (e.key === "-") self.zoom(1.25);
+    });
+    if (this.tools) {
+      this.tools.addEventListener("click", function (e) {
+        var act = e.target && e.target.getAttribute("data-act");
+        if (act === "fit") { self.setView(self.t0, self.tEnd); self.draw(); }
+        else if (act === "in") self.zoom(0.5);
+        else if (act === "out") self.zoom(2);
+        else if (act === "false") self.toFirstFalse();
+      });
+    }
+    window.addEventListener("resize", function () { self.draw(); });
+  };
+
+  var start = performance.now();
+  var runs = JSON.parse(document.getElementById("hindsight-runs").textContent);
+  var drawn = 0, drawMs = 0;
+  runs.forEach(function (run, i) {
+    var el = document.getElementById("timeline-" + i);
+    if (!el) return;
+    var section = document.getElementById("run-" + i);
+    var tl = new Timeline(el, run, section && section.querySelector(".tools"),
+      document.getElementById("state-" + i));
+    el.hindsightTimeline = tl;
+    drawn += 1;
+    drawMs = Math.max(drawMs, tl.drawMs);
+  });
+  // `#run-I-point-K` (the first false points link there) selects point K of run I.
+  function fromHash() {
+    var m = /^#run-(\d+)-point-(\d+)$/.exec(window.location.hash);
+    var el = m && document.getElementById("timeline-" + m[1]);
+    if (el && el.hindsightTimeline) {
+      el.hindsightTimeline.focusPoint(Number(m[2]));
+      el.scrollIntoView();
+    }
+  }
+  window.addEventListener("hashchange", fromHash);
+  fromHash();
+  var now = performance.now();
+  body.setAttribute("data-rendered", String(drawn));
+  // Milliseconds reading and drawing the timelines, the longest single draw (what a zoom
+  // or pan at that view costs), and from navigation start to here (page parsed).
+  body.setAttribute("data-render-ms", (now - start).toFixed(1));
+  body.setAttribute("data-draw-ms", drawMs.toFixed(1));
+  body.setAttribute("data-ready-ms", now.toFixed(1));
+})();
