@@ -1,6 +1,7 @@
 //! A study run as concurrent shard processes (as `examples/cluster/` runs it on Slurm or
-//! Kubernetes) merges into the same numbers as one process; `merge` names a missing shard,
-//! accepts it once re-run, and counts a shard given twice (identical) once.
+//! Kubernetes) merges into the same numbers and the same report page as one process;
+//! `merge` names a missing shard, accepts it once re-run, and counts a shard given twice
+//! (identical) once.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -85,8 +86,31 @@ fn concurrent_shards_merge_into_the_study_of_one_process() {
         .args(["--seed", SEED, "--runs", RUNS, "--json"])
         .output()
         .unwrap());
+    // The same document, model and property file named as the shards' command line did.
+    assert_eq!(
+        String::from_utf8_lossy(&merged.stdout),
+        String::from_utf8_lossy(&whole.stdout)
+    );
     let (m, w) = (numbers(&merged.stdout), numbers(&whole.stdout));
-    assert_eq!(m, w);
+    // And the same report page.
+    let page = |json: &[u8], name: &str| {
+        let study = dir.join(format!("{name}.json"));
+        std::fs::write(&study, json).unwrap();
+        let html = dir.join(format!("{name}.html"));
+        ok(hindsight()
+            .arg("report")
+            .arg("--study")
+            .arg(&study)
+            .args(["--title", "museum"])
+            .arg("-o")
+            .arg(&html)
+            .output()
+            .unwrap());
+        std::fs::read_to_string(html).unwrap()
+    };
+    let merged_page = page(&merged.stdout, "merged");
+    assert!(merged_page.contains("battery_recurrence"), "{merged_page}");
+    assert_eq!(merged_page, page(&whole.stdout, "whole"));
     assert_eq!(m["runs"].as_u64(), Some(120), "{m}");
     assert!(!m["properties"].as_array().unwrap().is_empty(), "{m}");
 

@@ -59,6 +59,7 @@ fn study(seed: u64, runs: u64) -> FixedStudy {
                 rule: rule(RuleKind::Sprt { threshold: 0.8 }),
             },
         ],
+        paths: None,
     }
 }
 

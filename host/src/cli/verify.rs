@@ -320,6 +320,10 @@ fn run_shard_cli(
                 rule: *rule,
             })
             .collect(),
+        paths: Some(crate::smc::shard::StudyPaths {
+            model: args.input.model.display().to_string(),
+            properties: props_path.display().to_string(),
+        }),
     };
     let runner = Runner::new(model, set, run_cfg);
     let mut bar = TerminalProgress::stderr();
@@ -390,9 +394,16 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
 
 /// The report of a merged fixed-size study (`merge`, and `verify --runs R` alone).
 fn merged_report(m: &crate::smc::shard::MergedResult) -> Report {
+    let (model, properties_file) = match &m.study.paths {
+        Some(p) => (p.model.clone(), p.properties.clone()),
+        None => (
+            m.study.model.clone(),
+            m.study.properties_fingerprint.clone(),
+        ),
+    };
     Report {
-        model: m.study.model.clone(),
-        properties_file: m.study.properties_fingerprint.clone(),
+        model,
+        properties_file,
         seed: m.study.seed,
         confidence: m.properties.first().map_or(0.0, |p| p.rule.confidence),
         precision: m.properties.first().map_or(0.0, |p| p.rule.precision),
@@ -541,6 +552,17 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         },
         progress_every: Duration::from_millis(200),
     };
+    // The page's settings lines.
+    let settings = || {
+        [
+            ("rule", format!("{:?}", rule.kind).to_lowercase()),
+            ("run length in steps", run_cfg.max_time.to_string()),
+            ("step limit", args.max_steps.to_string()),
+            ("events", format!("{:?}", run_cfg.events).to_lowercase()),
+        ]
+        .map(|(k, v)| (k.to_string(), v))
+        .to_vec()
+    };
     if let Some(runs) = args.runs {
         // A fixed-size study: one shard of it, or all of it (shard 0/1) reported as
         // `merge` reports the shards of one, so both give the same numbers.
@@ -564,6 +586,10 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         let mut report = merged_report(&m);
         report.model = args.input.model.display().to_string();
         report.properties_file = props_path.display().to_string();
+        if let Some(path) = &args.report {
+            // A fixed-size study keeps counts, not runs: the page has no timelines.
+            super::report::from_verify(path, &report, &loaded, settings(), &[])?;
+        }
         return print_report(&report, args.json);
     }
     let result = study(model, set, &run_cfg, &study_cfg, &rule, !args.json)?;
@@ -578,14 +604,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         report.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
     }
     if let Some(path) = &args.report {
-        let settings = [
-            ("rule", format!("{:?}", rule.kind).to_lowercase()),
-            ("run length in steps", run_cfg.max_time.to_string()),
-            ("step limit", args.max_steps.to_string()),
-            ("events", format!("{:?}", run_cfg.events).to_lowercase()),
-        ];
-        let settings = settings.map(|(k, v)| (k.to_string(), v)).to_vec();
-        super::report::from_verify(path, &report, &loaded, settings, &failing)?;
+        super::report::from_verify(path, &report, &loaded, settings(), &failing)?;
     }
     print_report(&report, args.json)
 }

@@ -172,6 +172,20 @@ pub struct FixedStudy {
     pub properties_fingerprint: String,
     /// The properties, in verdict order.
     pub properties: Vec<PropertySpec>,
+    /// Where the model and its property file were read, as the shard's command line
+    /// named them: what a merged report names. Not compared (machines mount files in
+    /// different places; the fingerprints say whether they are the same).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub paths: Option<StudyPaths>,
+}
+
+/// The model and property file of a study, as named on the command line.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StudyPaths {
+    /// The model's path.
+    pub model: String,
+    /// The property file's path.
+    pub properties: String,
 }
 
 /// One property's counts in a partial result.
@@ -379,7 +393,7 @@ pub fn merge(parts: &[PartialResult], keep_failing: usize) -> Result<MergedResul
             return Err(ShardError::Range(shard));
         }
         if let Some(before) = by_index.insert(shard.index, part) {
-            if before != part {
+            if before.properties != part.properties || before.runs != part.runs {
                 return Err(ShardError::Duplicate(shard));
             }
         }
