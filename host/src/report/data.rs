@@ -205,11 +205,13 @@ impl Run {
     /// and run index.
     pub fn from_csv(name: &str, text: &str) -> Result<Run, String> {
         const FIXED: [&str; 6] = ["time", "step", "event", "origin", "target", "params"];
-        let mut lines = text.lines().enumerate();
-        let header: Vec<&str> = match lines.next() {
-            Some((_, h)) => h.split(',').collect(),
-            None => return Err(format!("{name}:1:1: empty file: expected a CSV header")),
-        };
+        let records = crate::verify::record::records(text)
+            .map_err(|(line, col, m)| format!("{name}:{line}:{col}: {m}"))?;
+        let mut records = records.into_iter();
+        let header_rec = records
+            .next()
+            .ok_or_else(|| format!("{name}:1:1: empty file: expected a CSV header"))?;
+        let header: Vec<&str> = header_rec.fields.iter().map(|(f, _)| f.as_str()).collect();
         for (i, want) in FIXED.iter().enumerate() {
             if header.get(i) != Some(want) {
                 return Err(format!(
@@ -251,11 +253,10 @@ impl Run {
                 run.run = Some(k);
             }
         }
-        for (i, line) in lines {
-            if line.is_empty() {
-                continue;
-            }
-            let cells: Vec<&str> = line.split(',').collect();
+        for rec in records {
+            // `i + 1` is the record's line in errors.
+            let i = rec.line - 1;
+            let cells: Vec<&str> = rec.fields.iter().map(|(f, _)| f.as_str()).collect();
             if cells.len() != header.len() {
                 return Err(format!(
                     "{name}:{}:1: {} fields, the header has {}",
@@ -264,7 +265,7 @@ impl Run {
                     header.len()
                 ));
             }
-            let col = |c: usize| cells[..c].iter().map(|s| s.len() + 1).sum::<usize>() + 1;
+            let col = |c: usize| rec.fields[c].1;
             let time: u64 = cells[0].parse().map_err(|_| {
                 format!(
                     "{name}:{}:1: time `{}` is not a whole number",
@@ -387,6 +388,20 @@ mod tests {
                 }
             ]
         );
+    }
+
+    #[test]
+    fn quoted_fields_keep_commas_quotes_and_line_breaks() {
+        let text = "time,step,event,origin,target,params,s,verdict_p\n\
+                    0,init,,,,,\"a,b\",true\n\
+                    1,send,go,a,b,\"msg=x, \"\"y\"\"\",\"two\nlines\",false\n";
+        let r = Run::from_csv("q.csv", text).unwrap();
+        assert_eq!(r.values[0][0], serde_json::json!("a,b"));
+        assert_eq!(r.values[0][1], serde_json::json!("two\nlines"));
+        assert_eq!(r.params[1], "msg=x, \"y\"");
+        assert_eq!(r.verdicts, ["10"]);
+        let e = Run::from_csv("q.csv", &text.replace("\"a,b\"", "\"a,b")).unwrap_err();
+        assert!(e.starts_with("q.csv:"), "{e}");
     }
 
     #[test]
