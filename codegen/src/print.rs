@@ -54,6 +54,41 @@ fn interval(iv: &Interval) -> String {
     }
 }
 
+/// Node `node` of a compiled program as a formula in surface syntax (bounds in ticks,
+/// `P`/`H` as lowered to `S`; every binary operation parenthesised): what a report
+/// shows for a subformula.
+pub fn node_formula(compiled: &crate::Compiled, node: u16) -> String {
+    use monitor_core::Op;
+    let program = compiled.program();
+    let Some(n) = program.nodes.get(node as usize) else {
+        return format!("node {node}");
+    };
+    let sub = |c: u16| node_formula(compiled, c);
+    let bin = |a: u16, op: &str, b: u16| format!("({} {op} {})", sub(a), sub(b));
+    match n.op {
+        Op::Const(b) => b.to_string(),
+        Op::Atom(k) => match compiled.atom_exprs().get(k as usize) {
+            Some(e) => format!("{{{}}}", expr(e, compiled.checked())),
+            None => format!("atom {k}"),
+        },
+        Op::Not(a) => format!("!{}", sub(a)),
+        Op::And(a, b) => bin(a, "&&", b),
+        Op::Or(a, b) => bin(a, "||", b),
+        Op::Implies(a, b) => bin(a, "->", b),
+        Op::Iff(a, b) => bin(a, "<->", b),
+        Op::Yesterday(a) => format!("Y {}", sub(a)),
+        Op::WeakYesterday(a) => format!("Z {}", sub(a)),
+        Op::Since { lhs, rhs, lo, hi } => {
+            let iv = match (lo, hi) {
+                (0, None) => String::new(),
+                (lo, None) => format!("[{lo}:]"),
+                (lo, Some(hi)) => format!("[{lo}:{hi}]"),
+            };
+            bin(lhs, &format!("S{iv}"), rhs)
+        }
+    }
+}
+
 /// A checked formula in surface syntax (bounds in ticks); every binary operation is parenthesised.
 pub fn formula(f: &Formula, spec: &CheckedSpec) -> String {
     let bin = |a: &Formula, op: &str, b: &Formula| {

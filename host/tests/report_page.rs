@@ -79,6 +79,15 @@ fn a_museum_study_page_shows_every_property_and_where_the_failing_run_turned_fal
         let seconds = format!("t = {} s", due_time as f64 / 10.0);
         assert!(item.contains(&seconds), "{item} has {seconds}");
         assert!(item.contains("href=\"#prop-alarm_response\""), "{item}");
+        // From memory, the subformula that failed: the response window, true there
+        // (61 ticks without an alarm since a low battery); files carry no node values.
+        assert_eq!(item.contains("class=\"culprit\""), from_memory, "{item}");
+        if from_memory {
+            assert!(
+                item.contains("(!{alarm} S[61:] {battery_level &lt;= 30})</code> was true"),
+                "{item}"
+            );
+        }
         // The run is embedded for the timeline, with every point.
         let points = csv.lines().count() - 1;
         assert!(html.contains(&format!("{points} points over")), "{points}");

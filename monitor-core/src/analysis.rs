@@ -13,6 +13,8 @@
 //! - [`horizon`]: the largest time bound in a property's formula.
 //! - [`arithmetic`]: whether the atoms need floating point or integer division
 //!   (the `float` / `int-div` features of this crate).
+//! - [`culprit`]: at a point where a property is false, the deepest subformula whose
+//!   value at that point explains it (what a report points at).
 //!
 //! The conformance tests (`tests/tests/analysis.rs`) check [`settle`] and
 //! [`repeat_is_noop`] against the reference oracle on the corpus and on random
@@ -219,5 +221,59 @@ pub(crate) fn instr_arithmetic(ins: &Instr, vars: &[Var<'_>]) -> Arithmetic {
     Arithmetic {
         float,
         int_div: matches!(ins, Instr::Div(NumTy::Int) | Instr::Rem(NumTy::Int)),
+    }
+}
+
+/// The subformula that explains a node's value `value(node)` at this point: from `node`,
+/// descend while one child's value at this point alone decides the node's, with the
+/// polarity that decides it:
+/// - `!a` is explained by `a` (with the opposite value);
+/// - a false `a && b` by its first false operand, a true `a || b` by its first true one;
+/// - a false `a -> b` by `b` (false; `a` is true);
+/// - a true unbounded `a S b` by `b` when `b` is true now (the witness is this point);
+/// - anything else (a constant, an atom, `<->`, `Y`, `Z`, a bounded `S`, a node whose
+///   operands both decide it) is its own explanation.
+///
+/// `value` gives a node's value after the point (`None` if unknown, which stops the
+/// descent). A node stays within its property's run of nodes, so this ends.
+pub fn culprit(
+    program: &Program<'_>,
+    node: NodeId,
+    value: impl Fn(NodeId) -> Option<bool>,
+) -> NodeId {
+    let mut n = node;
+    loop {
+        let Some(op) = program.nodes.get(n as usize).map(|x| x.op) else {
+            return n;
+        };
+        let Some(v) = value(n) else {
+            return n;
+        };
+        let next = match op {
+            Op::Not(a) => Some(a),
+            Op::And(a, b) if !v => [a, b].into_iter().find(|&c| value(c) == Some(false)),
+            Op::Or(a, b) if v => [a, b].into_iter().find(|&c| value(c) == Some(true)),
+            Op::Implies(_, b) if !v => Some(b),
+            Op::Since {
+                rhs,
+                lo: 0,
+                hi: None,
+                ..
+            } if v && value(rhs) == Some(true) => Some(rhs),
+            Op::Const(_)
+            | Op::Atom(_)
+            | Op::And(..)
+            | Op::Or(..)
+            | Op::Implies(..)
+            | Op::Iff(..)
+            | Op::Yesterday(_)
+            | Op::WeakYesterday(_)
+            | Op::Since { .. } => None,
+        };
+        match next {
+            // Children come before their parent: the descent always moves down.
+            Some(c) if c < n => n = c,
+            _ => return n,
+        }
     }
 }

@@ -157,6 +157,8 @@ pub struct Failing {
     pub file: String,
     /// The CSV text.
     pub csv: String,
+    /// Per property that turned false: the subformula that explains it, and its value.
+    pub culprits: Vec<crate::verify::record::Culprit>,
 }
 
 /// `verify --report FILE`: the study in memory (`report` is what `--json` prints), each
@@ -190,6 +192,7 @@ pub fn from_verify(
         run.property = Some(f.property.clone());
         run.run = Some(f.run);
         run.step_seconds = study.step_seconds;
+        run.culprits = f.culprits.clone();
         data.runs.push(run);
     }
     data.study = Some(study);

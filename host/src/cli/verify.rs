@@ -459,7 +459,7 @@ pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
         events: loaded.events,
         ..RunConfig::default()
     };
-    let csv = replay_csv(model, set, &run_cfg, args.seed, args.run)?;
+    let (csv, _) = replay_csv(model, set, &run_cfg, args.seed, args.run)?;
     match &args.output {
         Some(p) => {
             std::fs::write(p, csv).map_err(|e| CliError::Failed(format!("{}: {e}", p.display())))?
@@ -469,20 +469,21 @@ pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Replays run `k` of a study with `seed` and returns its CSV (see `verify::record`).
+/// Replays run `k` of a study with `seed` and returns its CSV (see `verify::record`)
+/// and, per property that turned false, the subformula that explains it.
 fn replay_csv(
     model: &CompiledModel,
     set: &PropertySet,
     run_cfg: &RunConfig,
     seed: u64,
     k: u64,
-) -> Result<String, CliError> {
+) -> Result<(String, Vec<crate::verify::record::Culprit>), CliError> {
     let mut judge = Judge::new(set).map_err(CliError::Failed)?;
     let mut rec = crate::verify::record::Recorder::new(&mut judge, model);
     rec.start();
     let mut rng = crate::smc::runner::stream(seed, k);
     Simulator::new(model).run(&mut rng, run_cfg, &mut rec);
-    Ok(rec.csv)
+    Ok((rec.csv, rec.culprits))
 }
 
 /// Replays each kept failing run (run k is stream k of the seed) and, with
@@ -501,7 +502,7 @@ fn save_failing(
     let mut kept = Vec::new();
     for (name, p) in set.guarantee_names().iter().zip(&result.properties) {
         for &k in &p.failing_runs {
-            let csv = replay_csv(model, set, run_cfg, args.seed, k)?;
+            let (csv, culprits) = replay_csv(model, set, run_cfg, args.seed, k)?;
             let path = args.out.join(format!("{name}-run{k}.csv"));
             if args.save_failing > 0 {
                 std::fs::write(&path, &csv).map_err(io)?;
@@ -513,6 +514,7 @@ fn save_failing(
                 run: k,
                 file,
                 csv,
+                culprits,
             });
         }
     }

@@ -186,6 +186,11 @@ pub struct Run {
     pub values: Vec<Vec<serde_json::Value>>,
     /// Each property's verdict at each point, as a string of `1` (true) and `0` (false).
     pub verdicts: Vec<String>,
+    /// Per property that turned false, when the run was replayed in memory: the
+    /// property, the subformula whose value at the first false point explains it
+    /// (bounds in ticks), and that value.
+    #[serde(default)]
+    pub culprits: Vec<crate::verify::record::Culprit>,
 }
 
 /// A property's first false point in a run.

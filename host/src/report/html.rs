@@ -340,10 +340,21 @@ fn run(o: &mut String, i: usize, r: &Run) {
     o.push_str("<ul class=\"first-false\">\n");
     for f in r.first_false() {
         let mine = r.property.as_deref() == Some(f.property.as_str());
+        let because =
+            r.culprits
+                .iter()
+                .find(|c| c.property == f.property)
+                .map_or(String::new(), |c| {
+                    format!(
+                        ": <code class=\"culprit\">{}</code> was {} there",
+                        esc(&c.formula),
+                        c.value
+                    )
+                });
         let _ = writeln!(
             o,
             "<li class=\"{}\" data-property=\"{}\" data-point=\"{}\" data-time=\"{}\">\
-             <a href=\"#prop-{}\">{}</a> is false from t = {} (point {}) \
+             <a href=\"#prop-{}\">{}</a> is false from t = {} (point {}){because} \
              <a class=\"show\" href=\"#run-{i}-point-{}\">show</a></li>",
             if mine { "kept-for" } else { "other" },
             esc(&f.property),

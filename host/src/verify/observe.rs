@@ -366,6 +366,19 @@ impl<'a> Judge<'a> {
         &self.verdicts
     }
 
+    /// For property `prop`, the subformula that explains its verdict at the last point
+    /// ([`analysis::culprit`]) in surface syntax (bounds in ticks), with its value then.
+    pub fn culprit(&self, prop: usize) -> Option<(String, bool)> {
+        let program = self.monitor.program();
+        let root = program.props.get(prop)?.root;
+        let value = |n| self.monitor.node_value(&self.state, n);
+        let n = analysis::culprit(program, root, value);
+        Some((
+            codegen::print::node_formula(&self.set.compiled, n),
+            value(n)?,
+        ))
+    }
+
     /// The property set this judge works for.
     pub fn set(&self) -> &'a PropertySet {
         self.set

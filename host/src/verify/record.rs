@@ -19,6 +19,20 @@ pub struct Recorder<'j, 'a> {
     model: &'a CompiledModel,
     /// The CSV text so far, header included.
     pub csv: String,
+    /// Per property that turned false, why, at its first false point.
+    pub culprits: Vec<Culprit>,
+}
+
+/// Why a property turned false: at its first false point, the subformula whose value
+/// there explains it ([`Judge::culprit`]).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Culprit {
+    /// The property.
+    pub property: String,
+    /// The subformula, in surface syntax with bounds in ticks.
+    pub formula: String,
+    /// Its value at that point.
+    pub value: bool,
 }
 
 impl<'j, 'a> Recorder<'j, 'a> {
@@ -35,7 +49,12 @@ impl<'j, 'a> Recorder<'j, 'a> {
             csv.push_str(p);
         }
         csv.push('\n');
-        Recorder { judge, model, csv }
+        Recorder {
+            judge,
+            model,
+            csv,
+            culprits: Vec::new(),
+        }
     }
 
     /// Judges and records the initial point.
@@ -88,6 +107,19 @@ impl<'j, 'a> Recorder<'j, 'a> {
             let _ = write!(self.csv, ",{v}");
         }
         self.csv.push('\n');
+        let names: Vec<&str> = compiled.property_names().collect();
+        for (i, &v) in self.judge.verdicts().iter().enumerate() {
+            let name = names.get(i).copied().unwrap_or("?");
+            if !v && !self.culprits.iter().any(|c| c.property == name) {
+                if let Some((formula, value)) = self.judge.culprit(i) {
+                    self.culprits.push(Culprit {
+                        property: name.to_string(),
+                        formula,
+                        value,
+                    });
+                }
+            }
+        }
     }
 }
 
