@@ -6,8 +6,8 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 /// The pipeline's order: a module may use the ones before it (and itself).
-const ORDER: [&str; 9] = [
-    "expr", "model", "sim", "robot", "props", "smc", "verify", "live", "cli",
+const ORDER: [&str; 10] = [
+    "expr", "model", "sim", "robot", "props", "smc", "verify", "report", "live", "cli",
 ];
 
 fn src() -> PathBuf {
