@@ -109,10 +109,19 @@ pub fn parse(disassembly: &str, read_u32: impl Fn(u64) -> Option<u32>) -> Vec<Fu
             if let Some(target) = operands
                 .split_once('<')
                 .and_then(|(_, t)| t.split_once('>'))
-                .map(|(t, _)| t.split('+').next().unwrap_or(t))
+                .map(|(t, _)| t)
             {
-                let target = strip_hash(target);
-                if target != f.name {
+                // A branch into the middle of another function is no call: compiled code
+                // enters a function at its start. Such a "branch" is data (a jump table's
+                // bytes, padding) that the disassembler decoded as an instruction; seen on
+                // Cortex-M0, where `monitor_core::expr::cmp`'s table decoded as `bmi` into
+                // `firmware::finish` and made the step seem to reach defmt.
+                let (name, into_middle) = match target.split_once('+') {
+                    Some((name, _)) => (name, true),
+                    None => (target, false),
+                };
+                let target = strip_hash(name);
+                if target != f.name && !into_middle {
                     f.calls.push((site, target.to_string()));
                 }
             }
@@ -353,6 +362,7 @@ mod tests {
 00000200 <monitor_core::helper::h0123456789abcdef>:
      200:      \tldr\tr0, [pc, #0x8]          @ 0x20c <monitor_core::helper+0xc>
      204:      \tb.w\t0x310 <core::panicking::panic_const::panic_const_rem_by_zero> @ imm = #0x10
+     208:      \tbmi\t0x53e <unrelated+0x3e> @ imm = #0x330
 
 00000300 <core::panicking::panic_bounds_check>:
      300:      \tbl\t0x400 <core::panicking::panic_fmt> @ imm = #0x100
