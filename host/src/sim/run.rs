@@ -551,8 +551,11 @@ impl<'m> Simulator<'m> {
                 if self.runnable.is_empty()
                     && self.deliverable.is_empty()
                     && !self.pending_list.is_empty()
+                    && cfg.quiescence == Quiescence::Stop
                 {
-                    // An event nobody can ever take blocks time: JANI's deadlock.
+                    // An event nobody can ever take blocks time: JANI's deadlock. A live
+                    // run (`Quiescence::AdvanceTime`) goes on: a process playing a node may
+                    // still answer and unblock it, as any external message may.
                     return Ok(EndReason::Quiescent);
                 }
             }
