@@ -303,6 +303,7 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         config.speed =
             live::check_speed(s).map_err(|m| CliError::Input(format!("--speed: {m}")))?;
     }
+    let mut record = args.record.as_ref().map(create).transpose()?;
     if let Some(addr) = serve_addr {
         let title = args
             .model
@@ -312,11 +313,16 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         let server = live::serve::serve(addr, live::serve::page(&title, &spec))
             .map_err(|e| CliError::Failed(format!("--serve {addr}: {e}")))?;
         eprintln!("monitor: live page at http://{}/", server.addr);
-        out = Box::new(live::serve::Tee::new(out, server.hub));
+        use live::serve::{Stream, Tee};
+        out = Box::new(Tee::new(out, server.hub.clone(), Stream::Verdict));
+        // The page's points are the input records: the log's own lines with `--record`
+        // (written to the file first), else records written for the page alone.
+        let log = record.unwrap_or_else(|| Box::new(std::io::sink()));
+        record = Some(Box::new(Tee::new(log, server.hub, Stream::Input)));
     }
     let mut opts = Options {
         verdicts: out,
-        record: args.record.as_ref().map(create).transpose()?,
+        record,
         every_point: args.every_point,
         poll: Duration::from_micros(args.poll_us),
         log: Box::new(std::io::stderr()),

@@ -1,11 +1,13 @@
 //! The sidecar's live page (`hindsight monitor --serve ADDR`): a small HTTP/1.1 server on
-//! its own threads that serves one self-contained page and streams every verdict line to
-//! it as server-sent events, as the monitor writes them.
+//! its own threads that serves one self-contained page (the report's timeline script and
+//! styles, `report/page.js` and `page.css`, inline) and streams to it, as server-sent
+//! events in the order the sidecar writes them, every input record (the points: their
+//! time and the variables they set, as `--record` writes them) and every verdict line.
 //!
-//! The verdict output itself is untouched: [`Tee`] writes every byte to the file (or
-//! standard output) first and only then hands complete lines to the [`Hub`], so a slow or
-//! absent browser can neither lose nor delay a verdict line, and stopping the monitor
-//! flushes the file as before. Hand-written on `std::net` (two routes and an event
+//! The outputs themselves are untouched: a [`Tee`] writes every byte to the verdict file
+//! (or standard output), or to the input log, first and only then hands complete lines to
+//! the [`Hub`], so a slow or absent browser can neither lose nor delay a verdict line, and
+//! stopping the monitor flushes the files as before. Hand-written on `std::net` (two routes and an event
 //! stream need no framework, and no async runtime beside the sidecar's loop).
 
 use std::collections::VecDeque;
@@ -15,21 +17,42 @@ use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-/// Lines the page can get on (re)connecting; older ones are only in the verdict file.
+/// Lines of each stream the page can get on (re)connecting; older ones are only in the
+/// verdict file (and the input log).
 pub const HISTORY: usize = 100_000;
 
-/// One published verdict line: its sequence number (the event id) and when it was
-/// published (milliseconds since the Unix epoch, for the page's delay figure).
+/// What a published line is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stream {
+    /// A verdict line.
+    Verdict = 0,
+    /// An input record (`live::record::Input` as JSON).
+    Input = 1,
+}
+
+impl Stream {
+    fn key(self) -> &'static str {
+        match self {
+            Stream::Verdict => "verdict",
+            Stream::Input => "input",
+        }
+    }
+}
+
+/// One published line: its sequence number (the event id), when it was published
+/// (milliseconds since the Unix epoch, for the page's delay figure) and its stream.
 #[derive(Clone, Debug)]
 struct Published {
     id: u64,
     sent_ms: u64,
+    stream: Stream,
     line: Arc<str>,
 }
 
 #[derive(Default)]
 struct HubState {
-    history: VecDeque<Published>,
+    /// Verdict lines and input records, each its own history (inputs are many more).
+    history: [VecDeque<Published>; 2],
     next_id: u64,
     subscribers: Vec<Sender<Published>>,
 }
@@ -41,21 +64,23 @@ pub struct Hub {
 }
 
 impl Hub {
-    /// Publishes one verdict line (without its newline) to every connection.
-    pub fn publish(&self, line: &str) {
+    /// Publishes one line of `stream` (without its newline) to every connection.
+    pub fn publish(&self, stream: Stream, line: &str) {
         let Ok(mut s) = self.state.lock() else {
             return;
         };
         let p = Published {
             id: s.next_id,
             sent_ms: now_ms(),
+            stream,
             line: line.into(),
         };
         s.next_id += 1;
-        if s.history.len() == HISTORY {
-            s.history.pop_front();
+        let history = &mut s.history[stream as usize];
+        if history.len() == HISTORY {
+            history.pop_front();
         }
-        s.history.push_back(p.clone());
+        history.push_back(p.clone());
         // A connection that is gone drops its receiver: forget it.
         s.subscribers.retain(|tx| tx.send(p.clone()).is_ok());
     }
@@ -66,23 +91,26 @@ impl Hub {
         let Ok(mut s) = self.state.lock() else {
             return (Vec::new(), rx);
         };
-        let past = s
+        // Both histories, in the order they were published.
+        let mut past: Vec<Published> = s
             .history
             .iter()
+            .flatten()
             .filter(|p| last_id.is_none_or(|l| p.id > l))
             .cloned()
             .collect();
+        past.sort_by_key(|p| p.id);
         s.subscribers.push(tx);
         (past, rx)
     }
 
-    /// Every line still held, newline-terminated.
+    /// Every verdict line still held, newline-terminated.
     fn all_lines(&self) -> String {
         let Ok(s) = self.state.lock() else {
             return String::new();
         };
         let mut out = String::new();
-        for p in &s.history {
+        for p in &s.history[Stream::Verdict as usize] {
             out.push_str(&p.line);
             out.push('\n');
         }
@@ -100,15 +128,17 @@ fn now_ms() -> u64 {
 pub struct Tee {
     inner: Box<dyn Write + Send>,
     hub: Arc<Hub>,
+    stream: Stream,
     partial: Vec<u8>,
 }
 
 impl Tee {
-    /// Writes to `inner`, publishing lines to `hub`.
-    pub fn new(inner: Box<dyn Write + Send>, hub: Arc<Hub>) -> Tee {
+    /// Writes to `inner`, publishing its lines to `hub` as lines of `stream`.
+    pub fn new(inner: Box<dyn Write + Send>, hub: Arc<Hub>, stream: Stream) -> Tee {
         Tee {
             inner,
             hub,
+            stream,
             partial: Vec::new(),
         }
     }
@@ -121,7 +151,8 @@ impl Write for Tee {
         let mut rest = &buf[..n];
         while let Some(i) = rest.iter().position(|&b| b == b'\n') {
             self.partial.extend_from_slice(&rest[..i]);
-            self.hub.publish(&String::from_utf8_lossy(&self.partial));
+            self.hub
+                .publish(self.stream, &String::from_utf8_lossy(&self.partial));
             self.partial.clear();
             rest = &rest[i + 1..];
         }
@@ -134,20 +165,32 @@ impl Write for Tee {
     }
 }
 
-/// The live page for `spec`: its properties in order (a row each before any verdict),
-/// the unit that turns ticks into seconds, and `title` (e.g. the model's path).
+/// The live page for `spec`: its properties in order (a row and a verdict lane each
+/// before any verdict), its variables (a lane each: name, whether an event, initial
+/// value), the unit that turns ticks into seconds, and `title` (e.g. the model's path).
 pub fn page(title: &str, spec: &codegen::Compiled) -> String {
     let names: Vec<&str> = spec.property_names().collect();
-    let data = serde_json::json!({ "properties": names, "unit_ns": spec.tick_ns() });
+    let vars: Vec<serde_json::Value> = spec
+        .vars()
+        .iter()
+        .map(|v| {
+            serde_json::json!({
+                "name": v.name,
+                "event": v.kind == monitor_core::VarKind::Event,
+                "init": super::record::value_json(spec, v.init),
+            })
+        })
+        .collect();
+    let data = serde_json::json!({ "properties": names, "vars": vars, "unit_ns": spec.tick_ns() });
     // `<` escaped so no name can close the script element.
     let data = data.to_string().replace('<', "\\u003c");
-    let title = title
-        .replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;");
+    // The title last: nothing it holds is taken for a placeholder.
     include_str!("page.html")
-        .replace("__TITLE__", &title)
+        .replace("__CSS__", include_str!("../report/page.css"))
+        .replace("__JS__", include_str!("../report/page.js"))
         .replace("__SPEC__", &data)
+        .replace("__VERSION__", env!("CARGO_PKG_VERSION"))
+        .replace("__TITLE__", &crate::report::html::esc(title))
 }
 
 /// Resolves `--serve ADDR`: a bare port (`8080`) or `:8080` means loopback, so the page
@@ -268,11 +311,15 @@ fn connection(stream: TcpStream, hub: &Hub, page: &str) -> std::io::Result<()> {
     }
 }
 
-/// One event: `id` for a reconnect's `Last-Event-ID`, data `{"sent_ms":..,"verdict":LINE}`.
+/// One event: `id` for a reconnect's `Last-Event-ID`, data `{"sent_ms":..,"verdict":LINE}`
+/// or `{"sent_ms":..,"input":RECORD}`.
 fn event(p: &Published) -> String {
     format!(
-        "id: {}\ndata: {{\"sent_ms\":{},\"verdict\":{}}}\n\n",
-        p.id, p.sent_ms, p.line
+        "id: {}\ndata: {{\"sent_ms\":{},\"{}\":{}}}\n\n",
+        p.id,
+        p.sent_ms,
+        p.stream.key(),
+        p.line
     )
 }
 
@@ -337,7 +384,7 @@ mod tests {
                 Ok(())
             }
         }
-        let mut tee = Tee::new(Box::new(Shared(file.clone())), hub.clone());
+        let mut tee = Tee::new(Box::new(Shared(file.clone())), hub.clone(), Stream::Verdict);
         let (_, rx) = hub.subscribe(None);
         tee.write_all(b"{\"a\":1}\n{\"b\"").unwrap();
         assert_eq!(hub.all_lines(), "{\"a\":1}\n");
@@ -350,5 +397,42 @@ mod tests {
         let (past, _) = hub.subscribe(Some(0));
         assert_eq!(past.len(), 1);
         assert!(event(&past[0]).starts_with("id: 1\ndata: {\"sent_ms\":"));
+        assert!(event(&past[0]).ends_with(",\"verdict\":{\"b\":2}}\n\n"));
+        // Input records go to the page in the same order, but not into the verdict lines.
+        let mut inputs = Tee::new(Box::new(std::io::sink()), hub.clone(), Stream::Input);
+        inputs
+            .write_all(b"{\"kind\":\"tick\",\"time\":3}\n")
+            .unwrap();
+        tee.write_all(b"{\"c\":3}\n").unwrap();
+        assert_eq!(hub.all_lines(), "{\"a\":1}\n{\"b\":2}\n{\"c\":3}\n");
+        let (past, _) = hub.subscribe(Some(1));
+        let texts: Vec<String> = past.iter().map(event).collect();
+        assert!(texts[0].starts_with("id: 2\n"), "{texts:?}");
+        assert!(texts[0].ends_with(",\"input\":{\"kind\":\"tick\",\"time\":3}}\n\n"));
+        assert!(
+            texts[1].ends_with(",\"verdict\":{\"c\":3}}\n\n"),
+            "{texts:?}"
+        );
+    }
+
+    #[test]
+    fn the_page_inlines_the_report_script_and_the_spec() {
+        let spec = codegen::compile_spec(
+            "unit 10ms;\nstate level: int = 100;\nevent alarm;\n\
+             property low = H({alarm} -> {level < 30});\n",
+            "t.hspec",
+        )
+        .unwrap();
+        let page = page("museum <guide>", &spec);
+        assert!(page.contains(include_str!("../report/page.js")));
+        assert!(page.contains("hindsight monitor: museum &lt;guide&gt;"));
+        assert!(page.contains(
+            "{\"properties\":[\"low\"],\"unit_ns\":10000000,\"vars\":[{\"event\":false,\
+             \"init\":100,\"name\":\"level\"},{\"event\":true,\"init\":false,\"name\":\"alarm\"}]}"
+        ));
+        for placeholder in ["__CSS__", "__JS__", "__SPEC__", "__TITLE__", "__VERSION__"] {
+            assert!(!page.contains(placeholder), "{placeholder}");
+        }
+        assert!(!page.contains("http://") && !page.contains("https://"));
     }
 }

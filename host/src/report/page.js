@@ -1,4 +1,6 @@
-// hindsight report: draws each failing run as a timeline (plain JavaScript and SVG, inline).
+// hindsight report and the live page of `monitor --serve`: draws a run as a timeline
+// (plain JavaScript and SVG, inline). The report draws each saved failing run once; the
+// live page feeds one timeline point by point from the sidecar's event stream.
 // Lanes: the messages (sends above, receives below), one per property variable (numbers
 // as steps, booleans and text as bands), one per verdict (true green, false red, the first
 // false point marked and linked to its formula). Wheel or buttons zoom, dragging pans,
@@ -13,6 +15,8 @@
   function countError() {
     errors += 1;
     body.setAttribute("data-errors", String(errors));
+    var shown = document.getElementById("errors");
+    if (shown) shown.textContent = String(errors);
   }
   window.addEventListener("error", countError);
   window.addEventListener("unhandledrejection", countError);
@@ -56,76 +60,86 @@
     return (m <= 1 ? 1 : m <= 2 ? 2 : m <= 5 ? 5 : 10) * mag;
   }
 
-  // The points where get(k) differs from the point before (and point 0): a lane is drawn
-  // from these, so its cost is its number of changes, not the run's number of points.
-  function changes(n, get) {
-    var out = [];
-    for (var k = 0; k < n; k++) {
-      if (k === 0 || get(k) !== get(k - 1)) out.push(k);
+  // A property's verdict at point k: the report's columns are strings of 1 and 0, the
+  // live page's arrays of the sidecar's words (true, currently_true, ..., unknown).
+  function verdictAt(col, k) {
+    if (typeof col !== "string") return col[k];
+    var c = col.charCodeAt(k);
+    return c === 49 ? "true" : c === 48 ? "false" : "unknown";
+  }
+  var VERDICT_FILL = { "true": GREEN, "false": RED, currently_true: "#8fd694",
+    currently_false: "#f08a8a", unknown: "#bbbbbb" };
+  function isFalse(v) { return v === "false" || v === "currently_false"; }
+
+  // Point k is the last so far (points are added in order, and the last one may change
+  // while its verdicts arrive): keeps lane.ch, the points where get(k) differs from the
+  // point before (and point 0). A lane is drawn from these, so its cost is its number
+  // of changes, not the run's number of points.
+  function touch(lane, k) {
+    var ch = lane.ch, last = ch.length > 0 && ch[ch.length - 1] === k, v = lane.get(k);
+    var is = k === 0 || v !== lane.get(k - 1);
+    if (is && !last) ch.push(k);
+    else if (!is && last) ch.pop();
+    if (lane.kind === "verdict") {
+      if (lane.first === k && !isFalse(v)) lane.first = -1;
+      if (lane.first < 0 && isFalse(v)) lane.first = k;
+    } else if (lane.kind !== "messages") {
+      // Numbers draw as steps, booleans as marks, anything else (or a mix) as text.
+      if (typeof v === "number") {
+        lane.nums = true;
+        if (v < lane.min) lane.min = v;
+        if (v > lane.max) lane.max = v;
+      } else if (typeof v === "boolean") lane.bools = true;
+      else lane.other = true;
+      lane.kind = lane.other || (lane.nums && lane.bools) ? "text" : lane.nums ? "num" : "bool";
     }
-    return out;
   }
 
   function lanesOf(run) {
-    var lanes = [{ kind: "messages", name: "messages" }];
+    var lanes = [{ kind: "messages", name: "messages", ch: [] }];
     run.vars.forEach(function (name, i) {
       var col = run.values[i];
-      var kind = "bool", min = Infinity, max = -Infinity;
-      for (var k = 0; k < col.length; k++) {
-        var v = col[k];
-        if (typeof v === "number") {
-          if (kind === "bool") kind = "num";
-          if (v < min) min = v;
-          if (v > max) max = v;
-        } else if (typeof v !== "boolean") {
-          kind = "text";
-          break;
-        }
-      }
-      if (kind === "num" && col.some(function (v) { return typeof v !== "number"; })) kind = "text";
-      var get = function (k) { return col[k]; };
-      lanes.push({ kind: kind, name: name, get: get, min: min, max: max, ch: changes(col.length, get) });
+      lanes.push({ kind: "bool", name: name, get: function (k) { return col[k]; }, min: Infinity,
+        max: -Infinity, ch: [] });
     });
     run.verdict_names.forEach(function (name, j) {
-      var col = run.verdicts[j];
-      var get = function (k) { return col.charCodeAt(k) === 49; };
-      lanes.push({ kind: "verdict", name: name, first: col.indexOf("0"), get: get, ch: changes(col.length, get) });
+      var col = run.verdicts;
+      lanes.push({ kind: "verdict", name: name, first: -1, ch: [],
+        get: function (k) { return verdictAt(col[j], k); } });
     });
     return lanes;
   }
 
-  function Timeline(el, run, tools, state) {
+  // A run's timeline in `el`, with its buttons in `tools` and the selected point's state
+  // in `state`. `opts.follow`: the view keeps the run's end in sight as points are added
+  // (`grow`); zooming or panning stops that, the "follow" button starts it again.
+  function Timeline(el, run, tools, state, opts) {
     this.el = el;
     this.run = run;
     this.tools = tools;
     this.state = state;
-    this.n = run.time.length;
-    this.t0 = this.n ? run.time[0] : 0;
-    this.tEnd = this.n ? run.time[this.n - 1] : 1;
-    if (this.tEnd <= this.t0) this.tEnd = this.t0 + 1;
-    this.view = [this.t0, this.tEnd];
+    this.follow = !!(opts && opts.follow);
     this.sel = -1;
     this.pinned = false;
     this.lanes = lanesOf(run);
+    // The two kinds of point the message lane marks (the report's sends and receives, the
+    // live page's samples and requests).
+    var kinds = run.message_kinds || ["send", "receive"];
+    this.sendName = run.names.indexOf(kinds[0]);
+    this.receiveName = run.names.indexOf(kinds[1]);
     // Sends and receives before each point, so a pixel asks "any message here?" in O(log n).
-    var names = run.names, send = names.indexOf("send"), receive = names.indexOf("receive");
-    this.sends = new Int32Array(this.n + 1);
-    this.receives = new Int32Array(this.n + 1);
-    for (var k = 0; k < this.n; k++) {
-      this.sends[k + 1] = this.sends[k] + (run.step[k] === send ? 1 : 0);
-      this.receives[k + 1] = this.receives[k] + (run.step[k] === receive ? 1 : 0);
-    }
+    this.sends = [0];
+    this.receives = [0];
+    this.sendIdx = [];
+    this.n = 0;
+    this.grow();
+    this.view = [this.t0, this.tEnd];
     this.height = AXIS + this.lanes.length * LANE + PAD;
     this.measure();
     this.bind();
     var t = performance.now();
     this.draw();
     this.drawMs = performance.now() - t;
-    this.sendIdx = [];
-    var sendName = run.names.indexOf("send");
-    for (var p = 0; p < this.n; p++) {
-      if (run.step[p] === sendName) this.sendIdx.push(p);
-    }
     if (state && this.sendIdx.length > 0) {
       this.seqEl = document.createElement("div");
       this.seqEl.className = "seq";
@@ -141,6 +155,53 @@
       this.drawTree();
     }
   }
+
+  // Takes in the points added to the run's columns since the last call (and the last
+  // point again: its verdicts may have changed), then redraws on the next frame.
+  Timeline.prototype.grow = function () {
+    var run = this.run, to = run.time.length, from = Math.max(this.n - 1, 0);
+    var send = run.names.indexOf("send"), lanes = this.lanes;
+    for (var k = from; k < to; k++) {
+      for (var i = 1; i < lanes.length; i++) touch(lanes[i], k);
+      if (k < this.n) continue;
+      this.sends.push(this.sends[k] + (run.step[k] === this.sendName ? 1 : 0));
+      this.receives.push(this.receives[k] + (run.step[k] === this.receiveName ? 1 : 0));
+      if (run.step[k] === send) this.sendIdx.push(k);
+    }
+    var oldEnd = this.tEnd, whole = this.view && this.view[0] <= this.t0 && this.view[1] >= oldEnd;
+    this.n = to;
+    this.t0 = to ? run.time[0] : 0;
+    this.tEnd = to ? Math.max(run.time[to - 1], this.t0 + 1) : 1;
+    if (!this.view) return;
+    if (this.follow) {
+      var span = this.view[1] - this.view[0];
+      this.view = whole ? [this.t0, this.tEnd] : [Math.max(this.tEnd - span, this.t0), this.tEnd];
+      if (!this.pinned) this.sel = to - 1;
+    }
+    this.schedule();
+  };
+  Timeline.prototype.schedule = function () {
+    var self = this;
+    if (this.pending) return;
+    this.pending = true;
+    requestAnimationFrame(function () {
+      self.pending = false;
+      self.draw();
+      if (self.sel >= 0) self.showState();
+      if (self.onDrawn) self.onDrawn();
+    });
+  };
+  Timeline.prototype.setFollow = function (on) {
+    this.follow = on;
+    this.el.setAttribute("data-follow", on ? "on" : "off");
+    var b = this.tools && this.tools.querySelector("[data-act=follow]");
+    if (b) b.className = on ? "on" : "";
+    if (on) {
+      var span = this.view[1] - this.view[0];
+      this.setView(this.tEnd - span, this.tEnd);
+      this.draw();
+    }
+  };
 
   // The drawing width, read once per draw (reading layout per point would be slow).
   Timeline.prototype.measure = function () {
@@ -232,7 +293,7 @@
   // Message ticks: sends in the upper half, receives in the lower; one per pixel and kind.
   Timeline.prototype.ticks = function (y, h, lo, hi) {
     var time = this.run.time, step = this.run.step, seen = {}, d = ["", ""];
-    var send = this.run.names.indexOf("send"), receive = this.run.names.indexOf("receive");
+    var send = this.sendName, receive = this.receiveName;
     var R = this.width() - RIGHT;
     if (hi - lo > 2 * (R - LABEL)) {
       // More points than pixels: ask each pixel whether it holds a send or a receive.
@@ -284,6 +345,7 @@
     var parts = ['<svg width="' + W + '" height="' + this.height + '">', this.axis()];
     this.lanes.forEach(function (lane, i) {
       var y = AXIS + i * LANE, h = LANE - 6;
+      parts.push('<g class="lane" data-kind="' + lane.kind + '" data-name="' + esc(lane.name) + '">');
       parts.push('<rect x="0" y="' + y + '" width="' + W + '" height="' + (LANE - 2) + '" fill="' +
         (i % 2 ? "#fff" : "#f6f6f6") + '"/>');
       var label = esc(lane.name);
@@ -306,7 +368,8 @@
           return seen[v];
         }, "#bbb", lo, hi));
       } else {
-        parts.push(self.bands(lane, yb, h, function (v) { return v ? GREEN : RED; }, MIXED, lo, hi));
+        parts.push(self.bands(lane, yb, h, function (v) { return VERDICT_FILL[v] || "#bbbbbb"; }, MIXED,
+          lo, hi));
         if (lane.first >= 0) {
           var ft = time[lane.first], fx = self.x(ft);
           if (fx >= LABEL - 1 && fx <= W - RIGHT + 1) {
@@ -319,6 +382,7 @@
           }
         }
       }
+      parts.push("</g>");
     });
     if (this.sel >= 0) {
       var sx = this.x(time[this.sel]);
@@ -343,7 +407,8 @@
     var rows = [["point", k + " of " + this.n + (this.pinned ? " (pinned)" : "")],
       ["time", this.timeText(r.time[k])], ["step", nm[r.step[k]]]];
     if (nm[r.event[k]]) {
-      rows.push(["message", nm[r.event[k]] + ": " + nm[r.origin[k]] + " \u2192 " + nm[r.target[k]]]);
+      var from = nm[r.origin[k]], to = nm[r.target[k]];
+      rows.push(["message", nm[r.event[k]] + (from || to ? ": " + from + " \u2192 " + to : "")]);
     }
     if (r.params[k]) rows.push(["parameters", r.params[k]]);
     var html = "<table><tbody>";
@@ -354,9 +419,9 @@
       html += "<tr><th>" + esc(name) + "</th><td>" + esc(r.values[i][k]) + "</td></tr>";
     });
     r.verdict_names.forEach(function (name, j) {
-      var ok = r.verdicts[j].charCodeAt(k) === 49;
+      var v = verdictAt(r.verdicts[j], k);
       html += '<tr><th><a href="#prop-' + anchor(name) + '">' + esc(name) + '</a></th><td class="' +
-        (ok ? "t" : "f") + '">' + (ok ? "true" : "false") + "</td></tr>";
+        (isFalse(v) ? "f" : v === "unknown" ? "u" : "t") + '">' + esc(v) + "</td></tr>";
     });
     this.state.innerHTML = html + "</tbody></table>";
   };
@@ -542,6 +607,7 @@
   };
   Timeline.prototype.zoom = function (factor, around) {
     var a = this.view[0], b = this.view[1];
+    if (this.follow) this.setFollow(false);
     if (around === undefined) around = (a + b) / 2;
     this.setView(around - (around - a) * factor, around + (b - around) * factor);
     this.draw();
@@ -551,6 +617,7 @@
     if (this.n === 0) return;
     k = Math.min(Math.max(k, 0), this.n - 1);
     var t = this.run.time[k], span = Math.max((this.tEnd - this.t0) / 20, 20);
+    if (this.follow) this.setFollow(false);
     this.setView(t - span / 2, t + span / 2);
     this.select(k, true);
   };
@@ -585,7 +652,10 @@
       var x = localX(e);
       if (drag) {
         var dx = x - drag.x;
-        if (Math.abs(dx) > 3) drag.moved = true;
+        if (Math.abs(dx) > 3 && !drag.moved) {
+          drag.moved = true;
+          if (self.follow) self.setFollow(false);
+        }
         if (drag.moved) {
           var per = (drag.view[1] - drag.view[0]) / (self.width() - LABEL - RIGHT);
           self.setView(drag.view[0] - dx * per, drag.view[1] - dx * per);
@@ -609,40 +679,158 @@
         else if (act === "in") self.zoom(0.5);
         else if (act === "out") self.zoom(2);
         else if (act === "false") self.toFirstFalse();
+        else if (act === "follow") self.setFollow(true);
       });
     }
     window.addEventListener("resize", function () { self.draw(); });
   };
 
-  var start = performance.now();
-  var runs = JSON.parse(document.getElementById("hindsight-runs").textContent);
-  var drawn = 0, drawMs = 0;
-  runs.forEach(function (run, i) {
-    var el = document.getElementById("timeline-" + i);
-    if (!el) return;
-    var section = document.getElementById("run-" + i);
-    var tl = new Timeline(el, run, section && section.querySelector(".tools"),
-      document.getElementById("state-" + i));
-    el.hindsightTimeline = tl;
-    drawn += 1;
-    drawMs = Math.max(drawMs, tl.drawMs);
-  });
-  // `#run-I-point-K` (the first false points link there) selects point K of run I.
-  function fromHash() {
-    var m = /^#run-(\d+)-point-(\d+)$/.exec(window.location.hash);
-    var el = m && document.getElementById("timeline-" + m[1]);
-    if (el && el.hindsightTimeline) {
-      el.hindsightTimeline.focusPoint(Number(m[2]));
-      el.scrollIntoView();
+  // The report: every saved failing run, drawn once.
+  function report(data) {
+    var start = performance.now();
+    var runs = JSON.parse(data.textContent);
+    var drawn = 0, drawMs = 0;
+    runs.forEach(function (run, i) {
+      var el = document.getElementById("timeline-" + i);
+      if (!el) return;
+      var section = document.getElementById("run-" + i);
+      var tl = new Timeline(el, run, section && section.querySelector(".tools"),
+        document.getElementById("state-" + i));
+      el.hindsightTimeline = tl;
+      drawn += 1;
+      drawMs = Math.max(drawMs, tl.drawMs);
+    });
+    // `#run-I-point-K` (the first false points link there) selects point K of run I.
+    function fromHash() {
+      var m = /^#run-(\d+)-point-(\d+)$/.exec(window.location.hash);
+      var el = m && document.getElementById("timeline-" + m[1]);
+      if (el && el.hindsightTimeline) {
+        el.hindsightTimeline.focusPoint(Number(m[2]));
+        el.scrollIntoView();
+      }
     }
+    window.addEventListener("hashchange", fromHash);
+    fromHash();
+    var now = performance.now();
+    body.setAttribute("data-rendered", String(drawn));
+    // Milliseconds reading and drawing the timelines, the longest single draw (what a zoom
+    // or pan at that view costs), and from navigation start to here (page parsed).
+    body.setAttribute("data-render-ms", (now - start).toFixed(1));
+    body.setAttribute("data-draw-ms", drawMs.toFixed(1));
+    body.setAttribute("data-ready-ms", now.toFixed(1));
   }
-  window.addEventListener("hashchange", fromHash);
-  fromHash();
-  var now = performance.now();
-  body.setAttribute("data-rendered", String(drawn));
-  // Milliseconds reading and drawing the timelines, the longest single draw (what a zoom
-  // or pan at that view costs), and from navigation start to here (page parsed).
-  body.setAttribute("data-render-ms", (now - start).toFixed(1));
-  body.setAttribute("data-draw-ms", drawMs.toFixed(1));
-  body.setAttribute("data-ready-ms", now.toFixed(1));
+
+  // The live page (`monitor --serve`): the sidecar's inputs and verdict lines arrive as
+  // server-sent events in the order it wrote them. Each input is a point (its variables'
+  // values carried from the point before, an event true only at its point); the verdict
+  // lines after it are that point's verdicts, carried to the points after it.
+  function live(data) {
+    var spec = JSON.parse(data.textContent), props = spec.properties, vars = spec.vars;
+    var run = { name: "live", property: null, run: null, step_seconds: spec.unit_ns / 1e9,
+      vars: vars.map(function (v) { return v.name; }), verdict_names: props, time: [],
+      names: ["sample", "request", ""], message_kinds: ["sample", "request"], step: [], event: [],
+      origin: [], target: [], params: [], values: vars.map(function () { return []; }),
+      verdicts: props.map(function () { return []; }) };
+    var ids = {}, index = {}, rows = {}, now = vars.map(function (v) { return v.init; });
+    var verdict = props.map(function () { return "unknown"; });
+    var lines = 0, lastTime = 0, delays = [], waiting = [];
+    function intern(s) {
+      if (!(s in ids)) { ids[s] = run.names.length; run.names.push(s); }
+      return ids[s];
+    }
+    run.names.forEach(function (s, i) { ids[s] = i; });
+    function text(id, v) { document.getElementById(id).textContent = v; }
+    function seconds(t) { return num(t * spec.unit_ns / 1e9) + " s"; }
+    props.forEach(function (p, j) {
+      index[p] = j;
+      var tr = document.createElement("tr");
+      tr.id = "prop-" + anchor(p);
+      tr.setAttribute("data-property", p);
+      tr.innerHTML = "<td><b>" + esc(p) + "</b></td><td><span class=\"badge v-none\">none</span></td>" +
+        "<td class=\"since\">-</td><td class=\"ff\">-</td>";
+      document.getElementById("rows").appendChild(tr);
+      rows[p] = tr;
+    });
+    var el = document.getElementById("timeline-live");
+    var tl = new Timeline(el, run, document.querySelector(".tools"), document.getElementById("state-live"),
+      { follow: true });
+    el.hindsightTimeline = tl;
+    tl.setFollow(true);
+    function point(time, kind, source, params, sets) {
+      run.time.push(time);
+      run.step.push(intern(kind));
+      run.event.push(intern(source || ""));
+      run.origin.push(ids[""]);
+      run.target.push(ids[""]);
+      run.params.push(params);
+      vars.forEach(function (v, i) {
+        var x = sets && Object.prototype.hasOwnProperty.call(sets, v.name) ? sets[v.name]
+          : v.event ? false : now[i];
+        now[i] = x;
+        run.values[i].push(x);
+      });
+      verdict.forEach(function (w, j) { run.verdicts[j].push(w); });
+      if (time > lastTime) lastTime = time;
+    }
+    function input(r) {
+      if (r.kind === "sample" || r.kind === "request") {
+        point(r.time, r.kind, r.source, r.filter ? "may not falsify: " + r.filter.join(", ") : "", r.sets);
+      } else if (r.kind === "tick") point(r.time, "tick", "", "", null);
+      else if (r.kind === "loss") {
+        point(r.time, "loss", r.source, r.count + " lost (" + r.reason + "): " + r.vars.join(", "), null);
+      } else if (r.kind === "restart") point(r.time, "restart", r.source, "gap " + r.gap, null);
+    }
+    function judged(v) {
+      var j = index[v.property], tr = rows[v.property];
+      if (j === undefined) return;
+      if (run.time.length === 0) point(v.time, "tick", "", "", null);
+      verdict[j] = v.verdict;
+      run.verdicts[j][run.time.length - 1] = v.verdict;
+      tr.setAttribute("data-verdict", v.verdict);
+      var badge = tr.querySelector(".badge");
+      badge.className = "badge v-" + v.verdict;
+      badge.textContent = v.verdict;
+      tr.querySelector(".since").textContent = seconds(v.time);
+      if (isFalse(v.verdict) && !tr.hasAttribute("data-first-false")) {
+        tr.setAttribute("data-first-false", String(v.time * spec.unit_ns / 1e9));
+        tr.querySelector(".ff").textContent = seconds(v.time);
+      }
+      if (v.time > lastTime) lastTime = v.time;
+    }
+    // The delay from the sidecar writing a verdict line to the frame that draws it.
+    tl.onDrawn = function () {
+      var t = Date.now();
+      waiting.forEach(function (sent) { delays.push(Math.max(0, t - sent)); });
+      waiting = [];
+      if (delays.length > 10000) delays = delays.slice(-10000);
+      text("lines", lines);
+      text("points", run.time.length);
+      text("last", seconds(lastTime));
+      if (delays.length) {
+        var s = delays.slice().sort(function (a, b) { return a - b; });
+        text("delay-last", delays[delays.length - 1]);
+        text("delay-median", s[Math.floor(s.length / 2)]);
+        text("delay-max", s[s.length - 1]);
+      }
+    };
+    var status = document.getElementById("status");
+    var es = new EventSource("/events");
+    es.onopen = function () { status.textContent = "live"; status.className = ""; };
+    es.onerror = function () { status.textContent = "reconnecting"; status.className = "down"; };
+    es.onmessage = function (e) {
+      var m = JSON.parse(e.data);
+      if (m.input) input(m.input);
+      if (m.verdict) {
+        lines += 1;
+        waiting.push(m.sent_ms);
+        judged(m.verdict);
+      }
+      tl.grow();
+    };
+  }
+
+  var runs = document.getElementById("hindsight-runs");
+  if (runs) report(runs);
+  var spec = document.getElementById("hindsight-live");
+  if (spec) live(spec);
 })();
