@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use live_common::{example, finish, scratch, unique, Guard};
+use live_common::{example, finish, hindsight, museum, museum_config, scratch, unique, Guard};
 
 /// Model time per wall-clock time: a model step of 100 ms takes 50 ms, so the sidecar's
 /// rounding to the nearest tick absorbs 25 ms of scheduling jitter either way, and a
@@ -28,14 +28,6 @@ const REQUIREMENTS: [&str; 5] = [
     "poi_response",
     "visitors_recurrence",
 ];
-
-fn museum() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-guide")
-}
-
-fn hindsight() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_hindsight"))
-}
 
 /// What one live session produced.
 struct Session {
@@ -88,15 +80,7 @@ impl Session {
 fn session(tag: &str, duration: &str, battery_period: Option<&str>) -> Session {
     let dir = scratch(tag);
     let prefix = unique(tag);
-    let layout = hindsight()
-        .arg("run")
-        .arg(museum())
-        .args(["--layout", "--prefix", &prefix])
-        .output()
-        .unwrap();
-    assert!(layout.status.success());
-    let config = dir.join("museum.toml");
-    std::fs::write(&config, &layout.stdout).unwrap();
+    let config = museum_config(&dir, &prefix);
     let verdicts = dir.join("verdicts.jsonl");
     let record = dir.join("input.jsonl");
     let monitor_err = dir.join("monitor.err");

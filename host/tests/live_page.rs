@@ -1,7 +1,9 @@
 //! The sidecar's live page (`monitor --serve`): a browser connected while the museum runs
-//! sees the verdicts arrive, the page's lines are the verdict file's, and stopping the
-//! monitor loses no verdict line. The browser is headless Chromium (installed by
-//! `.ci/run`); without it, and outside CI, the browser part is skipped with a note.
+//! sees the verdicts arrive in the report's timeline (a verdict lane per property, its
+//! changes at the times of the verdict lines), the page's lines are the verdict file's,
+//! and stopping the monitor loses no verdict line. The browser is headless Chromium
+//! (installed by `.ci/run`, driven by `browser/mod.rs`); without it, and outside CI, the
+//! browser part is skipped with a note.
 
 #[path = "live_common/mod.rs"]
 mod live_common;
@@ -10,20 +12,11 @@ mod browser;
 
 use std::io::{Read, Write};
 use std::net::TcpStream;
-use std::path::PathBuf;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use browser::{chromium, shot_path, Browser};
-use live_common::{finish, scratch, unique, Guard};
-
-fn hindsight() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_hindsight"))
-}
-
-fn museum() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-guide")
-}
+use live_common::{finish, hindsight, museum, museum_config, scratch, unique, Guard};
 
 /// A plain GET, status line and all, for the server's own routes.
 fn get(addr: &str, path: &str) -> String {
@@ -34,27 +27,58 @@ fn get(addr: &str, path: &str) -> String {
     text
 }
 
-/// What the page shows: verdict lines received, and each row's property and verdict.
-const PAGE_STATE: &str = "JSON.stringify({lines: +document.getElementById('lines').textContent, \
+/// What the page shows: verdict lines received, each row's property and verdict, the
+/// timeline's points, and per verdict lane its changes (time, verdict), the colours
+/// drawn in it and the time of its first-false mark.
+const PAGE_STATE: &str = "(function () { \
+    var tl = document.getElementById('timeline-live').hindsightTimeline; \
+    return JSON.stringify({lines: +tl.el.getAttribute('data-lines'), \
     errors: +document.getElementById('errors').textContent, \
     median: +document.getElementById('delay-median').textContent, \
     max: +document.getElementById('delay-max').textContent, \
+    points: tl.n, follow: tl.el.getAttribute('data-follow'), \
     rows: Array.from(document.querySelectorAll('tr[data-property]')).map(function (r) { \
-      return [r.getAttribute('data-property'), r.getAttribute('data-verdict')]; })})";
+      return [r.getAttribute('data-property'), r.getAttribute('data-verdict')]; }), \
+    lanes: tl.lanes.filter(function (l) { return l.kind === 'verdict'; }).map(function (l) { \
+      var g = tl.el.querySelector('g.lane[data-kind=verdict][data-name=' + l.name + ']'); \
+      var mark = tl.el.querySelector('g.ff-mark[data-property=' + l.name + ']'); \
+      return {name: l.name, changes: l.ch.map(function (k) { return [tl.run.time[k], l.get(k)]; }), \
+        fills: Array.from(g.querySelectorAll('rect')).slice(1).map(function (r) { \
+          return r.getAttribute('fill'); }), \
+        mark: mark && +mark.getAttribute('data-time')}; })}); })()";
+
+/// The colour of each verdict in a verdict lane (`report/page.js`, `VERDICT_FILL`).
+fn fill(verdict: &str) -> &'static str {
+    match verdict {
+        "true" => "#59a14f",
+        "false" => "#d62728",
+        "currently_true" => "#8fd694",
+        "currently_false" => "#f08a8a",
+        _ => "#bbbbbb",
+    }
+}
+
+/// Per property, its verdict changes among `lines`: (time, verdict), a later line at the
+/// same time replacing the earlier one (both land on the same point).
+fn changes(lines: &[serde_json::Value], property: &str) -> Vec<(u64, String)> {
+    let mut out: Vec<(u64, String)> = Vec::new();
+    for l in lines.iter().filter(|l| l["property"] == property) {
+        let (t, v) = (l["time"].as_u64().unwrap(), l["verdict"].as_str().unwrap());
+        if out.last().is_some_and(|(lt, _)| *lt == t) {
+            out.pop();
+        }
+        if out.last().is_none_or(|(_, lv)| lv != v) {
+            out.push((t, v.to_string()));
+        }
+    }
+    out
+}
 
 #[test]
 fn the_live_page_shows_the_verdicts_as_they_arrive() {
     let dir = scratch("live-page");
     let prefix = unique("live-page");
-    let layout = hindsight()
-        .arg("run")
-        .arg(museum())
-        .args(["--layout", "--prefix", &prefix])
-        .output()
-        .unwrap();
-    assert!(layout.status.success());
-    let config = dir.join("museum.toml");
-    std::fs::write(&config, &layout.stdout).unwrap();
+    let config = museum_config(&dir, &prefix);
     let verdicts = dir.join("verdicts.jsonl");
     let err_path = dir.join("monitor.err");
     let mut monitor = Guard(Some(
@@ -102,16 +126,30 @@ fn the_live_page_shows_the_verdicts_as_they_arrive() {
         );
         b
     });
-    let run = hindsight()
-        .arg("run")
-        .arg(museum())
-        .args(["--prefix", &prefix, "--seed", "2", "--speed", "10"])
-        .args(["--duration", "60s"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .output()
-        .unwrap();
-    assert!(run.status.success());
+    let mut run = Guard(Some(
+        hindsight()
+            .arg("run")
+            .arg(museum())
+            .args(["--prefix", &prefix, "--seed", "2", "--speed", "10"])
+            .args(["--duration", "60s"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    ));
+    // While the system runs (6 s of wall-clock time), the timeline already shows verdicts.
+    let during = browser.as_mut().map(|b| {
+        b.wait_for(
+            "document.getElementById('timeline-live').hindsightTimeline.lanes.some(function (l) { \
+               return l.kind === 'verdict' && l.ch.length > 0 && l.get(l.ch[l.ch.length - 1]) !== 'unknown'; })",
+            Duration::from_secs(30),
+        );
+        b.eval("document.getElementById('timeline-live').hindsightTimeline.n")
+            .as_u64()
+            .unwrap()
+    });
+    let (status, _) = finish(&mut run);
+    assert!(status.success());
     let served_body = |addr: &str| {
         let t = get(addr, "/verdicts.jsonl");
         t[t.find("\r\n\r\n").unwrap() + 4..].to_string()
@@ -123,6 +161,11 @@ fn the_live_page_shows_the_verdicts_as_they_arrive() {
         b.wait_for(
             &format!("+document.getElementById('lines').textContent >= {so_far}"),
             Duration::from_secs(30),
+        );
+        // The view followed the run to its end (no zoom or pan happened).
+        b.wait_for(
+            "document.getElementById('timeline-live').getAttribute('data-follow') === 'on'",
+            Duration::from_secs(5),
         );
         let state: serde_json::Value =
             serde_json::from_str(b.eval(PAGE_STATE).as_str().unwrap()).unwrap();
@@ -172,6 +215,52 @@ fn the_live_page_shows_the_verdicts_as_they_arrive() {
             "{p}: {state}"
         );
     }
+    // The timeline: every property's lane changes where its verdict lines change it, at
+    // their times (the points before its first line are unknown), shows the colour of
+    // each of those verdicts, and marks the first false one.
+    let during = during.unwrap();
+    let points = state["points"].as_u64().unwrap();
+    assert!(
+        during < points,
+        "the page had {during} of {points} points when it first showed a verdict"
+    );
+    let lanes = state["lanes"].as_array().unwrap();
+    assert_eq!(lanes.len(), state["rows"].as_array().unwrap().len());
+    for lane in lanes {
+        let p = lane["name"].as_str().unwrap();
+        let mut got: Vec<(u64, String)> = lane["changes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| (c[0].as_u64().unwrap(), c[1].as_str().unwrap().to_string()))
+            .collect();
+        if got.first().is_some_and(|(_, v)| v == "unknown") {
+            got.remove(0);
+        }
+        let want = changes(&lines[..shown], p);
+        assert_eq!(got, want, "{p}: {state}");
+        let fills: Vec<&str> = lane["fills"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap())
+            .collect();
+        for (_, v) in &want {
+            assert!(fills.contains(&fill(v)), "{p}: no {v} drawn in {fills:?}");
+        }
+        let first_false = want
+            .iter()
+            .find(|(_, v)| v == "false" || v == "currently_false");
+        assert_eq!(
+            lane["mark"].as_u64(),
+            first_false.map(|(t, _)| *t),
+            "{p}: {state}"
+        );
+    }
+    assert!(
+        lanes.iter().any(|l| l["mark"].as_u64().is_some()),
+        "no property turned false: {state}"
+    );
     println!(
         "verdict to page: median {} ms, max {} ms over {shown} lines",
         state["median"], state["max"]

@@ -1,137 +1,57 @@
-//! The report in a real browser: headless Chromium opens the pages hindsight writes for
-//! the museum (a failing bound with its saved run, and a sweep), with every host name
-//! unresolvable, and the test reads the DOM after the scripts ran, the console and a
-//! screenshot (kept in `target/report-screenshots/`).
+//! The report in a real browser: headless Chromium (the driver of `browser/mod.rs`) opens
+//! the pages hindsight writes for the museum (a failing bound with its saved run, and a
+//! sweep), with every host name unresolvable, and the test reads the DOM after the
+//! scripts ran, the console, every request, and a screenshot (kept in
+//! `target/screenshots/`).
 //!
 //! Chromium is `$CHROMIUM` or `/usr/bin/chromium` (`.ci/run` installs it). Without it the
 //! tests say why and pass, unless `CI` is set: then a missing browser is a failure.
 
+mod browser;
 mod report_common;
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::path::Path;
+use std::time::Duration;
 
-use report_common::{expected_first_false, hindsight, museum, scratch};
-
-/// The browser, or `None` (with the reason printed) when the test may skip.
-fn browser() -> Option<PathBuf> {
-    let path = std::env::var_os("CHROMIUM")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("/usr/bin/chromium"));
-    if path.is_file() {
-        return Some(path);
-    }
-    if std::env::var_os("CI").is_some() {
-        panic!(
-            "CI is set and there is no Chromium at {} (.ci/run installs it with \
-             `apt-get install -y chromium`; CHROMIUM=path names another)",
-            path.display()
-        );
-    }
-    eprintln!(
-        "skipped: no Chromium at {} (install it, or run .ci/run, or set CHROMIUM=path)",
-        path.display()
-    );
-    None
-}
-
-/// Where screenshots are kept for people (and CI artifacts) to look at.
-fn screenshots() -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .parent()
-        .unwrap()
-        .join("report-screenshots");
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// Runs Chromium headless on `url` with `extra` flags and a fresh profile; returns
-/// stdout and stderr. No host name resolves, so any fetch fails loudly in the console.
-fn chromium(browser: &Path, url: &str, extra: &[String], profile: &Path) -> (String, String) {
-    let _ = std::fs::remove_dir_all(profile);
-    let mut child = Command::new(browser)
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--hide-scrollbars",
-            "--window-size=1400,3400",
-            "--host-resolver-rules=MAP * ~NOTFOUND",
-            "--enable-logging=stderr",
-            "--v=0",
-        ])
-        .arg(format!("--user-data-dir={}", profile.display()))
-        .args(extra)
-        .arg(url)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start chromium");
-    let (mut out, mut err) = (child.stdout.take().unwrap(), child.stderr.take().unwrap());
-    let reader = std::thread::spawn(move || {
-        let mut s = String::new();
-        std::io::Read::read_to_string(&mut out, &mut s).ok();
-        s
-    });
-    let err_reader = std::thread::spawn(move || {
-        let mut s = String::new();
-        std::io::Read::read_to_string(&mut err, &mut s).ok();
-        s
-    });
-    // A generous bound for a loaded machine; the browser is killed (by its own pid) after.
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > Duration::from_secs(180) {
-            let _ = child.kill();
-            panic!("chromium did not finish {url} in 180 s");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    (reader.join().unwrap(), err_reader.join().unwrap())
-}
+use browser::{chromium, shot_path, Browser};
+use report_common::{expected_first_false, hindsight, scratch};
 
 /// What the browser made of a page.
 struct Opened {
     /// The DOM after the scripts ran.
     dom: String,
-    /// Console messages (every level: the page itself never writes to the console).
-    console: Vec<String>,
 }
 
-/// Opens `page` (with `fragment`), dumps its DOM and takes a screenshot named `shot`.
-fn open(browser: &Path, page: &Path, fragment: &str, shot: &str) -> Opened {
-    let url = format!(
-        "file://{}{fragment}",
-        page.canonicalize().unwrap().display()
+/// Opens `page` (with `fragment`) once its script has drawn, checks that the console
+/// stayed silent and nothing but the file itself was requested, and keeps a screenshot
+/// named `shot`.
+fn open(b: &mut Browser, page: &Path, fragment: &str, shot: &str) -> Opened {
+    let file = format!("file://{}", page.canonicalize().unwrap().display());
+    b.errors.clear();
+    b.requests.clear();
+    b.open(&format!("{file}{fragment}"));
+    b.wait_for(
+        "document.body.hasAttribute('data-rendered')",
+        Duration::from_secs(60),
     );
-    let profile = scratch(&format!("profile-{shot}"));
-    let (dom, log) = chromium(browser, &url, &["--dump-dom".to_string()], &profile);
-    let console = log
-        .lines()
-        .filter(|l| l.contains(":CONSOLE"))
-        .map(str::to_string)
-        .collect();
-    let png = screenshots().join(format!("{shot}.png"));
-    let _ = std::fs::remove_file(&png);
-    chromium(
-        browser,
-        &url,
-        &[format!("--screenshot={}", png.display())],
-        &profile,
-    );
-    let bytes = std::fs::read(&png).unwrap_or_else(|e| panic!("{}: {e}", png.display()));
+    let dom = b.dom();
+    let png = shot_path(&format!("{shot}.png"));
+    b.screenshot(&png);
     assert!(
-        bytes.starts_with(b"\x89PNG") && bytes.len() > 10_000,
+        std::fs::metadata(&png).unwrap().len() > 10_000,
         "{}",
         png.display()
     );
-    Opened { dom, console }
+    assert_eq!(b.errors, Vec::<String>::new(), "console errors");
+    for u in &b.requests {
+        assert!(u.starts_with(&file) || u == "about:blank", "fetched {u}");
+    }
+    Opened { dom }
+}
+
+/// A browser for the test, or `None` when the test may skip.
+fn browser(tag: &str) -> Option<Browser> {
+    chromium().map(|c| Browser::start(&c, &scratch(&format!("profile-{tag}"))))
 }
 
 /// The value of `name` in the first tag that contains `marker`.
@@ -146,13 +66,14 @@ fn attr_in_tag(dom: &str, marker: &str, name: &str) -> Option<String> {
 
 #[test]
 fn the_museum_report_renders_in_chromium_without_errors_or_fetches() {
-    let Some(browser) = browser() else { return };
-    let m = museum("browser");
+    let Some(mut browser) = browser("museum") else {
+        return;
+    };
+    let m = report_common::museum("browser");
     let csv = std::fs::read_to_string(&m.failing_csv).unwrap();
     let (due_time, due_point) = expected_first_false(&csv);
-    let opened = open(&browser, &m.verify_page, "", "museum-report");
+    let opened = open(&mut browser, &m.verify_page, "", "museum-report");
     let dom = &opened.dom;
-    assert_eq!(opened.console, Vec::<String>::new(), "console messages");
     assert_eq!(
         attr_in_tag(dom, "<body", "data-errors").as_deref(),
         Some("0")
@@ -188,12 +109,11 @@ fn the_museum_report_renders_in_chromium_without_errors_or_fetches() {
 
     // A link to the first false point selects it: the state panel shows that point.
     let opened = open(
-        &browser,
+        &mut browser,
         &m.verify_page,
         &format!("#run-0-point-{due_point}"),
         "museum-report-first-false",
     );
-    assert_eq!(opened.console, Vec::<String>::new());
     let dom = &opened.dom;
     assert_eq!(
         attr_in_tag(dom, "<body", "data-errors").as_deref(),
@@ -298,7 +218,9 @@ fn bt_statuses(csv: &str, point: usize) -> std::collections::BTreeMap<String, St
 
 #[test]
 fn a_sweep_report_renders_in_chromium() {
-    let Some(browser) = browser() else { return };
+    let Some(mut browser) = browser("sweep") else {
+        return;
+    };
     let dir = scratch("browser-sweep");
     let page = dir.join("sweep.html");
     let (code, _, err) = hindsight(&[
@@ -316,8 +238,7 @@ fn a_sweep_report_renders_in_chromium() {
         &page.display().to_string(),
     ]);
     assert_eq!(code, 0, "{err}");
-    let opened = open(&browser, &page, "", "museum-sweep");
-    assert_eq!(opened.console, Vec::<String>::new());
+    let opened = open(&mut browser, &page, "", "museum-sweep");
     let dom = &opened.dom;
     assert_eq!(
         attr_in_tag(dom, "<body", "data-errors").as_deref(),

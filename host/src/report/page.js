@@ -822,6 +822,7 @@
       if (m.input) input(m.input);
       if (m.verdict) {
         lines += 1;
+        el.setAttribute("data-lines", String(lines));
         waiting.push(m.sent_ms);
         judged(m.verdict);
       }

@@ -1,7 +1,9 @@
-//! A headless Chromium driven over the DevTools protocol (a websocket, `tungstenite`), for
-//! the page tests: navigate, evaluate JavaScript in the page in real time (a live page's
-//! event stream never lets `--dump-dom --virtual-time-budget` finish), collect console
-//! errors, uncaught exceptions and every network request, take a screenshot.
+//! The one browser driver of the page tests (`report_browser`, `live_page`): a headless
+//! Chromium driven over the DevTools protocol (a websocket, `tungstenite`): navigate,
+//! evaluate JavaScript in the page in real time (a live page's event stream never lets
+//! `--dump-dom --virtual-time-budget` finish), read the DOM after the scripts ran, collect
+//! console errors, uncaught exceptions and every network request, take screenshots. No
+//! host name resolves (`--host-resolver-rules`), so a fetch from the network fails too.
 #![allow(dead_code)]
 
 use std::net::TcpStream;
@@ -13,24 +15,44 @@ use serde_json::{json, Value};
 use tungstenite::stream::MaybeTlsStream;
 use tungstenite::{Message, WebSocket};
 
-/// The Chromium binary, or `None` outside CI when it is not installed (in CI its absence
-/// fails the test: `.ci/run` installs it).
+/// The Chromium binary (`$CHROMIUM` or `/usr/bin/chromium`), or `None`, with the reason
+/// printed, when it is absent and `CI` is unset (in CI its absence fails the test:
+/// `.ci/run` installs it).
 pub fn chromium() -> Option<PathBuf> {
     let p = PathBuf::from(std::env::var("CHROMIUM").unwrap_or("/usr/bin/chromium".into()));
-    if p.exists() {
+    if p.is_file() {
         return Some(p);
     }
     assert!(
         std::env::var_os("CI").is_none(),
-        "{} is missing: .ci/run installs it",
+        "CI is set and there is no Chromium at {} (.ci/run installs it with \
+         `apt-get install -y chromium`; CHROMIUM=path names another)",
         p.display()
     );
     eprintln!(
-        "note: {} not installed, browser checks skipped",
+        "skipped: no Chromium at {} (install it, or run .ci/run, or set CHROMIUM=path)",
         p.display()
     );
     None
 }
+
+/// The flags of every test browser: headless, a fresh profile, nothing in the background
+/// that would go to the network, and no host name resolving.
+const FLAGS: [&str; 12] = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--hide-scrollbars",
+    "--window-size=1400,900",
+    // The live page's server is on loopback, named by its address.
+    "--host-resolver-rules=MAP * ~NOTFOUND, EXCLUDE 127.0.0.1",
+    "--remote-debugging-port=0",
+];
 
 /// Where screenshots are kept as test artifacts: `target/screenshots/`.
 pub fn shot_path(name: &str) -> PathBuf {
@@ -56,19 +78,7 @@ impl Browser {
         let _ = std::fs::remove_dir_all(profile);
         std::fs::create_dir_all(profile).unwrap();
         let child = Command::new(chromium)
-            .args([
-                "--headless",
-                "--no-sandbox",
-                "--disable-gpu",
-                "--disable-quic",
-                "--no-first-run",
-                "--disable-background-networking",
-                "--disable-component-update",
-                "--disable-sync",
-                "--hide-scrollbars",
-                "--window-size=1200,700",
-                "--remote-debugging-port=0",
-            ])
+            .args(FLAGS)
             .arg(format!("--user-data-dir={}", profile.display()))
             .arg("about:blank")
             .stdout(Stdio::null())
@@ -173,12 +183,19 @@ impl Browser {
         }
     }
 
-    /// Opens `url` and waits until its document has loaded.
+    /// Opens `url` and waits until its document has loaded (a fresh document even when
+    /// only the fragment differs from the page open before).
     pub fn open(&mut self, url: &str) {
+        self.call("Page.navigate", json!({ "url": "about:blank" }));
         self.call("Page.navigate", json!({ "url": url }));
         self.wait_for(
-            "document.readyState === 'complete'",
+            "location.href !== 'about:blank' && document.readyState === 'complete'",
             Duration::from_secs(30),
+        );
+        let at = self.eval("location.href");
+        assert!(
+            !at.as_str().unwrap_or_default().starts_with("chrome-error:"),
+            "{url} did not load"
         );
     }
 
@@ -201,9 +218,25 @@ impl Browser {
         }
     }
 
-    /// A PNG of the page, written to `path`.
+    /// The document as HTML, after the scripts ran.
+    pub fn dom(&mut self) -> String {
+        let v = self.eval("document.documentElement.outerHTML");
+        v.as_str().unwrap_or_default().to_string()
+    }
+
+    /// A PNG of the whole page (beyond the window), written to `path`.
     pub fn screenshot(&mut self, path: &Path) {
-        let r = self.call("Page.captureScreenshot", json!({ "format": "png" }));
+        let m = self.call("Page.getLayoutMetrics", json!({}));
+        let size = &m["cssContentSize"];
+        let clip = json!({
+            "x": 0, "y": 0, "scale": 1,
+            "width": size["width"].as_f64().unwrap_or(1400.0),
+            "height": size["height"].as_f64().unwrap_or(900.0).min(6000.0),
+        });
+        let r = self.call(
+            "Page.captureScreenshot",
+            json!({ "format": "png", "captureBeyondViewport": true, "clip": clip }),
+        );
         let png = base64_decode(r["data"].as_str().unwrap());
         assert!(png.starts_with(b"\x89PNG"), "not a PNG");
         std::fs::write(path, png).unwrap();

@@ -299,3 +299,29 @@ pub fn raw_subscriber(
         .create()
         .unwrap()
 }
+
+/// The `hindsight` binary of this build.
+pub fn hindsight() -> std::process::Command {
+    std::process::Command::new(env!("CARGO_BIN_EXE_hindsight"))
+}
+
+/// The museum guide example.
+pub fn museum() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-guide")
+}
+
+/// Writes the sidecar's config for the museum run under service prefix `prefix`
+/// (`hindsight run --layout`) to `dir/museum.toml`; its path.
+pub fn museum_config(dir: &std::path::Path, prefix: &str) -> PathBuf {
+    let layout = hindsight()
+        .arg("run")
+        .arg(museum())
+        .args(["--layout", "--prefix", prefix])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&layout.stderr);
+    assert!(layout.status.success(), "run --layout: {err}");
+    let config = dir.join("museum.toml");
+    std::fs::write(&config, &layout.stdout).unwrap();
+    config
+}
