@@ -797,7 +797,8 @@
       }
       if (v.time > lastTime) lastTime = v.time;
     }
-    // The delay from the sidecar writing a verdict line to the frame that draws it.
+    // The delay from the sidecar writing a verdict line to the frame that draws it (for
+    // the lines written after the page opened: older ones come from the server's history).
     tl.onDrawn = function () {
       var t = Date.now();
       waiting.forEach(function (sent) { delays.push(Math.max(0, t - sent)); });
@@ -814,7 +815,7 @@
       }
     };
     var status = document.getElementById("status");
-    var es = new EventSource("/events");
+    var opened = Date.now(), es = new EventSource("/events");
     es.onopen = function () { status.textContent = "live"; status.className = ""; };
     es.onerror = function () { status.textContent = "reconnecting"; status.className = "down"; };
     es.onmessage = function (e) {
@@ -823,7 +824,7 @@
       if (m.verdict) {
         lines += 1;
         el.setAttribute("data-lines", String(lines));
-        waiting.push(m.sent_ms);
+        if (m.sent_ms >= opened) waiting.push(m.sent_ms);
         judged(m.verdict);
       }
       tl.grow();
