@@ -170,6 +170,7 @@ fn the_live_page_shows_the_verdicts_as_they_arrive() {
         let state: serde_json::Value =
             serde_json::from_str(b.eval(PAGE_STATE).as_str().unwrap()).unwrap();
         b.screenshot(&shot_path("live-page.png"));
+        follow_the_end(b);
         state
     });
     let served = served_body(&addr);
@@ -266,6 +267,51 @@ fn the_live_page_shows_the_verdicts_as_they_arrive() {
         state["median"], state["max"]
     );
     assert!(state["max"].as_u64().unwrap() < 5_000, "{state}");
+}
+
+/// The timeline's view as `[start, end, run end, points]`.
+const VIEW: &str =
+    "(function () { var tl = document.getElementById('timeline-live').hindsightTimeline; \
+    return [tl.view[0], tl.view[1], tl.tEnd, tl.n]; })()";
+
+/// Waits until the live timeline has more points than `n` (the sidecar's heartbeats
+/// keep adding points after the system stopped); its view then.
+fn grown(b: &mut Browser, n: u64) -> Vec<f64> {
+    b.wait_for(
+        &format!("document.getElementById('timeline-live').hindsightTimeline.n > {n}"),
+        Duration::from_secs(30),
+    );
+    let v = b.eval(VIEW);
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+/// A zoom stops the view from following the run's end, and keeps it while points are
+/// added; the "follow the end" button starts following again.
+fn follow_the_end(b: &mut Browser) {
+    let follow = "document.getElementById('timeline-live').getAttribute('data-follow')";
+    assert_eq!(b.eval(follow), "on");
+    b.eval("document.querySelector('[data-act=in]').click()");
+    assert_eq!(b.eval(follow), "off");
+    let before = b.eval(VIEW);
+    let before: Vec<f64> = serde_json::from_value(before).unwrap();
+    let after = grown(b, before[3] as u64);
+    assert_eq!(after[..2], before[..2], "the zoomed view moved");
+    assert!(after[1] < after[2], "{after:?}");
+    b.eval("document.querySelector('[data-act=follow]').click()");
+    assert_eq!(b.eval(follow), "on");
+    let now: Vec<f64> = serde_json::from_value(b.eval(VIEW)).unwrap();
+    let later = grown(b, now[3] as u64);
+    // Following: the view ends at the run's end, with the zoomed span.
+    assert_eq!(later[1], later[2], "{later:?}");
+    assert!(later[1] > after[1], "{later:?} after {after:?}");
+    assert!(
+        (later[1] - later[0] - (before[1] - before[0])).abs() < 1e-6,
+        "{later:?} {before:?}"
+    );
 }
 
 #[test]
