@@ -17,6 +17,10 @@ use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
+/// The shortest time between two writes to one page (the page draws at most once per
+/// animation frame, about 16 ms, anyway).
+const BATCH: Duration = Duration::from_millis(10);
+
 /// Lines of each stream the page can get on (re)connecting; older ones are only in the
 /// verdict file (and the input log).
 pub const HISTORY: usize = 100_000;
@@ -347,6 +351,10 @@ fn events(mut stream: TcpStream, hub: &Hub, last_id: Option<u64>) -> std::io::Re
                 }
                 stream.write_all(text.as_bytes())?;
                 stream.flush()?;
+                // At most one write per BATCH: a line after a quiet spell goes out at
+                // once, a flood of input records in batches, so this thread does not
+                // wake per sample and take the sidecar's core.
+                std::thread::sleep(BATCH);
             }
             // A comment keeps proxies from closing an idle stream, and finds a gone peer.
             Err(RecvTimeoutError::Timeout) => {
