@@ -436,6 +436,25 @@ fn shards_merged_equal_the_whole_study_and_gaps_are_refused() {
 }
 
 #[test]
+fn a_partial_file_without_a_shard_is_refused_not_ignored() {
+    let dir = std::env::temp_dir().join(format!("hindsight-partial-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("p.json");
+    let (code, out, err) = hindsight(&[
+        "verify",
+        COIN,
+        "--runs",
+        "50",
+        "--partial",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{out}");
+    assert!(err.contains("--shard"), "{err}");
+    assert!(!file.exists(), "nothing is written without --shard");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
 fn racing_timers_split_fairly_and_timing_is_exact() {
     // a and b fire together after 2 units: which sends first is a fair choice (p = 1/2);
     // c fires after 3 units, always last; a is sent exactly at time 2.

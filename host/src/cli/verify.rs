@@ -100,8 +100,8 @@ pub struct VerifyArgs {
     /// (the same numbers as its shards merged). With --shard, the size of the study it slices.
     #[arg(long, value_name = "N", conflicts_with = "save_failing")]
     pub runs: Option<u64>,
-    /// File for the partial result of --shard.
-    #[arg(long, value_name = "FILE")]
+    /// File for the partial result of --shard (which it needs).
+    #[arg(long, value_name = "FILE", requires = "shard")]
     pub partial: Option<PathBuf>,
     /// Also write one self-contained HTML page (see `hindsight report --help`): settings,
     /// formulas, probabilities and the failing runs as timelines (those of --save-failing,
