@@ -547,13 +547,7 @@ impl Cx<'_> {
         ty_span: Span,
         publisher: bool,
     ) -> Option<Vec<FlatField>> {
-        let fields = match self.interfaces.message(ty.trim()) {
-            Ok(f) => f,
-            Err(m) => {
-                self.err(ty_span, m);
-                return None;
-            }
-        };
+        let fields = self.looked_up(ty_span, self.interfaces.message(ty.trim()))?;
         match self.topics.iter_mut().find(|t| t.key == key) {
             Some(t) => t.decls.push((ty.to_string(), ty_span, publisher)),
             None => self.topics.push(Topic {
@@ -564,18 +558,18 @@ impl Cx<'_> {
         Some(fields)
     }
 
-    /// `i`, the index of a `what` (service, action) declared again: a different type at
-    /// `ty_span` than the first declaration's `first` is an error.
+    /// The index of a `what` (service, action) already declared, `first` its index and
+    /// type: a different type at `ty_span` than the first declaration's is an error.
     fn redeclared(
         &mut self,
         what: &str,
         key: &str,
         ty: &str,
         ty_span: Span,
-        i: usize,
-        first: &str,
-    ) -> usize {
-        if type_key(first) != type_key(ty) {
+        first: Option<(usize, String)>,
+    ) -> Option<usize> {
+        let (i, first) = first?;
+        if type_key(&first) != type_key(ty) {
             self.err(
                 ty_span,
                 format!(
@@ -584,58 +578,49 @@ impl Cx<'_> {
                 ),
             );
         }
-        i
+        Some(i)
+    }
+
+    /// The fields an interface lookup found, or `None` with its error reported at `span`.
+    fn looked_up<F>(&mut self, span: Span, found: Result<F, String>) -> Option<F> {
+        found.map_err(|m| self.err(span, m)).ok()
     }
 
     fn declare_service(&mut self, key: &str, ty: &str, ty_span: Span) -> Option<usize> {
-        let found = self.services.iter().position(|s| s.key == key);
-        if let Some(i) = found {
-            let first = self.services[i].ty.clone();
-            return Some(self.redeclared("service", key, ty, ty_span, i, &first));
+        let first = self.services.iter().enumerate().find(|(_, s)| s.key == key);
+        let first = first.map(|(i, s)| (i, s.ty.clone()));
+        if first.is_some() {
+            return self.redeclared("service", key, ty, ty_span, first);
         }
-        match self.interfaces.service(ty.trim()) {
-            Ok(fields) => {
-                self.services.push(Service {
-                    key: key.to_string(),
-                    ty: ty.trim().to_string(),
-                    fields,
-                    server: None,
-                    server_span: ty_span,
-                    clients: Vec::new(),
-                });
-                Some(self.services.len() - 1)
-            }
-            Err(m) => {
-                self.err(ty_span, m);
-                None
-            }
-        }
+        let fields = self.looked_up(ty_span, self.interfaces.service(ty.trim()))?;
+        self.services.push(Service {
+            key: key.to_string(),
+            ty: ty.trim().to_string(),
+            fields,
+            server: None,
+            server_span: ty_span,
+            clients: Vec::new(),
+        });
+        Some(self.services.len() - 1)
     }
 
     fn declare_action(&mut self, key: &str, ty: &str, ty_span: Span) -> Option<usize> {
-        let found = self.actions.iter().position(|s| s.key == key);
-        if let Some(i) = found {
-            let first = self.actions[i].ty.clone();
-            return Some(self.redeclared("action", key, ty, ty_span, i, &first));
+        let first = self.actions.iter().enumerate().find(|(_, a)| a.key == key);
+        let first = first.map(|(i, a)| (i, a.ty.clone()));
+        if first.is_some() {
+            return self.redeclared("action", key, ty, ty_span, first);
         }
-        match self.interfaces.action(ty.trim()) {
-            Ok(fields) => {
-                self.actions.push(Action {
-                    key: key.to_string(),
-                    ty: ty.trim().to_string(),
-                    fields,
-                    server: None,
-                    server_span: ty_span,
-                    clients: Vec::new(),
-                    threads: Vec::new(),
-                });
-                Some(self.actions.len() - 1)
-            }
-            Err(m) => {
-                self.err(ty_span, m);
-                None
-            }
-        }
+        let fields = self.looked_up(ty_span, self.interfaces.action(ty.trim()))?;
+        self.actions.push(Action {
+            key: key.to_string(),
+            ty: ty.trim().to_string(),
+            fields,
+            server: None,
+            server_span: ty_span,
+            clients: Vec::new(),
+            threads: Vec::new(),
+        });
+        Some(self.actions.len() - 1)
     }
 
     /// Every declaration of a topic has the type of its first one.
