@@ -341,14 +341,6 @@ impl<'a> Value<'a> {
         }
     }
 
-    /// The boolean, if this is one.
-    pub fn as_bool(&self) -> Option<bool> {
-        match self {
-            Value::Bool(b) => Some(*b),
-            _ => None,
-        }
-    }
-
     /// The integer, if this is one.
     pub fn as_i64(&self) -> Option<i64> {
         match self {

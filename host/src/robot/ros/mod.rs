@@ -199,20 +199,6 @@ pub fn sanitize(name: &str) -> String {
     name.trim().trim_start_matches('/').replace('/', "__")
 }
 
-/// The event a message on `topic` is sent as: `topic_<sanitized topic>_msg`; its parameters
-/// are the message's [`FlatField::param_name`]s.
-pub fn topic_event(topic: &str) -> String {
-    format!("topic_{}_msg", sanitize(topic))
-}
-
-/// The events of service `service` that a property may watch: the server receives
-/// `srv_<s>_request` and answers with `srv_<s>_response` (parameters are the request's and
-/// the response's [`FlatField::param_name`]s).
-pub fn service_events(service: &str) -> (String, String) {
-    let s = sanitize(service);
-    (format!("srv_{s}_request"), format!("srv_{s}_response"))
-}
-
 /// `pkg/msg/T` and `pkg/T` name the same type.
 fn type_key(t: &str) -> String {
     let parts: Vec<&str> = t.trim().split('/').collect();
@@ -746,8 +732,6 @@ mod tests {
             "NavigationComponent__GoToPoi"
         );
         assert_eq!(sanitize("level"), "level");
-        assert_eq!(topic_event("/a/b"), "topic_a__b_msg");
-        assert_eq!(service_events("/adder").1, "srv_adder_response");
         assert_eq!(type_key("std_msgs/msg/Int32"), type_key("std_msgs/Int32"));
         assert_ne!(type_key("std_msgs/Int32"), type_key("std_msgs/Int16"));
     }
