@@ -536,43 +536,35 @@ impl Cx<'_> {
                     params,
                 ))
             }
-            "ros_service_handle_response" => {
-                let Some(s) = self.service_named(el, &d.srv_clients, &alias, "a service client")
-                else {
+            "ros_service_handle_response" | "ros_service_handle_request" => {
+                // A client's callback on its response, or the server's on a request.
+                let response = el.name == "ros_service_handle_response";
+                let (aliases, role) = if response {
+                    (&d.srv_clients, "a service client")
+                } else {
+                    (&d.srv_servers, "a service server")
+                };
+                let Some(s) = self.service_named(el, aliases, &alias, role) else {
                     return Vec::new();
                 };
-                let key = s.key.clone();
-                let sc = Scope {
-                    fields: vec![(
-                        "_res",
-                        &s.fields.response,
-                        format!("the response of `{}`", s.ty),
-                    )],
-                    ..Scope::default()
-                };
-                self.callback(
-                    el,
-                    u,
-                    &sc,
-                    &format!("srv_{key}_response_client_{}", u.name),
-                    None,
-                )
-            }
-            "ros_service_handle_request" => {
-                let Some(s) = self.service_named(el, &d.srv_servers, &alias, "a service server")
-                else {
-                    return Vec::new();
-                };
-                let key = s.key.clone();
-                let sc = Scope {
-                    fields: vec![(
+                let key = &s.key;
+                let (var, part, fields, event) = if response {
+                    let event = format!("srv_{key}_response_client_{}", u.name);
+                    ("_res", "response", &s.fields.response, event)
+                } else {
+                    (
                         "_req",
+                        "request",
                         &s.fields.request,
-                        format!("the request of `{}`", s.ty),
-                    )],
+                        format!("srv_{key}_request"),
+                    )
+                };
+                let what = format!("the {part} of `{}`", s.ty);
+                let sc = Scope {
+                    fields: vec![(var, fields, what)],
                     ..Scope::default()
                 };
-                self.callback(el, u, &sc, &format!("srv_{key}_request"), None)
+                self.callback(el, u, &sc, &event, None)
             }
             "ros_service_send_response" => {
                 let Some(s) = self.service_named(el, &d.srv_servers, &alias, "a service server")
