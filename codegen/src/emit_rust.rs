@@ -285,6 +285,17 @@ enum State {
     Window { lo: u64, hi: u64, cap: u32 },
 }
 
+impl State {
+    /// The state before the first point, as a Rust expression.
+    fn initial(&self) -> String {
+        match self {
+            State::Flag(b) => b.to_string(),
+            State::Stamp => "0".into(),
+            State::Window { .. } => "Window::EMPTY".into(),
+        }
+    }
+}
+
 fn node_state(op: &Op) -> Option<State> {
     match *op {
         Op::Yesterday(_) => Some(State::Flag(false)),
@@ -624,11 +635,8 @@ impl Emitter<'_, '_> {
         o.open("Monitor {");
         o.line("last: 0,");
         for (i, st) in states.iter().enumerate() {
-            match st {
-                Some(State::Flag(b)) => o.line(&format!("n{i}: {b},")),
-                Some(State::Stamp) => o.line(&format!("n{i}: 0,")),
-                Some(State::Window { .. }) => o.line(&format!("n{i}: Window::EMPTY,")),
-                None => {}
+            if let Some(st) = st {
+                o.line(&format!("n{i}: {},", st.initial()));
             }
         }
         o.close("}");
@@ -639,9 +647,9 @@ impl Emitter<'_, '_> {
         o.line("self.last = 0;");
         for (i, st) in states.iter().enumerate() {
             match st {
-                Some(State::Flag(b)) => o.line(&format!("self.n{i} = {b};")),
-                Some(State::Stamp) => o.line(&format!("self.n{i} = 0;")),
+                // Emptied in place: a window keeps its buffer.
                 Some(State::Window { .. }) => o.line(&format!("self.n{i}.clear();")),
+                Some(st) => o.line(&format!("self.n{i} = {};", st.initial())),
                 None => {}
             }
         }

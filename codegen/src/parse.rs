@@ -362,22 +362,30 @@ fn unary<'s>(cx: &Cx<'s>, i: &'s str) -> R<'s, Formula> {
     let (i, _) = ws(i)?;
     let start = i;
     if let Some((r, op)) = prefix_op(cx, i)? {
-        cx.enter(start)?;
-        let (r, arg) = unary(cx, r)?;
-        cx.leave();
-        let span = cx.span(start, r);
-        let depth = arg.depth + 1;
-        if depth > MAX_DEPTH {
-            return Err(at_span(cx, too_deep(span), span));
-        }
-        let f = Formula {
-            kind: FormulaKind::Prefix(op, Box::new(arg)),
-            span,
-            depth,
-        };
-        return Ok((r, f));
+        return prefixed(cx, start, r, unary, |arg| FormulaKind::Prefix(op, arg));
     }
     primary(cx, i)
+}
+
+/// The node of a prefix operator written at `start`: its operand parsed from `r` by
+/// `operand` (one nesting level deeper), within the height limit, made by `kind`.
+fn prefixed<'s, K>(
+    cx: &Cx<'s>,
+    start: &'s str,
+    r: &'s str,
+    operand: impl FnOnce(&Cx<'s>, &'s str) -> R<'s, Node<K>>,
+    kind: impl FnOnce(Box<Node<K>>) -> K,
+) -> R<'s, Node<K>> {
+    cx.enter(start)?;
+    let (r, arg) = operand(cx, r)?;
+    cx.leave();
+    let span = cx.span(start, r);
+    let depth = arg.depth + 1;
+    if depth > MAX_DEPTH {
+        return Err(at_span(cx, too_deep(span), span));
+    }
+    let kind = kind(Box::new(arg));
+    Ok((r, Node { kind, span, depth }))
 }
 
 fn primary<'s>(cx: &Cx<'s>, i: &'s str) -> R<'s, Formula> {

@@ -84,13 +84,8 @@ pub(crate) enum FormulaKind {
     Infix(InfixOp, Box<Formula>, Box<Formula>),
 }
 
-#[derive(Clone, Debug, PartialEq)]
-pub(crate) struct Formula {
-    pub kind: FormulaKind,
-    pub span: Span,
-    /// Height of the tree (a leaf is 1).
-    pub depth: u32,
-}
+/// A formula: a [`Node`] of [`FormulaKind`].
+pub(crate) type Formula = Node<FormulaKind>;
 
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) enum ExprKind {
@@ -104,10 +99,16 @@ pub(crate) enum ExprKind {
     Binary(BinaryOp, Box<Expr>, Box<Expr>),
 }
 
+/// An expression inside an atom: a [`Node`] of [`ExprKind`].
+pub(crate) type Expr = Node<ExprKind>;
+
+/// A node of a parsed formula or expression: what it is, where it was written, and the
+/// height of its tree (a leaf is 1), which the parser bounds.
 #[derive(Clone, Debug, PartialEq)]
-pub(crate) struct Expr {
-    pub kind: ExprKind,
+pub(crate) struct Node<K> {
+    pub kind: K,
     pub span: Span,
+    /// Height of the tree (a leaf is 1).
     pub depth: u32,
 }
 

@@ -384,6 +384,20 @@ fn shards_merged_equal_the_whole_study_and_gaps_are_refused() {
     let single = json(&["merge", &whole]);
     assert_eq!(merged["properties"], single["properties"]);
     assert_eq!(merged["runs"], 300);
+    // `merge --json` prints the fields `verify --json` prints, and no page-only ones
+    // (settings, formulas), which `hindsight report --study` reads back.
+    let keys = |v: &serde_json::Value| {
+        let mut k: Vec<String> = v.as_object().unwrap().keys().cloned().collect();
+        k.sort();
+        k
+    };
+    let study_keys = "confidence decided discarded model precision properties properties_file \
+                      quiescent runs seconds seed step_limit time_horizon";
+    let row_keys = "cut_short decision lower probability property runs successes upper";
+    for report in [&merged, &json(&["verify", COIN, "--precision", "0.1"])] {
+        assert_eq!(keys(report).join(" "), study_keys);
+        assert_eq!(keys(prop(report, "heads")).join(" "), row_keys);
+    }
     let (code, _, err) = hindsight(&["merge", &a, &c]);
     assert_eq!(code, 2);
     assert!(err.contains("missing"), "{err}");
@@ -397,6 +411,16 @@ fn shards_merged_equal_the_whole_study_and_gaps_are_refused() {
         merged["properties"]
     );
     let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn a_partial_file_without_a_shard_is_refused_not_ignored() {
+    let file = std::env::temp_dir().join(format!("hindsight-partial-{}.json", std::process::id()));
+    let partial = file.to_str().unwrap();
+    let (code, out, err) = hindsight(&["verify", COIN, "--runs", "50", "--partial", partial]);
+    assert_eq!(code, 2, "{out}");
+    assert!(err.contains("--shard"), "{err}");
+    assert!(!file.exists(), "nothing is written without --shard");
 }
 
 #[test]

@@ -921,6 +921,15 @@ fn bad_models_give_positioned_errors() {
 </ascxml>"#,
             "s.ascxml:3:26: service `add` has no server",
         ),
+        // A second server of one action: at the second, naming where the first is.
+        (
+            r#"<ascxml name="S" initial="a">
+  <ros_action_server name="s1" action_name="/f" type="example_interfaces/Fibonacci"/>
+  <ros_action_server name="s2" action_name="/f" type="example_interfaces/Fibonacci"/>
+  <state id="a"/>
+</ascxml>"#,
+            "s.ascxml:3:3: action `/f` already has a server, `S` (s.ascxml:2:3)",
+        ),
         // A timer rate that is not a frequency.
         (
             r#"<ascxml name="S" initial="a">

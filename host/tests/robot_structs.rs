@@ -461,43 +461,8 @@ fn a_struct_that_contains_itself_is_an_error() {
     assert!(!err.contains("`List`"), "{err}");
 }
 
-mod alloc {
-    //! A counting allocator for this test binary (per thread, so parallel tests do not mix).
-    use std::alloc::{GlobalAlloc, Layout, System};
-    use std::cell::Cell;
-
-    pub struct Counting;
-
-    thread_local! {
-        static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-    }
-
-    // Forwards to the system allocator and counts calls.
-    #[allow(unsafe_code)]
-    unsafe impl GlobalAlloc for Counting {
-        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-            let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
-            // SAFETY: same contract as the caller's.
-            unsafe { System.alloc(layout) }
-        }
-        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-            // SAFETY: same contract as the caller's.
-            unsafe { System.dealloc(ptr, layout) }
-        }
-        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-            let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
-            // SAFETY: same contract as the caller's.
-            unsafe { System.realloc(ptr, layout, new_size) }
-        }
-    }
-
-    pub fn count() -> u64 {
-        ALLOCATIONS.with(|n| n.get())
-    }
-}
-
 #[global_allocator]
-static GLOBAL: alloc::Counting = alloc::Counting;
+static GLOBAL: common::alloc::Counting = common::alloc::Counting;
 
 /// Struct values live in buffers reused between steps and runs: once warm, whole runs of
 /// the struct cases (copying structs, sending them, growing arrays of structs) allocate
@@ -521,9 +486,9 @@ fn struct_runs_allocate_nothing_once_warm() {
             }
             for seed in 0..3 {
                 let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-                let before = alloc::count();
+                let before = common::alloc::count();
                 let out = sim.run(&mut rng, &cfg, &mut ());
-                let n = alloc::count() - before;
+                let n = common::alloc::count() - before;
                 assert!(out.steps > 0);
                 assert_eq!(
                     n, 0,

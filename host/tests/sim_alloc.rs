@@ -3,53 +3,18 @@
 //! The first runs grow the simulator's buffers (queues, message slots, arrays);
 //! after that, whole runs - every step, every reset - must not allocate.
 
-use hindsight::model::ModelSource;
+mod common;
+
 use hindsight::sim::{CompiledModel, EndReason, EventSemantics, RunConfig, Simulator};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 use std::path::{Path, PathBuf};
 
-struct Counting;
-
-thread_local! {
-    /// Allocations made by this thread (tests run on several threads).
-    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
-}
-
-// Forwards to the system allocator and counts calls.
-#[allow(unsafe_code)]
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
-
 #[global_allocator]
-static GLOBAL: Counting = Counting;
-
-fn allocations() -> u64 {
-    ALLOCATIONS.with(|n| n.get())
-}
+static GLOBAL: common::alloc::Counting = common::alloc::Counting;
 
 fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus next to the repository")
+    common::corpus_root()
 }
 
 /// Warms up with `warm` runs, then checks that `runs` more runs allocate nothing.
@@ -62,9 +27,9 @@ fn assert_steady_state_allocation_free(m: &CompiledModel, cfg: &RunConfig, warm:
     let mut steps = 0;
     for seed in 0..runs {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let before = allocations();
+        let before = common::alloc::count();
         let out = sim.run(&mut rng, cfg, &mut ());
-        let n = allocations() - before;
+        let n = common::alloc::count() - before;
         assert!(
             !matches!(out.end, EndReason::Error(_) | EndReason::Spin(_)),
             "{out:?}"
@@ -81,25 +46,7 @@ fn assert_steady_state_allocation_free(m: &CompiledModel, cfg: &RunConfig, warm:
 
 #[test]
 fn museum_runs_allocate_nothing() {
-    let dir = corpus().join("museum-simpar2025/model_scxml");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "scxml"))
-        .collect();
-    paths.sort();
-    let files: Vec<(String, String)> = paths
-        .iter()
-        .map(|p| {
-            let t = std::fs::read_to_string(p).unwrap();
-            (
-                p.display().to_string(),
-                t.replace("_event.thread_id", "_event.data.thread_id"),
-            )
-        })
-        .collect();
-    let src = ModelSource::from_texts(files.iter().map(|(a, b)| (a.as_str(), b.as_str()))).unwrap();
-    let m = CompiledModel::compile(src).unwrap();
+    let m = common::museum_fixed();
     assert_steady_state_allocation_free(&m, &RunConfig::default(), 3, 3);
 }
 

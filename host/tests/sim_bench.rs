@@ -2,41 +2,16 @@
 //!
 //! Run with `cargo test --release -p hindsight --test sim_bench -- --ignored --nocapture`.
 
-use hindsight::model::ModelSource;
+mod common;
+
 use hindsight::sim::{CompiledModel, EndReason, RunConfig, Simulator};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 fn corpus() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus next to the repository")
-}
-
-fn museum() -> CompiledModel {
-    let dir = corpus().join("museum-simpar2025/model_scxml");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "scxml"))
-        .collect();
-    paths.sort();
-    let files: Vec<(String, String)> = paths
-        .iter()
-        .map(|p| {
-            let t = std::fs::read_to_string(p).unwrap();
-            (
-                p.display().to_string(),
-                t.replace("_event.thread_id", "_event.data.thread_id"),
-            )
-        })
-        .collect();
-    let src = ModelSource::from_texts(files.iter().map(|(a, b)| (a.as_str(), b.as_str()))).unwrap();
-    CompiledModel::compile(src).unwrap()
+    common::corpus_root()
 }
 
 /// Runs `runs` seeded runs; prints runs/s and steps/s; returns steps per second.
@@ -72,7 +47,7 @@ fn measure(name: &str, m: &CompiledModel, cfg: &RunConfig, runs: u64) -> f64 {
 #[ignore = "benchmark: run in release with --ignored --nocapture"]
 fn throughput() {
     let t0 = Instant::now();
-    let m = museum();
+    let m = common::museum_fixed();
     println!("museum: compiled in {:.3} s", t0.elapsed().as_secs_f64());
     // 100 s of model time: the global timer's 1000 steps of 100 ms.
     measure("museum (100 s model time)", &m, &RunConfig::default(), 500);

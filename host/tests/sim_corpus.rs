@@ -3,7 +3,6 @@
 
 mod common;
 
-use hindsight::model::ModelSource;
 use hindsight::sim::{CompiledModel, EndReason, RunConfig, Simulator, TraceRecorder};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -95,34 +94,9 @@ fn museum_reports_the_event_thread_id_bug() {
     assert!(line[29..].starts_with("thread_id == 0"), "{line}");
 }
 
-/// The museum model with the one-line fix of `NavigationComponent.scxml`.
-fn museum_fixed() -> CompiledModel {
-    let dir = corpus().join("museum-simpar2025/model_scxml");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "scxml"))
-        .collect();
-    paths.sort();
-    let files: Vec<(String, String)> = paths
-        .iter()
-        .map(|p| {
-            let text = std::fs::read_to_string(p).unwrap();
-            let text = if p.ends_with("NavigationComponent.scxml") {
-                text.replace("_event.thread_id", "_event.data.thread_id")
-            } else {
-                text
-            };
-            (p.display().to_string(), text)
-        })
-        .collect();
-    let src = ModelSource::from_texts(files.iter().map(|(a, b)| (a.as_str(), b.as_str()))).unwrap();
-    CompiledModel::compile(src).unwrap()
-}
-
 #[test]
 fn museum_runs() {
-    let m = museum_fixed();
+    let m = common::museum_fixed();
     // 57 machines plus the `NONE` sink machine the generator wrote.
     assert_eq!(m.machine_count(), 58);
     assert!(m.warnings().is_empty(), "{:?}", m.warnings());

@@ -10,7 +10,7 @@ use nom::sequence::preceded;
 use nom::Parser;
 
 use super::{
-    at_span, expected, fail_at, is_ident_char, sym, too_deep, word, ws, Cx, Fail, PErr, R,
+    at_span, expected, fail_at, is_ident_char, prefixed, sym, too_deep, word, ws, Cx, Fail, PErr, R,
 };
 use crate::ast::{BinaryOp, UnaryOp};
 use crate::syntax::*;
@@ -143,20 +143,7 @@ fn unary_expr<'s>(cx: &Cx<'s>, i: &'s str) -> R<'s, Expr> {
         word_is(i, "not").map(|r| (r, UnaryOp::Not))
     };
     if let Some((r, op)) = op {
-        cx.enter(start)?;
-        let (r, arg) = unary_expr(cx, r)?;
-        cx.leave();
-        let span = cx.span(start, r);
-        let depth = arg.depth + 1;
-        if depth > MAX_DEPTH {
-            return Err(at_span(cx, too_deep(span), span));
-        }
-        let e = Expr {
-            kind: ExprKind::Unary(op, Box::new(arg)),
-            span,
-            depth,
-        };
-        return Ok((r, e));
+        return prefixed(cx, start, r, unary_expr, |arg| ExprKind::Unary(op, arg));
     }
     primary_expr(cx, i)
 }

@@ -165,14 +165,12 @@ pub struct Failing {
 /// formula as written and as compiled, and the failing runs replayed.
 pub fn from_verify(
     path: &Path,
-    report: &impl serde::Serialize,
+    report: &Study,
     loaded: &Loaded,
     settings: Vec<(String, String)>,
     failing: &[Failing],
 ) -> Result<(), CliError> {
-    let bad = |e: serde_json::Error| CliError::Failed(format!("report: {e}"));
-    let mut study: Study =
-        serde_json::from_value(serde_json::to_value(report).map_err(bad)?).map_err(bad)?;
+    let mut study = report.clone();
     study.settings = settings;
     let checked = loaded.set.compiled().checked();
     for p in &mut study.properties {

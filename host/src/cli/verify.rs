@@ -3,8 +3,6 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use serde::Serialize;
-
 use super::CliError;
 use crate::robot::load::ExternalComponent;
 use crate::sim::{CompiledModel, EventSemantics, RunConfig, Simulator};
@@ -13,6 +11,7 @@ use crate::smc::stats::{RuleConfig, RuleKind};
 use crate::smc::{StudyConfig, StudyResult};
 use crate::verify::load::{LoadOptions, Loaded};
 use crate::verify::observe::{Judge, PropertySet};
+use crate::verify::result::{PropertyRow, Study};
 use crate::verify::study::Runner;
 
 /// The stopping rule, as named on the command line.
@@ -101,92 +100,14 @@ pub struct VerifyArgs {
     /// (the same numbers as its shards merged). With --shard, the size of the study it slices.
     #[arg(long, value_name = "N", conflicts_with = "save_failing")]
     pub runs: Option<u64>,
-    /// File for the partial result of --shard.
-    #[arg(long, value_name = "FILE")]
+    /// File for the partial result of --shard (which it needs).
+    #[arg(long, value_name = "FILE", requires = "shard")]
     pub partial: Option<PathBuf>,
     /// Also write one self-contained HTML page (see `hindsight report --help`): settings,
     /// formulas, probabilities and the failing runs as timelines (those of --save-failing,
     /// else one per property).
     #[arg(long, value_name = "FILE", conflicts_with = "shard")]
     pub report: Option<PathBuf>,
-}
-
-/// One property's line of the report.
-#[derive(Debug, Serialize)]
-pub struct PropertyReport {
-    /// The guarantee's id.
-    pub property: String,
-    /// Estimated probability that a run satisfies it (`null` with no judged run).
-    pub probability: Option<f64>,
-    /// Lower end of the interval (widened over unknown runs).
-    pub lower: f64,
-    /// Upper end of the interval.
-    pub upper: f64,
-    /// Runs judged.
-    pub runs: u64,
-    /// Runs that satisfied it.
-    pub successes: u64,
-    /// Runs cut short before its verdict was final (not judged).
-    pub cut_short: u64,
-    /// With --threshold: `accept` (P >= theta) or `reject`.
-    pub decision: Option<String>,
-}
-
-impl PropertyReport {
-    fn new(
-        name: &str,
-        estimate: &crate::smc::stats::Estimate,
-        interval: &crate::smc::stats::Interval,
-        counts: &crate::smc::runner::PropertyCounts,
-    ) -> Self {
-        PropertyReport {
-            property: name.to_string(),
-            probability: estimate.estimate,
-            lower: interval.lower,
-            upper: interval.upper,
-            runs: counts.judged(),
-            successes: counts.successes,
-            cut_short: counts.unknown,
-            decision: estimate.decision.map(|d| format!("{d:?}").to_lowercase()),
-        }
-    }
-}
-
-/// The whole report.
-#[derive(Debug, Serialize)]
-pub struct Report {
-    /// The model path.
-    pub model: String,
-    /// The property file.
-    pub properties_file: String,
-    /// Study seed.
-    pub seed: u64,
-    /// Confidence of the intervals.
-    pub confidence: f64,
-    /// Target precision.
-    pub precision: f64,
-    /// Runs started and consumed.
-    pub runs: u64,
-    /// Runs discarded because an assumption was violated.
-    pub discarded: u64,
-    /// Runs that ended at the time horizon.
-    pub time_horizon: u64,
-    /// Runs that reached the step limit.
-    pub step_limit: u64,
-    /// Runs stopped early because every verdict was final.
-    pub decided: u64,
-    /// Runs that ended because nothing could move.
-    pub quiescent: u64,
-    /// Wall-clock seconds.
-    pub seconds: f64,
-    /// Seconds of model time in one step, when the model has a time unit.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub step_seconds: Option<f64>,
-    /// The run length in seconds of model time, when the model has a time unit.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub max_time_seconds: Option<f64>,
-    /// Per guarantee.
-    pub properties: Vec<PropertyReport>,
 }
 
 /// The model and property arguments every command that loads a model takes.
@@ -393,7 +314,7 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
 }
 
 /// The report of a merged fixed-size study (`merge`, and `verify --runs R` alone).
-fn merged_report(m: &crate::smc::shard::MergedResult) -> Report {
+fn merged_report(m: &crate::smc::shard::MergedResult) -> Study {
     let (model, properties_file) = match &m.study.paths {
         Some(p) => (p.model.clone(), p.properties.clone()),
         None => (
@@ -401,7 +322,7 @@ fn merged_report(m: &crate::smc::shard::MergedResult) -> Report {
             m.study.properties_fingerprint.clone(),
         ),
     };
-    Report {
+    Study {
         model,
         properties_file,
         seed: m.study.seed,
@@ -416,10 +337,11 @@ fn merged_report(m: &crate::smc::shard::MergedResult) -> Report {
         seconds: 0.0,
         step_seconds: None,
         max_time_seconds: None,
+        settings: Vec::new(),
         properties: m
             .properties
             .iter()
-            .map(|p| PropertyReport::new(&p.id, &p.estimate, &p.interval, &p.counts))
+            .map(|p| PropertyRow::new(&p.id, &p.estimate, &p.interval, &p.counts))
             .collect(),
     }
 }
@@ -611,8 +533,8 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     print_report(&report, args.json)
 }
 
-fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -> Report {
-    Report {
+fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -> Study {
+    Study {
         step_seconds: None,
         max_time_seconds: None,
         model: args.input.model.display().to_string(),
@@ -627,17 +549,18 @@ fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -
         decided: r.runs.decided,
         quiescent: r.runs.quiescent,
         seconds: r.elapsed.as_secs_f64(),
+        settings: Vec::new(),
         properties: set
             .guarantee_names()
             .iter()
             .zip(&r.properties)
-            .map(|(name, p)| PropertyReport::new(name, &p.estimate, &p.interval, &p.counts))
+            .map(|(name, p)| PropertyRow::new(name, &p.estimate, &p.interval, &p.counts))
             .collect(),
     }
 }
 
 /// Prints a report as JSON or as the table.
-fn print_report(report: &Report, json: bool) -> Result<(), CliError> {
+fn print_report(report: &Study, json: bool) -> Result<(), CliError> {
     if json {
         let text = serde_json::to_string_pretty(report)
             .map_err(|e| CliError::Failed(format!("json: {e}")))?;
@@ -648,7 +571,7 @@ fn print_report(report: &Report, json: bool) -> Result<(), CliError> {
     Ok(())
 }
 
-fn print_table(r: &Report) {
+fn print_table(r: &Study) {
     let w = r
         .properties
         .iter()

@@ -341,14 +341,6 @@ impl<'a> Value<'a> {
         }
     }
 
-    /// The boolean, if this is one.
-    pub fn as_bool(&self) -> Option<bool> {
-        match self {
-            Value::Bool(b) => Some(*b),
-            _ => None,
-        }
-    }
-
     /// The integer, if this is one.
     pub fn as_i64(&self) -> Option<i64> {
         match self {
@@ -388,18 +380,21 @@ impl<'a> Value<'a> {
                 let _ = write!(out, "{v}");
             }
             Value::Str(s) => out.push_str(strings.get(*s)),
-            Value::List(l) => {
-                out.push('[');
-                for (i, v) in l.iter().enumerate() {
-                    if i > 0 {
-                        out.push(',');
-                    }
-                    v.write_to(strings, out);
-                }
-                out.push(']');
-            }
+            Value::List(l) => write_list(l.iter(), out, |v, out| v.write_to(strings, out)),
         }
     }
+}
+
+/// Writes `items` as `[a,b]`, each by `write`.
+fn write_list<T>(items: impl Iterator<Item = T>, out: &mut String, write: impl Fn(T, &mut String)) {
+    out.push('[');
+    for (i, v) in items.enumerate() {
+        if i > 0 {
+            out.push(',');
+        }
+        write(v, out);
+    }
+    out.push(']');
 }
 
 /// An owned copy of a [`Value`], for traces kept after the run.
@@ -430,30 +425,14 @@ impl From<Value<'_>> for OwnedValue {
 }
 
 impl OwnedValue {
-    /// Writes the value as text (strings resolved, lists as `[a,b]`).
+    /// Writes the value as text, as [`Value::write_to`] does.
     pub fn write_to(&self, strings: &Strings, out: &mut String) {
-        use std::fmt::Write;
         match self {
-            OwnedValue::Bool(b) => {
-                let _ = write!(out, "{b}");
-            }
-            OwnedValue::Int(v) => {
-                let _ = write!(out, "{v}");
-            }
-            OwnedValue::Float(v) => {
-                let _ = write!(out, "{v}");
-            }
-            OwnedValue::Str(s) => out.push_str(strings.get(*s)),
-            OwnedValue::List(l) => {
-                out.push('[');
-                for (i, v) in l.iter().enumerate() {
-                    if i > 0 {
-                        out.push(',');
-                    }
-                    v.write_to(strings, out);
-                }
-                out.push(']');
-            }
+            OwnedValue::Bool(b) => Value::Bool(*b).write_to(strings, out),
+            OwnedValue::Int(v) => Value::Int(*v).write_to(strings, out),
+            OwnedValue::Float(v) => Value::Float(*v).write_to(strings, out),
+            OwnedValue::Str(s) => Value::Str(*s).write_to(strings, out),
+            OwnedValue::List(l) => write_list(l.iter(), out, |v, out| v.write_to(strings, out)),
         }
     }
 }

@@ -6,6 +6,8 @@
 
 use serde::{Deserialize, Serialize};
 
+pub use crate::verify::result::{PropertyRow, Study};
+
 /// Everything one page shows.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct ReportData {
@@ -17,75 +19,6 @@ pub struct ReportData {
     pub sweeps: Vec<Sweep>,
     /// Failing runs, each drawn as a timeline.
     pub runs: Vec<Run>,
-}
-
-/// A study: what `verify --json` (or `merge --json`) prints, plus formulas and settings.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-pub struct Study {
-    /// The model path.
-    pub model: String,
-    /// The property file.
-    pub properties_file: String,
-    /// Study seed.
-    pub seed: u64,
-    /// Confidence of the intervals.
-    pub confidence: f64,
-    /// Target precision.
-    pub precision: f64,
-    /// Runs started and consumed.
-    pub runs: u64,
-    /// Runs discarded because an assumption was violated.
-    pub discarded: u64,
-    /// Runs that ended at the time horizon.
-    pub time_horizon: u64,
-    /// Runs that reached the step limit.
-    pub step_limit: u64,
-    /// Runs stopped early because every verdict was final.
-    pub decided: u64,
-    /// Runs that ended because nothing could move.
-    pub quiescent: u64,
-    /// Wall-clock seconds.
-    #[serde(default)]
-    pub seconds: f64,
-    /// Seconds of model time in one step, when the model has a time unit.
-    #[serde(default)]
-    pub step_seconds: Option<f64>,
-    /// The run length in seconds of model time, when the model has a time unit.
-    #[serde(default)]
-    pub max_time_seconds: Option<f64>,
-    /// Further settings as name and value (rule, run length, threads), in order.
-    #[serde(default)]
-    pub settings: Vec<(String, String)>,
-    /// One row per guarantee.
-    pub properties: Vec<PropertyRow>,
-}
-
-/// One guarantee's result.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-pub struct PropertyRow {
-    /// The guarantee's id.
-    pub property: String,
-    /// Estimated probability (`None` with no judged run).
-    pub probability: Option<f64>,
-    /// Lower end of the interval.
-    pub lower: f64,
-    /// Upper end of the interval.
-    pub upper: f64,
-    /// Runs judged.
-    pub runs: u64,
-    /// Runs that satisfied it.
-    pub successes: u64,
-    /// Runs cut short before its verdict was final.
-    pub cut_short: u64,
-    /// With a threshold: `accept` or `reject`.
-    #[serde(default)]
-    pub decision: Option<String>,
-    /// The formula as written in the property file.
-    #[serde(default)]
-    pub formula: Option<String>,
-    /// The formula as compiled (checked, bounds in ticks, every operation parenthesised).
-    #[serde(default)]
-    pub compiled: Option<String>,
 }
 
 /// A sweep: what `sweep --json` prints.

@@ -394,19 +394,9 @@ mod tests {
             "\"items\"",
             " ",
         ];
-        let mut state = 0x2545_f491_4f6c_dd1du64;
         let (mut oks, mut errs) = (0, 0);
-        for _ in 0..20_000 {
-            let mut next = || {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                state
-            };
-            let mut text = String::new();
-            for _ in 0..(next() % 12) {
-                text.push_str(tokens[(next() % tokens.len() as u64) as usize]);
-            }
+        for text in crate::robot::random_text::texts(&tokens, 0x2545_f491_4f6c_dd1du64, 12, 20_000)
+        {
             match parse(&text) {
                 Ok(v) => {
                     oks += 1;

@@ -108,14 +108,6 @@ impl InputKind {
             InputKind::DataJson => "json",
         }
     }
-
-    /// True for the BT plugin kinds.
-    pub fn is_bt_plugin(self) -> bool {
-        matches!(
-            self,
-            InputKind::BtPluginAscxml | InputKind::BtPluginRosScxml
-        )
-    }
 }
 
 /// One `<input type src>`.
@@ -183,13 +175,6 @@ impl Parameters {
         self.bt_tick_rate
             .as_ref()
             .map_or(DEFAULT_BT_TICK_RATE_HZ, |p| p.value.hz)
-    }
-
-    /// The tick period in nanoseconds (1 s by default).
-    pub fn bt_tick_period_ns(&self) -> u64 {
-        self.bt_tick_rate
-            .as_ref()
-            .map_or(1_000_000_000, |p| p.value.period_ns)
     }
 
     /// Whether a finished tree is ticked again, or the default.

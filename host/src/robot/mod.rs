@@ -25,6 +25,8 @@ pub mod interfaces;
 pub mod load;
 pub mod main_file;
 mod main_ignored;
+#[cfg(test)]
+mod random_text;
 pub mod ros;
 pub mod types;
 pub mod write;

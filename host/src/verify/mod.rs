@@ -3,4 +3,5 @@
 pub mod load;
 pub mod observe;
 pub mod record;
+pub mod result;
 pub mod study;

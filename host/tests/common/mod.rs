@@ -1,8 +1,10 @@
-//! What the integration tests share: where the shared corpus is.
+//! What the integration tests share: where the shared corpus is, the museum model the
+//! simulator tests run, and a counting allocator.
 //!
 //! Each test file that needs it says `mod common;`; not every file uses every helper.
 #![allow(dead_code)]
 
+pub mod alloc;
 pub mod canon;
 
 use std::path::{Path, PathBuf};
@@ -20,4 +22,34 @@ pub fn corpus_root() -> PathBuf {
 /// `shared/corpus/<relative>`.
 pub fn corpus(relative: &str) -> PathBuf {
     corpus_root().join(relative)
+}
+
+/// The museum guide's plain SCXML machines (`museum-simpar2025/model_scxml`), compiled,
+/// with the one-line fix of `NavigationComponent.scxml` (`_event.thread_id` ->
+/// `_event.data.thread_id`) without which it does not compile.
+pub fn museum_fixed() -> hindsight::sim::CompiledModel {
+    let dir = corpus("museum-simpar2025/model_scxml");
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "scxml"))
+        .collect();
+    paths.sort();
+    let files: Vec<(String, String)> = paths
+        .iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(p).unwrap();
+            let text = if p.ends_with("NavigationComponent.scxml") {
+                text.replace("_event.thread_id", "_event.data.thread_id")
+            } else {
+                text
+            };
+            (p.display().to_string(), text)
+        })
+        .collect();
+    let src = hindsight::model::ModelSource::from_texts(
+        files.iter().map(|(a, b)| (a.as_str(), b.as_str())),
+    )
+    .unwrap();
+    hindsight::sim::CompiledModel::compile(src).unwrap()
 }

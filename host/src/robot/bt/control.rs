@@ -290,6 +290,26 @@ pub(super) fn n_children(ctx: &Ctx) -> String {
     ctx.children.len().to_string()
 }
 
+/// The `finish` of [`reset_children`] for a node that keeps why it halts its children in
+/// two flags: answers FAILURE if `failure` is set, else SUCCESS if `success` is, else
+/// halted; then clears `idx` and both flags.
+pub(super) fn answer_by_flags(ctx: &Ctx, idx: &str, failure: &str, success: &str) -> Vec<Element> {
+    let b = &ctx.b;
+    vec![
+        b.if_chain(
+            vec![
+                (failure.into(), vec![ctx.respond(FAILURE)]),
+                (success.into(), vec![ctx.respond(SUCCESS)]),
+            ],
+            vec![ctx.respond_halted()],
+        )
+        .expect("two branches"),
+        b.assign(idx, "0"),
+        b.assign(failure, "false"),
+        b.assign(success, "false"),
+    ]
+}
+
 /// The `reset_children` state shared by the sequence-like nodes: halts every child in
 /// order, then answers the parent according to `finish`.
 pub(super) fn reset_children(ctx: &Ctx, idx: &str, finish: Vec<Element>) -> Element {

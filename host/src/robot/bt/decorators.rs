@@ -71,16 +71,7 @@ pub(super) fn repeat(ctx: &Ctx, n: i64, retry: bool) -> Element {
     let more = format!("{limit} == -1 || {count} < {limit}");
     let mut m = repeat_head(ctx, count, limit, n, "start_tick");
     // Out of cycles: Repeat succeeded.
-    m.push(
-        b.state("start_tick")
-            .with_child(b.tr(None, Some(&more), Some("tick_child"), vec![]))
-            .with_child(b.tr(
-                None,
-                None,
-                Some("wait_for_tick"),
-                vec![ctx.respond(again), b.assign(count, "0")],
-            )),
-    );
+    m.push(attempt_or_answer(ctx, "start_tick", &more, count, again));
     m.push(
         b.state("handle_tick_loop")
             .with_child(b.tr(
@@ -134,16 +125,7 @@ fn retry_node(ctx: &Ctx, n: i64) -> Element {
     let (count, limit) = ("try_count", "max_attempts");
     let more = format!("{limit} == -1 || {count} < {limit}");
     let mut m = repeat_head(ctx, count, limit, n, "handle_tick");
-    m.push(
-        b.state("handle_tick")
-            .with_child(b.tr(None, Some(&more), Some("tick_child"), vec![]))
-            .with_child(b.tr(
-                None,
-                None,
-                Some("wait_for_tick"),
-                vec![ctx.respond(FAILURE), b.assign(count, "0")],
-            )),
-    );
+    m.push(attempt_or_answer(ctx, "handle_tick", &more, count, FAILURE));
     m.push(repeat_tick_child(
         ctx,
         FAILURE,
@@ -187,6 +169,20 @@ fn repeat_head(ctx: &Ctx, count: &str, limit: &str, n: i64, start: &str) -> Elem
         vec![ctx.respond_halted()],
     )));
     m
+}
+
+/// State `name` of Repeat / RetryUntilSuccessful: ticks the child while `more` holds, else
+/// answers `status` and resets `count`.
+fn attempt_or_answer(ctx: &Ctx, name: &str, more: &str, count: &str, status: u8) -> Element {
+    let b = &ctx.b;
+    b.state(name)
+        .with_child(b.tr(None, Some(more), Some("tick_child"), vec![]))
+        .with_child(b.tr(
+            None,
+            None,
+            Some("wait_for_tick"),
+            vec![ctx.respond(status), b.assign(count, "0")],
+        ))
 }
 
 /// `tick_child` of Repeat / RetryUntilSuccessful: `again` goes to `again_to` doing

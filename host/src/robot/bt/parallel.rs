@@ -2,7 +2,8 @@
 //! (a condition child chooses the branch child).
 
 use super::control::{
-    init_state, n_children, on_child_status, reset_children, Ctx, FAILURE, RUNNING, SUCCESS,
+    answer_by_flags, init_state, n_children, on_child_status, reset_children, Ctx, FAILURE,
+    RUNNING, SUCCESS,
 };
 use crate::model::xml::Element;
 
@@ -185,19 +186,7 @@ pub(super) fn if_then_else(ctx: &Ctx) -> Element {
                 vec![b.assign(idx, "0")],
             )),
     );
-    let finish = vec![
-        b.if_chain(
-            vec![
-                ("ret_failure".into(), vec![ctx.respond(FAILURE)]),
-                ("ret_success".into(), vec![ctx.respond(SUCCESS)]),
-            ],
-            vec![ctx.respond_halted()],
-        )
-        .expect("two branches"),
-        b.assign(idx, "0"),
-        b.assign("ret_failure", "false"),
-        b.assign("ret_success", "false"),
-    ];
+    let finish = answer_by_flags(ctx, idx, "ret_failure", "ret_success");
     m.push(reset_children(ctx, idx, finish));
     let cond_resp = ctx.child_resp(0);
     m.push(

@@ -2,8 +2,8 @@
 //! ReactiveFallback: the nodes that tick their children one after another.
 
 use super::control::{
-    init_state, n_children, on_child_status, reset_children, sequence_head, Ctx, HaltEffect,
-    FAILURE, RUNNING, SUCCESS,
+    answer_by_flags, init_state, n_children, on_child_status, reset_children, sequence_head, Ctx,
+    HaltEffect, FAILURE, RUNNING, SUCCESS,
 };
 use crate::model::xml::Element;
 
@@ -14,19 +14,7 @@ pub(super) fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
     let b = &ctx.b;
     let idx = "current_child_idx";
     let mut m = sequence_head(ctx, idx, &["seq_failure", "seq_success"]);
-    let finish = vec![
-        b.if_chain(
-            vec![
-                ("seq_failure".into(), vec![ctx.respond(FAILURE)]),
-                ("seq_success".into(), vec![ctx.respond(SUCCESS)]),
-            ],
-            vec![ctx.respond_halted()],
-        )
-        .expect("two branches"),
-        b.assign(idx, "0"),
-        b.assign("seq_failure", "false"),
-        b.assign("seq_success", "false"),
-    ];
+    let finish = answer_by_flags(ctx, idx, "seq_failure", "seq_success");
     m.push(reset_children(ctx, idx, finish));
     let guard = b.if_then(
         &format!("{idx} < children_count"),

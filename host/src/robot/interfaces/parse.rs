@@ -606,19 +606,8 @@ mod tests {
             "int32", "x", "X", "=", "[", "]", "[<=", "<=", "'", "\"", "é", "#", "---", " ", "\n",
             "3", "-1", "string", "p/T", "\\", ",", "\u{feff}", "1e999", "\r\n", "[]", "T",
         ];
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
         let (mut oks, mut errs) = (0, 0);
-        for _ in 0..20_000 {
-            let mut next = || {
-                state ^= state << 13;
-                state ^= state >> 7;
-                state ^= state << 17;
-                state
-            };
-            let mut text = String::new();
-            for _ in 0..(next() % 9) {
-                text.push_str(tokens[(next() % tokens.len() as u64) as usize]);
-            }
+        for text in crate::robot::random_text::texts(&tokens, 0x9e37_79b9_7f4a_7c15u64, 9, 20_000) {
             for kind in [
                 InterfaceKind::Message,
                 InterfaceKind::Service,

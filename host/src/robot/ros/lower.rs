@@ -439,6 +439,23 @@ impl Cx<'_> {
         Vec::new()
     }
 
+    /// The service `alias` names among `aliases` (a machine's service clients or servers,
+    /// `role` saying which); `None` when it names none (reported) or the service's type was
+    /// not found (reported where it is declared).
+    fn service_named(
+        &mut self,
+        el: &Element,
+        aliases: &[super::Alias],
+        alias: &str,
+        role: &str,
+    ) -> Option<super::Service> {
+        let Some(key) = find(aliases, alias) else {
+            self.unknown_alias(el, role);
+            return None;
+        };
+        self.services.iter().find(|s| s.key == key).cloned()
+    }
+
     /// One ROS tag inside a state or executable content.
     fn lower_ros(&mut self, el: &Element, u: &UnitCx, scope: &Scope) -> Vec<Node> {
         if !KNOWN_TAGS.contains(&el.name.as_str()) {
@@ -498,12 +515,11 @@ impl Cx<'_> {
                 self.callback(el, u, &sc, &format!("topic_{key}_msg"), None)
             }
             "ros_service_send_request" => {
-                let Some(key) = find(&d.srv_clients, &alias).map(String::from) else {
-                    return self.unknown_alias(el, "a service client");
-                };
-                let Some(s) = self.services.iter().find(|s| s.key == key).cloned() else {
+                let Some(s) = self.service_named(el, &d.srv_clients, &alias, "a service client")
+                else {
                     return Vec::new();
                 };
+                let key = s.key.clone();
                 if s.server.is_none() {
                     self.err(el.span, format!("service `{key}` has no server"));
                 }
@@ -520,53 +536,42 @@ impl Cx<'_> {
                     params,
                 ))
             }
-            "ros_service_handle_response" => {
-                let Some(key) = find(&d.srv_clients, &alias).map(String::from) else {
-                    return self.unknown_alias(el, "a service client");
+            "ros_service_handle_response" | "ros_service_handle_request" => {
+                // A client's callback on its response, or the server's on a request.
+                let response = el.name == "ros_service_handle_response";
+                let (aliases, role) = if response {
+                    (&d.srv_clients, "a service client")
+                } else {
+                    (&d.srv_servers, "a service server")
                 };
-                let Some(s) = self.services.iter().find(|s| s.key == key).cloned() else {
+                let Some(s) = self.service_named(el, aliases, &alias, role) else {
                     return Vec::new();
                 };
-                let sc = Scope {
-                    fields: vec![(
-                        "_res",
-                        &s.fields.response,
-                        format!("the response of `{}`", s.ty),
-                    )],
-                    ..Scope::default()
-                };
-                self.callback(
-                    el,
-                    u,
-                    &sc,
-                    &format!("srv_{key}_response_client_{}", u.name),
-                    None,
-                )
-            }
-            "ros_service_handle_request" => {
-                let Some(key) = find(&d.srv_servers, &alias).map(String::from) else {
-                    return self.unknown_alias(el, "a service server");
-                };
-                let Some(s) = self.services.iter().find(|s| s.key == key).cloned() else {
-                    return Vec::new();
-                };
-                let sc = Scope {
-                    fields: vec![(
+                let key = &s.key;
+                let (var, part, fields, event) = if response {
+                    let event = format!("srv_{key}_response_client_{}", u.name);
+                    ("_res", "response", &s.fields.response, event)
+                } else {
+                    (
                         "_req",
+                        "request",
                         &s.fields.request,
-                        format!("the request of `{}`", s.ty),
-                    )],
+                        format!("srv_{key}_request"),
+                    )
+                };
+                let what = format!("the {part} of `{}`", s.ty);
+                let sc = Scope {
+                    fields: vec![(var, fields, what)],
                     ..Scope::default()
                 };
-                self.callback(el, u, &sc, &format!("srv_{key}_request"), None)
+                self.callback(el, u, &sc, &event, None)
             }
             "ros_service_send_response" => {
-                let Some(key) = find(&d.srv_servers, &alias).map(String::from) else {
-                    return self.unknown_alias(el, "a service server");
-                };
-                let Some(s) = self.services.iter().find(|s| s.key == key).cloned() else {
+                let Some(s) = self.service_named(el, &d.srv_servers, &alias, "a service server")
+                else {
                     return Vec::new();
                 };
+                let key = s.key.clone();
                 let params = self.params(
                     el,
                     &s.fields.response,

@@ -199,20 +199,6 @@ pub fn sanitize(name: &str) -> String {
     name.trim().trim_start_matches('/').replace('/', "__")
 }
 
-/// The event a message on `topic` is sent as: `topic_<sanitized topic>_msg`; its parameters
-/// are the message's [`FlatField::param_name`]s.
-pub fn topic_event(topic: &str) -> String {
-    format!("topic_{}_msg", sanitize(topic))
-}
-
-/// The events of service `service` that a property may watch: the server receives
-/// `srv_<s>_request` and answers with `srv_<s>_response` (parameters are the request's and
-/// the response's [`FlatField::param_name`]s).
-pub fn service_events(service: &str) -> (String, String) {
-    let s = sanitize(service);
-    (format!("srv_{s}_request"), format!("srv_{s}_response"))
-}
-
 /// `pkg/msg/T` and `pkg/T` name the same type.
 fn type_key(t: &str) -> String {
     let parts: Vec<&str> = t.trim().split('/').collect();
@@ -267,26 +253,42 @@ struct Topic {
     decls: Vec<(String, Span, bool)>,
 }
 
+/// A declared service ([`Service`]) or action ([`Action`]): its type and fields, its server
+/// and clients.
 #[derive(Clone, Debug)]
-struct Service {
+struct Endpoint<F> {
     key: String,
     ty: String,
-    fields: ServiceFields,
+    fields: F,
     server: Option<String>,
     server_span: Span,
     clients: Vec<String>,
-}
-
-#[derive(Clone, Debug)]
-struct Action {
-    key: String,
-    ty: String,
-    fields: ActionFields,
-    server: Option<String>,
-    server_span: Span,
-    clients: Vec<String>,
+    /// An action's thread machines (none for a service).
     threads: Vec<String>,
 }
+
+type Service = Endpoint<ServiceFields>;
+type Action = Endpoint<ActionFields>;
+
+/// How services or actions are declared: their word (also of their `<what>_name`
+/// attribute), where [`Cx`] keeps them, and how their type's fields are looked up.
+struct EndpointKind<F> {
+    what: &'static str,
+    all: for<'c, 'a> fn(&'c mut Cx<'a>) -> &'c mut Vec<Endpoint<F>>,
+    lookup: fn(&dyn InterfaceLookup, &str) -> Result<F, String>,
+}
+
+const SERVICES: EndpointKind<ServiceFields> = EndpointKind {
+    what: "service",
+    all: |c| &mut c.services,
+    lookup: |i, t| i.service(t),
+};
+
+const ACTIONS: EndpointKind<ActionFields> = EndpointKind {
+    what: "action",
+    all: |c| &mut c.actions,
+    lookup: |i, t| i.action(t),
+};
 
 #[derive(Clone, Debug)]
 struct Timer {
@@ -421,78 +423,8 @@ impl Cx<'_> {
                             ),
                         }
                     }
-                    "ros_service_server" | "ros_service_client" => {
-                        let server = el.name == "ros_service_server";
-                        let Some((sname, _)) = self.attr_or_err(el, "service_name") else {
-                            continue;
-                        };
-                        let Some((ty, ty_span)) = self.attr_or_err(el, "type") else {
-                            continue;
-                        };
-                        let key = sanitize(&sname);
-                        let alias = el.attr_value("name").unwrap_or(&sname).trim().to_string();
-                        if let Some(i) = self.declare_service(&key, &ty, ty_span) {
-                            if server {
-                                if let Some(other) = &self.services[i].server {
-                                    let at = self.sm.diag(self.services[i].server_span, "");
-                                    self.err(
-                                        el.span,
-                                        format!(
-                                            "service `{sname}` already has a server, `{other}` ({}:{}:{})",
-                                            at.file,
-                                            at.line,
-                                            at.col
-                                        ),
-                                    );
-                                }
-                                self.services[i].server = Some(name.clone());
-                                self.services[i].server_span = el.span;
-                            }
-                        }
-                        let a = Alias {
-                            alias,
-                            key,
-                            msg: None,
-                        };
-                        if server {
-                            d.srv_servers.push(a);
-                        } else {
-                            d.srv_clients.push(a);
-                        }
-                    }
-                    "ros_action_server" | "ros_action_client" => {
-                        let server = el.name == "ros_action_server";
-                        let Some((aname, _)) = self.attr_or_err(el, "action_name") else {
-                            continue;
-                        };
-                        let Some((ty, ty_span)) = self.attr_or_err(el, "type") else {
-                            continue;
-                        };
-                        let key = sanitize(&aname);
-                        let alias = el.attr_value("name").unwrap_or(&aname).trim().to_string();
-                        if let Some(i) = self.declare_action(&key, &ty, ty_span) {
-                            if server {
-                                if let Some(other) = &self.actions[i].server {
-                                    self.err(
-                                        el.span,
-                                        format!("action `{aname}` already has a server, `{other}`"),
-                                    );
-                                }
-                                self.actions[i].server = Some(name.clone());
-                                self.actions[i].server_span = el.span;
-                            }
-                        }
-                        let a = Alias {
-                            alias,
-                            key,
-                            msg: None,
-                        };
-                        if server {
-                            d.act_servers.push(a);
-                        } else {
-                            d.act_clients.push(a);
-                        }
-                    }
+                    "ros_service_server" | "ros_service_client" | "ros_action_server"
+                    | "ros_action_client" => self.endpoint_tag(el, &name, &mut d),
                     "ros_action_thread" => threads.push((ci, el)),
                     _ => {}
                 }
@@ -547,13 +479,7 @@ impl Cx<'_> {
         ty_span: Span,
         publisher: bool,
     ) -> Option<Vec<FlatField>> {
-        let fields = match self.interfaces.message(ty.trim()) {
-            Ok(f) => f,
-            Err(m) => {
-                self.err(ty_span, m);
-                return None;
-            }
-        };
+        let fields = self.looked_up(ty_span, self.interfaces.message(ty.trim()))?;
         match self.topics.iter_mut().find(|t| t.key == key) {
             Some(t) => t.decls.push((ty.to_string(), ty_span, publisher)),
             None => self.topics.push(Topic {
@@ -564,78 +490,102 @@ impl Cx<'_> {
         Some(fields)
     }
 
-    /// `i`, the index of a `what` (service, action) declared again: a different type at
-    /// `ty_span` than the first declaration's `first` is an error.
-    fn redeclared(
+    /// The fields an interface lookup found, or `None` with its error reported at `span`.
+    fn looked_up<F>(&mut self, span: Span, found: Result<F, String>) -> Option<F> {
+        found.map_err(|m| self.err(span, m)).ok()
+    }
+
+    /// A `<ros_service_server|client>` or `<ros_action_server|client>` tag `el` of machine
+    /// `machine`: declares the service or action, records a server, and adds the tag's
+    /// alias to the machine's declarations `d`.
+    fn endpoint_tag(&mut self, el: &Element, machine: &str, d: &mut Decls) {
+        let service = el.name.starts_with("ros_service");
+        let alias = if service {
+            self.declare_endpoint(el, machine, &SERVICES)
+        } else {
+            self.declare_endpoint(el, machine, &ACTIONS)
+        };
+        let Some(alias) = alias else {
+            return;
+        };
+        match (service, el.name.ends_with("_server")) {
+            (true, true) => d.srv_servers.push(alias),
+            (true, false) => d.srv_clients.push(alias),
+            (false, true) => d.act_servers.push(alias),
+            (false, false) => d.act_clients.push(alias),
+        }
+    }
+
+    /// The endpoint tag `el` of machine `machine` naming a `what` (service, action) in its
+    /// `<what>_name` attribute (`kind` says which): declares it,
+    /// records a server tag's machine as its one server, and gives the tag's alias; `None`
+    /// after an error in a required attribute.
+    fn declare_endpoint<F>(
         &mut self,
-        what: &str,
-        key: &str,
-        ty: &str,
-        ty_span: Span,
-        i: usize,
-        first: &str,
-    ) -> usize {
-        if type_key(first) != type_key(ty) {
-            self.err(
-                ty_span,
-                format!(
-                    "{what} `{key}` is declared with type `{}` here but `{first}` elsewhere",
-                    ty.trim()
-                ),
-            );
+        el: &Element,
+        machine: &str,
+        kind: &EndpointKind<F>,
+    ) -> Option<Alias> {
+        let (what, all) = (kind.what, kind.all);
+        let (ename, _) = self.attr_or_err(el, &format!("{what}_name"))?;
+        let (ty, ty_span) = self.attr_or_err(el, "type")?;
+        let key = sanitize(&ename);
+        let alias = el.attr_value("name").unwrap_or(&ename).trim().to_string();
+        let declared = self.declare(kind, (&key, &ty, ty_span));
+        if let Some(i) = declared.filter(|_| el.name.ends_with("_server")) {
+            let first = &all(self)[i];
+            if let Some((other, span)) = first.server.clone().map(|o| (o, first.server_span)) {
+                let at = self.sm.diag(span, "");
+                let msg = format!(
+                    "{what} `{ename}` already has a server, `{other}` ({}:{}:{})",
+                    at.file, at.line, at.col
+                );
+                self.err(el.span, msg);
+            }
+            all(self)[i].server = Some(machine.to_string());
+            all(self)[i].server_span = el.span;
         }
-        i
+        Some(Alias {
+            alias,
+            key,
+            msg: None,
+        })
     }
 
-    fn declare_service(&mut self, key: &str, ty: &str, ty_span: Span) -> Option<usize> {
-        let found = self.services.iter().position(|s| s.key == key);
-        if let Some(i) = found {
-            let first = self.services[i].ty.clone();
-            return Some(self.redeclared("service", key, ty, ty_span, i, &first));
-        }
-        match self.interfaces.service(ty.trim()) {
-            Ok(fields) => {
-                self.services.push(Service {
-                    key: key.to_string(),
-                    ty: ty.trim().to_string(),
-                    fields,
-                    server: None,
-                    server_span: ty_span,
-                    clients: Vec::new(),
-                });
-                Some(self.services.len() - 1)
+    /// Records a declaration of the service or action (`kind`) `key` with type `ty`: its
+    /// index, or `None` after an error. Declared again, it must have the type of its first
+    /// declaration.
+    fn declare<F>(
+        &mut self,
+        kind: &EndpointKind<F>,
+        (key, ty, ty_span): (&str, &str, Span),
+    ) -> Option<usize> {
+        let (what, all, lookup) = (kind.what, kind.all, kind.lookup);
+        if let Some(i) = all(self).iter().position(|e| e.key == key) {
+            let first = all(self)[i].ty.clone();
+            if type_key(&first) != type_key(ty) {
+                self.err(
+                    ty_span,
+                    format!(
+                        "{what} `{key}` is declared with type `{}` here but `{first}` elsewhere",
+                        ty.trim()
+                    ),
+                );
             }
-            Err(m) => {
-                self.err(ty_span, m);
-                None
-            }
+            return Some(i);
         }
-    }
-
-    fn declare_action(&mut self, key: &str, ty: &str, ty_span: Span) -> Option<usize> {
-        let found = self.actions.iter().position(|s| s.key == key);
-        if let Some(i) = found {
-            let first = self.actions[i].ty.clone();
-            return Some(self.redeclared("action", key, ty, ty_span, i, &first));
-        }
-        match self.interfaces.action(ty.trim()) {
-            Ok(fields) => {
-                self.actions.push(Action {
-                    key: key.to_string(),
-                    ty: ty.trim().to_string(),
-                    fields,
-                    server: None,
-                    server_span: ty_span,
-                    clients: Vec::new(),
-                    threads: Vec::new(),
-                });
-                Some(self.actions.len() - 1)
-            }
-            Err(m) => {
-                self.err(ty_span, m);
-                None
-            }
-        }
+        let fields = self.looked_up(ty_span, lookup(self.interfaces, ty.trim()))?;
+        let all = all(self);
+        all.push(Endpoint {
+            key: key.to_string(),
+            ty: ty.trim().to_string(),
+            fields,
+            server: None,
+            server_span: ty_span,
+            clients: Vec::new(),
+            threads: Vec::new(),
+        });
+        Some(all.len() - 1)
     }
 
     /// Every declaration of a topic has the type of its first one.
@@ -761,8 +711,6 @@ mod tests {
             "NavigationComponent__GoToPoi"
         );
         assert_eq!(sanitize("level"), "level");
-        assert_eq!(topic_event("/a/b"), "topic_a__b_msg");
-        assert_eq!(service_events("/adder").1, "srv_adder_response");
         assert_eq!(type_key("std_msgs/msg/Int32"), type_key("std_msgs/Int32"));
         assert_ne!(type_key("std_msgs/Int32"), type_key("std_msgs/Int16"));
     }
