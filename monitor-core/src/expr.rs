@@ -123,7 +123,7 @@ pub(crate) fn eval(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, St
     }
     // The stack never holds more values than the code has instructions: a short
     // atom gets a short stack to clear.
-    if code.len() <= 8 {
+    if !cfg!(feature = "compact") && code.len() <= 8 {
         eval_stack::<8>(code, vals, atom)
     } else {
         eval_stack::<MAX_STACK>(code, vals, atom)

@@ -48,8 +48,9 @@
 //! - `float` (default): atoms over `float` values. Without it a program with a
 //!   float atom is rejected ([`TableError::Feature`]) and no soft-float routine
 //!   is linked into the step.
-//! - `compact`: one interpreter loop for programs of every size and the atom
-//!   machine without its shortcuts: a smaller step for firmware, same results.
+//! - `compact`: one interpreter loop for programs of every size and one atom
+//!   stack machine (its full depth) without its shortcuts: a smaller step for
+//!   firmware, same results.
 //! - `int-div` (default): integer `/` and `%` in atoms (64-bit division, a
 //!   library routine on 32-bit cores); without it such a program is rejected.
 #![no_std]

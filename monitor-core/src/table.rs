@@ -63,7 +63,13 @@ impl<'a> Reader<'a> {
 
     /// A varint of a type of `bits` bits (16, 32 or 64).
     fn varint(&mut self, bits: u32) -> Result<u64, TableError> {
-        let max_bytes = bits.div_ceil(7);
+        // `bits.div_ceil(7)` for the widths read (16, 32, 64): without a
+        // division, a library routine on a Cortex-M0 (no divide instruction).
+        let max_bytes = match bits {
+            16 => 3,
+            32 => 5,
+            _ => 10,
+        };
         let mut out = 0u64;
         for i in 0..max_bytes {
             let b = self.byte()?;
