@@ -15,7 +15,8 @@
 //! a `time` column and one column per variable; other columns (the recorded
 //! verdicts) are ignored here. Every variable of the spec must have a column.
 //! An empty cell leaves a state variable unchanged and an event false. A bad
-//! spec or CSV fails the build with `file:line:col: error: ...`.
+//! spec or CSV fails the build with codegen's diagnostic
+//! (`file:line:col: message` and the line with a caret).
 
 use std::fmt::Write as _;
 use std::fs;
@@ -23,7 +24,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use codegen::emit_rust::{emit_rust, input_fields, EmitOptions};
-use codegen::Compiled;
+use codegen::{Compiled, Diagnostic, LineIndex, Snippet};
 use monitor_core::{Ty, Value, VarKind};
 
 const SPEC: &str = "museum.hspec";
@@ -83,9 +84,14 @@ fn write(path: &Path, bytes: &[u8]) -> Result<(), String> {
     fs::write(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// `file:line:col: error: msg`, lines and columns from 1.
-fn error(file: &str, line: usize, col: usize, msg: impl std::fmt::Display) -> String {
-    format!("{file}:{line}:{col}: error: {msg}")
+/// `msg` at `line`:`col` (from 1) of `text`, the contents of `file`, as codegen
+/// renders every diagnostic: `file:line:col: msg` and the line with a caret.
+fn error(file: &str, text: &str, line: usize, col: usize, msg: impl std::fmt::Display) -> String {
+    let index = LineIndex::new(text);
+    let (line, col) = (line as u32, col as u32);
+    Diagnostic::error(file, (line, col), msg.to_string())
+        .with_snippet(Snippet::at_line_col(text, &index, line, col))
+        .to_string()
 }
 
 /// The CSV's points, one per data row, each with a value for every spec variable in declaration order.
@@ -101,11 +107,12 @@ fn parse_trace(
         .filter(|(_, l)| !l.starts_with('#') && !l.trim().is_empty());
     let (header_line, header) = rows
         .next()
-        .ok_or_else(|| error(file, 1, 1, "no header row"))?;
+        .ok_or_else(|| error(file, text, 1, 1, "no header row"))?;
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
     if names.first() != Some(&"time") {
         return Err(error(
             file,
+            text,
             header_line,
             1,
             "the first column must be `time`",
@@ -118,6 +125,7 @@ fn parse_trace(
             names.iter().position(|n| *n == v.name).ok_or_else(|| {
                 error(
                     file,
+                    text,
                     header_line,
                     1,
                     format!("no column for variable `{}` of {SPEC}", v.name),
@@ -131,16 +139,17 @@ fn parse_trace(
     let mut points = Vec::new();
     for (line, row) in rows {
         let cells: Vec<&str> = row.split(',').collect();
-        // Byte column (from 1) of each cell.
+        // Column (from 1, in characters) of each cell.
         let mut starts = Vec::with_capacity(cells.len());
         let mut at = 1;
         for c in &cells {
             starts.push(at);
-            at += c.len() + 1;
+            at += c.chars().count() + 1;
         }
         if cells.len() != names.len() {
             return Err(error(
                 file,
+                text,
                 line,
                 1,
                 format!("{} cells, the header has {}", cells.len(), names.len()),
@@ -149,10 +158,11 @@ fn parse_trace(
         let time: u64 = cells[0]
             .trim()
             .parse()
-            .map_err(|e| error(file, line, 1, format!("time {:?}: {e}", cells[0])))?;
+            .map_err(|e| error(file, text, line, 1, format!("time {:?}: {e}", cells[0])))?;
         if time < last_time {
             return Err(error(
                 file,
+                text,
                 line,
                 1,
                 format!("time {time} is before the previous point's {last_time}"),
@@ -170,6 +180,7 @@ fn parse_trace(
             let bad = |what: &str| {
                 error(
                     file,
+                    text,
                     line,
                     starts[col],
                     format!("`{}`: {what} {cell:?}", var.name),
@@ -189,7 +200,13 @@ fn parse_trace(
         points.push((time, state.clone()));
     }
     if points.is_empty() {
-        return Err(error(file, header_line, 1, "no points after the header"));
+        return Err(error(
+            file,
+            text,
+            header_line,
+            1,
+            "no points after the header",
+        ));
     }
     Ok(points)
 }

@@ -89,7 +89,9 @@ pub(crate) fn enabled(code: &[Instr], vars: &[Var<'_>]) -> bool {
 /// another type) falls through to the general machine, so errors are the same.
 #[inline]
 pub(crate) fn eval(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, StepError> {
+    // The common shapes without the stack; `compact` (firmware) keeps only the stack.
     match *code {
+        _ if cfg!(feature = "compact") => {}
         [Instr::Load(n)] => {
             if let Some(Value::Bool(b)) = vals.get(n as usize) {
                 return Ok(*b);
@@ -121,7 +123,7 @@ pub(crate) fn eval(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, St
     }
     // The stack never holds more values than the code has instructions: a short
     // atom gets a short stack to clear.
-    if code.len() <= 8 {
+    if !cfg!(feature = "compact") && code.len() <= 8 {
         eval_stack::<8>(code, vals, atom)
     } else {
         eval_stack::<MAX_STACK>(code, vals, atom)

@@ -52,7 +52,7 @@ pub const fn window_capacity(lo: u64, hi: u64) -> Option<u32> {
     let cap = if width == u64::MAX {
         1
     } else {
-        match (hi / (width + 1)).checked_add(1) {
+        match div(hi, width + 1, 64).checked_add(1) {
             Some(c) => c,
             None => return None,
         }
@@ -62,6 +62,35 @@ pub const fn window_capacity(lo: u64, hi: u64) -> Option<u32> {
     } else {
         Some(cap as u32)
     }
+}
+
+/// `n / d` for `d >= 1` whose quotient is below `2^bits` (`bits <= 64`).
+///
+/// On a 64-bit core a division instruction; on a 32-bit one a 64-bit division is
+/// a library routine (`__aeabi_uldivmod`: several hundred bytes of flash and many
+/// cycles), so there it is a restoring division of `bits` steps instead, and
+/// firmware links no division routine. From bit `bits - 1` down, `r >> k >= d`
+/// means `d << k <= r`: neither the shift nor the subtraction overflows.
+#[inline]
+pub(crate) const fn div(n: u64, d: u64, bits: u32) -> u64 {
+    if cfg!(target_pointer_width = "64") {
+        return n / d;
+    }
+    steps_div(n, d, bits)
+}
+
+/// [`div`]'s restoring division, on every target (so that its tests run on the host).
+pub(crate) const fn steps_div(n: u64, d: u64, bits: u32) -> u64 {
+    let (mut r, mut q) = (n, 0u64);
+    let mut k = bits;
+    while k > 0 {
+        k -= 1;
+        if r >> k >= d {
+            r -= d << k;
+            q |= 1 << k;
+        }
+    }
+    q
 }
 
 /// Classifies a `Since` by its bounds; `None` when `lo > hi` or the capacity overflows.
@@ -100,4 +129,29 @@ pub const fn bit_words(bits: usize) -> usize {
 /// Index of the first node-owned word for a program with `atoms` atoms and `nodes` nodes.
 pub const fn first_node_word(atoms: usize, nodes: usize) -> usize {
     HEADER_WORDS + bit_words(atoms) + bit_words(nodes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::steps_div;
+
+    #[test]
+    fn restoring_division_equals_division() {
+        let cases = [
+            (0, 1, 64),
+            (10, 3, 64),
+            (100, 51, 64),
+            (u64::MAX, 1, 64),
+            (u64::MAX, 2, 64),
+            (u64::MAX, u64::MAX, 64),
+            (u64::MAX - 1, 3, 64),
+            ((1 << 34) - 5, 1 << 33, 64),
+            (1_000_003, 999_997, 32),
+            (1 << 40, 1 << 9, 32),
+            (u32::MAX as u64 * 7, 7, 32),
+        ];
+        for (n, d, bits) in cases {
+            assert_eq!(steps_div(n, d, bits), n / d, "{n} / {d}");
+        }
+    }
 }

@@ -8,7 +8,14 @@
 //! order. This crate only runs programs:
 //!
 //! 1. **Get a program**: generated Rust source builds one from `static` arrays,
-//!    or [`table::Table::from_bytes`] (feature `postcard`) decodes one from bytes.
+#![cfg_attr(
+    feature = "postcard",
+    doc = "   or [`table::Table::from_bytes`] (feature `postcard`) decodes one from bytes."
+)]
+#![cfg_attr(
+    not(feature = "postcard"),
+    doc = "   or `table::Table::from_bytes` (feature `postcard`) decodes one from bytes."
+)]
 //! 2. **Validate**: [`Monitor::try_new`] checks every index, type, bound and
 //!    state slot once, so that stepping cannot panic or misbehave.
 //!    [`Monitor::try_new_planned`] also decides once what each node and atom
@@ -29,11 +36,21 @@
 //! # Crate features
 //!
 //! - `serde`: `Serialize`/`Deserialize` for every program type.
-//! - `postcard`: [`table::Table`], a validated postcard loader (implies `serde`).
+#![cfg_attr(
+    feature = "postcard",
+    doc = "- `postcard`: [`table::Table`], a validated postcard loader (implies `serde`)."
+)]
+#![cfg_attr(
+    not(feature = "postcard"),
+    doc = "- `postcard`: `table::Table`, a validated postcard loader (implies `serde`)."
+)]
 //! - `defmt`: `defmt::Format` for the error types.
 //! - `float` (default): atoms over `float` values. Without it a program with a
 //!   float atom is rejected ([`TableError::Feature`]) and no soft-float routine
 //!   is linked into the step.
+//! - `compact`: one interpreter loop for programs of every size and one atom
+//!   stack machine (its full depth) without its shortcuts: a smaller step for
+//!   firmware, same results.
 //! - `int-div` (default): integer `/` and `%` in atoms (64-bit division, a
 //!   library routine on 32-bit cores); without it such a program is rejected.
 #![no_std]

@@ -4,7 +4,7 @@ use crate::error::{StepError, TableError};
 use crate::expr;
 use crate::layout;
 use crate::plan::{self, AtomStep, Kind, Step};
-use crate::program::{Atom, Instr, Op, Program, Value, VarKind};
+use crate::program::{Atom, Instr, Node, Op, Program, Value, VarKind};
 
 /// A [`Program`] that passed every check: it can be stepped without panicking.
 ///
@@ -26,7 +26,7 @@ pub struct Monitor<'a, const N: usize = 0> {
     /// First word of the nodes' own state ([`layout::first_node_word`]), decided once.
     nodes_at: usize,
     /// At most 64 atoms and 64 nodes, decided once: the atoms and the node values
-    /// of a point each fit one register ([`Monitor::advance_small`]).
+    /// of a point each fit one register ([`Monitor::advance`]).
     small: bool,
     /// Whether `plan` and `atom_plan` hold the program (at most `N` nodes and atoms).
     planned: bool,
@@ -221,28 +221,13 @@ impl<'a, const N: usize> Monitor<'a, N> {
         }
         // Atoms first: an error leaves the temporal state untouched.
         if N > 0 && self.planned {
-            if self.small {
-                return self.step_planned_small(state, time, vars, verdicts);
-            }
-            let bits = self.planned_atoms(state, vars)?;
-            self.advance_planned(state, time, bits, verdicts);
-            return Ok(());
+            let atoms = self.plan_atoms();
+            let first = atom_words(atoms, p.instrs, vars, state)?;
+            self.advance(self.plan_nodes(), state, time, first, verdicts);
+        } else {
+            let first = atom_words(p.atoms, p.instrs, vars, state)?;
+            self.advance(p.nodes, state, time, first, verdicts);
         }
-        if self.small {
-            let bits = atom_word(p.atoms, p.instrs, vars, 0)?;
-            // No scratch word without atoms: the value word comes next.
-            if !p.atoms.is_empty() {
-                wr(state, layout::HEADER_WORDS, bits);
-            }
-            self.advance_small(state, time, bits, verdicts);
-            return Ok(());
-        }
-        // Into the scratch words, 64 atoms at a time.
-        for (w, chunk) in p.atoms.chunks(64).enumerate() {
-            let bits = atom_word(chunk, p.instrs, vars, w * 64)?;
-            wr(state, layout::HEADER_WORDS + w, bits);
-        }
-        self.advance(state, time, verdicts);
         Ok(())
     }
 
@@ -266,14 +251,11 @@ impl<'a, const N: usize> Monitor<'a, N> {
         for (k, a) in atoms.iter().enumerate() {
             wr(state, layout::HEADER_WORDS + k, *a);
         }
+        let first = atoms.first().copied().unwrap_or(0);
         if N > 0 && self.planned {
-            let bits = atoms.first().copied().unwrap_or(0);
-            self.advance_planned(state, time, bits, verdicts);
-        } else if self.small {
-            let bits = atoms.first().copied().unwrap_or(0);
-            self.advance_small(state, time, bits, verdicts);
+            self.advance(self.plan_nodes(), state, time, first, verdicts);
         } else {
-            self.advance(state, time, verdicts);
+            self.advance(self.program.nodes, state, time, first, verdicts);
         }
         Ok(())
     }
@@ -321,92 +303,55 @@ impl<'a, const N: usize> Monitor<'a, N> {
         state.first().and_then(|t| t.checked_sub(1))
     }
 
-    /// The planned step of a program of at most 64 atoms and 64 nodes, after the
-    /// checks: atoms and node values each in one register, the plan in order.
+    /// The plan's atoms (empty unless planned).
     #[inline(always)]
-    fn step_planned_small(
+    fn plan_atoms(&self) -> &[AtomStep] {
+        self.atom_plan
+            .get(..self.program.atoms.len())
+            .unwrap_or(&[])
+    }
+
+    /// The plan's nodes (empty unless planned).
+    #[inline(always)]
+    fn plan_nodes(&self) -> &[Step] {
+        self.plan.get(..self.program.nodes.len()).unwrap_or(&[])
+    }
+
+    /// Updates every node, planned ([`Step`]) or not ([`Node`]): one loop for
+    /// both; the state length and the time were checked by the caller, and the
+    /// atoms of this point are in the scratch words, the first of them also in
+    /// `atoms`.
+    ///
+    /// Every access goes through `get`/`get_mut` (the slots were validated, so the
+    /// fallbacks never run): the step links no panic path into firmware. The value
+    /// bits of the nodes being updated are built in a register and stored once per
+    /// 64 nodes; a node's children come before it, so their values at this point
+    /// are either in that register or in a word already stored. A program of at
+    /// most 64 atoms and 64 nodes (most of them) takes a loop without the word
+    /// bookkeeping, unless the `compact` feature keeps only the general loop.
+    #[inline(always)]
+    fn advance<S: NodeStep>(
         &self,
+        nodes: &[S],
         state: &mut [u64],
         t: u64,
-        vars: &[Value],
+        atoms: u64,
         verdicts: &mut [bool],
-    ) -> Result<(), StepError> {
-        let p = &self.program;
-        let mut atoms = 0u64;
-        let atom_plan = self.atom_plan.get(..p.atoms.len()).unwrap_or(&[]);
-        for (k, a) in atom_plan.iter().enumerate() {
-            atoms |= (a.eval(p.instrs, vars, k)? as u64) << (k & 63);
-        }
+    ) {
+        // Header, atom and value words before `off`; nodes' own words from `off` on.
         let (off, vals) = (self.nodes_at, self.values_at);
-        // The state length was checked (it covers every node's words): never `None`.
-        let Some((head, body)) = state.split_at_mut_checked(off) else {
-            return Ok(());
-        };
-        // No scratch word without atoms: the value word comes next.
-        if !p.atoms.is_empty() {
-            wr(head, layout::HEADER_WORDS, atoms);
-        }
-        let first_point = rd(head, 0) == 0;
-        let old = rd(head, vals);
-        let mut new = 0u64;
-        let plan = self.plan.get(..p.nodes.len()).unwrap_or(&[]);
-        for (i, s) in plan.iter().enumerate() {
-            let now = new;
-            let v = exec(
-                s,
-                body,
-                t,
-                first_point,
-                |a| atoms >> (a & 63) & 1 == 1,
-                |c| now >> (c & 63) & 1 == 1,
-                old >> (i & 63) & 1 == 1,
-            );
-            new |= (v as u64) << (i & 63);
-        }
-        wr(head, vals, new);
-        wr(head, 0, t + 1);
-        for (out, pr) in verdicts.iter_mut().zip(p.props) {
-            *out = new >> (pr.root & 63) & 1 == 1;
-        }
-        Ok(())
-    }
-
-    /// The atoms of this point through [`Monitor::atom_plan`], into the scratch
-    /// words 64 at a time (a program with more than 64 atoms or nodes); the first
-    /// word is returned.
-    #[inline(always)]
-    fn planned_atoms(&self, state: &mut [u64], vars: &[Value]) -> Result<u64, StepError> {
-        let p = &self.program;
-        let steps = self.atom_plan.get(..p.atoms.len()).unwrap_or(&[]);
-        for (w, chunk) in steps.chunks(64).enumerate() {
-            let mut bits = 0u64;
-            for (b, a) in chunk.iter().enumerate() {
-                bits |= (a.eval(p.instrs, vars, w * 64 + b)? as u64) << (b & 63);
-            }
-            wr(state, layout::HEADER_WORDS + w, bits);
-        }
-        Ok(rd(state, layout::HEADER_WORDS))
-    }
-
-    /// [`Monitor::advance`] over the plan; `atoms` is the first atom word (all
-    /// of them for a small program, which keeps its node values in one register).
-    #[inline(always)]
-    fn advance_planned(&self, state: &mut [u64], t: u64, atoms: u64, verdicts: &mut [bool]) {
-        let off = self.nodes_at;
-        let vals = self.values_at;
-        let steps = self.plan.get(..self.program.nodes.len()).unwrap_or(&[]);
         // The state length was checked (it covers every node's words): never `None`.
         let Some((head, body)) = state.split_at_mut_checked(off) else {
             return;
         };
         let first_point = rd(head, 0) == 0;
-        if self.small {
+        if !cfg!(feature = "compact") && self.small {
             let old = rd(head, vals);
             let mut new = 0u64;
-            for (i, s) in steps.iter().enumerate() {
+            for (i, node) in nodes.iter().enumerate() {
                 let now = new;
-                let v = exec(
-                    s,
+                let v = node.value(
+                    off,
                     body,
                     t,
                     first_point,
@@ -426,7 +371,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
         let mut old = rd(head, vals);
         let mut new = 0u64;
         let mut base = 0usize;
-        for (i, s) in steps.iter().enumerate() {
+        for (i, node) in nodes.iter().enumerate() {
             if i - base >= 64 {
                 wr(head, vals + base / 64, new);
                 base = i;
@@ -434,8 +379,8 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 new = 0;
             }
             let (now, h): (u64, &[u64]) = (new, head);
-            let v = exec(
-                s,
+            let v = node.value(
+                off,
                 body,
                 t,
                 first_point,
@@ -460,149 +405,123 @@ impl<'a, const N: usize> Monitor<'a, N> {
             *out = rd(head, vals + r / 64) >> (r % 64) & 1 == 1;
         }
     }
+}
 
-    /// [`Monitor::advance`] for a program of at most 64 atoms and 64 nodes, with
-    /// this point's atoms in `atoms`: the node values are built in one register,
-    /// stored once, and the verdicts are read from it.
+/// One atom at one point: a program's [`Atom`] or its plan ([`AtomStep`]).
+trait AtomValue {
+    /// The atom's value from the variables; `atom` is its index (for errors).
+    fn value(&self, instrs: &[Instr], vars: &[Value], atom: usize) -> Result<bool, StepError>;
+}
+
+impl AtomValue for Atom {
+    /// A boolean variable (one `Load`, the most common atom) is read directly; any
+    /// other atom, or a value of another type, goes through [`expr::eval`], so
+    /// results and errors are those of the general machine.
     #[inline(always)]
-    fn advance_small(&self, state: &mut [u64], t: u64, atoms: u64, verdicts: &mut [bool]) {
-        let off = self.nodes_at;
-        let vals = self.values_at;
-        // The state length was checked (it covers every node's words): never `None`.
-        let Some((head, body)) = state.split_at_mut_checked(off) else {
-            return;
-        };
-        let first_point = rd(head, 0) == 0;
-        let old = rd(head, vals);
-        let mut new = 0u64;
-        for (i, node) in self.program.nodes.iter().enumerate() {
-            let now = new;
-            let v = node_step(
-                &node.op,
-                (node.slot as usize).wrapping_sub(off),
-                body,
-                t,
-                first_point,
-                |a| atoms >> (a & 63) & 1 == 1,
-                |c| now >> (c & 63) & 1 == 1,
-                old >> (i & 63) & 1 == 1,
-            );
-            new |= (v as u64) << (i & 63);
-        }
-        wr(head, vals, new);
-        wr(head, 0, t + 1);
-        for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
-            *out = new >> (pr.root & 63) & 1 == 1;
-        }
-    }
-
-    /// Updates every node; the state length and the time were checked by the caller.
-    ///
-    /// Every access goes through `get`/`get_mut` (the slots were validated, so the
-    /// fallbacks never run): the step links no panic path into firmware. The value
-    /// bits of the nodes being updated are built in a register and stored once per
-    /// 64 nodes; a node's children come before it, so their values at this point
-    /// are either in that register or in a word already stored. A network of at
-    /// most 64 nodes (most of them) takes a loop without the word bookkeeping.
-    #[inline]
-    fn advance(&self, state: &mut [u64], t: u64, verdicts: &mut [bool]) {
-        let first_point = rd(state, 0) == 0;
-        let vals = self.values_at;
-        let nodes = self.program.nodes;
-        // Header, atom and value words before `off`; nodes' own words from `off` on.
-        let off = self.nodes_at;
-        // The state length was checked (it covers every node's words): never `None`.
-        let Some((head, body)) = state.split_at_mut_checked(off) else {
-            return;
-        };
-        let atom = |head: &[u64], a: u16| {
-            rd(head, layout::HEADER_WORDS + a as usize / 64) >> (a % 64) & 1 == 1
-        };
-        if nodes.len() <= 64 {
-            let old = rd(head, vals);
-            let mut new = 0u64;
-            for (i, node) in nodes.iter().enumerate() {
-                let now = new;
-                let v = node_step(
-                    &node.op,
-                    (node.slot as usize).wrapping_sub(off),
-                    body,
-                    t,
-                    first_point,
-                    |a| atom(head, a),
-                    |c| now >> (c & 63) & 1 == 1,
-                    old >> (i & 63) & 1 == 1,
-                );
-                new |= (v as u64) << (i & 63);
-            }
-            wr(head, vals, new);
-        } else {
-            let mut old = rd(head, vals);
-            let mut new = 0u64;
-            let mut base = 0usize;
-            for (i, node) in nodes.iter().enumerate() {
-                if i - base >= 64 {
-                    wr(head, vals + base / 64, new);
-                    base = i;
-                    old = rd(head, vals + base / 64);
-                    new = 0;
-                }
-                let (now, h): (u64, &[u64]) = (new, head);
-                let v = node_step(
-                    &node.op,
-                    (node.slot as usize).wrapping_sub(off),
-                    body,
-                    t,
-                    first_point,
-                    |a| atom(h, a),
-                    |c| {
-                        let c = c as usize;
-                        let w = if c >= base {
-                            now >> ((c - base) & 63)
-                        } else {
-                            rd(h, vals + c / 64) >> (c % 64)
-                        };
-                        w & 1 == 1
-                    },
-                    old >> ((i - base) & 63) & 1 == 1,
-                );
-                new |= (v as u64) << ((i - base) & 63);
-            }
-            wr(head, vals + base / 64, new);
-        }
-        wr(head, 0, t + 1);
-        for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
-            let r = pr.root as usize;
-            *out = rd(head, vals + r / 64) >> (r % 64) & 1 == 1;
+    fn value(&self, instrs: &[Instr], vars: &[Value], atom: usize) -> Result<bool, StepError> {
+        let start = self.start as usize;
+        match (self.len, instrs.get(start)) {
+            (1, Some(Instr::Load(n))) => match vars.get(*n as usize) {
+                Some(Value::Bool(v)) => Ok(*v),
+                _ => general_atom(instrs, start, self.len, vars, atom),
+            },
+            _ => general_atom(instrs, start, self.len, vars, atom),
         }
     }
 }
 
-/// The bits of up to 64 atoms (`chunk`, the first being atom `base`) at this point.
-///
-/// A boolean variable (one `Load`, the most common atom) is read directly; any other
-/// atom, or a value of another type, goes through [`expr::eval`], so results and
-/// errors are those of the general machine.
+impl AtomValue for AtomStep {
+    #[inline(always)]
+    fn value(&self, instrs: &[Instr], vars: &[Value], atom: usize) -> Result<bool, StepError> {
+        self.eval(instrs, vars, atom)
+    }
+}
+
+/// Computes every atom of this point into the scratch words of `state`, 64 at a
+/// time, and returns the first word (0 without atoms).
 #[inline(always)]
-fn atom_word(
-    chunk: &[Atom],
+fn atom_words<A: AtomValue>(
+    atoms: &[A],
     instrs: &[Instr],
     vars: &[Value],
-    base: usize,
+    state: &mut [u64],
 ) -> Result<u64, StepError> {
-    let mut bits = 0u64;
-    for (b, a) in chunk.iter().enumerate() {
-        let start = a.start as usize;
-        let v = match (a.len, instrs.get(start)) {
-            (1, Some(Instr::Load(n))) => match vars.get(*n as usize) {
-                Some(Value::Bool(v)) => *v,
-                _ => general_atom(instrs, start, a.len, vars, base + b)?,
-            },
-            _ => general_atom(instrs, start, a.len, vars, base + b)?,
-        };
-        bits |= (v as u64) << (b & 63);
+    if !cfg!(feature = "compact") && atoms.len() <= 64 {
+        // One word in a register (most programs): no chunk bookkeeping.
+        let mut bits = 0u64;
+        for (b, a) in atoms.iter().enumerate() {
+            bits |= (a.value(instrs, vars, b)? as u64) << (b & 63);
+        }
+        // No scratch word without atoms: the value word comes next.
+        if !atoms.is_empty() {
+            wr(state, layout::HEADER_WORDS, bits);
+        }
+        return Ok(bits);
     }
-    Ok(bits)
+    let mut first = 0u64;
+    for (w, chunk) in atoms.chunks(64).enumerate() {
+        let mut bits = 0u64;
+        for (b, a) in chunk.iter().enumerate() {
+            bits |= (a.value(instrs, vars, w * 64 + b)? as u64) << (b & 63);
+        }
+        if w == 0 {
+            first = bits;
+        }
+        wr(state, layout::HEADER_WORDS + w, bits);
+    }
+    Ok(first)
+}
+
+/// One node at one point: a program's [`Node`] or its plan ([`Step`]).
+trait NodeStep {
+    /// The node's value at this point, given its children's values at this point
+    /// (`bit`), the atoms (`atom`) and its own value at the last point
+    /// (`own_prev`); `words` holds the nodes' own words, from word `off` of the state.
+    #[allow(clippy::too_many_arguments)]
+    fn value(
+        &self,
+        off: usize,
+        words: &mut [u64],
+        t: u64,
+        first_point: bool,
+        atom: impl Fn(u16) -> bool,
+        bit: impl Fn(u16) -> bool,
+        own_prev: bool,
+    ) -> bool;
+}
+
+impl NodeStep for Node {
+    #[inline(always)]
+    fn value(
+        &self,
+        off: usize,
+        words: &mut [u64],
+        t: u64,
+        first_point: bool,
+        atom: impl Fn(u16) -> bool,
+        bit: impl Fn(u16) -> bool,
+        own_prev: bool,
+    ) -> bool {
+        let slot = (self.slot as usize).wrapping_sub(off);
+        node_step(&self.op, slot, words, t, first_point, atom, bit, own_prev)
+    }
+}
+
+impl NodeStep for Step {
+    /// A plan's slot already counts from `off`.
+    #[inline(always)]
+    fn value(
+        &self,
+        _off: usize,
+        words: &mut [u64],
+        t: u64,
+        first_point: bool,
+        atom: impl Fn(u16) -> bool,
+        bit: impl Fn(u16) -> bool,
+        own_prev: bool,
+    ) -> bool {
+        exec(self, words, t, first_point, atom, bit, own_prev)
+    }
 }
 
 /// Atom number `atom`, `len` instructions from `start`, through the atom machine.
@@ -742,20 +661,25 @@ fn node_step(
                     w != 0 && t.wrapping_sub(w - 1) <= b
                 }
                 Some(hi) => match words.get_mut(slot..) {
-                    // A point interval's capacity is `hi + 1`; any other's costs a
-                    // division ([`layout::window_capacity`]), done only when needed.
-                    Some(w) => window_step(w, lo, hi, t, f, g, || {
-                        if lo == hi {
-                            hi.saturating_add(1) as usize
-                        } else {
-                            layout::window_capacity(lo, hi).unwrap_or(1) as usize
-                        }
-                    }),
+                    // The capacity is only computed when needed.
+                    Some(w) => window_step(w, lo, hi, t, f, g, || window_capacity(lo, hi)),
                     None => false,
                 },
             }
         }
     }
+}
+
+/// [`layout::window_capacity`] of a validated window (`0 < lo <= hi`, the
+/// capacity fits a `u32`), as the unplanned step needs it at a point: a point
+/// interval's is `hi + 1`; any other's a division whose quotient validation
+/// bounds below `2^32` ([`layout::div`]: no division routine on a 32-bit core).
+#[inline(never)]
+fn window_capacity(lo: u64, hi: u64) -> usize {
+    if lo == hi {
+        return hi.saturating_add(1) as usize;
+    }
+    (layout::div(hi, hi - (lo - 1), 32) as usize).saturating_add(1)
 }
 
 #[inline(always)]
@@ -777,7 +701,7 @@ fn wr(w: &mut [u64], i: usize, v: u64) {
 /// oldest run decides the verdict (it has the smallest `first`, and every live
 /// run still has `last + hi >= t`). The ring's capacity (`capacity`, at least 1)
 /// is only asked for when a run expires or a witness arrives.
-#[inline]
+#[inline(always)]
 fn window_step(
     w: &mut [u64],
     lo: u64,

@@ -63,7 +63,13 @@ impl<'a> Reader<'a> {
 
     /// A varint of a type of `bits` bits (16, 32 or 64).
     fn varint(&mut self, bits: u32) -> Result<u64, TableError> {
-        let max_bytes = bits.div_ceil(7);
+        // `bits.div_ceil(7)` for the widths read (16, 32, 64): without a
+        // division, a library routine on a Cortex-M0 (no divide instruction).
+        let max_bytes = match bits {
+            16 => 3,
+            32 => 5,
+            _ => 10,
+        };
         let mut out = 0u64;
         for i in 0..max_bytes {
             let b = self.byte()?;
@@ -179,18 +185,25 @@ impl<'a> Reader<'a> {
     }
 
     fn instr(&mut self) -> Result<Instr, TableError> {
-        Ok(match self.variant()? {
+        let v = self.variant()?;
+        // The arithmetic variants' one field is read at one call site (code size).
+        let n = if (5..=10).contains(&v) {
+            self.num_ty()?
+        } else {
+            NumTy::Int
+        };
+        Ok(match v {
             0 => Instr::Push(self.value()?),
             1 => Instr::Load(self.u16()?),
             2 => Instr::Not,
             3 => Instr::And,
             4 => Instr::Or,
-            5 => Instr::Neg(self.num_ty()?),
-            6 => Instr::Add(self.num_ty()?),
-            7 => Instr::Sub(self.num_ty()?),
-            8 => Instr::Mul(self.num_ty()?),
-            9 => Instr::Div(self.num_ty()?),
-            10 => Instr::Rem(self.num_ty()?),
+            5 => Instr::Neg(n),
+            6 => Instr::Add(n),
+            7 => Instr::Sub(n),
+            8 => Instr::Mul(n),
+            9 => Instr::Div(n),
+            10 => Instr::Rem(n),
             11 => Instr::Cmp(self.cmp_op()?, self.ty()?),
             12 => Instr::ToFloat,
             _ => return Err(TableError::Decode),
@@ -205,19 +218,28 @@ impl<'a> Reader<'a> {
     }
 
     fn node(&mut self) -> Result<Node, TableError> {
-        let op = match self.variant()? {
+        let v = self.variant()?;
+        // Every variant but `Const` starts with one or two ids, read at one call
+        // site each (code size), in the order postcard writes them.
+        let a = if (1..=9).contains(&v) { self.u16()? } else { 0 };
+        let b = if (3..=6).contains(&v) || v == 9 {
+            self.u16()?
+        } else {
+            0
+        };
+        let op = match v {
             0 => Op::Const(self.bool()?),
-            1 => Op::Atom(self.u16()?),
-            2 => Op::Not(self.u16()?),
-            3 => Op::And(self.u16()?, self.u16()?),
-            4 => Op::Or(self.u16()?, self.u16()?),
-            5 => Op::Implies(self.u16()?, self.u16()?),
-            6 => Op::Iff(self.u16()?, self.u16()?),
-            7 => Op::Yesterday(self.u16()?),
-            8 => Op::WeakYesterday(self.u16()?),
+            1 => Op::Atom(a),
+            2 => Op::Not(a),
+            3 => Op::And(a, b),
+            4 => Op::Or(a, b),
+            5 => Op::Implies(a, b),
+            6 => Op::Iff(a, b),
+            7 => Op::Yesterday(a),
+            8 => Op::WeakYesterday(a),
             9 => Op::Since {
-                lhs: self.u16()?,
-                rhs: self.u16()?,
+                lhs: a,
+                rhs: b,
                 lo: self.u64()?,
                 hi: match self.byte()? {
                     0 => None,

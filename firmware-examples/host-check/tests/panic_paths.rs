@@ -1,4 +1,4 @@
-//! What can panic below the monitor step in the linked firmware (`museum_spec::step` for the generated monitor, `firmware::step_point` for the table).
+//! What the monitor step reaches in the linked firmware (`museum_spec::step` for the generated monitor, `firmware::step_point` for the table): no panic, no soft-float or division routine.
 
 use host_check::callgraph::analyse;
 use host_check::{read_image, STEPS};
@@ -34,5 +34,22 @@ fn the_monitor_step_links_no_panic_path() {
             report.panic_calls,
             report.locations
         );
+    }
+}
+
+#[test]
+fn an_integer_specs_step_reaches_no_soft_float_or_division_routine() {
+    // museum.hspec's atoms are integer and boolean, and the images build
+    // monitor-core without `float` and `int-div`: neither the generated step nor
+    // the interpreter's (a window's capacity included) may call such a routine.
+    for (name, step) in STEPS {
+        let (path, _) = read_image(name).unwrap();
+        let report = analyse(&path, step).unwrap();
+        let routines: Vec<&String> = report
+            .reachable
+            .iter()
+            .filter(|f| host_check::callgraph::is_soft_float_or_division(f))
+            .collect();
+        assert!(routines.is_empty(), "{name}: {routines:?}");
     }
 }
