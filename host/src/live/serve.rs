@@ -13,7 +13,7 @@
 use std::collections::VecDeque;
 use std::io::{BufRead, BufReader, Write};
 use std::net::{SocketAddr, TcpListener, TcpStream, ToSocketAddrs};
-use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
+use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
@@ -24,6 +24,19 @@ const BATCH: Duration = Duration::from_millis(10);
 /// Lines of each stream the page can get on (re)connecting; older ones are only in the
 /// verdict file (and the input log).
 pub const HISTORY: usize = 100_000;
+
+/// Lines queued for one connection that its thread has not yet written. A connection
+/// whose browser stops reading (a laptop asleep, a frozen tab) fills its queue and is
+/// dropped: the sidecar never waits for a browser, and no browser makes the sidecar's
+/// memory grow. Its page reconnects with `Last-Event-ID` and gets what it missed from
+/// the history. About 40 bytes a line, held from the start (`sync_channel` allocates its
+/// buffer at once), so 8,192 lines are about 330 KiB per connection, and a page that
+/// reads lets through 8,192 lines per [`BATCH`] (800k lines a second) before it is dropped.
+pub const QUEUE: usize = 8_192;
+
+/// How long a write to a page may wait for it to read, before its connection is closed
+/// (its thread and queue then go too; the page reconnects when it reads again).
+const WRITE_TIMEOUT: Duration = Duration::from_secs(30);
 
 /// What a published line is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -58,7 +71,7 @@ struct HubState {
     /// Verdict lines and input records, each its own history (inputs are many more).
     history: [VecDeque<Published>; 2],
     next_id: u64,
-    subscribers: Vec<Sender<Published>>,
+    subscribers: Vec<SyncSender<Published>>,
 }
 
 /// Where verdict lines meet the page's connections.
@@ -85,15 +98,19 @@ impl Hub {
             history.pop_front();
         }
         history.push_back(p.clone());
-        // A connection that is gone drops its receiver: forget it.
-        s.subscribers.retain(|tx| tx.send(p.clone()).is_ok());
+        // Never blocks: a connection that is gone drops its receiver, one whose queue is
+        // full is behind by QUEUE lines; both are forgotten. Dropping the sender ends the
+        // connection once its thread has written what is queued (`events`).
+        // (`try_send` fails with `Full` or `Disconnected`.)
+        s.subscribers.retain(|tx| tx.try_send(p.clone()).is_ok());
     }
 
-    /// The lines after `last_id` (all with `None`) and a receiver of the later ones.
-    fn subscribe(&self, last_id: Option<u64>) -> (Vec<Published>, Receiver<Published>) {
-        let (tx, rx) = channel();
+    /// The lines after `last_id` (all with `None`) still held, how many lines after it
+    /// are no longer held (older than the history), and a receiver of the later ones.
+    fn subscribe(&self, last_id: Option<u64>) -> (Vec<Published>, u64, Receiver<Published>) {
+        let (tx, rx) = sync_channel(QUEUE);
         let Ok(mut s) = self.state.lock() else {
-            return (Vec::new(), rx);
+            return (Vec::new(), 0, rx);
         };
         // Both histories, in the order they were published.
         let mut past: Vec<Published> = s
@@ -104,8 +121,16 @@ impl Hub {
             .cloned()
             .collect();
         past.sort_by_key(|p| p.id);
+        let after = last_id.map_or(0, |l| l.saturating_add(1)).min(s.next_id);
+        let skipped = (s.next_id - after).saturating_sub(past.len() as u64);
         s.subscribers.push(tx);
-        (past, rx)
+        (past, skipped, rx)
+    }
+
+    /// How many connections are subscribed (for the tests).
+    #[cfg(test)]
+    fn subscribers(&self) -> usize {
+        self.state.lock().map_or(0, |s| s.subscribers.len())
     }
 
     /// Every verdict line still held, newline-terminated.
@@ -315,6 +340,13 @@ fn connection(stream: TcpStream, hub: &Hub, page: &str) -> std::io::Result<()> {
     }
 }
 
+/// The event that says `n` lines are no longer held (published before the oldest line
+/// of the history): data `{"skipped":N}`, no `id`, so a reconnect resumes after the last
+/// line the page had.
+fn skipped_event(n: u64) -> String {
+    format!("data: {{\"skipped\":{n}}}\n\n")
+}
+
 /// One event: `id` for a reconnect's `Last-Event-ID`, data `{"sent_ms":..,"verdict":LINE}`
 /// or `{"sent_ms":..,"input":RECORD}`.
 fn event(p: &Published) -> String {
@@ -329,13 +361,17 @@ fn event(p: &Published) -> String {
 
 fn events(mut stream: TcpStream, hub: &Hub, last_id: Option<u64>) -> std::io::Result<()> {
     stream.set_read_timeout(None)?;
+    stream.set_write_timeout(Some(WRITE_TIMEOUT))?;
     write!(
         stream,
         "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\n\
          Connection: keep-alive\r\n\r\nretry: 1000\n\n"
     )?;
-    let (past, rx) = hub.subscribe(last_id);
+    let (past, skipped, rx) = hub.subscribe(last_id);
     let mut batch = String::new();
+    if skipped > 0 {
+        batch.push_str(&skipped_event(skipped));
+    }
     for p in &past {
         batch.push_str(&event(p));
     }
@@ -361,6 +397,8 @@ fn events(mut stream: TcpStream, hub: &Hub, last_id: Option<u64>) -> std::io::Re
                 stream.write_all(b": idle\n\n")?;
                 stream.flush()?;
             }
+            // The hub dropped this connection (its queue was full): it ends here, and the
+            // page reconnects after the last line written.
             Err(RecvTimeoutError::Disconnected) => return Ok(()),
         }
     }
@@ -393,7 +431,7 @@ mod tests {
             }
         }
         let mut tee = Tee::new(Box::new(Shared(file.clone())), hub.clone(), Stream::Verdict);
-        let (_, rx) = hub.subscribe(None);
+        let (_, _, rx) = hub.subscribe(None);
         tee.write_all(b"{\"a\":1}\n{\"b\"").unwrap();
         assert_eq!(hub.all_lines(), "{\"a\":1}\n");
         tee.write_all(b":2}\n").unwrap();
@@ -402,7 +440,7 @@ mod tests {
         let got: Vec<u64> = rx.try_iter().map(|p| p.id).collect();
         assert_eq!(got, vec![0, 1]);
         // A reconnect after id 0 gets only what followed.
-        let (past, _) = hub.subscribe(Some(0));
+        let (past, _, _) = hub.subscribe(Some(0));
         assert_eq!(past.len(), 1);
         assert!(event(&past[0]).starts_with("id: 1\ndata: {\"sent_ms\":"));
         assert!(event(&past[0]).ends_with(",\"verdict\":{\"b\":2}}\n\n"));
@@ -413,7 +451,7 @@ mod tests {
             .unwrap();
         tee.write_all(b"{\"c\":3}\n").unwrap();
         assert_eq!(hub.all_lines(), "{\"a\":1}\n{\"b\":2}\n{\"c\":3}\n");
-        let (past, _) = hub.subscribe(Some(1));
+        let (past, _, _) = hub.subscribe(Some(1));
         let texts: Vec<String> = past.iter().map(event).collect();
         assert!(texts[0].starts_with("id: 2\n"), "{texts:?}");
         assert!(texts[0].ends_with(",\"input\":{\"kind\":\"tick\",\"time\":3}}\n\n"));
@@ -421,6 +459,56 @@ mod tests {
             texts[1].ends_with(",\"verdict\":{\"c\":3}}\n\n"),
             "{texts:?}"
         );
+    }
+
+    #[test]
+    fn a_connection_that_stops_reading_is_dropped_and_publishing_goes_on() {
+        let hub = Hub::default();
+        let (_, _, stalled) = hub.subscribe(None);
+        let (_, _, reading) = hub.subscribe(None);
+        let mut read = 0;
+        for i in 0..QUEUE + 10 {
+            hub.publish(Stream::Input, &format!("{{\"time\":{i}}}"));
+            read += reading.try_iter().count();
+        }
+        // The stalled one was dropped when its queue was full; the reading one stays.
+        assert_eq!(hub.subscribers(), 1);
+        assert_eq!(read, QUEUE + 10);
+        // What was queued before the drop is still there for its thread to write, then
+        // the connection ends.
+        let queued: Vec<u64> = stalled.try_iter().map(|p| p.id).collect();
+        assert_eq!(queued, (0..QUEUE as u64).collect::<Vec<_>>());
+        assert!(matches!(
+            stalled.recv_timeout(Duration::from_millis(1)),
+            Err(RecvTimeoutError::Disconnected)
+        ));
+        // Publishing goes on, and the page's reconnect gets the rest from the history.
+        hub.publish(Stream::Verdict, "{\"v\":1}");
+        assert_eq!(reading.try_iter().count(), 1);
+        let (past, skipped, _) = hub.subscribe(Some(QUEUE as u64 - 1));
+        assert_eq!(skipped, 0);
+        assert_eq!(past.len(), 11);
+        assert_eq!(past[0].id, QUEUE as u64);
+    }
+
+    #[test]
+    fn a_reconnect_older_than_the_history_is_told_how_much_it_missed() {
+        let hub = Hub::default();
+        for i in 0..HISTORY + 5 {
+            hub.publish(Stream::Input, &format!("{i}"));
+        }
+        hub.publish(Stream::Verdict, "v");
+        // Inputs 0..5 are gone; the verdict line (id HISTORY + 5) is held.
+        let (past, skipped, _) = hub.subscribe(Some(2));
+        assert_eq!(skipped, 2);
+        assert_eq!(past.len(), HISTORY + 1);
+        assert_eq!(past[0].id, 5);
+        let (past, skipped, _) = hub.subscribe(None);
+        assert_eq!((past.len(), skipped), (HISTORY + 1, 5));
+        assert_eq!(skipped_event(5), "data: {\"skipped\":5}\n\n");
+        // Up to date: nothing missed.
+        let (past, skipped, _) = hub.subscribe(Some(HISTORY as u64 + 5));
+        assert_eq!((past.len(), skipped), (0, 0));
     }
 
     #[test]
