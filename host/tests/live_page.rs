@@ -38,7 +38,8 @@ const PAGE_STATE: &str = "(function () { \
     max: +document.getElementById('delay-max').textContent, \
     points: tl.n, follow: tl.el.getAttribute('data-follow'), \
     rows: Array.from(document.querySelectorAll('tr[data-property]')).map(function (r) { \
-      return [r.getAttribute('data-property'), r.getAttribute('data-verdict')]; }), \
+      return [r.getAttribute('data-property'), r.getAttribute('data-verdict'), \
+        r.getAttribute('data-first-false')]; }), \
     lanes: tl.lanes.filter(function (l) { return l.kind === 'verdict'; }).map(function (l) { \
       var g = tl.el.querySelector('g.lane[data-kind=verdict][data-name=' + l.name + ']'); \
       var mark = tl.el.querySelector('g.ff-mark[data-property=' + l.name + ']'); \
@@ -171,7 +172,8 @@ fn the_live_page_shows_the_verdicts_as_they_arrive() {
             serde_json::from_str(b.eval(PAGE_STATE).as_str().unwrap()).unwrap();
         b.screenshot(&shot_path("live-page.png"));
         follow_the_end(b);
-        state
+        let kept = a_page_that_keeps_50_points(b, &addr, &state);
+        (state, kept)
     });
     let served = served_body(&addr);
 
@@ -191,7 +193,7 @@ fn the_live_page_shows_the_verdicts_as_they_arrive() {
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
 
-    let (Some(state), Some(b)) = (state, browser) else {
+    let (Some((state, kept)), Some(b)) = (state, browser) else {
         return;
     };
     assert!(b.errors.is_empty(), "page errors: {:?}", b.errors);
@@ -262,6 +264,7 @@ fn the_live_page_shows_the_verdicts_as_they_arrive() {
         lanes.iter().any(|l| l["mark"].as_u64().is_some()),
         "no property turned false: {state}"
     );
+    the_kept_lanes_follow_the_lines(&kept, &lines);
     println!(
         "verdict to page: median {} ms, max {} ms over {shown} lines",
         state["median"], state["max"]
@@ -312,6 +315,124 @@ fn follow_the_end(b: &mut Browser) {
         (later[1] - later[0] - (before[1] - before[0])).abs() < 1e-6,
         "{later:?} {before:?}"
     );
+}
+
+/// The page opened with `?keep=50` once the run is over (the server's history gives it
+/// every point so far): it holds the last 50 points at most, says it dropped the others,
+/// and its verdict table still shows each property's first false time, that of a point
+/// it no longer holds, as the page that kept everything (`full`) does. What it showed.
+fn a_page_that_keeps_50_points(
+    b: &mut Browser,
+    addr: &str,
+    full: &serde_json::Value,
+) -> serde_json::Value {
+    b.open(&format!("http://{addr}/?keep=50"));
+    let lines = full["lines"].as_u64().unwrap();
+    b.wait_for(
+        &format!("+document.getElementById('lines').textContent >= {lines}"),
+        Duration::from_secs(30),
+    );
+    // The heartbeats add points until every first false time shown is of a dropped point
+    // (a verdict line may be written well after its time, so that can take a while).
+    b.wait_for(
+        "(function () { var tl = document.getElementById('timeline-live').hindsightTimeline; \
+         var ff = Array.from(document.querySelectorAll('tr[data-first-false]')); \
+         return ff.length > 0 && ff.every(function (r) { \
+           return +r.getAttribute('data-first-false') < tl.run.time[0] * tl.run.step_seconds; }); })()",
+        Duration::from_secs(30),
+    );
+    let kept: serde_json::Value = serde_json::from_str(
+        b.eval(
+            "(function () { var tl = document.getElementById('timeline-live').hindsightTimeline; \
+             var note = document.getElementById('kept'); \
+             return JSON.stringify({points: tl.n, columns: tl.run.time.length, \
+               dropped: +tl.el.getAttribute('data-dropped'), note: note.hidden ? '' : note.textContent, \
+               first_kept: tl.run.time[0] * tl.run.step_seconds, t0: tl.run.time[0], \
+               step: tl.run.step_seconds, \
+               lines: +tl.el.getAttribute('data-lines'), \
+               lanes: tl.lanes.filter(function (l) { return l.kind === 'verdict'; }).map(function (l) { \
+                 return {name: l.name, last: l.get(tl.n - 1), \
+                   changes: l.ch.map(function (k) { return [tl.run.time[k], l.get(k)]; })}; }), \
+               rows: Array.from(document.querySelectorAll('tr[data-property]')).map(function (r) { \
+                 return [r.getAttribute('data-property'), r.getAttribute('data-first-false'), \
+                   r.getAttribute('data-verdict')]; })}); })()",
+        )
+        .as_str()
+        .unwrap(),
+    )
+    .unwrap();
+    let points = kept["points"].as_u64().unwrap();
+    assert!(points <= 50 && points == kept["columns"], "{kept}");
+    let dropped = kept["dropped"].as_u64().unwrap();
+    assert!(
+        points + dropped >= full["points"].as_u64().unwrap(),
+        "{kept} {full}"
+    );
+    assert!(
+        kept["note"].as_str().unwrap().starts_with(&format!(
+            "Showing the last 50 points at most ({dropped} older "
+        )),
+        "{kept}"
+    );
+    let first_kept = kept["first_kept"].as_f64().unwrap();
+    let mut before = 0;
+    for (k, f) in kept["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(full["rows"].as_array().unwrap())
+    {
+        assert_eq!(k[0], f[0]);
+        if let Some(ff) = f[2].as_str() {
+            assert_eq!(k[1].as_str(), Some(ff), "{kept} {full}");
+            before += usize::from(ff.parse::<f64>().unwrap() < first_kept);
+        }
+    }
+    assert!(
+        before > 0,
+        "no first false before the points kept: {kept} {full}"
+    );
+    kept
+}
+
+/// The lanes the page that keeps 50 points rebuilt from them: each changes where the
+/// verdict lines it had change its property after its first point's time, and ends at
+/// the verdict its row shows; each row's first false time is that of the lines.
+fn the_kept_lanes_follow_the_lines(kept: &serde_json::Value, lines: &[serde_json::Value]) {
+    let (t0, shown) = (
+        kept["t0"].as_u64().unwrap(),
+        kept["lines"].as_u64().unwrap(),
+    );
+    let shown = &lines[..shown as usize];
+    let step = kept["step"].as_f64().unwrap();
+    let rows = kept["rows"].as_array().unwrap();
+    for (lane, row) in kept["lanes"].as_array().unwrap().iter().zip(rows) {
+        let p = lane["name"].as_str().unwrap();
+        assert_eq!(row[0], p);
+        let first_false = shown.iter().find(|l| {
+            l["property"] == p && matches!(l["verdict"].as_str(), Some("false" | "currently_false"))
+        });
+        let ff = row[1].as_str().map(|f| f.parse::<f64>().unwrap());
+        let want = first_false.map(|l| l["time"].as_u64().unwrap() as f64 * step);
+        assert!(
+            ff.is_some() == want.is_some()
+                && ff.zip(want).is_none_or(|(a, b)| (a - b).abs() < 1e-6),
+            "{p}: first false {ff:?}, lines say {want:?}"
+        );
+        assert_eq!(lane["last"], row[2], "{p}: {kept}");
+        let got: Vec<(u64, String)> = lane["changes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| (c[0].as_u64().unwrap(), c[1].as_str().unwrap().to_string()))
+            .filter(|(t, _)| *t > t0)
+            .collect();
+        let want: Vec<(u64, String)> = changes(shown, p)
+            .into_iter()
+            .filter(|(t, _)| *t > t0)
+            .collect();
+        assert_eq!(got, want, "{p}: {kept}");
+    }
 }
 
 #[test]

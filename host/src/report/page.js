@@ -180,6 +180,29 @@
     }
     this.schedule();
   };
+  // Forgets the run's first `count` points (the live page keeps only its last ones, so a
+  // sidecar running for days does not fill the browser's memory): the columns lose them
+  // and the lanes are rebuilt from the points kept, so a point's index shifts by `count`.
+  // O(points kept); the live page drops in chunks, so that is a few steps per point.
+  Timeline.prototype.dropFront = function (count) {
+    var run = this.run, view = this.view;
+    count = Math.min(count, run.time.length);
+    if (count <= 0) return;
+    [run.time, run.step, run.event, run.origin, run.target, run.params].concat(run.values, run.verdicts)
+      .forEach(function (col) { col.splice(0, count); });
+    this.lanes = lanesOf(run);
+    this.sends = [0];
+    this.receives = [0];
+    this.sendIdx = [];
+    this.sel -= count;
+    if (this.sel < 0) { this.sel = -1; this.pinned = false; }
+    this.n = 0;
+    this.view = null;
+    this.grow();
+    // A view that began before the points kept starts at the first of them.
+    this.view = view;
+    if (view[0] < this.t0) this.setView(this.t0, Math.max(view[1], this.t0 + 1));
+  };
   Timeline.prototype.schedule = function () {
     var self = this;
     if (this.pending) return;
@@ -734,6 +757,14 @@
     var ids = {}, index = {}, rows = {}, now = vars.map(function (v) { return v.init; });
     var verdict = props.map(function () { return "unknown"; });
     var lines = 0, lastTime = 0, delays = [], waiting = [];
+    // The page keeps the last `keep` points (`?keep=N` sets it): more would fill the
+    // browser's memory when a sidecar runs for days. Past it, the oldest eighth goes at
+    // once, so the lanes are rebuilt once per keep / 8 points. The verdict table does
+    // not read the points (each row keeps its first false time from the verdict lines),
+    // so it stays whole; the timeline's first-false mark is the first among the points kept.
+    var keep = 200000, dropped = 0, skipped = 0;
+    var asked = /[?&]keep=(\d+)/.exec(window.location.search);
+    if (asked && Number(asked[1]) > 0) keep = Number(asked[1]);
     function intern(s) {
       if (!(s in ids)) { ids[s] = run.names.length; run.names.push(s); }
       return ids[s];
@@ -756,6 +787,34 @@
       { follow: true });
     el.hindsightTimeline = tl;
     tl.setFollow(true);
+    var note = document.createElement("p");
+    note.className = "help";
+    note.id = "kept";
+    note.hidden = true;
+    tl.tools.parentNode.insertBefore(note, tl.tools);
+    function bound() {
+      if (run.time.length <= keep) return;
+      // The last point stays: the verdict lines that follow it are its verdicts.
+      var count = Math.min(run.time.length - keep + Math.floor(keep / 8), run.time.length - 1);
+      tl.dropFront(count);
+      dropped += count;
+      el.setAttribute("data-dropped", String(dropped));
+      notice();
+    }
+    function notice() {
+      var parts = [];
+      if (dropped) {
+        parts.push("Showing the last " + keep + " points at most (" + dropped +
+          " older ones dropped from this page, so that it does not fill the browser's memory).");
+      }
+      if (skipped) {
+        parts.push(skipped + " lines were older than the server's history when this page connected" +
+          " and are not shown.");
+      }
+      parts.push("The full record is in the input log (--record) and the verdict file.");
+      note.textContent = parts.join(" ");
+      note.hidden = !(dropped || skipped);
+    }
     function point(time, kind, source, params, sets) {
       run.time.push(time);
       run.step.push(intern(kind));
@@ -820,6 +879,11 @@
     es.onerror = function () { status.textContent = "reconnecting"; status.className = "down"; };
     es.onmessage = function (e) {
       var m = JSON.parse(e.data);
+      if (m.skipped) {
+        skipped += m.skipped;
+        el.setAttribute("data-skipped", String(skipped));
+        notice();
+      }
       if (m.input) input(m.input);
       if (m.verdict) {
         lines += 1;
@@ -827,6 +891,7 @@
         if (m.sent_ms >= opened) waiting.push(m.sent_ms);
         judged(m.verdict);
       }
+      bound();
       tl.grow();
     };
   }
