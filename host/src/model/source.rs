@@ -154,8 +154,9 @@ fn floor_boundary(text: &str, mut i: usize) -> usize {
 
 /// The reference at the start of `rest`, when it starts with `&`: the character it
 /// stands for and the bytes it takes (`&lt;` is 4), or what is wrong with it; `None`
-/// when `rest` does not start with `&`. The one scanner of references, used by both
-/// XML readers (attribute values of models and of property files) and by
+/// when `rest` does not start with `&`. The one scanner of references, used by the
+/// XML tree (`model::xml`, attribute values of every XML file read), by the property
+/// reader's position-keeping unescaping (formulas, element text) and by
 /// [`SourceMap::unescaped_offset`]; names are decoded by [`resolve_entity`].
 pub(crate) fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
     let after = rest.strip_prefix('&')?;
@@ -175,8 +176,7 @@ pub(crate) fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
 
 /// The character an XML entity name (without `&` and `;`) stands for: the five
 /// predefined entities and character references (`&#65;`, `&#x41;`). `&#0;` is `None`:
-/// U+0000 is not an XML character (XML 1.0, production `Char`). The one entity decoder
-/// of both XML readers (models and property files).
+/// U+0000 is not an XML character (XML 1.0, production `Char`). The one entity decoder.
 pub(crate) fn resolve_entity(name: &str) -> Option<char> {
     match name {
         "lt" => Some('<'),
@@ -195,8 +195,9 @@ pub(crate) fn resolve_entity(name: &str) -> Option<char> {
     }
 }
 
-/// Unescapes an XML attribute value; `Err(offset)` gives the byte offset of a bad entity.
-pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, usize> {
+/// Unescapes an XML attribute value; `Err` gives the byte offset of a bad reference
+/// and what is wrong with it.
+pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, String)> {
     if !raw.contains('&') {
         return Ok(std::borrow::Cow::Borrowed(raw));
     }
@@ -210,7 +211,8 @@ pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, usize> {
                 out.push(c);
                 pos += consumed;
             }
-            _ => return Err(pos),
+            Some(Err(message)) => return Err((pos, message)),
+            None => return Err((pos, "malformed reference".to_owned())),
         }
     }
     out.push_str(&raw[pos..]);
@@ -259,11 +261,14 @@ mod tests {
 
     #[test]
     fn bad_entity_is_an_error() {
-        assert_eq!(unescape("a &bogus; b"), Err(2));
-        assert_eq!(unescape("a & b"), Err(2));
+        assert_eq!(unescape("a &bogus; b").unwrap_err().0, 2);
+        assert_eq!(unescape("a & b").unwrap_err().0, 2);
         assert_eq!(unescape("&#x41;&lt;").unwrap(), "A<");
-        assert_eq!(unescape("a&#0;"), Err(1));
-        assert_eq!(unescape("&#x0;"), Err(0));
+        assert_eq!(
+            unescape("a&#0;").unwrap_err(),
+            (1, "unknown reference `&#0;`".to_owned())
+        );
+        assert_eq!(unescape("&#x0;").unwrap_err().0, 0);
         assert_eq!(unescape("x &#233;!").unwrap(), "x é!");
         assert_eq!(
             reference("&nbsp; b"),

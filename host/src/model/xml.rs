@@ -1,8 +1,14 @@
-//! A small XML element tree with byte spans, built with quick-xml, that the model readers walk.
+//! The one XML element tree of the project, with byte spans, built with quick-xml: the
+//! model, robot and property-file readers all walk it.
 //!
 //! Reading into a tree first (with an explicit stack, so nesting depth cannot
-//! overflow the call stack) keeps the SCXML, types and model-list readers
-//! simple: each one walks elements and reports errors at exact positions.
+//! overflow the call stack) keeps the readers simple: each one walks elements and
+//! reports errors at exact positions. Attribute values are unescaped once, by the one
+//! entity decoder (`source::reference`); the raw value's range and the raw range of an
+//! element's text stay available, for readers that map decoded text back to the file
+//! character by character (property formulas).
+
+use std::fmt;
 
 use super::source::{unescape, Diagnostic, FileId, SourceMap, Span};
 use quick_xml::events::Event;
@@ -22,6 +28,8 @@ pub struct Attr {
     pub value: String,
     /// Span of the first byte of the raw (escaped) value in the file.
     pub value_span: Span,
+    /// Length in bytes of the raw value in the file (0 for a generated attribute).
+    pub value_len: u32,
 }
 
 /// A child of an element.
@@ -46,6 +54,10 @@ pub struct Element {
     pub attrs: Vec<Attr>,
     /// Children in document order.
     pub children: Vec<Node>,
+    /// Byte offset just past the last text, CDATA or reference directly inside (0 when
+    /// there is none, or for a generated element): with the first [`Node::Text`], the
+    /// raw range of the element's text content.
+    pub text_end: u32,
 }
 
 impl Element {
@@ -57,6 +69,7 @@ impl Element {
             span,
             attrs: Vec::new(),
             children: Vec::new(),
+            text_end: 0,
         }
     }
 
@@ -73,12 +86,14 @@ impl Element {
             Some(a) => {
                 a.value = value;
                 a.value_span = span;
+                a.value_len = 0;
             }
             None => self.attrs.push(Attr {
                 name: name.to_string(),
                 name_span: span,
                 value,
                 value_span: span,
+                value_len: 0,
             }),
         }
     }
@@ -189,7 +204,41 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
             "internal error: file not in source map",
         ));
     };
-    let src = f.text();
+    parse_text(f.text(), file).map_err(|e| {
+        sm.diag(
+            Span {
+                file,
+                offset: e.offset,
+            },
+            e.to_string(),
+        )
+    })
+}
+
+/// Why a text is not one well-formed element tree, and the byte offset where.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct XmlError {
+    /// Byte offset in the text.
+    pub offset: u32,
+    /// What is wrong (without the `malformed XML: ` that [`fmt::Display`] puts first).
+    pub message: String,
+}
+
+impl fmt::Display for XmlError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "malformed XML: {}", self.message)
+    }
+}
+
+/// Parses `src` (the text of file `file`) into its root element: the one XML reader
+/// of models, robot models and property files. Attribute values are unescaped by the
+/// one entity decoder ([`unescape`]); a bad reference, like any malformed XML, stops
+/// the reading.
+pub(crate) fn parse_text(src: &str, file: FileId) -> Result<Element, XmlError> {
+    let fail = |offset: u64, message: String| XmlError {
+        offset: offset.min(u32::MAX as u64) as u32,
+        message,
+    };
     let at = |offset: u64| Span {
         file,
         offset: offset.min(u32::MAX as u64) as u32,
@@ -201,9 +250,7 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
         let start = reader.buffer_position();
         let ev = match reader.read_event() {
             Ok(ev) => ev,
-            Err(e) => {
-                return Err(sm.diag(at(reader.error_position()), format!("malformed XML: {e}")));
-            }
+            Err(e) => return Err(fail(reader.error_position(), e.to_string())),
         };
         match ev {
             ev @ (Event::Start(_) | Event::Empty(_)) => {
@@ -215,39 +262,23 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
                 let name = e.name().as_ref().to_string();
                 let mut attrs = Vec::new();
                 for a in e.attributes() {
-                    let a = match a {
-                        Ok(a) => a,
-                        Err(err) => {
-                            return Err(sm.diag(at(start), format!("malformed attribute: {err}")));
-                        }
-                    };
+                    let a = a.map_err(|err| fail(start, err.to_string()))?;
                     let key = a.key.as_ref();
                     let key_off = offset_in(src, key.as_bytes()).unwrap_or(start as u32);
                     let raw: &str = &a.value;
                     let val_off = offset_in(src, raw.as_bytes()).unwrap_or(key_off);
                     let value = match unescape(raw) {
                         Ok(v) => v.into_owned(),
-                        Err(k) => {
-                            return Err(sm.diag(
-                                Span {
-                                    file,
-                                    offset: val_off + k as u32,
-                                },
-                                "unknown or malformed entity reference in attribute value",
-                            ));
+                        Err((k, message)) => {
+                            return Err(fail(u64::from(val_off) + k as u64, message));
                         }
                     };
                     attrs.push(Attr {
                         name: key.to_string(),
-                        name_span: Span {
-                            file,
-                            offset: key_off,
-                        },
+                        name_span: at(u64::from(key_off)),
                         value,
-                        value_span: Span {
-                            file,
-                            offset: val_off,
-                        },
+                        value_span: at(u64::from(val_off)),
+                        value_len: raw.len() as u32,
                     });
                 }
                 let el = Element {
@@ -255,21 +286,22 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
                     span: at(start),
                     attrs,
                     children: Vec::new(),
+                    text_end: 0,
                 };
                 if is_empty {
-                    attach(&mut stack, &mut root, el, sm)?;
+                    attach(&mut stack, &mut root, el)?;
                 } else {
                     if stack.len() >= MAX_DEPTH {
-                        return Err(sm.diag(at(start), "elements nested too deeply"));
+                        return Err(fail(start, "elements nested too deeply".to_owned()));
                     }
                     stack.push(el);
                 }
             }
             Event::End(_) => {
                 let Some(el) = stack.pop() else {
-                    return Err(sm.diag(at(start), "unexpected closing tag"));
+                    return Err(fail(start, "unexpected closing tag".to_owned()));
                 };
-                attach(&mut stack, &mut root, el, sm)?;
+                attach(&mut stack, &mut root, el)?;
             }
             Event::Comment(c) => {
                 if let Some(top) = stack.last_mut() {
@@ -277,42 +309,46 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
                     top.children.push(Node::Comment(text, at(start)));
                 }
             }
-            Event::Text(t) => {
-                let raw: &str = t.as_ref();
-                let blank = raw.bytes().all(|b| b.is_ascii_whitespace());
-                if !blank {
-                    let off = raw
-                        .bytes()
-                        .position(|b| !b.is_ascii_whitespace())
-                        .unwrap_or(0) as u64;
-                    match stack.last_mut() {
-                        Some(top) => top.children.push(Node::Text(at(start + off))),
-                        None => {
-                            return Err(sm.diag(at(start + off), "text outside the root element"))
+            ev @ (Event::Text(_) | Event::CData(_) | Event::GeneralRef(_)) => {
+                // Text, CDATA and references are content; blank text is not.
+                let off = match &ev {
+                    Event::Text(t) => {
+                        let raw: &str = t.as_ref();
+                        match raw.bytes().position(|b| !b.is_ascii_whitespace()) {
+                            Some(off) => off as u64,
+                            None => continue,
                         }
+                    }
+                    _ => 0,
+                };
+                let end = reader.buffer_position();
+                match stack.last_mut() {
+                    Some(top) => {
+                        top.children.push(Node::Text(at(start + off)));
+                        top.text_end = end.min(u32::MAX as u64) as u32;
+                    }
+                    None => {
+                        return Err(fail(
+                            start + off,
+                            "text outside the root element".to_owned(),
+                        ))
                     }
                 }
             }
-            Event::CData(_) | Event::GeneralRef(_) => match stack.last_mut() {
-                Some(top) => top.children.push(Node::Text(at(start))),
-                None => return Err(sm.diag(at(start), "text outside the root element")),
-            },
             Event::Decl(_) | Event::PI(_) | Event::DocType(_) => {}
             Event::Eof => break,
         }
     }
     if let Some(open) = stack.last() {
-        return Err(sm.diag(open.span, format!("<{}> is never closed", open.name)));
+        return Err(fail(
+            u64::from(open.span.offset),
+            format!("<{}> is never closed", open.name),
+        ));
     }
-    root.ok_or_else(|| sm.diag(at(0), "the file contains no XML element"))
+    root.ok_or_else(|| fail(0, "no root element".to_owned()))
 }
 
-fn attach(
-    stack: &mut [Element],
-    root: &mut Option<Element>,
-    el: Element,
-    sm: &SourceMap,
-) -> Result<(), Diagnostic> {
+fn attach(stack: &mut [Element], root: &mut Option<Element>, el: Element) -> Result<(), XmlError> {
     match stack.last_mut() {
         Some(parent) => {
             parent.children.push(Node::Element(el));
@@ -320,7 +356,10 @@ fn attach(
         }
         None => {
             if root.is_some() {
-                return Err(sm.diag(el.span, "more than one root element"));
+                return Err(XmlError {
+                    offset: el.span.offset,
+                    message: "more than one root element".to_owned(),
+                });
             }
             *root = Some(el);
             Ok(())
