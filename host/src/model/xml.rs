@@ -4,8 +4,8 @@
 //! Reading into a tree first (with an explicit stack, so nesting depth cannot
 //! overflow the call stack) keeps the readers simple: each one walks elements and
 //! reports errors at exact positions. Attribute values are unescaped once, by the one
-//! entity decoder (`source::reference`); the raw value's range and the raw range of an
-//! element's text stay available, for readers that map decoded text back to the file
+//! entity decoder (`source::reference`); the spans of raw values and text cover their
+//! raw range in the file, for readers that map decoded text back to the file
 //! character by character (property formulas).
 
 use std::fmt;
@@ -26,10 +26,9 @@ pub struct Attr {
     pub name_span: Span,
     /// The unescaped value.
     pub value: String,
-    /// Span of the first byte of the raw (escaped) value in the file.
+    /// Span of the raw (escaped) value in the file, between the quotes (empty for a
+    /// generated attribute).
     pub value_span: Span,
-    /// Length in bytes of the raw value in the file (0 for a generated attribute).
-    pub value_len: u32,
 }
 
 /// A child of an element.
@@ -39,7 +38,8 @@ pub enum Node {
     Element(Element),
     /// A comment's text (between `<!--` and `-->`).
     Comment(String, Span),
-    /// Non-blank character data.
+    /// Non-blank character data (text from its first non-blank byte, CDATA or a
+    /// reference), spanning its raw text in the file.
     Text(Span),
 }
 
@@ -54,10 +54,6 @@ pub struct Element {
     pub attrs: Vec<Attr>,
     /// Children in document order.
     pub children: Vec<Node>,
-    /// Byte offset just past the last text, CDATA or reference directly inside (0 when
-    /// there is none, or for a generated element): with the first [`Node::Text`], the
-    /// raw range of the element's text content.
-    pub text_end: u32,
 }
 
 impl Element {
@@ -69,7 +65,6 @@ impl Element {
             span,
             attrs: Vec::new(),
             children: Vec::new(),
-            text_end: 0,
         }
     }
 
@@ -86,14 +81,12 @@ impl Element {
             Some(a) => {
                 a.value = value;
                 a.value_span = span;
-                a.value_len = 0;
             }
             None => self.attrs.push(Attr {
                 name: name.to_string(),
                 name_span: span,
                 value,
                 value_span: span,
-                value_len: 0,
             }),
         }
     }
@@ -204,15 +197,7 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
             "internal error: file not in source map",
         ));
     };
-    parse_text(f.text(), file).map_err(|e| {
-        sm.diag(
-            Span {
-                file,
-                offset: e.offset,
-            },
-            e.to_string(),
-        )
-    })
+    parse_text(f.text(), file).map_err(|e| sm.diag(file.at(e.offset), e.to_string()))
 }
 
 /// Why a text is not one well-formed element tree, and the byte offset where.
@@ -239,10 +224,7 @@ pub(crate) fn parse_text(src: &str, file: FileId) -> Result<Element, XmlError> {
         offset: offset.min(u32::MAX as u64) as u32,
         message,
     };
-    let at = |offset: u64| Span {
-        file,
-        offset: offset.min(u32::MAX as u64) as u32,
-    };
+    let at = |offset: u64| file.at(offset.min(u32::MAX as u64) as u32);
     let mut reader = Reader::from_str(src);
     let mut stack: Vec<Element> = Vec::new();
     let mut root: Option<Element> = None;
@@ -277,8 +259,10 @@ pub(crate) fn parse_text(src: &str, file: FileId) -> Result<Element, XmlError> {
                         name: key.to_string(),
                         name_span: at(u64::from(key_off)),
                         value,
-                        value_span: at(u64::from(val_off)),
-                        value_len: raw.len() as u32,
+                        value_span: Span {
+                            hi: val_off.saturating_add(raw.len() as u32),
+                            ..at(u64::from(val_off))
+                        },
                     });
                 }
                 let el = Element {
@@ -286,7 +270,6 @@ pub(crate) fn parse_text(src: &str, file: FileId) -> Result<Element, XmlError> {
                     span: at(start),
                     attrs,
                     children: Vec::new(),
-                    text_end: 0,
                 };
                 if is_empty {
                     attach(&mut stack, &mut root, el)?;
@@ -321,12 +304,12 @@ pub(crate) fn parse_text(src: &str, file: FileId) -> Result<Element, XmlError> {
                     }
                     _ => 0,
                 };
-                let end = reader.buffer_position();
+                let end = reader.buffer_position().min(u32::MAX as u64) as u32;
                 match stack.last_mut() {
-                    Some(top) => {
-                        top.children.push(Node::Text(at(start + off)));
-                        top.text_end = end.min(u32::MAX as u64) as u32;
-                    }
+                    Some(top) => top.children.push(Node::Text(Span {
+                        hi: end,
+                        ..at(start + off)
+                    })),
                     None => {
                         return Err(fail(
                             start + off,
@@ -341,7 +324,7 @@ pub(crate) fn parse_text(src: &str, file: FileId) -> Result<Element, XmlError> {
     }
     if let Some(open) = stack.last() {
         return Err(fail(
-            u64::from(open.span.offset),
+            u64::from(open.span.lo),
             format!("<{}> is never closed", open.name),
         ));
     }
@@ -357,7 +340,7 @@ fn attach(stack: &mut [Element], root: &mut Option<Element>, el: Element) -> Res
         None => {
             if root.is_some() {
                 return Err(XmlError {
-                    offset: el.span.offset,
+                    offset: el.span.lo,
                     message: "more than one root element".to_owned(),
                 });
             }
@@ -384,12 +367,12 @@ mod tests {
         assert_eq!(root.name, "a");
         let x = root.attr("x").unwrap();
         assert_eq!(x.value, "1 < 2");
-        assert_eq!(x.value_span.offset as usize, text.find("1 &lt;").unwrap());
+        assert_eq!(x.value_span.lo as usize, text.find("1 &lt;").unwrap());
         let kids: Vec<_> = root.elements().map(|e| e.name.as_str()).collect();
         assert_eq!(kids, ["b", "c"]);
         assert!(matches!(&root.children[0], Node::Comment(c, _) if c.contains("TYPE v:int32")));
         let b = root.elements().next().unwrap();
-        assert_eq!(b.span.offset as usize, text.find("<b/>").unwrap());
+        assert_eq!(b.span.lo as usize, text.find("<b/>").unwrap());
     }
 
     #[test]

@@ -86,19 +86,21 @@ impl<'p, 'a> FileReader<'p, 'a> {
 
     /// The file location of `span`.
     pub(super) fn at(&self, span: Span) -> Location {
-        self.lines.location(span.offset as usize)
+        self.lines.location(span.lo as usize)
     }
 
     /// The raw (still escaped) value of an attribute read from the file.
     pub(super) fn raw(&self, attr: &Attr) -> &'a str {
-        let start = attr.value_span.offset as usize;
-        let end = start.saturating_add(attr.value_len as usize);
-        self.lines.text().get(start..end).unwrap_or_default()
+        let span = attr.value_span;
+        self.lines
+            .text()
+            .get(span.lo as usize..span.hi as usize)
+            .unwrap_or_default()
     }
 
-    /// Where the first text, CDATA or reference directly inside `element` is, if any.
-    fn text_span(element: &Element) -> Option<Span> {
-        element.children.iter().find_map(|node| match node {
+    /// The text, CDATA and references directly inside `element`.
+    fn texts(element: &Element) -> impl DoubleEndedIterator<Item = Span> + '_ {
+        element.children.iter().filter_map(|node| match node {
             Node::Text(span) => Some(*span),
             _ => None,
         })
@@ -107,7 +109,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
     /// Reports unknown attributes and text content; returns nothing.
     pub(super) fn check_attrs(&mut self, element: &Element, allowed: &[&str]) {
         self.check_attrs_allow_text(element, allowed);
-        if let Some(span) = Self::text_span(element) {
+        if let Some(span) = Self::texts(element).next() {
             self.error(
                 self.at(span),
                 PropsErrorKind::UnexpectedText {
@@ -135,9 +137,13 @@ impl<'p, 'a> FileReader<'p, 'a> {
     /// The unescaped text content of an element (`None`, with an error, if it has none):
     /// its raw text from the first non-blank chunk to the end of the last one.
     pub(super) fn element_text(&mut self, element: &Element) -> Option<SourceText> {
-        let raw = Self::text_span(element).and_then(|span| {
-            let start = span.offset as usize;
-            let raw = self.lines.text().get(start..element.text_end as usize)?;
+        let (first, last) = (
+            Self::texts(element).next(),
+            Self::texts(element).next_back(),
+        );
+        let raw = first.zip(last).and_then(|(first, last)| {
+            let start = first.lo as usize;
+            let raw = self.lines.text().get(start..last.hi as usize)?;
             Some((raw.trim_end(), start))
         });
         let Some((raw, offset)) = raw else {
@@ -179,7 +185,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
         let attr = Self::attr(element, name)?;
         let at = self.at(attr.name_span);
         let raw = self.raw(attr);
-        self.value(raw, attr.value_span.offset as usize)
+        self.value(raw, attr.value_span.lo as usize)
             .map(|value| (value, at))
     }
 
