@@ -23,7 +23,8 @@
 
 use std::fmt;
 
-/// A byte range `lo..hi` in source number `source` of a [`SourceMap`].
+/// A byte range `lo..hi` in source number `source` of a [`SourceMap`]: the one span
+/// type of the project (in `host`, `source` is a file of the model's source map).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub struct Span {
     /// Index of the source in its [`SourceMap`].
@@ -35,6 +36,24 @@ pub struct Span {
 }
 
 impl Span {
+    /// The empty span at byte `offset` of source (file) `source`: a position.
+    pub fn at(source: u32, offset: u32) -> Span {
+        Span {
+            source,
+            lo: offset,
+            hi: offset,
+        }
+    }
+
+    /// The span `delta` bytes further in the same source, same length.
+    pub fn shifted(self, delta: u32) -> Span {
+        Span {
+            source: self.source,
+            lo: self.lo.saturating_add(delta),
+            hi: self.hi.saturating_add(delta),
+        }
+    }
+
     /// The smallest span covering `self` and `other` (same source assumed).
     pub fn to(self, other: Span) -> Span {
         Span {

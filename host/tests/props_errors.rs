@@ -70,6 +70,28 @@ fn malformed_xml() {
 }
 
 #[test]
+fn deep_nesting_is_an_error_not_a_stack_overflow() {
+    // The tree form converts recursively; the one XML tree stops nesting at 256
+    // elements, at the first element too deep.
+    let head = "<properties><guarantees><guarantee id=\"g\">";
+    let depth = 5000;
+    let text = format!(
+        "{head}{}<true/>{}</guarantee></guarantees></properties>",
+        "<not>".repeat(depth),
+        "</not>".repeat(depth)
+    );
+    let (at, kind) = single(&text);
+    let column = head.len() + (256 - 3) * "<not>".len() + 1;
+    assert_eq!(
+        (at, kind),
+        (
+            Location::new(1, column as u32),
+            PropsErrorKind::Xml("elements nested too deeply".to_owned())
+        )
+    );
+}
+
+#[test]
 fn bad_references_in_attribute_values() {
     let text = current(PORT, "  <property id=\"p\" expr=\"{ev} &amp&amp; true\"/>");
     let (at, kind) = single(&text);

@@ -768,12 +768,10 @@ fn printed_definitions_read_back() {
         d.file = None;
         for p in &mut d.parts {
             for f in &mut p.fields {
-                f.span.offset = 0;
-                f.span.file = hindsight::model::source::FileId(0);
+                f.span = hindsight::model::source::FileId(0).at(0);
             }
             for c in &mut p.constants {
-                c.span.offset = 0;
-                c.span.file = hindsight::model::source::FileId(0);
+                c.span = hindsight::model::source::FileId(0).at(0);
             }
         }
         d

@@ -273,7 +273,7 @@ fn model_of(sm: SourceMap, machines: &[Element]) -> Result<CompiledModel, Diagno
     };
     let mut errs = Diagnostics::default();
     for m in machines {
-        let file = m.span.file;
+        let file = hindsight::model::FileId::of(m.span);
         src.add_machine_tree(m, file, &mut errs);
     }
     if !errs.is_empty() {

@@ -1,10 +1,10 @@
 //! Source files, byte spans and diagnostics: every error about a model points at a file, line and column.
 //!
 //! The model reader keeps the text of every file it read in a [`SourceMap`];
-//! parsed items carry a [`Span`] (file + byte offset). Line and column are
-//! computed only when a [`Diagnostic`] is made, so spans cost 8 bytes. Lines,
-//! columns, the diagnostic and its rendering are codegen's ([`codegen::diag`]),
-//! the one source foundation of every reader.
+//! parsed items carry a [`Span`] (codegen's: a byte range whose `source` is the file's
+//! [`FileId`]). Line and column are computed only when a [`Diagnostic`] is made, so
+//! spans cost 12 bytes. Spans, lines, columns, the diagnostic and its rendering are
+//! codegen's ([`codegen::diag`]), the one source foundation of every reader.
 
 use std::path::{Path, PathBuf};
 
@@ -20,28 +20,25 @@ pub fn about_file(path: impl AsRef<Path>, message: impl Into<String>) -> Diagnos
     Diagnostic::about_file(path.as_ref().display().to_string(), message.into())
 }
 
-/// Index of a file in a [`SourceMap`].
+/// Index of a file in a [`SourceMap`] (a span's `source`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct FileId(pub u32);
 
-/// A position in a source file: the file and a byte offset into its text.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Span {
-    /// The file.
-    pub file: FileId,
-    /// Byte offset from the start of the file's text.
-    pub offset: u32,
-}
+impl FileId {
+    /// The file that `span` is in.
+    pub fn of(span: Span) -> FileId {
+        FileId(span.source)
+    }
 
-impl Span {
-    /// The span `delta` bytes further in the same file.
-    pub fn shifted(self, delta: u32) -> Span {
-        Span {
-            file: self.file,
-            offset: self.offset.saturating_add(delta),
-        }
+    /// The empty span at byte `offset` of this file.
+    pub fn at(self, offset: u32) -> Span {
+        Span::at(self.0, offset)
     }
 }
+
+/// A position or byte range in a source file: the project's one span type, codegen's
+/// ([`codegen::diag::Span`]); its `source` is the file's [`FileId`].
+pub use codegen::diag::Span;
 
 /// One source file: its path, text and the byte offsets where lines start.
 #[derive(Clone, Debug)]
@@ -102,12 +99,12 @@ impl SourceMap {
 
     /// A diagnostic at `span` with `message`.
     pub fn diag(&self, span: Span, message: impl Into<String>) -> Diagnostic {
-        match self.file(span.file) {
+        match self.file(FileId::of(span)) {
             Some(f) => Diagnostic::in_text(
                 f.path.display().to_string(),
                 &f.text,
                 &f.lines,
-                span.offset as usize,
+                span.lo as usize,
                 message.into(),
             ),
             None => about_file("<unknown>", message),
@@ -119,11 +116,11 @@ impl SourceMap {
     /// Expressions are parsed from the unescaped value; this maps an offset in
     /// the unescaped text back to the file (`&amp;` counts as one character).
     pub fn unescaped_offset(&self, span: Span, k: u32) -> Span {
-        let Some(f) = self.file(span.file) else {
+        let Some(f) = self.file(FileId::of(span)) else {
             return span;
         };
         let raw = f.text.as_str();
-        let mut raw_pos = floor_boundary(raw, span.offset as usize);
+        let mut raw_pos = floor_boundary(raw, span.lo as usize);
         let mut out = 0u32;
         while out < k && raw_pos < raw.len() {
             let rest = &raw[raw_pos..];
@@ -137,10 +134,7 @@ impl SourceMap {
             out = out.saturating_add(produced as u32);
             raw_pos += consumed;
         }
-        Span {
-            file: span.file,
-            offset: raw_pos as u32,
-        }
+        FileId::of(span).at(raw_pos as u32)
     }
 }
 
@@ -154,8 +148,9 @@ fn floor_boundary(text: &str, mut i: usize) -> usize {
 
 /// The reference at the start of `rest`, when it starts with `&`: the character it
 /// stands for and the bytes it takes (`&lt;` is 4), or what is wrong with it; `None`
-/// when `rest` does not start with `&`. The one scanner of references, used by both
-/// XML readers (attribute values of models and of property files) and by
+/// when `rest` does not start with `&`. The one scanner of references, used by the
+/// XML tree (`model::xml`, attribute values of every XML file read), by the property
+/// reader's position-keeping unescaping (formulas, element text) and by
 /// [`SourceMap::unescaped_offset`]; names are decoded by [`resolve_entity`].
 pub(crate) fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
     let after = rest.strip_prefix('&')?;
@@ -175,8 +170,7 @@ pub(crate) fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
 
 /// The character an XML entity name (without `&` and `;`) stands for: the five
 /// predefined entities and character references (`&#65;`, `&#x41;`). `&#0;` is `None`:
-/// U+0000 is not an XML character (XML 1.0, production `Char`). The one entity decoder
-/// of both XML readers (models and property files).
+/// U+0000 is not an XML character (XML 1.0, production `Char`). The one entity decoder.
 pub(crate) fn resolve_entity(name: &str) -> Option<char> {
     match name {
         "lt" => Some('<'),
@@ -195,8 +189,9 @@ pub(crate) fn resolve_entity(name: &str) -> Option<char> {
     }
 }
 
-/// Unescapes an XML attribute value; `Err(offset)` gives the byte offset of a bad entity.
-pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, usize> {
+/// Unescapes an XML attribute value; `Err` gives the byte offset of a bad reference
+/// and what is wrong with it.
+pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, String)> {
     if !raw.contains('&') {
         return Ok(std::borrow::Cow::Borrowed(raw));
     }
@@ -210,7 +205,8 @@ pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, usize> {
                 out.push(c);
                 pos += consumed;
             }
-            _ => return Err(pos),
+            Some(Err(message)) => return Err((pos, message)),
+            None => return Err((pos, "malformed reference".to_owned())),
         }
     }
     out.push_str(&raw[pos..]);
@@ -225,13 +221,13 @@ mod tests {
     fn line_and_column() {
         let mut sm = SourceMap::new();
         let f = sm.add("a.scxml", "ab\ncdé\nx".to_string());
-        let d = sm.diag(Span { file: f, offset: 0 }, "m");
+        let d = sm.diag(f.at(0), "m");
         assert_eq!((d.line, d.col), (1, 1));
-        let d = sm.diag(Span { file: f, offset: 4 }, "m");
+        let d = sm.diag(f.at(4), "m");
         assert_eq!((d.line, d.col), (2, 2));
-        let d = sm.diag(Span { file: f, offset: 7 }, "m");
+        let d = sm.diag(f.at(7), "m");
         assert_eq!((d.line, d.col), (2, 4));
-        let d = sm.diag(Span { file: f, offset: 8 }, "m");
+        let d = sm.diag(f.at(8), "m");
         assert_eq!((d.line, d.col), (3, 1));
         assert_eq!(d.to_string(), "a.scxml:3:1: m\n    x\n    ^");
     }
@@ -242,28 +238,25 @@ mod tests {
         let text = r#"<if cond="a &amp;&amp; b.c"/>"#;
         let f = sm.add("x", text.to_string());
         let start = text.find("a &").unwrap() as u32;
-        let span = Span {
-            file: f,
-            offset: start,
-        };
+        let span = f.at(start);
         let raw = &text[start as usize..text.rfind('"').unwrap()];
         let un = unescape(raw).unwrap();
         assert_eq!(un, "a && b.c");
         let k = un.find('b').unwrap() as u32;
         let mapped = sm.unescaped_offset(span, k);
-        assert_eq!(
-            &text[mapped.offset as usize..mapped.offset as usize + 1],
-            "b"
-        );
+        assert_eq!(&text[mapped.lo as usize..mapped.lo as usize + 1], "b");
     }
 
     #[test]
     fn bad_entity_is_an_error() {
-        assert_eq!(unescape("a &bogus; b"), Err(2));
-        assert_eq!(unescape("a & b"), Err(2));
+        assert_eq!(unescape("a &bogus; b").unwrap_err().0, 2);
+        assert_eq!(unescape("a & b").unwrap_err().0, 2);
         assert_eq!(unescape("&#x41;&lt;").unwrap(), "A<");
-        assert_eq!(unescape("a&#0;"), Err(1));
-        assert_eq!(unescape("&#x0;"), Err(0));
+        assert_eq!(
+            unescape("a&#0;").unwrap_err(),
+            (1, "unknown reference `&#0;`".to_owned())
+        );
+        assert_eq!(unescape("&#x0;").unwrap_err().0, 0);
         assert_eq!(unescape("x &#233;!").unwrap(), "x é!");
         assert_eq!(
             reference("&nbsp; b"),

@@ -1,8 +1,14 @@
-//! A small XML element tree with byte spans, built with quick-xml, that the model readers walk.
+//! The one XML element tree of the project, with byte spans, built with quick-xml: the
+//! model, robot and property-file readers all walk it.
 //!
 //! Reading into a tree first (with an explicit stack, so nesting depth cannot
-//! overflow the call stack) keeps the SCXML, types and model-list readers
-//! simple: each one walks elements and reports errors at exact positions.
+//! overflow the call stack) keeps the readers simple: each one walks elements and
+//! reports errors at exact positions. Attribute values are unescaped once, by the one
+//! entity decoder (`source::reference`); the spans of raw values and text cover their
+//! raw range in the file, for readers that map decoded text back to the file
+//! character by character (property formulas).
+
+use std::fmt;
 
 use super::source::{unescape, Diagnostic, FileId, SourceMap, Span};
 use quick_xml::events::Event;
@@ -20,7 +26,8 @@ pub struct Attr {
     pub name_span: Span,
     /// The unescaped value.
     pub value: String,
-    /// Span of the first byte of the raw (escaped) value in the file.
+    /// Span of the raw (escaped) value in the file, between the quotes (empty for a
+    /// generated attribute).
     pub value_span: Span,
 }
 
@@ -31,7 +38,8 @@ pub enum Node {
     Element(Element),
     /// A comment's text (between `<!--` and `-->`).
     Comment(String, Span),
-    /// Non-blank character data.
+    /// Non-blank character data (text from its first non-blank byte, CDATA or a
+    /// reference), spanning its raw text in the file.
     Text(Span),
 }
 
@@ -189,11 +197,34 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
             "internal error: file not in source map",
         ));
     };
-    let src = f.text();
-    let at = |offset: u64| Span {
-        file,
+    parse_text(f.text(), file).map_err(|e| sm.diag(file.at(e.offset), e.to_string()))
+}
+
+/// Why a text is not one well-formed element tree, and the byte offset where.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct XmlError {
+    /// Byte offset in the text.
+    pub offset: u32,
+    /// What is wrong (without the `malformed XML: ` that [`fmt::Display`] puts first).
+    pub message: String,
+}
+
+impl fmt::Display for XmlError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "malformed XML: {}", self.message)
+    }
+}
+
+/// Parses `src` (the text of file `file`) into its root element: the one XML reader
+/// of models, robot models and property files. Attribute values are unescaped by the
+/// one entity decoder ([`unescape`]); a bad reference, like any malformed XML, stops
+/// the reading.
+pub(crate) fn parse_text(src: &str, file: FileId) -> Result<Element, XmlError> {
+    let fail = |offset: u64, message: String| XmlError {
         offset: offset.min(u32::MAX as u64) as u32,
+        message,
     };
+    let at = |offset: u64| file.at(offset.min(u32::MAX as u64) as u32);
     let mut reader = Reader::from_str(src);
     let mut stack: Vec<Element> = Vec::new();
     let mut root: Option<Element> = None;
@@ -201,9 +232,7 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
         let start = reader.buffer_position();
         let ev = match reader.read_event() {
             Ok(ev) => ev,
-            Err(e) => {
-                return Err(sm.diag(at(reader.error_position()), format!("malformed XML: {e}")));
-            }
+            Err(e) => return Err(fail(reader.error_position(), e.to_string())),
         };
         match ev {
             ev @ (Event::Start(_) | Event::Empty(_)) => {
@@ -215,38 +244,24 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
                 let name = e.name().as_ref().to_string();
                 let mut attrs = Vec::new();
                 for a in e.attributes() {
-                    let a = match a {
-                        Ok(a) => a,
-                        Err(err) => {
-                            return Err(sm.diag(at(start), format!("malformed attribute: {err}")));
-                        }
-                    };
+                    let a = a.map_err(|err| fail(start, err.to_string()))?;
                     let key = a.key.as_ref();
                     let key_off = offset_in(src, key.as_bytes()).unwrap_or(start as u32);
                     let raw: &str = &a.value;
                     let val_off = offset_in(src, raw.as_bytes()).unwrap_or(key_off);
                     let value = match unescape(raw) {
                         Ok(v) => v.into_owned(),
-                        Err(k) => {
-                            return Err(sm.diag(
-                                Span {
-                                    file,
-                                    offset: val_off + k as u32,
-                                },
-                                "unknown or malformed entity reference in attribute value",
-                            ));
+                        Err((k, message)) => {
+                            return Err(fail(u64::from(val_off) + k as u64, message));
                         }
                     };
                     attrs.push(Attr {
                         name: key.to_string(),
-                        name_span: Span {
-                            file,
-                            offset: key_off,
-                        },
+                        name_span: at(u64::from(key_off)),
                         value,
                         value_span: Span {
-                            file,
-                            offset: val_off,
+                            hi: val_off.saturating_add(raw.len() as u32),
+                            ..at(u64::from(val_off))
                         },
                     });
                 }
@@ -257,19 +272,19 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
                     children: Vec::new(),
                 };
                 if is_empty {
-                    attach(&mut stack, &mut root, el, sm)?;
+                    attach(&mut stack, &mut root, el)?;
                 } else {
                     if stack.len() >= MAX_DEPTH {
-                        return Err(sm.diag(at(start), "elements nested too deeply"));
+                        return Err(fail(start, "elements nested too deeply".to_owned()));
                     }
                     stack.push(el);
                 }
             }
             Event::End(_) => {
                 let Some(el) = stack.pop() else {
-                    return Err(sm.diag(at(start), "unexpected closing tag"));
+                    return Err(fail(start, "unexpected closing tag".to_owned()));
                 };
-                attach(&mut stack, &mut root, el, sm)?;
+                attach(&mut stack, &mut root, el)?;
             }
             Event::Comment(c) => {
                 if let Some(top) = stack.last_mut() {
@@ -277,42 +292,46 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
                     top.children.push(Node::Comment(text, at(start)));
                 }
             }
-            Event::Text(t) => {
-                let raw: &str = t.as_ref();
-                let blank = raw.bytes().all(|b| b.is_ascii_whitespace());
-                if !blank {
-                    let off = raw
-                        .bytes()
-                        .position(|b| !b.is_ascii_whitespace())
-                        .unwrap_or(0) as u64;
-                    match stack.last_mut() {
-                        Some(top) => top.children.push(Node::Text(at(start + off))),
-                        None => {
-                            return Err(sm.diag(at(start + off), "text outside the root element"))
+            ev @ (Event::Text(_) | Event::CData(_) | Event::GeneralRef(_)) => {
+                // Text, CDATA and references are content; blank text is not.
+                let off = match &ev {
+                    Event::Text(t) => {
+                        let raw: &str = t.as_ref();
+                        match raw.bytes().position(|b| !b.is_ascii_whitespace()) {
+                            Some(off) => off as u64,
+                            None => continue,
                         }
+                    }
+                    _ => 0,
+                };
+                let end = reader.buffer_position().min(u32::MAX as u64) as u32;
+                match stack.last_mut() {
+                    Some(top) => top.children.push(Node::Text(Span {
+                        hi: end,
+                        ..at(start + off)
+                    })),
+                    None => {
+                        return Err(fail(
+                            start + off,
+                            "text outside the root element".to_owned(),
+                        ))
                     }
                 }
             }
-            Event::CData(_) | Event::GeneralRef(_) => match stack.last_mut() {
-                Some(top) => top.children.push(Node::Text(at(start))),
-                None => return Err(sm.diag(at(start), "text outside the root element")),
-            },
             Event::Decl(_) | Event::PI(_) | Event::DocType(_) => {}
             Event::Eof => break,
         }
     }
     if let Some(open) = stack.last() {
-        return Err(sm.diag(open.span, format!("<{}> is never closed", open.name)));
+        return Err(fail(
+            u64::from(open.span.lo),
+            format!("<{}> is never closed", open.name),
+        ));
     }
-    root.ok_or_else(|| sm.diag(at(0), "the file contains no XML element"))
+    root.ok_or_else(|| fail(0, "no root element".to_owned()))
 }
 
-fn attach(
-    stack: &mut [Element],
-    root: &mut Option<Element>,
-    el: Element,
-    sm: &SourceMap,
-) -> Result<(), Diagnostic> {
+fn attach(stack: &mut [Element], root: &mut Option<Element>, el: Element) -> Result<(), XmlError> {
     match stack.last_mut() {
         Some(parent) => {
             parent.children.push(Node::Element(el));
@@ -320,7 +339,10 @@ fn attach(
         }
         None => {
             if root.is_some() {
-                return Err(sm.diag(el.span, "more than one root element"));
+                return Err(XmlError {
+                    offset: el.span.lo,
+                    message: "more than one root element".to_owned(),
+                });
             }
             *root = Some(el);
             Ok(())
@@ -345,12 +367,12 @@ mod tests {
         assert_eq!(root.name, "a");
         let x = root.attr("x").unwrap();
         assert_eq!(x.value, "1 < 2");
-        assert_eq!(x.value_span.offset as usize, text.find("1 &lt;").unwrap());
+        assert_eq!(x.value_span.lo as usize, text.find("1 &lt;").unwrap());
         let kids: Vec<_> = root.elements().map(|e| e.name.as_str()).collect();
         assert_eq!(kids, ["b", "c"]);
         assert!(matches!(&root.children[0], Node::Comment(c, _) if c.contains("TYPE v:int32")));
         let b = root.elements().next().unwrap();
-        assert_eq!(b.span.offset as usize, text.find("<b/>").unwrap());
+        assert_eq!(b.span.lo as usize, text.find("<b/>").unwrap());
     }
 
     #[test]

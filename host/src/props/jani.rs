@@ -317,21 +317,39 @@ impl Reader<'_, '_> {
         if let Json::Bool(b) = node.value {
             return Some(SourceText::generated(if b { "true" } else { "false" }, at));
         }
-        let e = self.expr(node)?;
-        if e.ty != Ty::Bool {
+        self.wrapped_boolean(
+            node,
+            node.offset,
+            "a state formula must be boolean",
+            ["{", "}"],
+        )
+    }
+
+    /// The boolean expression `node` as plain text between `around[0]` and `around[1]`
+    /// (generated at `offset`, where the type `error` is reported if it is not boolean).
+    pub(super) fn wrapped_boolean(
+        &mut self,
+        node: &Node,
+        offset: usize,
+        error: &str,
+        around: [&str; 2],
+    ) -> Option<SourceText> {
+        let r = self.expr(node)?;
+        if r.ty != Ty::Bool {
             self.error(
-                node.offset,
+                offset,
                 PropsErrorKind::Type {
-                    message: "a state formula must be boolean".into(),
+                    message: error.into(),
                 },
             );
             return None;
         }
-        let e = self.plain(node, e)?;
+        let text = self.plain(node, r)?;
+        let at = self.at(offset);
         let mut out = SourceText::empty();
-        out.push_generated("{", at);
-        out.push_source(&e);
-        out.push_generated("}", at);
+        out.push_generated(around[0], at);
+        out.push_source(&text);
+        out.push_generated(around[1], at);
         Some(out)
     }
 

@@ -54,17 +54,16 @@
 //!
 //! # Errors
 //!
-//! Malformed XML stops reading at the first error. Otherwise every problem is collected
-//! ([`Diagnostics`]): unknown elements and attributes, missing attributes and elements,
-//! bad values and types, duplicate ids, unknown references, predicate cycles, each with
-//! file, line and column.
+//! Malformed XML (a bad reference in an attribute value included) stops reading at the
+//! first error. Otherwise every problem is collected ([`Diagnostics`]): unknown elements
+//! and attributes, missing attributes and elements, bad values and types, duplicate ids,
+//! unknown references, predicate cycles, each with file, line and column.
 
 mod error;
 pub mod jani;
 mod read;
 pub mod ros;
 mod source;
-mod xml;
 
 use std::path::{Path, PathBuf};
 
@@ -185,8 +184,15 @@ pub fn parse_file(path: &Path) -> Result<PropertyFile, Diagnostics> {
 /// Reads and checks a property file's text; `path` is only used in errors.
 pub fn parse_str(text: &str, path: &Path) -> Result<PropertyFile, Diagnostics> {
     let lines = source::LineIndex::new(text);
-    let root = xml::parse_document(text, &lines)
-        .map_err(|(at, kind)| Diagnostics::from(vec![error::error_at(path, &lines, at, kind)]))?;
+    let root = crate::model::xml::parse_text(text, crate::model::FileId(0)).map_err(|e| {
+        let at = lines.location(e.offset as usize);
+        Diagnostics::from(vec![error::error_at(
+            path,
+            &lines,
+            at,
+            PropsErrorKind::Xml(e.message),
+        )])
+    })?;
     let mut reader = read::FileReader::new(path, &lines);
     let file = reader.read(&root);
     let mut errors = reader.into_errors();

@@ -6,8 +6,9 @@ use std::path::Path;
 
 use super::error::{PropsError, PropsErrorKind};
 use super::source::{unescape_attribute, LineIndex, Location, SourceText};
-use super::xml::{Attr, Element};
 use super::{Port, PortKind, Property, PropertyFile};
+use crate::model::source::Span;
+use crate::model::xml::{Attr, Element, Node};
 
 mod tree;
 use tree::Converter;
@@ -83,39 +84,71 @@ impl<'p, 'a> FileReader<'p, 'a> {
             .push(super::error::error_at(self.path, self.lines, at, kind));
     }
 
+    /// The file location of `span`.
+    pub(super) fn at(&self, span: Span) -> Location {
+        self.lines.location(span.lo as usize)
+    }
+
+    /// The raw (still escaped) value of an attribute read from the file.
+    pub(super) fn raw(&self, attr: &Attr) -> &'a str {
+        let span = attr.value_span;
+        self.lines
+            .text()
+            .get(span.lo as usize..span.hi as usize)
+            .unwrap_or_default()
+    }
+
+    /// The text, CDATA and references directly inside `element`.
+    fn texts(element: &Element) -> impl DoubleEndedIterator<Item = Span> + '_ {
+        element.children.iter().filter_map(|node| match node {
+            Node::Text(span) => Some(*span),
+            _ => None,
+        })
+    }
+
     /// Reports unknown attributes and text content; returns nothing.
-    pub(super) fn check_attrs(&mut self, element: &Element<'a>, allowed: &[&str]) {
+    pub(super) fn check_attrs(&mut self, element: &Element, allowed: &[&str]) {
         self.check_attrs_allow_text(element, allowed);
-        if let Some(at) = element.text {
+        if let Some(span) = Self::texts(element).next() {
             self.error(
-                at,
+                self.at(span),
                 PropsErrorKind::UnexpectedText {
-                    element: element.name.to_owned(),
+                    element: element.name.clone(),
                 },
             );
         }
     }
 
     /// Reports unknown attributes of an element whose text is its content.
-    pub(super) fn check_attrs_allow_text(&mut self, element: &Element<'a>, allowed: &[&str]) {
+    pub(super) fn check_attrs_allow_text(&mut self, element: &Element, allowed: &[&str]) {
         for attr in &element.attrs {
-            if !allowed.contains(&attr.name) {
+            if !allowed.contains(&attr.name.as_str()) {
                 self.error(
-                    attr.at,
+                    self.at(attr.name_span),
                     PropsErrorKind::UnknownAttribute {
-                        element: element.name.to_owned(),
-                        name: attr.name.to_owned(),
+                        element: element.name.clone(),
+                        name: attr.name.clone(),
                     },
                 );
             }
         }
     }
 
-    /// The unescaped text content of an element (`None`, with an error, if it has none).
-    pub(super) fn element_text(&mut self, element: &Element<'a>) -> Option<SourceText> {
-        let Some((raw, offset)) = element.raw_text else {
+    /// The unescaped text content of an element (`None`, with an error, if it has none):
+    /// its raw text from the first non-blank chunk to the end of the last one.
+    pub(super) fn element_text(&mut self, element: &Element) -> Option<SourceText> {
+        let (first, last) = (
+            Self::texts(element).next(),
+            Self::texts(element).next_back(),
+        );
+        let raw = first.zip(last).and_then(|(first, last)| {
+            let start = first.lo as usize;
+            let raw = self.lines.text().get(start..last.hi as usize)?;
+            Some((raw.trim_end(), start))
+        });
+        let Some((raw, offset)) = raw else {
             self.error(
-                element.at,
+                self.at(element.span),
                 PropsErrorKind::BadValue {
                     attribute: format!("<{}> text", element.name),
                     value: String::new(),
@@ -124,22 +157,17 @@ impl<'p, 'a> FileReader<'p, 'a> {
             );
             return None;
         };
-        let attr = Attr {
-            name: element.name,
-            at: element.at,
-            raw,
-            offset,
-        };
-        self.value(&attr)
+        self.value(raw, offset)
     }
 
-    pub(super) fn attr<'e>(element: &'e Element<'a>, name: &str) -> Option<&'e Attr<'a>> {
-        element.attrs.iter().find(|attr| attr.name == name)
+    pub(super) fn attr<'e>(element: &'e Element, name: &str) -> Option<&'e Attr> {
+        element.attr(name)
     }
 
-    /// The unescaped value of an attribute.
-    fn value(&mut self, attr: &Attr<'a>) -> Option<SourceText> {
-        match unescape_attribute(attr.raw, attr.offset, self.lines) {
+    /// The unescaped value of the raw text `raw` at byte `offset` of the file, its
+    /// tabs and line breaks normalised to spaces.
+    fn value(&mut self, raw: &str, offset: usize) -> Option<SourceText> {
+        match unescape_attribute(raw, offset, self.lines) {
             Ok(value) => Some(value),
             Err((offset, message)) => {
                 let at = self.lines.location(offset);
@@ -151,22 +179,24 @@ impl<'p, 'a> FileReader<'p, 'a> {
 
     pub(super) fn optional(
         &mut self,
-        element: &Element<'a>,
+        element: &Element,
         name: &str,
     ) -> Option<(SourceText, Location)> {
         let attr = Self::attr(element, name)?;
-        let at = attr.at;
-        self.value(attr).map(|value| (value, at))
+        let at = self.at(attr.name_span);
+        let raw = self.raw(attr);
+        self.value(raw, attr.value_span.lo as usize)
+            .map(|value| (value, at))
     }
 
     pub(super) fn required(
         &mut self,
-        element: &Element<'a>,
+        element: &Element,
         name: &'static str,
     ) -> Option<(SourceText, Location)> {
         if Self::attr(element, name).is_none() {
             self.error(
-                element.at,
+                self.at(element.span),
                 PropsErrorKind::MissingAttribute {
                     element: element.name.to_owned(),
                     name,
@@ -180,7 +210,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
     /// A required attribute that names something: non-empty, no surrounding blanks.
     pub(super) fn required_name(
         &mut self,
-        element: &Element<'a>,
+        element: &Element,
         name: &'static str,
     ) -> Option<String> {
         let (value, at) = self.required(element, name)?;
@@ -201,12 +231,12 @@ impl<'p, 'a> FileReader<'p, 'a> {
 
     pub(super) fn unknown_child(
         &mut self,
-        child: &Element<'a>,
-        parent: &Element<'a>,
+        child: &Element,
+        parent: &Element,
         expected: &'static str,
     ) {
         self.error(
-            child.at,
+            self.at(child.span),
             PropsErrorKind::UnknownElement {
                 name: child.name.to_owned(),
                 parent: parent.name.to_owned(),
@@ -215,7 +245,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
         );
     }
 
-    pub(super) fn declared_type(&mut self, element: &Element<'a>) -> Option<(String, Ty)> {
+    pub(super) fn declared_type(&mut self, element: &Element) -> Option<(String, Ty)> {
         let (value, at) = self.required(element, "type")?;
         match Ty::of(value.as_str()) {
             Some(ty) => Some((value.as_str().to_owned(), ty)),
@@ -234,7 +264,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
     }
 
     /// Reads the root element.
-    pub(crate) fn read(&mut self, root: &Element<'a>) -> PropertyFile {
+    pub(crate) fn read(&mut self, root: &Element) -> PropertyFile {
         let mut file = PropertyFile {
             path: self.path.to_path_buf(),
             ports: Vec::new(),
@@ -243,7 +273,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
         };
         if root.name != "properties" {
             self.error(
-                root.at,
+                self.at(root.span),
                 PropsErrorKind::UnknownElement {
                     name: root.name.to_owned(),
                     parent: String::new(),
@@ -253,15 +283,15 @@ impl<'p, 'a> FileReader<'p, 'a> {
             return file;
         }
         self.check_attrs(root, &[]);
-        let mut predicates: Vec<&Element<'a>> = Vec::new();
-        let mut tree_guarantees: Vec<&Element<'a>> = Vec::new();
-        let mut tree_assumptions: Vec<&Element<'a>> = Vec::new();
-        for section in &root.children {
+        let mut predicates: Vec<&Element> = Vec::new();
+        let mut tree_guarantees: Vec<&Element> = Vec::new();
+        let mut tree_assumptions: Vec<&Element> = Vec::new();
+        for section in root.elements() {
             self.check_attrs(section, &[]);
-            match section.name {
+            match section.name.as_str() {
                 "ports" => {
-                    for port in &section.children {
-                        match port.name {
+                    for port in section.elements() {
+                        match port.name.as_str() {
                             "scxml_event_send" => self.event_send(port, &mut file.ports),
                             "port" => self.tree_port(port, &mut file.ports),
                             "ros_topic" => self.ros_topic(port, &mut file.ports),
@@ -275,7 +305,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
                     }
                 }
                 "predicates" => {
-                    for predicate in &section.children {
+                    for predicate in section.elements() {
                         if predicate.name == "predicate" {
                             predicates.push(predicate);
                         } else {
@@ -286,7 +316,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
                 "guarantees" | "assumes" => {
                     let guarantees = section.name == "guarantees";
                     let tree_name = if guarantees { "guarantee" } else { "assume" };
-                    for property in &section.children {
+                    for property in section.elements() {
                         if property.name == "property" {
                             let read = if Self::attr(property, "pattern").is_some() {
                                 self.pattern_property(property)
@@ -376,13 +406,13 @@ impl<'p, 'a> FileReader<'p, 'a> {
     }
 
     /// `<scxml_event_send event origin target>` with `<state_var>` / `<event_var>`.
-    fn event_send(&mut self, element: &Element<'a>, ports: &mut Vec<Port>) {
+    fn event_send(&mut self, element: &Element, ports: &mut Vec<Port>) {
         self.check_attrs(element, &["event", "origin", "target"]);
         let event = self.required_name(element, "event");
         let origin = self.required_name(element, "origin");
         let target = self.required_name(element, "target");
-        for var in &element.children {
-            let kind = match var.name {
+        for var in element.elements() {
+            let kind = match var.name.as_str() {
                 "state_var" => {
                     self.check_attrs(var, &["id", "param", "type", "expr"]);
                     let param = self.required_name(var, "param");
@@ -414,7 +444,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
                     event: event.clone(),
                     origin: origin.clone(),
                     target: target.clone(),
-                    at: var.at,
+                    at: self.at(var.span),
                 });
             }
         }
@@ -423,14 +453,14 @@ impl<'p, 'a> FileReader<'p, 'a> {
     /// The single child `<name>` of a tree-form port.
     fn single_child<'e>(
         &mut self,
-        element: &'e Element<'a>,
+        element: &'e Element,
         name: &'static str,
-    ) -> Option<&'e Element<'a>> {
-        let mut found = element.children.iter().filter(|child| child.name == name);
+    ) -> Option<&'e Element> {
+        let mut found = element.elements().filter(|child| child.name == name);
         let first = found.next();
         if let Some(again) = found.next() {
             self.error(
-                again.at,
+                self.at(again.span),
                 PropsErrorKind::RepeatedElement {
                     element: element.name.to_owned(),
                     name: name.to_owned(),
@@ -439,7 +469,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
         }
         if first.is_none() {
             self.error(
-                element.at,
+                self.at(element.span),
                 PropsErrorKind::MissingElement {
                     element: element.name.to_owned(),
                     name,
@@ -451,12 +481,12 @@ impl<'p, 'a> FileReader<'p, 'a> {
 
     /// The older `<port id type>` with `<origin refid>`, `<target refid>` and
     /// `<message event [param_name expr]>`.
-    fn tree_port(&mut self, element: &Element<'a>, ports: &mut Vec<Port>) {
+    fn tree_port(&mut self, element: &Element, ports: &mut Vec<Port>) {
         self.check_attrs(element, &["id", "type"]);
         let id = self.required_name(element, "id");
         let ty = self.declared_type(element);
-        for child in &element.children {
-            if !matches!(child.name, "origin" | "target" | "message") {
+        for child in element.elements() {
+            if !matches!(child.name.as_str(), "origin" | "target" | "message") {
                 self.unknown_child(child, element, "<origin>, <target> or <message>");
             }
         }
@@ -491,7 +521,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
         } else {
             if let Some(attr) = Self::attr(message, "expr") {
                 self.error(
-                    attr.at,
+                    self.at(attr.name_span),
                     PropsErrorKind::Type {
                         message: "`expr` (an initial value) needs `param_name`: a port without \
                                   it is an event variable"
@@ -502,7 +532,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
             }
             if ty != Ty::Bool {
                 self.error(
-                    element.at,
+                    self.at(element.span),
                     PropsErrorKind::Type {
                         message: format!(
                             "port `{id}` has no `param_name`, so it is an event variable and \
@@ -520,15 +550,15 @@ impl<'p, 'a> FileReader<'p, 'a> {
             event,
             origin,
             target,
-            at: element.at,
+            at: self.at(element.span),
         });
     }
 
     /// `<property id [logic="pmtl"] expr>`.
-    fn text_property(&mut self, element: &Element<'a>) -> Option<Property> {
+    fn text_property(&mut self, element: &Element) -> Option<Property> {
         self.check_attrs(element, &["id", "logic", "expr"]);
-        if !element.children.is_empty() {
-            for child in &element.children {
+        if element.elements().next().is_some() {
+            for child in element.elements() {
                 self.unknown_child(child, element, "no child elements (the formula is `expr`)");
             }
         }
@@ -549,7 +579,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
         let (id, (formula, _)) = (id?, formula?);
         if formula.as_str().trim().is_empty() {
             self.error(
-                element.at,
+                self.at(element.span),
                 PropsErrorKind::BadValue {
                     attribute: "expr".to_owned(),
                     value: String::new(),
@@ -561,7 +591,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
         Some(Property {
             id,
             formula,
-            at: element.at,
+            at: self.at(element.span),
             converted: false,
         })
     }

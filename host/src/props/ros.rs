@@ -33,8 +33,8 @@
 use super::error::PropsErrorKind;
 use super::read::FileReader;
 use super::source::{Location, SourceText};
-use super::xml::Element;
 use super::{Port, PortKind, Property, ANY};
+use crate::model::xml::Element;
 
 /// The message name of a ROS topic in the translated model: `/a/b` -> `topic_a__b_msg`.
 pub fn topic_event(topic: &str) -> String {
@@ -67,7 +67,7 @@ fn ros_name(name: &str) -> String {
 
 impl<'a> FileReader<'_, 'a> {
     /// `<ros_topic topic|topic_name type [event="publish"]>` with its variables.
-    pub(super) fn ros_topic(&mut self, element: &Element<'a>, ports: &mut Vec<Port>) {
+    pub(super) fn ros_topic(&mut self, element: &Element, ports: &mut Vec<Port>) {
         self.check_attrs(element, &["topic", "topic_name", "type", "event"]);
         let name = match (
             Self::attr(element, "topic").is_some(),
@@ -77,7 +77,7 @@ impl<'a> FileReader<'_, 'a> {
             (false, true) => self.required_name(element, "topic_name"),
             (true, true) => {
                 self.error(
-                    element.at,
+                    self.at(element.span),
                     PropsErrorKind::BadValue {
                         attribute: "topic_name".to_owned(),
                         value: String::new(),
@@ -99,7 +99,7 @@ impl<'a> FileReader<'_, 'a> {
     }
 
     /// `<ros_service service_name type event="request|response">` with its variables.
-    pub(super) fn ros_service(&mut self, element: &Element<'a>, ports: &mut Vec<Port>) {
+    pub(super) fn ros_service(&mut self, element: &Element, ports: &mut Vec<Port>) {
         self.check_attrs(element, &["service_name", "type", "event"]);
         let name = self.required_name(element, "service_name");
         self.required_name(element, "type");
@@ -118,9 +118,9 @@ impl<'a> FileReader<'_, 'a> {
     }
 
     /// The `<state_var id type field expr>` and `<event_var id>` children of a ROS port.
-    fn ros_variables(&mut self, element: &Element<'a>, event: &str, ports: &mut Vec<Port>) {
-        for var in &element.children {
-            let kind = match var.name {
+    fn ros_variables(&mut self, element: &Element, event: &str, ports: &mut Vec<Port>) {
+        for var in element.elements() {
+            let kind = match var.name.as_str() {
                 "state_var" => {
                     self.check_attrs(var, &["id", "type", "field", "expr"]);
                     let field = self.required_name(var, "field");
@@ -151,7 +151,7 @@ impl<'a> FileReader<'_, 'a> {
                     event: event.to_owned(),
                     origin: ANY.to_owned(),
                     target: ANY.to_owned(),
-                    at: var.at,
+                    at: self.at(var.span),
                 });
             }
         }
@@ -169,7 +169,7 @@ impl<'a> FileReader<'_, 'a> {
     }
 
     /// `<property id pattern=...>`: a specification pattern turned into a formula.
-    pub(super) fn pattern_property(&mut self, element: &Element<'a>) -> Option<Property> {
+    pub(super) fn pattern_property(&mut self, element: &Element) -> Option<Property> {
         self.check_attrs(
             element,
             &[
@@ -189,8 +189,8 @@ impl<'a> FileReader<'_, 'a> {
         // The condition may be an attribute or an `<event>` child; a `<scope>` child
         // may say `globally`.
         let mut event = self.optional(element, "event").map(|(v, _)| v);
-        for child in &element.children {
-            match child.name {
+        for child in element.elements() {
+            match child.name.as_str() {
                 "event" if event.is_none() => {
                     self.check_attrs_allow_text(child, &[]);
                     event = self.element_text(child);
@@ -223,7 +223,7 @@ impl<'a> FileReader<'_, 'a> {
         let within = self.within(element);
         let Some(event) = event.map(|e| atom(&e)) else {
             self.error(
-                element.at,
+                self.at(element.span),
                 PropsErrorKind::MissingAttribute {
                     element: "property".to_owned(),
                     name: "event",
@@ -231,7 +231,7 @@ impl<'a> FileReader<'_, 'a> {
             );
             return None;
         };
-        let at = element.at;
+        let at = self.at(element.span);
         let mut f = SourceText::empty();
         let g = |f: &mut SourceText, s: &str| f.push_generated(s, at);
         let used_ok = match pattern.as_str() {
@@ -332,7 +332,7 @@ impl<'a> FileReader<'_, 'a> {
     }
 
     /// `within` with `time_unit` as a bound with a unit suffix (`6200ms`), or `None`.
-    fn within(&mut self, element: &Element<'a>) -> Option<String> {
+    fn within(&mut self, element: &Element) -> Option<String> {
         let unit = match self.optional(element, "time_unit") {
             None => "s".to_owned(),
             Some((unit, at)) => {

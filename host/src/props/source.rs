@@ -57,11 +57,9 @@ impl<'a> LineIndex<'a> {
         Snippet::at_line_col(self.text, &self.index, at.line, at.column)
     }
 
-    /// The byte offset of `slice` in the indexed text, if it is a sub-slice of it.
-    pub(crate) fn offset_of(&self, slice: &[u8]) -> Option<usize> {
-        let base = self.text.as_ptr() as usize;
-        let at = slice.as_ptr() as usize;
-        (at >= base && at + slice.len() <= base + self.text.len()).then(|| at - base)
+    /// The indexed text.
+    pub(crate) fn text(&self) -> &'a str {
+        self.text
     }
 }
 

@@ -492,7 +492,7 @@ fn load_full(
     };
     let mut errs = Diagnostics::default();
     for m in &out.machines {
-        src.add_machine_tree(m, m.span.file, &mut errs);
+        src.add_machine_tree(m, crate::model::FileId::of(m.span), &mut errs);
     }
     src.check_names(&mut errs);
     if !errs.is_empty() {

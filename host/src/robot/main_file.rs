@@ -299,8 +299,8 @@ impl MainFile {
             };
             if let Some((_, first)) = seen.iter().find(|(n, _)| n == section) {
                 let (line, _) = sm
-                    .file(first.file)
-                    .map_or((0, 0), |f| f.line_col(first.offset));
+                    .file(FileId::of(*first))
+                    .map_or((0, 0), |f| f.line_col(first.lo));
                 r.errs.push(sm.diag(
                     el.span,
                     format!("<{}> is given twice (first on line {line})", el.name),

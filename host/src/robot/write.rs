@@ -1,6 +1,6 @@
 //! Writes element trees back to XML text: how `hindsight convert` saves a lowered model as plain SCXML.
 
-use crate::model::source::{FileId, Span};
+use crate::model::source::FileId;
 use crate::model::types::{BaseType, TypeDef, TypeDefs, TypeExpr};
 use crate::model::xml::{Element, Node};
 
@@ -19,10 +19,7 @@ pub fn to_xml(root: &Element) -> String {
 /// `<field id type>`, and `<enumeration id>` with `<label id>`), which the plain reader
 /// takes back from a model folder: the types a converted robot model's machines name.
 pub fn types_xml(defs: &TypeDefs) -> String {
-    let at = Span {
-        file: FileId(0),
-        offset: 0,
-    };
+    let at = FileId(0).at(0);
     let mut root = Element::new("dataTypeList", at);
     for (name, def, _) in &defs.defs {
         match def {
@@ -138,7 +135,7 @@ pub fn escape_into(text: &str, out: &mut String) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::source::{FileId, SourceMap, Span};
+    use crate::model::source::{FileId, SourceMap};
     use crate::model::xml;
 
     fn reparse(text: &str) -> Element {
@@ -149,10 +146,7 @@ mod tests {
 
     #[test]
     fn round_trip_keeps_names_values_and_comments() {
-        let at = Span {
-            file: FileId(0),
-            offset: 0,
-        };
+        let at = FileId(0).at(0);
         let mut root = Element::new("scxml", at).with_attr("name", "M");
         let mut dm = Element::new("datamodel", at);
         dm.push_comment(" TYPE x:int32 ");
@@ -202,10 +196,7 @@ mod tests {
 
     #[test]
     fn double_dash_in_comment_stays_a_comment() {
-        let at = Span {
-            file: FileId(0),
-            offset: 0,
-        };
+        let at = FileId(0).at(0);
         let mut root = Element::new("scxml", at);
         root.push_comment("a -- b");
         let back = reparse(&to_xml(&root));

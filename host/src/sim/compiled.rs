@@ -693,7 +693,7 @@ impl<'s> Builder<'s> {
                     };
                     let sources = &self.src.sources;
                     let span = src.span;
-                    let abs = move |k: u32| sources.unescaped_offset(span, k).offset;
+                    let abs = move |k: u32| sources.unescaped_offset(span, k).lo;
                     let scope = Scope {
                         vars: &vars,
                         event: EventScope::None,

@@ -7,7 +7,7 @@ use super::observer::{Flow, Inbox, Observer, Scalar, SentMessage, EXTERNAL};
 use crate::expr::compile::{Code, Entropy, Env, EvalError, EvalErrorKind, MAX_PATH};
 use crate::expr::value::{Cell, StrId, Strings};
 use crate::expr::Value;
-use crate::model::{Diagnostic, Span};
+use crate::model::Diagnostic;
 use std::collections::VecDeque;
 
 mod config;

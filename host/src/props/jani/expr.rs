@@ -98,21 +98,12 @@ impl Reader<'_, '_> {
                     }
                     "¬" => {
                         let e = self.operand(node, "exp")?;
-                        let r = self.expr(e)?;
-                        if r.ty != Ty::Bool {
-                            self.error(
-                                node.offset,
-                                PropsErrorKind::Type {
-                                    message: "`¬` takes a boolean".into(),
-                                },
-                            );
-                            return None;
-                        }
-                        let t = self.plain(e, r)?;
-                        let mut out = SourceText::empty();
-                        out.push_generated("!(", at);
-                        out.push_source(&t);
-                        out.push_generated(")", at);
+                        let out = self.wrapped_boolean(
+                            e,
+                            node.offset,
+                            "`¬` takes a boolean",
+                            ["!(", ")"],
+                        )?;
                         Some(Rendered {
                             text: out,
                             ty: Ty::Bool,

@@ -5,9 +5,9 @@ use std::collections::HashMap;
 
 use super::super::error::PropsErrorKind;
 use super::super::source::{Location, SourceText};
-use super::super::xml::Element;
 use super::super::{Port, PortKind, Property};
 use super::{FileReader, Ty};
+use crate::model::xml::Element;
 
 /// A value-level expression of the tree form, as text.
 struct Term {
@@ -38,8 +38,8 @@ struct VarInfo {
 }
 
 /// Where a predicate stands during conversion.
-enum PredicateState<'e, 'a> {
-    Pending(&'e Element<'a>),
+enum PredicateState<'e> {
+    Pending(&'e Element),
     Converting,
     Done(Option<(SourceText, Ty, bool)>),
 }
@@ -48,7 +48,7 @@ enum PredicateState<'e, 'a> {
 pub(super) struct Converter<'r, 'p, 'a, 'e> {
     reader: &'r mut FileReader<'p, 'a>,
     variables: HashMap<String, VarInfo>,
-    predicates: HashMap<&'a str, PredicateState<'e, 'a>>,
+    predicates: HashMap<&'a str, PredicateState<'e>>,
     order: Vec<&'a str>,
 }
 
@@ -56,7 +56,7 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
     pub(super) fn new(
         reader: &'r mut FileReader<'p, 'a>,
         ports: &[Port],
-        predicates: &[&'e Element<'a>],
+        predicates: &[&'e Element],
     ) -> Self {
         let mut variables = HashMap::new();
         for port in ports {
@@ -68,14 +68,14 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
             };
             variables.entry(port.id.clone()).or_insert(VarInfo { ty });
         }
-        let mut table: HashMap<&'a str, PredicateState<'e, 'a>> = HashMap::new();
+        let mut table: HashMap<&'a str, PredicateState<'e>> = HashMap::new();
         let mut order = Vec::new();
         let mut first_at: HashMap<&'a str, Location> = HashMap::new();
         for &predicate in predicates {
             reader.check_attrs(predicate, &["id"]);
             let Some(id_attr) = FileReader::attr(predicate, "id") else {
                 reader.error(
-                    predicate.at,
+                    reader.at(predicate.span),
                     PropsErrorKind::MissingAttribute {
                         element: "predicate".to_owned(),
                         name: "id",
@@ -83,10 +83,10 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
                 );
                 continue;
             };
-            let id = id_attr.raw;
+            let id = reader.raw(id_attr);
             if let Some(&first) = first_at.get(id) {
                 reader.error(
-                    predicate.at,
+                    reader.at(predicate.span),
                     PropsErrorKind::Duplicate {
                         what: "predicate",
                         id: id.to_owned(),
@@ -97,14 +97,14 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
             }
             if variables.contains_key(id) {
                 reader.error(
-                    predicate.at,
+                    reader.at(predicate.span),
                     PropsErrorKind::Type {
                         message: format!("predicate `{id}` has the name of a variable"),
                     },
                 );
                 continue;
             }
-            first_at.insert(id, predicate.at);
+            first_at.insert(id, reader.at(predicate.span));
             table.insert(id, PredicateState::Pending(predicate));
             order.push(id);
         }
@@ -123,31 +123,32 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
         }
     }
 
-    pub(super) fn tree_property(&mut self, element: &'e Element<'a>) -> Option<Property> {
+    pub(super) fn tree_property(&mut self, element: &'e Element) -> Option<Property> {
         self.reader.check_attrs(element, &["id"]);
         let id = self.reader.required_name(element, "id");
         let body = self.only_child(element)?;
-        let mut formula = self.formula(body, element.name)?;
+        let mut formula = self.formula(body, &element.name)?;
         // The top level needs no parentheses.
         formula = strip_outer(formula);
         Some(Property {
             id: id?,
             formula,
-            at: element.at,
+            at: self.reader.at(element.span),
             converted: true,
         })
     }
 
-    fn only_child(&mut self, element: &'e Element<'a>) -> Option<&'e Element<'a>> {
-        if element.children.len() == 1 {
-            element.children.first()
+    fn only_child(&mut self, element: &'e Element) -> Option<&'e Element> {
+        let mut children = element.elements();
+        if let (Some(only), None) = (children.next(), children.next()) {
+            Some(only)
         } else {
             self.reader.error(
-                element.at,
+                self.reader.at(element.span),
                 PropsErrorKind::Arity {
-                    element: element.name.to_owned(),
+                    element: element.name.clone(),
                     expected: "exactly one element",
-                    found: element.children.len(),
+                    found: element.elements().count(),
                 },
             );
             None
@@ -156,19 +157,20 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
 
     fn operands(
         &mut self,
-        element: &'e Element<'a>,
+        element: &'e Element,
         expected: &'static str,
         ok: impl Fn(usize) -> bool,
-    ) -> Option<&'e [Element<'a>]> {
-        if ok(element.children.len()) {
-            Some(&element.children)
+    ) -> Option<Vec<&'e Element>> {
+        let children: Vec<&'e Element> = element.elements().collect();
+        if ok(children.len()) {
+            Some(children)
         } else {
             self.reader.error(
-                element.at,
+                self.reader.at(element.span),
                 PropsErrorKind::Arity {
-                    element: element.name.to_owned(),
+                    element: element.name.clone(),
                     expected,
-                    found: element.children.len(),
+                    found: element.elements().count(),
                 },
             );
             None
@@ -176,7 +178,7 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
     }
 
     /// The `[a:b]` interval of a temporal element's `lower_bound` / `upper_bound`.
-    fn interval(&mut self, element: &'e Element<'a>) -> Option<String> {
+    fn interval(&mut self, element: &'e Element) -> Option<String> {
         self.reader
             .check_attrs(element, &["lower_bound", "upper_bound"]);
         let mut bound = |name: &'static str| -> Result<Option<u64>, ()> {
@@ -205,7 +207,10 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
         };
         if let (Some(lower), Some(upper)) = (lower, upper) {
             if lower > upper {
-                let at = FileReader::attr(element, "upper_bound").map_or(element.at, |a| a.at);
+                let at = FileReader::attr(element, "upper_bound")
+                    .map_or(self.reader.at(element.span), |a| {
+                        self.reader.at(a.name_span)
+                    });
                 self.reader.error(
                     at,
                     PropsErrorKind::BadValue {
@@ -226,19 +231,19 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
     }
 
     /// A formula: self-delimited Rye text (an atom, a constant, or in parentheses).
-    fn formula(&mut self, element: &'e Element<'a>, parent: &str) -> Option<SourceText> {
-        let at = element.at;
+    fn formula(&mut self, element: &'e Element, parent: &str) -> Option<SourceText> {
+        let at = self.reader.at(element.span);
         let mut out = SourceText::empty();
-        match element.name {
+        match element.name.as_str() {
             "true" | "false" => {
                 self.reader.check_attrs(element, &[]);
                 self.operands(element, "no operands", |n| n == 0)?;
-                out.push_generated(element.name, at);
+                out.push_generated(&element.name, at);
             }
             "not" => {
                 self.reader.check_attrs(element, &[]);
                 let operand = self.only_child(element)?;
-                let inner = self.formula(operand, element.name)?;
+                let inner = self.formula(operand, &element.name)?;
                 out.push_generated("(!", at);
                 out.push_source(&inner);
                 out.push_generated(")", at);
@@ -260,7 +265,7 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
                 };
                 let parts: Vec<Option<SourceText>> = operands
                     .iter()
-                    .map(|child| self.formula(child, element.name))
+                    .map(|child| self.formula(child, &element.name))
                     .collect();
                 let parts: Vec<SourceText> = parts.into_iter().collect::<Option<_>>()?;
                 if let [only] = parts.as_slice() {
@@ -278,7 +283,7 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
             "historically" | "previously" | "once" => {
                 let interval = self.interval(element);
                 let operand = self.only_child(element);
-                let inner = self.formula(operand?, element.name)?;
+                let inner = self.formula(operand?, &element.name)?;
                 let word = if element.name == "historically" {
                     "historically"
                 } else {
@@ -291,8 +296,8 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
             "since" => {
                 let interval = self.interval(element);
                 let operands = self.operands(element, "two operands", |n| n == 2)?;
-                let left = self.formula(&operands[0], element.name);
-                let right = self.formula(&operands[1], element.name);
+                let left = self.formula(operands[0], &element.name);
+                let right = self.formula(operands[1], &element.name);
                 let (interval, left, right) = (interval?, left?, right?);
                 out.push_generated("(", at);
                 out.push_source(&left);
@@ -336,7 +341,7 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
             return None;
         };
         let result = self.only_child(element).and_then(|body| {
-            let term = self.term(body, element.name)?;
+            let term = self.term(body, &element.name)?;
             Some((term.text, term.ty, term.compound))
         });
         self.predicates
@@ -345,9 +350,9 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
     }
 
     /// A value-level expression.
-    fn term(&mut self, element: &'e Element<'a>, parent: &str) -> Option<Term> {
-        let at = element.at;
-        let name = element.name;
+    fn term(&mut self, element: &'e Element, parent: &str) -> Option<Term> {
+        let at = self.reader.at(element.span);
+        let name = element.name.as_str();
         let mut text = SourceText::empty();
         match name {
             "var" => {
@@ -478,7 +483,7 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
             ),
             "opposite" | "not" => {
                 let operand = self.only_child(element)?;
-                let inner = self.term(operand, element.name)?;
+                let inner = self.term(operand, &element.name)?;
                 let (symbol, ok) = if name == "not" {
                     ("!", inner.ty == Ty::Bool)
                 } else {
@@ -524,7 +529,7 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
         };
         let terms: Vec<Option<Term>> = operands
             .iter()
-            .map(|child| self.term(child, element.name))
+            .map(|child| self.term(child, &element.name))
             .collect();
         let terms: Vec<Term> = terms.into_iter().collect::<Option<_>>()?;
         let types: Vec<Ty> = terms.iter().map(|t| t.ty).collect();
@@ -568,10 +573,10 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
         })
     }
 
-    fn type_error(&mut self, element: &Element<'a>, types: &[Ty]) {
+    fn type_error(&mut self, element: &Element, types: &[Ty]) {
         let found: Vec<&str> = types.iter().map(|t| t.name()).collect();
         self.reader.error(
-            element.at,
+            self.reader.at(element.span),
             PropsErrorKind::Type {
                 message: format!(
                     "<{}> cannot take operands of type {}",

@@ -25,10 +25,7 @@ pub fn parse_interface(
         )]);
     };
     let text = src.text();
-    let at = |offset: usize| Span {
-        file,
-        offset: offset as u32,
-    };
+    let at = |offset: usize| file.at(offset as u32);
     let mut errs = Vec::new();
     let mut parts = vec![MessageDef::default()];
     // A byte-order mark is not part of the first line.
@@ -61,7 +58,7 @@ pub fn parse_interface(
         }
         match parse_line(trimmed, start + indent, package) {
             Ok(Item::Field(mut f)) => {
-                f.span = at(f.span.offset as usize);
+                f.span = at(f.span.lo as usize);
                 let part = parts.last_mut().expect("at least one part");
                 if part.fields.iter().any(|g| g.name == f.name)
                     || part.constants.iter().any(|c| c.name == f.name)
@@ -213,10 +210,7 @@ fn parse_line(line: &str, base: usize, package: &str) -> Result<Item, LineError>
 }
 
 fn placeholder(offset: usize) -> Span {
-    Span {
-        file: FileId(0),
-        offset: offset as u32,
-    }
+    FileId(0).at(offset as u32)
 }
 
 fn string_bound(ty: &FieldType) -> Option<u32> {

@@ -54,7 +54,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
         let r = {
             let sources = &self.b.src.sources;
             let span = src.span;
-            let abs = move |k: u32| sources.unescaped_offset(span, k).offset;
+            let abs = move |k: u32| sources.unescaped_offset(span, k).lo;
             let scope = Scope {
                 vars: &self.b.vars[self.mi as usize],
                 event: match event {
@@ -488,7 +488,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
         MachineDef {
             name: m.name.name.clone(),
             name_str: self.b.strings.intern(&m.name.name),
-            file: m.span.file,
+            file: FileId::of(m.span),
             vars,
             defaults,
             init,

@@ -88,10 +88,11 @@ impl Simulator<'_> {
                     Some(&t) if t != u32::MAX => Some(t),
                     _ if s == model.none_str => None,
                     _ => {
-                        let span = def.code_spans.get(pc as usize).copied().unwrap_or(Span {
-                            file: def.file,
-                            offset: 0,
-                        });
+                        let span = def
+                            .code_spans
+                            .get(pc as usize)
+                            .copied()
+                            .unwrap_or(def.file.at(0));
                         return Err(Stop::End(Box::new(EndReason::Error(RunError {
                             machine: MachineId(m as u32),
                             time: self.time,

@@ -6,16 +6,10 @@ impl Simulator<'_> {
     pub(super) fn diag_error(&self, m: usize, pc: Option<usize>, e: EvalError) -> Stop {
         let def = &self.model.machines[m];
         let span = if e.at != 0 {
-            Span {
-                file: def.file,
-                offset: e.at,
-            }
+            def.file.at(e.at)
         } else {
             pc.and_then(|p| def.code_spans.get(p).copied())
-                .unwrap_or(Span {
-                    file: def.file,
-                    offset: 0,
-                })
+                .unwrap_or(def.file.at(0))
         };
         Stop::End(Box::new(EndReason::Error(RunError {
             machine: MachineId(m as u32),
@@ -35,10 +29,7 @@ impl Simulator<'_> {
             .states
             .get(s as usize)
             .map(|st| st.span)
-            .unwrap_or(Span {
-                file: def.file,
-                offset: 0,
-            });
+            .unwrap_or(def.file.at(0));
         Stop::End(Box::new(EndReason::Spin(SpinReport {
             kind,
             machine: MachineId(m as u32),
