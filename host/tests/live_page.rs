@@ -158,6 +158,20 @@ fn the_live_page_shows_the_verdicts_as_they_arrive() {
         let t = get(addr, "/verdicts.jsonl");
         t[t.find("\r\n\r\n").unwrap() + 4..].to_string()
     };
+    // Once the system stops, its recurrence properties turn false on the sidecar's
+    // heartbeats, about 1 s of model time (0.1 s of wall clock) after the run's end: wait
+    // for those lines, so that the page is checked with a false verdict in it however
+    // fast the run's process exited.
+    let turned_false = |body: &str| {
+        body.lines().any(|l| {
+            serde_json::from_str::<serde_json::Value>(l)
+                .is_ok_and(|v| v["verdict"] == "false" || v["verdict"] == "currently_false")
+        })
+    };
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while !turned_false(&served_body(&addr)) && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(50));
+    }
     // The page catches up with every line served so far.
     let so_far = served_body(&addr).lines().count();
     assert!(so_far >= 5, "{so_far} verdict lines");
