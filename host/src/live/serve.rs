@@ -216,6 +216,7 @@ pub fn page(title: &str, spec: &codegen::Compiled) -> String {
     // The title last: nothing it holds is taken for a placeholder.
     include_str!("page.html")
         .replace("__CSS__", include_str!("../report/page.css"))
+        .replace("__LIVE_JS__", include_str!("page_live.js"))
         .replace("__JS__", include_str!("../report/page.js"))
         .replace("__SPEC__", &data)
         .replace("__VERSION__", env!("CARGO_PKG_VERSION"))
@@ -521,12 +522,20 @@ mod tests {
         .unwrap();
         let page = page("museum <guide>", &spec);
         assert!(page.contains(include_str!("../report/page.js")));
+        assert!(page.contains(include_str!("page_live.js")));
         assert!(page.contains("hindsight monitor: museum &lt;guide&gt;"));
         assert!(page.contains(
             "{\"properties\":[\"low\"],\"unit_ns\":10000000,\"vars\":[{\"event\":false,\
              \"init\":100,\"name\":\"level\"},{\"event\":true,\"init\":false,\"name\":\"alarm\"}]}"
         ));
-        for placeholder in ["__CSS__", "__JS__", "__SPEC__", "__TITLE__", "__VERSION__"] {
+        for placeholder in [
+            "__CSS__",
+            "__JS__",
+            "__LIVE_JS__",
+            "__SPEC__",
+            "__TITLE__",
+            "__VERSION__",
+        ] {
             assert!(!page.contains(placeholder), "{placeholder}");
         }
         assert!(!page.contains("http://") && !page.contains("https://"));
