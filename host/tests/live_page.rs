@@ -29,9 +29,12 @@ fn get(addr: &str, path: &str) -> String {
 
 /// What the page shows: verdict lines received, each row's property and verdict, the
 /// timeline's points, and per verdict lane its changes (time, verdict), the colours
-/// drawn in it and the time of its first-false mark.
+/// drawn in it and the time of its first-false mark. Points keep arriving (heartbeats) and
+/// the page draws them on the next animation frame, so this draws what the page holds first:
+/// the drawing and the counts are then of one moment.
 const PAGE_STATE: &str = "(function () { \
     var tl = document.getElementById('timeline-live').hindsightTimeline; \
+    tl.draw(); \
     return JSON.stringify({lines: +tl.el.getAttribute('data-lines'), \
     errors: +document.getElementById('errors').textContent, \
     median: +document.getElementById('delay-median').textContent, \
@@ -370,6 +373,7 @@ fn a_page_that_keeps_50_points(
              return JSON.stringify({points: tl.n, columns: tl.run.time.length, \
                dropped: +tl.el.getAttribute('data-dropped'), note: note.hidden ? '' : note.textContent, \
                first_kept: tl.run.time[0] * tl.run.step_seconds, t0: tl.run.time[0], \
+               view: document.querySelector('.tools .view').textContent, \
                step: tl.run.step_seconds, \
                lines: +tl.el.getAttribute('data-lines'), \
                lanes: tl.lanes.filter(function (l) { return l.kind === 'verdict'; }).map(function (l) { \
@@ -396,6 +400,16 @@ fn a_page_that_keeps_50_points(
         )),
         "{kept}"
     );
+    // Point numbers count from the run's first point, dropped ones included (the view's
+    // text is of the last frame drawn: heartbeats may have added points since).
+    let of: u64 = kept["view"]
+        .as_str()
+        .unwrap()
+        .rsplit(" of ")
+        .next()
+        .and_then(|n| n.trim_end_matches(')').parse().ok())
+        .unwrap_or_else(|| panic!("{kept}"));
+    assert!(of > dropped && of <= points + dropped, "{kept}");
     let first_kept = kept["first_kept"].as_f64().unwrap();
     let mut before = 0;
     for (k, f) in kept["rows"]

@@ -120,6 +120,9 @@
     this.state = state;
     this.follow = !!(opts && opts.follow);
     this.sel = -1;
+    // Points dropped from the front (the live page's cap): shown numbers count from the
+    // run's first point, not from the first one kept.
+    this.base = 0;
     this.pinned = false;
     this.lanes = lanesOf(run);
     // The two kinds of point the message lane marks (the report's sends and receives, the
@@ -195,6 +198,7 @@
     this.receives = [0];
     this.sendIdx = [];
     this.sel -= count;
+    this.base += count;
     if (this.sel < 0) { this.sel = -1; this.pinned = false; }
     this.n = 0;
     this.view = null;
@@ -419,15 +423,15 @@
     var view = this.tools && this.tools.querySelector(".view");
     if (view) {
       view.textContent = "showing " + this.timeText(this.view[0]) + " to " + this.timeText(this.view[1]) +
-        " (points " + lower(time, this.view[0]) + " to " + Math.max(upper(time, this.view[1]) - 1, 0) +
-        " of " + this.n + ")";
+        " (points " + (this.base + lower(time, this.view[0])) + " to " +
+        (this.base + Math.max(upper(time, this.view[1]) - 1, 0)) + " of " + (this.base + this.n) + ")";
     }
   };
 
   Timeline.prototype.showState = function () {
     var r = this.run, k = this.sel, nm = r.names;
     if (k < 0 || !this.state) return;
-    var rows = [["point", k + " of " + this.n + (this.pinned ? " (pinned)" : "")],
+    var rows = [["point", (this.base + k) + " of " + (this.base + this.n) + (this.pinned ? " (pinned)" : "")],
       ["time", this.timeText(r.time[k])], ["step", nm[r.step[k]]]];
     if (nm[r.event[k]]) {
       var from = nm[r.origin[k]], to = nm[r.target[k]];
