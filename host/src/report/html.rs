@@ -35,21 +35,10 @@ pub fn anchor(name: &str) -> String {
         .collect()
 }
 
-/// A number without float noise (at most 6 decimals, trailing zeros dropped).
-fn num(v: f64) -> String {
-    let s = format!("{v:.6}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".into()
-    } else {
-        s.to_string()
-    }
-}
-
 /// A model time as the page writes it: seconds when the step is known, else steps.
 pub fn time_text(t: u64, step_seconds: Option<f64>) -> String {
     match step_seconds {
-        Some(s) => format!("{} s", num(t as f64 * s)),
+        Some(s) => format!("{} s", plot::label(t as f64 * s)),
         None => format!("{t} (steps)"),
     }
 }
@@ -143,14 +132,14 @@ fn study(o: &mut String, s: &Study, runs: &[Run]) {
         ("model".into(), s.model.clone()),
         ("properties".into(), s.properties_file.clone()),
         ("seed".into(), s.seed.to_string()),
-        ("confidence".into(), num(s.confidence)),
-        ("precision".into(), num(s.precision)),
+        ("confidence".into(), plot::label(s.confidence)),
+        ("precision".into(), plot::label(s.precision)),
     ];
     if let Some(step) = s.step_seconds {
-        settings.push(("model time step".into(), format!("{} s", num(step))));
+        settings.push(("model time step".into(), format!("{} s", plot::label(step))));
     }
     if let Some(max) = s.max_time_seconds {
-        settings.push(("run length".into(), format!("{} s", num(max))));
+        settings.push(("run length".into(), format!("{} s", plot::label(max))));
     }
     settings.extend(s.settings.iter().cloned());
     if s.seconds > 0.0 {

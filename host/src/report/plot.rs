@@ -64,8 +64,9 @@ fn nice_step(span: f64, ticks: f64) -> f64 {
     nice * mag
 }
 
-/// Formats a tick label without float noise.
-fn label(v: f64) -> String {
+/// A number without float noise (at most 6 decimals, trailing zeros dropped): tick
+/// labels here, settings and times in the page.
+pub(crate) fn label(v: f64) -> String {
     let s = format!("{v:.6}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s == "-0" {
