@@ -1,21 +1,10 @@
 //! `hindsight` on robot models: the museum guide in its high-level form (verify, sweep in
 //! seconds, convert), and bad robot models rejected with positions and exit code 2.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
-fn hindsight(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_hindsight"))
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .args(args)
-        .output()
-        .expect("run hindsight");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+use common::hindsight;
+use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("hindsight-robot-{name}-{}", std::process::id()));

@@ -3,26 +3,14 @@
 
 mod live_common;
 
+mod common;
+
+use common::hindsight;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use hindsight::cli::monitor::guarantees_spec;
 use hindsight::cli::verify::ModelArgs;
-
-/// Runs `hindsight` from the repository root: exit code, stdout, stderr.
-fn hindsight(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_hindsight"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("run hindsight");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")

@@ -8,6 +8,7 @@
 //! tests say why and pass, unless `CI` is set: then a missing browser is a failure.
 
 mod browser;
+mod common;
 mod report_common;
 
 use std::path::Path;

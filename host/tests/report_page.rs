@@ -2,6 +2,7 @@
 //! false point of a failing run at the right time, sweeps with thresholds, no reference to
 //! anything outside the page, and bad input named by file and line.
 
+mod common;
 mod report_common;
 
 use report_common::{expected_first_false, external_refs, hindsight, museum, scratch};

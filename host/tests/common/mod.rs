@@ -1,4 +1,4 @@
-//! What the integration tests share: where the shared corpus is, the museum model the
+//! What the integration tests share: running the `hindsight` binary, where the shared corpus is, the museum model the
 //! simulator tests run, and a counting allocator.
 //!
 //! Each test file that needs it says `mod common;`; not every file uses every helper.
@@ -8,6 +8,21 @@ pub mod alloc;
 pub mod canon;
 
 use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Runs hindsight from the repository root; returns the exit code, stdout and stderr.
+pub fn hindsight(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_hindsight"))
+        .args(args)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .output()
+        .expect("run hindsight");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
 
 /// `shared/corpus`, found next to the repository or a worktree container above it (the
 /// repository may be checked out at `X/repo` or `X/wt/name`, with `X/shared`).

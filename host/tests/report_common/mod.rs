@@ -2,22 +2,8 @@
 //! fails it), the pages hindsight writes for it, and what those pages must not contain.
 #![allow(dead_code)]
 
+pub use crate::common::hindsight;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-/// Runs hindsight from the repository root; returns the exit code, stdout and stderr.
-pub fn hindsight(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_hindsight"))
-        .args(args)
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-        .output()
-        .expect("run hindsight");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 /// A fresh folder under the test target's tmp folder.
 pub fn scratch(name: &str) -> PathBuf {
