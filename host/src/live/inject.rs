@@ -208,12 +208,42 @@ impl<T> Outgoing<T> {
     }
 }
 
+/// Bridged entries found by the id of a model event they take: built once, read per message.
+struct ByEvent<T> {
+    /// Per event id: the index into `entries` if the event is bridged.
+    index: Vec<Option<usize>>,
+    entries: Vec<T>,
+}
+
+impl<T> ByEvent<T> {
+    fn new(event_count: usize) -> Self {
+        ByEvent {
+            index: vec![None; event_count],
+            entries: Vec::new(),
+        }
+    }
+
+    /// Adds `entry`, found from each of `events`.
+    fn push(&mut self, events: impl IntoIterator<Item = crate::sim::EventId>, entry: T) {
+        for e in events {
+            if let Some(slot) = self.index.get_mut(e.0 as usize) {
+                *slot = Some(self.entries.len());
+            }
+        }
+        self.entries.push(entry);
+    }
+
+    /// The entry `msg`'s event goes to, if any.
+    fn of(&mut self, msg: &SentMessage<'_>) -> Option<&mut T> {
+        let i = (*self.index.get(msg.event().0 as usize)?)?;
+        self.entries.get_mut(i)
+    }
+}
+
 /// Clients of the services processes serve: requests out, responses into the model.
 pub struct ServiceBridge {
-    /// Per event id: the index into `services` if it is a bridged request.
-    by_event: Vec<Option<usize>>,
-    /// `(request layout, response layout, client)`.
-    services: Vec<(TopicLayout, TopicLayout, Outgoing<()>)>,
+    /// `(request layout, response layout, client)`, found by the request's event.
+    services: ByEvent<(TopicLayout, TopicLayout, Outgoing<()>)>,
 }
 
 impl ServiceBridge {
@@ -225,19 +255,12 @@ impl ServiceBridge {
         services: Vec<(String, TopicLayout, TopicLayout)>,
         prefix: &str,
     ) -> Result<ServiceBridge, String> {
-        let mut by_event = vec![None; event_count];
-        let mut out = Vec::new();
+        let mut out = ByEvent::new(event_count);
         for (path, request, response) in services {
             let client = Outgoing::open(node, prefix, path, request.size)?;
-            if let Some(slot) = by_event.get_mut(request.event.0 as usize) {
-                *slot = Some(out.len());
-            }
-            out.push((request, response, client));
+            out.push([request.event], (request, response, client));
         }
-        Ok(ServiceBridge {
-            by_event,
-            services: out,
-        })
+        Ok(ServiceBridge { services: out })
     }
 
     /// Sends `msg` to its process if it is a request of a bridged service.
@@ -245,16 +268,15 @@ impl ServiceBridge {
         if msg.origin() == EXTERNAL {
             return Ok(());
         }
-        let Some(Some(i)) = self.by_event.get(msg.event().0 as usize) else {
+        let Some((request, _, client)) = self.services.of(msg) else {
             return Ok(());
         };
-        let (request, _, client) = &mut self.services[*i];
         client.send(request, msg, ())
     }
 
     /// Takes every response that arrived and queues it in `inbox`, oldest request first.
     pub fn poll(&mut self, inbox: &mut Inbox) {
-        for (_, response, client) in &mut self.services {
+        for (_, response, client) in &mut self.services.entries {
             client.receive(|bytes, ()| match response.decode(bytes) {
                 Some((params, _seq)) => {
                     inbox.push(response.event, params);
@@ -267,7 +289,7 @@ impl ServiceBridge {
 
     /// What each bridged service did so far.
     pub fn stats(&self) -> impl Iterator<Item = &ServiceStats> {
-        self.services.iter().map(|s| &s.2.stats)
+        self.services.entries.iter().map(|s| &s.2.stats)
     }
 }
 
@@ -314,9 +336,8 @@ struct Served {
 /// Servers of the model's services and actions that processes call: requests and goals
 /// into the model, its answers back.
 pub struct ServiceServers {
-    /// Per event id: the index into `services` if it is a bridged answer to a client.
-    by_event: Vec<Option<usize>>,
-    services: Vec<Served>,
+    /// Found by the events of the model's answers to a client.
+    services: ByEvent<Served>,
 }
 
 impl ServiceServers {
@@ -328,8 +349,7 @@ impl ServiceServers {
         services: Vec<(String, TopicLayout, Answer)>,
         prefix: &str,
     ) -> Result<ServiceServers, String> {
-        let mut by_event = vec![None; event_count];
-        let mut out = Vec::new();
+        let mut out = ByEvent::new(event_count);
         for (path, request, response) in services {
             let svc = prefixed(prefix, path);
             let name = super::service_name(&svc).map_err(|e| e.to_string())?;
@@ -342,33 +362,26 @@ impl ServiceServers {
                 .initial_max_slice_len(response.size())
                 .create()
                 .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
-            for e in response.events() {
-                if let Some(slot) = by_event.get_mut(e.0 as usize) {
-                    *slot = Some(out.len());
-                }
-            }
-            out.push(Served {
+            let served = Served {
                 request,
-                response,
-                server,
                 waiting: VecDeque::new(),
                 seq: 0,
                 stats: ServiceStats {
                     service: svc,
                     ..ServiceStats::default()
                 },
-            });
+                response,
+                server,
+            };
+            out.push(served.response.events(), served);
         }
-        Ok(ServiceServers {
-            by_event,
-            services: out,
-        })
+        Ok(ServiceServers { services: out })
     }
 
     /// Takes every request that arrived and queues it in `inbox` as the client's request.
     /// A malformed request is counted and gets no answer.
     pub fn poll(&mut self, inbox: &mut Inbox) {
-        for s in &mut self.services {
+        for s in &mut self.services.entries {
             while let Ok(Some(req)) = s.server.receive() {
                 match s.request.decode(req.payload()) {
                     Some((params, _seq)) => {
@@ -385,10 +398,9 @@ impl ServiceServers {
     /// Answers the oldest waiting request with `msg` if it is the model's answer to a
     /// bridged client.
     pub fn answer(&mut self, msg: &SentMessage<'_>) -> Result<(), String> {
-        let Some(Some(i)) = self.by_event.get(msg.event().0 as usize) else {
+        let Some(s) = self.services.of(msg) else {
             return Ok(());
         };
-        let s = &mut self.services[*i];
         let Some(req) = s.waiting.pop_front() else {
             return Ok(());
         };
@@ -422,7 +434,7 @@ impl ServiceServers {
     /// What each served service did so far (`requests`: from processes; `answered`: by
     /// the model).
     pub fn stats(&self) -> impl Iterator<Item = &ServiceStats> {
-        self.services.iter().map(|s| &s.stats)
+        self.services.entries.iter().map(|s| &s.stats)
     }
 }
 
