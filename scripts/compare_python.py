@@ -177,61 +177,74 @@ def interval_text(lo, hi, sep):
     return f"[{lo}{sep}{'' if hi is None else hi}]"
 
 
-def to_reelay(e, notes):
-    """Reelay's Rye syntax, fully parenthesised (no reliance on its precedence)."""
+# Each tool's syntax for the boolean and one-step operators: `{a}`/`{b}` are the
+# translated operands; a `str` under "Y"/"Z" that is not a template is why the tool
+# cannot express the operator. `temporal` translates `P`, `H` and `S`.
+REELAY = {
+    "atom": "{{{name}}}",
+    "true": "({p} or not {p})",
+    "false": "({p} and not {p})",
+    "const_note": "`true`/`false` are not Reelay keywords: written as `{p} or not {p}` / `{p} and not {p}`",
+    "not": "not ({a})",
+    "imp": "({a}) implies ({b})",
+    "Y": "pre ({a})",
+    "Z": Unsupported("Reelay has no weak yesterday `Z`"),
+}
+RTAMT = {
+    "atom": "({name} >= 0.5)",
+    "true": "(1 > 0)",
+    "false": "(0 > 1)",
+    "const_note": "`true`/`false` are not RTAMT keywords: written as `(1 > 0)` / `(0 > 1)`",
+    "not": "not({a})",
+    "imp": "({a}) -> ({b})",
+    "Y": Unsupported("RTAMT's `prev` is true at the first point (that is `Z`, not `Y`)"),
+    "Z": "prev({a})",
+}
+
+
+def translate(e, syn, temporal, notes):
+    """`e` in the syntax `syn`, fully parenthesised (no reliance on the tool's precedence)."""
     k = e[0]
-    r = lambda x: to_reelay(x, notes)
+    r = lambda x: translate(x, syn, temporal, notes)
     if k == "atom":
-        return "{" + e[1] + "}"
+        return syn["atom"].format(name=e[1])
     if k == "const":
-        notes.add("`true`/`false` are not Reelay keywords: written as `{p} or not {p}` / `{p} and not {p}`")
-        return "({p} or not {p})" if e[1] else "({p} and not {p})"
-    if k == "not":
-        return f"not ({r(e[1])})"
+        notes.add(syn["const_note"])
+        return syn["true"] if e[1] else syn["false"]
+    if k in ("not", "Y", "Z"):
+        if isinstance(syn[k], Unsupported):
+            raise syn[k]
+        return syn[k].format(a=r(e[1]))
     if k in ("and", "or"):
         return f"({r(e[1])}) {k} ({r(e[2])})"
     if k == "imp":
-        return f"({r(e[1])}) implies ({r(e[2])})"
+        return syn["imp"].format(a=r(e[1]), b=r(e[2]))
     if k == "iff":
         a, b = r(e[1]), r(e[2])
-        return f"(({a}) implies ({b})) and (({b}) implies ({a}))"
-    if k == "Y":
-        return f"pre ({r(e[1])})"
-    if k == "Z":
-        raise Unsupported("Reelay has no weak yesterday `Z`")
-    if k in ("P", "H"):
-        word = "once" if k == "P" else "historically"
-        bound = "" if (e[1], e[2]) == (0, None) else interval_text(e[1], e[2], ":")
-        return f"{word}{bound} ({r(e[3])})"
-    if k == "S":
-        bound = "" if (e[1], e[2]) == (0, None) else interval_text(e[1], e[2], ":")
-        return f"({r(e[3])}) since{bound} ({r(e[4])})"
+        return f"({syn['imp'].format(a=a, b=b)}) and ({syn['imp'].format(a=b, b=a)})"
+    if k in ("P", "H", "S"):
+        return temporal(e, r, notes)
     raise ValueError(k)
 
 
-def to_rtamt(e, notes):
-    """RTAMT past-time STL over 0/1 float signals; unbounded-above intervals rewritten."""
+def reelay_temporal(e, r, notes):
+    """Reelay's `once`, `historically` and `since`, bounds as `[lo:hi]`."""
     k = e[0]
-    r = lambda x: to_rtamt(x, notes)
-    if k == "atom":
-        return f"({e[1]} >= 0.5)"
-    if k == "const":
-        notes.add("`true`/`false` are not RTAMT keywords: written as `(1 > 0)` / `(0 > 1)`")
-        return "(1 > 0)" if e[1] else "(0 > 1)"
-    if k == "not":
-        return f"not({r(e[1])})"
-    if k in ("and", "or"):
-        return f"({r(e[1])}) {k} ({r(e[2])})"
-    if k == "imp":
-        return f"({r(e[1])}) -> ({r(e[2])})"
-    if k == "iff":
-        a, b = r(e[1]), r(e[2])
-        return f"(({a}) -> ({b})) and (({b}) -> ({a}))"
-    if k == "Y":
-        raise Unsupported("RTAMT's `prev` is true at the first point (that is `Z`, not `Y`)")
-    if k == "Z":
-        return f"prev({r(e[1])})"
-    lo, hi = e[1], e[2]
+    bound = "" if (e[1], e[2]) == (0, None) else interval_text(e[1], e[2], ":")
+    if k in ("P", "H"):
+        word = "once" if k == "P" else "historically"
+        return f"{word}{bound} ({r(e[3])})"
+    return f"({r(e[3])}) since{bound} ({r(e[4])})"
+
+
+def to_reelay(e, notes):
+    """Reelay's Rye syntax."""
+    return translate(e, REELAY, reelay_temporal, notes)
+
+
+def rtamt_temporal(e, r, notes):
+    """RTAMT's past operators; unbounded-above intervals rewritten."""
+    k, lo, hi = e[0], e[1], e[2]
     if k in ("P", "H"):
         word = "once" if k == "P" else "historically"
         body = e[3] if k == "P" else ("not", e[3])
@@ -243,16 +256,19 @@ def to_rtamt(e, notes):
                   "H[a:] f = not once[a:a](once not f) (exact with one point per tick)")
         inner = f"once[{lo}:{lo}](once({r(body)}))"
         return inner if k == "P" else f"not({inner})"
-    if k == "S":
-        a, b = r(e[3]), r(e[4])
-        if (lo, hi) == (0, None):
-            return f"({a}) since ({b})"
-        if hi is not None:
-            return f"({a}) since[{lo}:{hi}] ({b})"
-        notes.add("RTAMT has no `[a:]` bound: f S[a:] g = historically[0:a-1] f and "
-                  "once[a:a](f since g) (exact with one point per tick)")
-        return f"(historically[0:{lo - 1}]({a})) and (once[{lo}:{lo}](({a}) since ({b})))"
-    raise ValueError(k)
+    a, b = r(e[3]), r(e[4])
+    if (lo, hi) == (0, None):
+        return f"({a}) since ({b})"
+    if hi is not None:
+        return f"({a}) since[{lo}:{hi}] ({b})"
+    notes.add("RTAMT has no `[a:]` bound: f S[a:] g = historically[0:a-1] f and "
+              "once[a:a](f since g) (exact with one point per tick)")
+    return f"(historically[0:{lo - 1}]({a})) and (once[{lo}:{lo}](({a}) since ({b})))"
+
+
+def to_rtamt(e, notes):
+    """RTAMT past-time STL over 0/1 float signals."""
+    return translate(e, RTAMT, rtamt_temporal, notes)
 
 
 # ---------------------------------------------------------------------------
