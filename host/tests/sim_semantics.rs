@@ -472,17 +472,33 @@ fn quiescence_can_keep_time_running_like_scan() {
 }
 
 #[test]
-fn trace_csv() {
+fn trace_rows_name_event_origin_target_and_params() {
     let m = model("ping_pong");
     let (_, rec) = run(&m, 1, &RunConfig::default());
-    let mut out = Vec::new();
-    rec.write_csv(&m, &mut out).unwrap();
-    let text = String::from_utf8(out).unwrap();
-    let lines: Vec<&str> = text.lines().collect();
-    assert_eq!(lines[0], "time,event,origin,target,params");
-    assert_eq!(lines[1], "0,ping,Ping,Pong,n=0");
-    assert_eq!(lines[2], "0,pong,Pong,Ping,n=1");
-    assert_eq!(lines.last(), Some(&"0,finished,Ping,NONE,n=10"));
+    let row = |r: &hindsight::sim::TraceRow| {
+        let target = r.target.map_or("NONE", |t| m.machine_name(t));
+        let params: Vec<String> = r.params.iter().map(|v| format!("{v:?}")).collect();
+        (
+            r.time,
+            m.event_name(r.event).to_string(),
+            m.machine_name(r.origin).to_string(),
+            target.to_string(),
+            params.join(";"),
+        )
+    };
+    let rows: Vec<_> = rec.rows.iter().map(row).collect();
+    let want = |e: &str, o: &str, t: &str, n: i64| {
+        (
+            0,
+            e.to_string(),
+            o.to_string(),
+            t.to_string(),
+            format!("Int({n})"),
+        )
+    };
+    assert_eq!(rows[0], want("ping", "Ping", "Pong", 0));
+    assert_eq!(rows[1], want("pong", "Pong", "Ping", 1));
+    assert_eq!(rows.last(), Some(&want("finished", "Ping", "NONE", 10)));
 }
 
 #[test]

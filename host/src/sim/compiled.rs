@@ -157,7 +157,6 @@ pub(crate) struct EventDef {
     pub name_str: StrId,
     pub params: Vec<(String, Ty)>,
     pub defaults: Vec<Cell>,
-    pub senders: Vec<u32>,
     pub receivers: Vec<u32>,
 }
 
@@ -310,14 +309,6 @@ impl CompiledModel {
             path.pop();
         }
         false
-    }
-
-    /// Machines that send event `e` (`<send>` or `<raise>`).
-    pub fn event_senders(&self, e: EventId) -> impl Iterator<Item = MachineId> + '_ {
-        self.events
-            .get(e.0 as usize)
-            .into_iter()
-            .flat_map(|d| d.senders.iter().map(|&m| MachineId(m)))
     }
 
     /// Machines with a transition on event `e`.
@@ -486,7 +477,6 @@ impl<'s> Builder<'s> {
                         .collect(),
                     params,
                     name: e.name.clone(),
-                    senders: e.senders.iter().copied().collect(),
                     receivers: e.receivers.iter().copied().collect(),
                 }
             })

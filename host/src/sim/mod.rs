@@ -12,8 +12,8 @@
 //!    calls an [`Observer`] at every trace point. Runs reuse every buffer:
 //!    a run in steady state does not allocate.
 //! 3. [`TraceRecorder`] is an observer that keeps the message trace (time,
-//!    event, origin, target, parameters) and writes it as CSV; it costs
-//!    nothing when not used.
+//!    event, origin, target, parameters) for tests and tools; it costs
+//!    nothing when not used (`verify --record` writes the CSV a replay reads).
 //!
 //! # Semantics (SCAN's channel system)
 //!
