@@ -116,6 +116,7 @@ use monitor_core::layout::{self, SinceKind};
 use monitor_core::{Instr, Monitor, Op, Program, TableError, Ty, Value, VarKind};
 
 mod atoms;
+mod fixed;
 mod names;
 mod out;
 
@@ -484,106 +485,11 @@ impl Emitter<'_, '_> {
     }
 
     fn error(&mut self) {
-        let o = &mut self.out;
-        o.line("");
-        o.doc("Why a point was not judged; the monitor is unchanged when this is returned.");
-        o.line("#[derive(Clone, Copy, Debug, PartialEq, Eq)]");
-        o.open("pub enum StepError {");
-        o.doc("The point's timestamp is earlier than the previous point's.");
-        o.open("TimeWentBackwards {");
-        o.doc("Timestamp of the previous point.");
-        o.line("last: u64,");
-        o.doc("The rejected timestamp.");
-        o.line("now: u64,");
-        o.close("},");
-        o.doc("`u64::MAX` is reserved and cannot be a timestamp.");
-        o.line("TimeOutOfRange,");
-        o.doc("Integer overflow or division by zero while computing an atom.");
-        o.open("Arithmetic {");
-        o.doc("Index of the atom.");
-        o.line("atom: u16,");
-        o.close("},");
-        o.close("}");
-        o.line("");
-        o.open("impl core::fmt::Display for StepError {");
-        o.open("fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {");
-        o.open("match self {");
-        o.open("StepError::TimeWentBackwards { last, now } => {");
-        o.line("write!(f, \"timestamp {now} is before the previous point's {last}\")");
-        o.close("}");
-        o.line("StepError::TimeOutOfRange => write!(f, \"timestamp u64::MAX is reserved\"),");
-        o.open("StepError::Arithmetic { atom } => {");
-        o.line("write!(f, \"atom {atom}: integer overflow or division by zero\")");
-        o.close("}");
-        o.close("}");
-        o.close("}");
-        o.close("}");
-        o.line("");
-        o.line("impl core::error::Error for StepError {}");
+        self.out.block(fixed::STEP_ERROR);
     }
 
     fn window(&mut self) {
-        let o = &mut self.out;
-        o.line("");
-        o.doc("Witnesses of an `S[LO:HI]` at timestamps `first..=last`, gaps at most `HI - LO`.");
-        o.line("#[derive(Clone, Copy, Debug)]");
-        o.open("struct Run {");
-        o.line("first: u64,");
-        o.line("last: u64,");
-        o.close("}");
-        o.line("");
-        o.doc("State of `f S[LO:HI] g` with `0 < LO <= HI`: a ring of at most `N` runs,");
-        o.doc("oldest at `head`; `N` is the most runs that can be live at once.");
-        o.line("#[derive(Clone, Copy, Debug)]");
-        o.open("struct Window<const N: usize, const LO: u64, const HI: u64> {");
-        o.line("head: u32,");
-        o.line("len: u32,");
-        o.line("runs: [Run; N],");
-        o.close("}");
-        o.line("");
-        o.open("impl<const N: usize, const LO: u64, const HI: u64> Window<N, LO, HI> {");
-        o.doc("Checked when compiled: the bounds and capacity are valid.");
-        o.line("const VALID: () = assert!(N > 0 && N <= u32::MAX as usize && LO > 0 && LO <= HI);");
-        o.line(
-            "const EMPTY: Self = Window { head: 0, len: 0, runs: [Run { first: 0, last: 0 }; N] };",
-        );
-        o.line("");
-        o.line("#[inline(always)]");
-        o.open("fn clear(&mut self) {");
-        o.line("self.head = 0;");
-        o.line("self.len = 0;");
-        o.close("}");
-        o.line("");
-        o.doc("One point at time `t` with `f` and `g`; true when a witness lies in `[t - HI, t - LO]`.");
-        o.line("#[inline(always)]");
-        o.open("fn step(&mut self, t: u64, f: bool, g: bool) -> bool {");
-        o.line("let () = Self::VALID;");
-        o.line("let mut head = self.head as usize % N;");
-        o.line("let mut len = if f { self.len as usize } else { 0 };");
-        o.line("// Expire runs whose last witness is older than t - HI.");
-        o.open("while len > 0 && self.runs[head % N].last.saturating_add(HI) < t {");
-        o.line("head = if head + 1 >= N { 0 } else { head + 1 };");
-        o.line("len -= 1;");
-        o.close("}");
-        o.open("if len == 0 {");
-        o.line("head = 0;");
-        o.close("}");
-        o.open("if g {");
-        o.line("let newest = head.wrapping_add(len).wrapping_add(N - 1) % N;");
-        o.open("if len > 0 && t.wrapping_sub(self.runs[newest].last) <= HI - LO {");
-        o.line("self.runs[newest].last = t;");
-        o.close("} else if len < N {");
-        o.depth += 1;
-        o.line("self.runs[head.wrapping_add(len) % N] = Run { first: t, last: t };");
-        o.line("len += 1;");
-        o.close("}");
-        o.line("// len == N cannot happen: at most N runs are ever live at once.");
-        o.close("}");
-        o.line("self.head = head as u32;");
-        o.line("self.len = len as u32;");
-        o.line("len > 0 && self.runs[head % N].first.saturating_add(LO) <= t");
-        o.close("}");
-        o.close("}");
+        self.out.block(fixed::WINDOW);
     }
 
     fn monitor(&mut self) {

@@ -17,6 +17,13 @@ impl Out {
         self.buf.push('\n');
     }
 
+    /// Every line of `text`, each indented to the current depth (blank lines stay blank).
+    pub(super) fn block(&mut self, text: &str) {
+        for l in text.lines() {
+            self.line(l);
+        }
+    }
+
     pub(super) fn open(&mut self, s: &str) {
         self.line(s);
         self.depth += 1;
