@@ -510,19 +510,6 @@ impl<M> Diagnostic<M> {
         Self::error(file, (0, 0), message)
     }
 
-    /// An error at byte `offset` of `text`, the whole text of `file` indexed by
-    /// `index`: the position and the caret both come from the offset.
-    pub fn in_text(
-        file: impl Into<String>,
-        text: &str,
-        index: &LineIndex,
-        offset: usize,
-        message: M,
-    ) -> Self {
-        Self::error(file, index.line_col(text, offset), message)
-            .with_snippet(Snippet::of(text, offset, offset))
-    }
-
     /// The same problem showing `snippet` under its first line.
     pub fn with_snippet(mut self, snippet: Snippet) -> Self {
         self.source_line = snippet.line;
@@ -795,6 +782,10 @@ mod tests {
         };
         assert_eq!(at(file, 7), ("a.scxml".into(), 2, 4));
         assert_eq!(at(file, 99), ("a.scxml".into(), 3, 2));
+        assert_eq!(
+            sm.diag(file.at(8), "m").to_string(),
+            "a.scxml:3:1: m\n    x\n    ^"
+        );
         assert_eq!(at(piece, 2), ("m.xml".into(), 4, 5));
         // After the two-byte `é`: columns count characters.
         assert_eq!(at(piece, 4), ("m.xml".into(), 4, 6));
