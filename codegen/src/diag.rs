@@ -4,6 +4,12 @@
 //! models, property files) share with the formula compiler, so positions are
 //! computed and problems are printed in one place:
 //!
+//! - a [`SourceMap`] holds every text that positions point into, each a [`Source`]
+//!   with its file: a whole file a reader read (a model's SCXML, a `.msg`, a
+//!   `.hspec`) or a piece of text placed inside a file (a formula from an XML
+//!   attribute, at the [`crate::Origin`] of its first character). A [`Span`] is a
+//!   byte range in one source ([`FileId`]); [`Source::line_col`] is the one way a
+//!   byte offset becomes the file's line and column;
 //! - [`LineIndex`] turns a byte offset of a text into a 1-based line and a column
 //!   counted in characters, and gives the line's text for the caret;
 //! - [`PositionRun`]s map text that is not a verbatim copy of its file (a formula
@@ -13,18 +19,16 @@
 //!   kind (the property reader's), rendered the same way whatever the payload;
 //!   [`Diagnostics`] collects them in the order found.
 //!
-//! Inside the compiler every parsed node keeps a [`Span`]: a byte range in one
-//! source of a [`SourceMap`]. A source is either a whole `.hspec` file (line 1,
-//! column 1) or a piece of text that starts somewhere inside another file, such as
-//! a formula taken from an XML attribute: its [`crate::Origin`] gives the file,
-//! line and column of its first character, so positions point into that file.
-//! Passes collect problems instead of stopping at the first one and hand back a
-//! [`Diagnostics`]: located, already rendered, independent of the sources.
+//! Spans are 12 bytes; a line and column are computed only when a diagnostic is
+//! made. Inside the compiler every parsed node keeps a span; passes collect problems
+//! instead of stopping at the first one and hand back [`Diagnostics`]: located,
+//! already rendered, independent of the sources.
 
 use std::fmt;
+use std::path::{Path, PathBuf};
 
-/// A byte range `lo..hi` in source number `source` of a [`SourceMap`]: the one span
-/// type of the project (in `host`, `source` is a file of the model's source map).
+/// A byte range `lo..hi` in source number `source` (a [`FileId`]) of a [`SourceMap`]:
+/// the one span type of the project.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub struct Span {
     /// Index of the source in its [`SourceMap`].
@@ -69,25 +73,10 @@ impl Span {
 pub struct Location {
     /// File name as given to the parser.
     pub file: String,
-    /// 1-based line.
+    /// 1-based line (0 for a span whose source is not in the map).
     pub line: u32,
-    /// 1-based column, counted in characters.
+    /// 1-based column, counted in characters (0 when `line` is).
     pub col: u32,
-}
-
-#[derive(Clone, Debug)]
-struct Source {
-    name: String,
-    text: String,
-    line: u32,
-    col: u32,
-    /// `false` for text synthesised from structured input: every position in it
-    /// resolves to the origin itself, since its columns do not exist in the file.
-    exact: bool,
-    /// A position map, when the text is not a verbatim copy of the file from
-    /// `line`:`col` on (a formula after XML entities, or one generated from a tree):
-    /// sorted by offset, the first at 0. Empty: count forward from `line`:`col`.
-    runs: Vec<PositionRun>,
 }
 
 /// Where a run of a source's text comes from in its file: the map that keeps every
@@ -106,29 +95,142 @@ pub struct PositionRun {
     pub exact: bool,
 }
 
-/// The texts that spans point into, with where each starts in its file.
+/// Index of a source in a [`SourceMap`] (a span's `source`): in `host` a file the
+/// model reader read, in the compiler a `.hspec` file or a piece of one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct FileId(pub u32);
+
+impl FileId {
+    /// The source that `span` is in.
+    pub fn of(span: Span) -> FileId {
+        FileId(span.source)
+    }
+
+    /// The empty span at byte `offset` of this source.
+    pub fn at(self, offset: u32) -> Span {
+        Span::at(self.0, offset)
+    }
+}
+
+/// One text that spans point into, and where it is in its file: either a whole file
+/// (its first character at line 1, column 1) or a piece of text placed somewhere
+/// inside a file, such as a formula taken from an XML attribute.
+#[derive(Clone, Debug)]
+pub struct Source {
+    path: PathBuf,
+    text: String,
+    /// Where lines start in `text`: line and column inside the text, in O(log lines).
+    lines: LineIndex,
+    place: Place,
+}
+
+/// Where a source's text sits in its file.
+#[derive(Clone, Debug)]
+struct Place {
+    /// 1-based line and column of the text's first character.
+    line: u32,
+    col: u32,
+    /// `false` for text synthesised from structured input: every position in it
+    /// resolves to `line`:`col`, since its columns do not exist in the file.
+    exact: bool,
+    /// A position map, when the text is not a verbatim copy of the file from
+    /// `line`:`col` on (a formula after XML entities, or one generated from a tree):
+    /// sorted by offset, the first at 0. Empty: count forward from `line`:`col`.
+    runs: Vec<PositionRun>,
+}
+
+impl Place {
+    /// A whole file.
+    const WHOLE: Place = Place {
+        line: 1,
+        col: 1,
+        exact: true,
+        runs: Vec::new(),
+    };
+}
+
+impl Source {
+    /// The file the text is (in), as given to the reader.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The source's text.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// 1-based line and column (in characters) in the file of byte `offset` of the
+    /// text, clamped to it; an offset inside a multi-byte character counts as that
+    /// character. The one way a position is computed, for files and pieces alike.
+    pub fn line_col(&self, offset: u32) -> (u32, u32) {
+        let text = self.text.as_str();
+        let at = floor_boundary(text, offset as usize);
+        let place = &self.place;
+        if let Some(mapped) = locate_in_runs(text, &place.runs, at) {
+            return mapped;
+        }
+        if !place.exact {
+            return (place.line, place.col);
+        }
+        let (line, col) = self.lines.line_col(text, at);
+        if line == 1 {
+            (place.line, place.col.saturating_add(col - 1))
+        } else {
+            (place.line.saturating_add(line - 1), col)
+        }
+    }
+}
+
+/// The texts that spans point into, with where each is in its file: every file a
+/// reader read, and every piece of text the compiler parsed.
 #[derive(Clone, Debug, Default)]
 pub struct SourceMap {
     sources: Vec<Source>,
 }
 
 impl SourceMap {
-    /// Adds a source whose first character is at `line`:`col` of file `name`.
-    /// `exact == false` marks synthesised text (see [`Location`]).
-    pub(crate) fn add(&mut self, name: &str, text: &str, line: u32, col: u32, exact: bool) -> u32 {
+    /// An empty map.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    fn push(&mut self, path: PathBuf, text: String, place: Place) -> FileId {
         self.sources.push(Source {
-            name: name.to_string(),
-            text: text.to_string(),
+            path,
+            lines: LineIndex::new(&text),
+            text,
+            place,
+        });
+        FileId(u32::try_from(self.sources.len() - 1).unwrap_or(u32::MAX))
+    }
+
+    /// Adds the whole text of the file at `path` and returns its id.
+    pub fn add(&mut self, path: impl Into<PathBuf>, text: String) -> FileId {
+        self.push(path.into(), text, Place::WHOLE)
+    }
+
+    /// Adds a piece of text whose first character is at `line`:`col` of file `name`.
+    /// `exact == false` marks synthesised text (every position in it is `line`:`col`).
+    pub(crate) fn add_piece(
+        &mut self,
+        name: &str,
+        text: &str,
+        line: u32,
+        col: u32,
+        exact: bool,
+    ) -> u32 {
+        let place = Place {
             line: line.max(1),
             col: col.max(1),
             exact,
             runs: Vec::new(),
-        });
-        (self.sources.len() - 1) as u32
+        };
+        self.push(name.into(), text.to_string(), place).0
     }
 
-    /// Adds a source whose positions come from the map `runs` (see [`PositionRun`]);
-    /// with no runs, it starts at `line`:`col` like [`SourceMap::add`].
+    /// Adds a piece whose positions come from the map `runs` (see [`PositionRun`]);
+    /// with no runs, it starts at `line`:`col` like [`SourceMap::add_piece`].
     pub(crate) fn add_mapped(
         &mut self,
         name: &str,
@@ -136,18 +238,30 @@ impl SourceMap {
         (line, col): (u32, u32),
         runs: &[PositionRun],
     ) -> u32 {
-        let id = self.add(name, text, line, col, true);
         let mut runs = runs.to_vec();
         runs.sort_by_key(|r| r.offset);
-        if let Some(src) = self.sources.last_mut() {
-            src.runs = runs;
-        }
-        id
+        let place = Place {
+            line: line.max(1),
+            col: col.max(1),
+            exact: true,
+            runs,
+        };
+        self.push(name.into(), text.to_string(), place).0
+    }
+
+    /// The source with this id.
+    pub fn source(&self, id: FileId) -> Option<&Source> {
+        self.sources.get(id.0 as usize)
+    }
+
+    /// All sources, in the order they were added.
+    pub fn sources(&self) -> &[Source] {
+        &self.sources
     }
 
     /// The text of source `id`.
     pub fn text(&self, id: u32) -> Option<&str> {
-        self.sources.get(id as usize).map(|s| s.text.as_str())
+        self.source(FileId(id)).map(Source::text)
     }
 
     /// The source text a span covers (empty for a span that does not resolve).
@@ -157,59 +271,52 @@ impl SourceMap {
             .unwrap_or("")
     }
 
-    /// File, line and column of the start of `span`.
+    /// File, line and column of the start of `span` (line and column 0 when its
+    /// source is not in the map).
     pub fn locate(&self, span: Span) -> Location {
-        self.resolve(span).0
-    }
-
-    /// Location plus the source line, the caret's 0-based character column in it and its length.
-    fn resolve(&self, span: Span) -> (Location, Option<Snippet>) {
-        let Some(src) = self.sources.get(span.source as usize) else {
-            let loc = Location {
-                file: "<unknown>".into(),
-                line: 1,
-                col: 1,
-            };
-            return (loc, None);
-        };
-        let text = src.text.as_str();
-        let lo = floor_boundary(text, span.lo as usize);
-        let snippet = Snippet::of(text, lo, span.hi as usize);
-        let (line, col) = if let Some(at) = locate_in_runs(text, &src.runs, lo) {
-            at
-        } else if src.exact {
-            let newlines = text[..lo].matches('\n').count() as u32;
-            let col = if newlines == 0 {
-                src.col.saturating_add(snippet.caret_col as u32)
-            } else {
-                snippet.caret_col as u32 + 1
-            };
-            (src.line.saturating_add(newlines), col)
-        } else {
-            (src.line, src.col)
-        };
-        let loc = Location {
-            file: src.name.clone(),
-            line,
-            col,
-        };
-        (loc, Some(snippet))
-    }
-
-    /// Renders one problem at `span`.
-    pub(crate) fn diagnostic(&self, severity: Severity, span: Span, message: String) -> Diagnostic {
-        let (loc, snippet) = self.resolve(span);
-        let snippet = snippet.unwrap_or_default();
-        Diagnostic {
-            severity,
-            message,
-            file: loc.file,
-            line: loc.line,
-            col: loc.col,
-            source_line: snippet.line,
-            caret_col: snippet.caret_col,
-            caret_len: snippet.caret_len,
+        match self.source(FileId::of(span)) {
+            Some(src) => {
+                let (line, col) = src.line_col(span.lo);
+                Location {
+                    file: src.path.display().to_string(),
+                    line,
+                    col,
+                }
+            }
+            None => Location {
+                file: UNKNOWN.into(),
+                line: 0,
+                col: 0,
+            },
         }
+    }
+
+    /// Renders one problem at `span`, carets under the span (cut at its line's end);
+    /// a problem about the whole of an `<unknown>` file when the span's source is
+    /// not in the map.
+    pub fn diagnostic(&self, severity: Severity, span: Span, message: String) -> Diagnostic {
+        let Some(src) = self.source(FileId::of(span)) else {
+            let mut d = Diagnostic::about_file(UNKNOWN, message);
+            d.severity = severity;
+            return d;
+        };
+        let Location { file, line, col } = self.locate(span);
+        let mut d = Diagnostic::error(file, (line, col), message).with_snippet(Snippet::of(
+            &src.text,
+            span.lo as usize,
+            span.hi as usize,
+        ));
+        d.severity = severity;
+        d
+    }
+
+    /// An error at the start of `span`, one caret under it.
+    pub fn diag(&self, span: Span, message: impl Into<String>) -> Diagnostic {
+        self.diagnostic(
+            Severity::Error,
+            Span::at(span.source, span.lo),
+            message.into(),
+        )
     }
 
     /// Renders every collected problem.
@@ -222,6 +329,9 @@ impl SourceMap {
         )
     }
 }
+
+/// The file name of a span whose source is not in its map.
+const UNKNOWN: &str = "<unknown>";
 
 /// The file position (line, column) of byte `at` of `text`, whose position map is
 /// `runs` (sorted by offset; an offset before the first run counts in the first run);
@@ -398,19 +508,6 @@ impl<M> Diagnostic<M> {
     /// An error about the whole file `file` (it cannot be read, it is missing, ...).
     pub fn about_file(file: impl Into<String>, message: M) -> Self {
         Self::error(file, (0, 0), message)
-    }
-
-    /// An error at byte `offset` of `text`, the whole text of `file` indexed by
-    /// `index`: the position and the caret both come from the offset.
-    pub fn in_text(
-        file: impl Into<String>,
-        text: &str,
-        index: &LineIndex,
-        offset: usize,
-        message: M,
-    ) -> Self {
-        Self::error(file, index.line_col(text, offset), message)
-            .with_snippet(Snippet::of(text, offset, offset))
     }
 
     /// The same problem showing `snippet` under its first line.
@@ -645,7 +742,9 @@ mod tests {
         let text = "<a>\n  <b x=\"1\"/>\r\n</a>";
         let index = LineIndex::new(text);
         let at = text.find("x=").unwrap();
-        let d = Diagnostic::in_text("m.xml", text, &index, at, "bad `x`");
+        let mut sm = SourceMap::new();
+        let file = sm.add("m.xml", text.to_string());
+        let d = sm.diag(file.at(at as u32).to(file.at(at as u32 + 3)), "bad `x`");
         assert_eq!(
             d.to_string(),
             "m.xml:2:6: bad `x`\n      <b x=\"1\"/>\n         ^"
@@ -661,6 +760,58 @@ mod tests {
         let kind = d.map(|m| m.len());
         assert_eq!(kind.message, 7);
         assert_eq!((kind.line, kind.col), (2, 6));
+    }
+
+    #[test]
+    fn one_map_for_whole_files_and_placed_pieces() {
+        let mut sm = SourceMap::new();
+        let file = sm.add("a.scxml", "ab\ncdé\nx".to_string());
+        // A formula from an attribute at 4:3 of `m.xml`, continued on the next line.
+        let piece = FileId(sm.add_piece("m.xml", "p é\n  q", 4, 3, true));
+        let made = FileId(sm.add_piece("m.xml", "event e;", 9, 5, false));
+        let runs = [PositionRun {
+            offset: 0,
+            line: 2,
+            col: 7,
+            exact: true,
+        }];
+        let mapped = FileId(sm.add_mapped("m.xml", "a < b", (1, 1), &runs));
+        let at = |id: FileId, k: u32| {
+            let l = sm.locate(id.at(k));
+            (l.file, l.line, l.col)
+        };
+        assert_eq!(at(file, 7), ("a.scxml".into(), 2, 4));
+        assert_eq!(at(file, 99), ("a.scxml".into(), 3, 2));
+        assert_eq!(
+            sm.diag(file.at(8), "m").to_string(),
+            "a.scxml:3:1: m\n    x\n    ^"
+        );
+        assert_eq!(at(piece, 2), ("m.xml".into(), 4, 5));
+        // After the two-byte `é`: columns count characters.
+        assert_eq!(at(piece, 4), ("m.xml".into(), 4, 6));
+        assert_eq!(at(piece, 7), ("m.xml".into(), 5, 3));
+        assert_eq!(at(made, 6), ("m.xml".into(), 9, 5));
+        assert_eq!(at(mapped, 4), ("m.xml".into(), 2, 11));
+        assert_eq!(sm.sources().len(), 4);
+        assert_eq!(sm.source(piece).map(|s| s.line_col(2)), Some((4, 5)));
+        // One rendering: carets under the span for the compiler, one caret for `diag`.
+        let q = piece.at(7).to(piece.at(8));
+        assert_eq!(
+            sm.diagnostic(Severity::Warning, q, "unused".into())
+                .to_string(),
+            "m.xml:5:3: warning: unused\n      q\n      ^"
+        );
+        let word = file.at(3).to(file.at(7));
+        assert_eq!(
+            sm.diagnostic(Severity::Error, word, "m".into()).caret_len,
+            3
+        );
+        assert_eq!(sm.diag(word, "m").caret_len, 1);
+        // A span of no source in the map is about an unknown file, with no position.
+        let lost = sm.diag(FileId(9).at(0), "gone");
+        assert_eq!(lost.to_string(), "<unknown>: gone");
+        assert_eq!(sm.locate(FileId(9).at(0)).line, 0);
+        assert_eq!(sm.slice(word), "cdé");
     }
 
     #[test]

@@ -60,7 +60,8 @@ mod syntax;
 
 pub use compile::{Compiled, PropertyInfo};
 pub use diag::{
-    Diagnostic, Diagnostics, LineIndex, Location, PositionRun, Severity, Snippet, SourceMap, Span,
+    Diagnostic, Diagnostics, FileId, LineIndex, Location, PositionRun, Severity, Snippet, Source,
+    SourceMap, Span,
 };
 pub use lower::Limits;
 pub use spec::{

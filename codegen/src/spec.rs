@@ -134,7 +134,7 @@ impl Spec<Parsed> {
     /// Parses a `.hspec` text; `file` names it in diagnostics.
     pub fn parse(src: &str, file: &str) -> Result<Spec<Parsed>, Diagnostics> {
         let mut sources = SourceMap::default();
-        let id = sources.add(file, src, 1, 1, true);
+        let id = sources.add(file, src.to_string()).0;
         let mut sink = Sink::default();
         let syntax = parse::parse_spec(src, id, &mut sink);
         Self::parsed(sources, sink, syntax)
@@ -163,7 +163,7 @@ impl Spec<Parsed> {
             ..SpecSyntax::default()
         };
         if let Some((text, o)) = &input.unit {
-            let id = sources.add(&o.file, text, o.line, o.col, true);
+            let id = sources.add_piece(&o.file, text, o.line, o.col, true);
             if let Some(t) = parse::parse_time(text, id, &mut sink) {
                 syntax.units.push(t);
             }
@@ -177,7 +177,7 @@ impl Spec<Parsed> {
                 },
             };
             let o = &d.origin;
-            let id = sources.add(&o.file, &text, o.line, o.col, false);
+            let id = sources.add_piece(&o.file, &text, o.line, o.col, false);
             if let Some(decl) = parse::parse_decl(&text, id, &mut sink) {
                 syntax.decls.push(decl);
             }

@@ -723,8 +723,12 @@ fn discovery_from_a_relative_path() {
             ("ros_fields__is_ok".to_string(), "bool".to_string())
         ]
     );
-    assert!(sm.files().iter().all(|f| f.path().is_relative()));
-    assert_eq!(sm.files().len(), 44, "every file of ros_support_interfaces");
+    assert!(sm.sources().iter().all(|f| f.path().is_relative()));
+    assert_eq!(
+        sm.sources().len(),
+        44,
+        "every file of ros_support_interfaces"
+    );
 }
 
 /// A deep diamond of messages (2^20 leaves) is refused quickly, not expanded; one nested

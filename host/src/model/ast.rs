@@ -18,7 +18,7 @@ pub struct Ident {
 /// An expression's source text (unescaped) and the span of its raw attribute value.
 ///
 /// Offset `k` in `text` maps back to the file with
-/// [`super::SourceMap::unescaped_offset`].
+/// [`super::source::unescaped_offset`].
 #[derive(Clone, Debug)]
 pub struct SrcExpr {
     /// Unescaped ECMAScript text.

@@ -1,7 +1,7 @@
 //! Reads one `.scxml` file (the flat subset SCAN accepts) into a [`Machine`], collecting every error.
 
 use super::ast::*;
-use super::source::{Diagnostic, FileId, SourceMap, Span};
+use super::source::{unescaped_offset, Diagnostic, FileId, SourceMap, Span};
 use super::types::{parse_type_comment, TypeAnn, TypeExpr};
 use super::xml::{self, Element, Node};
 
@@ -132,7 +132,7 @@ impl Reader<'_> {
             None => {
                 let stem = self
                     .sm
-                    .file(file)
+                    .source(file)
                     .and_then(|f| f.path().file_stem())
                     .map(|s| s.to_string_lossy().into_owned())
                     .unwrap_or_default();
@@ -418,7 +418,7 @@ impl Reader<'_> {
                     if !part.trim().is_empty() {
                         v.push(Ident {
                             name: part.trim().to_string(),
-                            span: self.sm.unescaped_offset(a.value_span, off),
+                            span: unescaped_offset(self.sm, a.value_span, off),
                         });
                     }
                     off += part.len() as u32 + 1;

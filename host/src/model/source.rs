@@ -1,141 +1,50 @@
-//! Source files, byte spans and diagnostics: every error about a model points at a file, line and column.
+//! What reading XML adds to the source foundation: the entity decoder and the map
+//! from an unescaped attribute value back to its file.
 //!
-//! The model reader keeps the text of every file it read in a [`SourceMap`];
-//! parsed items carry a [`Span`] (codegen's: a byte range whose `source` is the file's
-//! [`FileId`]). Line and column are computed only when a [`Diagnostic`] is made, so
-//! spans cost 12 bytes. Spans, lines, columns, the diagnostic and its rendering are
-//! codegen's ([`codegen::diag`]), the one source foundation of every reader.
+//! The model reader keeps the text of every file it read in codegen's [`SourceMap`]
+//! (the project's one, shared with the formula compiler); parsed items carry a
+//! [`Span`] whose `source` is the file's [`FileId`]. Line and column are computed only
+//! when a [`Diagnostic`] is made. Spans, lines, columns, the diagnostic and its
+//! rendering are codegen's ([`codegen::diag`]); they are re-exported here so the
+//! readers name one module.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use codegen::diag::LineIndex;
-
-/// An error (or warning) about a model is the project's one diagnostic (line 0: about a
-/// whole file, such as a missing one); one or more of them, [`Diagnostics`], are the
-/// error type of loading and compiling a model.
-pub use codegen::diag::{Diagnostic, Diagnostics};
+/// The map of every file read for a model, its ids and spans, and the project's one
+/// diagnostic: an error (or warning) about a model (line 0: about a whole file, such
+/// as a missing one); one or more of them, [`Diagnostics`], are the error type of
+/// loading and compiling a model.
+pub use codegen::diag::{Diagnostic, Diagnostics, FileId, SourceMap, Span};
 
 /// A diagnostic about the whole file at `path` (no line or column).
 pub fn about_file(path: impl AsRef<Path>, message: impl Into<String>) -> Diagnostic {
     Diagnostic::about_file(path.as_ref().display().to_string(), message.into())
 }
 
-/// Index of a file in a [`SourceMap`] (a span's `source`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct FileId(pub u32);
-
-impl FileId {
-    /// The file that `span` is in.
-    pub fn of(span: Span) -> FileId {
-        FileId(span.source)
-    }
-
-    /// The empty span at byte `offset` of this file.
-    pub fn at(self, offset: u32) -> Span {
-        Span::at(self.0, offset)
-    }
-}
-
-/// A position or byte range in a source file: the project's one span type, codegen's
-/// ([`codegen::diag::Span`]); its `source` is the file's [`FileId`].
-pub use codegen::diag::Span;
-
-/// One source file: its path, text and the byte offsets where lines start.
-#[derive(Clone, Debug)]
-pub struct SourceFile {
-    path: PathBuf,
-    text: String,
-    lines: LineIndex,
-}
-
-impl SourceFile {
-    /// The file's path as given to the reader.
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
-
-    /// The file's full text.
-    pub fn text(&self) -> &str {
-        &self.text
-    }
-
-    /// 1-based line and column (in characters) of a byte offset.
-    pub fn line_col(&self, offset: u32) -> (u32, u32) {
-        self.lines.line_col(&self.text, offset as usize)
-    }
-}
-
-/// Every file read for a model, so that spans can be turned into line and column.
-#[derive(Clone, Debug, Default)]
-pub struct SourceMap {
-    files: Vec<SourceFile>,
-}
-
-impl SourceMap {
-    /// An empty map.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Adds a file's text and returns its id.
-    pub fn add(&mut self, path: impl Into<PathBuf>, text: String) -> FileId {
-        self.files.push(SourceFile {
-            path: path.into(),
-            lines: LineIndex::new(&text),
-            text,
-        });
-        FileId(self.files.len() as u32 - 1)
-    }
-
-    /// The file with this id.
-    pub fn file(&self, id: FileId) -> Option<&SourceFile> {
-        self.files.get(id.0 as usize)
-    }
-
-    /// All files, in the order they were added.
-    pub fn files(&self) -> &[SourceFile] {
-        &self.files
-    }
-
-    /// A diagnostic at `span` with `message`.
-    pub fn diag(&self, span: Span, message: impl Into<String>) -> Diagnostic {
-        match self.file(FileId::of(span)) {
-            Some(f) => Diagnostic::in_text(
-                f.path.display().to_string(),
-                &f.text,
-                &f.lines,
-                span.lo as usize,
-                message.into(),
-            ),
-            None => about_file("<unknown>", message),
-        }
-    }
-
-    /// The span of byte `k` of an attribute value whose raw (escaped) text starts at `span`.
-    ///
-    /// Expressions are parsed from the unescaped value; this maps an offset in
-    /// the unescaped text back to the file (`&amp;` counts as one character).
-    pub fn unescaped_offset(&self, span: Span, k: u32) -> Span {
-        let Some(f) = self.file(FileId::of(span)) else {
-            return span;
+/// The span of byte `k` of an attribute value whose raw (escaped) text starts at `span`.
+///
+/// Expressions are parsed from the unescaped value; this maps an offset in
+/// the unescaped text back to the file (`&amp;` counts as one character).
+pub fn unescaped_offset(sm: &SourceMap, span: Span, k: u32) -> Span {
+    let Some(f) = sm.source(FileId::of(span)) else {
+        return span;
+    };
+    let raw = f.text();
+    let mut raw_pos = floor_boundary(raw, span.lo as usize);
+    let mut out = 0u32;
+    while out < k && raw_pos < raw.len() {
+        let rest = &raw[raw_pos..];
+        let (produced, consumed) = match reference(rest) {
+            Some(Ok((c, consumed))) => (c.len_utf8(), consumed),
+            _ => {
+                let c = rest.chars().next().map_or(1, char::len_utf8);
+                (c, c)
+            }
         };
-        let raw = f.text.as_str();
-        let mut raw_pos = floor_boundary(raw, span.lo as usize);
-        let mut out = 0u32;
-        while out < k && raw_pos < raw.len() {
-            let rest = &raw[raw_pos..];
-            let (produced, consumed) = match reference(rest) {
-                Some(Ok((c, consumed))) => (c.len_utf8(), consumed),
-                _ => {
-                    let c = rest.chars().next().map_or(1, char::len_utf8);
-                    (c, c)
-                }
-            };
-            out = out.saturating_add(produced as u32);
-            raw_pos += consumed;
-        }
-        FileId::of(span).at(raw_pos as u32)
+        out = out.saturating_add(produced as u32);
+        raw_pos += consumed;
     }
+    FileId::of(span).at(raw_pos as u32)
 }
 
 fn floor_boundary(text: &str, mut i: usize) -> usize {
@@ -151,7 +60,7 @@ fn floor_boundary(text: &str, mut i: usize) -> usize {
 /// when `rest` does not start with `&`. The one scanner of references, used by the
 /// XML tree (`model::xml`, attribute values of every XML file read), by the property
 /// reader's position-keeping unescaping (formulas, element text) and by
-/// [`SourceMap::unescaped_offset`]; names are decoded by [`resolve_entity`].
+/// [`unescaped_offset`]; names are decoded by [`resolve_entity`].
 pub(crate) fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
     let after = rest.strip_prefix('&')?;
     // A name longer than any entity or reasonable character reference is taken as a
@@ -218,21 +127,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn line_and_column() {
-        let mut sm = SourceMap::new();
-        let f = sm.add("a.scxml", "ab\ncdé\nx".to_string());
-        let d = sm.diag(f.at(0), "m");
-        assert_eq!((d.line, d.col), (1, 1));
-        let d = sm.diag(f.at(4), "m");
-        assert_eq!((d.line, d.col), (2, 2));
-        let d = sm.diag(f.at(7), "m");
-        assert_eq!((d.line, d.col), (2, 4));
-        let d = sm.diag(f.at(8), "m");
-        assert_eq!((d.line, d.col), (3, 1));
-        assert_eq!(d.to_string(), "a.scxml:3:1: m\n    x\n    ^");
-    }
-
-    #[test]
     fn unescaped_offsets_map_back() {
         let mut sm = SourceMap::new();
         let text = r#"<if cond="a &amp;&amp; b.c"/>"#;
@@ -243,7 +137,7 @@ mod tests {
         let un = unescape(raw).unwrap();
         assert_eq!(un, "a && b.c");
         let k = un.find('b').unwrap() as u32;
-        let mapped = sm.unescaped_offset(span, k);
+        let mapped = unescaped_offset(&sm, span, k);
         assert_eq!(&text[mapped.lo as usize..mapped.lo as usize + 1], "b");
     }
 

@@ -191,7 +191,7 @@ fn offset_in(src: &str, part: &[u8]) -> Option<u32> {
 
 /// Parses the text of file `file` into its root element.
 pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
-    let Some(f) = sm.file(file) else {
+    let Some(f) = sm.source(file) else {
         return Err(crate::model::about_file(
             "<unknown>",
             "internal error: file not in source map",

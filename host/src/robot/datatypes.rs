@@ -229,7 +229,7 @@ fn read_json(
     defs: &mut TypeDefs,
     uses: &mut Vec<(TypeExpr, Span)>,
 ) -> Result<(), Vec<Diagnostic>> {
-    let text = sm.file(file).map(|f| f.text()).unwrap_or("");
+    let text = sm.source(file).map(|f| f.text()).unwrap_or("");
     let at = |offset: usize| file.at(offset as u32);
     let root = json::parse(text).map_err(|(o, m)| vec![sm.diag(at(o), m)])?;
     let root_at = root.offset;

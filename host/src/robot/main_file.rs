@@ -299,7 +299,7 @@ impl MainFile {
             };
             if let Some((_, first)) = seen.iter().find(|(n, _)| n == section) {
                 let (line, _) = sm
-                    .file(FileId::of(*first))
+                    .source(FileId::of(*first))
                     .map_or((0, 0), |f| f.line_col(first.lo));
                 r.errs.push(sm.diag(
                     el.span,

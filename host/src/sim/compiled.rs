@@ -17,6 +17,7 @@ use crate::expr::compile::{
 use crate::expr::parse_expr;
 use crate::expr::value::{Cell, StrId, Strings, StructDef, Ty, TypeTable};
 use crate::model::ast::{Delay, Exec, Machine, SendTarget, SrcExpr};
+use crate::model::source::unescaped_offset;
 use crate::model::types::{TypeDef, TypeExpr};
 use crate::model::{Diagnostic, Diagnostics, FileId, ModelSource, SourceMap, Span};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -632,7 +633,7 @@ impl<'s> Builder<'s> {
 
     fn expr_diag(&self, src: &SrcExpr, e: &CompileError) -> Diagnostic {
         self.src.sources.diag(
-            self.src.sources.unescaped_offset(src.span, e.at),
+            unescaped_offset(&self.src.sources, src.span, e.at),
             e.msg.clone(),
         )
     }
@@ -675,7 +676,7 @@ impl<'s> Builder<'s> {
                     let ast = match parse_expr(&src.text) {
                         Ok(a) => a,
                         Err(pe) => {
-                            let at = self.src.sources.unescaped_offset(src.span, pe.offset);
+                            let at = unescaped_offset(&self.src.sources, src.span, pe.offset);
                             self.err(at, pe.message);
                             self.failed_vars.insert((mi as u32, d.id.name.clone()));
                             continue;
@@ -683,7 +684,7 @@ impl<'s> Builder<'s> {
                     };
                     let sources = &self.src.sources;
                     let span = src.span;
-                    let abs = move |k: u32| sources.unescaped_offset(span, k).lo;
+                    let abs = move |k: u32| unescaped_offset(sources, span, k).lo;
                     let scope = Scope {
                         vars: &vars,
                         event: EventScope::None,

@@ -97,7 +97,7 @@ pub fn root_machine_name(sm: &SourceMap, tree: FileId) -> String {
 
 fn stem(sm: &SourceMap, tree: FileId) -> String {
     let s = sm
-        .file(tree)
+        .source(tree)
         .and_then(|f| f.path().file_stem())
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "bt".into());

@@ -18,7 +18,7 @@ pub fn parse_interface(
     name: &str,
     kind: InterfaceKind,
 ) -> Result<InterfaceDef, Vec<Diagnostic>> {
-    let Some(src) = sm.file(file) else {
+    let Some(src) = sm.source(file) else {
         return Err(vec![crate::model::about_file(
             "<unknown>",
             "internal error: interface file not in the source map",

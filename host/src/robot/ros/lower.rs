@@ -2,7 +2,7 @@
 
 use super::expr::{rewrite, Scope};
 use super::{find, Cx, DECLARATIONS};
-use crate::model::source::Span;
+use crate::model::source::{unescaped_offset, Span};
 use crate::model::xml::{Element, Node};
 use crate::robot::types::FlatField;
 
@@ -264,7 +264,7 @@ impl Cx<'_> {
                 match rewrite(&a.value, scope) {
                     Ok(v) => a.value = v,
                     Err((k, m)) => {
-                        let at = self.sm.unescaped_offset(a.value_span, k as u32);
+                        let at = unescaped_offset(self.sm, a.value_span, k as u32);
                         self.err(at, m);
                     }
                 }
@@ -279,7 +279,7 @@ impl Cx<'_> {
         match rewrite(&v, scope) {
             Ok(v) => Some((v, span)),
             Err((k, m)) => {
-                let at = self.sm.unescaped_offset(span, k as u32);
+                let at = unescaped_offset(self.sm, span, k as u32);
                 self.err(at, m);
                 None
             }

@@ -178,7 +178,7 @@ impl<'s> Builder<'s> {
                         .insert(unknown_param_type(&p.name.name, &site.send.event.name));
                     match parse_expr(&p.expr.text) {
                         Err(pe) => {
-                            let at = self.src.sources.unescaped_offset(p.expr.span, pe.offset);
+                            let at = unescaped_offset(&self.src.sources, p.expr.span, pe.offset);
                             self.err(at, pe.message);
                         }
                         Ok(ast) => match self.compile_in_site(site, &ast) {

@@ -46,7 +46,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
         let ast = match parse_expr(&src.text) {
             Ok(a) => a,
             Err(pe) => {
-                let at = self.b.src.sources.unescaped_offset(src.span, pe.offset);
+                let at = unescaped_offset(&self.b.src.sources, src.span, pe.offset);
                 self.b.err(at, pe.message);
                 return None;
             }
@@ -54,7 +54,7 @@ impl<'b, 's> MachineCompiler<'b, 's> {
         let r = {
             let sources = &self.b.src.sources;
             let span = src.span;
-            let abs = move |k: u32| sources.unescaped_offset(span, k).lo;
+            let abs = move |k: u32| unescaped_offset(sources, span, k).lo;
             let scope = Scope {
                 vars: &self.b.vars[self.mi as usize],
                 event: match event {
