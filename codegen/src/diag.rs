@@ -437,7 +437,8 @@ impl Snippet {
     }
 }
 
-fn floor_boundary(text: &str, mut i: usize) -> usize {
+/// The largest char boundary of `text` at or before byte `i` (clamped to its length).
+pub fn floor_boundary(text: &str, mut i: usize) -> usize {
     i = i.min(text.len());
     while !text.is_char_boundary(i) {
         i -= 1;

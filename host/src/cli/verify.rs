@@ -136,7 +136,7 @@ pub struct ModelArgs {
     /// with a step bound.
     #[arg(long = "skip", value_name = "NAME")]
     pub skip: Vec<String>,
-    /// A folder of ROS interface packages (DIR/<pkg>/msg/*.msg, or a package itself) for a
+    /// A folder of ROS interface packages (DIR/PKG/msg/*.msg, or a package itself) for a
     /// robot model; repeat for more. Searched first, before the folders beside and above
     /// the model, the sourced ROS workspace (AMENT_PREFIX_PATH) and the built-ins.
     #[arg(long = "interfaces", value_name = "DIR")]

@@ -13,7 +13,7 @@
 //! - [`config`]: the TOML config, checked against the spec (`file:line:col` errors).
 //! - [`engine`]: five-valued verdicts and the loss rule (see its docs).
 //! - [`record`]: the verdict line and input log formats; replay.
-//! - [`bench`]: throughput and added latency against a plain subscriber.
+//! - [`mod@bench`]: throughput and added latency against a plain subscriber.
 //! - [`pace`]: `hindsight run`'s observer, pacing a simulation on the same [`Clock`].
 //! - [`serve`]: the live page (`--serve`): verdict lines streamed to a browser.
 //!
@@ -106,7 +106,7 @@ pub struct Options {
     pub probe: Option<Probe>,
 }
 
-/// A latency probe for [`bench`]: each tapped sample carries, as a little-endian
+/// A latency probe for [`mod@bench`]: each tapped sample carries, as a little-endian
 /// `u64` at `offset`, the nanoseconds since `epoch` when it was sent.
 #[derive(Clone, Copy, Debug)]
 pub struct Probe {

@@ -31,7 +31,7 @@ pub const HISTORY: usize = 100_000;
 /// memory grow. Its page reconnects with `Last-Event-ID` and gets what it missed from
 /// the history. About 40 bytes a line, held from the start (`sync_channel` allocates its
 /// buffer at once), so 8,192 lines are about 330 KiB per connection, and a page that
-/// reads lets through 8,192 lines per [`BATCH`] (800k lines a second) before it is dropped.
+/// reads lets through 8,192 lines per batch (800k lines a second) before it is dropped.
 pub const QUEUE: usize = 8_192;
 
 /// How long a write to a page may wait for it to read, before its connection is closed

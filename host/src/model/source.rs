@@ -30,7 +30,7 @@ pub fn unescaped_offset(sm: &SourceMap, span: Span, k: u32) -> Span {
         return span;
     };
     let raw = f.text();
-    let mut raw_pos = floor_boundary(raw, span.lo as usize);
+    let mut raw_pos = codegen::diag::floor_boundary(raw, span.lo as usize);
     let mut out = 0u32;
     while out < k && raw_pos < raw.len() {
         let rest = &raw[raw_pos..];
@@ -45,14 +45,6 @@ pub fn unescaped_offset(sm: &SourceMap, span: Span, k: u32) -> Span {
         raw_pos += consumed;
     }
     FileId::of(span).at(raw_pos as u32)
-}
-
-fn floor_boundary(text: &str, mut i: usize) -> usize {
-    i = i.min(text.len());
-    while !text.is_char_boundary(i) {
-        i -= 1;
-    }
-    i
 }
 
 /// The reference at the start of `rest`, when it starts with `&`: the character it

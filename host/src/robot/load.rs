@@ -368,7 +368,7 @@ fn inert_stub(root: &Element, interfaces: &Interfaces) -> Element {
 }
 
 /// [`load`], leaving out the node models named in `external` (their `<scxml name>`):
-/// the model runs without their behaviour ([`inert_stub`]), and what each declared is
+/// the model runs without their behaviour (an inert stub), and what each declared is
 /// returned so that a process can take its place. An unknown name is an error.
 pub fn load_without(
     main_path: &Path,

@@ -10,7 +10,7 @@ const MAX_FIXED_LEN: u32 = 4096;
 /// Parses the text of interface file `file` (already in `sm`) as `package/kind/name`.
 ///
 /// Message types named without a package are looked for in `package`. Whether the named
-/// types exist is checked later, by [`Interfaces::check`].
+/// types exist is checked later, by [`super::Interfaces::check`].
 pub fn parse_interface(
     sm: &SourceMap,
     file: FileId,
