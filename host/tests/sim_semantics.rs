@@ -547,3 +547,31 @@ fn compiled_models_are_shared_between_threads() {
         .dump_machine(m.machine_id("Judge").unwrap())
         .contains("send winner_p to NONE"));
 }
+
+/// XML attribute-value normalisation (XML 1.0 sections 2.11 and 3.3.3; AS2FM reads models
+/// with lxml, which applies it): a tab or line break written inside an attribute is a
+/// space by the time the expression is read (`\r\n` is one), while `&#10;` stays a line
+/// break. A string literal written over two lines is therefore `'x y'`.
+#[test]
+fn attribute_line_breaks_are_spaces_in_expressions() {
+    let text = "<scxml name=\"a\" initial=\"s0\" version=\"1.0\" \
+        xmlns=\"http://www.w3.org/2005/07/scxml\"><datamodel>\
+        <data id=\"s\" expr=\"'x\r\ny'\"/><data id=\"t\" expr=\"'p&#10;q'\"/>\
+        <data id=\"crlf_is_space\" expr=\"false\"/><data id=\"ref_is_newline\" expr=\"false\"/>\
+        </datamodel><state id=\"s0\"><onentry>\
+        <assign location=\"crlf_is_space\" expr=\"s ==\n'x y'\"/>\
+        <assign location=\"ref_is_newline\" expr=\"t != 'p q'\"/>\
+        </onentry></state></scxml>";
+    let src = hindsight::model::ModelSource::from_texts([("a.scxml", text)]).unwrap();
+    let m = CompiledModel::compile(src).unwrap();
+    let mut sim = Simulator::new(&m);
+    sim.run(
+        &mut rng(0),
+        &RunConfig::default(),
+        &mut TraceRecorder::new(),
+    );
+    let a = m.machine_id("a").unwrap();
+    for var in ["crlf_is_space", "ref_is_newline"] {
+        assert_eq!(sim.var(a, var), Some(Value::Bool(true)), "{var}");
+    }
+}

@@ -34,8 +34,9 @@ pub fn unescaped_offset(sm: &SourceMap, span: Span, k: u32) -> Span {
     let mut out = 0u32;
     while out < k && raw_pos < raw.len() {
         let rest = &raw[raw_pos..];
-        let (produced, consumed) = match reference(rest) {
-            Some(Ok((c, consumed))) => (c.len_utf8(), consumed),
+        let (produced, consumed) = match (normalised_space(rest), reference(rest)) {
+            (Some(consumed), _) => (1, consumed),
+            (None, Some(Ok((c, consumed)))) => (c.len_utf8(), consumed),
             _ => {
                 let c = rest.chars().next().map_or(1, char::len_utf8);
                 (c, c)
@@ -90,18 +91,45 @@ pub(crate) fn resolve_entity(name: &str) -> Option<char> {
     }
 }
 
-/// Unescapes an XML attribute value; `Err` gives the byte offset of a bad reference
-/// and what is wrong with it.
+/// The characters attribute-value normalisation turns into a space (a `\r\n` pair is
+/// one line break, so one space).
+const ATTR_WHITESPACE: [char; 3] = ['\t', '\n', '\r'];
+
+/// The bytes of raw attribute text at the start of `rest` that normalise to one space
+/// (`\r\n` is 2), or `None` when `rest` does not start with a line break or tab.
+fn normalised_space(rest: &str) -> Option<usize> {
+    if rest.starts_with("\r\n") {
+        Some(2)
+    } else if rest.starts_with(ATTR_WHITESPACE) {
+        Some(1)
+    } else {
+        None
+    }
+}
+
+/// An XML attribute value as an XML processor gives it to the application: references
+/// replaced, and every literal tab, line break (`\r\n`, `\r` or `\n`) turned into one
+/// space. A character reference is kept as written (`&#10;` is a line break). This is
+/// XML 1.0's attribute-value normalisation for CDATA attributes (sections 2.11 and
+/// 3.3.3), which AS2FM gets from lxml: an `expr` written over two lines reads the same
+/// in both tools. `Err` gives the byte offset of a bad reference and what is wrong.
 pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, String)> {
-    if !raw.contains('&') {
+    const SPECIAL: [char; 4] = ['&', '\t', '\n', '\r'];
+    if !raw.contains(SPECIAL) {
         return Ok(std::borrow::Cow::Borrowed(raw));
     }
     let mut out = String::with_capacity(raw.len());
     let mut pos = 0usize;
-    while let Some(i) = raw[pos..].find('&') {
+    while let Some(i) = raw[pos..].find(SPECIAL) {
         out.push_str(&raw[pos..pos + i]);
         pos += i;
-        match reference(&raw[pos..]) {
+        let rest = &raw[pos..];
+        if let Some(consumed) = normalised_space(rest) {
+            out.push(' ');
+            pos += consumed;
+            continue;
+        }
+        match reference(rest) {
             Some(Ok((c, consumed))) => {
                 out.push(c);
                 pos += consumed;
@@ -131,6 +159,24 @@ mod tests {
         let k = un.find('b').unwrap() as u32;
         let mapped = unescaped_offset(&sm, span, k);
         assert_eq!(&text[mapped.lo as usize..mapped.lo as usize + 1], "b");
+    }
+
+    #[test]
+    fn attribute_whitespace_is_normalised_but_references_are_not() {
+        assert_eq!(unescape("a\tb\nc\rd\r\ne").unwrap(), "a b c d e");
+        assert_eq!(unescape("a&#10;b&#9;c").unwrap(), "a\nb\tc");
+        assert_eq!(unescape("x &lt;\r\ny").unwrap(), "x < y");
+        // Offsets after a normalised `\r\n` still land on the right byte of the file.
+        let mut sm = SourceMap::new();
+        let text = "<a expr=\"x &lt;\r\n  y\"/>";
+        let f = sm.add("x", text.to_string());
+        let start = text.find("x &").unwrap() as u32;
+        let raw = &text[start as usize..text.rfind('"').unwrap()];
+        let un = unescape(raw).unwrap();
+        assert_eq!(un, "x <   y");
+        let k = un.find('y').unwrap() as u32;
+        let mapped = unescaped_offset(&sm, f.at(start), k);
+        assert_eq!(&text[mapped.lo as usize..mapped.lo as usize + 1], "y");
     }
 
     #[test]

@@ -232,7 +232,9 @@ pub(crate) fn unescape_attribute(
             }
         });
         let chunk = &rest[..run];
+        // A `\r\n` pair is one line break, so one space (XML 1.0 section 2.11).
         let normalised: String = chunk
+            .replace("\r\n", "\n")
             .chars()
             .map(|c| {
                 if matches!(c, '\t' | '\n' | '\r') {
@@ -247,4 +249,24 @@ pub(crate) fn unescape_attribute(
         at += run;
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn attribute_line_breaks_become_one_space_each_and_keep_their_positions() {
+        let file = "<p formula=\"{a}\r\n  S {b}\tor\n{c}&#10;\"/>";
+        let start = file.find('{').unwrap();
+        let raw = &file[start..file.rfind('"').unwrap()];
+        let lines = LineIndex::new(file);
+        let out = unescape_attribute(raw, start, &lines).unwrap();
+        // `\r\n` is one line break: one space, not two; `&#10;` stays a line break.
+        assert_eq!(out.as_str(), "{a}   S {b} or {c}\n");
+        let at = |needle: &str| out.location(out.as_str().find(needle).unwrap());
+        assert_eq!(at("{a}"), Location::new(1, 13));
+        assert_eq!(at("S {b}"), Location::new(2, 3));
+        assert_eq!(at("{c}"), Location::new(3, 1));
+    }
 }
