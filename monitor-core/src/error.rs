@@ -87,6 +87,42 @@ pub enum StepError {
     },
 }
 
+impl TableError {
+    /// The kind of error as one number, for logs that have no room for the
+    /// messages (firmware): 1 [`TableError::Decode`], 2 `Version`, 3 `Var`,
+    /// 4 `Atom`, 5 `Feature`, 6 `Node`, 7 `Layout`, 8 `Property`, 9 `TooLarge`.
+    /// The host's `Display` of the same table says which element.
+    pub const fn code(&self) -> u8 {
+        match self {
+            TableError::Decode => 1,
+            TableError::Version { .. } => 2,
+            TableError::Var { .. } => 3,
+            TableError::Atom { .. } => 4,
+            TableError::Feature { .. } => 5,
+            TableError::Node { .. } => 6,
+            TableError::Layout { .. } => 7,
+            TableError::Property { .. } => 8,
+            TableError::TooLarge => 9,
+        }
+    }
+}
+
+impl StepError {
+    /// The kind of error as one number, for logs that have no room for the
+    /// messages (firmware): 1 [`StepError::TimeWentBackwards`], 2
+    /// `TimeOutOfRange`, 3 `StateSize`, 4 `InputSize`, 5 `VarType`, 6 `Arithmetic`.
+    pub const fn code(&self) -> u8 {
+        match self {
+            StepError::TimeWentBackwards { .. } => 1,
+            StepError::TimeOutOfRange => 2,
+            StepError::StateSize { .. } => 3,
+            StepError::InputSize { .. } => 4,
+            StepError::VarType { .. } => 5,
+            StepError::Arithmetic { .. } => 6,
+        }
+    }
+}
+
 impl fmt::Display for TableError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
