@@ -118,7 +118,13 @@ impl<const N: usize> Default for Finality<N> {
 impl<const N: usize> Finality<N> {
     /// Nothing known to be final yet.
     pub const fn new() -> Self {
-        Finality { finals: [None; N] }
+        // `settle` writes every entry before `all_final` reads one, so the
+        // start value does not matter: all zero bytes (`Some(false)`) lets the
+        // compiler clear the array like the others instead of linking
+        // `__aeabi_memset4` for `None` (160 B of flash).
+        Finality {
+            finals: [Some(false); N],
+        }
     }
 
     /// After a step: whether every property's verdict is now final.
