@@ -165,3 +165,41 @@ impl fmt::Display for StepError {
 
 impl core::error::Error for TableError {}
 impl core::error::Error for StepError {}
+
+#[cfg(test)]
+mod tests {
+    use super::{StepError, TableError};
+
+    #[test]
+    fn codes_tell_every_kind_apart() {
+        let table = [
+            TableError::Decode,
+            TableError::Version { found: 2 },
+            TableError::Var { var: 1 },
+            TableError::Atom { atom: 1 },
+            TableError::Feature { atom: 1 },
+            TableError::Node { node: 1 },
+            TableError::Layout { node: 1 },
+            TableError::Property { prop: 1 },
+            TableError::TooLarge,
+        ];
+        let codes: [u8; 9] = table.map(|e| e.code());
+        assert_eq!(codes, [1, 2, 3, 4, 5, 6, 7, 8, 9]);
+        let step = [
+            StepError::TimeWentBackwards { last: 2, now: 1 },
+            StepError::TimeOutOfRange,
+            StepError::StateSize {
+                expected: 1,
+                found: 2,
+            },
+            StepError::InputSize {
+                expected: 1,
+                found: 2,
+            },
+            StepError::VarType { var: 0 },
+            StepError::Arithmetic { atom: 0 },
+        ];
+        let codes: [u8; 6] = step.map(|e| e.code());
+        assert_eq!(codes, [1, 2, 3, 4, 5, 6]);
+    }
+}
