@@ -198,7 +198,7 @@ impl<'a> Reader<'a> {
     fn instr(&mut self) -> Option<Instr> {
         let v = self.variant()?;
         // The arithmetic variants' one field is read at one call site (code size).
-        let n = if (5..=10).contains(&v) {
+        let n = if matches!(v, 5..=10) {
             self.num_ty()?
         } else {
             NumTy::Int
@@ -236,8 +236,8 @@ impl<'a> Reader<'a> {
         let v = self.variant()?;
         // Every variant but `Const` starts with one or two ids, read at one call
         // site each (code size), in the order postcard writes them.
-        let a = if (1..=9).contains(&v) { self.u16()? } else { 0 };
-        let b = if (3..=6).contains(&v) || v == 9 {
+        let a = if matches!(v, 1..=9) { self.u16()? } else { 0 };
+        let b = if matches!(v, 3..=6 | 9) {
             self.u16()?
         } else {
             0
