@@ -87,6 +87,42 @@ pub enum StepError {
     },
 }
 
+impl TableError {
+    /// The kind of error as one number, for logs that have no room for the
+    /// messages (firmware): 1 [`TableError::Decode`], 2 `Version`, 3 `Var`,
+    /// 4 `Atom`, 5 `Feature`, 6 `Node`, 7 `Layout`, 8 `Property`, 9 `TooLarge`.
+    /// The host's `Display` of the same table says which element.
+    pub const fn code(&self) -> u8 {
+        match self {
+            TableError::Decode => 1,
+            TableError::Version { .. } => 2,
+            TableError::Var { .. } => 3,
+            TableError::Atom { .. } => 4,
+            TableError::Feature { .. } => 5,
+            TableError::Node { .. } => 6,
+            TableError::Layout { .. } => 7,
+            TableError::Property { .. } => 8,
+            TableError::TooLarge => 9,
+        }
+    }
+}
+
+impl StepError {
+    /// The kind of error as one number, for logs that have no room for the
+    /// messages (firmware): 1 [`StepError::TimeWentBackwards`], 2
+    /// `TimeOutOfRange`, 3 `StateSize`, 4 `InputSize`, 5 `VarType`, 6 `Arithmetic`.
+    pub const fn code(&self) -> u8 {
+        match self {
+            StepError::TimeWentBackwards { .. } => 1,
+            StepError::TimeOutOfRange => 2,
+            StepError::StateSize { .. } => 3,
+            StepError::InputSize { .. } => 4,
+            StepError::VarType { .. } => 5,
+            StepError::Arithmetic { .. } => 6,
+        }
+    }
+}
+
 impl fmt::Display for TableError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -129,3 +165,41 @@ impl fmt::Display for StepError {
 
 impl core::error::Error for TableError {}
 impl core::error::Error for StepError {}
+
+#[cfg(test)]
+mod tests {
+    use super::{StepError, TableError};
+
+    #[test]
+    fn codes_tell_every_kind_apart() {
+        let table = [
+            TableError::Decode,
+            TableError::Version { found: 2 },
+            TableError::Var { var: 1 },
+            TableError::Atom { atom: 1 },
+            TableError::Feature { atom: 1 },
+            TableError::Node { node: 1 },
+            TableError::Layout { node: 1 },
+            TableError::Property { prop: 1 },
+            TableError::TooLarge,
+        ];
+        let codes: [u8; 9] = table.map(|e| e.code());
+        assert_eq!(codes, [1, 2, 3, 4, 5, 6, 7, 8, 9]);
+        let step = [
+            StepError::TimeWentBackwards { last: 2, now: 1 },
+            StepError::TimeOutOfRange,
+            StepError::StateSize {
+                expected: 1,
+                found: 2,
+            },
+            StepError::InputSize {
+                expected: 1,
+                found: 2,
+            },
+            StepError::VarType { var: 0 },
+            StepError::Arithmetic { atom: 0 },
+        ];
+        let codes: [u8; 6] = step.map(|e| e.code());
+        assert_eq!(codes, [1, 2, 3, 4, 5, 6]);
+    }
+}
