@@ -261,12 +261,12 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 bits |= (v as u64) << (k & 63);
                 nodes |= if v { a.pos } else { a.neg };
             }
-            if !atoms.is_empty() {
-                wr(state, layout::HEADER_WORDS, bits);
-            }
             if info.has(Plan::FOLDED) {
-                self.advance_folded(state, time, nodes, verdicts);
+                self.advance_folded(state, time, bits, nodes, verdicts);
             } else {
+                if !atoms.is_empty() {
+                    wr(state, layout::HEADER_WORDS, bits);
+                }
                 self.advance(self.plan_nodes(), state, time, bits, verdicts);
             }
             return Ok(());
@@ -283,7 +283,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
     #[inline(always)]
     fn advance_plan(&self, state: &mut [u64], time: u64, first: u64, verdicts: &mut [bool]) {
         if self.info.has(Plan::FOLDED) {
-            self.advance_folded(state, time, self.literals(first), verdicts);
+            self.advance_folded(state, time, first, self.literals(first), verdicts);
         } else {
             self.advance(self.plan_nodes(), state, time, first, verdicts);
         }
@@ -303,18 +303,27 @@ impl<'a, const N: usize> Monitor<'a, N> {
         nodes
     }
 
-    /// The network step of a folded plan ([`Plan::FOLDED`]): `nodes` holds the
-    /// literal nodes' bits; each step adds its node's (and its fused `Not`'s).
-    /// At most 64 nodes: the values of this point and the last each fit one register.
+    /// The network step of a folded plan ([`Plan::FOLDED`]): `atoms` are this
+    /// point's atoms, `nodes` the literal nodes' bits; each step adds its node's
+    /// (and its fused `Not`'s). One to 64 atoms and at most 64 nodes: the state
+    /// opens with exactly three words (time, atoms, values; [`layout`]), and the
+    /// values of this point and the last each fit one register.
     #[inline(always)]
-    fn advance_folded(&self, state: &mut [u64], t: u64, nodes: u64, verdicts: &mut [bool]) {
-        let (off, vals) = (self.nodes_at, self.values_at);
+    fn advance_folded(
+        &self,
+        state: &mut [u64],
+        t: u64,
+        atoms: u64,
+        nodes: u64,
+        verdicts: &mut [bool],
+    ) {
         // The state length was checked (it covers every node's words): never `None`.
-        let Some((head, body)) = state.split_at_mut_checked(off) else {
+        let Some(([time_word, atom_word, value_word], body)) = state.split_first_chunk_mut::<3>()
+        else {
             return;
         };
-        let first_point = rd(head, 0) == 0;
-        let old = rd(head, vals);
+        let first_point = *time_word == 0;
+        let old = *value_word;
         let d = if first_point { plan::D } else { 0 };
         let mut new = nodes;
         for s in self.plan_nodes() {
@@ -332,8 +341,9 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 new |= (!v as u64) << (s.neg & 63);
             }
         }
-        wr(head, vals, new);
-        wr(head, 0, t + 1);
+        *atom_word = atoms;
+        *value_word = new;
+        *time_word = t + 1;
         for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
             *out = new >> (pr.root & 63) & 1 == 1;
         }

@@ -332,7 +332,7 @@ pub(crate) struct Plan {
 impl Plan {
     /// The plan arrays hold the program (at most `N` nodes and atoms).
     pub const PLANNED: u8 = 1;
-    /// At most 64 nodes and 64 atoms, at least one atom, not `compact`: the
+    /// 1 to 64 nodes and 1 to 64 atoms, not `compact`: the
     /// literal nodes (constants, atoms and `Not`s of literals) are not steps but
     /// bits, in each atom's [`AtomStep::pos`]/[`AtomStep::neg`] (a `true`
     /// constant in both masks of atom 0); a `Not` of a step is fused into it
@@ -383,7 +383,8 @@ pub(crate) fn build(
         *step = AtomStep::of(a, p);
     }
     let compact = cfg!(feature = "compact");
-    let folded = !compact && p.nodes.len() <= 64 && p.atoms.len() <= 64 && !p.atoms.is_empty();
+    // One atom word and one value word: the state opens with exactly three words.
+    let folded = !compact && (1..=64).contains(&p.nodes.len()) && (1..=64).contains(&p.atoms.len());
     let mut plan = Plan {
         steps: 0,
         flags: Plan::PLANNED | if folded { Plan::FOLDED } else { 0 },
