@@ -3,7 +3,7 @@
 use crate::error::{StepError, TableError};
 use crate::expr;
 use crate::layout;
-use crate::plan::{self, AtomStep, Kind, Step};
+use crate::plan::{self, AtomStep, Kind, Plan, Step};
 use crate::program::{Atom, Instr, Node, Op, Program, Value, VarKind};
 
 /// A [`Program`] that passed every check: it can be stepped without panicking.
@@ -15,8 +15,8 @@ use crate::program::{Atom, Instr, Node, Op, Program, Value, VarKind};
 /// `N` is the room for a plan (`plan.rs`): a `Monitor<'_, N>` built with
 /// [`Monitor::try_new_planned`] decides each node's kind, children, state slot
 /// and window capacity and each atom's shape once, for programs of at most `N`
-/// nodes and `N` atoms, and steps faster. It holds `N` entries of 32 bytes and
-/// `N` of 16 (const generics: no allocation); the default `N = 0` plans nothing
+/// nodes and `N` atoms, and steps faster. It holds `N` entries of 40 bytes and
+/// `N` of 32 (const generics: no allocation); the default `N = 0` plans nothing
 /// and holds nothing more.
 #[derive(Clone, Copy, Debug)]
 pub struct Monitor<'a, const N: usize = 0> {
@@ -27,12 +27,12 @@ pub struct Monitor<'a, const N: usize = 0> {
     nodes_at: usize,
     /// At most 64 atoms and 64 nodes, decided once: the atoms and the node values
     /// of a point each fit one register ([`Monitor::advance`]).
-    small: bool,
-    /// Whether `plan` and `atom_plan` hold the program (at most `N` nodes and atoms).
-    planned: bool,
-    /// Node `i`'s plan, for `i < program.nodes.len()` when `planned`.
+    /// Whether `plan` and `atom_plan` hold the program (`info.planned`) and what
+    /// the plan decided for the whole program ([`Plan`]).
+    info: Plan,
+    /// The plan's steps, the first `info.steps` used, when planned.
     plan: [Step; N],
-    /// Atom `k`'s plan, for `k < program.atoms.len()` when `planned`.
+    /// Atom `k`'s plan, for `k < program.atoms.len()` when planned.
     atom_plan: [AtomStep; N],
 }
 
@@ -137,18 +137,29 @@ impl<'a, const N: usize> Monitor<'a, N> {
             state_words: next_word as usize,
             values_at: layout::HEADER_WORDS + layout::bit_words(p.atoms.len()),
             nodes_at,
-            small: p.atoms.len() <= 64 && p.nodes.len() <= 64,
-            planned: false,
+            info: Plan {
+                steps: 0,
+                flags: if p.atoms.len() <= 64 && p.nodes.len() <= 64 {
+                    Plan::SMALL
+                } else {
+                    0
+                },
+            },
             plan: [Step::NONE; N],
             atom_plan: [AtomStep::NONE; N],
         };
         if N > 0 {
-            monitor.planned = plan::build(
+            if let Some(info) = plan::build(
                 &program,
                 nodes_at,
                 &mut monitor.plan,
                 &mut monitor.atom_plan,
-            );
+            ) {
+                monitor.info = Plan {
+                    steps: info.steps,
+                    flags: info.flags | monitor.info.flags,
+                };
+            }
         }
         Ok(monitor)
     }
@@ -156,7 +167,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
     /// Whether this monitor steps through its plan: `N > 0` and the program has
     /// at most `N` nodes and `N` atoms (see [`Monitor::try_new_planned`]).
     pub fn is_planned(&self) -> bool {
-        N > 0 && self.planned
+        N > 0 && self.info.has(Plan::PLANNED)
     }
 
     /// The program this monitor runs.
@@ -214,21 +225,128 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 found: vars.len(),
             });
         }
-        for (i, (v, d)) in vars.iter().zip(p.vars).enumerate() {
-            if v.ty() != d.ty {
-                return Err(StepError::VarType { var: i as u16 });
+        if N > 0 && self.info.has(Plan::PLANNED) {
+            return self.step_planned(state, time, vars, verdicts);
+        }
+        check_types(p, vars)?;
+        // Atoms first: an error leaves the temporal state untouched.
+        let first = atom_words(p.atoms, p.instrs, vars, state)?;
+        self.advance(p.nodes, state, time, first, verdicts);
+        Ok(())
+    }
+
+    /// [`Monitor::try_step`] through the plan, once the point's shape is checked.
+    #[inline(always)]
+    fn step_planned(
+        &self,
+        state: &mut [u64],
+        time: u64,
+        vars: &[Value],
+        verdicts: &mut [bool],
+    ) -> Result<(), StepError> {
+        let (p, info, atoms) = (&self.program, &self.info, self.plan_atoms());
+        if info.has(Plan::FAST) {
+            // The atom reads check the types of the variables they read (a
+            // mismatch gives the full check's error: the first variable of
+            // another type), before anything is written. When some variable
+            // is read by no atom, the full check (a tight loop) runs first.
+            if info.has(Plan::UNREAD) {
+                check_types(p, vars)?;
+            }
+            let (mut bits, mut nodes) = (0u64, 0u64);
+            for (k, a) in atoms.iter().enumerate() {
+                let Some(v) = a.fast(vars) else {
+                    return Err(type_error(p, vars));
+                };
+                bits |= (v as u64) << (k & 63);
+                nodes |= if v { a.pos } else { a.neg };
+            }
+            if info.has(Plan::FOLDED) {
+                self.advance_folded(state, time, bits, nodes, verdicts);
+            } else {
+                if !atoms.is_empty() {
+                    wr(state, layout::HEADER_WORDS, bits);
+                }
+                self.advance(self.plan_nodes(), state, time, bits, verdicts);
+            }
+            return Ok(());
+        }
+        check_types(p, vars)?;
+        // Atoms first: an error leaves the temporal state untouched.
+        let first = atom_words(atoms, p.instrs, vars, state)?;
+        self.advance_plan(state, time, first, verdicts);
+        Ok(())
+    }
+
+    /// The network step of a planned monitor, from the atoms of this point
+    /// (stored in the state's scratch words, the first of them in `first`).
+    #[inline(always)]
+    fn advance_plan(&self, state: &mut [u64], time: u64, first: u64, verdicts: &mut [bool]) {
+        if self.info.has(Plan::FOLDED) {
+            self.advance_folded(state, time, first, self.literals(first), verdicts);
+        } else {
+            self.advance(self.plan_nodes(), state, time, first, verdicts);
+        }
+    }
+
+    /// Folded plans: the literal nodes' bits for the atoms `atoms`.
+    #[inline(always)]
+    fn literals(&self, atoms: u64) -> u64 {
+        let mut nodes = 0u64;
+        for (k, a) in self.plan_atoms().iter().enumerate() {
+            nodes |= if atoms >> (k & 63) & 1 == 1 {
+                a.pos
+            } else {
+                a.neg
+            };
+        }
+        nodes
+    }
+
+    /// The network step of a folded plan ([`Plan::FOLDED`]): `atoms` are this
+    /// point's atoms, `nodes` the literal nodes' bits; each step adds its node's
+    /// (and its fused `Not`'s). One to 64 atoms and at most 64 nodes: the state
+    /// opens with exactly three words (time, atoms, values; [`layout`]), and the
+    /// values of this point and the last each fit one register.
+    #[inline(always)]
+    fn advance_folded(
+        &self,
+        state: &mut [u64],
+        t: u64,
+        atoms: u64,
+        nodes: u64,
+        verdicts: &mut [bool],
+    ) {
+        // The state length was checked (it covers every node's words): never `None`.
+        let Some(([time_word, atom_word, value_word], body)) = state.split_first_chunk_mut::<3>()
+        else {
+            return;
+        };
+        let first_point = *time_word == 0;
+        let old = *value_word;
+        let d = if first_point { plan::D } else { 0 };
+        let mut new = nodes;
+        for s in self.plan_nodes() {
+            let i = s.dest & 63;
+            let f = (new >> (s.a & 63)) as u16 & 1;
+            let g = (new >> (s.b & 63)) as u16 & 1;
+            let v = if s.kind == Kind::Logic {
+                let c = (old >> i) as u16 & 1;
+                (s.table >> (f | g << 1 | c << 2 | d)) & 1 == 1
+            } else {
+                special(s, body, t, f == 1, g == 1, d)
+            };
+            new |= (v as u64) << i;
+            if s.negate != 0 {
+                new |= (!v as u64) << (s.neg & 63);
             }
         }
-        // Atoms first: an error leaves the temporal state untouched.
-        if N > 0 && self.planned {
-            let atoms = self.plan_atoms();
-            let first = atom_words(atoms, p.instrs, vars, state)?;
-            self.advance(self.plan_nodes(), state, time, first, verdicts);
-        } else {
-            let first = atom_words(p.atoms, p.instrs, vars, state)?;
-            self.advance(p.nodes, state, time, first, verdicts);
+        *atom_word = atoms;
+        *value_word = new;
+        *time_word = t + 1;
+        for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
+            *out = new >> (pr.root & 63) & 1 == 1;
         }
-        Ok(())
     }
 
     /// Like [`Monitor::try_step`] for a caller that computes the atoms itself:
@@ -252,8 +370,8 @@ impl<'a, const N: usize> Monitor<'a, N> {
             wr(state, layout::HEADER_WORDS + k, *a);
         }
         let first = atoms.first().copied().unwrap_or(0);
-        if N > 0 && self.planned {
-            self.advance(self.plan_nodes(), state, time, first, verdicts);
+        if N > 0 && self.info.has(Plan::PLANNED) {
+            self.advance_plan(state, time, first, verdicts);
         } else {
             self.advance(self.program.nodes, state, time, first, verdicts);
         }
@@ -268,13 +386,15 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 found: verdicts.len(),
             });
         }
-        if time == u64::MAX {
-            return Err(StepError::TimeOutOfRange);
-        }
+        // `last` is 1 + the last time (0 before the first point): `time + 1 < last`
+        // is "time went backwards", and a `time` of `u64::MAX` wraps to 0.
         let last = rd(state, 0);
-        if last != 0 && time < last - 1 {
+        if time.wrapping_add(1) < last || time == u64::MAX {
+            if time == u64::MAX {
+                return Err(StepError::TimeOutOfRange);
+            }
             return Err(StepError::TimeWentBackwards {
-                last: last - 1,
+                last: last.wrapping_sub(1),
                 now: time,
             });
         }
@@ -311,10 +431,10 @@ impl<'a, const N: usize> Monitor<'a, N> {
             .unwrap_or(&[])
     }
 
-    /// The plan's nodes (empty unless planned).
+    /// The plan's steps (empty unless planned).
     #[inline(always)]
     fn plan_nodes(&self) -> &[Step] {
-        self.plan.get(..self.program.nodes.len()).unwrap_or(&[])
+        self.plan.get(..self.info.steps as usize).unwrap_or(&[])
     }
 
     /// Updates every node, planned ([`Step`]) or not ([`Node`]): one loop for
@@ -345,7 +465,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
             return;
         };
         let first_point = rd(head, 0) == 0;
-        if !cfg!(feature = "compact") && self.small {
+        if !cfg!(feature = "compact") && self.info.has(Plan::SMALL) {
             let old = rd(head, vals);
             let mut new = 0u64;
             for (i, node) in nodes.iter().enumerate() {
@@ -404,6 +524,29 @@ impl<'a, const N: usize> Monitor<'a, N> {
             let r = pr.root as usize;
             *out = rd(head, vals + r / 64) >> (r % 64) & 1 == 1;
         }
+    }
+}
+
+/// Every value of `vars` has its variable's declared type (same length, checked before).
+#[inline(always)]
+fn check_types(p: &Program<'_>, vars: &[Value]) -> Result<(), StepError> {
+    for (i, (v, d)) in vars.iter().zip(p.vars).enumerate() {
+        if v.ty() != d.ty {
+            return Err(StepError::VarType { var: i as u16 });
+        }
+    }
+    Ok(())
+}
+
+/// The error of a point whose shape a planned atom read found wrong: the first
+/// variable of another type than declared, as [`check_types`] reports it.
+#[cold]
+#[inline(never)]
+fn type_error(p: &Program<'_>, vars: &[Value]) -> StepError {
+    match check_types(p, vars) {
+        Err(e) => e,
+        // Not reached: the read that failed saw a value of another type.
+        Ok(()) => StepError::VarType { var: 0 },
     }
 }
 
@@ -537,7 +680,8 @@ fn general_atom(
     expr::eval(code, vars, atom as u16)
 }
 
-/// One planned node at one point, as [`node_step`] computes it from the node's [`Op`].
+/// One planned node at one point (not folded: one step per node), as
+/// [`node_step`] computes it from the node's [`Op`].
 #[inline(always)]
 fn exec(
     s: &Step,
@@ -548,33 +692,41 @@ fn exec(
     bit: impl Fn(u16) -> bool,
     own_prev: bool,
 ) -> bool {
+    if s.kind == Kind::Atom {
+        return atom(s.a);
+    }
+    let (f, g) = (bit(s.a), bit(s.b));
+    let d = if first_point { plan::D } else { 0 };
+    if s.kind == Kind::Logic {
+        let x = f as u16 | (g as u16) << 1 | (own_prev as u16) << 2 | d;
+        return (s.table >> x) & 1 == 1;
+    }
+    special(s, words, t, f, g, d)
+}
+
+/// A step that is not `Logic` (the cold part of a step, one branch away), its
+/// children's values `f` and `g`; `d` is [`plan::D`] at the first point, else 0;
+/// `words` the nodes' own words, whose `s.slot` .. are this node's.
+#[inline(always)]
+fn special(s: &Step, words: &mut [u64], t: u64, f: bool, g: bool, d: u16) -> bool {
     let slot = s.slot as usize;
     match s.kind {
-        Kind::False => false,
-        Kind::True => true,
-        Kind::Atom => atom(s.a),
-        Kind::Not => !bit(s.a),
-        Kind::And => bit(s.a) & bit(s.b),
-        Kind::Or => bit(s.a) | bit(s.b),
-        Kind::Implies => !bit(s.a) | bit(s.b),
-        Kind::Iff => bit(s.a) == bit(s.b),
-        Kind::Yesterday => {
-            let out = !first_point && rd(words, slot) != 0;
-            wr(words, slot, bit(s.a) as u64);
-            out
+        // Not reached: `Logic` is computed before.
+        Kind::Logic => false,
+        // Not reached: atoms are read before (`exec`) or folded.
+        Kind::Atom => false,
+        Kind::Latch => {
+            // The table reads the word (the child's last value) in place of own_prev.
+            let c = if rd(words, slot) != 0 { plan::C } else { 0 };
+            wr(words, slot, f as u64);
+            (s.table >> (c | d)) & 1 == 1
         }
-        Kind::WeakYesterday => {
-            let out = first_point || rd(words, slot) != 0;
-            wr(words, slot, bit(s.a) as u64);
-            out
-        }
-        Kind::Since => bit(s.b) | (bit(s.a) & !first_point & own_prev),
         Kind::SinceAtLeast => {
             let mut w = rd(words, slot);
-            if !bit(s.a) {
+            if !f {
                 w = 0;
             }
-            if bit(s.b) && w == 0 {
+            if g && w == 0 {
                 w = t + 1;
             }
             wr(words, slot, w);
@@ -582,17 +734,17 @@ fn exec(
         }
         Kind::SinceUpTo => {
             let mut w = rd(words, slot);
-            if !bit(s.a) {
+            if !f {
                 w = 0;
             }
-            if bit(s.b) {
+            if g {
                 w = t + 1;
             }
             wr(words, slot, w);
             w != 0 && t.wrapping_sub(w - 1) <= s.hi
         }
         Kind::SinceWindow => match words.get_mut(slot..) {
-            Some(w) => window_step(w, s.lo, s.hi, t, bit(s.a), bit(s.b), || s.cap as usize),
+            Some(w) => window_step(w, s.lo, s.hi, t, f, g, || s.cap as usize),
             None => false,
         },
     }

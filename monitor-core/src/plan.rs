@@ -1,44 +1,37 @@
-//! What a validated program does at every point, decided once: one [`Step`] per node and one [`AtomStep`] per atom.
+//! What a validated program does at every point, decided once: [`Step`]s for the nodes and one [`AtomStep`] per atom.
 //!
 //! [`crate::Monitor::try_step`] on a `Monitor<'_, N>` with `N > 0` runs these
 //! instead of re-deriving them from [`Op`] and the atom bytecode at every point:
-//! a node's kind is one byte (a `Since` node's kind from [`layout::since_kind`],
-//! its window capacity computed here and not per point), its children and its
-//! state slot are plain indices, and the atoms of the common shapes (a boolean
-//! variable, its negation, an integer variable compared with a constant) are
-//! read without the atom machine. The plan lives in the monitor itself, in
-//! arrays of `N` entries (const generics: no allocation); a program with more
-//! than `N` nodes or atoms runs the unplanned interpreter.
+//! every connective and unbounded `S` is a 16-bit truth table over its children,
+//! its own last value and "first point" (no dispatch per operator); a bounded
+//! `Since` node's kind comes from [`layout::since_kind`], its window capacity
+//! computed here and not per point; children and state slots are plain
+//! indices; the atoms of the common shapes (a boolean variable, its negation,
+//! an integer variable compared with a constant) are read without the atom
+//! machine, and they check their variable's type as they read it. In a program
+//! of at most 64 nodes and atoms the literal nodes (constants, atoms and `Not`s
+//! of them) are no steps at all but bits set by the atom reads, and a `Not` of
+//! a step's node is written by that step ([`Plan::FOLDED`]). The plan lives in
+//! the monitor itself, in arrays of `N` entries (const generics: no
+//! allocation); a program with more than `N` nodes or atoms runs the unplanned
+//! interpreter.
 
 use crate::error::StepError;
 use crate::layout::{self, SinceKind};
 use crate::program::{Atom, CmpOp, Instr, Op, Program, Ty, Value};
 
-/// The kind of a planned node.
+/// The kind of a planned step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Kind {
-    /// A constant `false` (also an unused plan entry).
-    False,
-    /// A constant `true`.
-    True,
-    /// Atom `a`.
+    /// A boolean function of `a`, `b`, the node's own last value and the first
+    /// point, read from [`Step::table`]: constants, every connective, unbounded `S`
+    /// (also an unused plan entry: `table` 0 is `false`).
+    Logic,
+    /// `Y a` / `Z a`: [`Step::table`] of the child's last value (the node's
+    /// own word) and the first point; the word then takes `a`'s value.
+    Latch,
+    /// Atom `a` (only when atoms are not folded, see [`Plan::FOLDED`]).
     Atom,
-    /// `!a`
-    Not,
-    /// `a && b`
-    And,
-    /// `a || b`
-    Or,
-    /// `a -> b`
-    Implies,
-    /// `a <-> b`
-    Iff,
-    /// `Y a`
-    Yesterday,
-    /// `Z a`
-    WeakYesterday,
-    /// `a S b`, no bound.
-    Since,
     /// `a S[0:hi] b`.
     SinceUpTo,
     /// `a S[lo:] b`, `lo > 0`.
@@ -47,7 +40,31 @@ pub(crate) enum Kind {
     SinceWindow,
 }
 
-/// One node, planned: kind, children, state slot and bounds.
+/// Bit positions of a [`Step::table`] index.
+pub(crate) const A: u16 = 1;
+/// Bit of the second child.
+pub(crate) const B: u16 = 2;
+/// Bit of the node's own value at the last point (`Logic`) or of its word (`Latch`).
+pub(crate) const C: u16 = 4;
+/// Bit set at the first point.
+pub(crate) const D: u16 = 8;
+
+/// The truth table of `f` over the four inputs of a [`Step::table`] index:
+/// bit `x` of the result is `f(x & A != 0, x & B != 0, x & C != 0, x & D != 0)`.
+fn table(f: impl Fn(bool, bool, bool, bool) -> bool) -> u16 {
+    let mut t = 0u16;
+    for x in 0..16u16 {
+        t |= (f(x & A != 0, x & B != 0, x & C != 0, x & D != 0) as u16) << x;
+    }
+    t
+}
+
+/// One step of the plan: one node (and, fused into it, the `Not` of it, see
+/// [`Step::negate`]), its kind, children, state slot and bounds.
+///
+/// Every boolean node and unbounded `S` is a 16-bit truth table over its two
+/// children's values at this point, its own value at the last point and "first
+/// point" (`kind` `Logic`): one table lookup, no dispatch per operator.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Step {
     /// Lower bound (`SinceAtLeast`, `SinceWindow`).
@@ -62,6 +79,14 @@ pub(crate) struct Step {
     pub a: u16,
     /// Second child (`rhs` for `Since`).
     pub b: u16,
+    /// The node this step computes.
+    pub dest: u16,
+    /// The node that is `Not(dest)`, computed by this step too when `negate` is 1.
+    pub neg: u16,
+    /// `Logic`, `Latch`: the value for each index `A | B | C | D` ([`table`]).
+    pub table: u16,
+    /// 1 when this step also writes `!value` to node `neg`, else 0.
+    pub negate: u8,
     /// What the node computes.
     pub kind: Kind,
 }
@@ -75,45 +100,54 @@ impl Step {
         cap: 1,
         a: 0,
         b: 0,
-        kind: Kind::False,
+        dest: 0,
+        neg: 0,
+        table: 0,
+        negate: 0,
+        kind: Kind::Logic,
     };
 
-    /// The plan of a validated node whose own words start at `slot`, or `None`
-    /// for bounds [`layout::since_kind`] rejects (validation already did).
-    fn of(op: &Op, slot: u32) -> Option<Step> {
-        let s = |kind, a, b| Step {
+    /// The plan of validated node `dest` whose own words start at `slot`, or
+    /// `None` for bounds [`layout::since_kind`] rejects (validation already did).
+    fn of(op: &Op, dest: u16, slot: u32) -> Option<Step> {
+        let s = |kind, a, b, table| Step {
             slot,
             a,
             b,
+            dest,
+            table,
             kind,
             ..Step::NONE
         };
+        let logic = |a, b, f: fn(bool, bool, bool, bool) -> bool| s(Kind::Logic, a, b, table(f));
         Some(match *op {
-            Op::Const(false) => s(Kind::False, 0, 0),
-            Op::Const(true) => s(Kind::True, 0, 0),
-            Op::Atom(a) => s(Kind::Atom, a, 0),
-            Op::Not(a) => s(Kind::Not, a, 0),
-            Op::And(a, b) => s(Kind::And, a, b),
-            Op::Or(a, b) => s(Kind::Or, a, b),
-            Op::Implies(a, b) => s(Kind::Implies, a, b),
-            Op::Iff(a, b) => s(Kind::Iff, a, b),
-            Op::Yesterday(a) => s(Kind::Yesterday, a, 0),
-            Op::WeakYesterday(a) => s(Kind::WeakYesterday, a, 0),
+            Op::Const(c) => s(Kind::Logic, 0, 0, if c { u16::MAX } else { 0 }),
+            Op::Atom(a) => s(Kind::Atom, a, 0, 0),
+            Op::Not(a) => logic(a, a, |a, _, _, _| !a),
+            Op::And(a, b) => logic(a, b, |a, b, _, _| a && b),
+            Op::Or(a, b) => logic(a, b, |a, b, _, _| a || b),
+            Op::Implies(a, b) => logic(a, b, |a, b, _, _| !a || b),
+            Op::Iff(a, b) => logic(a, b, |a, b, _, _| a == b),
+            // `Y a`: false at the first point, else a's last value (the own word).
+            Op::Yesterday(a) => s(Kind::Latch, a, a, table(|_, _, c, d| c && !d)),
+            // `Z a`: true at the first point.
+            Op::WeakYesterday(a) => s(Kind::Latch, a, a, table(|_, _, c, d| c || d)),
             Op::Since { lhs, rhs, lo, hi } => match layout::since_kind(lo, hi)? {
-                SinceKind::Unbounded => s(Kind::Since, lhs, rhs),
+                // g || (f && own last value), the last value being false at the first point.
+                SinceKind::Unbounded => logic(lhs, rhs, |f, g, c, d| g || (f && c && !d)),
                 SinceKind::UpTo(hi) => Step {
                     hi,
-                    ..s(Kind::SinceUpTo, lhs, rhs)
+                    ..s(Kind::SinceUpTo, lhs, rhs, 0)
                 },
                 SinceKind::AtLeast(lo) => Step {
                     lo,
-                    ..s(Kind::SinceAtLeast, lhs, rhs)
+                    ..s(Kind::SinceAtLeast, lhs, rhs, 0)
                 },
                 SinceKind::Window { lo, hi, cap } => Step {
                     lo,
                     hi,
                     cap: cap.max(1),
-                    ..s(Kind::SinceWindow, lhs, rhs)
+                    ..s(Kind::SinceWindow, lhs, rhs, 0)
                 },
             },
         })
@@ -166,6 +200,11 @@ pub(crate) struct AtomStep {
     pub len: u16,
     /// The shape.
     pub kind: AtomKind,
+    /// Folded plans ([`Plan::FOLDED`]): the nodes that are true when this atom is
+    /// (the atom's nodes, an even number of `Not`s over them).
+    pub pos: u64,
+    /// Folded plans: the nodes that are true when this atom is false.
+    pub neg: u64,
 }
 
 impl AtomStep {
@@ -175,6 +214,8 @@ impl AtomStep {
         var: 0,
         len: 0,
         kind: AtomKind::General,
+        pos: 0,
+        neg: 0,
     };
 
     /// The plan of a validated atom: its shape, matched on its code and the variable types.
@@ -192,8 +233,8 @@ impl AtomStep {
         let var = |var, kind, c| AtomStep {
             c,
             var,
-            len: 0,
             kind,
+            ..AtomStep::NONE
         };
         match *code {
             [Instr::Load(n)] if ty(n) == Some(Ty::Bool) => var(n, AtomKind::Bool, 0),
@@ -210,6 +251,27 @@ impl AtomStep {
             }
             _ => general,
         }
+    }
+
+    /// This atom's value when it has one of the shapes read directly and its
+    /// variable has the type declared; `None` otherwise (a value of another type,
+    /// or `General`).
+    #[inline(always)]
+    pub fn fast(&self, vals: &[Value]) -> Option<bool> {
+        // The value's variant first (one compare): a boolean variable, the most
+        // common atom, is then one test of the kind away.
+        let c = self.c;
+        Some(match (vals.get(self.var as usize)?, self.kind) {
+            (Value::Bool(b), AtomKind::Bool) => *b,
+            (Value::Bool(b), AtomKind::NotBool) => !*b,
+            (Value::Int(x), AtomKind::IntEq) => *x == c,
+            (Value::Int(x), AtomKind::IntNe) => *x != c,
+            (Value::Int(x), AtomKind::IntLt) => *x < c,
+            (Value::Int(x), AtomKind::IntLe) => *x <= c,
+            (Value::Int(x), AtomKind::IntGt) => *x > c,
+            (Value::Int(x), AtomKind::IntGe) => *x >= c,
+            _ => return None,
+        })
     }
 
     /// This atom's value; `atom` is its index (for errors).
@@ -257,27 +319,154 @@ const fn flip(op: CmpOp) -> CmpOp {
     }
 }
 
+/// What [`build`] decided for the whole program: three bytes, so that an
+/// unplanned `Monitor<'_>` (firmware) stays as small as before plans.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Plan {
+    /// The number of steps in the plan's node array.
+    pub steps: u16,
+    /// [`Plan::PLANNED`] .. [`Plan::UNREAD`].
+    pub flags: u8,
+}
+
+impl Plan {
+    /// The plan arrays hold the program (at most `N` nodes and atoms).
+    pub const PLANNED: u8 = 1;
+    /// 1 to 64 nodes and 1 to 64 atoms, not `compact`: the
+    /// literal nodes (constants, atoms and `Not`s of literals) are not steps but
+    /// bits, in each atom's [`AtomStep::pos`]/[`AtomStep::neg`] (a `true`
+    /// constant in both masks of atom 0); a `Not` of a step is fused into it
+    /// ([`Step::negate`]); the steps are the other nodes, in node order.
+    /// Otherwise there is one step per node, in node order, and none is fused.
+    pub const FOLDED: u8 = 2;
+    /// Every atom has a shape [`AtomStep::fast`] reads, at most 64 atoms and 64
+    /// variables, not `compact`: the atom reads check their variables' types,
+    /// and the whole check runs apart only when some variable is read by no atom.
+    pub const FAST: u8 = 4;
+    /// `FAST`: some variable is read by no atom.
+    pub const UNREAD: u8 = 8;
+    /// At most 64 atoms and 64 nodes (planned or not, see `Monitor::advance`).
+    pub const SMALL: u8 = 16;
+
+    /// Whether every flag of `f` is set.
+    #[inline(always)]
+    pub const fn has(&self, f: u8) -> bool {
+        self.flags & f == f
+    }
+}
+
+/// A node's value when it does not depend on the network: a constant, or
+/// atom `k` (`true`) or its negation (`false`).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Lit {
+    /// Not a literal: a step computes it.
+    No,
+    /// A constant.
+    Const(bool),
+    /// Atom `.0`, negated when `.1` is false.
+    Atom(u16, bool),
+}
+
 /// The plan of a validated `program` into `nodes` and `atoms`, `nodes_at` being
-/// [`layout::first_node_word`]; `false` (and nothing planned) when the program
+/// [`layout::first_node_word`]; `None` (and nothing planned) when the program
 /// has more nodes or atoms than the arrays hold.
 pub(crate) fn build(
     p: &Program<'_>,
     nodes_at: usize,
     nodes: &mut [Step],
     atoms: &mut [AtomStep],
-) -> bool {
+) -> Option<Plan> {
     if p.nodes.len() > nodes.len() || p.atoms.len() > atoms.len() {
-        return false;
-    }
-    for (step, n) in nodes.iter_mut().zip(p.nodes) {
-        let slot = (n.slot as usize).saturating_sub(nodes_at) as u32;
-        match Step::of(&n.op, slot) {
-            Some(s) => *step = s,
-            None => return false,
-        }
+        return None;
     }
     for (step, a) in atoms.iter_mut().zip(p.atoms) {
         *step = AtomStep::of(a, p);
     }
-    true
+    let compact = cfg!(feature = "compact");
+    // One atom word and one value word: the state opens with exactly three words.
+    let folded = !compact && (1..=64).contains(&p.nodes.len()) && (1..=64).contains(&p.atoms.len());
+    let mut plan = Plan {
+        steps: 0,
+        flags: Plan::PLANNED | if folded { Plan::FOLDED } else { 0 },
+    };
+    let planned = atoms.get(..p.atoms.len()).unwrap_or(&[]);
+    if !compact
+        && p.atoms.len() <= 64
+        && p.vars.len() <= 64
+        && planned.iter().all(|a| a.kind != AtomKind::General)
+    {
+        let mut read = 0u64;
+        for a in planned {
+            read |= 1u64 << (a.var & 63);
+        }
+        plan.flags |= Plan::FAST;
+        if read.count_ones() as usize != p.vars.len() {
+            plan.flags |= Plan::UNREAD;
+        }
+    }
+    // Folded: each node's literal value, and the step computing each non-literal node.
+    let mut lit = [Lit::No; 64];
+    let mut step_of = [u8::MAX; 64];
+    let mut n = 0usize;
+    for (i, node) in p.nodes.iter().enumerate() {
+        let slot = (node.slot as usize).saturating_sub(nodes_at) as u32;
+        let step = Step::of(&node.op, i as u16, slot)?;
+        if folded {
+            let bit = 1u64 << (i & 63);
+            let of = |c: u16| lit.get(c as usize).copied().unwrap_or(Lit::No);
+            let l = match node.op {
+                Op::Const(c) => Lit::Const(c),
+                Op::Atom(k) => Lit::Atom(k, true),
+                Op::Not(c) => match of(c) {
+                    Lit::Const(v) => Lit::Const(!v),
+                    Lit::Atom(k, pol) => Lit::Atom(k, !pol),
+                    Lit::No => Lit::No,
+                },
+                _ => Lit::No,
+            };
+            match l {
+                // True whatever atom 0 is (folded plans have one).
+                Lit::Const(v) => {
+                    let a = atoms.first_mut()?;
+                    if v {
+                        a.pos |= bit;
+                        a.neg |= bit;
+                    }
+                }
+                Lit::Atom(k, pol) => {
+                    let a = atoms.get_mut(k as usize)?;
+                    if pol {
+                        a.pos |= bit;
+                    } else {
+                        a.neg |= bit;
+                    }
+                }
+                Lit::No => {}
+            }
+            if let Some(x) = lit.get_mut(i) {
+                *x = l;
+            }
+            if l != Lit::No {
+                continue;
+            }
+            // `Not` of a step's node: that step writes it too.
+            if let Op::Not(c) = node.op {
+                let at = step_of.get(c as usize).copied().unwrap_or(u8::MAX) as usize;
+                if let Some(s) = nodes.get_mut(..n).and_then(|s| s.get_mut(at)) {
+                    if s.negate == 0 {
+                        s.negate = 1;
+                        s.neg = i as u16;
+                        continue;
+                    }
+                }
+            }
+            if let Some(x) = step_of.get_mut(i) {
+                *x = n as u8;
+            }
+        }
+        *nodes.get_mut(n)? = step;
+        n += 1;
+    }
+    plan.steps = n as u16;
+    Some(plan)
 }
