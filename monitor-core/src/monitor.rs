@@ -695,7 +695,10 @@ fn exec(
     if s.kind == Kind::Atom {
         return atom(s.a);
     }
-    let (f, g) = (bit(s.a), bit(s.b));
+    // Only the children the operator reads (`Step::reads`): in a program of more
+    // than 64 nodes a child's bit may have to be loaded from a stored word.
+    let f = s.reads & plan::A as u8 != 0 && bit(s.a);
+    let g = s.reads & plan::B as u8 != 0 && bit(s.b);
     let d = if first_point { plan::D } else { 0 };
     if s.kind == Kind::Logic {
         let x = f as u16 | (g as u16) << 1 | (own_prev as u16) << 2 | d;

@@ -49,6 +49,24 @@ pub(crate) const C: u16 = 4;
 /// Bit set at the first point.
 pub(crate) const D: u16 = 8;
 
+/// The children a truth table depends on: [`A`] if flipping `a` changes some
+/// entry, [`B`] likewise.
+const fn table_reads(table: u16) -> u8 {
+    let mut reads = 0u16;
+    let mut x = 0u16;
+    while x < 16 {
+        let v = (table >> x) & 1;
+        if (table >> (x ^ A)) & 1 != v {
+            reads |= A;
+        }
+        if (table >> (x ^ B)) & 1 != v {
+            reads |= B;
+        }
+        x += 1;
+    }
+    reads as u8
+}
+
 /// The truth table of `f` over the four inputs of a [`Step::table`] index:
 /// bit `x` of the result is `f(x & A != 0, x & B != 0, x & C != 0, x & D != 0)`.
 fn table(f: impl Fn(bool, bool, bool, bool) -> bool) -> u16 {
@@ -87,6 +105,11 @@ pub(crate) struct Step {
     pub table: u16,
     /// 1 when this step also writes `!value` to node `neg`, else 0.
     pub negate: u8,
+    /// Which children the unfolded step reads: [`A`] for `a`, [`B`] for `b` (a
+    /// constant reads neither, `Not` and `Y`/`Z` only `a`), so that a large
+    /// program's step, where a child's bit may be in a stored word, reads no more
+    /// than the operator needs.
+    pub reads: u8,
     /// What the node computes.
     pub kind: Kind,
 }
@@ -104,6 +127,7 @@ impl Step {
         neg: 0,
         table: 0,
         negate: 0,
+        reads: 0,
         kind: Kind::Logic,
     };
 
@@ -116,6 +140,12 @@ impl Step {
             b,
             dest,
             table,
+            reads: match kind {
+                Kind::Logic => table_reads(table),
+                Kind::Latch => A as u8,
+                Kind::Atom => 0,
+                _ => (A | B) as u8,
+            },
             kind,
             ..Step::NONE
         };
@@ -469,4 +499,36 @@ pub(crate) fn build(
     }
     plan.steps = n as u16;
     Some(plan)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_step_reads_only_the_children_its_operator_needs() {
+        let reads = |op: Op| Step::of(&op, 9, 0).map(|s| s.reads);
+        assert_eq!(reads(Op::Const(true)), Some(0));
+        assert_eq!(reads(Op::Const(false)), Some(0));
+        assert_eq!(reads(Op::Not(3)), Some(A as u8));
+        assert_eq!(reads(Op::Yesterday(3)), Some(A as u8));
+        for op in [
+            Op::And(1, 2),
+            Op::Or(1, 2),
+            Op::Implies(1, 2),
+            Op::Iff(1, 2),
+        ] {
+            assert_eq!(reads(op), Some((A | B) as u8));
+        }
+        let since = |lo, hi| Op::Since {
+            lhs: 1,
+            rhs: 2,
+            lo,
+            hi,
+        };
+        assert_eq!(reads(since(0, None)), Some((A | B) as u8));
+        assert_eq!(reads(since(0, Some(5))), Some((A | B) as u8));
+        assert_eq!(reads(since(2, Some(5))), Some((A | B) as u8));
+        assert_eq!(table_reads(table(|_, b, _, _| b)), B as u8);
+    }
 }
