@@ -304,22 +304,14 @@ impl AtomStep {
         })
     }
 
-    /// This atom's value; `atom` is its index (for errors).
+    /// This atom's value; `atom` is its index (for errors): [`AtomStep::fast`],
+    /// else the atom machine (`General`) or, for a value of another type than
+    /// declared (the caller checked, so never), the machine's error.
     #[inline(always)]
     pub fn eval(&self, instrs: &[Instr], vals: &[Value], atom: usize) -> Result<bool, StepError> {
-        // The variables' types were checked by the caller, so the fallbacks only
-        // keep this total; they give the general machine's result and error.
-        let c = self.c;
-        match (self.kind, vals.get(self.var as usize)) {
-            (AtomKind::Bool, Some(Value::Bool(b))) => Ok(*b),
-            (AtomKind::NotBool, Some(Value::Bool(b))) => Ok(!*b),
-            (AtomKind::IntEq, Some(Value::Int(x))) => Ok(*x == c),
-            (AtomKind::IntNe, Some(Value::Int(x))) => Ok(*x != c),
-            (AtomKind::IntLt, Some(Value::Int(x))) => Ok(*x < c),
-            (AtomKind::IntLe, Some(Value::Int(x))) => Ok(*x <= c),
-            (AtomKind::IntGt, Some(Value::Int(x))) => Ok(*x > c),
-            (AtomKind::IntGe, Some(Value::Int(x))) => Ok(*x >= c),
-            _ => self.general(instrs, vals, atom),
+        match self.fast(vals) {
+            Some(v) => Ok(v),
+            None => self.general(instrs, vals, atom),
         }
     }
 
