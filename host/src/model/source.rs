@@ -95,9 +95,13 @@ pub(crate) fn resolve_entity(name: &str) -> Option<char> {
 /// one line break, so one space).
 const ATTR_WHITESPACE: [char; 3] = ['\t', '\n', '\r'];
 
+/// The characters an attribute value's decoding stops at: a reference, or whitespace
+/// to normalise.
+pub(crate) const ATTR_SPECIAL: [char; 4] = ['&', '\t', '\n', '\r'];
+
 /// The bytes of raw attribute text at the start of `rest` that normalise to one space
 /// (`\r\n` is 2), or `None` when `rest` does not start with a line break or tab.
-fn normalised_space(rest: &str) -> Option<usize> {
+pub(crate) fn normalised_space(rest: &str) -> Option<usize> {
     if rest.starts_with("\r\n") {
         Some(2)
     } else if rest.starts_with(ATTR_WHITESPACE) {
@@ -114,13 +118,12 @@ fn normalised_space(rest: &str) -> Option<usize> {
 /// 3.3.3), which AS2FM gets from lxml: an `expr` written over two lines reads the same
 /// in both tools. `Err` gives the byte offset of a bad reference and what is wrong.
 pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, String)> {
-    const SPECIAL: [char; 4] = ['&', '\t', '\n', '\r'];
-    if !raw.contains(SPECIAL) {
+    if !raw.contains(ATTR_SPECIAL) {
         return Ok(std::borrow::Cow::Borrowed(raw));
     }
     let mut out = String::with_capacity(raw.len());
     let mut pos = 0usize;
-    while let Some(i) = raw[pos..].find(SPECIAL) {
+    while let Some(i) = raw[pos..].find(ATTR_SPECIAL) {
         out.push_str(&raw[pos..pos + i]);
         pos += i;
         let rest = &raw[pos..];

@@ -223,28 +223,18 @@ pub(crate) fn unescape_attribute(
             at += consumed;
             continue;
         }
-        // A run up to the next reference or line break.
-        let run = rest.find(['&', '\n']).map_or(rest.len(), |i| {
-            if rest.as_bytes()[i] == b'\n' {
-                i + 1
-            } else {
-                i
-            }
-        });
-        let chunk = &rest[..run];
-        // A `\r\n` pair is one line break, so one space (XML 1.0 section 2.11).
-        let normalised: String = chunk
-            .replace("\r\n", "\n")
-            .chars()
-            .map(|c| {
-                if matches!(c, '\t' | '\n' | '\r') {
-                    ' '
-                } else {
-                    c
-                }
-            })
-            .collect();
-        out.push_exact(&normalised, lines.location(at));
+        // A tab or line break is one space (`\r\n` one): the model reader's rule.
+        if let Some(consumed) = crate::model::source::normalised_space(rest) {
+            out.push_exact(" ", lines.location(at));
+            rest = &rest[consumed..];
+            at += consumed;
+            continue;
+        }
+        // A run up to the next reference, tab or line break, copied as it is.
+        let run = rest
+            .find(crate::model::source::ATTR_SPECIAL)
+            .unwrap_or(rest.len());
+        out.push_exact(&rest[..run], lines.location(at));
         rest = &rest[run..];
         at += run;
     }
