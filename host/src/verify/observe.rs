@@ -316,9 +316,14 @@ pub struct Judge<'a> {
     /// The program has no `Y` / `Z` node: a point equal to the last one stepped (same
     /// time, same values) leaves the monitor state and verdicts exactly as they are.
     repeat_is_noop: bool,
-    /// The time and values of the last point stepped (`None` before the first).
+    /// The time of the last point stepped (`None` before the first).
     last_time: Option<u64>,
-    last_vals: Vec<Value>,
+    /// Some value may differ from the last point stepped: set by every write that
+    /// changes a value, cleared by a step. Tracked per write, so that telling a
+    /// repeated point costs nothing per variable.
+    changed: bool,
+    /// The event variables that may hold `true`: the ones the next point clears.
+    raised: Vec<usize>,
 }
 
 impl<'a> Judge<'a> {
@@ -340,7 +345,8 @@ impl<'a> Judge<'a> {
             decided: false,
             repeat_is_noop,
             last_time: None,
-            last_vals: vals.clone(),
+            changed: true,
+            raised: Vec::new(),
             vals,
         })
     }
@@ -349,6 +355,11 @@ impl<'a> Judge<'a> {
     pub fn start(&mut self) -> Flow {
         let vars = self.monitor.program().vars;
         valuation::init(vars, &mut self.vals);
+        self.raised.clear();
+        self.raised.extend(
+            (0..vars.len()).filter(|&v| vars[v].kind == VarKind::Event && !is_false(self.vals[v])),
+        );
+        self.changed = true;
         self.state.fill(0);
         self.error = None;
         self.decided = false;
@@ -391,14 +402,11 @@ impl<'a> Judge<'a> {
         // extend the newest run to the same time), so the state after the step would be
         // bit for bit the one before it, and so the verdicts and their finality. Most
         // points of a run (messages that set no port) repeat the last one.
-        if self.repeat_is_noop
-            && self.last_time == Some(time)
-            && same_values(&self.vals, &self.last_vals)
-        {
+        if self.repeat_is_noop && self.last_time == Some(time) && !self.changed {
             return Flow::Continue;
         }
         self.last_time = Some(time);
-        self.last_vals.copy_from_slice(&self.vals);
+        self.changed = false;
         if let Err(e) = self
             .monitor
             .try_step(&mut self.state, time, &self.vals, &mut self.verdicts)
@@ -421,8 +429,27 @@ impl<'a> Judge<'a> {
         Flow::Continue
     }
 
+    /// Starts a point: every event variable becomes `false`
+    /// ([`valuation::begin_point`]'s rule), touching only the ones that were raised.
     fn begin(&mut self) {
-        valuation::begin_point(self.monitor.program().vars, &mut self.vals);
+        for v in self.raised.drain(..) {
+            if !is_false(self.vals[v]) {
+                self.vals[v] = Value::Bool(false);
+                self.changed = true;
+            }
+        }
+    }
+
+    /// Writes variable `var` of this point.
+    fn write(&mut self, var: usize, value: Value) {
+        if same_value(self.vals[var], value) {
+            return;
+        }
+        self.vals[var] = value;
+        self.changed = true;
+        if self.monitor.program().vars[var].kind == VarKind::Event {
+            self.raised.push(var);
+        }
     }
 
     fn convert(&self, v: SimValue<'_>, ty: Ty) -> Option<Value> {
@@ -514,17 +541,20 @@ impl<'a> Judge<'a> {
     }
 }
 
-/// Whether two valuations are identical (floats bit for bit, so `-0.0` differs from `0.0`
+/// Whether two values are identical (floats bit for bit, so `-0.0` differs from `0.0`
 /// and a NaN equals itself: the atoms see exactly the same input).
-fn same_values(a: &[Value], b: &[Value]) -> bool {
-    a.len() == b.len()
-        && a.iter().zip(b).all(|(x, y)| match (x, y) {
-            (Value::Bool(x), Value::Bool(y)) => x == y,
-            (Value::Int(x), Value::Int(y)) => x == y,
-            (Value::Float(x), Value::Float(y)) => x.to_bits() == y.to_bits(),
-            (Value::Str(x), Value::Str(y)) => x == y,
-            _ => false,
-        })
+fn same_value(a: Value, b: Value) -> bool {
+    match (a, b) {
+        (Value::Bool(x), Value::Bool(y)) => x == y,
+        (Value::Int(x), Value::Int(y)) => x == y,
+        (Value::Float(x), Value::Float(y)) => x.to_bits() == y.to_bits(),
+        (Value::Str(x), Value::Str(y)) => x == y,
+        _ => false,
+    }
+}
+
+fn is_false(v: Value) -> bool {
+    same_value(v, Value::Bool(false))
 }
 
 impl Observer for Judge<'_> {
@@ -550,7 +580,7 @@ impl Observer for Judge<'_> {
                     .and_then(|v| self.part(v, path, *length, decl.ty, msg.model())),
             };
             match value {
-                Some(v) => self.vals[port.var] = v,
+                Some(v) => self.write(port.var, v),
                 None => {
                     self.error = Some(format!(
                         "time {time}: `{}` from {} to {}: parameter for `{}` is not a {:?}",
@@ -616,7 +646,7 @@ fn missing_param(model: &CompiledModel, event: EventId, param: &str) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::same_values;
+    use super::{same_value, Judge, PropertySet};
     use monitor_core::{analysis, valuation, Monitor, Value};
 
     /// The fact [`super::Judge`] relies on to skip repeated points: without `Y` / `Z`, a
@@ -677,15 +707,106 @@ mod tests {
         assert!(repeats > 1000);
     }
 
+    /// The judge tells a repeated point by tracking writes, not by comparing every
+    /// variable. Oracle: a monitor of the same program stepped at every point, its
+    /// variables kept by [`valuation::begin_point`]; after every point the judge's
+    /// verdicts, values and state must equal the oracle's. Random points at repeated and
+    /// advancing times write random values (often the value already held, often none).
+    #[test]
+    fn tracked_writes_skip_exactly_the_repeated_points() {
+        use crate::sim::{CompiledModel, Flow};
+        let machine = "<scxml name=\"a\" initial=\"s0\" version=\"1.0\" \
+            xmlns=\"http://www.w3.org/2005/07/scxml\"><datamodel>\
+            <data id=\"x\" type=\"int32\" expr=\"0\"/></datamodel>\
+            <state id=\"s0\"><onentry><send event=\"e\" target=\"b\">\
+            <param name=\"v\" expr=\"x\"/></send></onentry></state></scxml>";
+        let sink = "<scxml name=\"b\" initial=\"s0\" version=\"1.0\" \
+            xmlns=\"http://www.w3.org/2005/07/scxml\"><state id=\"s0\"/></scxml>";
+        let model = CompiledModel::compile(
+            crate::model::ModelSource::from_texts([("a.scxml", machine), ("b.scxml", sink)])
+                .unwrap(),
+        )
+        .unwrap();
+        let props = "<properties><ports>\
+            <scxml_event_send event=\"e\" origin=\"a\" target=\"b\">\
+            <event_var id=\"p\"/><event_var id=\"q\"/>\
+            <state_var id=\"n\" param=\"v\" type=\"int32\" expr=\"0\"/>\
+            </scxml_event_send></ports><guarantees>\
+            <property id=\"g1\" logic=\"pmtl\" expr=\"historically({p} -> once {n &gt; 2})\"/>\
+            <property id=\"g2\" logic=\"pmtl\" expr=\"{q} since[1:3] {n == 1}\"/>\
+            <property id=\"g3\" logic=\"pmtl\" expr=\"once[0:2] ({p} &amp;&amp; !{q})\"/>\
+            <property id=\"g4\" logic=\"pmtl\" expr=\"!{p} since[2:] {n &lt; 2}\"/>\
+            </guarantees></properties>";
+        let file = crate::props::parse_str(props, std::path::Path::new("p.xml")).unwrap();
+        let set = PropertySet::new(&file, &model).unwrap();
+        let mut judge = Judge::new(&set).unwrap();
+        let program = set.compiled().program();
+        let oracle = Monitor::try_new(program).unwrap();
+        let var = |name: &str| set.compiled().var_index(name).unwrap();
+        let (p, q, n) = (var("p"), var("q"), var("n"));
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let (mut repeats, mut steps) = (0, 0);
+        for _ in 0..30 {
+            let mut st = vec![0; oracle.state_words()];
+            let mut vals = vec![Value::Bool(false); program.vars.len()];
+            valuation::init(program.vars, &mut vals);
+            let mut out = vec![false; oracle.properties()];
+            assert_eq!(judge.start(), Flow::Continue);
+            oracle.try_step(&mut st, 0, &vals, &mut out).unwrap();
+            let mut t = 0;
+            let mut last = (0, vals.clone());
+            for _ in 0..120 {
+                let r = next();
+                t += [0, 0, 0, 1, 2][(r % 5) as usize];
+                judge.begin();
+                valuation::begin_point(program.vars, &mut vals);
+                let mut writes = Vec::new();
+                if r >> 8 & 3 == 0 {
+                    writes.push((p, Value::Bool(true)));
+                }
+                if r >> 10 & 3 == 0 {
+                    writes.push((q, Value::Bool(true)));
+                }
+                if r >> 12 & 3 == 0 {
+                    writes.push((n, Value::Int((r >> 14) as i64 % 4)));
+                }
+                for (v, value) in writes {
+                    judge.write(v, value);
+                    vals[v] = value;
+                }
+                let repeat = t == last.0 && vals == last.1;
+                last = (t, vals.clone());
+                let flow = judge.step(t);
+                oracle.try_step(&mut st, t, &vals, &mut out).unwrap();
+                assert_eq!(judge.values(), &vals[..]);
+                assert_eq!(judge.state, st, "at time {t}");
+                assert_eq!(judge.verdicts(), &out[..], "at time {t}");
+                if repeat {
+                    repeats += 1;
+                } else {
+                    steps += 1;
+                }
+                if flow == Flow::Stop {
+                    break;
+                }
+            }
+        }
+        // Both kinds of point came many times.
+        assert!(repeats > 200 && steps > 200, "{repeats} {steps}");
+    }
+
     #[test]
     fn floats_compare_bit_for_bit() {
-        let a = [Value::Float(0.0), Value::Int(1)];
-        assert!(same_values(&a, &a));
-        assert!(!same_values(&a, &[Value::Float(-0.0), Value::Int(1)]));
-        assert!(same_values(
-            &[Value::Float(f64::NAN)],
-            &[Value::Float(f64::NAN)]
-        ));
-        assert!(!same_values(&[Value::Int(1)], &[Value::Float(1.0)]));
+        assert!(same_value(Value::Float(0.0), Value::Float(0.0)));
+        assert!(!same_value(Value::Float(0.0), Value::Float(-0.0)));
+        assert!(same_value(Value::Float(f64::NAN), Value::Float(f64::NAN)));
+        assert!(!same_value(Value::Int(1), Value::Float(1.0)));
+        assert!(!same_value(Value::Bool(false), Value::Int(0)));
     }
 }
