@@ -121,16 +121,119 @@ pub(crate) fn eval(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, St
         }
         _ => {}
     }
+    #[cfg(feature = "compact")]
+    {
+        eval_words(code, vals, atom)
+    }
     // The stack never holds more values than the code has instructions: a short
     // atom gets a short stack to clear.
-    if !cfg!(feature = "compact") && code.len() <= 8 {
+    #[cfg(not(feature = "compact"))]
+    if code.len() <= 8 {
         eval_stack::<8>(code, vals, atom)
     } else {
         eval_stack::<MAX_STACK>(code, vals, atom)
     }
 }
 
+/// A value as one word of the `compact` machine: its payload without its
+/// variant (a `bool` 0 or 1, an `i64` or `f64`'s bits, a string id).
+#[cfg(feature = "compact")]
+#[inline(always)]
+fn word(v: Value) -> u64 {
+    match v {
+        Value::Bool(b) => b as u64,
+        Value::Int(i) => i as u64,
+        Value::Float(f) => f.to_bits(),
+        Value::Str(s) => s as u64,
+    }
+}
+
+/// The `compact` atom machine: a stack of words, not of [`Value`]s (8 bytes
+/// a slot instead of 16, stored with one instruction, no variant to match).
+/// [`check`] typed every instruction's operands on load and the step checks
+/// every variable's value against its declared type before any atom, so the
+/// instructions' own types ([`NumTy`], the `Ty` of `Cmp`) say what each word
+/// holds: the results and errors of checked code over checked values are
+/// [`eval_stack`]'s.
+#[cfg(feature = "compact")]
+fn eval_words(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, StepError> {
+    let mut stack = [0u64; MAX_STACK];
+    let mut sp = 0usize;
+    let arith = StepError::Arithmetic { atom };
+    for ins in code {
+        // Checked programs never underflow or overflow; the guards only keep this panic-free.
+        let pops = match *ins {
+            Instr::Push(_) | Instr::Load(_) => 0,
+            Instr::Not | Instr::Neg(_) | Instr::ToFloat => 1,
+            _ => 2,
+        };
+        let Some(base) = sp.checked_sub(pops) else {
+            return Err(arith);
+        };
+        let a = stack.get(base).copied().unwrap_or(0);
+        let b = stack.get(sp.wrapping_sub(1)).copied().unwrap_or(0);
+        let v = match *ins {
+            Instr::Push(v) => word(v),
+            Instr::Load(n) => match vals.get(n as usize) {
+                Some(v) => word(*v),
+                None => return Err(StepError::VarType { var: n }),
+            },
+            Instr::Not => a ^ 1,
+            Instr::And => a & b,
+            Instr::Or => a | b,
+            Instr::Neg(NumTy::Int) => (a as i64).checked_neg().ok_or(arith)? as u64,
+            Instr::Add(NumTy::Int) => (a as i64).checked_add(b as i64).ok_or(arith)? as u64,
+            Instr::Sub(NumTy::Int) => (a as i64).checked_sub(b as i64).ok_or(arith)? as u64,
+            Instr::Mul(NumTy::Int) => (a as i64).checked_mul(b as i64).ok_or(arith)? as u64,
+            #[cfg(feature = "int-div")]
+            Instr::Div(NumTy::Int) => (a as i64).checked_div(b as i64).ok_or(arith)? as u64,
+            #[cfg(feature = "int-div")]
+            Instr::Rem(NumTy::Int) => (a as i64).checked_rem(b as i64).ok_or(arith)? as u64,
+            Instr::Cmp(op, Ty::Int) => int_cmp(op, a as i64, b as i64) as u64,
+            #[cfg(feature = "float")]
+            Instr::Cmp(op, Ty::Float) => {
+                cmp(op, f64::from_bits(a).partial_cmp(&f64::from_bits(b))) as u64
+            }
+            // Booleans and string ids: equal words are equal values.
+            Instr::Cmp(op, _) => cmp(op, Some(a.cmp(&b))) as u64,
+            #[cfg(feature = "float")]
+            Instr::Neg(NumTy::Float) => (-f64::from_bits(a)).to_bits(),
+            #[cfg(feature = "float")]
+            Instr::ToFloat => (a as i64 as f64).to_bits(),
+            #[cfg(feature = "float")]
+            Instr::Add(NumTy::Float)
+            | Instr::Sub(NumTy::Float)
+            | Instr::Mul(NumTy::Float)
+            | Instr::Div(NumTy::Float)
+            | Instr::Rem(NumTy::Float) => {
+                let (x, y) = (f64::from_bits(a), f64::from_bits(b));
+                match *ins {
+                    Instr::Add(_) => x + y,
+                    Instr::Sub(_) => x - y,
+                    Instr::Mul(_) => x * y,
+                    Instr::Div(_) => x / y,
+                    _ => x % y,
+                }
+                .to_bits()
+            }
+            // What this build leaves out (`enabled` rejected it on load).
+            #[allow(unreachable_patterns)]
+            _ => return Err(arith),
+        };
+        let Some(slot) = stack.get_mut(base) else {
+            return Err(arith);
+        };
+        *slot = v;
+        sp = base + 1;
+    }
+    match (sp, stack.first()) {
+        (1, Some(&b)) => Ok(b != 0),
+        _ => Err(arith),
+    }
+}
+
 /// The general stack machine, with room for `D` values.
+#[cfg(not(feature = "compact"))]
 fn eval_stack<const D: usize>(
     code: &[Instr],
     vals: &[Value],
@@ -185,6 +288,7 @@ fn eval_stack<const D: usize>(
     }
 }
 
+#[cfg(not(feature = "compact"))]
 fn binary(ins: Instr, a: Value, b: Value) -> Option<Value> {
     #[cfg(feature = "float")]
     use Value::Float;
