@@ -6,11 +6,17 @@ use crate::program::{CmpOp, Instr, NumTy, Ty, Value, Var};
 /// Deepest stack an atom may use; deeper expressions are rejected by the compiler.
 pub const MAX_STACK: usize = 32;
 
+// [`check`] keeps its stack of types in a `u64`, two bits a type.
+const _: () = assert!(MAX_STACK * 2 <= 64);
+
 /// Type-checks one atom's bytecode against the variable types; `true` when it
 /// never underflows, never exceeds [`MAX_STACK`], types every operand and leaves
 /// exactly one boolean.
 pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> bool {
-    let mut stack = [Ty::Bool; MAX_STACK];
+    // The stack of types, two bits a type with the top in the low bits
+    // ([`MAX_STACK`] of them fill a `u64`): no array to clear (a `memset`
+    // call in firmware) and no bounds to check.
+    let mut stack = 0u64;
     let mut sp = 0usize;
     if code.is_empty() {
         return false;
@@ -49,24 +55,21 @@ pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> bool {
         if sp < pops.len() {
             return false;
         }
-        for (k, want) in pops.iter().enumerate() {
-            // `get`, not indexing: no bounds-check panic (and its message
-            // formatting) in a firmware image that loads tables.
-            if stack.get(sp - pops.len() + k) != Some(want) {
+        // Popped right first: the last of `pops` is on top.
+        for want in pops.iter().rev() {
+            if stack & 3 != *want as u64 {
                 return false;
             }
+            stack >>= 2;
         }
         sp -= pops.len();
         if sp >= MAX_STACK {
             return false;
         }
-        let Some(slot) = stack.get_mut(sp) else {
-            return false;
-        };
-        *slot = push;
+        stack = stack << 2 | push as u64;
         sp += 1;
     }
-    sp == 1 && stack[0] == Ty::Bool
+    sp == 1 && stack == Ty::Bool as u64
 }
 
 /// Whether this build evaluates `code`: without feature `float` no

@@ -180,19 +180,17 @@ impl<'a> Reader<'a> {
         })
     }
 
-    fn var(&mut self) -> Option<Var<'a>> {
-        let mut var = Var {
-            name: self.str()?,
-            ty: self.ty()?,
-            kind: match self.variant()? {
-                0 => VarKind::Event,
-                1 => VarKind::State,
-                _ => return None,
-            },
-            init: Value::Bool(false),
+    /// A variable, written into `out` field by field: returned as an
+    /// `Option<Var>` it was copied once more through `memcpy` (code size).
+    fn var(&mut self, out: &mut Var<'a>) -> Option<()> {
+        out.name = self.str()?;
+        out.ty = self.ty()?;
+        out.kind = match self.variant()? {
+            0 => VarKind::Event,
+            1 => VarKind::State,
+            _ => return None,
         };
-        self.value(&mut var.init)?;
-        Some(var)
+        self.value(&mut out.init)
     }
 
     fn instr(&mut self) -> Option<Instr> {
@@ -295,6 +293,25 @@ impl<'a> Reader<'a> {
         }
         Some(len)
     }
+
+    /// [`Reader::seq`] for elements read in place: each starts as `blank`
+    /// and `read` writes its fields.
+    fn seq_in<T: Copy>(
+        &mut self,
+        blank: T,
+        read: impl Fn(&mut Self, &mut T) -> Option<()>,
+        mut put: impl FnMut(usize, T) -> bool,
+    ) -> Option<usize> {
+        let len = self.varint(usize::BITS)? as usize;
+        for i in 0..len {
+            let mut element = blank;
+            read(self, &mut element)?;
+            if !put(i, element) {
+                return None;
+            }
+        }
+        Some(len)
+    }
 }
 
 /// Where [`read_program`] puts each element of a table, as it reads it.
@@ -356,7 +373,16 @@ pub fn read_program<'a>(bytes: &'a [u8], sink: &mut impl Sink<'a>) -> Result<Cou
 fn read_body<'a>(r: &mut Reader<'a>, sink: &mut impl Sink<'a>) -> Option<Counts> {
     sink.tick_ns(r.u64()?);
     let counts = Counts {
-        vars: r.seq(Reader::var, |i, v| sink.var(i, v))?,
+        vars: r.seq_in(
+            Var {
+                name: "",
+                ty: Ty::Bool,
+                kind: VarKind::Event,
+                init: Value::Bool(false),
+            },
+            Reader::var,
+            |i, v| sink.var(i, v),
+        )?,
         strings: r.seq(Reader::str, |i, s| sink.string(i, s))?,
         instrs: r.seq(Reader::instr, |i, ins| sink.instr(i, ins))?,
         atoms: r.seq(Reader::atom, |i, a| sink.atom(i, a))?,
