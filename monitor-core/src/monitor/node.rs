@@ -213,12 +213,17 @@ fn window_capacity(lo: u64, hi: u64) -> usize {
     (layout::div(hi, hi - (lo - 1), 32) as usize).saturating_add(1)
 }
 
-#[inline(always)]
+/// State word `i` (0 past the end: never, the slots were validated). Under
+/// `compact` one shared copy of it and of [`wr`], not one bounds check per
+/// use (firmware: about 110 B of flash less).
+#[cfg_attr(not(feature = "compact"), inline(always))]
+#[cfg_attr(feature = "compact", inline(never))]
 pub(super) fn rd(w: &[u64], i: usize) -> u64 {
     w.get(i).copied().unwrap_or(0)
 }
 
-#[inline(always)]
+#[cfg_attr(not(feature = "compact"), inline(always))]
+#[cfg_attr(feature = "compact", inline(never))]
 pub(super) fn wr(w: &mut [u64], i: usize, v: u64) {
     if let Some(x) = w.get_mut(i) {
         *x = v;
