@@ -175,12 +175,17 @@ fn eval_words(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, StepErr
         };
         let a = stack.get(base).copied().unwrap_or(0);
         let b = stack.get(sp.wrapping_sub(1)).copied().unwrap_or(0);
-        let v = match *ins {
-            Instr::Push(v) => word(v),
-            Instr::Load(n) => match vals.get(n as usize) {
-                Some(v) => word(*v),
-                None => return Err(StepError::VarType { var: n }),
+        // A pushed or loaded value, converted at one place.
+        let operand = match ins {
+            Instr::Push(v) => Some(v),
+            Instr::Load(n) => match vals.get(*n as usize) {
+                Some(v) => Some(v),
+                None => return Err(StepError::VarType { var: *n }),
             },
+            _ => None,
+        };
+        let v = match *ins {
+            _ if operand.is_some() => operand.map_or(0, |v| word(*v)),
             Instr::Not => a ^ 1,
             Instr::And => a & b,
             Instr::Or => a | b,
@@ -192,13 +197,17 @@ fn eval_words(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, StepErr
             Instr::Div(NumTy::Int) => (a as i64).checked_div(b as i64).ok_or(arith)? as u64,
             #[cfg(feature = "int-div")]
             Instr::Rem(NumTy::Int) => (a as i64).checked_rem(b as i64).ok_or(arith)? as u64,
-            Instr::Cmp(op, Ty::Int) => int_cmp(op, a as i64, b as i64) as u64,
-            #[cfg(feature = "float")]
-            Instr::Cmp(op, Ty::Float) => {
-                cmp(op, f64::from_bits(a).partial_cmp(&f64::from_bits(b))) as u64
+            // One comparison of orderings for every type: integers signed,
+            // booleans and string ids as words (equal words are equal values).
+            Instr::Cmp(op, ty) => {
+                let ord = match ty {
+                    Ty::Int => Some((a as i64).cmp(&(b as i64))),
+                    #[cfg(feature = "float")]
+                    Ty::Float => f64::from_bits(a).partial_cmp(&f64::from_bits(b)),
+                    _ => Some(a.cmp(&b)),
+                };
+                cmp(op, ord) as u64
             }
-            // Booleans and string ids: equal words are equal values.
-            Instr::Cmp(op, _) => cmp(op, Some(a.cmp(&b))) as u64,
             #[cfg(feature = "float")]
             Instr::Neg(NumTy::Float) => (-f64::from_bits(a)).to_bits(),
             #[cfg(feature = "float")]
