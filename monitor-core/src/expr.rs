@@ -245,7 +245,7 @@ fn eval_words(code: &[Instr], vals: &[Value], atom: u16) -> Result<bool, StepErr
 }
 
 /// The general stack machine, with room for `D` values.
-#[cfg(not(feature = "compact"))]
+#[cfg(any(test, not(feature = "compact")))]
 fn eval_stack<const D: usize>(
     code: &[Instr],
     vals: &[Value],
@@ -300,7 +300,7 @@ fn eval_stack<const D: usize>(
     }
 }
 
-#[cfg(not(feature = "compact"))]
+#[cfg(any(test, not(feature = "compact")))]
 fn binary(ins: Instr, a: Value, b: Value) -> Option<Value> {
     #[cfg(feature = "float")]
     use Value::Float;
@@ -371,5 +371,123 @@ fn cmp(op: CmpOp, ord: Option<core::cmp::Ordering>) -> bool {
         (CmpOp::Le, Some(o)) => o != Greater,
         (CmpOp::Gt, Some(o)) => o == Greater,
         (CmpOp::Ge, Some(o)) => o != Less,
+    }
+}
+
+#[cfg(all(test, feature = "compact"))]
+mod tests {
+    extern crate std;
+    use std::{vec, vec::Vec};
+
+    use super::{eval_stack, eval_words, MAX_STACK};
+    use crate::program::{CmpOp, Instr, NumTy, Ty, Value};
+
+    const CMPS: [CmpOp; 6] = [
+        CmpOp::Eq,
+        CmpOp::Ne,
+        CmpOp::Lt,
+        CmpOp::Le,
+        CmpOp::Gt,
+        CmpOp::Ge,
+    ];
+
+    /// The word machine gives the value machine's result (verdict or error)
+    /// on checked code over every instruction, at the extremes of each type.
+    #[test]
+    fn the_word_machine_agrees_with_the_value_machine() {
+        let mut codes: Vec<Vec<Instr>> = Vec::new();
+        let ints = [0i64, 1, -1, 7, -3, i64::MAX, i64::MIN];
+        let mut int_ops = vec![
+            Instr::Add(NumTy::Int),
+            Instr::Sub(NumTy::Int),
+            Instr::Mul(NumTy::Int),
+        ];
+        if cfg!(feature = "int-div") {
+            int_ops.extend([Instr::Div(NumTy::Int), Instr::Rem(NumTy::Int)]);
+        }
+        for &a in &ints {
+            for &b in &ints {
+                for &op in &int_ops {
+                    for &c in &CMPS {
+                        codes.push(vec![
+                            Instr::Push(Value::Int(a)),
+                            Instr::Load(0),
+                            op,
+                            Instr::Push(Value::Int(b)),
+                            Instr::Cmp(c, Ty::Int),
+                        ]);
+                    }
+                }
+                for &c in &CMPS {
+                    codes.push(vec![
+                        Instr::Push(Value::Int(a)),
+                        Instr::Neg(NumTy::Int),
+                        Instr::Push(Value::Int(b)),
+                        Instr::Cmp(c, Ty::Int),
+                    ]);
+                }
+            }
+        }
+        for a in [false, true] {
+            for b in [false, true] {
+                for op in [Instr::And, Instr::Or] {
+                    codes.push(vec![
+                        Instr::Push(Value::Bool(a)),
+                        Instr::Push(Value::Bool(b)),
+                        op,
+                        Instr::Not,
+                    ]);
+                }
+                for c in [CmpOp::Eq, CmpOp::Ne] {
+                    codes.push(vec![
+                        Instr::Push(Value::Bool(a)),
+                        Instr::Push(Value::Bool(b)),
+                        Instr::Cmp(c, Ty::Bool),
+                    ]);
+                    codes.push(vec![
+                        Instr::Push(Value::Str(a as u32)),
+                        Instr::Push(Value::Str(b as u32 + 7)),
+                        Instr::Cmp(c, Ty::Str),
+                    ]);
+                }
+            }
+        }
+        if cfg!(feature = "float") {
+            let floats = [0.0, -0.0, 1.5, -2.25, f64::NAN, f64::INFINITY, f64::MAX];
+            let ops = [
+                Instr::Add(NumTy::Float),
+                Instr::Sub(NumTy::Float),
+                Instr::Mul(NumTy::Float),
+                Instr::Div(NumTy::Float),
+                Instr::Rem(NumTy::Float),
+            ];
+            for &a in &floats {
+                for &b in &floats {
+                    for &op in &ops {
+                        for &c in &CMPS {
+                            codes.push(vec![
+                                Instr::Push(Value::Float(a)),
+                                Instr::Push(Value::Float(b)),
+                                op,
+                                Instr::Neg(NumTy::Float),
+                                Instr::Load(0),
+                                Instr::ToFloat,
+                                Instr::Cmp(c, Ty::Float),
+                            ]);
+                        }
+                    }
+                }
+            }
+        }
+        for x in [0i64, 5, -5, i64::MIN] {
+            let vals = [Value::Int(x)];
+            for code in &codes {
+                assert_eq!(
+                    eval_words(code, &vals, 3),
+                    eval_stack::<MAX_STACK>(code, &vals, 3),
+                    "{code:?} over {x}"
+                );
+            }
+        }
     }
 }
