@@ -1,5 +1,6 @@
 //! The atom stack machine: type-checked once on load, then evaluated with a fixed stack.
 
+use crate::analysis::Arithmetic;
 use crate::error::StepError;
 use crate::program::{CmpOp, Instr, NumTy, Ty, Value, Var};
 
@@ -9,24 +10,26 @@ pub const MAX_STACK: usize = 32;
 // [`check`] keeps its stack of types in a `u64`, two bits a type.
 const _: () = assert!(MAX_STACK * 2 <= 64);
 
-/// Type-checks one atom's bytecode against the variable types; `true` when it
+/// Type-checks one atom's bytecode against the variable types: when it
 /// never underflows, never exceeds [`MAX_STACK`], types every operand and leaves
-/// exactly one boolean.
-pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> bool {
+/// exactly one boolean, what it computes ([`enabled`] says whether this build
+/// does), else `None`.
+pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> Option<Arithmetic> {
     // The stack of types, two bits a type with the top in the low bits
     // ([`MAX_STACK`] of them fill a `u64`): no array to clear (a `memset`
     // call in firmware) and no bounds to check.
     let mut stack = 0u64;
     let mut sp = 0usize;
+    let mut needs = Arithmetic::default();
     if code.is_empty() {
-        return false;
+        return None;
     }
     for ins in code {
         let (pops, push): (&[Ty], Ty) = match *ins {
             Instr::Push(v) => (&[], v.ty()),
             Instr::Load(n) => match vars.get(n as usize) {
                 Some(v) => (&[], v.ty),
-                None => return false,
+                None => return None,
             },
             Instr::Not => (&[Ty::Bool], Ty::Bool),
             Instr::And | Instr::Or => (&[Ty::Bool, Ty::Bool], Ty::Bool),
@@ -41,7 +44,7 @@ pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> bool {
             Instr::Cmp(op, ty) => {
                 let ordered = matches!(op, CmpOp::Lt | CmpOp::Le | CmpOp::Gt | CmpOp::Ge);
                 if ordered && matches!(ty, Ty::Bool | Ty::Str) {
-                    return false;
+                    return None;
                 }
                 match ty {
                     Ty::Bool => (&[Ty::Bool, Ty::Bool], Ty::Bool),
@@ -52,35 +55,36 @@ pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> bool {
             }
             Instr::ToFloat => (&[Ty::Int], Ty::Float),
         };
+        // A float pushed or popped; `analysis::arithmetic`'s rules.
+        needs.float |= push == Ty::Float || pops.first() == Some(&Ty::Float);
+        needs.int_div |= matches!(ins, Instr::Div(NumTy::Int) | Instr::Rem(NumTy::Int));
         if sp < pops.len() {
-            return false;
+            return None;
         }
         // Popped right first: the last of `pops` is on top.
         for want in pops.iter().rev() {
             if stack & 3 != *want as u64 {
-                return false;
+                return None;
             }
             stack >>= 2;
         }
         sp -= pops.len();
         if sp >= MAX_STACK {
-            return false;
+            return None;
         }
         stack = stack << 2 | push as u64;
         sp += 1;
     }
-    sp == 1 && stack == Ty::Bool as u64
+    (sp == 1 && stack == Ty::Bool as u64).then_some(needs)
 }
 
-/// Whether this build evaluates `code`: without feature `float` no
-/// instruction may touch a float (load, push, compute or compare one), without
-/// feature `int-div` none may divide integers. Checked on load, so that the
-/// step never meets what the build left out.
-pub(crate) fn enabled(code: &[Instr], vars: &[Var<'_>]) -> bool {
-    code.iter().all(|ins| {
-        let needs = crate::analysis::instr_arithmetic(ins, vars);
-        (cfg!(feature = "float") || !needs.float) && (cfg!(feature = "int-div") || !needs.int_div)
-    })
+/// Whether this build evaluates code that computes `needs` ([`check`]):
+/// without feature `float` no instruction may touch a float (load, push,
+/// compute or compare one), without feature `int-div` none may divide
+/// integers. Checked on load, so that the step never meets what the build
+/// left out.
+pub(crate) fn enabled(needs: Arithmetic) -> bool {
+    (cfg!(feature = "float") || !needs.float) && (cfg!(feature = "int-div") || !needs.int_div)
 }
 
 /// Evaluates a checked atom over `vals`. Errors on a value of the wrong type
@@ -488,6 +492,60 @@ mod tests {
                     "{code:?} over {x}"
                 );
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod check_tests {
+    use super::check;
+    use crate::analysis::{instr_arithmetic, Arithmetic};
+    use crate::program::{CmpOp, Instr, NumTy, Ty, Value, Var, VarKind};
+
+    /// What [`check`] says a checked atom computes is what the analysis of
+    /// its instructions says.
+    #[test]
+    fn check_finds_the_arithmetic_the_analysis_finds() {
+        let var = |ty, init| Var {
+            name: "v",
+            ty,
+            kind: VarKind::State,
+            init,
+        };
+        let vars = [
+            var(Ty::Int, Value::Int(0)),
+            var(Ty::Float, Value::Float(0.0)),
+        ];
+        let (i, f) = (Instr::Push(Value::Int(2)), Instr::Push(Value::Float(2.0)));
+        let cmp_i = Instr::Cmp(CmpOp::Lt, Ty::Int);
+        let cmp_f = Instr::Cmp(CmpOp::Lt, Ty::Float);
+        let codes: [&[Instr]; 12] = [
+            &[Instr::Load(0), i, cmp_i],
+            &[Instr::Load(1), f, cmp_f],
+            &[Instr::Load(0), Instr::ToFloat, f, cmp_f],
+            &[i, Instr::Neg(NumTy::Int), i, cmp_i],
+            &[f, Instr::Neg(NumTy::Float), f, cmp_f],
+            &[i, i, Instr::Div(NumTy::Int), i, cmp_i],
+            &[i, i, Instr::Rem(NumTy::Int), i, cmp_i],
+            &[f, f, Instr::Div(NumTy::Float), f, cmp_f],
+            &[f, f, Instr::Add(NumTy::Float), f, cmp_f],
+            &[i, i, Instr::Mul(NumTy::Int), i, cmp_i],
+            &[Instr::Push(Value::Bool(true)), Instr::Not],
+            &[
+                Instr::Push(Value::Str(1)),
+                Instr::Push(Value::Str(2)),
+                Instr::Cmp(CmpOp::Eq, Ty::Str),
+            ],
+        ];
+        for code in codes {
+            let want = code.iter().map(|ins| instr_arithmetic(ins, &vars)).fold(
+                Arithmetic::default(),
+                |a, b| Arithmetic {
+                    float: a.float || b.float,
+                    int_div: a.int_div || b.int_div,
+                },
+            );
+            assert_eq!(check(code, &vars), Some(want), "{code:?}");
         }
     }
 }
