@@ -25,50 +25,45 @@ pub(crate) fn check(code: &[Instr], vars: &[Var<'_>]) -> Option<Arithmetic> {
         return None;
     }
     for ins in code {
-        let (pops, push): (&[Ty], Ty) = match *ins {
-            Instr::Push(v) => (&[], v.ty()),
+        // How many operands it pops, all of type `arg`, and what it pushes.
+        let num = |n| match n {
+            NumTy::Int => Ty::Int,
+            NumTy::Float => Ty::Float,
+        };
+        let (pops, arg, push) = match *ins {
+            Instr::Push(v) => (0, Ty::Bool, v.ty()),
             Instr::Load(n) => match vars.get(n as usize) {
-                Some(v) => (&[], v.ty),
+                Some(v) => (0, Ty::Bool, v.ty),
                 None => return None,
             },
-            Instr::Not => (&[Ty::Bool], Ty::Bool),
-            Instr::And | Instr::Or => (&[Ty::Bool, Ty::Bool], Ty::Bool),
-            Instr::Neg(NumTy::Int) => (&[Ty::Int], Ty::Int),
-            Instr::Neg(NumTy::Float) => (&[Ty::Float], Ty::Float),
+            Instr::Not => (1, Ty::Bool, Ty::Bool),
+            Instr::And | Instr::Or => (2, Ty::Bool, Ty::Bool),
+            Instr::Neg(n) => (1, num(n), num(n)),
             Instr::Add(n) | Instr::Sub(n) | Instr::Mul(n) | Instr::Div(n) | Instr::Rem(n) => {
-                match n {
-                    NumTy::Int => (&[Ty::Int, Ty::Int], Ty::Int),
-                    NumTy::Float => (&[Ty::Float, Ty::Float], Ty::Float),
-                }
+                (2, num(n), num(n))
             }
             Instr::Cmp(op, ty) => {
                 let ordered = matches!(op, CmpOp::Lt | CmpOp::Le | CmpOp::Gt | CmpOp::Ge);
                 if ordered && matches!(ty, Ty::Bool | Ty::Str) {
                     return None;
                 }
-                match ty {
-                    Ty::Bool => (&[Ty::Bool, Ty::Bool], Ty::Bool),
-                    Ty::Int => (&[Ty::Int, Ty::Int], Ty::Bool),
-                    Ty::Float => (&[Ty::Float, Ty::Float], Ty::Bool),
-                    Ty::Str => (&[Ty::Str, Ty::Str], Ty::Bool),
-                }
+                (2, ty, Ty::Bool)
             }
-            Instr::ToFloat => (&[Ty::Int], Ty::Float),
+            Instr::ToFloat => (1, Ty::Int, Ty::Float),
         };
         // A float pushed or popped; `analysis::arithmetic`'s rules.
-        needs.float |= push == Ty::Float || pops.first() == Some(&Ty::Float);
+        needs.float |= push == Ty::Float || (pops > 0 && arg == Ty::Float);
         needs.int_div |= matches!(ins, Instr::Div(NumTy::Int) | Instr::Rem(NumTy::Int));
-        if sp < pops.len() {
+        if sp < pops {
             return None;
         }
-        // Popped right first: the last of `pops` is on top.
-        for want in pops.iter().rev() {
-            if stack & 3 != *want as u64 {
+        for _ in 0..pops {
+            if stack & 3 != arg as u64 {
                 return None;
             }
             stack >>= 2;
         }
-        sp -= pops.len();
+        sp -= pops;
         if sp >= MAX_STACK {
             return None;
         }
