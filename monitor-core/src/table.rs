@@ -313,44 +313,6 @@ impl<'a> Reader<'a> {
             root: self.u16(),
         }
     }
-
-    /// A sequence: its length, then each element read by `read` and handed
-    /// to `put(i, element)`, which returns `false` when it has no room
-    /// (corrupt input like any other: `None`). No element read after the
-    /// input turned out corrupt is handed on.
-    fn seq<T>(
-        &mut self,
-        read: impl Fn(&mut Self) -> T,
-        mut put: impl FnMut(usize, T) -> bool,
-    ) -> Option<usize> {
-        let len = self.varint(usize::BITS) as usize;
-        for i in 0..len {
-            let element = read(self);
-            if self.bad || !put(i, element) {
-                return None;
-            }
-        }
-        (!self.bad).then_some(len)
-    }
-
-    /// [`Reader::seq`] for elements read in place: each starts as `blank`
-    /// and `read` writes its fields.
-    fn seq_in<T: Copy>(
-        &mut self,
-        blank: T,
-        read: impl Fn(&mut Self, &mut T),
-        mut put: impl FnMut(usize, T) -> bool,
-    ) -> Option<usize> {
-        let len = self.varint(usize::BITS) as usize;
-        for i in 0..len {
-            let mut element = blank;
-            read(self, &mut element);
-            if self.bad || !put(i, element) {
-                return None;
-            }
-        }
-        (!self.bad).then_some(len)
-    }
 }
 
 /// Where [`read_program`] puts each element of a table, as it reads it.
@@ -413,30 +375,74 @@ pub fn read_program<'a>(bytes: &'a [u8], sink: &mut impl Sink<'a>) -> Result<Cou
 }
 
 /// [`read_program`] after the version; `None`: corrupt bytes.
+///
+/// The six sequences are read by one loop, each as its length and its
+/// elements, each element handed to the sink as soon as it is read (`false`
+/// from the sink: no room, corrupt input like any other). No element read
+/// after the input turned out corrupt is handed on. One loop rather than one
+/// per element type (code size).
 fn read_body<'a>(r: &mut Reader<'a>, sink: &mut impl Sink<'a>) -> Option<Counts> {
     let tick_ns = r.u64();
     if r.bad {
         return None;
     }
     sink.tick_ns(tick_ns);
-    let counts = Counts {
-        vars: r.seq_in(
-            Var {
-                name: "",
-                ty: Ty::Bool,
-                kind: VarKind::Event,
-                init: Value::Bool(false),
-            },
-            Reader::var,
-            |i, v| sink.var(i, v),
-        )?,
-        strings: r.seq(Reader::str, |i, s| sink.string(i, s))?,
-        instrs: r.seq(Reader::instr, |i, ins| sink.instr(i, ins))?,
-        atoms: r.seq(Reader::atom, |i, a| sink.atom(i, a))?,
-        nodes: r.seq(Reader::node, |i, n| sink.node(i, n))?,
-        props: r.seq(Reader::prop, |i, p| sink.prop(i, p))?,
-    };
-    r.rest.is_empty().then_some(counts)
+    let mut counts = [0usize; 6];
+    for (kind, count) in counts.iter_mut().enumerate() {
+        let len = r.varint(usize::BITS) as usize;
+        for i in 0..len {
+            let room = match kind {
+                0 => {
+                    // Read in place: a `Var` returned by value was copied
+                    // once more through `memcpy` (code size).
+                    let mut v = Var {
+                        name: "",
+                        ty: Ty::Bool,
+                        kind: VarKind::Event,
+                        init: Value::Bool(false),
+                    };
+                    r.var(&mut v);
+                    !r.bad && sink.var(i, v)
+                }
+                1 => {
+                    let s = r.str();
+                    !r.bad && sink.string(i, s)
+                }
+                2 => {
+                    let ins = r.instr();
+                    !r.bad && sink.instr(i, ins)
+                }
+                3 => {
+                    let a = r.atom();
+                    !r.bad && sink.atom(i, a)
+                }
+                4 => {
+                    let n = r.node();
+                    !r.bad && sink.node(i, n)
+                }
+                _ => {
+                    let p = r.prop();
+                    !r.bad && sink.prop(i, p)
+                }
+            };
+            if !room {
+                return None;
+            }
+        }
+        if r.bad {
+            return None;
+        }
+        *count = len;
+    }
+    let [vars, strings, instrs, atoms, nodes, props] = counts;
+    r.rest.is_empty().then_some(Counts {
+        vars,
+        strings,
+        instrs,
+        atoms,
+        nodes,
+        props,
+    })
 }
 
 /// Storage for one decoded program: `heapless` vectors with room for `V`
