@@ -169,6 +169,22 @@ fn node_step(
             // (a window's capacity is only computed when it is needed).
             match hi {
                 None if lo == 0 => g || (f && !first_point && own_prev),
+                // `compact`: `S[a:]` and `S[0:b]`, one word each, in one arm
+                // (firmware size): the oldest witness is kept, the newest
+                // replaces it when there is an upper bound.
+                #[cfg(feature = "compact")]
+                _ if hi.is_none() || lo == 0 => {
+                    let mut w = rd(words, slot);
+                    if !f {
+                        w = 0;
+                    }
+                    if g && (hi.is_some() || w == 0) {
+                        w = t + 1;
+                    }
+                    wr(words, slot, w);
+                    let age = t.wrapping_sub(w.wrapping_sub(1));
+                    w != 0 && hi.map_or(age >= lo, |b| age <= b)
+                }
                 None => {
                     let mut w = rd(words, slot);
                     if !f {
