@@ -152,11 +152,25 @@ fn node_step(
         Op::Or(a, b) => bit(a) || bit(b),
         Op::Implies(a, b) => !bit(a) || bit(b),
         Op::Iff(a, b) => bit(a) == bit(b),
+        // `compact`: `Y` and `Z` in one arm (firmware size); they differ at
+        // the first point only.
+        #[cfg(feature = "compact")]
+        Op::Yesterday(a) | Op::WeakYesterday(a) => {
+            let out = if first_point {
+                matches!(op, Op::WeakYesterday(_))
+            } else {
+                rd(words, slot) != 0
+            };
+            wr(words, slot, bit(a) as u64);
+            out
+        }
+        #[cfg(not(feature = "compact"))]
         Op::Yesterday(a) => {
             let out = !first_point && rd(words, slot) != 0;
             wr(words, slot, bit(a) as u64);
             out
         }
+        #[cfg(not(feature = "compact"))]
         Op::WeakYesterday(a) => {
             let out = first_point || rd(words, slot) != 0;
             wr(words, slot, bit(a) as u64);
