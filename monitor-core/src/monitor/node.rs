@@ -283,6 +283,16 @@ fn window_step(
     if !f {
         len = 0;
     }
+    // `compact`: the capacity once, whenever a run is live or a witness
+    // arrives, and one expiry loop (firmware size).
+    #[cfg(feature = "compact")]
+    let cap = if len > 0 || g { capacity() } else { 1 };
+    #[cfg(feature = "compact")]
+    while len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
+        head = if head + 1 >= cap { 0 } else { head + 1 };
+        len -= 1;
+    }
+    #[cfg(not(feature = "compact"))]
     if len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
         let cap = capacity();
         while len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
@@ -294,6 +304,7 @@ fn window_step(
         head = 0;
     }
     if g {
+        #[cfg(not(feature = "compact"))]
         let cap = capacity();
         // Index of the newest run and of the slot after it, without `%` (cap >= 1).
         let mut tail = head + len;
