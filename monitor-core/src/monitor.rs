@@ -74,10 +74,10 @@ impl<'a, const N: usize> Monitor<'a, N> {
             let err = TableError::Atom { atom: i as u16 };
             let end = a.start as usize + a.len as usize;
             let code = p.instrs.get(a.start as usize..end).ok_or(err)?;
-            if !expr::check(code, p.vars) {
+            let Some(needs) = expr::check(code, p.vars) else {
                 return Err(err);
-            }
-            if !expr::enabled(code, p.vars) {
+            };
+            if !expr::enabled(needs) {
                 return Err(TableError::Feature { atom: i as u16 });
             }
         }

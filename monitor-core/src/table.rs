@@ -50,19 +50,37 @@ pub const TABLE_VERSION: u32 = 1;
 ///
 /// Each `program.rs` type's derived `Serialize` writes exactly this;
 /// `tests/validate.rs` checks the reader against postcard on every variant.
+///
+/// A corrupt or truncated input sets `bad` and the reader goes on with zeros
+/// (each element reads at least one byte, and every sequence stops at the
+/// first element read after that): one test per element and one at the end
+/// instead of a branch after every field (code size), with the same result,
+/// [`TableError::Decode`].
 struct Reader<'a> {
     rest: &'a [u8],
+    bad: bool,
 }
 
 impl<'a> Reader<'a> {
-    fn byte(&mut self) -> Option<u8> {
-        let (&b, rest) = self.rest.split_first()?;
-        self.rest = rest;
-        Some(b)
+    /// Marks the input corrupt; returns `T`'s zero to go on with.
+    #[cold]
+    fn fail<T: Default>(&mut self) -> T {
+        self.bad = true;
+        T::default()
+    }
+
+    fn byte(&mut self) -> u8 {
+        match self.rest.split_first() {
+            Some((&b, rest)) => {
+                self.rest = rest;
+                b
+            }
+            None => self.fail(),
+        }
     }
 
     /// A varint of a type of `bits` bits (16, 32 or 64).
-    fn varint(&mut self, bits: u32) -> Option<u64> {
+    fn varint(&mut self, bits: u32) -> u64 {
         // `bits.div_ceil(7)` for the widths read (16, 32, 64): without a
         // division, a library routine on a Cortex-M0 (no divide instruction).
         let max_bytes = match bits {
@@ -72,144 +90,159 @@ impl<'a> Reader<'a> {
         };
         let mut out = 0u64;
         for i in 0..max_bytes {
-            let b = self.byte()?;
+            let b = self.byte();
             let low = (b & 0x7f) as u64;
             if i == max_bytes - 1 && (b & 0x80 != 0 || low >> (bits - 7 * i) != 0) {
-                return None;
+                break;
             }
             out |= low << (7 * i);
             if b & 0x80 == 0 {
-                return Some(out);
+                return out;
             }
         }
-        None
+        self.fail()
     }
 
-    fn u16(&mut self) -> Option<u16> {
-        Some(self.varint(16)? as u16)
+    fn u16(&mut self) -> u16 {
+        self.varint(16) as u16
     }
 
-    fn u32(&mut self) -> Option<u32> {
-        Some(self.varint(32)? as u32)
+    fn u32(&mut self) -> u32 {
+        self.varint(32) as u32
     }
 
-    fn u64(&mut self) -> Option<u64> {
+    fn u64(&mut self) -> u64 {
         self.varint(64)
     }
 
-    fn i64(&mut self) -> Option<i64> {
-        let z = self.varint(64)?;
-        Some((z >> 1) as i64 ^ -((z & 1) as i64))
+    fn i64(&mut self) -> i64 {
+        let z = self.varint(64);
+        (z >> 1) as i64 ^ -((z & 1) as i64)
     }
 
-    fn bool(&mut self) -> Option<bool> {
-        match self.byte()? {
-            0 => Some(false),
-            1 => Some(true),
-            _ => None,
+    fn bool(&mut self) -> bool {
+        match self.byte() {
+            0 => false,
+            1 => true,
+            _ => self.fail(),
         }
     }
 
-    fn f64(&mut self) -> Option<f64> {
-        let (bytes, rest) = self.rest.split_first_chunk::<8>()?;
-        self.rest = rest;
-        Some(f64::from_le_bytes(*bytes))
+    fn f64(&mut self) -> f64 {
+        match self.rest.split_first_chunk::<8>() {
+            Some((bytes, rest)) => {
+                self.rest = rest;
+                f64::from_le_bytes(*bytes)
+            }
+            None => self.fail(),
+        }
     }
 
-    fn str(&mut self) -> Option<&'a str> {
-        let len = self.varint(usize::BITS)? as usize;
-        let (bytes, rest) = self.rest.split_at_checked(len)?;
+    fn str(&mut self) -> &'a str {
+        let len = self.varint(usize::BITS) as usize;
+        let Some((bytes, rest)) = self.rest.split_at_checked(len) else {
+            return self.fail();
+        };
         self.rest = rest;
         // Valid UTF-8 is one chunk with no invalid bytes after it: the same
         // answer as `str::from_utf8`, whose word-at-a-time validator is
         // larger in firmware (52-64 B of flash).
         let mut chunks = bytes.utf8_chunks();
         match chunks.next() {
-            None => Some(""),
-            Some(c) if c.invalid().is_empty() && c.valid().len() == bytes.len() => Some(c.valid()),
-            Some(_) => None,
+            None => "",
+            Some(c) if c.invalid().is_empty() && c.valid().len() == bytes.len() => c.valid(),
+            Some(_) => self.fail(),
         }
     }
 
     /// A variant index (postcard writes it as a varint `u32`).
-    fn variant(&mut self) -> Option<u32> {
+    fn variant(&mut self) -> u32 {
         self.u32()
     }
 
-    /// A value, written into `out` where it will live: returned as an
-    /// `Option<Value>`, its 15 bytes after the tag were copied through
-    /// `memcpy` (not otherwise linked on a Cortex-M4F: 742 B of flash).
-    fn value(&mut self, out: &mut Value) -> Option<()> {
-        *out = match self.variant()? {
-            0 => Value::Bool(self.bool()?),
-            1 => Value::Int(self.i64()?),
-            2 => Value::Float(self.f64()?),
-            3 => Value::Str(self.u32()?),
-            _ => return None,
+    /// A value, written into `out` where it will live: returned by value,
+    /// its 15 bytes after the tag were copied through `memcpy` (not
+    /// otherwise linked on a Cortex-M4F: 742 B of flash).
+    fn value(&mut self, out: &mut Value) {
+        *out = match self.variant() {
+            0 => Value::Bool(self.bool()),
+            1 => Value::Int(self.i64()),
+            2 => Value::Float(self.f64()),
+            3 => Value::Str(self.u32()),
+            _ => Value::Bool(self.fail()),
         };
-        Some(())
     }
 
-    fn ty(&mut self) -> Option<Ty> {
-        Some(match self.variant()? {
+    fn ty(&mut self) -> Ty {
+        match self.variant() {
             0 => Ty::Bool,
             1 => Ty::Int,
             2 => Ty::Float,
             3 => Ty::Str,
-            _ => return None,
-        })
+            _ => {
+                self.bad = true;
+                Ty::Bool
+            }
+        }
     }
 
-    fn num_ty(&mut self) -> Option<NumTy> {
-        Some(match self.variant()? {
+    fn num_ty(&mut self) -> NumTy {
+        match self.variant() {
             0 => NumTy::Int,
             1 => NumTy::Float,
-            _ => return None,
-        })
+            _ => {
+                self.bad = true;
+                NumTy::Int
+            }
+        }
     }
 
-    fn cmp_op(&mut self) -> Option<CmpOp> {
-        Some(match self.variant()? {
+    fn cmp_op(&mut self) -> CmpOp {
+        match self.variant() {
             0 => CmpOp::Eq,
             1 => CmpOp::Ne,
             2 => CmpOp::Lt,
             3 => CmpOp::Le,
             4 => CmpOp::Gt,
             5 => CmpOp::Ge,
-            _ => return None,
-        })
+            _ => {
+                self.bad = true;
+                CmpOp::Eq
+            }
+        }
     }
 
-    fn var(&mut self) -> Option<Var<'a>> {
-        let mut var = Var {
-            name: self.str()?,
-            ty: self.ty()?,
-            kind: match self.variant()? {
-                0 => VarKind::Event,
-                1 => VarKind::State,
-                _ => return None,
-            },
-            init: Value::Bool(false),
+    /// A variable, written into `out` field by field: returned by value it
+    /// was copied once more through `memcpy` (code size).
+    fn var(&mut self, out: &mut Var<'a>) {
+        out.name = self.str();
+        out.ty = self.ty();
+        out.kind = match self.variant() {
+            0 => VarKind::Event,
+            1 => VarKind::State,
+            _ => {
+                self.bad = true;
+                VarKind::Event
+            }
         };
-        self.value(&mut var.init)?;
-        Some(var)
+        self.value(&mut out.init);
     }
 
-    fn instr(&mut self) -> Option<Instr> {
-        let v = self.variant()?;
+    fn instr(&mut self) -> Instr {
+        let v = self.variant();
         // The arithmetic variants' one field is read at one call site (code size).
         let n = if matches!(v, 5..=10) {
-            self.num_ty()?
+            self.num_ty()
         } else {
             NumTy::Int
         };
-        Some(match v {
+        match v {
             0 => {
                 let mut v = Value::Bool(false);
-                self.value(&mut v)?;
+                self.value(&mut v);
                 Instr::Push(v)
             }
-            1 => Instr::Load(self.u16()?),
+            1 => Instr::Load(self.u16()),
             2 => Instr::Not,
             3 => Instr::And,
             4 => Instr::Or,
@@ -219,31 +252,34 @@ impl<'a> Reader<'a> {
             8 => Instr::Mul(n),
             9 => Instr::Div(n),
             10 => Instr::Rem(n),
-            11 => Instr::Cmp(self.cmp_op()?, self.ty()?),
+            11 => Instr::Cmp(self.cmp_op(), self.ty()),
             12 => Instr::ToFloat,
-            _ => return None,
-        })
+            _ => {
+                self.bad = true;
+                Instr::Not
+            }
+        }
     }
 
-    fn atom(&mut self) -> Option<Atom> {
-        Some(Atom {
-            start: self.u16()?,
-            len: self.u16()?,
-        })
+    fn atom(&mut self) -> Atom {
+        Atom {
+            start: self.u16(),
+            len: self.u16(),
+        }
     }
 
-    fn node(&mut self) -> Option<Node> {
-        let v = self.variant()?;
+    fn node(&mut self) -> Node {
+        let v = self.variant();
         // Every variant but `Const` starts with one or two ids, read at one call
         // site each (code size), in the order postcard writes them.
-        let a = if matches!(v, 1..=9) { self.u16()? } else { 0 };
+        let a = if matches!(v, 1..=9) { self.u16() } else { 0 };
         let b = if matches!(v, 3..=6 | 9) {
-            self.u16()?
+            self.u16()
         } else {
             0
         };
         let op = match v {
-            0 => Op::Const(self.bool()?),
+            0 => Op::Const(self.bool()),
             1 => Op::Atom(a),
             2 => Op::Not(a),
             3 => Op::And(a, b),
@@ -255,45 +291,27 @@ impl<'a> Reader<'a> {
             9 => Op::Since {
                 lhs: a,
                 rhs: b,
-                lo: self.u64()?,
-                hi: match self.byte()? {
+                lo: self.u64(),
+                hi: match self.byte() {
                     0 => None,
-                    1 => Some(self.u64()?),
-                    _ => return None,
+                    1 => Some(self.u64()),
+                    _ => self.fail(),
                 },
             },
-            _ => return None,
+            _ => Op::Const(self.fail()),
         };
-        Some(Node {
+        Node {
             op,
-            slot: self.u32()?,
-        })
-    }
-
-    fn prop(&mut self) -> Option<Property<'a>> {
-        Some(Property {
-            name: self.str()?,
-            first: self.u16()?,
-            root: self.u16()?,
-        })
-    }
-
-    /// A sequence: its length, then each element read by `read` and handed
-    /// to `put(i, element)`, which returns `false` when it has no room
-    /// (corrupt input like any other: `None`).
-    fn seq<T>(
-        &mut self,
-        read: impl Fn(&mut Self) -> Option<T>,
-        mut put: impl FnMut(usize, T) -> bool,
-    ) -> Option<usize> {
-        let len = self.varint(usize::BITS)? as usize;
-        for i in 0..len {
-            let element = read(self)?;
-            if !put(i, element) {
-                return None;
-            }
+            slot: self.u32(),
         }
-        Some(len)
+    }
+
+    fn prop(&mut self) -> Property<'a> {
+        Property {
+            name: self.str(),
+            first: self.u16(),
+            root: self.u16(),
+        }
     }
 }
 
@@ -342,28 +360,89 @@ pub struct Counts {
 /// element the sink has no room for give an error; nothing is validated
 /// beyond the encoding (that is [`Monitor::try_new`]'s job).
 pub fn read_program<'a>(bytes: &'a [u8], sink: &mut impl Sink<'a>) -> Result<Counts, TableError> {
-    let mut r = Reader { rest: bytes };
-    let version = r.u32().ok_or(TableError::Decode)?;
+    let mut r = Reader {
+        rest: bytes,
+        bad: false,
+    };
+    let version = r.u32();
+    if r.bad {
+        return Err(TableError::Decode);
+    }
     if version != TABLE_VERSION {
         return Err(TableError::Version { found: version });
     }
     read_body(&mut r, sink).ok_or(TableError::Decode)
 }
 
-/// [`read_program`] after the version. Every reader returns an `Option`
-/// (`None`: corrupt bytes) rather than a `Result`: the error is one value,
-/// made once here, and each `?` of the decoder is one branch (code size).
+/// [`read_program`] after the version; `None`: corrupt bytes.
+///
+/// The six sequences are read by one loop, each as its length and its
+/// elements, each element handed to the sink as soon as it is read (`false`
+/// from the sink: no room, corrupt input like any other). No element read
+/// after the input turned out corrupt is handed on. One loop rather than one
+/// per element type (code size).
 fn read_body<'a>(r: &mut Reader<'a>, sink: &mut impl Sink<'a>) -> Option<Counts> {
-    sink.tick_ns(r.u64()?);
-    let counts = Counts {
-        vars: r.seq(Reader::var, |i, v| sink.var(i, v))?,
-        strings: r.seq(Reader::str, |i, s| sink.string(i, s))?,
-        instrs: r.seq(Reader::instr, |i, ins| sink.instr(i, ins))?,
-        atoms: r.seq(Reader::atom, |i, a| sink.atom(i, a))?,
-        nodes: r.seq(Reader::node, |i, n| sink.node(i, n))?,
-        props: r.seq(Reader::prop, |i, p| sink.prop(i, p))?,
-    };
-    r.rest.is_empty().then_some(counts)
+    let tick_ns = r.u64();
+    if r.bad {
+        return None;
+    }
+    sink.tick_ns(tick_ns);
+    let mut counts = [0usize; 6];
+    for (kind, count) in counts.iter_mut().enumerate() {
+        let len = r.varint(usize::BITS) as usize;
+        for i in 0..len {
+            let room = match kind {
+                0 => {
+                    // Read in place: a `Var` returned by value was copied
+                    // once more through `memcpy` (code size).
+                    let mut v = Var {
+                        name: "",
+                        ty: Ty::Bool,
+                        kind: VarKind::Event,
+                        init: Value::Bool(false),
+                    };
+                    r.var(&mut v);
+                    !r.bad && sink.var(i, v)
+                }
+                1 => {
+                    let s = r.str();
+                    !r.bad && sink.string(i, s)
+                }
+                2 => {
+                    let ins = r.instr();
+                    !r.bad && sink.instr(i, ins)
+                }
+                3 => {
+                    let a = r.atom();
+                    !r.bad && sink.atom(i, a)
+                }
+                4 => {
+                    let n = r.node();
+                    !r.bad && sink.node(i, n)
+                }
+                _ => {
+                    let p = r.prop();
+                    !r.bad && sink.prop(i, p)
+                }
+            };
+            if !room {
+                return None;
+            }
+        }
+        if r.bad {
+            return None;
+        }
+        *count = len;
+    }
+    let [vars, strings, instrs, atoms, nodes, props] = counts;
+    r.rest.is_empty().then_some(Counts {
+        vars,
+        strings,
+        instrs,
+        atoms,
+        nodes,
+        props,
+    })
 }
 
 /// Storage for one decoded program: `heapless` vectors with room for `V`
@@ -490,7 +569,21 @@ impl<
         self.tick_ns = tick_ns;
     }
     fn var(&mut self, _: usize, v: Var<'a>) -> bool {
-        self.vars.push(v).is_ok()
+        // Field by field: a copy of the whole `Var` went through `memcpy`
+        // in pieces (its only calls on a Cortex-M0: 600 B of flash).
+        self.vars
+            .push(Var {
+                name: v.name,
+                ty: v.ty,
+                kind: v.kind,
+                init: match v.init {
+                    Value::Bool(b) => Value::Bool(b),
+                    Value::Int(i) => Value::Int(i),
+                    Value::Float(f) => Value::Float(f),
+                    Value::Str(s) => Value::Str(s),
+                },
+            })
+            .is_ok()
     }
     fn string(&mut self, _: usize, s: &'a str) -> bool {
         self.strings.push(s).is_ok()
@@ -531,8 +624,11 @@ mod tests {
             encoded[1..=bytes.len()].copy_from_slice(bytes);
             let mut r = Reader {
                 rest: &encoded[..=bytes.len()],
+                bad: false,
             };
-            assert_eq!(r.str(), core::str::from_utf8(bytes).ok(), "{bytes:?}");
+            let s = r.str();
+            let read = (!r.bad).then_some(s);
+            assert_eq!(read, core::str::from_utf8(bytes).ok(), "{bytes:?}");
         }
     }
 }

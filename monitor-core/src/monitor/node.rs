@@ -152,11 +152,25 @@ fn node_step(
         Op::Or(a, b) => bit(a) || bit(b),
         Op::Implies(a, b) => !bit(a) || bit(b),
         Op::Iff(a, b) => bit(a) == bit(b),
+        // `compact`: `Y` and `Z` in one arm (firmware size); they differ at
+        // the first point only.
+        #[cfg(feature = "compact")]
+        Op::Yesterday(a) | Op::WeakYesterday(a) => {
+            let out = if first_point {
+                matches!(op, Op::WeakYesterday(_))
+            } else {
+                rd(words, slot) != 0
+            };
+            wr(words, slot, bit(a) as u64);
+            out
+        }
+        #[cfg(not(feature = "compact"))]
         Op::Yesterday(a) => {
             let out = !first_point && rd(words, slot) != 0;
             wr(words, slot, bit(a) as u64);
             out
         }
+        #[cfg(not(feature = "compact"))]
         Op::WeakYesterday(a) => {
             let out = first_point || rd(words, slot) != 0;
             wr(words, slot, bit(a) as u64);
@@ -169,6 +183,22 @@ fn node_step(
             // (a window's capacity is only computed when it is needed).
             match hi {
                 None if lo == 0 => g || (f && !first_point && own_prev),
+                // `compact`: `S[a:]` and `S[0:b]`, one word each, in one arm
+                // (firmware size): the oldest witness is kept, the newest
+                // replaces it when there is an upper bound.
+                #[cfg(feature = "compact")]
+                _ if hi.is_none() || lo == 0 => {
+                    let mut w = rd(words, slot);
+                    if !f {
+                        w = 0;
+                    }
+                    if g && (hi.is_some() || w == 0) {
+                        w = t + 1;
+                    }
+                    wr(words, slot, w);
+                    let age = t.wrapping_sub(w.wrapping_sub(1));
+                    w != 0 && hi.map_or(age >= lo, |b| age <= b)
+                }
                 None => {
                     let mut w = rd(words, slot);
                     if !f {
@@ -213,12 +243,17 @@ fn window_capacity(lo: u64, hi: u64) -> usize {
     (layout::div(hi, hi - (lo - 1), 32) as usize).saturating_add(1)
 }
 
-#[inline(always)]
+/// State word `i` (0 past the end: never, the slots were validated). Under
+/// `compact` one shared copy of it and of [`wr`], not one bounds check per
+/// use (firmware: about 110 B of flash less).
+#[cfg_attr(not(feature = "compact"), inline(always))]
+#[cfg_attr(feature = "compact", inline(never))]
 pub(super) fn rd(w: &[u64], i: usize) -> u64 {
     w.get(i).copied().unwrap_or(0)
 }
 
-#[inline(always)]
+#[cfg_attr(not(feature = "compact"), inline(always))]
+#[cfg_attr(feature = "compact", inline(never))]
 pub(super) fn wr(w: &mut [u64], i: usize, v: u64) {
     if let Some(x) = w.get_mut(i) {
         *x = v;
@@ -248,6 +283,16 @@ fn window_step(
     if !f {
         len = 0;
     }
+    // `compact`: the capacity once, whenever a run is live or a witness
+    // arrives, and one expiry loop (firmware size).
+    #[cfg(feature = "compact")]
+    let cap = if len > 0 || g { capacity() } else { 1 };
+    #[cfg(feature = "compact")]
+    while len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
+        head = if head + 1 >= cap { 0 } else { head + 1 };
+        len -= 1;
+    }
+    #[cfg(not(feature = "compact"))]
     if len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
         let cap = capacity();
         while len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
@@ -259,6 +304,7 @@ fn window_step(
         head = 0;
     }
     if g {
+        #[cfg(not(feature = "compact"))]
         let cap = capacity();
         // Index of the newest run and of the slot after it, without `%` (cap >= 1).
         let mut tail = head + len;
