@@ -341,14 +341,18 @@ const fn flip(op: CmpOp) -> CmpOp {
     }
 }
 
-/// What [`build`] decided for the whole program: three bytes, so that an
+/// What [`build`] decided for the whole program: four bytes, so that an
 /// unplanned `Monitor<'_>` (firmware) stays as small as before plans.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Plan {
     /// The number of steps in the plan's node array.
     pub steps: u16,
-    /// [`Plan::PLANNED`] .. [`Plan::UNREAD`].
+    /// [`Plan::PLANNED`] .. [`Plan::TABLE`].
     pub flags: u8,
+    /// [`Plan::TABLE`]: the number of memory bits of a table index ([`build_table`]).
+    pub mem: u8,
+    /// [`Plan::RUN`]: the variable of atom 0.
+    pub shift: u8,
 }
 
 impl Plan {
@@ -362,13 +366,22 @@ impl Plan {
     /// Otherwise there is one step per node, in node order, and none is fused.
     pub const FOLDED: u8 = 2;
     /// Every atom has a shape [`AtomStep::fast`] reads, at most 64 atoms and 64
-    /// variables, not `compact`: the atom reads check their variables' types,
-    /// and the whole check runs apart only when some variable is read by no atom.
+    /// variables, not `compact`: one pass over the variables checks their
+    /// types and gathers the boolean ones as bits, then the atoms are read
+    /// without a type check.
     pub const FAST: u8 = 4;
-    /// `FAST`: some variable is read by no atom.
-    pub const UNREAD: u8 = 8;
+    /// `FAST` and every atom is a boolean variable or its negation
+    /// ([`AtomKind::Bool`], [`AtomKind::NotBool`]): a bit of the variables' bits.
+    pub const BOOLS: u8 = 8;
     /// At most 64 atoms and 64 nodes (planned or not, see `Monitor::advance`).
     pub const SMALL: u8 = 16;
+    /// `FOLDED` and every step is `Logic`, with at most [`TABLE_BITS`] atoms and
+    /// memory bits together: after the first point, the value word is one
+    /// lookup in the monitor's transition table ([`build_table`]).
+    pub const TABLE: u8 = 32;
+    /// `BOOLS`, and atom `k` is boolean variable `shift + k` (not negated): the
+    /// atoms are one shift and mask of the variables' bits.
+    pub const RUN: u8 = 64;
 
     /// Whether every flag of `f` is set.
     #[inline(always)]
@@ -410,6 +423,8 @@ pub(crate) fn build(
     let mut plan = Plan {
         steps: 0,
         flags: Plan::PLANNED | if folded { Plan::FOLDED } else { 0 },
+        mem: 0,
+        shift: 0,
     };
     let planned = atoms.get(..p.atoms.len()).unwrap_or(&[]);
     if !compact
@@ -417,13 +432,21 @@ pub(crate) fn build(
         && p.vars.len() <= 64
         && planned.iter().all(|a| a.kind != AtomKind::General)
     {
-        let mut read = 0u64;
-        for a in planned {
-            read |= 1u64 << (a.var & 63);
-        }
         plan.flags |= Plan::FAST;
-        if read.count_ones() as usize != p.vars.len() {
-            plan.flags |= Plan::UNREAD;
+        if planned
+            .iter()
+            .all(|a| matches!(a.kind, AtomKind::Bool | AtomKind::NotBool))
+        {
+            plan.flags |= Plan::BOOLS;
+            let shift = planned.first().map_or(0, |a| a.var);
+            if planned
+                .iter()
+                .enumerate()
+                .all(|(k, a)| a.kind == AtomKind::Bool && a.var as usize == shift as usize + k)
+            {
+                plan.flags |= Plan::RUN;
+                plan.shift = shift as u8;
+            }
         }
     }
     // Folded: each node's literal value, and the step computing each non-literal node.
@@ -491,6 +514,83 @@ pub(crate) fn build(
     }
     plan.steps = n as u16;
     Some(plan)
+}
+
+/// The most index bits (atoms and memory bits together) of a transition table.
+pub(crate) const TABLE_BITS: usize = 8;
+
+/// The value word of a folded plan whose steps are all `Logic`: `nodes` holds
+/// the literal nodes' bits, `old` the value word of the last point, `d` is
+/// [`D`] at the first point (else 0). As `Monitor::advance_folded` computes it.
+#[inline(always)]
+pub(crate) fn fold_logic(steps: &[Step], old: u64, nodes: u64, d: u16) -> u64 {
+    let mut new = nodes;
+    for s in steps {
+        let i = s.dest & 63;
+        let f = (new >> (s.a & 63)) as u16 & 1;
+        let g = (new >> (s.b & 63)) as u16 & 1;
+        let c = (old >> i) as u16 & 1;
+        let v = (s.table >> (f | g << 1 | c << 2 | d)) & 1 == 1;
+        new |= (v as u64) << i;
+        if s.negate != 0 {
+            new |= (!v as u64) << (s.neg & 63);
+        }
+    }
+    new
+}
+
+/// Whether a truth table reads the node's own last value ([`C`]).
+const fn reads_own(table: u16) -> bool {
+    let mut x = 0u16;
+    while x < 16 {
+        if (table >> x) & 1 != (table >> (x ^ C)) & 1 {
+            return true;
+        }
+        x += 1;
+    }
+    false
+}
+
+/// The transition table of a folded plan ([`Plan::TABLE`]) whose steps are all
+/// `Logic`: `table[i]` is the value word after a point that is not the first,
+/// where index `i` holds the point's atoms (bit `k`: atom `k`) and above them
+/// the last values of the nodes that read their own (`mem[j]`, bit
+/// `atoms.len() + j`). Returns the number of memory bits, or `None` (nothing
+/// to use) when a step is not `Logic` or the index does not fit `table` or
+/// [`TABLE_BITS`].
+pub(crate) fn build_table(
+    steps: &[Step],
+    atoms: &[AtomStep],
+    table: &mut [u64],
+    mem: &mut [u8],
+) -> Option<u8> {
+    if steps.iter().any(|s| s.kind != Kind::Logic) {
+        return None;
+    }
+    let mut m = 0usize;
+    for s in steps {
+        if reads_own(s.table) {
+            *mem.get_mut(m)? = (s.dest & 63) as u8;
+            m += 1;
+        }
+    }
+    let bits = atoms.len() + m;
+    if bits > TABLE_BITS || 1usize << bits > table.len() {
+        return None;
+    }
+    let mem = mem.get(..m)?;
+    for idx in 0..1usize << bits {
+        let mut old = 0u64;
+        for (j, &at) in mem.iter().enumerate() {
+            old |= ((idx >> (atoms.len() + j)) as u64 & 1) << (at & 63);
+        }
+        let mut nodes = 0u64;
+        for (k, a) in atoms.iter().enumerate() {
+            nodes |= if idx >> k & 1 == 1 { a.pos } else { a.neg };
+        }
+        *table.get_mut(idx)? = fold_logic(steps, old, nodes, 0);
+    }
+    Some(m as u8)
 }
 
 #[cfg(test)]
