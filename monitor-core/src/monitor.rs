@@ -39,8 +39,8 @@ pub struct Monitor<'a, const N: usize = 0> {
     /// Atom `k`'s plan, for `k < program.atoms.len()` when planned.
     atom_plan: [AtomStep; N],
     /// [`Plan::TABLE`]: the value word after a point that is not the first, by
-    /// atoms and memory bits ([`plan::build_table`]); the first `1 << (atoms +
-    /// info.mem)` used.
+    /// atoms and memory bits ([`plan::build_table`]); [`Plan::LITS`]: the
+    /// literal nodes' bits by atoms ([`plan::build_literals`]).
     table: [u64; N],
     /// [`Plan::TABLE`]: the nodes whose last values are the memory bits of a
     /// table index, the first `info.mem` used.
@@ -182,6 +182,8 @@ impl<'a, const N: usize> Monitor<'a, N> {
                     {
                         monitor.info.flags |= Plan::TABLE;
                         monitor.info.mem = m;
+                    } else if plan::build_literals(atoms, &mut monitor.table).is_some() {
+                        monitor.info.flags |= Plan::LITS;
                     }
                 }
             }
@@ -341,6 +343,9 @@ impl<'a, const N: usize> Monitor<'a, N> {
     /// Folded plans: the literal nodes' bits for the atoms `atoms`.
     #[inline(always)]
     fn literals(&self, atoms: u64) -> u64 {
+        if self.info.has(Plan::LITS) {
+            return self.table.get(atoms as usize).copied().unwrap_or(0);
+        }
         let mut nodes = 0u64;
         for (k, a) in self.plan_atoms().iter().enumerate() {
             nodes |= if atoms >> (k & 63) & 1 == 1 {

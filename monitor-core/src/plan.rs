@@ -382,6 +382,10 @@ impl Plan {
     /// `BOOLS`, and atom `k` is boolean variable `shift + k` (not negated): the
     /// atoms are one shift and mask of the variables' bits.
     pub const RUN: u8 = 64;
+    /// `FOLDED`, not `TABLE`, and at most [`TABLE_BITS`] atoms: the monitor's
+    /// table holds the literal nodes' bits of every value of the atoms
+    /// ([`build_literals`]), one lookup instead of a loop over the atoms.
+    pub const LITS: u8 = 128;
 
     /// Whether every flag of `f` is set.
     #[inline(always)]
@@ -591,6 +595,23 @@ pub(crate) fn build_table(
         *table.get_mut(idx)? = fold_logic(steps, old, nodes, 0);
     }
     Some(m as u8)
+}
+
+/// The literal nodes' bits of a folded plan for each value of its atoms
+/// ([`Plan::LITS`]): `table[i]` for atoms `i`; `None` (nothing to use) when
+/// the atoms are more than [`TABLE_BITS`] or than `table` indexes.
+pub(crate) fn build_literals(atoms: &[AtomStep], table: &mut [u64]) -> Option<()> {
+    if atoms.len() > TABLE_BITS || 1usize << atoms.len() > table.len() {
+        return None;
+    }
+    for idx in 0..1usize << atoms.len() {
+        let mut nodes = 0u64;
+        for (k, a) in atoms.iter().enumerate() {
+            nodes |= if idx >> k & 1 == 1 { a.pos } else { a.neg };
+        }
+        *table.get_mut(idx)? = nodes;
+    }
+    Some(())
 }
 
 #[cfg(test)]
