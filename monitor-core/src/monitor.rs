@@ -20,7 +20,7 @@ use node::{rd, special, wr, NodeStep};
 /// [`Monitor::try_new_planned`] decides each node's kind, children, state slot
 /// and window capacity and each atom's shape once, for programs of at most `N`
 /// nodes and `N` atoms, and steps faster. It holds `N` entries of 40 bytes,
-/// `N` of 32 and `N` of 9 (const generics: no allocation); the default `N = 0`
+/// `N` of 32 and `N` of 8 (const generics: no allocation); the default `N = 0`
 /// plans nothing and holds nothing more.
 #[derive(Clone, Copy, Debug)]
 pub struct Monitor<'a, const N: usize = 0> {
@@ -42,9 +42,6 @@ pub struct Monitor<'a, const N: usize = 0> {
     /// atoms and memory bits ([`plan::build_table`]); [`Plan::LITS`]: the
     /// literal nodes' bits by atoms ([`plan::build_literals`]).
     table: [u64; N],
-    /// [`Plan::TABLE`]: the nodes whose last values are the memory bits of a
-    /// table index, the first `info.mem` used.
-    mem: [u8; N],
 }
 
 /// The most nodes, atoms or variables a program may have (ids are `u16`).
@@ -155,13 +152,12 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 } else {
                     0
                 },
-                mem: 0,
                 shift: 0,
+                top: 0,
             },
             plan: [Step::NONE; N],
             atom_plan: [AtomStep::NONE; N],
             table: [0; N],
-            mem: [0; N],
         };
         if N > 0 {
             if let Some(info) = plan::build(
@@ -177,11 +173,9 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 if info.has(Plan::FOLDED) {
                     let steps = monitor.plan.get(..info.steps as usize).unwrap_or(&[]);
                     let atoms = monitor.atom_plan.get(..p.atoms.len()).unwrap_or(&[]);
-                    if let Some(m) =
-                        plan::build_table(steps, atoms, &mut monitor.table, &mut monitor.mem)
-                    {
+                    if let Some(m) = plan::build_table(steps, atoms, &mut monitor.table) {
                         monitor.info.flags |= Plan::TABLE;
-                        monitor.info.mem = m;
+                        monitor.info.top = 64 - m as u8;
                     } else if plan::build_literals(atoms, &mut monitor.table).is_some() {
                         monitor.info.flags |= Plan::LITS;
                     }
@@ -381,11 +375,15 @@ impl<'a, const N: usize> Monitor<'a, N> {
         let old = *value_word;
         let new = if self.info.has(Plan::TABLE) && !first_point {
             // The index: the atoms, then the memory bits above them.
-            let mut idx = atoms;
-            let at = self.program.atoms.len();
-            for (j, &m) in self.mem_nodes().iter().enumerate() {
-                idx |= (old >> (m & 63) & 1) << ((at + j) & 63);
-            }
+            let n = self.program.atoms.len();
+            let idx = match self.table.as_slice() {
+                // One multiply gathers the memory bits (most tables).
+                [.., k, mem] if *k != 0 => {
+                    atoms | (old & mem).wrapping_mul(*k) >> (self.info.top & 63) << (n & 63)
+                }
+                [.., mem] => plan::gather(atoms, n, old, *mem),
+                [] => 0,
+            };
             self.table.get(idx as usize).copied().unwrap_or(0)
         } else {
             self.fold(body, t, old, nodes(), first_point)
@@ -516,12 +514,6 @@ impl<'a, const N: usize> Monitor<'a, N> {
         self.atom_plan
             .get(..self.program.atoms.len())
             .unwrap_or(&[])
-    }
-
-    /// [`Plan::TABLE`]: the nodes of the memory bits (empty otherwise).
-    #[inline(always)]
-    fn mem_nodes(&self) -> &[u8] {
-        self.mem.get(..self.info.mem as usize).unwrap_or(&[])
     }
 
     /// The plan's steps (empty unless planned).

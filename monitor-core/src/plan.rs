@@ -349,10 +349,11 @@ pub(crate) struct Plan {
     pub steps: u16,
     /// [`Plan::PLANNED`] .. [`Plan::TABLE`].
     pub flags: u8,
-    /// [`Plan::TABLE`]: the number of memory bits of a table index ([`build_table`]).
-    pub mem: u8,
     /// [`Plan::RUN`]: the variable of atom 0.
     pub shift: u8,
+    /// [`Plan::TABLE`] with a gathering multiplier ([`build_table`]): 64 less
+    /// the number of memory bits.
+    pub top: u8,
 }
 
 impl Plan {
@@ -427,8 +428,8 @@ pub(crate) fn build(
     let mut plan = Plan {
         steps: 0,
         flags: Plan::PLANNED | if folded { Plan::FOLDED } else { 0 },
-        mem: 0,
         shift: 0,
+        top: 0,
     };
     let planned = atoms.get(..p.atoms.len()).unwrap_or(&[]);
     if !compact
@@ -558,35 +559,34 @@ const fn reads_own(table: u16) -> bool {
 /// The transition table of a folded plan ([`Plan::TABLE`]) whose steps are all
 /// `Logic`: `table[i]` is the value word after a point that is not the first,
 /// where index `i` holds the point's atoms (bit `k`: atom `k`) and above them
-/// the last values of the nodes that read their own (`mem[j]`, bit
-/// `atoms.len() + j`). Returns the number of memory bits, or `None` (nothing
-/// to use) when a step is not `Logic` or the index does not fit `table` or
-/// [`TABLE_BITS`].
-pub(crate) fn build_table(
-    steps: &[Step],
-    atoms: &[AtomStep],
-    table: &mut [u64],
-    mem: &mut [u8],
-) -> Option<u8> {
+/// the last values of the nodes that read their own (the memory bits, in node
+/// order), for `i < 2^(atoms + memory bits)`; the table's last entry is the
+/// mask of those nodes ([`gather`]), the one before it a multiplier that
+/// gathers them into the top bits of a word ([`multiplier`], 0 if none does).
+/// Returns the number of memory bits, or `None` (nothing to use) when a step
+/// is not `Logic` or the index does not fit [`TABLE_BITS`] or `table` (all but
+/// its last two entries).
+pub(crate) fn build_table(steps: &[Step], atoms: &[AtomStep], table: &mut [u64]) -> Option<u32> {
     if steps.iter().any(|s| s.kind != Kind::Logic) {
         return None;
     }
-    let mut m = 0usize;
+    let mut mem = 0u64;
     for s in steps {
         if reads_own(s.table) {
-            *mem.get_mut(m)? = (s.dest & 63) as u8;
-            m += 1;
+            mem |= 1 << (s.dest & 63);
         }
     }
-    let bits = atoms.len() + m;
-    if bits > TABLE_BITS || 1usize << bits > table.len() {
+    let bits = atoms.len() + mem.count_ones() as usize;
+    if bits > TABLE_BITS || (1usize << bits) + 2 > table.len() {
         return None;
     }
-    let mem = mem.get(..m)?;
     for idx in 0..1usize << bits {
-        let mut old = 0u64;
-        for (j, &at) in mem.iter().enumerate() {
-            old |= ((idx >> (atoms.len() + j)) as u64 & 1) << (at & 63);
+        // The inverse of `gather`: memory bit j to its node.
+        let (mut old, mut rest, mut j) = (0u64, mem, atoms.len());
+        while rest != 0 {
+            old |= ((idx >> j) as u64 & 1) << rest.trailing_zeros();
+            rest &= rest - 1;
+            j += 1;
         }
         let mut nodes = 0u64;
         for (k, a) in atoms.iter().enumerate() {
@@ -594,7 +594,60 @@ pub(crate) fn build_table(
         }
         *table.get_mut(idx)? = fold_logic(steps, old, nodes, 0);
     }
-    Some(m as u8)
+    let [.., magic, last] = table else {
+        return None;
+    };
+    (*magic, *last) = (multiplier(mem), mem);
+    Some(mem.count_ones())
+}
+
+/// A multiplier `k` such that `(x & mem) * k >> (64 - m)` is [`gather`]'s
+/// memory part of `x` (the `m` bits of `x` under `mem`, lowest first) for
+/// every `x`, or 0 when the direct construction (bit `j` of `mem` moved to bit
+/// `64 - m + j`) does not give one (the moved bits would collide or carry).
+/// Checked over every value of the bits, at most 2^8 of them.
+fn multiplier(mem: u64) -> u64 {
+    let m = mem.count_ones();
+    if m == 0 || m as usize > TABLE_BITS {
+        return 0;
+    }
+    let (mut k, mut rest, mut j) = (0u64, mem, 0u32);
+    while rest != 0 {
+        let at = rest.trailing_zeros();
+        // Bit `at` to `64 - m + j`: only upwards (a left shift).
+        let Some(by) = (64 - m + j).checked_sub(at) else {
+            return 0;
+        };
+        k |= 1 << by;
+        rest &= rest - 1;
+        j += 1;
+    }
+    for v in 0..1u64 << m {
+        // The value `v` spread over the bits of `mem`, and gathered back.
+        let (mut x, mut rest, mut j) = (0u64, mem, 0);
+        while rest != 0 {
+            x |= (v >> j & 1) << rest.trailing_zeros();
+            rest &= rest - 1;
+            j += 1;
+        }
+        if x.wrapping_mul(k) >> (64 - m) != v {
+            return 0;
+        }
+    }
+    k
+}
+
+/// A transition table's index ([`build_table`]): the atoms `atoms` (`n` of
+/// them), then above them the bits of `old` under `mem`, lowest first.
+#[inline(always)]
+pub(crate) fn gather(atoms: u64, n: usize, old: u64, mem: u64) -> u64 {
+    let (mut idx, mut rest, mut j) = (atoms, mem, n);
+    while rest != 0 {
+        idx |= (old >> rest.trailing_zeros() & 1) << (j & 63);
+        rest &= rest - 1;
+        j += 1;
+    }
+    idx
 }
 
 /// The literal nodes' bits of a folded plan for each value of its atoms
@@ -643,5 +696,32 @@ mod tests {
         assert_eq!(reads(since(0, Some(5))), Some((A | B) as u8));
         assert_eq!(reads(since(2, Some(5))), Some((A | B) as u8));
         assert_eq!(table_reads(table(|_, b, _, _| b)), B as u8);
+    }
+
+    #[test]
+    fn a_multiplier_gathers_like_the_loop_or_is_zero() {
+        // Bits 0, 1 and 3: bit 3's move lands a cross term in the window.
+        assert_eq!(multiplier(0b1011), 0);
+        assert_eq!(multiplier(0), 0);
+        let masks = [
+            1u64 << 63,
+            0b11,
+            1 << 4 | 1 << 8,
+            0x8000_0100_0010_0001,
+            0xff << 20,
+        ];
+        for mem in masks {
+            let k = multiplier(mem);
+            assert_ne!(k, 0, "{mem:#x}");
+            let top = 64 - mem.count_ones();
+            for old in [0, u64::MAX, 0x5555_5555_5555_5555, 0xdead_beef_0123_4567] {
+                let want = gather(0b101, 3, old, mem);
+                assert_eq!(
+                    0b101 | (old & mem).wrapping_mul(k) >> top << 3,
+                    want,
+                    "{mem:#x}"
+                );
+            }
+        }
     }
 }
