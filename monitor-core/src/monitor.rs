@@ -3,7 +3,7 @@
 use crate::error::{StepError, TableError};
 use crate::expr;
 use crate::layout;
-use crate::plan::{self, AtomKind, AtomStep, Kind, Plan, Step};
+use crate::plan::{self, AtomStep, Kind, Plan, Step};
 use crate::program::{Atom, Instr, Op, Program, Ty, Value, VarKind};
 
 mod node;
@@ -296,7 +296,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 bits = vb >> (info.shift & 63) & mask;
             } else if info.has(Plan::BOOLS) {
                 for (k, a) in atoms.iter().enumerate() {
-                    let v = (vb >> (a.var & 63) ^ (a.kind == AtomKind::NotBool) as u64) & 1;
+                    let v = (vb.wrapping_shr(a.var as u32) ^ a.c as u64) & 1;
                     bits |= v << (k & 63);
                 }
             } else {
@@ -402,19 +402,20 @@ impl<'a, const N: usize> Monitor<'a, N> {
     fn fold(&self, body: &mut [u64], t: u64, old: u64, nodes: u64, first_point: bool) -> u64 {
         let d = if first_point { plan::D } else { 0 };
         let mut new = nodes;
+        // Shifts by `wrapping_shl`/`wrapping_shr`: every index is below 64.
         for s in self.plan_nodes() {
-            let i = s.dest & 63;
-            let f = (new >> (s.a & 63)) as u16 & 1;
-            let g = (new >> (s.b & 63)) as u16 & 1;
+            let i = s.dest as u32;
+            let f = new.wrapping_shr(s.a as u32) & 1;
+            let g = new.wrapping_shr(s.b as u32) & 1;
             let v = if s.kind == Kind::Logic {
-                let c = (old >> i) as u16 & 1;
-                (s.table >> (f | g << 1 | c << 2 | d)) & 1 == 1
+                let c = old.wrapping_shr(i) & 1;
+                (s.table as u64).wrapping_shr((f | g << 1 | c << 2) as u32 | d as u32) & 1
             } else {
-                special(s, body, t, f == 1, g == 1, d)
+                special(s, body, t, f == 1, g == 1, d) as u64
             };
-            new |= (v as u64) << i;
+            new |= v.wrapping_shl(i);
             if s.negate != 0 {
-                new |= (!v as u64) << (s.neg & 63);
+                new |= (v ^ 1).wrapping_shl(s.neg as u32);
             }
         }
         new

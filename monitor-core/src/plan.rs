@@ -222,7 +222,8 @@ const fn int_kind(op: CmpOp) -> AtomKind {
 /// One atom, planned.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct AtomStep {
-    /// The constant of the `Int*` kinds.
+    /// The constant of the `Int*` kinds; 1 for `NotBool` (the bit that flips
+    /// the variable's), 0 for `Bool`.
     pub c: i64,
     /// The variable read (every kind but `General`) or the first instruction (`General`).
     pub var: u16,
@@ -268,7 +269,7 @@ impl AtomStep {
         };
         match *code {
             [Instr::Load(n)] if ty(n) == Some(Ty::Bool) => var(n, AtomKind::Bool, 0),
-            [Instr::Load(n), Instr::Not] if ty(n) == Some(Ty::Bool) => var(n, AtomKind::NotBool, 0),
+            [Instr::Load(n), Instr::Not] if ty(n) == Some(Ty::Bool) => var(n, AtomKind::NotBool, 1),
             [Instr::Load(n), Instr::Push(Value::Int(c)), Instr::Cmp(op, Ty::Int)]
                 if ty(n) == Some(Ty::Int) =>
             {
