@@ -239,15 +239,26 @@ impl<'a, const N: usize> Monitor<'a, N> {
         verdicts: &mut [bool],
     ) -> Result<(), StepError> {
         let p = &self.program;
-        // Every check of the point's shape in one test, the error built out of line.
-        let last = state.first().copied().unwrap_or(0);
-        let ok = (state.len() == self.state_words)
-            & (verdicts.len() == p.props.len())
-            & (vars.len() == p.vars.len())
-            & (time.wrapping_add(1) >= last)
-            & (time != u64::MAX);
-        if !ok {
-            return Err(self.point_error(state, time, vars.len(), verdicts));
+        if cfg!(feature = "compact") {
+            // The checks one after the other: the smallest code (firmware).
+            self.check_point(state, time, verdicts)?;
+            if vars.len() != p.vars.len() {
+                return Err(StepError::InputSize {
+                    expected: p.vars.len(),
+                    found: vars.len(),
+                });
+            }
+        } else {
+            // Every check of the point's shape in one test, the error built out of line.
+            let last = state.first().copied().unwrap_or(0);
+            let ok = (state.len() == self.state_words)
+                & (verdicts.len() == p.props.len())
+                & (vars.len() == p.vars.len())
+                & (time.wrapping_add(1) >= last)
+                & (time != u64::MAX);
+            if !ok {
+                return Err(self.point_error(state, time, vars.len(), verdicts));
+            }
         }
         if N > 0 && self.info.has(Plan::PLANNED) {
             return self.step_planned(state, time, vars, verdicts);
