@@ -8,10 +8,13 @@
 //! computed here and not per point; children and state slots are plain
 //! indices; the atoms of the common shapes (a boolean variable, its negation,
 //! an integer variable compared with a constant) are read without the atom
-//! machine, and they check their variable's type as they read it. In a program
-//! of at most 64 nodes and atoms the literal nodes (constants, atoms and `Not`s
-//! of them) are no steps at all but bits set by the atom reads, and a `Not` of
-//! a step's node is written by that step ([`Plan::FOLDED`]). The plan lives in
+//! machine, after one pass over the variables has checked their types and
+//! gathered the booleans as bits ([`Plan::FAST`]). In a program of at most 64
+//! nodes and atoms the literal nodes (constants, atoms and `Not`s of them) are
+//! no steps at all but bits set by the atoms, and a `Not` of a step's node is
+//! written by that step ([`Plan::FOLDED`]); when every step is then a truth
+//! table and the atoms and memory bits are few, a transition table steps a
+//! point by one lookup ([`Plan::TABLE`], [`build_table`]). The plan lives in
 //! the monitor itself, in arrays of `N` entries (const generics: no
 //! allocation); a program with more than `N` nodes or atoms runs the unplanned
 //! interpreter.
@@ -342,13 +345,13 @@ const fn flip(op: CmpOp) -> CmpOp {
     }
 }
 
-/// What [`build`] decided for the whole program: four bytes, so that an
+/// What [`build`] decided for the whole program: six bytes, so that an
 /// unplanned `Monitor<'_>` (firmware) stays as small as before plans.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Plan {
     /// The number of steps in the plan's node array.
     pub steps: u16,
-    /// [`Plan::PLANNED`] .. [`Plan::TABLE`].
+    /// [`Plan::PLANNED`] .. [`Plan::LITS`].
     pub flags: u8,
     /// [`Plan::RUN`]: the variable of atom 0.
     pub shift: u8,
