@@ -318,7 +318,8 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 }
             }
             if info.has(Plan::FOLDED) {
-                self.advance_folded(state, time, bits, || self.literals(bits), verdicts);
+                let lits = || self.literals(bits);
+                self.advance_folded(state, time, bits, bits, lits, verdicts);
             } else {
                 if !atoms.is_empty() {
                     wr(state, layout::HEADER_WORDS, bits);
@@ -339,7 +340,12 @@ impl<'a, const N: usize> Monitor<'a, N> {
     #[inline(always)]
     fn advance_plan(&self, state: &mut [u64], time: u64, first: u64, verdicts: &mut [bool]) {
         if self.info.has(Plan::FOLDED) {
-            self.advance_folded(state, time, first, || self.literals(first), verdicts);
+            // Only the atoms' bits index the tables: a caller's word
+            // (`try_step_atoms`) may have more set.
+            let n = self.program.atoms.len() as u32;
+            let exact = first & u64::MAX.checked_shr(64u32.wrapping_sub(n)).unwrap_or(0);
+            let lits = || self.literals(exact);
+            self.advance_folded(state, time, first, exact, lits, verdicts);
         } else {
             self.advance(self.plan_nodes(), state, time, first, verdicts);
         }
@@ -362,8 +368,9 @@ impl<'a, const N: usize> Monitor<'a, N> {
         nodes
     }
 
-    /// The network step of a folded plan ([`Plan::FOLDED`]): `atoms` are this
-    /// point's atoms, `nodes` gives the literal nodes' bits; each step adds its
+    /// The network step of a folded plan ([`Plan::FOLDED`]): `atoms` is this
+    /// point's atom word as given, `exact` its bits of the atoms alone (the
+    /// tables' index), `nodes` gives the literal nodes' bits; each step adds its
     /// node's (and its fused `Not`'s). One to 64 atoms and at most 64 nodes: the
     /// state opens with exactly three words (time, atoms, values; [`layout`]),
     /// and the values of this point and the last each fit one register. With a
@@ -374,6 +381,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
         state: &mut [u64],
         t: u64,
         atoms: u64,
+        exact: u64,
         nodes: impl FnOnce() -> u64,
         verdicts: &mut [bool],
     ) {
@@ -390,9 +398,9 @@ impl<'a, const N: usize> Monitor<'a, N> {
             let idx = match self.table.as_slice() {
                 // One multiply gathers the memory bits (most tables).
                 [.., k, mem] if *k != 0 => {
-                    atoms | (old & mem).wrapping_mul(*k) >> (self.info.top & 63) << (n & 63)
+                    exact | (old & mem).wrapping_mul(*k) >> (self.info.top & 63) << (n & 63)
                 }
-                [.., mem] => plan::gather(atoms, n, old, *mem),
+                [.., mem] => plan::gather(exact, n, old, *mem),
                 [] => 0,
             };
             self.table.get(idx as usize).copied().unwrap_or(0)
