@@ -4,7 +4,7 @@ use crate::error::{StepError, TableError};
 use crate::expr;
 use crate::layout;
 use crate::plan::{self, AtomStep, Kind, Plan, Step};
-use crate::program::{Atom, Instr, Op, Program, Value, VarKind};
+use crate::program::{Atom, Instr, Op, Program, Ty, Value, VarKind};
 
 mod node;
 
@@ -19,9 +19,9 @@ use node::{rd, special, wr, NodeStep};
 /// `N` is the room for a plan (`plan.rs`): a `Monitor<'_, N>` built with
 /// [`Monitor::try_new_planned`] decides each node's kind, children, state slot
 /// and window capacity and each atom's shape once, for programs of at most `N`
-/// nodes and `N` atoms, and steps faster. It holds `N` entries of 40 bytes and
-/// `N` of 32 (const generics: no allocation); the default `N = 0` plans nothing
-/// and holds nothing more.
+/// nodes and `N` atoms, and steps faster. It holds `N` entries of 40 bytes,
+/// `N` of 32 and `N` of 8 (const generics: no allocation); the default `N = 0`
+/// plans nothing and holds nothing more.
 #[derive(Clone, Copy, Debug)]
 pub struct Monitor<'a, const N: usize = 0> {
     program: Program<'a>,
@@ -38,6 +38,10 @@ pub struct Monitor<'a, const N: usize = 0> {
     plan: [Step; N],
     /// Atom `k`'s plan, for `k < program.atoms.len()` when planned.
     atom_plan: [AtomStep; N],
+    /// [`Plan::TABLE`]: the value word after a point that is not the first, by
+    /// atoms and memory bits ([`plan::build_table`]); [`Plan::LITS`]: the
+    /// literal nodes' bits by atoms ([`plan::build_literals`]).
+    table: [u64; N],
 }
 
 /// The most nodes, atoms or variables a program may have (ids are `u16`).
@@ -148,9 +152,12 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 } else {
                     0
                 },
+                shift: 0,
+                top: 0,
             },
             plan: [Step::NONE; N],
             atom_plan: [AtomStep::NONE; N],
+            table: [0; N],
         };
         if N > 0 {
             if let Some(info) = plan::build(
@@ -160,9 +167,19 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 &mut monitor.atom_plan,
             ) {
                 monitor.info = Plan {
-                    steps: info.steps,
                     flags: info.flags | monitor.info.flags,
+                    ..info
                 };
+                if info.has(Plan::FOLDED) {
+                    let steps = monitor.plan.get(..info.steps as usize).unwrap_or(&[]);
+                    let atoms = monitor.atom_plan.get(..p.atoms.len()).unwrap_or(&[]);
+                    if let Some(m) = plan::build_table(steps, atoms, &mut monitor.table) {
+                        monitor.info.flags |= Plan::TABLE;
+                        monitor.info.top = 64 - m as u8;
+                    } else if plan::build_literals(atoms, &mut monitor.table).is_some() {
+                        monitor.info.flags |= Plan::LITS;
+                    }
+                }
             }
         }
         Ok(monitor)
@@ -221,13 +238,27 @@ impl<'a, const N: usize> Monitor<'a, N> {
         vars: &[Value],
         verdicts: &mut [bool],
     ) -> Result<(), StepError> {
-        self.check_point(state, time, verdicts)?;
         let p = &self.program;
-        if vars.len() != p.vars.len() {
-            return Err(StepError::InputSize {
-                expected: p.vars.len(),
-                found: vars.len(),
-            });
+        if cfg!(feature = "compact") {
+            // The checks one after the other: the smallest code (firmware).
+            self.check_point(state, time, verdicts)?;
+            if vars.len() != p.vars.len() {
+                return Err(StepError::InputSize {
+                    expected: p.vars.len(),
+                    found: vars.len(),
+                });
+            }
+        } else {
+            // Every check of the point's shape in one test, the error built out of line.
+            let last = state.first().copied().unwrap_or(0);
+            let ok = (state.len() == self.state_words)
+                & (verdicts.len() == p.props.len())
+                & (vars.len() == p.vars.len())
+                & (time.wrapping_add(1) >= last)
+                & (time != u64::MAX);
+            if !ok {
+                return Err(self.point_error(state, time, vars.len(), verdicts));
+            }
         }
         if N > 0 && self.info.has(Plan::PLANNED) {
             return self.step_planned(state, time, vars, verdicts);
@@ -250,23 +281,45 @@ impl<'a, const N: usize> Monitor<'a, N> {
     ) -> Result<(), StepError> {
         let (p, info, atoms) = (&self.program, &self.info, self.plan_atoms());
         if info.has(Plan::FAST) {
-            // The atom reads check the types of the variables they read (a
-            // mismatch gives the full check's error: the first variable of
-            // another type), before anything is written. When some variable
-            // is read by no atom, the full check (a tight loop) runs first.
-            if info.has(Plan::UNREAD) {
-                check_types(p, vars)?;
-            }
-            let (mut bits, mut nodes) = (0u64, 0u64);
-            for (k, a) in atoms.iter().enumerate() {
-                let Some(v) = a.fast(vars) else {
-                    return Err(type_error(p, vars));
+            // One pass over the variables (at most 64): each value's type
+            // against the declared one (a mismatch gives the first variable of
+            // another type, before anything is written) and the booleans' bits.
+            let (mut bad, mut vb) = (false, 0u64);
+            for (i, (v, d)) in vars.iter().zip(p.vars).enumerate() {
+                let (ty, b) = match *v {
+                    Value::Bool(b) => (Ty::Bool, b),
+                    Value::Int(_) => (Ty::Int, false),
+                    Value::Float(_) => (Ty::Float, false),
+                    Value::Str(_) => (Ty::Str, false),
                 };
-                bits |= (v as u64) << (k & 63);
-                nodes |= if v { a.pos } else { a.neg };
+                bad |= ty != d.ty;
+                vb |= (b as u64) << (i & 63);
+            }
+            if bad {
+                return Err(type_error(p, vars));
+            }
+            let mut bits = 0u64;
+            if info.has(Plan::RUN) {
+                // At most 64 variables: `shift + atoms <= 64`.
+                let mask = u64::MAX
+                    .checked_shr(64u32.wrapping_sub(atoms.len() as u32))
+                    .unwrap_or(0);
+                bits = vb >> (info.shift & 63) & mask;
+            } else if info.has(Plan::BOOLS) {
+                for (k, a) in atoms.iter().enumerate() {
+                    let v = (vb.wrapping_shr(a.var as u32) ^ a.c as u64) & 1;
+                    bits |= v << (k & 63);
+                }
+            } else {
+                for (k, a) in atoms.iter().enumerate() {
+                    // The types were checked: never `None`.
+                    let v = a.fast(vars).unwrap_or(false);
+                    bits |= (v as u64) << (k & 63);
+                }
             }
             if info.has(Plan::FOLDED) {
-                self.advance_folded(state, time, bits, nodes, verdicts);
+                let lits = || self.literals(bits);
+                self.advance_folded(state, time, bits, bits, lits, verdicts);
             } else {
                 if !atoms.is_empty() {
                     wr(state, layout::HEADER_WORDS, bits);
@@ -287,7 +340,12 @@ impl<'a, const N: usize> Monitor<'a, N> {
     #[inline(always)]
     fn advance_plan(&self, state: &mut [u64], time: u64, first: u64, verdicts: &mut [bool]) {
         if self.info.has(Plan::FOLDED) {
-            self.advance_folded(state, time, first, self.literals(first), verdicts);
+            // Only the atoms' bits index the tables: a caller's word
+            // (`try_step_atoms`) may have more set.
+            let n = self.program.atoms.len() as u32;
+            let exact = first & u64::MAX.checked_shr(64u32.wrapping_sub(n)).unwrap_or(0);
+            let lits = || self.literals(exact);
+            self.advance_folded(state, time, first, exact, lits, verdicts);
         } else {
             self.advance(self.plan_nodes(), state, time, first, verdicts);
         }
@@ -296,6 +354,9 @@ impl<'a, const N: usize> Monitor<'a, N> {
     /// Folded plans: the literal nodes' bits for the atoms `atoms`.
     #[inline(always)]
     fn literals(&self, atoms: u64) -> u64 {
+        if self.info.has(Plan::LITS) {
+            return self.table.get(atoms as usize).copied().unwrap_or(0);
+        }
         let mut nodes = 0u64;
         for (k, a) in self.plan_atoms().iter().enumerate() {
             nodes |= if atoms >> (k & 63) & 1 == 1 {
@@ -307,18 +368,21 @@ impl<'a, const N: usize> Monitor<'a, N> {
         nodes
     }
 
-    /// The network step of a folded plan ([`Plan::FOLDED`]): `atoms` are this
-    /// point's atoms, `nodes` the literal nodes' bits; each step adds its node's
-    /// (and its fused `Not`'s). One to 64 atoms and at most 64 nodes: the state
-    /// opens with exactly three words (time, atoms, values; [`layout`]), and the
-    /// values of this point and the last each fit one register.
+    /// The network step of a folded plan ([`Plan::FOLDED`]): `atoms` is this
+    /// point's atom word as given, `exact` its bits of the atoms alone (the
+    /// tables' index), `nodes` gives the literal nodes' bits; each step adds its
+    /// node's (and its fused `Not`'s). One to 64 atoms and at most 64 nodes: the
+    /// state opens with exactly three words (time, atoms, values; [`layout`]),
+    /// and the values of this point and the last each fit one register. With a
+    /// transition table ([`Plan::TABLE`]) every point but the first is one lookup.
     #[inline(always)]
     fn advance_folded(
         &self,
         state: &mut [u64],
         t: u64,
         atoms: u64,
-        nodes: u64,
+        exact: u64,
+        nodes: impl FnOnce() -> u64,
         verdicts: &mut [bool],
     ) {
         // The state length was checked (it covers every node's words): never `None`.
@@ -328,29 +392,52 @@ impl<'a, const N: usize> Monitor<'a, N> {
         };
         let first_point = *time_word == 0;
         let old = *value_word;
-        let d = if first_point { plan::D } else { 0 };
-        let mut new = nodes;
-        for s in self.plan_nodes() {
-            let i = s.dest & 63;
-            let f = (new >> (s.a & 63)) as u16 & 1;
-            let g = (new >> (s.b & 63)) as u16 & 1;
-            let v = if s.kind == Kind::Logic {
-                let c = (old >> i) as u16 & 1;
-                (s.table >> (f | g << 1 | c << 2 | d)) & 1 == 1
-            } else {
-                special(s, body, t, f == 1, g == 1, d)
+        let new = if self.info.has(Plan::TABLE) && !first_point {
+            // The index: the atoms, then the memory bits above them.
+            let n = self.program.atoms.len();
+            let idx = match self.table.as_slice() {
+                // One multiply gathers the memory bits (most tables).
+                [.., k, mem] if *k != 0 => {
+                    exact | (old & mem).wrapping_mul(*k) >> (self.info.top & 63) << (n & 63)
+                }
+                [.., mem] => plan::gather(exact, n, old, *mem),
+                [] => 0,
             };
-            new |= (v as u64) << i;
-            if s.negate != 0 {
-                new |= (!v as u64) << (s.neg & 63);
-            }
-        }
+            self.table.get(idx as usize).copied().unwrap_or(0)
+        } else {
+            self.fold(body, t, old, nodes(), first_point)
+        };
         *atom_word = atoms;
         *value_word = new;
         *time_word = t + 1;
         for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
             *out = new >> (pr.root & 63) & 1 == 1;
         }
+    }
+
+    /// The folded steps at one point, from the literal nodes' bits `nodes` and
+    /// the last point's value word `old`: this point's value word.
+    #[inline(always)]
+    fn fold(&self, body: &mut [u64], t: u64, old: u64, nodes: u64, first_point: bool) -> u64 {
+        let d = if first_point { plan::D } else { 0 };
+        let mut new = nodes;
+        // Shifts by `wrapping_shl`/`wrapping_shr`: every index is below 64.
+        for s in self.plan_nodes() {
+            let i = s.dest as u32;
+            let f = new.wrapping_shr(s.a as u32) & 1;
+            let g = new.wrapping_shr(s.b as u32) & 1;
+            let v = if s.kind == Kind::Logic {
+                let c = old.wrapping_shr(i) & 1;
+                (s.table as u64).wrapping_shr((f | g << 1 | c << 2) as u32 | d as u32) & 1
+            } else {
+                special(s, body, t, f == 1, g == 1, d) as u64
+            };
+            new |= v.wrapping_shl(i);
+            if s.negate != 0 {
+                new |= (v ^ 1).wrapping_shl(s.neg as u32);
+            }
+        }
+        new
     }
 
     /// Like [`Monitor::try_step`] for a caller that computes the atoms itself:
@@ -380,6 +467,20 @@ impl<'a, const N: usize> Monitor<'a, N> {
             self.advance(self.program.nodes, state, time, first, verdicts);
         }
         Ok(())
+    }
+
+    /// The error of a point [`Monitor::try_step`] found of the wrong shape: the
+    /// first of [`Monitor::check_point`]'s, else the variables' count.
+    #[cold]
+    #[inline(never)]
+    fn point_error(&self, state: &[u64], time: u64, vars: usize, verdicts: &[bool]) -> StepError {
+        match self.check_point(state, time, verdicts) {
+            Err(e) => e,
+            Ok(()) => StepError::InputSize {
+                expected: self.program.vars.len(),
+                found: vars,
+            },
+        }
     }
 
     fn check_point(&self, state: &[u64], time: u64, verdicts: &[bool]) -> Result<(), StepError> {

@@ -8,10 +8,13 @@
 //! computed here and not per point; children and state slots are plain
 //! indices; the atoms of the common shapes (a boolean variable, its negation,
 //! an integer variable compared with a constant) are read without the atom
-//! machine, and they check their variable's type as they read it. In a program
-//! of at most 64 nodes and atoms the literal nodes (constants, atoms and `Not`s
-//! of them) are no steps at all but bits set by the atom reads, and a `Not` of
-//! a step's node is written by that step ([`Plan::FOLDED`]). The plan lives in
+//! machine, after one pass over the variables has checked their types and
+//! gathered the booleans as bits ([`Plan::FAST`]). In a program of at most 64
+//! nodes and atoms the literal nodes (constants, atoms and `Not`s of them) are
+//! no steps at all but bits set by the atoms, and a `Not` of a step's node is
+//! written by that step ([`Plan::FOLDED`]); when every step is then a truth
+//! table and the atoms and memory bits are few, a transition table steps a
+//! point by one lookup ([`Plan::TABLE`], [`build_table`]). The plan lives in
 //! the monitor itself, in arrays of `N` entries (const generics: no
 //! allocation); a program with more than `N` nodes or atoms runs the unplanned
 //! interpreter.
@@ -222,7 +225,8 @@ const fn int_kind(op: CmpOp) -> AtomKind {
 /// One atom, planned.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct AtomStep {
-    /// The constant of the `Int*` kinds.
+    /// The constant of the `Int*` kinds; 1 for `NotBool` (the bit that flips
+    /// the variable's), 0 for `Bool`.
     pub c: i64,
     /// The variable read (every kind but `General`) or the first instruction (`General`).
     pub var: u16,
@@ -268,7 +272,7 @@ impl AtomStep {
         };
         match *code {
             [Instr::Load(n)] if ty(n) == Some(Ty::Bool) => var(n, AtomKind::Bool, 0),
-            [Instr::Load(n), Instr::Not] if ty(n) == Some(Ty::Bool) => var(n, AtomKind::NotBool, 0),
+            [Instr::Load(n), Instr::Not] if ty(n) == Some(Ty::Bool) => var(n, AtomKind::NotBool, 1),
             [Instr::Load(n), Instr::Push(Value::Int(c)), Instr::Cmp(op, Ty::Int)]
                 if ty(n) == Some(Ty::Int) =>
             {
@@ -341,14 +345,19 @@ const fn flip(op: CmpOp) -> CmpOp {
     }
 }
 
-/// What [`build`] decided for the whole program: three bytes, so that an
+/// What [`build`] decided for the whole program: six bytes, so that an
 /// unplanned `Monitor<'_>` (firmware) stays as small as before plans.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct Plan {
     /// The number of steps in the plan's node array.
     pub steps: u16,
-    /// [`Plan::PLANNED`] .. [`Plan::UNREAD`].
+    /// [`Plan::PLANNED`] .. [`Plan::LITS`].
     pub flags: u8,
+    /// [`Plan::RUN`]: the variable of atom 0.
+    pub shift: u8,
+    /// [`Plan::TABLE`] with a gathering multiplier ([`build_table`]): 64 less
+    /// the number of memory bits.
+    pub top: u8,
 }
 
 impl Plan {
@@ -362,13 +371,26 @@ impl Plan {
     /// Otherwise there is one step per node, in node order, and none is fused.
     pub const FOLDED: u8 = 2;
     /// Every atom has a shape [`AtomStep::fast`] reads, at most 64 atoms and 64
-    /// variables, not `compact`: the atom reads check their variables' types,
-    /// and the whole check runs apart only when some variable is read by no atom.
+    /// variables, not `compact`: one pass over the variables checks their
+    /// types and gathers the boolean ones as bits, then the atoms are read
+    /// without a type check.
     pub const FAST: u8 = 4;
-    /// `FAST`: some variable is read by no atom.
-    pub const UNREAD: u8 = 8;
+    /// `FAST` and every atom is a boolean variable or its negation
+    /// ([`AtomKind::Bool`], [`AtomKind::NotBool`]): a bit of the variables' bits.
+    pub const BOOLS: u8 = 8;
     /// At most 64 atoms and 64 nodes (planned or not, see `Monitor::advance`).
     pub const SMALL: u8 = 16;
+    /// `FOLDED` and every step is `Logic`, with at most [`TABLE_BITS`] atoms and
+    /// memory bits together: after the first point, the value word is one
+    /// lookup in the monitor's transition table ([`build_table`]).
+    pub const TABLE: u8 = 32;
+    /// `BOOLS`, and atom `k` is boolean variable `shift + k` (not negated): the
+    /// atoms are one shift and mask of the variables' bits.
+    pub const RUN: u8 = 64;
+    /// `FOLDED`, not `TABLE`, and at most [`TABLE_BITS`] atoms: the monitor's
+    /// table holds the literal nodes' bits of every value of the atoms
+    /// ([`build_literals`]), one lookup instead of a loop over the atoms.
+    pub const LITS: u8 = 128;
 
     /// Whether every flag of `f` is set.
     #[inline(always)]
@@ -410,6 +432,8 @@ pub(crate) fn build(
     let mut plan = Plan {
         steps: 0,
         flags: Plan::PLANNED | if folded { Plan::FOLDED } else { 0 },
+        shift: 0,
+        top: 0,
     };
     let planned = atoms.get(..p.atoms.len()).unwrap_or(&[]);
     if !compact
@@ -417,13 +441,21 @@ pub(crate) fn build(
         && p.vars.len() <= 64
         && planned.iter().all(|a| a.kind != AtomKind::General)
     {
-        let mut read = 0u64;
-        for a in planned {
-            read |= 1u64 << (a.var & 63);
-        }
         plan.flags |= Plan::FAST;
-        if read.count_ones() as usize != p.vars.len() {
-            plan.flags |= Plan::UNREAD;
+        if planned
+            .iter()
+            .all(|a| matches!(a.kind, AtomKind::Bool | AtomKind::NotBool))
+        {
+            plan.flags |= Plan::BOOLS;
+            let shift = planned.first().map_or(0, |a| a.var);
+            if planned
+                .iter()
+                .enumerate()
+                .all(|(k, a)| a.kind == AtomKind::Bool && a.var as usize == shift as usize + k)
+            {
+                plan.flags |= Plan::RUN;
+                plan.shift = shift as u8;
+            }
         }
     }
     // Folded: each node's literal value, and the step computing each non-literal node.
@@ -493,6 +525,152 @@ pub(crate) fn build(
     Some(plan)
 }
 
+/// The most index bits (atoms and memory bits together) of a transition table.
+pub(crate) const TABLE_BITS: usize = 8;
+
+/// The value word of a folded plan whose steps are all `Logic`: `nodes` holds
+/// the literal nodes' bits, `old` the value word of the last point, `d` is
+/// [`D`] at the first point (else 0). As `Monitor::advance_folded` computes it.
+#[inline(always)]
+pub(crate) fn fold_logic(steps: &[Step], old: u64, nodes: u64, d: u16) -> u64 {
+    let mut new = nodes;
+    for s in steps {
+        let i = s.dest & 63;
+        let f = (new >> (s.a & 63)) as u16 & 1;
+        let g = (new >> (s.b & 63)) as u16 & 1;
+        let c = (old >> i) as u16 & 1;
+        let v = (s.table >> (f | g << 1 | c << 2 | d)) & 1 == 1;
+        new |= (v as u64) << i;
+        if s.negate != 0 {
+            new |= (!v as u64) << (s.neg & 63);
+        }
+    }
+    new
+}
+
+/// Whether a truth table reads the node's own last value ([`C`]).
+const fn reads_own(table: u16) -> bool {
+    let mut x = 0u16;
+    while x < 16 {
+        if (table >> x) & 1 != (table >> (x ^ C)) & 1 {
+            return true;
+        }
+        x += 1;
+    }
+    false
+}
+
+/// The transition table of a folded plan ([`Plan::TABLE`]) whose steps are all
+/// `Logic`: `table[i]` is the value word after a point that is not the first,
+/// where index `i` holds the point's atoms (bit `k`: atom `k`) and above them
+/// the last values of the nodes that read their own (the memory bits, in node
+/// order), for `i < 2^(atoms + memory bits)`; the table's last entry is the
+/// mask of those nodes ([`gather`]), the one before it a multiplier that
+/// gathers them into the top bits of a word ([`multiplier`], 0 if none does).
+/// Returns the number of memory bits, or `None` (nothing to use) when a step
+/// is not `Logic` or the index does not fit [`TABLE_BITS`] or `table` (all but
+/// its last two entries).
+pub(crate) fn build_table(steps: &[Step], atoms: &[AtomStep], table: &mut [u64]) -> Option<u32> {
+    if steps.iter().any(|s| s.kind != Kind::Logic) {
+        return None;
+    }
+    let mut mem = 0u64;
+    for s in steps {
+        if reads_own(s.table) {
+            mem |= 1 << (s.dest & 63);
+        }
+    }
+    let bits = atoms.len() + mem.count_ones() as usize;
+    if bits > TABLE_BITS || (1usize << bits) + 2 > table.len() {
+        return None;
+    }
+    for idx in 0..1usize << bits {
+        // The inverse of `gather`: memory bit j to its node.
+        let (mut old, mut rest, mut j) = (0u64, mem, atoms.len());
+        while rest != 0 {
+            old |= ((idx >> j) as u64 & 1) << rest.trailing_zeros();
+            rest &= rest - 1;
+            j += 1;
+        }
+        let mut nodes = 0u64;
+        for (k, a) in atoms.iter().enumerate() {
+            nodes |= if idx >> k & 1 == 1 { a.pos } else { a.neg };
+        }
+        *table.get_mut(idx)? = fold_logic(steps, old, nodes, 0);
+    }
+    let [.., magic, last] = table else {
+        return None;
+    };
+    (*magic, *last) = (multiplier(mem), mem);
+    Some(mem.count_ones())
+}
+
+/// A multiplier `k` such that `(x & mem) * k >> (64 - m)` is [`gather`]'s
+/// memory part of `x` (the `m` bits of `x` under `mem`, lowest first) for
+/// every `x`, or 0 when the direct construction (bit `j` of `mem` moved to bit
+/// `64 - m + j`) does not give one (the moved bits would collide or carry).
+/// Checked over every value of the bits, at most 2^8 of them.
+fn multiplier(mem: u64) -> u64 {
+    let m = mem.count_ones();
+    if m == 0 || m as usize > TABLE_BITS {
+        return 0;
+    }
+    let (mut k, mut rest, mut j) = (0u64, mem, 0u32);
+    while rest != 0 {
+        let at = rest.trailing_zeros();
+        // Bit `at` to `64 - m + j`: only upwards (a left shift).
+        let Some(by) = (64 - m + j).checked_sub(at) else {
+            return 0;
+        };
+        k |= 1 << by;
+        rest &= rest - 1;
+        j += 1;
+    }
+    for v in 0..1u64 << m {
+        // The value `v` spread over the bits of `mem`, and gathered back.
+        let (mut x, mut rest, mut j) = (0u64, mem, 0);
+        while rest != 0 {
+            x |= (v >> j & 1) << rest.trailing_zeros();
+            rest &= rest - 1;
+            j += 1;
+        }
+        if x.wrapping_mul(k) >> (64 - m) != v {
+            return 0;
+        }
+    }
+    k
+}
+
+/// A transition table's index ([`build_table`]): the atoms `atoms` (`n` of
+/// them), then above them the bits of `old` under `mem`, lowest first.
+#[inline(always)]
+pub(crate) fn gather(atoms: u64, n: usize, old: u64, mem: u64) -> u64 {
+    let (mut idx, mut rest, mut j) = (atoms, mem, n);
+    while rest != 0 {
+        idx |= (old >> rest.trailing_zeros() & 1) << (j & 63);
+        rest &= rest - 1;
+        j += 1;
+    }
+    idx
+}
+
+/// The literal nodes' bits of a folded plan for each value of its atoms
+/// ([`Plan::LITS`]): `table[i]` for atoms `i`; `None` (nothing to use) when
+/// the atoms are more than [`TABLE_BITS`] or than `table` indexes.
+pub(crate) fn build_literals(atoms: &[AtomStep], table: &mut [u64]) -> Option<()> {
+    if atoms.len() > TABLE_BITS || 1usize << atoms.len() > table.len() {
+        return None;
+    }
+    for idx in 0..1usize << atoms.len() {
+        let mut nodes = 0u64;
+        for (k, a) in atoms.iter().enumerate() {
+            nodes |= if idx >> k & 1 == 1 { a.pos } else { a.neg };
+        }
+        *table.get_mut(idx)? = nodes;
+    }
+    Some(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -522,5 +700,32 @@ mod tests {
         assert_eq!(reads(since(0, Some(5))), Some((A | B) as u8));
         assert_eq!(reads(since(2, Some(5))), Some((A | B) as u8));
         assert_eq!(table_reads(table(|_, b, _, _| b)), B as u8);
+    }
+
+    #[test]
+    fn a_multiplier_gathers_like_the_loop_or_is_zero() {
+        // Bits 0, 1 and 3: bit 3's move lands a cross term in the window.
+        assert_eq!(multiplier(0b1011), 0);
+        assert_eq!(multiplier(0), 0);
+        let masks = [
+            1u64 << 63,
+            0b11,
+            1 << 4 | 1 << 8,
+            0x8000_0100_0010_0001,
+            0xff << 20,
+        ];
+        for mem in masks {
+            let k = multiplier(mem);
+            assert_ne!(k, 0, "{mem:#x}");
+            let top = 64 - mem.count_ones();
+            for old in [0, u64::MAX, 0x5555_5555_5555_5555, 0xdead_beef_0123_4567] {
+                let want = gather(0b101, 3, old, mem);
+                assert_eq!(
+                    0b101 | (old & mem).wrapping_mul(k) >> top << 3,
+                    want,
+                    "{mem:#x}"
+                );
+            }
+        }
     }
 }

@@ -9,7 +9,9 @@
 //! `i64` extremes) through `Monitor<'_>`, a `Monitor<'_, 16>` (planned only for
 //! the smallest specs) and a `Monitor<'_, 256>` (planned, one value word or
 //! several): after every point the result and the whole state buffer must be
-//! the same.
+//! the same. Specs over boolean variables alone take the plan's other paths
+//! (atoms as bits of the variables, a transition table for networks of truth
+//! tables, a table of the literal nodes' bits), checked the same way.
 
 use hindsight_tests::gen::{self, FormulaConfig, Gen};
 use hindsight_tests::oracle;
@@ -164,4 +166,113 @@ fn planned_monitors_step_like_unplanned_ones() {
     assert!(fallback > 20, "{fallback} specs too large for N = 16");
     assert!(errors > 50, "{errors} points rejected");
     assert!(atomless > 20, "{atomless} specs without atoms");
+}
+
+/// Boolean-only networks: fixed ones (every node a truth table, so that the
+/// transition table is used; with windows; with an event) and random ones.
+const BOOL_FORMULAS: &[&str] = &[
+    "H({a0} -> H(!{a1}))",
+    "{a0} S {a1}",
+    "{a1} S {a0}",
+    "!{a2} || ({a0} S ({a1} && !{a0}))",
+    "H({a0} -> P {a1}) && !(({a2} || {a1}) S !{a0})",
+    "{a0} S[1:3] {a1}",
+    "P[0:2] {a2}",
+    "{a0} && {a1} && {a2} && {e}",
+    "({e} -> Y {a0}) && H(!{a2})",
+];
+
+#[test]
+fn boolean_monitors_step_like_unplanned_ones() {
+    let mut rng = gen::rng(0x626f_6f6c);
+    let mut errors = 0;
+    for case in 0..600 {
+        let mut text = String::from(
+            "state a0: bool = false;\nstate a1: bool = true;\nstate a2: bool = false;\nevent e;\n",
+        );
+        for k in 0..gen::range(&mut rng, 1, 3) {
+            let f = if gen::chance(&mut rng, 0.4) {
+                BOOL_FORMULAS[gen::range(&mut rng, 0, BOOL_FORMULAS.len() as u64 - 1) as usize]
+                    .to_string()
+            } else {
+                let cfg = FormulaConfig {
+                    max_depth: gen::range(&mut rng, 2, 6) as usize,
+                    atoms: 3,
+                    small: 4,
+                    p_large: 0.0,
+                    ..FormulaConfig::default()
+                };
+                oracle::print(&gen::formula(&mut rng, &cfg))
+            };
+            text.push_str(&format!("property p{k} = {f};\n"));
+        }
+        let compiled = codegen::compile_spec(&text, "planned.hspec")
+            .unwrap_or_else(|d| panic!("case {case}: codegen rejected\n{text}\n{d}"));
+        let program = compiled.program();
+        let plain = Monitor::try_new(program).expect("codegen output validates");
+        let narrow: Monitor<'_, 16> = Monitor::try_new_planned(program).expect("validates");
+        let wide: Monitor<'_, 256> = Monitor::try_new_planned(program).expect("validates");
+        let words = plain.state_words();
+        let mut states = [vec![0u64; words], vec![0u64; words], vec![0u64; words]];
+        let mut last = 0;
+        for k in 0..gen::range(&mut rng, 1, 60) {
+            let (time, mut vals) = point(&mut rng, last);
+            // a0 a1 a2 e, all booleans; now and then a value of another type.
+            vals[2] = Value::Bool(gen::chance(&mut rng, 0.5));
+            if gen::chance(&mut rng, 0.02) {
+                vals[gen::range(&mut rng, 0, 3) as usize] = Value::Int(1);
+            }
+            let [s0, s1, s2] = &mut states;
+            let want = step(&plain, s0, time, &vals);
+            let got = [step(&narrow, s1, time, &vals), step(&wide, s2, time, &vals)];
+            for (name, (got, state)) in ["N = 16", "N = 256"]
+                .iter()
+                .zip(got.iter().zip([&*s1, &*s2]))
+            {
+                assert_eq!(got, &want, "case {case}, point {k} ({name}):\n{text}");
+                assert_eq!(
+                    state, &*s0,
+                    "case {case}, point {k} ({name}): state\n{text}"
+                );
+            }
+            match want {
+                Ok(_) => last = time,
+                Err(_) => errors += 1,
+            }
+        }
+    }
+    assert!(errors > 20, "{errors} points rejected");
+}
+
+/// `try_step_atoms` reads atom `k` from bit `k % 64` of word `k / 64` and
+/// nothing else: bits past the last atom change no verdict of a planned
+/// monitor (its tables are indexed by the atoms), as they change none of an
+/// unplanned one.
+#[test]
+fn bits_past_the_atoms_are_ignored() {
+    for f in BOOL_FORMULAS {
+        let text = format!(
+            "state a0: bool = false;\nstate a1: bool = true;\nstate a2: bool = false;\nevent e;\nproperty p = {f};\n"
+        );
+        let compiled = codegen::compile_spec(&text, "planned.hspec").expect("compiles");
+        let program = compiled.program();
+        let plain = Monitor::try_new(program).expect("validates");
+        let planned: Monitor<'_, 64> = Monitor::try_new_planned(program).expect("validates");
+        let n = program.atoms.len();
+        let words = plain.state_words();
+        let (mut s0, mut s1) = (vec![0u64; words], vec![0u64; words]);
+        let mut rng = gen::rng(0x6174_6f6d);
+        for time in 0..200u64 {
+            let bits = gen::range(&mut rng, 0, u64::MAX - 1);
+            let exact = bits & (u64::MAX >> (64 - n));
+            let (mut want, mut got) = ([false], [false]);
+            plain
+                .try_step_atoms(&mut s0, time, &[exact], &mut want)
+                .expect("steps");
+            planned
+                .try_step_atoms(&mut s1, time, &[bits], &mut got)
+                .expect("steps");
+            assert_eq!(got, want, "{f}, time {time}, atoms {bits:#x}");
+        }
+    }
 }

@@ -277,9 +277,33 @@ fn window_step(
     g: bool,
     capacity: impl Fn() -> usize,
 ) -> bool {
-    let header = rd(w, 0);
-    let mut head = (header & 0xffff_ffff) as usize;
-    let mut len = (header >> 32) as usize;
+    // The header apart from the runs: run `k` is `runs[2k] = first`, `runs[2k + 1] = last`.
+    let Some((header, runs)) = w.split_first_mut() else {
+        return false;
+    };
+    // A run has expired when `last + hi < t` (no overflow: `last < t - hi`).
+    let horizon = t.checked_sub(hi);
+    let expired = |last: u64| horizon.is_some_and(|h| last < h);
+    // The oldest run decides: `first + lo <= t` (no overflow: `first <= t - lo`).
+    let started = |first: u64| t.checked_sub(lo).is_some_and(|h| first <= h);
+    let mut head = (*header & 0xffff_ffff) as usize;
+    let mut len = (*header >> 32) as usize;
+    if !cfg!(feature = "compact") && !g {
+        // Most points: no witness, and either `f` fails (every run ends) or
+        // the oldest run has not expired (nothing changes; a stored empty
+        // ring has `head` 0). Not in the smallest code (firmware).
+        if !f {
+            *header = 0;
+            return false;
+        }
+        if len == 0 {
+            return false;
+        }
+        let last = rd(runs, 1 + 2 * head);
+        if !expired(last) {
+            return started(rd(runs, 2 * head));
+        }
+    }
     if !f {
         len = 0;
     }
@@ -288,14 +312,14 @@ fn window_step(
     #[cfg(feature = "compact")]
     let cap = if len > 0 || g { capacity() } else { 1 };
     #[cfg(feature = "compact")]
-    while len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
+    while len > 0 && expired(rd(runs, 1 + 2 * head)) {
         head = if head + 1 >= cap { 0 } else { head + 1 };
         len -= 1;
     }
     #[cfg(not(feature = "compact"))]
-    if len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
+    if len > 0 && expired(rd(runs, 1 + 2 * head)) {
         let cap = capacity();
-        while len > 0 && rd(w, 2 + 2 * head).saturating_add(hi) < t {
+        while len > 0 && expired(rd(runs, 1 + 2 * head)) {
             head = if head + 1 >= cap { 0 } else { head + 1 };
             len -= 1;
         }
@@ -312,15 +336,15 @@ fn window_step(
             tail -= cap;
         }
         let newest = if tail == 0 { cap - 1 } else { tail - 1 };
-        if len > 0 && t.wrapping_sub(rd(w, 2 + 2 * newest)) <= hi - lo {
-            wr(w, 2 + 2 * newest, t);
+        if len > 0 && t.wrapping_sub(rd(runs, 1 + 2 * newest)) <= hi - lo {
+            wr(runs, 1 + 2 * newest, t);
         } else if len < cap {
-            wr(w, 1 + 2 * tail, t);
-            wr(w, 2 + 2 * tail, t);
+            wr(runs, 2 * tail, t);
+            wr(runs, 1 + 2 * tail, t);
             len += 1;
         }
         // len == cap cannot happen: at most floor(hi / (hi - lo + 1)) + 1 runs are live.
     }
-    wr(w, 0, head as u64 | (len as u64) << 32);
-    len > 0 && rd(w, 1 + 2 * head).saturating_add(lo) <= t
+    *header = head as u64 | (len as u64) << 32;
+    len > 0 && started(rd(runs, 2 * head))
 }
