@@ -95,6 +95,28 @@ fn step<const N: usize>(m: &Monitor<'_, N>, state: &mut [u64], time: u64, vals: 
     m.try_step(state, time, vals, &mut out).map(|()| out)
 }
 
+/// Steps the unplanned monitor and both planned ones at one point and asserts that the
+/// planned ones give its result and the same state; returns its result.
+fn step_three(
+    (plain, narrow, wide): (&Monitor<'_>, &Monitor<'_, 16>, &Monitor<'_, 256>),
+    states: &mut [Vec<u64>; 3],
+    (time, vals): (u64, &[Value]),
+    at: &str,
+    text: &str,
+) -> Step {
+    let [s0, s1, s2] = states;
+    let want = step(plain, s0, time, vals);
+    let got = [step(narrow, s1, time, vals), step(wide, s2, time, vals)];
+    for (name, (got, state)) in ["N = 16", "N = 256"]
+        .iter()
+        .zip(got.iter().zip([&*s1, &*s2]))
+    {
+        assert_eq!(got, &want, "{at} ({name}):\n{text}");
+        assert_eq!(state, &*s0, "{at} ({name}): state\n{text}");
+    }
+    want
+}
+
 #[test]
 fn planned_monitors_step_like_unplanned_ones() {
     let mut rng = gen::rng(0x706c_616e);
@@ -135,19 +157,13 @@ fn planned_monitors_step_like_unplanned_ones() {
         let mut last = 0;
         for k in 0..gen::range(&mut rng, 1, 80) {
             let (time, vals) = point(&mut rng, last);
-            let [s0, s1, s2] = &mut states;
-            let want = step(&plain, s0, time, &vals);
-            let got = [step(&narrow, s1, time, &vals), step(&wide, s2, time, &vals)];
-            for (name, (got, state)) in ["N = 16", "N = 256"]
-                .iter()
-                .zip(got.iter().zip([&*s1, &*s2]))
-            {
-                assert_eq!(got, &want, "case {case}, point {k} ({name}):\n{text}");
-                assert_eq!(
-                    state, &*s0,
-                    "case {case}, point {k} ({name}): state\n{text}"
-                );
-            }
+            let want = step_three(
+                (&plain, &narrow, &wide),
+                &mut states,
+                (time, &vals),
+                &format!("case {case}, point {k}"),
+                &text,
+            );
             match want {
                 Ok(_) => last = time,
                 Err(_) => errors += 1,
@@ -222,19 +238,13 @@ fn boolean_monitors_step_like_unplanned_ones() {
             if gen::chance(&mut rng, 0.02) {
                 vals[gen::range(&mut rng, 0, 3) as usize] = Value::Int(1);
             }
-            let [s0, s1, s2] = &mut states;
-            let want = step(&plain, s0, time, &vals);
-            let got = [step(&narrow, s1, time, &vals), step(&wide, s2, time, &vals)];
-            for (name, (got, state)) in ["N = 16", "N = 256"]
-                .iter()
-                .zip(got.iter().zip([&*s1, &*s2]))
-            {
-                assert_eq!(got, &want, "case {case}, point {k} ({name}):\n{text}");
-                assert_eq!(
-                    state, &*s0,
-                    "case {case}, point {k} ({name}): state\n{text}"
-                );
-            }
+            let want = step_three(
+                (&plain, &narrow, &wide),
+                &mut states,
+                (time, &vals),
+                &format!("case {case}, point {k}"),
+                &text,
+            );
             match want {
                 Ok(_) => last = time,
                 Err(_) => errors += 1,
