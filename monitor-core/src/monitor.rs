@@ -404,6 +404,14 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 [] => 0,
             };
             self.table.get(idx as usize).copied().unwrap_or(0)
+        } else if self.info.steps == 1 {
+            // One step (`P[a:b] p`, `p S[a:b] q`, `P[0:b] p`: a timed node over
+            // literals): no step loop.
+            let d = if first_point { plan::D } else { 0 };
+            match self.plan.first() {
+                Some(s) => fold_step(s, body, t, old, nodes(), d),
+                None => 0,
+            }
         } else {
             self.fold(body, t, old, nodes(), first_point)
         };
@@ -421,21 +429,8 @@ impl<'a, const N: usize> Monitor<'a, N> {
     fn fold(&self, body: &mut [u64], t: u64, old: u64, nodes: u64, first_point: bool) -> u64 {
         let d = if first_point { plan::D } else { 0 };
         let mut new = nodes;
-        // Shifts by `wrapping_shl`/`wrapping_shr`: every index is below 64.
         for s in self.plan_nodes() {
-            let i = s.dest as u32;
-            let f = new.wrapping_shr(s.a as u32) & 1;
-            let g = new.wrapping_shr(s.b as u32) & 1;
-            let v = if s.kind == Kind::Logic {
-                let c = old.wrapping_shr(i) & 1;
-                (s.table as u64).wrapping_shr((f | g << 1 | c << 2) as u32 | d as u32) & 1
-            } else {
-                special(s, body, t, f == 1, g == 1, d) as u64
-            };
-            new |= v.wrapping_shl(i);
-            if s.negate != 0 {
-                new |= (v ^ 1).wrapping_shl(s.neg as u32);
-            }
+            new = fold_step(s, body, t, old, new, d);
         }
         new
     }
@@ -630,6 +625,28 @@ impl<'a, const N: usize> Monitor<'a, N> {
             *out = rd(head, vals + r / 64) >> (r % 64) & 1 == 1;
         }
     }
+}
+
+/// One folded step: `new` is this point's value word so far (the literal nodes
+/// and the steps before `s`), `old` the last point's, `d` [`plan::D`] at the
+/// first point (else 0); `new` with this step's node (and its fused `Not`) added.
+#[inline(always)]
+fn fold_step(s: &Step, body: &mut [u64], t: u64, old: u64, new: u64, d: u16) -> u64 {
+    // Shifts by `wrapping_shl`/`wrapping_shr`: every index is below 64.
+    let i = s.dest as u32;
+    let f = new.wrapping_shr(s.a as u32) & 1;
+    let g = new.wrapping_shr(s.b as u32) & 1;
+    let v = if s.kind == Kind::Logic {
+        let c = old.wrapping_shr(i) & 1;
+        (s.table as u64).wrapping_shr((f | g << 1 | c << 2) as u32 | d as u32) & 1
+    } else {
+        special(s, body, t, f == 1, g == 1, d) as u64
+    };
+    let mut new = new | v.wrapping_shl(i);
+    if s.negate != 0 {
+        new |= (v ^ 1).wrapping_shl(s.neg as u32);
+    }
+    new
 }
 
 /// Every value of `vars` has its variable's declared type (same length, checked before).

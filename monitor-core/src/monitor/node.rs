@@ -122,11 +122,51 @@ pub(super) fn special(s: &Step, words: &mut [u64], t: u64, f: bool, g: bool, d: 
             wr(words, slot, w);
             w != 0 && t.wrapping_sub(w - 1) <= s.hi
         }
-        Kind::SinceWindow => match words.get_mut(slot..) {
-            Some(w) => window_step(w, s.lo, s.hi, t, f, g, || s.cap as usize),
-            None => false,
-        },
+        Kind::SinceWindow => {
+            if !g {
+                if let Some(v) = window_quiet(words, slot, s.lo, s.hi, t, f) {
+                    return v;
+                }
+            }
+            window_planned(s, words, t, f, g)
+        }
     }
+}
+
+/// A planned window's step at a point with a witness or an expiry (out of
+/// line: the step that calls it stays small enough to inline).
+#[inline(never)]
+fn window_planned(s: &Step, words: &mut [u64], t: u64, f: bool, g: bool) -> bool {
+    match words.get_mut(s.slot as usize..) {
+        Some(w) => window_step(w, s.lo, s.hi, t, f, g, || s.cap as usize),
+        None => false,
+    }
+}
+
+/// [`window_step`] at a point without a witness, when nothing expires (most
+/// points): the ring's header at `words[slot]` is cleared if `f` fails, else
+/// the oldest run alone gives the verdict. `None` when that run has expired
+/// (the general step then drops it). A planned step only (never `compact`).
+#[inline(always)]
+fn window_quiet(words: &mut [u64], slot: usize, lo: u64, hi: u64, t: u64, f: bool) -> Option<bool> {
+    let header = words.get_mut(slot)?;
+    if !f {
+        *header = 0;
+        return Some(false);
+    }
+    let h = *header;
+    if h >> 32 == 0 {
+        return Some(false);
+    }
+    // Run `head` is `first`, `last` at `slot + 1 + 2 head` (`head < cap < 2^32`).
+    let run = slot + 1 + 2 * (h & 0xffff_ffff) as usize;
+    let &[first, last] = words.get(run..)?.first_chunk::<2>()?;
+    // Expired when `last + hi < t` (no overflow: `last < t - hi`).
+    if t.checked_sub(hi).is_some_and(|x| last < x) {
+        return None;
+    }
+    // Started when `first + lo <= t` (no overflow: `first <= t - lo`).
+    Some(t.checked_sub(lo).is_some_and(|x| first <= x))
 }
 
 /// One node at one point: its value, given its children's values at this point
