@@ -404,22 +404,29 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 [] => 0,
             };
             self.table.get(idx as usize).copied().unwrap_or(0)
-        } else if self.info.steps == 1 {
+        } else if self.info.steps != 1 {
+            self.fold(body, t, old, nodes(), first_point)
+        } else {
             // One step (`P[a:b] p`, `p S[a:b] q`, `P[0:b] p`: a timed node over
             // literals): no step loop.
-            let d = if first_point { plan::D } else { 0 };
-            match self.plan.first() {
-                Some(s) => fold_step(s, body, t, old, nodes(), d),
-                None => 0,
-            }
-        } else {
-            self.fold(body, t, old, nodes(), first_point)
+            self.fold_one(body, t, old, nodes(), first_point)
         };
         *atom_word = atoms;
         *value_word = new;
         *time_word = t + 1;
         for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
             *out = new >> (pr.root & 63) & 1 == 1;
+        }
+    }
+
+    /// [`Monitor::fold`] of a plan of one step, out of line: the loop's
+    /// registers stay as they are for the other plans.
+    #[inline(never)]
+    fn fold_one(&self, body: &mut [u64], t: u64, old: u64, nodes: u64, first_point: bool) -> u64 {
+        let d = if first_point { plan::D } else { 0 };
+        match self.plan.first() {
+            Some(s) => fold_step::<true>(s, body, t, old, nodes, d),
+            None => 0,
         }
     }
 
@@ -430,7 +437,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
         let d = if first_point { plan::D } else { 0 };
         let mut new = nodes;
         for s in self.plan_nodes() {
-            new = fold_step(s, body, t, old, new, d);
+            new = fold_step::<false>(s, body, t, old, new, d);
         }
         new
     }
@@ -631,7 +638,14 @@ impl<'a, const N: usize> Monitor<'a, N> {
 /// and the steps before `s`), `old` the last point's, `d` [`plan::D`] at the
 /// first point (else 0); `new` with this step's node (and its fused `Not`) added.
 #[inline(always)]
-fn fold_step(s: &Step, body: &mut [u64], t: u64, old: u64, new: u64, d: u16) -> u64 {
+fn fold_step<const ONE: bool>(
+    s: &Step,
+    body: &mut [u64],
+    t: u64,
+    old: u64,
+    new: u64,
+    d: u16,
+) -> u64 {
     // Shifts by `wrapping_shl`/`wrapping_shr`: every index is below 64.
     let i = s.dest as u32;
     let f = new.wrapping_shr(s.a as u32) & 1;
@@ -640,7 +654,7 @@ fn fold_step(s: &Step, body: &mut [u64], t: u64, old: u64, new: u64, d: u16) -> 
         let c = old.wrapping_shr(i) & 1;
         (s.table as u64).wrapping_shr((f | g << 1 | c << 2) as u32 | d as u32) & 1
     } else {
-        special(s, body, t, f == 1, g == 1, d) as u64
+        special::<ONE>(s, body, t, f == 1, g == 1, d) as u64
     };
     let mut new = new | v.wrapping_shl(i);
     if s.negate != 0 {

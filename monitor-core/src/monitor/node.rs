@@ -80,14 +80,21 @@ fn exec(
         let x = f as u16 | (g as u16) << 1 | (own_prev as u16) << 2 | d;
         return (s.table >> x) & 1 == 1;
     }
-    special(s, words, t, f, g, d)
+    special::<false>(s, words, t, f, g, d)
 }
 
 /// A step that is not `Logic` (the cold part of a step, one branch away), its
 /// children's values `f` and `g`; `d` is [`plan::D`] at the first point, else 0;
 /// `words` the nodes' own words, whose `s.slot` .. are this node's.
 #[inline(always)]
-pub(super) fn special(s: &Step, words: &mut [u64], t: u64, f: bool, g: bool, d: u16) -> bool {
+pub(super) fn special<const ONE: bool>(
+    s: &Step,
+    words: &mut [u64],
+    t: u64,
+    f: bool,
+    g: bool,
+    d: u16,
+) -> bool {
     let slot = s.slot as usize;
     match s.kind {
         // Not reached: `Logic` is computed before.
@@ -122,7 +129,10 @@ pub(super) fn special(s: &Step, words: &mut [u64], t: u64, f: bool, g: bool, d: 
             wr(words, slot, w);
             w != 0 && t.wrapping_sub(w - 1) <= s.hi
         }
-        Kind::SinceWindow => {
+        // `ONE` (a plan of one step): the quiet point inline, the rest out of
+        // line; in a step loop the whole window step inline (fewer registers
+        // spilled around the loop).
+        Kind::SinceWindow if ONE => {
             if !g {
                 if let Some(v) = window_quiet(words, slot, s.lo, s.hi, t, f) {
                     return v;
@@ -130,6 +140,10 @@ pub(super) fn special(s: &Step, words: &mut [u64], t: u64, f: bool, g: bool, d: 
             }
             window_planned(s, words, t, f, g)
         }
+        Kind::SinceWindow => match words.get_mut(slot..) {
+            Some(w) => window_step(w, s.lo, s.hi, t, f, g, || s.cap as usize),
+            None => false,
+        },
     }
 }
 
