@@ -357,15 +357,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
         if self.info.has(Plan::LITS) {
             return self.table.get(atoms as usize).copied().unwrap_or(0);
         }
-        let mut nodes = 0u64;
-        for (k, a) in self.plan_atoms().iter().enumerate() {
-            nodes |= if atoms >> (k & 63) & 1 == 1 {
-                a.pos
-            } else {
-                a.neg
-            };
-        }
-        nodes
+        plan::literal_bits(self.plan_atoms(), atoms)
     }
 
     /// The network step of a folded plan ([`Plan::FOLDED`]): `atoms` is this
@@ -646,21 +638,12 @@ fn fold_step<const ONE: bool>(
     new: u64,
     d: u16,
 ) -> u64 {
-    // Shifts by `wrapping_shl`/`wrapping_shr`: every index is below 64.
-    let i = s.dest as u32;
-    let f = new.wrapping_shr(s.a as u32) & 1;
-    let g = new.wrapping_shr(s.b as u32) & 1;
-    let v = if s.kind == Kind::Logic {
-        let c = old.wrapping_shr(i) & 1;
-        (s.table as u64).wrapping_shr((f | g << 1 | c << 2) as u32 | d as u32) & 1
-    } else {
-        special::<ONE>(s, body, t, f == 1, g == 1, d) as u64
-    };
-    let mut new = new | v.wrapping_shl(i);
-    if s.negate != 0 {
-        new |= (v ^ 1).wrapping_shl(s.neg as u32);
+    if s.kind == Kind::Logic {
+        return plan::logic_step(s, old, new, d);
     }
-    new
+    let f = new.wrapping_shr(s.a as u32) & 1 == 1;
+    let g = new.wrapping_shr(s.b as u32) & 1 == 1;
+    plan::with_value(s, new, special::<ONE>(s, body, t, f, g, d) as u64)
 }
 
 /// Every value of `vars` has its variable's declared type (same length, checked before).

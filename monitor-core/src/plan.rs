@@ -528,24 +528,57 @@ pub(crate) fn build(
 /// The most index bits (atoms and memory bits together) of a transition table.
 pub(crate) const TABLE_BITS: usize = 8;
 
-/// The value word of a folded plan whose steps are all `Logic`: `nodes` holds
-/// the literal nodes' bits, `old` the value word of the last point, `d` is
-/// [`D`] at the first point (else 0). As `Monitor::advance_folded` computes it.
+/// One `Logic` step of a folded plan: `new` is this point's value word so far
+/// (the literal nodes and the steps before `s`), `old` the last point's, `d`
+/// [`D`] at the first point (else 0); `new` with this step's node (and its
+/// fused `Not`) added. The one copy of it: `Monitor`'s folded step and
+/// [`build_table`] both call it.
 #[inline(always)]
-pub(crate) fn fold_logic(steps: &[Step], old: u64, nodes: u64, d: u16) -> u64 {
-    let mut new = nodes;
-    for s in steps {
-        let i = s.dest & 63;
-        let f = (new >> (s.a & 63)) as u16 & 1;
-        let g = (new >> (s.b & 63)) as u16 & 1;
-        let c = (old >> i) as u16 & 1;
-        let v = (s.table >> (f | g << 1 | c << 2 | d)) & 1 == 1;
-        new |= (v as u64) << i;
-        if s.negate != 0 {
-            new |= (!v as u64) << (s.neg & 63);
-        }
+pub(crate) fn logic_step(s: &Step, old: u64, new: u64, d: u16) -> u64 {
+    // Shifts by `wrapping_shl`/`wrapping_shr`: every index is below 64.
+    let i = s.dest as u32;
+    let f = new.wrapping_shr(s.a as u32) & 1;
+    let g = new.wrapping_shr(s.b as u32) & 1;
+    let c = old.wrapping_shr(i) & 1;
+    let v = (s.table as u64).wrapping_shr((f | g << 1 | c << 2) as u32 | d as u32) & 1;
+    with_value(s, new, v)
+}
+
+/// `new` with step `s`'s node set to `v` (0 or 1) and its fused `Not` to `!v`.
+#[inline(always)]
+pub(crate) fn with_value(s: &Step, new: u64, v: u64) -> u64 {
+    let mut new = new | v.wrapping_shl(s.dest as u32);
+    if s.negate != 0 {
+        new |= (v ^ 1).wrapping_shl(s.neg as u32);
     }
     new
+}
+
+/// The literal nodes' bits of a folded plan for the atoms `bits` (bit `k`:
+/// atom `k`).
+#[inline(always)]
+pub(crate) fn literal_bits(atoms: &[AtomStep], bits: u64) -> u64 {
+    let mut nodes = 0u64;
+    for (k, a) in atoms.iter().enumerate() {
+        nodes |= if bits >> (k & 63) & 1 == 1 {
+            a.pos
+        } else {
+            a.neg
+        };
+    }
+    nodes
+}
+
+/// `v`'s bits spread over the bits of `mask`, lowest first (the inverse of
+/// [`gather`]'s memory part).
+fn spread(v: u64, mask: u64) -> u64 {
+    let (mut x, mut rest, mut j) = (0u64, mask, 0u32);
+    while rest != 0 {
+        x |= (v.wrapping_shr(j) & 1) << rest.trailing_zeros();
+        rest &= rest - 1;
+        j += 1;
+    }
+    x
 }
 
 /// Whether a truth table reads the node's own last value ([`C`]).
@@ -585,18 +618,13 @@ pub(crate) fn build_table(steps: &[Step], atoms: &[AtomStep], table: &mut [u64])
         return None;
     }
     for idx in 0..1usize << bits {
-        // The inverse of `gather`: memory bit j to its node.
-        let (mut old, mut rest, mut j) = (0u64, mem, atoms.len());
-        while rest != 0 {
-            old |= ((idx >> j) as u64 & 1) << rest.trailing_zeros();
-            rest &= rest - 1;
-            j += 1;
-        }
-        let mut nodes = 0u64;
-        for (k, a) in atoms.iter().enumerate() {
-            nodes |= if idx >> k & 1 == 1 { a.pos } else { a.neg };
-        }
-        *table.get_mut(idx)? = fold_logic(steps, old, nodes, 0);
+        // The index's memory bits back to their nodes (the inverse of `gather`).
+        let old = spread((idx >> atoms.len()) as u64, mem);
+        let nodes = literal_bits(atoms, idx as u64);
+        let new = steps
+            .iter()
+            .fold(nodes, |new, s| logic_step(s, old, new, 0));
+        *table.get_mut(idx)? = new;
     }
     let [.., magic, last] = table else {
         return None;
@@ -628,13 +656,7 @@ fn multiplier(mem: u64) -> u64 {
     }
     for v in 0..1u64 << m {
         // The value `v` spread over the bits of `mem`, and gathered back.
-        let (mut x, mut rest, mut j) = (0u64, mem, 0);
-        while rest != 0 {
-            x |= (v >> j & 1) << rest.trailing_zeros();
-            rest &= rest - 1;
-            j += 1;
-        }
-        if x.wrapping_mul(k) >> (64 - m) != v {
+        if spread(v, mem).wrapping_mul(k) >> (64 - m) != v {
             return 0;
         }
     }
@@ -662,11 +684,7 @@ pub(crate) fn build_literals(atoms: &[AtomStep], table: &mut [u64]) -> Option<()
         return None;
     }
     for idx in 0..1usize << atoms.len() {
-        let mut nodes = 0u64;
-        for (k, a) in atoms.iter().enumerate() {
-            nodes |= if idx >> k & 1 == 1 { a.pos } else { a.neg };
-        }
-        *table.get_mut(idx)? = nodes;
+        *table.get_mut(idx)? = literal_bits(atoms, idx as u64);
     }
     Some(())
 }
