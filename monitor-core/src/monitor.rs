@@ -39,7 +39,7 @@ pub struct Monitor<'a, const N: usize = 0> {
     /// Atom `k`'s plan, for `k < program.atoms.len()` when planned.
     atom_plan: [AtomStep; N],
     /// [`Plan::TABLE`]: the value word after a point that is not the first, by
-    /// atoms and memory bits ([`plan::build_table`]); [`Plan::LITS`]: the
+    /// atoms, timed steps' values and memory bits ([`plan::build_table`]); [`Plan::LITS`]: the
     /// literal nodes' bits by atoms ([`plan::build_literals`]).
     table: [u64; N],
 }
@@ -154,6 +154,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 },
                 shift: 0,
                 top: 0,
+                timed: 0,
             },
             plan: [Step::NONE; N],
             atom_plan: [AtomStep::NONE; N],
@@ -171,11 +172,20 @@ impl<'a, const N: usize> Monitor<'a, N> {
                     ..info
                 };
                 if info.has(Plan::FOLDED) {
-                    let steps = monitor.plan.get(..info.steps as usize).unwrap_or(&[]);
+                    let steps = monitor
+                        .plan
+                        .get_mut(..info.steps as usize)
+                        .unwrap_or(&mut []);
+                    let timed = plan::timed_first(steps);
                     let atoms = monitor.atom_plan.get(..p.atoms.len()).unwrap_or(&[]);
-                    if let Some(m) = plan::build_table(steps, atoms, &mut monitor.table) {
+                    let table = timed.and_then(|timed| {
+                        plan::build_table(steps, timed, atoms, &mut monitor.table)
+                            .map(|m| (timed, m))
+                    });
+                    if let Some((timed, m)) = table {
                         monitor.info.flags |= Plan::TABLE;
                         monitor.info.top = 64 - m as u8;
+                        monitor.info.timed = timed as u8;
                     } else if plan::build_literals(atoms, &mut monitor.table).is_some() {
                         monitor.info.flags |= Plan::LITS;
                     }
@@ -189,6 +199,16 @@ impl<'a, const N: usize> Monitor<'a, N> {
     /// at most `N` nodes and `N` atoms (see [`Monitor::try_new_planned`]).
     pub fn is_planned(&self) -> bool {
         N > 0 && self.info.has(Plan::PLANNED)
+    }
+
+    /// `Some(k)` when this monitor steps every point but the first by a
+    /// transition table, after `k` timed steps (`P[a:b] p`, `p S[a:b] q` over
+    /// atoms and other timed steps); `None` otherwise (an observation for
+    /// tests and benchmarks: the verdicts are the same either way).
+    pub fn table_after_timed_steps(&self) -> Option<usize> {
+        self.info
+            .has(Plan::TABLE)
+            .then_some(self.info.timed as usize)
     }
 
     /// The program this monitor runs.
@@ -366,7 +386,8 @@ impl<'a, const N: usize> Monitor<'a, N> {
     /// node's (and its fused `Not`'s). One to 64 atoms and at most 64 nodes: the
     /// state opens with exactly three words (time, atoms, values; [`layout`]),
     /// and the values of this point and the last each fit one register. With a
-    /// transition table ([`Plan::TABLE`]) every point but the first is one lookup.
+    /// transition table ([`Plan::TABLE`]) every point but the first is the timed
+    /// steps, if any, and one lookup.
     #[inline(always)]
     fn advance_folded(
         &self,
@@ -385,17 +406,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
         let first_point = *time_word == 0;
         let old = *value_word;
         let new = if self.info.has(Plan::TABLE) && !first_point {
-            // The index: the atoms, then the memory bits above them.
-            let n = self.program.atoms.len();
-            let idx = match self.table.as_slice() {
-                // One multiply gathers the memory bits (most tables).
-                [.., k, mem] if *k != 0 => {
-                    exact | (old & mem).wrapping_mul(*k) >> (self.info.top & 63) << (n & 63)
-                }
-                [.., mem] => plan::gather(exact, n, old, *mem),
-                [] => 0,
-            };
-            self.table.get(idx as usize).copied().unwrap_or(0)
+            self.table_step(body, t, old, exact)
         } else if self.info.steps != 1 {
             self.fold(body, t, old, nodes(), first_point)
         } else {
@@ -409,6 +420,44 @@ impl<'a, const N: usize> Monitor<'a, N> {
         for (out, pr) in verdicts.iter_mut().zip(self.program.props) {
             *out = new >> (pr.root & 63) & 1 == 1;
         }
+    }
+
+    /// A transition table's step ([`Plan::TABLE`]) at a point that is not the
+    /// first: the timed steps, then one lookup whose index is the atoms `exact`,
+    /// above them the memory bits of `old` and above those the timed steps'
+    /// values ([`plan::build_table`]).
+    #[inline(always)]
+    fn table_step(&self, body: &mut [u64], t: u64, old: u64, exact: u64) -> u64 {
+        let n = self.program.atoms.len();
+        let mut idx = match self.table.as_slice() {
+            // One multiply gathers the memory bits (most tables).
+            [.., k, mem] if *k != 0 => {
+                exact | (old & mem).wrapping_mul(*k) >> (self.info.top & 63) << (n & 63)
+            }
+            [.., mem] => plan::gather(exact, n, old, *mem),
+            [] => 0,
+        };
+        if self.info.timed != 0 {
+            idx = self.timed_steps(body, t, idx);
+        }
+        self.table.get(idx as usize).copied().unwrap_or(0)
+    }
+
+    /// The timed steps of a transition table's plan ([`Plan::timed`]) at a
+    /// point that is not the first: each reads its children from the table's
+    /// index `idx` and sets its own bit there ([`plan::build_table`]). Out of
+    /// line, so that `try_step` stays small enough to inline into its caller's
+    /// loop.
+    #[inline(never)]
+    fn timed_steps(&self, body: &mut [u64], t: u64, mut idx: u64) -> u64 {
+        let timed = self.plan.get(..self.info.timed as usize).unwrap_or(&[]);
+        for s in timed {
+            let f = plan::index_bit(idx, s.ia);
+            let g = plan::index_bit(idx, s.ib);
+            let v = special::<false>(s, body, t, f, g, 0) as u64;
+            idx |= v.wrapping_shl(s.at as u32);
+        }
+        idx
     }
 
     /// [`Monitor::fold`] of a plan of one step, out of line: the loop's

@@ -13,8 +13,10 @@
 //! nodes and atoms the literal nodes (constants, atoms and `Not`s of them) are
 //! no steps at all but bits set by the atoms, and a `Not` of a step's node is
 //! written by that step ([`Plan::FOLDED`]); when every step is then a truth
-//! table and the atoms and memory bits are few, a transition table steps a
-//! point by one lookup ([`Plan::TABLE`], [`build_table`]). The plan lives in
+//! table, or a timed `Since` over literals and other timed steps, and the
+//! atoms, timed steps and memory bits are few, a transition table steps a
+//! point by the timed steps and one lookup ([`Plan::TABLE`], [`timed_first`],
+//! [`build_table`]). The plan lives in
 //! the monitor itself, in arrays of `N` entries (const generics: no
 //! allocation); a program with more than `N` nodes or atoms runs the unplanned
 //! interpreter.
@@ -108,6 +110,13 @@ pub(crate) struct Step {
     pub table: u16,
     /// 1 when this step also writes `!value` to node `neg`, else 0.
     pub negate: u8,
+    /// A transition table's timed step ([`Plan::timed`]): where its children's
+    /// values are in the table's index, as [`index_bit`] reads them.
+    pub ia: u8,
+    /// Likewise for `b`.
+    pub ib: u8,
+    /// A transition table's timed step: the index bit it sets to its value.
+    pub at: u8,
     /// Which children the unfolded step reads: [`A`] for `a`, [`B`] for `b` (a
     /// constant reads neither, `Not` and `Y`/`Z` only `a`), so that a large
     /// program's step, where a child's bit may be in a stored word, reads no more
@@ -130,6 +139,9 @@ impl Step {
         neg: 0,
         table: 0,
         negate: 0,
+        ia: 0,
+        ib: 0,
+        at: 0,
         reads: 0,
         kind: Kind::Logic,
     };
@@ -356,8 +368,11 @@ pub(crate) struct Plan {
     /// [`Plan::RUN`]: the variable of atom 0.
     pub shift: u8,
     /// [`Plan::TABLE`] with a gathering multiplier ([`build_table`]): 64 less
-    /// the number of memory bits.
+    /// the number of index bits above the atoms.
     pub top: u8,
+    /// [`Plan::TABLE`]: the number of timed steps, first in the plan, that run
+    /// before the lookup ([`timed_first`]); 0 when every step is `Logic`.
+    pub timed: u8,
 }
 
 impl Plan {
@@ -380,9 +395,11 @@ impl Plan {
     pub const BOOLS: u8 = 8;
     /// At most 64 atoms and 64 nodes (planned or not, see `Monitor::advance`).
     pub const SMALL: u8 = 16;
-    /// `FOLDED` and every step is `Logic`, with at most [`TABLE_BITS`] atoms and
-    /// memory bits together: after the first point, the value word is one
-    /// lookup in the monitor's transition table ([`build_table`]).
+    /// `FOLDED`, every step is `Logic` or a timed `Since` over literals and
+    /// other timed steps ([`timed_first`]), with at most [`TABLE_BITS`] atoms,
+    /// timed steps and memory bits together: after the first point, the value
+    /// word is the timed steps ([`Plan::timed`] of them) and one lookup in the
+    /// monitor's transition table ([`build_table`]).
     pub const TABLE: u8 = 32;
     /// `BOOLS`, and atom `k` is boolean variable `shift + k` (not negated): the
     /// atoms are one shift and mask of the variables' bits.
@@ -434,6 +451,7 @@ pub(crate) fn build(
         flags: Plan::PLANNED | if folded { Plan::FOLDED } else { 0 },
         shift: 0,
         top: 0,
+        timed: 0,
     };
     let planned = atoms.get(..p.atoms.len()).unwrap_or(&[]);
     if !compact
@@ -593,35 +611,157 @@ const fn reads_own(table: u16) -> bool {
     false
 }
 
-/// The transition table of a folded plan ([`Plan::TABLE`]) whose steps are all
-/// `Logic`: `table[i]` is the value word after a point that is not the first,
-/// where index `i` holds the point's atoms (bit `k`: atom `k`) and above them
-/// the last values of the nodes that read their own (the memory bits, in node
-/// order), for `i < 2^(atoms + memory bits)`; the table's last entry is the
-/// mask of those nodes ([`gather`]), the one before it a multiplier that
-/// gathers them into the top bits of a word ([`multiplier`], 0 if none does).
-/// Returns the number of memory bits, or `None` (nothing to use) when a step
-/// is not `Logic` or the index does not fit [`TABLE_BITS`] or `table` (all but
-/// its last two entries).
-pub(crate) fn build_table(steps: &[Step], atoms: &[AtomStep], table: &mut [u64]) -> Option<u32> {
-    if steps.iter().any(|s| s.kind != Kind::Logic) {
+/// Whether `s` is a timed `Since` (a step with words of its own that a
+/// transition table cannot index).
+fn is_timed(s: &Step) -> bool {
+    matches!(
+        s.kind,
+        Kind::SinceUpTo | Kind::SinceAtLeast | Kind::SinceWindow
+    )
+}
+
+/// A node's bit and, for a step with a fused `Not`, that node's bit too.
+fn written(s: &Step) -> u64 {
+    let neg = if s.negate != 0 {
+        1u64 << (s.neg & 63)
+    } else {
+        0
+    };
+    1u64 << (s.dest & 63) | neg
+}
+
+/// Moves the timed steps of a folded plan before its `Logic` steps (keeping the
+/// order within each) when that computes the same values: every step is
+/// `Logic` or timed, and a timed step reads only literal nodes and the nodes of
+/// timed steps before it. The plan stays in dependency order (a `Logic` step
+/// only moves after steps it may read). Returns the number of timed steps, or
+/// `None` with `steps` unchanged.
+pub(crate) fn timed_first(steps: &mut [Step]) -> Option<usize> {
+    let stepped = steps.iter().fold(0u64, |m, s| m | written(s));
+    let mut ready = !stepped;
+    for s in steps.iter() {
+        if is_timed(s) {
+            let reads = 1u64 << (s.a & 63) | 1u64 << (s.b & 63);
+            if reads & !ready != 0 {
+                return None;
+            }
+            ready |= written(s);
+        } else if s.kind != Kind::Logic {
+            return None;
+        }
+    }
+    let mut n = 0;
+    for i in 0..steps.len() {
+        if steps.get(i).is_some_and(is_timed) {
+            steps.get_mut(n..=i)?.rotate_right(1);
+            n += 1;
+        }
+    }
+    Some(n)
+}
+
+/// Bit `at & 63` of a transition table's index, flipped when `at` has
+/// [`FLIP`]: a timed step's child ([`Step::ia`], [`Step::ib`]). Bit 63 of an
+/// index is always 0, so a constant is bit 63, flipped for `true`.
+#[inline(always)]
+pub(crate) fn index_bit(idx: u64, at: u8) -> bool {
+    (idx.wrapping_shr(at as u32) ^ (at >> 7) as u64) & 1 == 1
+}
+
+/// The flag of [`index_bit`]'s position that flips the bit.
+pub(crate) const FLIP: u8 = 0x80;
+
+/// Where node `x`, a timed step's child, is in a transition table's index
+/// ([`index_bit`]): a literal node (an atom, its negation or a constant; not
+/// under `stepped`) at its atom's bit, or the node of one of the `first`
+/// timed steps (or its fused `Not`) at that step's bit `at + j`; `None` for
+/// another node.
+fn index_of(x: u16, atoms: &[AtomStep], stepped: u64, first: &[Step], at: usize) -> Option<u8> {
+    let bit = 1u64 << (x & 63);
+    for (j, s) in first.iter().enumerate() {
+        let pos = (at + j) as u8;
+        if s.dest == x {
+            return Some(pos);
+        }
+        if s.negate != 0 && s.neg == x {
+            return Some(pos | FLIP);
+        }
+    }
+    if stepped & bit != 0 {
+        return None;
+    }
+    for (k, a) in atoms.iter().enumerate() {
+        match (a.pos & bit != 0, a.neg & bit != 0) {
+            // A `true` constant (in both masks of atom 0, see `build`).
+            (true, true) => return Some(63 | FLIP),
+            (true, false) => return Some(k as u8),
+            (false, true) => return Some(k as u8 | FLIP),
+            (false, false) => {}
+        }
+    }
+    // A `false` constant: a literal node no atom sets.
+    Some(63)
+}
+
+/// The transition table of a folded plan ([`Plan::TABLE`]) whose first
+/// `timed` steps are timed ([`timed_first`]) and the rest `Logic`:
+/// `table[i]` is the value word after a point that is not the first, where
+/// index `i` holds the point's atoms (bit `k`: atom `k`), above them the last
+/// values of the `Logic` nodes that read their own (the memory bits, in node
+/// order) and above those the values of the timed steps at this point (in
+/// plan order), for `i < 2^(atoms + memory bits + timed)`. The table's last
+/// entry is the mask of the memory nodes ([`gather`]), the one before it a
+/// multiplier that gathers them into the top bits of a word ([`multiplier`], 0
+/// if none does). Each timed step is given where its children and its value
+/// are in the index ([`Step::ia`], [`Step::ib`], [`Step::at`]): it reads and
+/// writes the index, not the value word. Returns the number of memory bits,
+/// or `None` (nothing to use, the steps unchanged) when the steps are not
+/// so, none is `Logic`, or the index does not fit [`TABLE_BITS`] or `table`
+/// (all but its last two entries).
+pub(crate) fn build_table(
+    steps: &mut [Step],
+    timed: usize,
+    atoms: &[AtomStep],
+    table: &mut [u64],
+) -> Option<u32> {
+    let (first, logic) = (steps.get(..timed)?, steps.get(timed..)?);
+    // A plan of timed steps alone gains nothing from a lookup.
+    if logic.is_empty()
+        || !first.iter().all(is_timed)
+        || logic.iter().any(|s| s.kind != Kind::Logic)
+    {
         return None;
     }
     let mut mem = 0u64;
-    for s in steps {
+    for s in logic {
         if reads_own(s.table) {
             mem |= 1 << (s.dest & 63);
         }
     }
-    let bits = atoms.len() + mem.count_ones() as usize;
+    let m = mem.count_ones() as usize;
+    let (n, at) = (atoms.len(), atoms.len() + m);
+    let bits = at + timed;
     if bits > TABLE_BITS || (1usize << bits) + 2 > table.len() {
         return None;
     }
+    // Each timed step's children: literal nodes or earlier timed steps (`timed_first`).
+    let stepped = steps.iter().fold(0u64, |m, s| m | written(s));
+    let mut reads = [(0u8, 0u8); TABLE_BITS];
+    for (j, s) in first.iter().enumerate() {
+        let before = first.get(..j)?;
+        *reads.get_mut(j)? = (
+            index_of(s.a, atoms, stepped, before, at)?,
+            index_of(s.b, atoms, stepped, before, at)?,
+        );
+    }
     for idx in 0..1usize << bits {
         // The index's memory bits back to their nodes (the inverse of `gather`).
-        let old = spread((idx >> atoms.len()) as u64, mem);
-        let nodes = literal_bits(atoms, idx as u64);
-        let new = steps
+        let old = spread((idx >> n) as u64, mem);
+        let mut nodes = literal_bits(atoms, idx as u64);
+        for (j, s) in first.iter().enumerate() {
+            nodes = with_value(s, nodes, (idx >> (at + j)) as u64 & 1);
+        }
+        let new = logic
             .iter()
             .fold(nodes, |new, s| logic_step(s, old, new, 0));
         *table.get_mut(idx)? = new;
@@ -630,7 +770,10 @@ pub(crate) fn build_table(steps: &[Step], atoms: &[AtomStep], table: &mut [u64])
         return None;
     };
     (*magic, *last) = (multiplier(mem), mem);
-    Some(mem.count_ones())
+    for (j, (s, (ia, ib))) in steps.iter_mut().zip(reads).take(timed).enumerate() {
+        (s.ia, s.ib, s.at) = (ia, ib, (at + j) as u8);
+    }
+    Some(m as u32)
 }
 
 /// A multiplier `k` such that `(x & mem) * k >> (64 - m)` is [`gather`]'s
@@ -718,6 +861,43 @@ mod tests {
         assert_eq!(reads(since(0, Some(5))), Some((A | B) as u8));
         assert_eq!(reads(since(2, Some(5))), Some((A | B) as u8));
         assert_eq!(table_reads(table(|_, b, _, _| b)), B as u8);
+    }
+
+    #[test]
+    fn timed_steps_move_first_only_over_literals_and_timed_steps() {
+        let since = |a, b, dest| {
+            Step::of(
+                &Op::Since {
+                    lhs: a,
+                    rhs: b,
+                    lo: 0,
+                    hi: Some(3),
+                },
+                dest,
+                0,
+            )
+        };
+        let and = |a, b, dest| Step::of(&Op::And(a, b), dest, 0);
+        let dests = |s: &[Step; 4]| s.map(|s| s.dest);
+        // Nodes 0 and 1 are literals; the `S` reads them, the `And`s do not feed it.
+        let none = Some(Step::NONE);
+        let mut steps = [and(0, 1, 2), since(0, 1, 3), and(2, 3, 4), none].map(Option::unwrap);
+        assert_eq!(timed_first(&mut steps[..3]), Some(1));
+        assert_eq!(dests(&steps), [3, 2, 4, 0]);
+        // A timed step over another's value, after it.
+        let mut steps =
+            [and(0, 1, 2), since(0, 1, 3), since(3, 1, 4), and(2, 4, 5)].map(Option::unwrap);
+        assert_eq!(timed_first(&mut steps), Some(2));
+        assert_eq!(dests(&steps), [3, 4, 2, 5]);
+        // The `S` reads node 2, which a truth table computes: nothing moves.
+        let mut steps = [and(0, 1, 2), since(0, 2, 3), none, none].map(Option::unwrap);
+        assert_eq!(timed_first(&mut steps[..2]), None);
+        assert_eq!(dests(&steps), [2, 3, 0, 0]);
+        // Nor over a `Not` fused into a truth table's step.
+        let mut steps = [and(0, 1, 2), since(0, 5, 3)].map(Option::unwrap);
+        steps[0].negate = 1;
+        steps[0].neg = 5;
+        assert_eq!(timed_first(&mut steps), None);
     }
 
     #[test]

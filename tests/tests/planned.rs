@@ -11,7 +11,8 @@
 //! several): after every point the result and the whole state buffer must be
 //! the same. Specs over boolean variables alone take the plan's other paths
 //! (atoms as bits of the variables, a transition table for networks of truth
-//! tables, a table of the literal nodes' bits), checked the same way.
+//! tables, with timed steps before it, a table of the literal nodes' bits),
+//! checked the same way.
 
 use hindsight_tests::gen::{self, FormulaConfig, Gen};
 use hindsight_tests::oracle;
@@ -196,12 +197,22 @@ const BOOL_FORMULAS: &[&str] = &[
     "P[0:2] {a2}",
     "{a0} && {a1} && {a2} && {e}",
     "({e} -> Y {a0}) && H(!{a2})",
+    // Timed steps over literals, then truth tables: a table after timed steps.
+    "H(({a1} -> P {a0}) && !(!{a1} S[2:] {a0}))",
+    "H(P[2:] true -> P[:3] {a2})",
+    // A timed step over another's value, and over its negation.
+    "P[0:3] (P[1:2] {a0}) -> {a1}",
+    "P[0:2] !(P[1:] {a1}) && H {a0}",
+    "({a0} S[0:2] !P[2:4] {a2}) || ({a1} S {a0})",
+    // Windows, constants and negated atoms as the timed steps' children.
+    "(true S[1:3] !{a0}) <-> ({a1} S[2:] true)",
+    "!(!{a2} S[0:1] {a1}) -> Y {a0}",
 ];
 
 #[test]
 fn boolean_monitors_step_like_unplanned_ones() {
     let mut rng = gen::rng(0x626f_6f6c);
-    let mut errors = 0;
+    let (mut errors, mut timed_tables) = (0, 0);
     for case in 0..600 {
         let mut text = String::from(
             "state a0: bool = false;\nstate a1: bool = true;\nstate a2: bool = false;\nevent e;\n",
@@ -228,6 +239,9 @@ fn boolean_monitors_step_like_unplanned_ones() {
         let plain = Monitor::try_new(program).expect("codegen output validates");
         let narrow: Monitor<'_, 16> = Monitor::try_new_planned(program).expect("validates");
         let wide: Monitor<'_, 256> = Monitor::try_new_planned(program).expect("validates");
+        if wide.table_after_timed_steps().is_some_and(|k| k > 0) {
+            timed_tables += 1;
+        }
         let words = plain.state_words();
         let mut states = [vec![0u64; words], vec![0u64; words], vec![0u64; words]];
         let mut last = 0;
@@ -252,6 +266,10 @@ fn boolean_monitors_step_like_unplanned_ones() {
         }
     }
     assert!(errors > 20, "{errors} points rejected");
+    assert!(
+        timed_tables > 60,
+        "{timed_tables} specs stepped by a table after timed steps"
+    );
 }
 
 /// `try_step_atoms` reads atom `k` from bit `k % 64` of word `k / 64` and
