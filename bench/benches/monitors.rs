@@ -197,6 +197,29 @@ fn bench() -> Result<(), String> {
             100.0 * trues[k] as f64 / n as f64
         );
     }
+    // The runtime's goal (issue 15): try_step within 4x the generated code
+    // and within 10x the baseline loop, on every formula.
+    let within = |k: usize| (med[k][0] <= 4.0 * med[k][2], med[k][0] <= 10.0 * base);
+    let count = |f: &dyn Fn(usize) -> bool| (0..FORMULAS.len()).filter(|&k| f(k)).count();
+    println!(
+        "\ngoal, try_step within 4x generated and within 10x baseline: {} of {} formulas \
+         ({} within 4x generated, {} within 10x baseline)",
+        count(&|k| within(k) == (true, true)),
+        FORMULAS.len(),
+        count(&|k| within(k).0),
+        count(&|k| within(k).1),
+    );
+    for (k, f) in FORMULAS.iter().enumerate() {
+        let (gen, baseline) = within(k);
+        if !(gen && baseline) {
+            let miss = match (gen, baseline) {
+                (false, false) => "4x generated, 10x baseline",
+                (false, true) => "4x generated",
+                _ => "10x baseline",
+            };
+            println!("  misses {miss}: `{f}`");
+        }
+    }
     // The point intervals: the spread of the cost over bounds 10 .. 100000.
     let sweep: Vec<usize> = (0..FORMULAS.len())
         .filter(|&k| FORMULAS[k].starts_with("P[") && point_interval(FORMULAS[k]))

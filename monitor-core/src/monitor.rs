@@ -299,7 +299,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
         vars: &[Value],
         verdicts: &mut [bool],
     ) -> Result<(), StepError> {
-        let (p, info, atoms) = (&self.program, &self.info, self.plan_atoms());
+        let (p, info) = (&self.program, &self.info);
         if info.has(Plan::FAST) {
             // One pass over the variables (at most 64): each value's type
             // against the declared one (a mismatch gives the first variable of
@@ -320,18 +320,17 @@ impl<'a, const N: usize> Monitor<'a, N> {
             }
             let mut bits = 0u64;
             if info.has(Plan::RUN) {
-                // At most 64 variables: `shift + atoms <= 64`.
-                let mask = u64::MAX
-                    .checked_shr(64u32.wrapping_sub(atoms.len() as u32))
-                    .unwrap_or(0);
-                bits = vb >> (info.shift & 63) & mask;
+                // At most 64 variables: `shift + atoms <= 64`. With no atom the
+                // mask is all ones and `bits` is read by nothing.
+                let n = p.atoms.len() as u32;
+                bits = vb >> (info.shift & 63) & u64::MAX >> (64u32.wrapping_sub(n) & 63);
             } else if info.has(Plan::BOOLS) {
-                for (k, a) in atoms.iter().enumerate() {
+                for (k, a) in self.plan_atoms().iter().enumerate() {
                     let v = (vb.wrapping_shr(a.var as u32) ^ a.c as u64) & 1;
                     bits |= v << (k & 63);
                 }
             } else {
-                for (k, a) in atoms.iter().enumerate() {
+                for (k, a) in self.plan_atoms().iter().enumerate() {
                     // The types were checked: never `None`.
                     let v = a.fast(vars).unwrap_or(false);
                     bits |= (v as u64) << (k & 63);
@@ -341,7 +340,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
                 let lits = || self.literals(bits);
                 self.advance_folded(state, time, bits, bits, lits, verdicts);
             } else {
-                if !atoms.is_empty() {
+                if !p.atoms.is_empty() {
                     wr(state, layout::HEADER_WORDS, bits);
                 }
                 self.advance(self.plan_nodes(), state, time, bits, verdicts);
@@ -350,7 +349,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
         }
         check_types(p, vars)?;
         // Atoms first: an error leaves the temporal state untouched.
-        let first = atom_words(atoms, p.instrs, vars, state)?;
+        let first = atom_words(self.plan_atoms(), p.instrs, vars, state)?;
         self.advance_plan(state, time, first, verdicts);
         Ok(())
     }
