@@ -266,10 +266,13 @@ fn boolean_monitors_step_like_unplanned_ones() {
         }
     }
     assert!(errors > 20, "{errors} points rejected");
-    assert!(
-        timed_tables > 60,
-        "{timed_tables} specs stepped by a table after timed steps"
-    );
+    // `compact` (the firmware's interpreter) folds nothing, so it builds no table.
+    if !cfg!(feature = "compact") {
+        assert!(
+            timed_tables > 60,
+            "{timed_tables} specs stepped by a table after timed steps"
+        );
+    }
 }
 
 /// `try_step_atoms` reads atom `k` from bit `k % 64` of word `k / 64` and
