@@ -170,7 +170,7 @@ impl Simulator<'_> {
         let base = self.rx_base[ei] as usize - model.events.len();
         for (k, &r) in model.events[ei].receivers.iter().enumerate() {
             let at = self.checked[base + k];
-            let choice = if at != 0 && self.changed[r as usize] < at {
+            let choice = if at != 0 && self.ms[r as usize].changed < at {
                 self.choice_kept[base + k]
             } else {
                 let c = match self.receive_choice(r, e, rng, cfg)? {
@@ -217,7 +217,7 @@ impl Simulator<'_> {
             } else {
                 self.receive_choice(r, e, rng, cfg)?.flatten()
             };
-            self.changed[m] = self.clock;
+            self.ms[m].changed = self.clock;
             // The receiver keeps its own copy: JANI assigns it with the receive itself.
             let rx = self.rx_base[e as usize] as usize + k;
             let (global, copy) = self.pool.split_at_mut(rx);
@@ -226,7 +226,7 @@ impl Simulator<'_> {
             self.ms[m].cur = rx as u32;
             self.steps += 1;
             self.instant_steps += 1;
-            self.instant_moves[m] = self.instant_moves[m].saturating_add(1);
+            self.ms[m].moves = self.ms[m].moves.saturating_add(1);
             let f = obs.on_receive(
                 self.time,
                 &SentMessage {
@@ -260,7 +260,7 @@ impl Simulator<'_> {
         while i < self.blocked_list.len() {
             let m = self.blocked_list[i] as usize;
             if self.send_possible(m) {
-                self.changed[m] = self.clock;
+                self.ms[m].changed = self.clock;
                 self.ms[m].blocked = false;
                 self.ms[m].awaiting = NO_MSG;
                 self.blocked_list.swap_remove(i);
