@@ -363,24 +363,24 @@ impl Simulator<'_> {
             self.refresh(m);
             return Ok(Flow::Continue);
         }
-        let mut out = std::mem::take(&mut self.ev_scratch[e]);
-        for &i in &sd.missing {
-            if let (Some(dst), Some(cur)) =
-                (out.get_mut(i as usize), self.pool[e].params.get(i as usize))
-            {
-                dst.clone_from(cur);
-            }
-        }
+        // The new parameters are evaluated into the event's scratch buffer (the old ones
+        // stay readable meanwhile), then the two buffers change places.
         let res = {
+            let out = &mut self.ev_scratch[e];
+            for &i in &sd.missing {
+                if let (Some(dst), Some(cur)) =
+                    (out.get_mut(i as usize), self.pool[e].params.get(i as usize))
+                {
+                    dst.clone_from(cur);
+                }
+            }
             let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
-            eval_params(sd, &mut env, &mut out)
+            eval_params(sd, &mut env, out)
         };
         if let Err(err) = res {
-            self.ev_scratch[e] = out;
             return Err(self.diag_error(m, Some(pc as usize), err));
         }
-        std::mem::swap(&mut self.pool[e].params, &mut out);
-        self.ev_scratch[e] = out;
+        std::mem::swap(&mut self.pool[e].params, &mut self.ev_scratch[e]);
         let declared = match &sd.to {
             SendTo::Machine(t) => *t,
             _ => u32::MAX,
