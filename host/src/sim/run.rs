@@ -56,6 +56,12 @@ struct MachineRt {
     intq: VecDeque<u32>,
     extq: VecDeque<u32>,
     vars: Vec<Cell>,
+    /// Position in [`Simulator::runnable`] (`NOT_RUNNABLE`: not there).
+    rpos: u32,
+    /// Steps taken at the current instant.
+    moves: u32,
+    /// The scheduler iteration it last changed in (state, variables, position, flags).
+    changed: u64,
 }
 
 /// Runs a compiled model; reuse one simulator for many runs (buffers are kept).
@@ -74,13 +80,11 @@ pub struct Simulator<'m> {
     /// Free message slots, per event.
     free: Vec<Vec<u32>>,
     runnable: Vec<u32>,
-    rpos: Vec<u32>,
     delayed: Vec<u32>,
     enabled: Vec<u32>,
     time: u64,
     steps: u64,
     instant_steps: u64,
-    instant_moves: Vec<u32>,
     /// Per machine, one scratch cell per instruction that builds arrays or structs,
     /// so each keeps its buffers' shape from step to step and run to run.
     scratch: Vec<Vec<Cell>>,
@@ -119,8 +123,6 @@ pub struct Simulator<'m> {
     keep_choices: bool,
     /// Scheduler iterations so far (never reset): the stamps below are its values.
     clock: u64,
-    /// Per machine: the iteration it last changed in (state, variables, position, flags).
-    changed: Vec<u64>,
     /// Per receiver of each event (indexed like the receivers' pool slots past the
     /// events' buffers): the iteration its choice was computed in (0: not computed).
     checked: Vec<u64>,
@@ -246,6 +248,9 @@ impl<'m> Simulator<'m> {
                     intq: VecDeque::new(),
                     extq: VecDeque::new(),
                     vars: d.defaults.clone(),
+                    rpos: NOT_RUNNABLE,
+                    moves: 0,
+                    changed: 0,
                 })
                 .collect(),
             // Under EventSemantics::As2fm, slot `e` is event `e`'s global buffer, and
@@ -286,13 +291,11 @@ impl<'m> Simulator<'m> {
                     .sum::<usize>(),
             free: vec![Vec::new(); model.events.len()],
             runnable: Vec::with_capacity(n),
-            rpos: vec![NOT_RUNNABLE; n],
             delayed: Vec::with_capacity(n),
             enabled: Vec::new(),
             time: 0,
             steps: 0,
             instant_steps: 0,
-            instant_moves: vec![0; n],
             scratch: model
                 .machines
                 .iter()
@@ -320,7 +323,6 @@ impl<'m> Simulator<'m> {
                 .all(|d| d.trans.iter().all(|t| !t.cond_draws)),
             keep_choices: false,
             clock: 0,
-            changed: vec![0; n],
             checked: vec![
                 0;
                 model
@@ -366,17 +368,17 @@ impl<'m> Simulator<'m> {
         let r = &self.ms[m];
         let can =
             !r.waiting && !r.blocked && (r.pc != IDLE || !r.intq.is_empty() || !r.extq.is_empty());
-        let pos = self.rpos[m];
+        let pos = r.rpos;
         if can && pos == NOT_RUNNABLE {
-            self.rpos[m] = self.runnable.len() as u32;
+            self.ms[m].rpos = self.runnable.len() as u32;
             self.runnable.push(m as u32);
         } else if !can && pos != NOT_RUNNABLE {
             let last = self.runnable.len() - 1;
             self.runnable.swap(pos as usize, last);
             let moved = self.runnable[pos as usize] as usize;
-            self.rpos[moved] = pos;
+            self.ms[moved].rpos = pos;
             self.runnable.pop();
-            self.rpos[m] = NOT_RUNNABLE;
+            self.ms[m].rpos = NOT_RUNNABLE;
         }
     }
 
@@ -404,7 +406,6 @@ impl<'m> Simulator<'m> {
         self.time = 0;
         self.steps = 0;
         self.instant_steps = 0;
-        self.instant_moves.iter_mut().for_each(|c| *c = 0);
         for f in &mut self.free {
             f.clear();
         }
@@ -415,7 +416,10 @@ impl<'m> Simulator<'m> {
             }
         }
         self.runnable.clear();
-        self.rpos.iter_mut().for_each(|p| *p = NOT_RUNNABLE);
+        for r in &mut self.ms {
+            r.rpos = NOT_RUNNABLE;
+            r.moves = 0;
+        }
         self.delayed.clear();
         let model = self.model;
         for (m, def) in model.machines.iter().enumerate() {
@@ -580,14 +584,14 @@ impl<'m> Simulator<'m> {
                 }
                 self.time += 1;
                 self.instant_steps = 0;
-                self.instant_moves.iter_mut().for_each(|c| *c = 0);
+                self.ms.iter_mut().for_each(|r| r.moves = 0);
                 let flow = obs.on_time(self.time);
                 let mut i = 0;
                 while i < self.delayed.len() {
                     let m = self.delayed[i] as usize;
                     if self.ms[m].wake <= self.time {
                         self.ms[m].waiting = false;
-                        self.changed[m] = self.clock;
+                        self.ms[m].changed = self.clock;
                         self.delayed.swap_remove(i);
                         self.refresh(m);
                     } else {
@@ -610,7 +614,7 @@ impl<'m> Simulator<'m> {
             }
             if self.instant_steps >= cfg.max_steps_per_instant {
                 let busiest = (0..self.ms.len())
-                    .max_by_key(|&m| self.instant_moves[m])
+                    .max_by_key(|&m| self.ms[m].moves)
                     .unwrap_or(0);
                 return Err(self.spin(busiest, SpinKind::NoTimeProgress));
             }
@@ -628,8 +632,9 @@ impl<'m> Simulator<'m> {
                 continue;
             }
             let m = self.runnable[k] as usize;
-            self.changed[m] = self.clock;
-            self.instant_moves[m] = self.instant_moves[m].saturating_add(1);
+            let r = &mut self.ms[m];
+            r.changed = self.clock;
+            r.moves = r.moves.saturating_add(1);
             if self.step(m, rng, cfg, obs)? == Flow::Stop {
                 return Ok(EndReason::Stopped);
             }

@@ -170,7 +170,7 @@ impl Simulator<'_> {
         let base = self.rx_base[ei] as usize - model.events.len();
         for (k, &r) in model.events[ei].receivers.iter().enumerate() {
             let at = self.checked[base + k];
-            let choice = if at != 0 && self.changed[r as usize] < at {
+            let choice = if at != 0 && self.ms[r as usize].changed < at {
                 self.choice_kept[base + k]
             } else {
                 let c = match self.receive_choice(r, e, rng, cfg)? {
@@ -217,7 +217,7 @@ impl Simulator<'_> {
             } else {
                 self.receive_choice(r, e, rng, cfg)?.flatten()
             };
-            self.changed[m] = self.clock;
+            self.ms[m].changed = self.clock;
             // The receiver keeps its own copy: JANI assigns it with the receive itself.
             let rx = self.rx_base[e as usize] as usize + k;
             let (global, copy) = self.pool.split_at_mut(rx);
@@ -226,7 +226,7 @@ impl Simulator<'_> {
             self.ms[m].cur = rx as u32;
             self.steps += 1;
             self.instant_steps += 1;
-            self.instant_moves[m] = self.instant_moves[m].saturating_add(1);
+            self.ms[m].moves = self.ms[m].moves.saturating_add(1);
             let f = obs.on_receive(
                 self.time,
                 &SentMessage {
@@ -260,7 +260,7 @@ impl Simulator<'_> {
         while i < self.blocked_list.len() {
             let m = self.blocked_list[i] as usize;
             if self.send_possible(m) {
-                self.changed[m] = self.clock;
+                self.ms[m].changed = self.clock;
                 self.ms[m].blocked = false;
                 self.ms[m].awaiting = NO_MSG;
                 self.blocked_list.swap_remove(i);
@@ -363,24 +363,24 @@ impl Simulator<'_> {
             self.refresh(m);
             return Ok(Flow::Continue);
         }
-        let mut out = std::mem::take(&mut self.ev_scratch[e]);
-        for &i in &sd.missing {
-            if let (Some(dst), Some(cur)) =
-                (out.get_mut(i as usize), self.pool[e].params.get(i as usize))
-            {
-                dst.clone_from(cur);
-            }
-        }
+        // The new parameters are evaluated into the event's scratch buffer (the old ones
+        // stay readable meanwhile), then the two buffers change places.
         let res = {
+            let out = &mut self.ev_scratch[e];
+            for &i in &sd.missing {
+                if let (Some(dst), Some(cur)) =
+                    (out.get_mut(i as usize), self.pool[e].params.get(i as usize))
+                {
+                    dst.clone_from(cur);
+                }
+            }
             let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
-            eval_params(sd, &mut env, &mut out)
+            eval_params(sd, &mut env, out)
         };
         if let Err(err) = res {
-            self.ev_scratch[e] = out;
             return Err(self.diag_error(m, Some(pc as usize), err));
         }
-        std::mem::swap(&mut self.pool[e].params, &mut out);
-        self.ev_scratch[e] = out;
+        std::mem::swap(&mut self.pool[e].params, &mut self.ev_scratch[e]);
         let declared = match &sd.to {
             SendTo::Machine(t) => *t,
             _ => u32::MAX,

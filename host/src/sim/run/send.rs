@@ -2,6 +2,22 @@
 
 use super::*;
 
+/// Pool slot `w`, to write a message into, and the parameters of slot `cur` (a machine's
+/// current message, `NO_MSG`: none), which the message's expressions read meanwhile.
+/// A free slot is never a current message; if it were, it would read as empty.
+fn write_and_read(pool: &mut [Slot], w: usize, cur: u32) -> (&mut Slot, &[Cell]) {
+    let c = cur as usize;
+    if cur == NO_MSG || c == w {
+        (&mut pool[w], &[])
+    } else if c < w {
+        let (lo, hi) = pool.split_at_mut(w);
+        (&mut hi[0], &lo[c].params)
+    } else {
+        let (lo, hi) = pool.split_at_mut(c);
+        (&mut lo[w], &hi[0].params)
+    }
+}
+
 impl Simulator<'_> {
     /// Starts the delay of a delayed send not yet delayed: the machine waits `n` units
     /// (true), or the send goes on now (false: no delay, or the delay is over).
@@ -131,24 +147,30 @@ impl Simulator<'_> {
                 self.pool.len() as u32 - 1
             }
         };
-        let mut out = std::mem::take(&mut self.pool[slot as usize].params);
-        for &i in &sd.missing {
-            if let (Some(dst), Some(d)) = (out.get_mut(i as usize), evdef.defaults.get(i as usize))
-            {
-                dst.clone_from(d);
-            }
-        }
         let res = {
-            let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
-            eval_params(sd, &mut env, &mut out)
-        };
-        {
-            let s = &mut self.pool[slot as usize];
-            s.params = out;
+            let r = &self.ms[m];
+            let (s, params) = write_and_read(&mut self.pool, slot as usize, r.cur);
+            for &i in &sd.missing {
+                if let (Some(dst), Some(d)) =
+                    (s.params.get_mut(i as usize), evdef.defaults.get(i as usize))
+                {
+                    dst.clone_from(d);
+                }
+            }
+            let mut env = Env {
+                vars: &r.vars,
+                params,
+                event: r.cur_event,
+                origin: r.cur_origin,
+                rng: &mut *rng,
+                strings: &model.strings,
+            };
+            let res = eval_params(sd, &mut env, &mut s.params);
             s.event = sd.event;
             s.origin = m as u32;
             s.target = target.unwrap_or(u32::MAX);
-        }
+            res
+        };
         if let Err(e) = res {
             self.free_slot(slot);
             return Err(self.diag_error(m, Some(pc as usize), e));
