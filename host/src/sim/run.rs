@@ -158,6 +158,17 @@ fn env<'s>(
     } else {
         &pool[r.cur as usize].params
     };
+    env_of(r, params, rng, strings)
+}
+
+/// Machine record `r`'s environment, `params` being its current message's parameters.
+#[inline]
+fn env_of<'s>(
+    r: &'s MachineRt,
+    params: &'s [Cell],
+    rng: &'s mut dyn Entropy,
+    strings: &'s Strings,
+) -> Env<'s> {
     Env {
         vars: &r.vars,
         params,
@@ -661,20 +672,7 @@ impl<'m> Simulator<'m> {
             let ok = match &td.cond {
                 None => true,
                 Some(c) => {
-                    let r = &self.ms[m];
-                    let params: &[Cell] = if r.cur == NO_MSG {
-                        &[]
-                    } else {
-                        &self.pool[r.cur as usize].params
-                    };
-                    let mut env = Env {
-                        vars: &r.vars,
-                        params,
-                        event: r.cur_event,
-                        origin: r.cur_origin,
-                        rng: &mut *rng,
-                        strings: &self.model.strings,
-                    };
+                    let mut env = env(&self.ms, &self.pool, m, &mut *rng, &self.model.strings);
                     match c(&mut env) {
                         Ok(b) => b,
                         Err(e) => return Err(self.diag_error(m, Some(td.pc as usize), e)),

@@ -157,14 +157,7 @@ impl Simulator<'_> {
                     dst.clone_from(d);
                 }
             }
-            let mut env = Env {
-                vars: &r.vars,
-                params,
-                event: r.cur_event,
-                origin: r.cur_origin,
-                rng: &mut *rng,
-                strings: &model.strings,
-            };
+            let mut env = env_of(r, params, &mut *rng, &model.strings);
             let res = eval_params(sd, &mut env, &mut s.params);
             s.event = sd.event;
             s.origin = m as u32;
