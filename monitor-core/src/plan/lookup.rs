@@ -2,7 +2,7 @@
 
 use super::{literal_bits, logic_step, with_value, AtomStep, Kind, Step, C};
 
-/// The most index bits (atoms and memory bits together) of a transition table.
+/// The most index bits (atoms, memory bits and timed steps together) of a transition table.
 pub(super) const TABLE_BITS: usize = 8;
 
 /// `v`'s bits spread over the bits of `mask`, lowest first (the inverse of
