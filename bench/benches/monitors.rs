@@ -12,7 +12,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use hindsight_bench::{
-    generated_state_bytes, run_baseline, run_generated, Interpreted, Trace, FORMULAS, SEED,
+    floor, generated_state_bytes, run_baseline, run_generated, Interpreted, Trace, FORMULAS, SEED,
 };
 
 struct Options {
@@ -122,6 +122,13 @@ fn bench() -> Result<(), String> {
             let i = (0..trace.len()).find(|&i| b.get(i) != a.get(i) || c.get(i) != a.get(i));
             return Err(format!("{f}: the engines disagree at point {i:?}"));
         }
+        if *f == floor::FORMULA {
+            let mut d = Vec::with_capacity(trace.len());
+            floor::run(&trace, &mut |v| d.push(v)).map_err(|e| format!("{f}: floor: {e}"))?;
+            if d != a {
+                return Err(format!("{f}: the contract floor disagrees with try_step"));
+            }
+        }
         trues.push(a.iter().filter(|v| **v).count() as u64);
     }
     println!(
@@ -131,6 +138,8 @@ fn bench() -> Result<(), String> {
     // Timed passes, interleaved: the baseline, then each formula's three runs.
     let n = trace.len();
     let mut base = Vec::new();
+    let mut floor_ns = Vec::new();
+    let fk = FORMULAS.iter().position(|f| *f == floor::FORMULA);
     let mut times = vec![[Vec::new(), Vec::new(), Vec::new()]; FORMULAS.len()];
     for _ in 0..opts.reps {
         let (ns, _) = timed!(n, |s| {
@@ -138,6 +147,14 @@ fn bench() -> Result<(), String> {
             Ok(())
         })?;
         base.push(ns);
+        if let Some(fk) = fk {
+            let (ns, c) = timed!(n, |s| floor::run(black_box(&trace), &mut s)
+                .map_err(|e| e.to_string()))?;
+            if c != trues[fk] {
+                return Err(format!("{}: floor verdict count changed", floor::FORMULA));
+            }
+            floor_ns.push(ns);
+        }
         for (k, t) in times.iter_mut().enumerate() {
             let tr = black_box(&trace);
             let e = |e: hindsight_bench::RunError| e.to_string();
@@ -219,6 +236,19 @@ fn bench() -> Result<(), String> {
             };
             println!("  misses {miss}: `{f}`");
         }
+    }
+    // What the goal leaves an interpreter: the contract floor (`floor.rs`).
+    if let Some(fk) = fk {
+        let fl = median(&mut floor_ns);
+        println!(
+            "\ncontract floor, `{}` by hand (try_step's arguments, checks and state, the \
+             formula in the code, nothing interpreted): {fl:.2} ns = {:.1}x generated, \
+             {:.1}x baseline; try_step = {:.1}x the floor",
+            floor::FORMULA,
+            fl / med[fk][2],
+            fl / base,
+            med[fk][0] / fl,
+        );
     }
     // The point intervals: the spread of the cost over bounds 10 .. 100000.
     let sweep: Vec<usize> = (0..FORMULAS.len())

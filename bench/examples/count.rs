@@ -4,7 +4,7 @@
 //! `valgrind --tool=callgrind --toggle-collect='hindsight_bench::*run*' target/release/examples/count K ENGINE N`
 //! counts only the measured loop (see `scripts/count-instructions`): formula `FORMULAS[K]`,
 //! engine `step` (try_step, planned), `step0` (try_step, unplanned), `atoms` (try_step_atoms), `gen` (generated code) or `base`
-//! (the baseline loop), over the first N points of the bench trace.
+//! (the baseline loop) or `floor` (the hand-written contract floor, formula 4 only), over the first N points of the bench trace.
 
 use std::process::ExitCode;
 
@@ -12,7 +12,7 @@ use hindsight_bench::{run_baseline, run_generated, Interpreted, Trace, FORMULAS,
 
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let usage = "usage: count K step|step0|atoms|gen|base N";
+    let usage = "usage: count K step|step0|atoms|gen|base|floor N";
     let (Some(k), Some(engine), Some(n)) = (
         args.first().and_then(|a| a.parse::<usize>().ok()),
         args.get(1),
@@ -40,6 +40,9 @@ fn main() -> ExitCode {
         "step0" => interp.run_unplanned(&trace, &mut sink),
         "atoms" => interp.run_atoms(&trace, &mut sink),
         "gen" => run_generated(k, &trace, &mut sink),
+        "floor" if *formula == hindsight_bench::floor::FORMULA => {
+            hindsight_bench::floor::run(&trace, &mut sink)
+        }
         "base" => {
             run_baseline(&trace, &mut sink);
             Ok(())

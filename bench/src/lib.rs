@@ -20,6 +20,7 @@
 //! None.
 
 mod cases;
+pub mod floor;
 
 pub use cases::{spec, FORMULAS};
 
@@ -63,7 +64,7 @@ impl XorShift64Star {
 #[derive(Clone, Debug)]
 pub struct Trace {
     /// Bit 0: `p`, bit 1: `q`, bit 2: `r`.
-    bits: Vec<u8>,
+    pub(crate) bits: Vec<u8>,
 }
 
 impl Trace {
@@ -120,7 +121,7 @@ impl Trace {
 }
 
 #[inline(always)]
-fn unpack(b: u8) -> (bool, bool, bool) {
+pub(crate) fn unpack(b: u8) -> (bool, bool, bool) {
     (b & 1 != 0, b & 2 != 0, b & 4 != 0)
 }
 
@@ -154,7 +155,7 @@ pub fn run_baseline(trace: &Trace, sink: &mut impl FnMut(bool)) {
 
 /// A compiled formula ready for the interpreter.
 pub struct Interpreted {
-    compiled: codegen::Compiled,
+    pub(crate) compiled: codegen::Compiled,
 }
 
 impl Interpreted {

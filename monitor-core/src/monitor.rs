@@ -584,7 +584,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
         self.plan.get(..self.info.steps as usize).unwrap_or(&[])
     }
 
-    /// Updates every node, planned ([`Step`]) or not ([`Node`]): one loop for
+    /// Updates every node, planned ([`Step`]) or not ([`Node`](crate::program::Node)): one loop for
     /// both; the state length and the time were checked by the caller, and the
     /// atoms of this point are in the scratch words, the first of them also in
     /// `atoms`.
