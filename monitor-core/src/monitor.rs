@@ -44,6 +44,15 @@ pub struct Monitor<'a, const N: usize = 0> {
     table: [u64; N],
 }
 
+/// [`Monitor::advance_folded`]'s shape, when the caller knows it: any folded
+/// plan (decided by its flags at each point), a transition table
+/// ([`Plan::TABLE`]) or one step.
+const SHAPE_ANY: u8 = 0;
+/// A transition table: see [`SHAPE_ANY`].
+const SHAPE_TABLE: u8 = 1;
+/// A plan of one step: see [`SHAPE_ANY`].
+const SHAPE_ONE: u8 = 2;
+
 /// The most nodes, atoms or variables a program may have (ids are `u16`).
 pub const MAX_IDS: usize = u16::MAX as usize;
 
@@ -301,29 +310,20 @@ impl<'a, const N: usize> Monitor<'a, N> {
     ) -> Result<(), StepError> {
         let (p, info) = (&self.program, &self.info);
         if info.has(Plan::FAST) {
-            // One pass over the variables (at most 64): each value's type
-            // against the declared one (a mismatch gives the first variable of
-            // another type, before anything is written) and the booleans' bits.
-            let (mut bad, mut vb) = (false, 0u64);
-            for (i, (v, d)) in vars.iter().zip(p.vars).enumerate() {
-                let (ty, b) = match *v {
-                    Value::Bool(b) => (Ty::Bool, b),
-                    Value::Int(_) => (Ty::Int, false),
-                    Value::Float(_) => (Ty::Float, false),
-                    Value::Str(_) => (Ty::Str, false),
-                };
-                bad |= ty != d.ty;
-                vb |= (b as u64) << (i & 63);
+            // The two commonest shapes first, each stepped with its flags known:
+            // atoms that are a run of boolean variables, and a transition table or
+            // one step (no test of the other flags, the literals only where read).
+            const RUN: u8 = Plan::FAST | Plan::BOOLS | Plan::RUN | Plan::FOLDED;
+            if info.flags & (RUN | Plan::TABLE) == RUN | Plan::TABLE {
+                return self.step_run::<SHAPE_TABLE>(state, time, vars, verdicts);
             }
-            if bad {
-                return Err(type_error(p, vars));
+            if info.flags & (RUN | Plan::TABLE) == RUN && info.steps == 1 {
+                return self.step_run::<SHAPE_ONE>(state, time, vars, verdicts);
             }
+            let vb = var_bits(p, vars)?;
             let mut bits = 0u64;
             if info.has(Plan::RUN) {
-                // At most 64 variables: `shift + atoms <= 64`. With no atom the
-                // mask is all ones and `bits` is read by nothing.
-                let n = p.atoms.len() as u32;
-                bits = vb >> (info.shift & 63) & u64::MAX >> (64u32.wrapping_sub(n) & 63);
+                bits = self.run_bits(vb);
             } else if info.has(Plan::BOOLS) {
                 for (k, a) in self.plan_atoms().iter().enumerate() {
                     let v = (vb.wrapping_shr(a.var as u32) ^ a.c as u64) & 1;
@@ -338,7 +338,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
             }
             if info.has(Plan::FOLDED) {
                 let lits = || self.literals(bits);
-                self.advance_folded(state, time, bits, bits, lits, verdicts);
+                self.advance_folded::<SHAPE_ANY>(state, time, bits, bits, lits, verdicts);
             } else {
                 if !p.atoms.is_empty() {
                     wr(state, layout::HEADER_WORDS, bits);
@@ -354,6 +354,39 @@ impl<'a, const N: usize> Monitor<'a, N> {
         Ok(())
     }
 
+    /// [`Monitor::step_planned`] of a folded plan whose atoms are a run of
+    /// boolean variables ([`Plan::RUN`]) and whose shape is `SHAPE`
+    /// ([`Monitor::advance_folded`]).
+    #[inline(always)]
+    fn step_run<const SHAPE: u8>(
+        &self,
+        state: &mut [u64],
+        time: u64,
+        vars: &[Value],
+        verdicts: &mut [bool],
+    ) -> Result<(), StepError> {
+        let bits = self.run_bits(var_bits(&self.program, vars)?);
+        let lits = || self.literals(bits);
+        self.advance_folded::<SHAPE>(state, time, bits, bits, lits, verdicts);
+        Ok(())
+    }
+
+    /// [`Plan::RUN`]: the atoms from the boolean variables' bits `vb`.
+    #[inline(always)]
+    fn run_bits(&self, vb: u64) -> u64 {
+        // At most 64 variables: `shift + atoms <= 64`. With no atom the mask is
+        // all ones and the bits are read by nothing.
+        let n = self.program.atoms.len() as u32;
+        vb >> (self.info.shift & 63) & u64::MAX >> (64u32.wrapping_sub(n) & 63)
+    }
+
+    /// A transition table's first point: the whole plan, out of line.
+    #[cold]
+    #[inline(never)]
+    fn fold_first(&self, body: &mut [u64], t: u64, old: u64, nodes: u64) -> u64 {
+        self.fold(body, t, old, nodes, true)
+    }
+
     /// The network step of a planned monitor, from the atoms of this point
     /// (stored in the state's scratch words, the first of them in `first`).
     #[inline(always)]
@@ -364,7 +397,7 @@ impl<'a, const N: usize> Monitor<'a, N> {
             let n = self.program.atoms.len() as u32;
             let exact = first & u64::MAX.checked_shr(64u32.wrapping_sub(n)).unwrap_or(0);
             let lits = || self.literals(exact);
-            self.advance_folded(state, time, first, exact, lits, verdicts);
+            self.advance_folded::<SHAPE_ANY>(state, time, first, exact, lits, verdicts);
         } else {
             self.advance(self.plan_nodes(), state, time, first, verdicts);
         }
@@ -386,9 +419,10 @@ impl<'a, const N: usize> Monitor<'a, N> {
     /// state opens with exactly three words (time, atoms, values; [`layout`]),
     /// and the values of this point and the last each fit one register. With a
     /// transition table ([`Plan::TABLE`]) every point but the first is the timed
-    /// steps, if any, and one lookup.
+    /// steps, if any, and one lookup. `SHAPE` is the plan's shape when the
+    /// caller knows it ([`SHAPE_TABLE`], [`SHAPE_ONE`]), else [`SHAPE_ANY`].
     #[inline(always)]
-    fn advance_folded(
+    fn advance_folded<const SHAPE: u8>(
         &self,
         state: &mut [u64],
         t: u64,
@@ -404,7 +438,11 @@ impl<'a, const N: usize> Monitor<'a, N> {
         };
         let first_point = *time_word == 0;
         let old = *value_word;
-        let new = if self.info.has(Plan::TABLE) && !first_point {
+        let new = if SHAPE == SHAPE_ONE {
+            self.fold_one(body, t, old, nodes(), first_point)
+        } else if SHAPE == SHAPE_TABLE && first_point {
+            self.fold_first(body, t, old, nodes())
+        } else if (SHAPE == SHAPE_TABLE || self.info.has(Plan::TABLE)) && !first_point {
             self.table_step(body, t, old, exact)
         } else if self.info.steps != 1 {
             self.fold(body, t, old, nodes(), first_point)
@@ -692,6 +730,28 @@ fn fold_step<const ONE: bool>(
     let f = new.wrapping_shr(s.a as u32) & 1 == 1;
     let g = new.wrapping_shr(s.b as u32) & 1 == 1;
     plan::with_value(s, new, special::<ONE>(s, body, t, f, g, d) as u64)
+}
+
+/// [`Plan::FAST`]: one pass over the variables (at most 64): each value's type
+/// against the declared one (a mismatch gives the first variable of another
+/// type, before anything is written) and the booleans' bits.
+#[inline(always)]
+fn var_bits(p: &Program<'_>, vars: &[Value]) -> Result<u64, StepError> {
+    let (mut bad, mut vb) = (false, 0u64);
+    for (i, (v, d)) in vars.iter().zip(p.vars).enumerate() {
+        let (ty, b) = match *v {
+            Value::Bool(b) => (Ty::Bool, b),
+            Value::Int(_) => (Ty::Int, false),
+            Value::Float(_) => (Ty::Float, false),
+            Value::Str(_) => (Ty::Str, false),
+        };
+        bad |= ty != d.ty;
+        vb |= (b as u64) << (i & 63);
+    }
+    if bad {
+        return Err(type_error(p, vars));
+    }
+    Ok(vb)
 }
 
 /// Every value of `vars` has its variable's declared type (same length, checked before).
