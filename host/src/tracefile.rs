@@ -115,7 +115,7 @@ fn parse_value(cell: &str, spec: &Compiled, var: usize) -> Result<Value, String>
     let decl = &spec.vars()[var];
     let bad = || {
         format!(
-            "`{cell}` is not a {} value for `{}`",
+            "`{cell}` is not a value of type `{}` for `{}`",
             decl.type_name, decl.name
         )
     };

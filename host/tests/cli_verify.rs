@@ -541,6 +541,65 @@ fn a_traced_run_replays_with_the_recorded_verdicts() {
 }
 
 #[test]
+fn replay_refuses_a_bad_trace_naming_file_line_and_column() {
+    let dir = std::env::temp_dir().join(format!("hindsight-replay-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let spec = dir.join("s.hspec");
+    std::fs::write(
+        &spec,
+        "unit 1s;\nstate p: bool = false;\nstate x: int = 0;\n\
+         property f = H({x < 5} -> P[0:3] {p});\n",
+    )
+    .unwrap();
+    let cases = [
+        (
+            "int.csv",
+            "time,p,x\n0,1,3\n1,0,99999999999999999999\n",
+            "int.csv:3:5: `99999999999999999999` is not a value of type `int` for `x`",
+        ),
+        (
+            "bool.csv",
+            "time,p,x\n0,true,3\n1,yes,3\n",
+            "bool.csv:3:3: `yes` is not a value of type `bool` for `p`",
+        ),
+        (
+            "time.csv",
+            "time,p,x\n0,1,3\n-1,0,2\n",
+            "time.csv:3:1: `-1` is not a timestamp",
+        ),
+        (
+            "back.csv",
+            "time,p,x\n5,1,3\n2,0,2\n",
+            "back.csv:3:1: timestamp 2 is before the previous point's 5",
+        ),
+        (
+            "twice.csv",
+            "time,p,x,x\n5,1,3,3\n",
+            "twice.csv:1:10: column `x` repeated",
+        ),
+        ("empty.csv", "", "empty.csv:1:1: empty trace"),
+        (
+            "unknown.csv",
+            "time,p,y\n0,1,3\n",
+            "unknown.csv:1:8: `y` is not a variable of the spec",
+        ),
+    ];
+    for (name, text, want) in cases {
+        let trace = dir.join(name);
+        std::fs::write(&trace, text).unwrap();
+        let (code, out, err) =
+            hindsight(&["replay", spec.to_str().unwrap(), trace.to_str().unwrap()]);
+        assert_eq!(code, 2, "{name}: {out}{err}");
+        assert!(
+            out.is_empty(),
+            "{name}: no verdict printed before the error: {out}"
+        );
+        assert!(err.contains(want), "{name}: {err}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
 fn with_a_time_unit_bounds_and_sweeps_are_in_seconds() {
     // The museum translation steps 100 ms; its requirements written over ROS names with
     // bounds in seconds hold, and the sweep's thresholds come out in seconds.

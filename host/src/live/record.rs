@@ -123,7 +123,7 @@ fn sets_back(
             (Ty::Float, serde_json::Value::Number(n)) => Value::Float(n.as_f64().unwrap_or(0.0)),
             _ => {
                 return Err(format!(
-                    "`{j}` is not a {} value for `{name}`",
+                    "`{j}` is not a value of type `{}` for `{name}`",
                     spec.vars()[var].type_name
                 ))
             }
