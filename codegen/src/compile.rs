@@ -4,7 +4,7 @@ use std::collections::BTreeSet;
 use std::sync::Mutex;
 
 use monitor_core::table::TABLE_VERSION;
-use monitor_core::{Atom, Instr, Monitor, Node, NodeId, Program, Property, Var};
+use monitor_core::{Atom, Instr, Monitor, Node, NodeId, Program, Property, StepError, Var};
 
 use crate::ast::{self, CheckedSpec, VarDecl};
 use crate::diag::Diagnostics;
@@ -210,5 +210,27 @@ impl Compiled {
     /// Warnings found while compiling (empty when there were none).
     pub fn warnings(&self) -> &Diagnostics {
         &self.warnings
+    }
+
+    /// A step error as its reader needs it: an atom by its text and a variable by
+    /// its name and type, where [`StepError`]'s own text gives their indices.
+    pub fn describe(&self, e: &StepError) -> String {
+        match *e {
+            StepError::Arithmetic { atom } => match self.atom_exprs.get(atom as usize) {
+                Some(x) => format!(
+                    "atom `{{{}}}`: integer overflow or division by zero",
+                    crate::print::expr(x, &self.checked)
+                ),
+                None => e.to_string(),
+            },
+            StepError::VarType { var } => match self.vars().get(var as usize) {
+                Some(d) => format!(
+                    "variable `{}`: a value that is not of its type `{}`",
+                    d.name, d.type_name
+                ),
+                None => e.to_string(),
+            },
+            _ => e.to_string(),
+        }
     }
 }

@@ -19,3 +19,46 @@ fn end_to_end_absence() {
         .unwrap();
     assert!(!v[0]);
 }
+
+#[test]
+fn step_errors_name_the_atom_and_the_variable() {
+    let c = compile_spec(
+        "unit 1s;\nstate p: bool = false;\nstate x: int = 0;\nproperty f = H({x / 0 > 1} || {p});\n",
+        "d.hspec",
+    )
+    .expect("compiles");
+    let m = Monitor::try_new(c.program()).expect("valid");
+    let mut s = vec![0u64; m.state_words()];
+    let e = m
+        .try_step(
+            &mut s,
+            0,
+            &[Value::Bool(false), Value::Int(3)],
+            &mut [false],
+        )
+        .expect_err("division by zero");
+    assert_eq!(
+        c.describe(&e),
+        "atom `{(x / 0) > 1}`: integer overflow or division by zero"
+    );
+    let e = m
+        .try_step(
+            &mut s,
+            0,
+            &[Value::Bool(false), Value::Bool(true)],
+            &mut [false],
+        )
+        .expect_err("a boolean for x");
+    assert_eq!(
+        c.describe(&e),
+        "variable `x`: a value that is not of its type `int`"
+    );
+    // Indices the spec does not have, and other errors, read as before.
+    for e in [
+        monitor_core::StepError::Arithmetic { atom: 9 },
+        monitor_core::StepError::VarType { var: 9 },
+        monitor_core::StepError::TimeOutOfRange,
+    ] {
+        assert_eq!(c.describe(&e), e.to_string());
+    }
+}

@@ -22,6 +22,8 @@ pub struct TracePoint {
     pub time: u64,
     /// `(variable index, value)` for every non-empty cell.
     pub sets: Vec<(usize, Value)>,
+    /// The row's line in the file, from 1.
+    pub line: usize,
 }
 
 /// Parses a CSV trace against a compiled spec's variables; errors name `file:line:col`.
@@ -100,7 +102,11 @@ pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoi
             let value = parse_value(cell.trim(), spec, var).map_err(|m| at(*col, m))?;
             sets.push((var, value));
         }
-        points.push(TracePoint { time, sets });
+        points.push(TracePoint {
+            time,
+            sets,
+            line: lno + 1,
+        });
     }
     Ok(points)
 }

@@ -596,6 +596,29 @@ fn replay_refuses_a_bad_trace_naming_file_line_and_column() {
         );
         assert!(err.contains(want), "{name}: {err}");
     }
+    // A step that fails names the row's line (after a comment and a blank line) and
+    // the atom by its text.
+    std::fs::write(
+        &spec,
+        "unit 1s;\nstate p: bool = false;\nstate x: int = 0;\n\
+         property f = H({x + 1 > 0} -> {p});\n",
+    )
+    .unwrap();
+    let trace = dir.join("max.csv");
+    std::fs::write(
+        &trace,
+        format!("time,p,x\n0,1,3\n# next\n\n1,1,{}\n", i64::MAX),
+    )
+    .unwrap();
+    let (code, out, err) = hindsight(&["replay", spec.to_str().unwrap(), trace.to_str().unwrap()]);
+    assert_eq!(code, 2, "{out}{err}");
+    assert!(out.is_empty(), "{out}");
+    assert!(
+        err.contains(
+            "max.csv:5: point 2: atom `{(x + 1) > 0}`: integer overflow or division by zero"
+        ),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -48,7 +48,13 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
         monitor
             .try_step(&mut state, p.time, &vals, &mut verdicts)
             .map_err(|e| {
-                CliError::Input(format!("{}: point {}: {e}", args.trace.display(), i + 1))
+                CliError::Input(format!(
+                    "{}:{}: point {}: {}",
+                    args.trace.display(),
+                    p.line,
+                    i + 1,
+                    compiled.describe(&e)
+                ))
             })?;
         if !args.quiet && (!args.changes || rows.last().is_none_or(|(_, v)| *v != verdicts)) {
             rows.push((p.time, verdicts.clone()));

@@ -254,7 +254,7 @@ impl Run<'_, '_> {
         }
         self.changes.clear();
         self.started = true;
-        let step = |e: monitor_core::StepError| LiveError::Engine(e.to_string());
+        let step = |e: monitor_core::StepError| LiveError::Engine(self.spec.describe(&e));
         let ok = match request {
             None => {
                 self.engine

@@ -181,7 +181,7 @@ pub fn apply(
     input: &Input,
     out: &mut Vec<Change>,
 ) -> Result<Option<bool>, String> {
-    let step = |e: monitor_core::StepError| e.to_string();
+    let step = |e: monitor_core::StepError| spec.describe(&e);
     match input {
         Input::Sample { time, source, sets } => {
             let sets = sets_back(spec, sets)?;

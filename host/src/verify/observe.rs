@@ -411,7 +411,10 @@ impl<'a> Judge<'a> {
             .monitor
             .try_step(&mut self.state, time, &self.vals, &mut self.verdicts)
         {
-            self.error = Some(format!("monitor step at time {time}: {e}"));
+            self.error = Some(format!(
+                "monitor step at time {time}: {}",
+                self.set.compiled.describe(&e)
+            ));
             return Flow::Stop;
         }
         let (m, st) = (&self.monitor, &self.state);
