@@ -517,6 +517,21 @@ impl Checker<'_> {
                             (a, b)
                         };
                         let ty = a.ty;
+                        // Both operands are always evaluated (the atom machine has no
+                        // jumps): an integer `/` or `%` by a literal 0 fails at every
+                        // point, so it is refused here rather than at the first step.
+                        if matches!(op, BinaryOp::Div | BinaryOp::Rem)
+                            && ty == Ty::Int
+                            && b.kind == ExprKind::Const(Value::Int(0))
+                        {
+                            self.sink.error(
+                                b.span,
+                                format!(
+                                    "integer `{op_sym}` by 0: the atom would fail at every point"
+                                ),
+                            );
+                            return None;
+                        }
                         mk(ExprKind::Binary(*op, Box::new(a), Box::new(b)), ty)
                     }
                 }

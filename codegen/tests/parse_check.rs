@@ -281,6 +281,26 @@ property q = {b + true} || {9223372036854775808 > b};
 }
 
 #[test]
+fn an_integer_division_by_a_literal_zero_is_refused_where_written() {
+    let e = errors(
+        "state x: int = 0;\nstate y: float = 0.0;\n\
+         property p = {x / 0 > 1};\nproperty q = {1 < x % (0)} || {y / 0 > 1};\n",
+    );
+    let at: Vec<(u32, u32)> = e.iter().map(|(l, c, _)| (*l, *c)).collect();
+    // The float division (`y / 0`, 0 converted to a float) is IEEE: not an error.
+    assert_eq!(at, vec![(3, 19), (4, 23)], "{e:#?}");
+    assert!(e[0].2.contains("integer `/` by 0"), "{}", e[0].2);
+    assert!(e[1].2.contains("integer `%` by 0"), "{}", e[1].2);
+    // A divisor that is not the literal 0 is left to the step.
+    assert!(Spec::parse(
+        "state x: int = 0;\nproperty p = {x / (x - x) > 1};\n",
+        "e.hspec"
+    )
+    .and_then(|s| s.check())
+    .is_ok());
+}
+
+#[test]
 fn parse_errors_recover_at_the_next_statement() {
     let src =
         "event a;\nproperty x = {a} &&;\nproperty y = ({a};\nfoo bar;\nproperty z = {a} {a};\n";
