@@ -440,7 +440,7 @@ fn blackboard_type_conflicts_name_both_places() {
         "conflict2",
         &t,
         "zero\"",
-        &format!("used as string here but as int32 at ./tree.xml:{l}:{c}"),
+        &format!("used as string here but as int32 at tree.xml:{l}:{c}"),
     );
     // A copy between entries of different types names where each got its type.
     let t = v3("<Sequence>\n<SetBlackboard output_key=\"a\" value=\"1\"/>\n<SetBlackboard output_key=\"b\" value=\"x\"/>\n<SetBlackboard output_key=\"b\" value=\"{a}\"/>\n</Sequence>");

@@ -138,6 +138,15 @@ fn bad_robot_models_name_file_line_and_column() {
             "BatteryLevelSkill.scxml:18:73: topic `BatteryComponent__battery_level` is subscribed with type `std_msgs/Bool`",
         ),
         (
+            // The plugin reads the name from the tree's port: the error is at the port.
+            "a BT node's service that nothing serves",
+            "policy.xml",
+            6,
+            "service_name=\"/BatteryLevelSkill/tick\"",
+            "service_name=\"/BatteryLevelSkil/tick\"",
+            "policy.xml:6:81: service `/BatteryLevelSkil/tick` has no server (no node model declares a <ros_service_server> for it; requested by <ros_service_send_request> at ",
+        ),
+        (
             "unsupported tag",
             "Components/BatteryComponent.scxml",
             14,

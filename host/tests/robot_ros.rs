@@ -919,7 +919,15 @@ fn bad_models_give_positioned_errors() {
   <ros_service_client service_name="/add" type="example_interfaces/srv/AddTwoInts"/>
   <state id="a"><onentry><ros_service_send_request name="/add"/></onentry></state>
 </ascxml>"#,
-            "s.ascxml:3:26: service `add` has no server",
+            "s.ascxml:2:37: service `/add` has no server (no node model declares a <ros_service_server> for it; requested by <ros_service_send_request> at s.ascxml:3:26)",
+        ),
+        // An action goal sent to nobody: at the client's action name.
+        (
+            r#"<ascxml name="S" initial="a">
+  <ros_action_client name="c" action_name="/fib" type="example_interfaces/Fibonacci"/>
+  <state id="a"><onentry><ros_action_send_goal name="c"/></onentry></state>
+</ascxml>"#,
+            "s.ascxml:2:44: action `/fib` has no server (no node model declares a <ros_action_server> for it; requested by <ros_action_send_goal> at s.ascxml:3:26)",
         ),
         // A second server of one action: at the second, naming where the first is.
         (

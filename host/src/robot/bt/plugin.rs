@@ -377,8 +377,10 @@ impl Lower<'_> {
     }
 
     /// The value of port `key` read at `span`: as an expression (`expr`) or as raw text;
-    /// `Some((text, true))` for a blackboard read.
-    fn get_input(&mut self, key: &str, span: Span, expr: bool) -> Option<(String, bool)> {
+    /// `Some((text, true, _))` for a blackboard read. The span is where the text was
+    /// written: the tree's port value for raw text (a service or topic name, say, so
+    /// that an error about it points at the tree), else `span`.
+    fn get_input(&mut self, key: &str, span: Span, expr: bool) -> Option<(String, bool, Span)> {
         let Some(decl) = self.plugin.port(key) else {
             self.err(
                 span,
@@ -402,13 +404,13 @@ impl Lower<'_> {
         };
         match &p.value {
             PortValue::Literal(v) => Some(if expr {
-                (literal_expr(v, &decl.ty), false)
+                (literal_expr(v, &decl.ty), false, span)
             } else {
-                (v.trim().to_string(), false)
+                (v.trim().to_string(), false, p.span)
             }),
             PortValue::Blackboard(name) => {
                 if expr {
-                    Some((format!("_event.data.{name}"), true))
+                    Some((format!("_event.data.{name}"), true, span))
                 } else {
                     self.err(
                         span,
@@ -484,14 +486,14 @@ impl Lower<'_> {
                     Ok(k) => {
                         let key = k.value.trim().to_string();
                         let expr = matches!(c.name.as_str(), "expr" | "cond");
-                        if let Some((v, bb)) = self.get_input(&key, gi.span, expr) {
+                        if let Some((v, bb, at)) = self.get_input(&key, gi.span, expr) {
                             if bb && c.name != "expr" {
                                 self.err(
                                     gi.span,
                                     format!("port `{key}` is a blackboard entry: a condition cannot read the blackboard (assign it to a variable first)"),
                                 );
                             } else {
-                                el.set_attr_at(&c.name, v, gi.span);
+                                el.set_attr_at(&c.name, v, at);
                                 reads |= bb;
                             }
                         }

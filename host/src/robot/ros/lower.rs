@@ -456,6 +456,25 @@ impl Cx<'_> {
         self.services.iter().find(|s| s.key == key).cloned()
     }
 
+    /// A request `el` to the `what` (service, action) that client `alias` names,
+    /// which nothing serves: reported where the name is written (in a behavior
+    /// tree, when a BT plugin read it from a port), naming the request.
+    fn no_server(&mut self, el: &Element, what: &str, clients: &[super::Alias], alias: &str) {
+        let Some(a) = clients.iter().find(|a| a.alias == alias.trim()) else {
+            return;
+        };
+        let (name, span) = a.name.clone();
+        let at = self.sm.diag(el.span, "");
+        self.err(
+            span,
+            format!(
+                "{what} `{name}` has no server (no node model declares a \
+                 <ros_{what}_server> for it; requested by <{}> at {}:{}:{})",
+                el.name, at.file, at.line, at.col
+            ),
+        );
+    }
+
     /// One ROS tag inside a state or executable content.
     fn lower_ros(&mut self, el: &Element, u: &UnitCx, scope: &Scope) -> Vec<Node> {
         if !KNOWN_TAGS.contains(&el.name.as_str()) {
@@ -521,7 +540,7 @@ impl Cx<'_> {
                 };
                 let key = s.key.clone();
                 if s.server.is_none() {
-                    self.err(el.span, format!("service `{key}` has no server"));
+                    self.no_server(el, "service", &d.srv_clients, &alias);
                 }
                 let params = self.params(
                     el,
@@ -659,7 +678,7 @@ impl Cx<'_> {
         match el.name.as_str() {
             "ros_action_send_goal" => {
                 if a.server.is_none() {
-                    self.err(el.span, format!("action `{key}` has no server"));
+                    self.no_server(el, "action", &d.act_clients, alias);
                 }
                 let params = self.params(el, &a.fields.goal, &goal_what, scope);
                 one(self.send(el.span, &cl("goal_req"), &handler, params))

@@ -215,6 +215,9 @@ struct Alias {
     key: String,
     /// For topics: the type this declaration names and its fields.
     msg: Option<(String, Vec<FlatField>)>,
+    /// The name as written (`/add`) and where: the `<what>_name` value, or a
+    /// behavior tree's port when a BT plugin read it from one.
+    name: (String, Span),
 }
 
 /// The ROS declarations at the top of one node model.
@@ -360,7 +363,7 @@ impl Cx<'_> {
                 match el.name.as_str() {
                     "ros_topic_publisher" | "ros_topic_subscriber" => {
                         let publisher = el.name == "ros_topic_publisher";
-                        let Some((topic, _)) = self.attr_or_err(el, "topic") else {
+                        let Some((topic, topic_span)) = self.attr_or_err(el, "topic") else {
                             continue;
                         };
                         let Some((ty, ty_span)) = self.attr_or_err(el, "type") else {
@@ -375,6 +378,7 @@ impl Cx<'_> {
                             alias,
                             key,
                             msg: Some((ty.trim().to_string(), fields)),
+                            name: (topic.trim().to_string(), topic_span),
                         };
                         if publisher {
                             d.publishers.push(a);
@@ -527,7 +531,7 @@ impl Cx<'_> {
         kind: &EndpointKind<F>,
     ) -> Option<Alias> {
         let (what, all) = (kind.what, kind.all);
-        let (ename, _) = self.attr_or_err(el, &format!("{what}_name"))?;
+        let (ename, ename_span) = self.attr_or_err(el, &format!("{what}_name"))?;
         let (ty, ty_span) = self.attr_or_err(el, "type")?;
         let key = sanitize(&ename);
         let alias = el.attr_value("name").unwrap_or(&ename).trim().to_string();
@@ -549,6 +553,7 @@ impl Cx<'_> {
             alias,
             key,
             msg: None,
+            name: (ename.trim().to_string(), ename_span),
         })
     }
 
