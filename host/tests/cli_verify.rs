@@ -179,6 +179,17 @@ fn bad_properties_and_arguments_exit_2() {
     assert_eq!(code, 2);
     let (code, _, _) = hindsight(&["verify", "no/such/model"]);
     assert_eq!(code, 2);
+    // A study of no runs is refused, not reported as an empty table.
+    for args in [
+        &["verify", COIN, "--runs", "0"][..],
+        &["verify", COIN, "--max-runs", "0"],
+        &["sweep", COIN, "--from", "1", "--to", "2", "--runs", "0"],
+    ] {
+        let (code, out, err) = hindsight(args);
+        assert_eq!(code, 2, "{args:?}: {out}{err}");
+        assert!(out.is_empty(), "{args:?}: {out}");
+        assert!(err.contains("must be at least 1"), "{args:?}: {err}");
+    }
     let _ = std::fs::remove_dir_all(dir);
 }
 

@@ -38,6 +38,16 @@ impl fmt::Display for CliError {
     }
 }
 
+/// A count of runs given on the command line: a whole number, at least 1 (a study of
+/// no runs estimates nothing).
+pub fn run_count(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(0) => Err("must be at least 1 (a study of no runs estimates nothing)".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("not a whole number of runs ({e})")),
+    }
+}
+
 /// Reads a whole file, naming it in the error.
 pub fn read_file(path: &std::path::Path) -> Result<String, CliError> {
     std::fs::read_to_string(path)

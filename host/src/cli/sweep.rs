@@ -59,8 +59,8 @@ pub struct SweepArgs {
     /// Step between values; default: one unit of `--from`'s last digit (`1`, `0.1s`).
     #[arg(long)]
     pub step: Option<String>,
-    /// Runs per property (every bound of a property is judged on the same runs).
-    #[arg(long, default_value_t = 200)]
+    /// Runs per property (every bound of a property is judged on the same runs; at least 1).
+    #[arg(long, default_value_t = 200, value_parser = super::run_count)]
     pub runs: u64,
     /// Confidence of the intervals.
     #[arg(long, default_value_t = 0.95)]

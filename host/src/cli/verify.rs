@@ -77,8 +77,8 @@ pub struct VerifyArgs {
     /// A run reaching this many steps is cut short: its open verdicts are unknown.
     #[arg(long, default_value_t = 100_000_000)]
     pub max_steps: u64,
-    /// Stop the study after this many runs even if the rule wants more.
-    #[arg(long)]
+    /// Stop the study after this many runs even if the rule wants more (at least 1).
+    #[arg(long, value_parser = super::run_count)]
     pub max_runs: Option<u64>,
     /// Print JSON (one object) instead of the table.
     #[arg(long)]
@@ -98,7 +98,12 @@ pub struct VerifyArgs {
     pub shard: Option<crate::smc::shard::Shard>,
     /// Run a fixed-size study of N runs: no early stop, the rule only gives the interval
     /// (the same numbers as its shards merged). With --shard, the size of the study it slices.
-    #[arg(long, value_name = "N", conflicts_with = "save_failing")]
+    #[arg(
+        long,
+        value_name = "N",
+        conflicts_with = "save_failing",
+        value_parser = super::run_count
+    )]
     pub runs: Option<u64>,
     /// File for the partial result of --shard (which it needs).
     #[arg(long, value_name = "FILE", requires = "shard")]
