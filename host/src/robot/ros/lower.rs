@@ -460,10 +460,11 @@ impl Cx<'_> {
     /// which nothing serves: reported where the name is written (in a behavior
     /// tree, when a BT plugin read it from a port), naming the request.
     fn no_server(&mut self, el: &Element, what: &str, clients: &[super::Alias], alias: &str) {
-        let Some(a) = clients.iter().find(|a| a.alias == alias.trim()) else {
-            return;
+        // The client was found before this is called; without it, the request's place.
+        let (name, span) = match clients.iter().find(|a| a.alias == alias.trim()) {
+            Some(a) => a.name.clone(),
+            None => (alias.trim().to_string(), el.span),
         };
-        let (name, span) = a.name.clone();
         let at = self.sm.diag(el.span, "");
         self.err(
             span,
