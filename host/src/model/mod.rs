@@ -27,7 +27,7 @@ pub use ast::Machine;
 pub use source::{about_file, Diagnostic, Diagnostics, FileId, SourceMap, Span};
 pub use types::{BaseType, TypeDef, TypeDefs, TypeExpr};
 
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 /// A model as read from disk, before compilation.
 #[derive(Clone, Debug, Default)]
@@ -238,7 +238,7 @@ pub fn load_spec(path: &Path) -> Result<ModelSource, Diagnostics> {
                         match (p.required(&sm, "id"), p.required(&sm, "path")) {
                             (Ok(id), Ok(pa)) => processes.push((
                                 id.value.clone(),
-                                base.join(&pa.value),
+                                join_clean(base, &pa.value),
                                 pa.value_span,
                             )),
                             (Err(d), _) | (_, Err(d)) => es.push(d),
@@ -250,7 +250,7 @@ pub fn load_spec(path: &Path) -> Result<ModelSource, Diagnostics> {
                 el.check_attrs(&sm, &["path"], &mut es);
                 match el.required(&sm, "path") {
                     Ok(a) => {
-                        let p = base.join(&a.value);
+                        let p = join_clean(base, &a.value);
                         if !p.is_file() {
                             es.push(
                                 sm.diag(a.value_span, format!("no such file `{}`", p.display())),
@@ -292,4 +292,32 @@ pub fn load_spec(path: &Path) -> Result<ModelSource, Diagnostics> {
     }
     m.check_names(&mut errs);
     errs.into_result(m)
+}
+
+/// `base` joined with a path `rel` that a model file names, without `rel`'s `.`
+/// components: `./policy.xml` is read, and named in messages, as `policy.xml` of the
+/// model's folder (a main file's inputs, a SCAN `model.xml`'s processes and files).
+pub(crate) fn join_clean(base: &Path, rel: &str) -> PathBuf {
+    let mut path = base.to_path_buf();
+    for c in Path::new(rel).components() {
+        if c != Component::CurDir {
+            path.push(c);
+        }
+    }
+    path
+}
+
+#[cfg(test)]
+mod join_tests {
+    use super::*;
+
+    #[test]
+    fn model_paths_are_named_without_dot_components() {
+        let base = Path::new("m");
+        assert_eq!(join_clean(base, "./policy.xml"), Path::new("m/policy.xml"));
+        assert_eq!(join_clean(base, "./a/./b.scxml"), Path::new("m/a/b.scxml"));
+        // `..` is kept (the folder may be a link), and an absolute path wins, as in `join`.
+        assert_eq!(join_clean(base, "../x.xml"), Path::new("m/../x.xml"));
+        assert_eq!(join_clean(base, "/abs/x.xml"), Path::new("/abs/x.xml"));
+    }
 }

@@ -42,7 +42,7 @@
 //! `xmlns` attributes. An unknown name close to one that is read (`<node_model>`, `scr=`)
 //! is an error with "did you mean": a misspelling would otherwise drop a section silently.
 
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 
 use crate::model::source::{Diagnostic, FileId, SourceMap, Span};
 use crate::model::xml::{self, Element, Node};
@@ -635,7 +635,7 @@ impl<'a> Reader<'a> {
             out.push(Input {
                 kind: *kind,
                 src: src.value.clone(),
-                path: join_clean(&self.base, s),
+                path: crate::model::join_clean(&self.base, s),
                 span: src.value_span,
                 element: c.span,
             });
@@ -723,18 +723,6 @@ fn tick_rate(text: &str) -> Result<TickRate, String> {
     })
 }
 
-/// `base` joined with `rel` without `rel`'s `.` components: `./policy.xml` is read, and
-/// named in messages, as `policy.xml` of the model's folder.
-fn join_clean(base: &Path, rel: &str) -> PathBuf {
-    let mut path = base.to_path_buf();
-    for c in Path::new(rel).components() {
-        if c != Component::CurDir {
-            path.push(c);
-        }
-    }
-    path
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -751,15 +739,5 @@ mod tests {
         assert!(tick_rate("-1").is_err());
         assert!(tick_rate("fast").is_err());
         assert!(tick_rate("inf").is_err());
-    }
-
-    #[test]
-    fn inputs_are_named_without_dot_components() {
-        let base = Path::new("m");
-        assert_eq!(join_clean(base, "./policy.xml"), Path::new("m/policy.xml"));
-        assert_eq!(join_clean(base, "./a/./b.scxml"), Path::new("m/a/b.scxml"));
-        // `..` is kept (the folder may be a link), and an absolute path wins, as in `join`.
-        assert_eq!(join_clean(base, "../x.xml"), Path::new("m/../x.xml"));
-        assert_eq!(join_clean(base, "/abs/x.xml"), Path::new("/abs/x.xml"));
     }
 }
