@@ -106,8 +106,8 @@ pub enum Kind {
     /// `SetBlackboard`: the entry and the text written, or the entry copied.
     SetBlackboard(String, Operand),
     /// `BlackboardCheckInt/Double/String/Bool`: `value_A`, `value_B`,
-    /// `return_on_mismatch`.
-    Check(CheckType, Operand, Operand, Status),
+    /// `return_on_mismatch`, and whether that was written as one of AS2FM's numbers.
+    Check(CheckType, Operand, Operand, Status, bool),
 }
 
 /// A node of the flattened tree.
@@ -115,6 +115,12 @@ pub enum Kind {
 pub struct Node {
     /// 1000, 1001, ... in pre-order.
     pub id: u32,
+    /// The number BT.CPP 4 gives the node (`TreeNode::UID`): it counts from 1 in the order
+    /// the factory creates nodes, depth-first pre-order with each SubTree node (which the
+    /// flat tree drops) before its body.
+    pub uid: u32,
+    /// The element name as written (`SequenceStar`, `BlackboardCheckInt`, a leaf type).
+    pub tag: String,
     /// What it is.
     pub kind: Kind,
     /// Indices into [`Tree::nodes`].
@@ -126,6 +132,22 @@ pub struct Node {
 pub struct Tree {
     /// The nodes, pre-order.
     pub nodes: Vec<Node>,
+    /// Every node element's name (an `Action`'s `ID`) in every `<BehaviorTree>` of the
+    /// document, used or not, in document order: BT.CPP checks them all at load.
+    pub names: Vec<String>,
+}
+
+fn names(el: &El, out: &mut Vec<String>) {
+    let name = match el.name.as_str() {
+        "Action" | "Condition" | "Control" | "Decorator" => {
+            el.attrs.get("ID").cloned().unwrap_or_default()
+        }
+        n => n.to_string(),
+    };
+    out.push(name);
+    for c in &el.children {
+        names(c, out);
+    }
 }
 
 /// How many children a kind takes: (least, most).
@@ -221,18 +243,21 @@ fn operand(a: &Attrs, k: &str) -> Result<Operand, String> {
 /// `BlackboardPreconditionNode::tick`, `default_return_status`); besides the names it
 /// takes AS2FM's numbers 1, 2, 3 (`bt_utils.py`, `BtResponse`).
 fn check(a: &Attrs, ty: CheckType) -> Result<Kind, String> {
-    let mismatch = match a.get("return_on_mismatch").map(|s| s.trim()) {
+    let raw = a.get("return_on_mismatch").map(|s| s.trim());
+    let mismatch = match raw {
         None => Status::Failure,
         Some("1") => Status::Success,
         Some("2") => Status::Failure,
         Some("3") => Status::Running,
         Some(s) => Status::parse(s).ok_or(format!("bad return_on_mismatch {s}"))?,
     };
+    let numeric = matches!(raw, Some("1" | "2" | "3"));
     Ok(Kind::Check(
         ty,
         operand(a, "value_A")?,
         operand(a, "value_B")?,
         mismatch,
+        numeric,
     ))
 }
 
@@ -307,9 +332,15 @@ pub fn read(text: &str) -> Result<Tree, String> {
         tree: Tree::default(),
         scopes: vec![Scope::default()],
         instances: 0,
+        uids: 0,
     };
     let body = main.children.first().ok_or("empty <BehaviorTree>")?;
     r.node(body, None)?;
+    for t in root.children.iter().filter(|c| c.name == "BehaviorTree") {
+        for c in &t.children {
+            names(c, &mut r.tree.names);
+        }
+    }
     Ok(r.tree)
 }
 
@@ -328,6 +359,8 @@ struct Flat<'a> {
     tree: Tree,
     scopes: Vec<Scope>,
     instances: usize,
+    /// BT.CPP UIDs handed out so far (SubTree nodes included).
+    uids: u32,
 }
 
 impl Flat<'_> {
@@ -375,12 +408,15 @@ impl Flat<'_> {
                 }
                 make(&attrs)?
             }
-            None if el.children.is_empty() => Kind::Leaf(ty),
+            None if el.children.is_empty() => Kind::Leaf(ty.clone()),
             None => return Err(format!("unknown node {ty}")),
         };
         let i = self.tree.nodes.len();
+        self.uids += 1;
         self.tree.nodes.push(Node {
             id: 1000 + i as u32,
+            uid: self.uids,
+            tag: ty,
             kind,
             children: Vec::new(),
         });
@@ -398,6 +434,8 @@ impl Flat<'_> {
             return Err("SubTrees nested too deep".into());
         }
         let id = el.attrs.get("ID").ok_or("SubTree without ID")?;
+        // The SubTree node itself takes a UID in BT.CPP 4 (it is a node there).
+        self.uids += 1;
         let body = *self.trees.get(id.as_str()).ok_or(format!("no tree {id}"))?;
         let mut scope = Scope {
             prefix: format!("__st{}.", self.instances),
