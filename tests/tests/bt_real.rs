@@ -14,7 +14,7 @@
 
 use hindsight_tests::bt::gen;
 use hindsight_tests::bt::oracle::{
-    btcpp4_refuses, run_with, End, Options, Outcome, Reading, Scripts, TickMode, BUDGET,
+    btcpp4_refuses, run_with, End, LeafEvent, Options, Outcome, Reading, Scripts, TickMode, BUDGET,
 };
 use hindsight_tests::bt::real::{self, Real, Request};
 use hindsight_tests::bt::tree::{self, Status, Tree};
@@ -121,6 +121,10 @@ struct Counts {
     errors: usize,
     livelocks: usize,
     hangs: usize,
+    /// Runs BT.CPP ran to the end where AS2FM's reading gives other root statuses, or
+    /// another sequence of leaf ticks (halts aside).
+    as2fm_statuses: usize,
+    as2fm_ticks: usize,
 }
 
 impl Counts {
@@ -177,6 +181,18 @@ fn check_all(
             };
             if let Some(d) = differ(&want, &got) {
                 fails.push(format!("{name}: {d}\n{}", show(xml, scripts, ticks, mode)));
+            }
+            if let (None, Some(t)) = (&got.end, tree.as_ref()) {
+                if let Ok(as2) = run_with(t, scripts, Options::of(Reading::As2fm), ticks) {
+                    let only_ticks = |l: &[LeafEvent]| {
+                        l.iter()
+                            .filter(|e| matches!(e, LeafEvent::Tick(_)))
+                            .copied()
+                            .collect::<Vec<_>>()
+                    };
+                    counts.as2fm_statuses += usize::from(as2.statuses != got.statuses);
+                    counts.as2fm_ticks += usize::from(only_ticks(&as2.log) != only_ticks(&got.log));
+                }
             }
         }
     }
@@ -314,7 +330,9 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
         "BehaviorTree.CPP {} (behaviortreepy {}): {generated} random trees, {v3} of them format 3 \
          (the 3.8 reading only), {} to the real library and {} cases from tests/bt/ ({} more \
          in format 3), each under tickOnce and tickExactlyOnce: {} runs ({} ran every tick, {} refused at load, \
-         {} threw, {} livelocks, {} hangs; {} harness starts) in {:.1} s; {} disagreements",
+         {} threw, {} livelocks, {} hangs; {} harness starts) in {:.1} s; {} disagreements. \
+         AS2FM's reading gives other root statuses on {} and other leaf ticks on {} of the \
+         runs BT.CPP ran to the end",
         real.version,
         real.binding,
         random / 2,
@@ -328,7 +346,9 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
         counts.hangs,
         real.starts,
         start.elapsed().as_secs_f64(),
-        fails.len()
+        fails.len(),
+        counts.as2fm_statuses,
+        counts.as2fm_ticks
     );
     assert!(
         fails.is_empty(),
