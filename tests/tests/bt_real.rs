@@ -125,7 +125,33 @@ struct Counts {
     /// another sequence of leaf ticks (halts aside).
     as2fm_statuses: usize,
     as2fm_ticks: usize,
+    /// Runs AS2FM's reading could run (no BT.CPP-4-only node), among those.
+    as2fm_compared: usize,
+    /// Per entry of [`FEATURES`], the runs of trees with it that BT.CPP ran to the end.
+    features: Vec<usize>,
 }
+
+/// Node kinds that must be in trees the real library runs to the end, in at least one
+/// run in 200.
+const FEATURES: &[&str] = &[
+    "<SequenceWithMemory>",
+    "<ReactiveSequence>",
+    "<ReactiveFallback>",
+    "<Parallel ",
+    "<IfThenElse>",
+    "<Repeat ",
+    "<RetryUntilSuccessful ",
+    "<SubTree ",
+    "value=\"{",
+    "<AsyncSequence>",
+    "<AsyncFallback>",
+    "<ParallelAll ",
+    "<WhileDoElse>",
+    "<KeepRunningUntilFailure>",
+    "<RunOnce ",
+    "<Switch2 ",
+    "<Switch6 ",
+];
 
 impl Counts {
     fn add(&mut self, o: &Outcome) {
@@ -182,8 +208,15 @@ fn check_all(
             if let Some(d) = differ(&want, &got) {
                 fails.push(format!("{name}: {d}\n{}", show(xml, scripts, ticks, mode)));
             }
+            if got.end.is_none() {
+                counts.features.resize(FEATURES.len(), 0);
+                for (f, k) in FEATURES.iter().zip(&mut counts.features) {
+                    *k += usize::from(xml.contains(f));
+                }
+            }
             if let (None, Some(t)) = (&got.end, tree.as_ref()) {
                 if let Ok(as2) = run_with(t, scripts, Options::of(Reading::As2fm), ticks) {
+                    counts.as2fm_compared += 1;
                     let only_ticks = |l: &[LeafEvent]| {
                         l.iter()
                             .filter(|e| matches!(e, LeafEvent::Tick(_)))
@@ -291,7 +324,8 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
         }
         generated += 1;
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let c = gen::case(&mut rng, 4 + (seed % 12) as i64);
+        let opts = gen::Options { btcpp4_nodes: true };
+        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
         if c.xml.contains("BTCPP_format=\"3\"") {
             // BT.CPP 4 does not know format 3's names: the 3.8 reading must run it.
             v3 += 1;
@@ -331,8 +365,8 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
          (the 3.8 reading only), {} to the real library and {} cases from tests/bt/ ({} more \
          in format 3), each under tickOnce and tickExactlyOnce: {} runs ({} ran every tick, {} refused at load, \
          {} threw, {} livelocks, {} hangs; {} harness starts) in {:.1} s; {} disagreements. \
-         AS2FM's reading gives other root statuses on {} and other leaf ticks on {} of the \
-         runs BT.CPP ran to the end",
+         Of the {} runs BT.CPP ran to the end whose nodes AS2FM has models of, AS2FM's \
+         reading gives other root statuses on {} and other leaf ticks on {}",
         real.version,
         real.binding,
         random / 2,
@@ -347,9 +381,20 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
         real.starts,
         start.elapsed().as_secs_f64(),
         fails.len(),
+        counts.as2fm_compared,
         counts.as2fm_statuses,
         counts.as2fm_ticks
     );
+    if n >= 1000 {
+        for (f, k) in FEATURES.iter().zip(&counts.features) {
+            eprintln!("  {k:>6} runs to the end with `{f}`");
+            assert!(
+                *k as u64 >= n / 100,
+                "only {k} of {} runs have `{f}`",
+                2 * n
+            );
+        }
+    }
     assert!(
         fails.is_empty(),
         "{} disagreements (first 5):\n{}",

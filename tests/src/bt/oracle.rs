@@ -178,30 +178,30 @@ const V4_NAMES: &[&str] = &[
     "AlwaysSuccess",
     "AlwaysFailure",
     "SetBlackboard",
-];
-
-/// The other built-in nodes BT.CPP 4.8.2 registers: a scripted leaf cannot take their
-/// names (`registerBuilder`: "ID [..] already registered"). (4.10 adds `TryCatch`.)
-const V4_OTHERS: &[&str] = &[
     "AsyncSequence",
     "AsyncFallback",
     "ParallelAll",
     "WhileDoElse",
     "KeepRunningUntilFailure",
+    "RunOnce",
+    "Switch2",
+    "Switch3",
+    "Switch4",
+    "Switch5",
+    "Switch6",
+];
+
+/// The other built-in nodes BT.CPP 4.8.2 registers: a scripted leaf cannot take their
+/// names (`registerBuilder`: "ID [..] already registered"). (4.10 adds `TryCatch`.)
+const V4_OTHERS: &[&str] = &[
     "Timeout",
     "Delay",
-    "RunOnce",
     "Script",
     "ScriptCondition",
     "Sleep",
     "UnsetBlackboard",
     "SubTree",
     "Precondition",
-    "Switch2",
-    "Switch3",
-    "Switch4",
-    "Switch5",
-    "Switch6",
     "LoopInt",
     "LoopBool",
     "LoopDouble",
@@ -250,6 +250,8 @@ pub struct Oracle<'t> {
     counts: Vec<(i64, i64)>,
     /// Ticks each leaf instance received.
     leaf_ticks: Vec<usize>,
+    /// RunOnce: the status its child finished with (`returned_status_`).
+    once: Vec<Option<Status>>,
     /// Entries as the text written (BT.CPP converts where a port reads).
     bb: BTreeMap<String, String>,
     /// Literal writes of each entry so far (BT.CPP 4 SetBlackboard copies).
@@ -290,6 +292,7 @@ impl<'t> Oracle<'t> {
                 .collect(),
             counts: vec![(0, 0); n],
             leaf_ticks: vec![0; n],
+            once: vec![None; n],
             bb: BTreeMap::new(),
             writes: BTreeMap::new(),
             any_typed: Default::default(),
@@ -439,14 +442,17 @@ impl<'t> Oracle<'t> {
                 }
                 self.reset_children(n);
             }
-            // `ParallelNode::halt` clears; AS2FM's counts restart on every tick anyway.
-            Kind::Parallel(..) => {
+            // `ParallelNode::halt` / `ParallelAllNode::halt` clear; AS2FM's counts restart
+            // on every tick anyway.
+            Kind::Parallel(..) | Kind::ParallelAll(_) => {
                 self.done[n].iter_mut().for_each(|d| *d = false);
                 self.counts[n] = (0, 0);
                 self.reset_children(n);
             }
             // `SequenceNode::halt`, `FallbackNode::halt`, `IfThenElseNode::halt`,
-            // `RepeatNode::halt`, `RetryNode::halt`: the index or count back to 0.
+            // `RepeatNode::halt`, `RetryNode::halt`: the index or count back to 0;
+            // `SwitchNode::halt`: `running_child_ = -1`; `RunOnceNode` (DecoratorNode::halt)
+            // keeps `already_ticked_`.
             _ => {
                 self.idx[n] = 0;
                 self.reset_children(n);
@@ -484,8 +490,21 @@ impl<'t> Oracle<'t> {
                 self.leaf_ticks[n] += 1;
                 Ok(s)
             }
-            Kind::Sequence => self.sequence(n, Success, Failure),
-            Kind::Fallback => self.sequence(n, Failure, Success),
+            Kind::Sequence => self.sequence(n, Success, Failure, false),
+            Kind::Fallback => self.sequence(n, Failure, Success, false),
+            _ if !self.btcpp() && self.tree.nodes[n].kind.btcpp4_only() => Err(Stop::Model(
+                format!("{} has no AS2FM model", self.tree.nodes[n].tag),
+            )),
+            Kind::AsyncSequence => self.sequence(n, Success, Failure, true),
+            Kind::AsyncFallback => self.sequence(n, Failure, Success, true),
+            &Kind::ParallelAll(f) => self.parallel_all(n, f),
+            Kind::WhileDoElse => self.while_do_else(n),
+            Kind::KeepRunningUntilFailure => self.keep_running(n),
+            Kind::RunOnce => self.run_once(n),
+            Kind::Switch(v, cases) => {
+                let (v, cases) = (v.clone(), cases.clone());
+                self.switch(n, &v, &cases)
+            }
             Kind::SequenceWithMemory => self.sequence_with_memory(n),
             Kind::ReactiveSequence => self.reactive(n, Success, Failure),
             Kind::ReactiveFallback => self.reactive(n, Failure, Success),
@@ -565,11 +584,20 @@ impl<'t> Oracle<'t> {
     }
 
     /// `SequenceNode::tick` (`cont` SUCCESS) and `FallbackNode::tick` (`cont` FAILURE);
-    /// AS2FM's `sequence.ascxml` / `fallback.ascxml` halt every child on finishing. (Only
-    /// the `AsyncSequence` / `AsyncFallback` registrations yield on a wake-up.)
-    fn sequence(&mut self, n: usize, cont: Status, stop: Status) -> Result<Status, Stop> {
-        while (self.idx[n] as usize) < self.n_children(n) {
+    /// AS2FM's `sequence.ascxml` / `fallback.ascxml` halt every child on finishing. Only
+    /// the `AsyncSequence` / `AsyncFallback` registrations (`asynch_`) yield on a
+    /// wake-up, as SequenceWithMemory does.
+    fn sequence(
+        &mut self,
+        n: usize,
+        cont: Status,
+        stop: Status,
+        asynch: bool,
+    ) -> Result<Status, Stop> {
+        let len = self.n_children(n);
+        while (self.idx[n] as usize) < len {
             let c = self.child(n, self.idx[n] as usize);
+            let prev = self.status[c];
             match self.tick(c)? {
                 Status::Running => return Ok(Status::Running),
                 s if s == stop => {
@@ -577,7 +605,12 @@ impl<'t> Oracle<'t> {
                     self.idx[n] = 0;
                     return Ok(stop);
                 }
-                _ => self.idx[n] += 1,
+                _ => {
+                    self.idx[n] += 1;
+                    if asynch && (self.idx[n] as usize) < len && self.yields(prev) {
+                        return Ok(Status::Running);
+                    }
+                }
             }
         }
         self.reset_children(n);
@@ -633,6 +666,139 @@ impl<'t> Oracle<'t> {
             self.pending = true;
         }
         y
+    }
+
+    /// `ParallelAllNode::tick` (4.10): every child not yet finished is ticked; once all
+    /// have finished, `haltChildren()` and FAILURE if at least `max_failures` failed
+    /// (negative counts from the end), else SUCCESS; throws when `max_failures` exceeds
+    /// the children ("Number of children is less than threshold").
+    fn parallel_all(&mut self, n: usize, f: i64) -> Result<Status, Stop> {
+        let len = self.n_children(n);
+        let th = if f < 0 {
+            (len as i64 + f + 1).max(0)
+        } else {
+            f
+        };
+        if (len as i64) < th {
+            return Err(Stop::Error(
+                "Number of children is less than threshold".into(),
+            ));
+        }
+        for i in 0..len {
+            if self.done[n][i] {
+                continue;
+            }
+            let c = self.child(n, i);
+            match self.tick(c)? {
+                Status::Success => self.done[n][i] = true,
+                Status::Failure => {
+                    self.done[n][i] = true;
+                    self.counts[n].1 += 1;
+                }
+                Status::Running => {}
+            }
+        }
+        if self.done[n].iter().all(|d| *d) {
+            self.reset_children(n);
+            self.done[n].iter_mut().for_each(|d| *d = false);
+            let failed = self.counts[n].1 >= th;
+            self.counts[n] = (0, 0);
+            return Ok(if failed {
+                Status::Failure
+            } else {
+                Status::Success
+            });
+        }
+        Ok(Status::Running)
+    }
+
+    /// `WhileDoElseNode::tick` (4.10): the condition on every tick; SUCCESS halts the
+    /// else branch (`haltChild(2)`) and ticks the do branch, FAILURE halts the do branch
+    /// and ticks the else branch (with two children, FAILURE); a finished answer resets
+    /// every child (the condition stays as it finished while a branch runs).
+    fn while_do_else(&mut self, n: usize) -> Result<Status, Stop> {
+        let len = self.n_children(n);
+        let cond = self.child(n, 0);
+        let s = match self.tick(cond)? {
+            Status::Running => return Ok(Status::Running),
+            Status::Success => {
+                if len == 3 {
+                    let e = self.child(n, 2);
+                    self.halt_child(e);
+                }
+                let d = self.child(n, 1);
+                self.tick(d)?
+            }
+            Status::Failure if len == 3 => {
+                let d = self.child(n, 1);
+                self.halt_child(d);
+                let e = self.child(n, 2);
+                self.tick(e)?
+            }
+            Status::Failure => Status::Failure,
+        };
+        if s != Status::Running {
+            self.reset_children(n);
+        }
+        Ok(s)
+    }
+
+    /// `KeepRunningUntilFailureNode::tick` (4.10): a finished child is reset; its
+    /// SUCCESS is RUNNING, its FAILURE FAILURE.
+    fn keep_running(&mut self, n: usize) -> Result<Status, Stop> {
+        let c = self.child(n, 0);
+        let s = self.tick(c)?;
+        if s == Status::Running {
+            return Ok(s);
+        }
+        self.halt_child(c);
+        Ok(if s == Status::Success {
+            Status::Running
+        } else {
+            Status::Failure
+        })
+    }
+
+    /// `RunOnceNode::tick` (4.10) with `then_skip` false: once the child has finished
+    /// (then reset), the node answers that status for ever without ticking it; a halt
+    /// (`DecoratorNode::halt`) does not forget it.
+    fn run_once(&mut self, n: usize) -> Result<Status, Stop> {
+        if let Some(s) = self.once[n] {
+            return Ok(s);
+        }
+        let c = self.child(n, 0);
+        let s = self.tick(c)?;
+        if s != Status::Running {
+            self.once[n] = Some(s);
+            self.halt_child(c);
+        }
+        Ok(s)
+    }
+
+    /// `SwitchNode::tick` (4.10): the first `case_i` equal to `variable` picks child i,
+    /// none (or no variable) the last; a child that ran on an earlier tick and is not
+    /// the one picked is halted (`haltChild(running_child_)`); a finished answer resets
+    /// every child.
+    fn switch(&mut self, n: usize, v: &Operand, cases: &[String]) -> Result<Status, Stop> {
+        let value = self.value(v).ok();
+        let pick = value
+            .and_then(|v| cases.iter().position(|c| *c == v))
+            .unwrap_or(cases.len());
+        // `running_child_` + 1 (0: none).
+        let running = self.idx[n] - 1;
+        if running >= 0 && running as usize != pick {
+            let c = self.child(n, running as usize);
+            self.halt_child(c);
+        }
+        let c = self.child(n, pick);
+        let s = self.tick(c)?;
+        if s == Status::Running {
+            self.idx[n] = pick as i64 + 1;
+        } else {
+            self.reset_children(n);
+            self.idx[n] = 0;
+        }
+        Ok(s)
     }
 
     /// `ReactiveSequence::tick` / `ReactiveFallback::tick` (and AS2FM's

@@ -105,9 +105,40 @@ pub enum Kind {
     AlwaysFailure,
     /// `SetBlackboard`: the entry and the text written, or the entry copied.
     SetBlackboard(String, Operand),
+    /// `AsyncSequence` (BT.CPP 4).
+    AsyncSequence,
+    /// `AsyncFallback` (BT.CPP 4).
+    AsyncFallback,
+    /// `ParallelAll` with `max_failures` as written (BT.CPP 4).
+    ParallelAll(i64),
+    /// `WhileDoElse` (BT.CPP 4).
+    WhileDoElse,
+    /// `KeepRunningUntilFailure` (BT.CPP 4).
+    KeepRunningUntilFailure,
+    /// `RunOnce` with `then_skip="false"` (BT.CPP 4; skipping answers SKIPPED, a status
+    /// the oracle does not model).
+    RunOnce,
+    /// `Switch2` ... `Switch6`: the `variable` and the `case_1..N` values (BT.CPP 4).
+    Switch(Operand, Vec<String>),
     /// `BlackboardCheckInt/Double/String/Bool`: `value_A`, `value_B`,
     /// `return_on_mismatch`, and whether that was written as one of AS2FM's numbers.
     Check(CheckType, Operand, Operand, Status, bool),
+}
+
+impl Kind {
+    /// A BT.CPP 4 node AS2FM has no model of (the lowering does not take it).
+    pub fn btcpp4_only(&self) -> bool {
+        matches!(
+            self,
+            Kind::AsyncSequence
+                | Kind::AsyncFallback
+                | Kind::ParallelAll(_)
+                | Kind::WhileDoElse
+                | Kind::KeepRunningUntilFailure
+                | Kind::RunOnce
+                | Kind::Switch(..)
+        )
+    }
 }
 
 /// A node of the flattened tree.
@@ -190,6 +221,26 @@ pub const NODES: &[(&[&str], Arity, Make)] = &[
         (1, 1),
         |a| Ok(Kind::Retry(int(a, "num_attempts")?)),
     ),
+    (&["AsyncSequence"], (1, ANY), |_| Ok(Kind::AsyncSequence)),
+    (&["AsyncFallback"], (1, ANY), |_| Ok(Kind::AsyncFallback)),
+    (&["ParallelAll"], (1, ANY), |a| {
+        Ok(Kind::ParallelAll(int_or(a, &["max_failures"], 1)?))
+    }),
+    (&["WhileDoElse"], (2, 3), |_| Ok(Kind::WhileDoElse)),
+    (&["KeepRunningUntilFailure"], (1, 1), |_| {
+        Ok(Kind::KeepRunningUntilFailure)
+    }),
+    (&["RunOnce"], (1, 1), |a| {
+        match a.get("then_skip").map(|s| s.trim()) {
+            Some("false") => Ok(Kind::RunOnce),
+            _ => Err("RunOnce without then_skip=\"false\" answers SKIPPED, which the oracle does not model".into()),
+        }
+    }),
+    (&["Switch2"], (3, 3), |a| switch(a, 2)),
+    (&["Switch3"], (4, 4), |a| switch(a, 3)),
+    (&["Switch4"], (5, 5), |a| switch(a, 4)),
+    (&["Switch5"], (6, 6), |a| switch(a, 5)),
+    (&["Switch6"], (7, 7), |a| switch(a, 6)),
     (&["AlwaysSuccess"], (0, 0), |_| Ok(Kind::AlwaysSuccess)),
     (&["AlwaysFailure"], (0, 0), |_| Ok(Kind::AlwaysFailure)),
     (&["SetBlackboard"], (0, 0), |a| {
@@ -237,6 +288,19 @@ fn operand(a: &Attrs, k: &str) -> Result<Operand, String> {
         Some(e) => Operand::Entry(e.to_string()),
         None => Operand::Lit(v.trim().to_string()),
     })
+}
+
+/// A `SwitchN` node: `variable` and `case_1` ... `case_N` (each a literal).
+fn switch(a: &Attrs, n: usize) -> Result<Kind, String> {
+    let cases = (1..=n)
+        .map(|i| {
+            let k = format!("case_{i}");
+            a.get(&k)
+                .map(|v| v.trim().to_string())
+                .ok_or(format!("missing `{k}`"))
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(Kind::Switch(operand(a, "variable")?, cases))
 }
 
 /// A `BlackboardCheck*` node. `return_on_mismatch` defaults to FAILURE (v3.8
