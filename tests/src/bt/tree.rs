@@ -327,10 +327,38 @@ fn check(a: &Attrs, ty: CheckType) -> Result<Kind, String> {
 
 /// A bare XML element.
 #[derive(Clone, Debug, Default)]
-struct El {
-    name: String,
-    attrs: Attrs,
-    children: Vec<El>,
+pub struct El {
+    /// The element name.
+    pub name: String,
+    /// Its attributes, unescaped.
+    pub attrs: BTreeMap<String, String>,
+    /// Its child elements (text is dropped).
+    pub children: Vec<El>,
+}
+
+impl El {
+    /// The element as XML text (attribute values escaped).
+    pub fn write(&self, out: &mut String) {
+        out.push('<');
+        out.push_str(&self.name);
+        for (k, v) in &self.attrs {
+            let v = v
+                .replace('&', "&amp;")
+                .replace('<', "&lt;")
+                .replace('>', "&gt;")
+                .replace('"', "&quot;");
+            out.push_str(&format!(" {k}=\"{v}\""));
+        }
+        if self.children.is_empty() {
+            out.push_str("/>");
+            return;
+        }
+        out.push('>');
+        for c in &self.children {
+            c.write(out);
+        }
+        out.push_str(&format!("</{}>", self.name));
+    }
 }
 
 fn start(e: &BytesStart<'_>) -> Result<El, String> {
@@ -350,7 +378,8 @@ fn start(e: &BytesStart<'_>) -> Result<El, String> {
     Ok(el)
 }
 
-fn parse_xml(text: &str) -> Result<El, String> {
+/// The document's root element.
+pub fn parse_xml(text: &str) -> Result<El, String> {
     let mut r = Reader::from_str(text);
     let mut stack = vec![El::default()];
     loop {
