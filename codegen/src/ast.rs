@@ -101,7 +101,7 @@ pub struct Formula {
     pub span: Span,
 }
 
-/// The operators of Past-MTL (semantics: DESIGN.md section 2).
+/// The operators of Past-MTL (semantics: `docs/SEMANTICS.md` section 4).
 #[derive(Clone, Debug, PartialEq)]
 pub enum FormulaKind {
     /// `true` / `false`.

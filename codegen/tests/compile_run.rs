@@ -61,7 +61,7 @@ fn eval_expr(e: &Expr, vals: &[Value]) -> Value {
     }
 }
 
-/// Direct transcription of DESIGN.md section 2, quadratic and obviously right.
+/// Direct transcription of `docs/SEMANTICS.md` section 4, quadratic and obviously right.
 fn holds(f: &Formula, trace: &[(u64, Vec<Value>)], i: usize) -> bool {
     let t = |k: usize| trace[k].0;
     match &f.kind {

@@ -8,9 +8,10 @@
 //! - `converted`: the guide (`examples/museum-guide`) translated by `hindsight convert`
 //!   and loaded back as plain SCXML;
 //! - `uc3 ...`: the museum guide as AS2FM's own tests have it
-//!   (`shared/corpus/as2fm/test_data/uc3_museum_guide`, read natively) against AS2FM's
-//!   own plain translation of that model (`as2fm/plain/uc3_museum_guide_main`), both
-//!   judged by the case's JANI properties (left out without `shared/corpus`).
+//!   (the external corpus's `as2fm/test_data/uc3_museum_guide`, read natively) against
+//!   AS2FM's own plain translation of that model (`as2fm/plain/uc3_museum_guide_main`),
+//!   both judged by the case's JANI properties (left out without the corpus:
+//!   `HINDSIGHT_CORPUS`, or `shared/corpus` next to the repository).
 //!
 //! For context, the paper's plain model (`examples/museum-scxml`, SCAN's queues, runs of
 //! 1001 steps like the guide's `max_time` of 100.1 s) comes from an older AS2FM whose
@@ -28,6 +29,9 @@
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+#[path = "../tests/common/corpus.rs"]
+mod corpus;
 
 use hindsight::robot::bt::Halts;
 use hindsight::sim::{EventSemantics, RunConfig, Simulator};
@@ -105,12 +109,9 @@ impl Case {
     /// The corpus's museum guide as AS2FM's tests have it (`as2fm/test_data/uc3_museum_guide`,
     /// read natively) and AS2FM's own plain translation of that very model
     /// (`as2fm/plain/uc3_museum_guide_main`, AS2FM's semantics), both judged by the case's
-    /// JANI property; `None` without `shared/corpus` next to the repository.
+    /// JANI property; `None` without the external corpus.
     fn corpus_pair() -> Option<[Case; 2]> {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .ancestors()
-            .map(|d| d.join("shared/corpus/as2fm"))
-            .find(|d| d.is_dir())?;
+        let root = corpus::find()?.join("as2fm");
         let high = Case::new(
             "uc3 high-level (corpus)",
             root.join("test_data/uc3_museum_guide/Main/main.xml"),

@@ -219,6 +219,9 @@ fn check_corpus(
 
 #[test]
 fn plain_translations_match_as2fm_expected_probabilities() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let root = corpus();
     check_corpus(SKIPS, |case, _| {
         CompiledModel::load(&root.join("plain").join(case)).map_err(|d| d.to_string())
@@ -235,6 +238,9 @@ const HIGH_LEVEL_SKIPS: &[(&str, &str)] = &[(
 
 #[test]
 fn high_level_models_match_as2fm_expected_probabilities() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let skips: Vec<(&str, &'static str)> = SKIPS.iter().chain(HIGH_LEVEL_SKIPS).copied().collect();
     check_corpus(&skips, |_, main| {
         hindsight::robot::load::load(main)
@@ -246,6 +252,9 @@ fn high_level_models_match_as2fm_expected_probabilities() {
 /// The same with the opt-in halting rule (`Halts::WhenNeeded`): the same cases pass.
 #[test]
 fn high_level_models_with_halts_when_needed_match_as2fm_expected_probabilities() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let skips: Vec<(&str, &'static str)> = SKIPS.iter().chain(HIGH_LEVEL_SKIPS).copied().collect();
     check_corpus(&skips, |_, main| {
         hindsight::robot::load::load_with(main, hindsight::robot::bt::Halts::WhenNeeded)
@@ -256,6 +265,9 @@ fn high_level_models_with_halts_when_needed_match_as2fm_expected_probabilities()
 
 #[test]
 fn skipped_cases_still_disagree() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     // A skip must stay justified: the skipped case still misses its expected value.
     let root = corpus();
     let case = "robot_navigation_with_bt_main";
@@ -275,6 +287,9 @@ fn skipped_cases_still_disagree() {
 /// action clients mostly deadlock.
 #[test]
 fn verify_cli_chooses_as2fm_semantics_for_jani_properties() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let root = corpus();
     let plain = root.join("plain/fibonacci_action_example_main");
     let props = root.join("test_data/fibonacci_action_example/properties.jani");
@@ -306,6 +321,9 @@ fn verify_cli_chooses_as2fm_semantics_for_jani_properties() {
 /// on it: the receivers the AS2FM semantics delivers to.
 #[test]
 fn receivers_match_as2fm_jani_translation_of_the_museum_guide() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let root = corpus();
     let model = CompiledModel::load(&root.join("plain/uc3_museum_guide_main")).unwrap();
     let jani: serde_json::Value = serde_json::from_str(
@@ -357,6 +375,9 @@ fn receivers_match_as2fm_jani_translation_of_the_museum_guide() {
 /// probabilistic edges (it is receptive either way, but JANI's edges differ in shape).
 #[test]
 fn receptive_states_match_as2fm_jani_translation_of_the_museum_guide() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     use hindsight::sim::{as2fm, StateId};
     let root = corpus();
     let model = CompiledModel::load(&root.join("plain/uc3_museum_guide_main")).unwrap();
@@ -412,6 +433,9 @@ fn receptive_states_match_as2fm_jani_translation_of_the_museum_guide() {
 /// file does not have is an error that lists the names.
 #[test]
 fn verify_skips_and_selects_jani_properties_by_name() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let main = corpus().join("examples/quick_start_battery_monitor/main.xml");
     let run = |extra: &[&str]| {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_hindsight"))

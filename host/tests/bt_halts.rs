@@ -123,6 +123,9 @@ fn the_museum_guide_sends_the_same_ros_messages_with_either_halting_rule() {
 
 #[test]
 fn corpus_trees_send_the_same_ros_messages_with_either_halting_rule() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let as2fm = common::corpus("as2fm");
     for main in [
         "test_data/uc1_docking/main.xml",

@@ -112,6 +112,9 @@ const KNOWN: &[(&str, &str, &str)] = &[
 
 #[test]
 fn convert_equals_as2fm_plain_translation_machine_by_machine() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let mut found: Vec<(String, String)> = Vec::new();
     let mut report = String::new();
     let mut compared = 0;
@@ -160,6 +163,9 @@ fn convert_equals_as2fm_plain_translation_machine_by_machine() {
 /// quick-start battery monitor the drainer's timer comes before the tree's tick.
 #[test]
 fn the_trees_tick_comes_after_the_node_models_timers() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let main = common::corpus("as2fm/examples/quick_start_battery_monitor/main.xml");
     let robot = hindsight::robot::load::load(&main).unwrap();
     let timer = robot

@@ -46,6 +46,9 @@ fn unescape(raw: &str) -> String {
 
 #[test]
 fn current_format_uc3() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let (file, text) = read("uc3-plain/properties.xml");
     let ids: Vec<&str> = file.ports.iter().map(|p| p.id.as_str()).collect();
     assert_eq!(
@@ -137,6 +140,9 @@ fn current_format_uc3() {
 
 #[test]
 fn tree_format_museum() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let (file, text) = read("museum-simpar2025/model_scxml/properties.xml");
     let summary: Vec<(&str, bool)> = file
         .ports

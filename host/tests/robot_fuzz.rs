@@ -308,6 +308,9 @@ fn mutated_museum_guides_are_errors_with_positions_or_run() {
 /// AS2FM's own models: actions, blackboard ports, struct declarations, other tree nodes.
 #[test]
 fn mutated_as2fm_models_are_errors_with_positions_or_run() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let as2fm = common::corpus("as2fm");
     let cases: [(&str, &str, &[&str]); 4] = [
         (

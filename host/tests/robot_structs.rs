@@ -167,6 +167,9 @@ fn plain(name: &str) -> CompiledModel {
 /// fields, elements and lengths of what it received and reports `success`.
 #[test]
 fn data_structs_send_whole_structs_and_reach_success() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     for name in ["data_structs_main_xml_def", "data_structs_main_json_def"] {
         let (_, expected) = case(name);
         assert_eq!(expected["success"], 1.0, "{name}");
@@ -208,6 +211,9 @@ fn data_structs_send_whole_structs_and_reach_success() {
 /// same values once our structs are flattened into its per-leaf parameters.
 #[test]
 fn struct_cases_send_what_the_plain_translation_sends() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     for name in [
         "data_structs_main_xml_def",
         "data_structs_main_json_def",
@@ -231,6 +237,9 @@ fn struct_cases_send_what_the_plain_translation_sends() {
 /// `recv_points[latest_id]` (growing the array); `success` carries the check as `data`.
 #[test]
 fn array_of_structs_grows_by_element_and_checks_true() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let name = "array_of_data_structs_main";
     let (_, expected) = case(name);
     assert_eq!(expected["success"], 1.0);
@@ -254,6 +263,9 @@ fn array_of_structs_grows_by_element_and_checks_true() {
 /// 'world')` on the `/object_loc` topic, with probability 1.
 #[test]
 fn overarching_tutorial_brings_the_butter_to_the_table() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let name = "overarching_tutorial_main_locations";
     let (_, expected) = case(name);
     assert_eq!(expected["butter_at_table"], 1.0);
@@ -469,6 +481,9 @@ static GLOBAL: common::alloc::Counting = common::alloc::Counting;
 /// nothing.
 #[test]
 fn struct_runs_allocate_nothing_once_warm() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     for name in [
         "data_structs_main_xml_def",
         "array_of_data_structs_main",
@@ -504,6 +519,9 @@ fn struct_runs_allocate_nothing_once_warm() {
 /// `types.xml`) reads back as a plain model folder that runs exactly like the robot model.
 #[test]
 fn converted_struct_models_read_back_and_run_the_same() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     use hindsight::robot::write::{to_xml, types_xml};
     for name in ["data_structs_main_json_def", "array_of_data_structs_main"] {
         let m = load_case(name);
@@ -531,6 +549,9 @@ fn converted_struct_models_read_back_and_run_the_same() {
 /// flattens them (`point__y`); a field the struct does not have is an error.
 #[test]
 fn property_ports_read_struct_fields() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     use hindsight::props::parse_str;
     use hindsight::smc::runner::stream;
     use hindsight::verify::observe::PropertySet;
@@ -570,6 +591,9 @@ fn property_ports_read_struct_fields() {
 /// by `model.xml`; the converted model runs like the robot model.
 #[test]
 fn convert_cli_writes_the_declared_types() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let (main, _) = case("data_structs_main_json_def");
     let out = std::env::temp_dir().join(format!(
         "hindsight-robot-structs-{}-convert-cli",

@@ -52,6 +52,9 @@ fn museum_runs_allocate_nothing() {
 
 #[test]
 fn uc3_runs_with_array_messages_allocate_nothing() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let m = CompiledModel::load(&corpus().join("uc3-plain/model.xml")).unwrap();
     let cfg = RunConfig {
         max_time: 300,
@@ -86,6 +89,9 @@ fn array_models_allocate_nothing_once_warm() {
 /// array messages, and the museum guide's 60 machines.
 #[test]
 fn as2fm_semantics_allocate_nothing_once_warm() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let cfg = RunConfig {
         events: EventSemantics::As2fm,
         ..RunConfig::default()

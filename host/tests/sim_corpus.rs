@@ -24,6 +24,9 @@ fn has_scxml(dir: &Path) -> bool {
 
 #[test]
 fn as2fm_plain_models_compile_and_run() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let mut dirs: Vec<PathBuf> = std::fs::read_dir(corpus().join("as2fm/plain"))
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -77,6 +80,9 @@ fn as2fm_plain_models_compile_and_run() {
 
 #[test]
 fn museum_reports_the_event_thread_id_bug() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let err = CompiledModel::load(&corpus().join("museum-simpar2025/model_scxml")).unwrap_err();
     assert_eq!(err.0.len(), 1, "{err}");
     let d = &err.0[0];
@@ -135,6 +141,9 @@ fn museum_runs() {
 
 #[test]
 fn uc3_compiles_and_runs() {
+    if common::corpus_or_skip().is_none() {
+        return;
+    }
     let m = CompiledModel::load(&corpus().join("uc3-plain/model.xml")).unwrap();
     assert_eq!(m.machine_count(), 278);
     assert!(m.properties_path().is_some());

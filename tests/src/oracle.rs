@@ -1,4 +1,4 @@
-//! The reference evaluator: Past-MTL verdicts computed straight from DESIGN.md section 2.
+//! The reference evaluator: Past-MTL verdicts computed straight from `docs/SEMANTICS.md` section 4.
 //!
 //! This is the oracle every engine (table interpreter, postcard table, generated
 //! code) is checked against, so it is written for obviousness, not speed: each

@@ -6,7 +6,7 @@
 //! state set true), `!name` (a boolean state set false) or `name=value` (an
 //! integer or float literal, `true`/`false`, or a `"string"`).
 //!
-//! [`valuations`] applies SCAN's event/state model (DESIGN.md section 2): an
+//! [`valuations`] applies SCAN's event/state model (`docs/SEMANTICS.md` section 1): an
 //! event variable is true only at a point that lists it; a state variable
 //! keeps its last value, starting from its declared initial value.
 //!

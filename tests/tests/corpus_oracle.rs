@@ -1,6 +1,6 @@
 //! Cross-checks the hand-computed conformance corpus against the oracle, independently of codegen.
 //!
-//! Every case's expectations were worked out by hand from DESIGN.md section 2;
+//! Every case's expectations were worked out by hand from `docs/SEMANTICS.md` sections 1 and 4;
 //! here the oracle recomputes them. To stay independent of `codegen`, this file
 //! carries its own small formula and atom-expression parser. It is strict on
 //! purpose: binary operators of different kinds may not be mixed without

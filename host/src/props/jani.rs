@@ -16,7 +16,7 @@
 //!
 //! A property is `{"name", "expression"}`; the expression may be wrapped in
 //! `filter` (`fun` `values`, `states` `initial`), then `Pmin`, `Pmax` or `P` of a path
-//! formula. Every run is judged at its last point (DESIGN.md section 2), and on a finite
+//! formula. Every run is judged at its last point (`docs/SEMANTICS.md` section 4), and on a finite
 //! run:
 //!
 //! | JANI | Past-MTL at the last point |

@@ -5,7 +5,7 @@
 //! ```xml
 //! <roaml>
 //!     <parameters>
-//!         <max_time value="100" unit="s" />          <!-- ns, us, ms, s, min, h -->
+//!         <max_time value="100" unit="s" />          <!-- ns, us, ms, s or min -->
 //!         <max_array_size value="10" />
 //!         <bt_tick_rate value="5.0" />               <!-- Hz -->
 //!         <bt_tick_if_not_running value="true" />
@@ -24,8 +24,8 @@
 //! `bt-plugin-ros-scxml` and node models of type `ros-scxml` (`.scxml` files with ROS tags).
 //! Either parameter element is accepted in either form. Paths are relative to the main file.
 //! `<parameters>` with `<max_time>` is required, as AS2FM requires it. AS2FM reads whole
-//! numbers of `s`, `ms`, `us` or `ns`; decimals (`2.5`, converted exactly) and `min`/`h`
-//! are accepted too. Several property inputs, `xml` and `hspec` ones, and no `<properties>`
+//! numbers of `s`, `ms`, `us` or `ns`; decimals (`2.5`, converted exactly) and `min` are
+//! accepted too (the units of `codegen::duration`; `h` is an error, as everywhere). Several property inputs, `xml` and `hspec` ones, and no `<properties>`
 //! at all are extensions (AS2FM wants exactly one `jani`).
 //!
 //! # What is accepted, ignored and refused

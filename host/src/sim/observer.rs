@@ -1,6 +1,6 @@
 //! What a run shows the outside world: the [`Observer`] callbacks at every trace point.
 //!
-//! The points are those of DESIGN.md section 2: one after every message sent
+//! The points are those of `docs/SEMANTICS.md` section 1: one after every message sent
 //! ([`Observer::on_send`]) or received ([`Observer::on_receive`]), and one at
 //! every time advance ([`Observer::on_time`]). The initial state is the point
 //! before [`super::Simulator::run`] calls anything. Each delivery is its own

@@ -4,7 +4,7 @@
 //! [`PropertySet::new`] compiles a property file's guarantees and assumptions into one
 //! monitor program (its ports become the spec's event and state variables) and resolves
 //! each port's message, origin, target and parameter to the model's ids once. A
-//! [`Judge`] then observes one run: at every point DESIGN.md section 2 defines (the
+//! [`Judge`] then observes one run: at every point `docs/SEMANTICS.md` section 1 defines (the
 //! initial state, every send, every receive, every time advance) it clears the event
 //! variables, applies the ports of a sent message, and steps the monitors. When every
 //! verdict is final ([`monitor_core::analysis::settle`]) it stops the run.

@@ -1,4 +1,5 @@
-//! What the integration tests share: running the `hindsight` binary, where the shared corpus is, the museum model the
+//! What the integration tests share: running the `hindsight` binary, where the external
+//! corpus is (and skipping a test without it: `corpus.rs`), the museum model the
 //! simulator tests run, and a counting allocator.
 //!
 //! Each test file that needs it says `mod common;`; not every file uses every helper.
@@ -6,6 +7,7 @@
 
 pub mod alloc;
 pub mod canon;
+pub mod corpus;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -24,26 +26,29 @@ pub fn hindsight(args: &[&str]) -> (i32, String, String) {
     )
 }
 
-/// `shared/corpus`, found next to the repository or a worktree container above it (the
-/// repository may be checked out at `X/repo` or `X/wt/name`, with `X/shared`).
-pub fn corpus_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .ancestors()
-        .map(|dir| dir.join("shared/corpus"))
-        .find(|dir| dir.is_dir())
-        .expect("shared/corpus next to the repository")
+/// The external corpus for a test that needs it, or `None` after noting that the test
+/// was skipped ([`corpus::corpus_or_skip`]); a test starts with
+/// `if common::corpus_or_skip().is_none() { return; }`.
+pub fn corpus_or_skip() -> Option<PathBuf> {
+    corpus::corpus_or_skip()
 }
 
-/// `shared/corpus/<relative>`.
+/// The external corpus, for a test that has called [`corpus_or_skip`].
+pub fn corpus_root() -> PathBuf {
+    corpus::root()
+}
+
+/// `<corpus>/<relative>`, for a test that has called [`corpus_or_skip`].
 pub fn corpus(relative: &str) -> PathBuf {
     corpus_root().join(relative)
 }
 
-/// The museum guide's plain SCXML machines (`museum-simpar2025/model_scxml`), compiled,
-/// with the one-line fix of `NavigationComponent.scxml` (`_event.thread_id` ->
-/// `_event.data.thread_id`) without which it does not compile.
+/// The museum guide's plain SCXML machines, compiled: `examples/museum-scxml`, the
+/// corpus's `museum-simpar2025/model_scxml` with the one-line fix of
+/// `NavigationComponent.scxml` (`_event.thread_id` -> `_event.data.thread_id`) without
+/// which it does not compile. In the repository, so tests using it run on any clone.
 pub fn museum_fixed() -> hindsight::sim::CompiledModel {
-    let dir = corpus("museum-simpar2025/model_scxml");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-scxml");
     let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -52,15 +57,7 @@ pub fn museum_fixed() -> hindsight::sim::CompiledModel {
     paths.sort();
     let files: Vec<(String, String)> = paths
         .iter()
-        .map(|p| {
-            let text = std::fs::read_to_string(p).unwrap();
-            let text = if p.ends_with("NavigationComponent.scxml") {
-                text.replace("_event.thread_id", "_event.data.thread_id")
-            } else {
-                text
-            };
-            (p.display().to_string(), text)
-        })
+        .map(|p| (p.display().to_string(), std::fs::read_to_string(p).unwrap()))
         .collect();
     let src = hindsight::model::ModelSource::from_texts(
         files.iter().map(|(a, b)| (a.as_str(), b.as_str())),
