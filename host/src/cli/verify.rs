@@ -301,7 +301,8 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
         let shard = match &e {
             ShardError::Mismatch { shard, .. }
             | ShardError::Duplicate(shard)
-            | ShardError::Range(shard) => Some(*shard),
+            | ShardError::Range(shard)
+            | ShardError::Counts { shard, .. } => Some(*shard),
             _ => None,
         };
         match shard {
