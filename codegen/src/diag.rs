@@ -330,6 +330,83 @@ impl SourceMap {
     }
 }
 
+/// Why `path` cannot be read as a source file, or `None` when it is a regular file
+/// (symbolic links followed): `not found`, `is a directory, not a file`, `is a FIFO
+/// (named pipe), not a regular file`, ... Decided from the file's metadata, before
+/// opening it, so a FIFO never blocks the reader and a device is never read.
+pub fn not_a_source_file(path: &Path) -> Option<String> {
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Some("not found".into()),
+        Err(e) => Some(format!("cannot read: {e}")),
+        Ok(m) if m.is_file() => None,
+        Ok(m) if m.is_dir() => Some("is a directory, not a file".into()),
+        Ok(m) => Some(format!("is {}, not a regular file", special_kind(&m))),
+    }
+}
+
+#[cfg(unix)]
+fn special_kind(m: &std::fs::Metadata) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    let t = m.file_type();
+    if t.is_fifo() {
+        "a FIFO (named pipe)"
+    } else if t.is_char_device() {
+        "a character device"
+    } else if t.is_block_device() {
+        "a block device"
+    } else if t.is_socket() {
+        "a socket"
+    } else {
+        "a special file"
+    }
+}
+
+#[cfg(not(unix))]
+fn special_kind(_: &std::fs::Metadata) -> &'static str {
+    "a special file"
+}
+
+/// Reads the source file at `path` as UTF-8 text: the one reader of every text file
+/// the project parses (models, robot models and their inputs, property files, specs,
+/// traces, ROS interfaces). A file that is not a regular file is refused before it is
+/// opened ([`not_a_source_file`]); a UTF-8 byte order mark is dropped (editors on
+/// Windows write one); a byte that is not UTF-8 is an error at its line and column
+/// (counted in characters, as every position), saying which byte. The error is about
+/// the file and shows none of its text.
+pub fn read_source(path: &Path) -> Result<String, Diagnostic> {
+    let name = || path.display().to_string();
+    if let Some(why) = not_a_source_file(path) {
+        return Err(Diagnostic::about_file(name(), why));
+    }
+    let bytes = std::fs::read(path)
+        .map_err(|e| Diagnostic::about_file(name(), format!("cannot read: {e}")))?;
+    decode_source(bytes).map_err(|(at, message)| Diagnostic::error(name(), at, message))
+}
+
+/// `bytes` as text, without a leading UTF-8 byte order mark; `Err` gives the line and
+/// column of the first byte that is not UTF-8, and what is wrong.
+pub fn decode_source(mut bytes: Vec<u8>) -> Result<String, ((u32, u32), String)> {
+    if bytes.starts_with(b"\xEF\xBB\xBF") {
+        bytes.drain(..3);
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let bytes = e.as_bytes();
+        let valid = e.utf8_error().valid_up_to();
+        let prefix = std::str::from_utf8(&bytes[..valid]).unwrap_or_default();
+        let at = LineIndex::new(prefix).line_col(prefix, valid);
+        let why = match e.utf8_error().error_len() {
+            Some(_) => format!(
+                "not UTF-8 text: byte 0x{:02X} does not belong here (save the file as UTF-8)",
+                bytes[valid]
+            ),
+            None => {
+                "not UTF-8 text: the file ends inside a character (save it as UTF-8)".to_owned()
+            }
+        };
+        (at, why)
+    })
+}
+
 /// The file name of a span whose source is not in its map.
 const UNKNOWN: &str = "<unknown>";
 
@@ -967,5 +1044,40 @@ mod tests {
         assert_eq!(locate_in_runs(text, &runs, 4), Some((4, 10)));
         assert_eq!(locate_in_runs(text, &runs, 8), Some((7, 1)));
         assert_eq!(locate_in_runs(text, &[], 1), None);
+    }
+
+    #[test]
+    fn sources_are_regular_utf8_files() {
+        let dir = std::env::temp_dir().join(format!("diag-read-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bom = dir.join("bom.txt");
+        std::fs::write(&bom, b"\xEF\xBB\xBFa\nb").unwrap();
+        assert_eq!(read_source(&bom).unwrap(), "a\nb");
+        let bad = dir.join("bad.txt");
+        std::fs::write(&bad, b"ok\nab\xC3\xA9c\xFFd").unwrap();
+        let d = read_source(&bad).unwrap_err();
+        assert_eq!((d.line, d.col), (2, 5));
+        assert!(d.message.contains("byte 0xFF"), "{d}");
+        let cut = dir.join("cut.txt");
+        std::fs::write(&cut, b"x\xC3").unwrap();
+        assert!(read_source(&cut)
+            .unwrap_err()
+            .message
+            .contains("ends inside"));
+        let d = read_source(&dir).unwrap_err();
+        assert_eq!(
+            d.to_string(),
+            format!("{}: is a directory, not a file", dir.display())
+        );
+        assert!(read_source(&dir.join("none"))
+            .unwrap_err()
+            .message
+            .contains("not found"));
+        #[cfg(unix)]
+        assert_eq!(
+            not_a_source_file(Path::new("/dev/zero")).as_deref(),
+            Some("is a character device, not a regular file")
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

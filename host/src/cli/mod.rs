@@ -48,10 +48,12 @@ pub fn run_count(s: &str) -> Result<u64, String> {
     }
 }
 
-/// Reads a whole file, naming it in the error.
+/// Reads a whole text file (a spec, trace, study, log or config) with the project's one
+/// source reader, `codegen::diag::read_source`: a folder, FIFO or device is refused
+/// without being opened, a UTF-8 byte order mark is dropped, and a byte that is not
+/// UTF-8 is reported at its `file:line:col`.
 pub fn read_file(path: &std::path::Path) -> Result<String, CliError> {
-    std::fs::read_to_string(path)
-        .map_err(|e| CliError::Input(format!("{}: cannot read: {e}", path.display())))
+    codegen::diag::read_source(path).map_err(|d| CliError::Input(d.to_string()))
 }
 
 /// Compiles a `.hspec` file, printing warnings to stderr.

@@ -67,8 +67,17 @@ pub fn parse_file_selected(
             kind,
         )])
     };
-    let bytes = std::fs::read(path).map_err(|e| fail(PropsErrorKind::Io(e.to_string())))?;
-    let text = String::from_utf8(bytes).map_err(|_| fail(PropsErrorKind::Encoding))?;
+    let text = match codegen::diag::read_source(path) {
+        Ok(text) => text,
+        Err(d) if d.line == 0 => return Err(fail(PropsErrorKind::Io(d.message))),
+        Err(d) => {
+            return Err(Diagnostics::from(vec![PropsError::error(
+                path.display().to_string(),
+                (d.line, d.col),
+                PropsErrorKind::Encoding,
+            )]))
+        }
+    };
     parse_str_selected(&text, path, model, keep)
 }
 
@@ -88,6 +97,17 @@ pub fn parse_str_selected(
     model: &CompiledModel,
     keep: &mut dyn FnMut(&str) -> bool,
 ) -> Result<PropertyFile, Diagnostics> {
+    // Not even the start of a JSON object: not the JANI file it was named as; its text,
+    // maybe a secret, is not shown.
+    if !text.trim_start().starts_with('{') {
+        return Err(Diagnostics::from(vec![PropsError::error(
+            path.display().to_string(),
+            (0, 0),
+            PropsErrorKind::Json(
+                "not a JANI file: it does not start with `{` (its text is not shown)".into(),
+            ),
+        )]));
+    }
     let lines = LineIndex::new(text);
     let root = json::parse(text).map_err(|(offset, message)| {
         Diagnostics::from(vec![super::error::error_at(

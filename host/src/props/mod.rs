@@ -167,22 +167,26 @@ pub fn parse_file(path: &Path) -> Result<PropertyFile, Diagnostics> {
             kind,
         )])
     };
-    let bytes = std::fs::read(path)
-        .map_err(|error| fail(Location::new(1, 1), PropsErrorKind::Io(error.to_string())))?;
-    match String::from_utf8(bytes) {
+    // The one reader of source files: a folder, FIFO or device is refused unopened, a
+    // byte order mark dropped, a byte that is not UTF-8 located.
+    match codegen::diag::read_source(path) {
         Ok(text) => parse_str(&text, path),
-        Err(error) => {
-            let valid = error.utf8_error().valid_up_to();
-            let bytes = error.as_bytes();
-            let prefix = std::str::from_utf8(&bytes[..valid]).unwrap_or_default();
-            let at = source::LineIndex::new(prefix).location(valid);
-            Err(fail(at, PropsErrorKind::Encoding))
-        }
+        Err(d) if d.line == 0 => Err(fail(Location::new(1, 1), PropsErrorKind::Io(d.message))),
+        Err(d) => Err(fail(Location::new(d.line, d.col), PropsErrorKind::Encoding)),
     }
 }
 
 /// Reads and checks a property file's text; `path` is only used in errors.
 pub fn parse_str(text: &str, path: &Path) -> Result<PropertyFile, Diagnostics> {
+    // Not even the start of XML: not the property file it was named as (a path that
+    // reaches `/etc/passwd`); its text, maybe a secret, is not shown.
+    if !text.trim_start().starts_with('<') {
+        return Err(Diagnostics::from(vec![PropsError::error(
+            path.display().to_string(),
+            (0, 0),
+            PropsErrorKind::Xml("it does not start with `<` (its text is not shown)".into()),
+        )]));
+    }
     let lines = source::LineIndex::new(text);
     let root = crate::model::xml::parse_text(text, crate::model::FileId(0)).map_err(|e| {
         let at = lines.location(e.offset as usize);

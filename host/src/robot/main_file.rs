@@ -244,8 +244,7 @@ impl MainFile {
     /// Reads the main file at `path` without looking at the files it names (for a caller
     /// that replaces some of them, such as the properties).
     pub fn parse(sm: &mut SourceMap, path: &Path) -> Result<MainFile, Vec<Diagnostic>> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| vec![crate::model::about_file(path, format!("cannot read: {e}"))])?;
+        let text = codegen::diag::read_source(path).map_err(|d| vec![d])?;
         let file = sm.add(path, text);
         MainFile::parse_file(sm, file, path)
     }
@@ -420,19 +419,16 @@ impl MainFile {
             .chain(self.properties.iter())
     }
 
-    /// An error at each `src` whose file does not exist.
+    /// An error at each `src` that names no regular file: missing, a folder, a FIFO, a
+    /// device (`codegen::diag::not_a_source_file`, which never opens it).
     pub fn missing_files(&self, sm: &SourceMap) -> Vec<Diagnostic> {
         self.inputs()
-            .filter(|i| !i.path.is_file())
-            .map(|i| {
-                sm.diag(
+            .filter_map(|i| {
+                let why = codegen::diag::not_a_source_file(&i.path)?;
+                Some(sm.diag(
                     i.span,
-                    format!(
-                        "{} file `{}` not found",
-                        i.kind.type_name(),
-                        i.path.display()
-                    ),
-                )
+                    format!("{} file `{}` {why}", i.kind.type_name(), i.path.display()),
+                ))
             })
             .collect()
     }
