@@ -200,6 +200,14 @@ impl Reader<'_, '_> {
             return None;
         };
         let name = name.to_owned();
+        if !super::is_valid_id(&name) {
+            let at = node.get("name").map_or(node.offset, |n| n.offset);
+            self.jani(
+                at,
+                format!("property name `{name}` is not {}", super::ID_RULE),
+            );
+            return None;
+        }
         let Some(expr) = node.get("expression") else {
             self.jani(
                 node.offset,

@@ -158,6 +158,31 @@ impl PropertyFile {
     }
 }
 
+/// The longest property or port id, in characters: with `-run<k>.csv` after it, a
+/// `--save-failing` file name stays under the 255 bytes file systems allow.
+pub const MAX_ID_LEN: usize = 200;
+
+/// What an id may hold, as the error at a bad one says it.
+pub const ID_RULE: &str = "an id of ASCII letters, digits, `_`, `-` and `.`, starting with a \
+     letter, digit or `_`, at most 200 characters (ids name CSV columns and the files of \
+     `verify --save-failing`)";
+
+/// Whether `id` may name a property or a port: ASCII letters, digits, `_`, `-` and `.`,
+/// starting with a letter, digit or `_`, at most [`MAX_ID_LEN`] characters. Checked
+/// where every id is declared (SCAN, ROS and tree-form property files, JANI property
+/// names), because ids become CSV header cells and file names (`<id>-run<k>.csv`):
+/// with this rule a name is never a path (`/`, `..`), never needs CSV quoting (`,`,
+/// `"`), and means the same on every file system. Every id of the corpus (SCAN names,
+/// JANI names such as `alarm-follows-battery-low`) fits.
+pub fn is_valid_id(id: &str) -> bool {
+    let mut chars = id.chars();
+    chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphanumeric() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+        && id.len() <= MAX_ID_LEN
+}
+
 /// Reads and checks the property file at `path`.
 pub fn parse_file(path: &Path) -> Result<PropertyFile, Diagnostics> {
     let fail = |at: Location, kind| {

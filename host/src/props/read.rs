@@ -229,6 +229,25 @@ impl<'p, 'a> FileReader<'p, 'a> {
         Some(text.to_owned())
     }
 
+    /// The id `name` declares (`id` of a property or port), checked against the id
+    /// rule ([`super::is_valid_id`]) at the attribute.
+    pub(super) fn required_id(&mut self, element: &Element) -> Option<String> {
+        let id = self.required_name(element, "id")?;
+        if !super::is_valid_id(&id) {
+            let (_, at) = self.required(element, "id")?;
+            self.error(
+                at,
+                PropsErrorKind::BadValue {
+                    attribute: "id".to_owned(),
+                    value: id,
+                    expected: super::ID_RULE.to_owned(),
+                },
+            );
+            return None;
+        }
+        Some(id)
+    }
+
     pub(super) fn unknown_child(
         &mut self,
         child: &Element,
@@ -434,7 +453,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
                     continue;
                 }
             };
-            let id = self.required_name(var, "id");
+            let id = self.required_id(var);
             if let (Some(id), Some(kind), Some(event), Some(origin), Some(target)) =
                 (id, kind, &event, &origin, &target)
             {
@@ -483,7 +502,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
     /// `<message event [param_name expr]>`.
     fn tree_port(&mut self, element: &Element, ports: &mut Vec<Port>) {
         self.check_attrs(element, &["id", "type"]);
-        let id = self.required_name(element, "id");
+        let id = self.required_id(element);
         let ty = self.declared_type(element);
         for child in element.elements() {
             if !matches!(child.name.as_str(), "origin" | "target" | "message") {
@@ -574,7 +593,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
                 );
             }
         }
-        let id = self.required_name(element, "id");
+        let id = self.required_id(element);
         let formula = self.required(element, "expr");
         let (id, (formula, _)) = (id?, formula?);
         if formula.as_str().trim().is_empty() {

@@ -144,7 +144,7 @@ impl<'a> FileReader<'_, 'a> {
                     continue;
                 }
             };
-            if let (Some(id), Some(kind)) = (self.required_name(var, "id"), kind) {
+            if let (Some(id), Some(kind)) = (self.required_id(var), kind) {
                 ports.push(Port {
                     id,
                     kind,
@@ -184,7 +184,7 @@ impl<'a> FileReader<'_, 'a> {
                 "time_unit",
             ],
         );
-        let id = self.required_name(element, "id");
+        let id = self.required_id(element);
         let (pattern, pattern_at) = self.required(element, "pattern")?;
         // The condition may be an attribute or an `<event>` child; a `<scope>` child
         // may say `globally`.
