@@ -500,12 +500,14 @@ pub fn merge(parts: &[PartialResult], keep_failing: usize) -> Result<MergedResul
         {
             return Err(ShardError::Range(shard));
         }
-        check_counts(part)?;
+        // Two different copies of a shard are named as such first: that one of them
+        // was altered is the more useful news.
         if let Some(before) = by_index.insert(shard.index, part) {
             if before.properties != part.properties || before.runs != part.runs {
                 return Err(ShardError::Duplicate(shard));
             }
         }
+        check_counts(part)?;
     }
     let missing: Vec<Shard> = (0..count)
         .filter(|i| !by_index.contains_key(i))
