@@ -99,10 +99,11 @@ pub fn parse_str_selected(
 ) -> Result<PropertyFile, Diagnostics> {
     // Not even the start of a JSON object: not the JANI file it was named as; its text,
     // maybe a secret, is not shown.
-    if !text.trim_start().starts_with('{') {
+    let start = text.trim_start();
+    if !start.is_empty() && !start.starts_with('{') {
         return Err(Diagnostics::from(vec![PropsError::error(
             path.display().to_string(),
-            (0, 0),
+            (1, 1),
             PropsErrorKind::Json(
                 "not a JANI file: it does not start with `{` (its text is not shown)".into(),
             ),

@@ -205,10 +205,12 @@ pub fn parse_file(path: &Path) -> Result<PropertyFile, Diagnostics> {
 pub fn parse_str(text: &str, path: &Path) -> Result<PropertyFile, Diagnostics> {
     // Not even the start of XML: not the property file it was named as (a path that
     // reaches `/etc/passwd`); its text, maybe a secret, is not shown.
-    if !text.trim_start().starts_with('<') {
+    // (At 1:1, with no excerpt; an empty file is "no root element" as before.)
+    let start = text.trim_start();
+    if !start.is_empty() && !start.starts_with('<') {
         return Err(Diagnostics::from(vec![PropsError::error(
             path.display().to_string(),
-            (0, 0),
+            (1, 1),
             PropsErrorKind::Xml("it does not start with `<` (its text is not shown)".into()),
         )]));
     }

@@ -58,7 +58,8 @@ pub fn main_file_of(path: &Path) -> Option<PathBuf> {
 
 /// Whether the XML file's root element is a robot main file's.
 fn is_main_file(path: &Path) -> bool {
-    let Ok(text) = std::fs::read_to_string(path) else {
+    // Through the one source reader: a FIFO named `*.xml` in the folder is never opened.
+    let Ok(text) = codegen::diag::read_source(path) else {
         return false;
     };
     // The first element after the prolog and comments.
