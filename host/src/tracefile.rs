@@ -7,7 +7,8 @@
 //! event variable false. Values: `true`/`false` (or `1`/`0`) for booleans,
 //! integers, floats, and strings (optionally in double quotes, `""` for a quote).
 //! Lines starting with `#` and blank lines are skipped. Quoting is the project's one CSV
-//! grammar (`codegen::csv`, RFC 4180).
+//! grammar (`codegen::csv`, RFC 4180). A float cell must be finite: `NaN`, `inf` are
+//! refused at their `file:line:col`.
 //!
 //! The columns that `hindsight trace` and `verify --save-failing` add around the
 //! variables (`step`, `event`, `origin`, `target`, `params`, `verdict_NAME`) are skipped
@@ -133,7 +134,17 @@ fn parse_value(cell: &str, spec: &Compiled, var: usize) -> Result<Value, String>
             _ => Err(bad()),
         },
         Ty::Int => cell.parse().map(Value::Int).map_err(|_| bad()),
-        Ty::Float => cell.parse().map(Value::Float).map_err(|_| bad()),
+        // A trace records measurements: a NaN or an infinity is a broken sensor or
+        // logger, not a value to judge silently (every comparison with NaN is false).
+        Ty::Float => match cell.parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(Value::Float(x)),
+            Ok(_) => Err(format!(
+                "`{cell}` for `{}` is not a finite number: NaN and infinities are refused \
+                 (every comparison with NaN is false, so a verdict over it would mean nothing)",
+                decl.name
+            )),
+            Err(_) => Err(bad()),
+        },
         // Strings the spec never mentions get an id past every constant: equal to none.
         Ty::Str => Ok(Value::Str(spec.string_id(cell).unwrap_or(u32::MAX))),
     }

@@ -163,6 +163,7 @@ pub fn parse_str_selected(
         ports: r.ports,
         guarantees,
         assumptions: Vec::new(),
+        ros_types: Vec::new(),
     })
 }
 
@@ -183,6 +184,31 @@ struct Reader<'r, 'a> {
 impl Reader<'_, '_> {
     fn at(&self, offset: usize) -> Location {
         self.lines.location(offset)
+    }
+
+    /// The `op` of an operator node (empty when it has none); `None`, with an error at
+    /// it, when `op` is there but no string (`"op": 3`), so no message names an empty
+    /// operator.
+    pub(super) fn op_of(&mut self, node: &Node) -> Option<String> {
+        let Some(op) = node.get("op") else {
+            return Some(String::new());
+        };
+        if let Some(s) = op.as_str() {
+            return Some(s.to_owned());
+        }
+        let what = match &op.value {
+            Json::Null => "null".to_owned(),
+            Json::Bool(b) => b.to_string(),
+            Json::Number(n) => format!("the number {n}"),
+            Json::Str(s) => s.clone(),
+            Json::Array(_) => "an array".to_owned(),
+            Json::Object(_) => "an object".to_owned(),
+        };
+        self.jani(
+            op.offset,
+            format!("`op` must be a string naming an operator, not {what}"),
+        );
+        None
     }
 
     fn error(&mut self, offset: usize, kind: PropsErrorKind) {
@@ -227,8 +253,8 @@ impl Reader<'_, '_> {
 
     /// `filter(values, P.. (path), initial)` or `P.. (path)`.
     fn probability(&mut self, node: &Node) -> Option<SourceText> {
-        let op = node.get("op").and_then(Node::as_str).unwrap_or("");
-        match op {
+        let op = self.op_of(node)?;
+        match op.as_str() {
             "filter" => {
                 let fun = node.get("fun").and_then(Node::as_str).unwrap_or("");
                 if fun != "values" {
@@ -294,7 +320,8 @@ impl Reader<'_, '_> {
 
     fn path_formula(&mut self, node: &Node) -> Option<SourceText> {
         let at = self.at(node.offset);
-        let op = node.get("op").and_then(Node::as_str).unwrap_or("");
+        let op = self.op_of(node)?;
+        let op = op.as_str();
         if !self.check_bounds(node) {
             return None;
         }

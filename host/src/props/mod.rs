@@ -81,6 +81,20 @@ pub struct PropertyFile {
     pub guarantees: Vec<Property>,
     /// Properties that restrict runs (a run violating one is discarded), in file order.
     pub assumptions: Vec<Property>,
+    /// The ROS interface types the ports name, where each is written: checked against a
+    /// robot model's interfaces when the file is loaded with one (`verify::load`).
+    pub ros_types: Vec<RosTypeUse>,
+}
+
+/// A ROS interface type named by a port (`<ros_topic type>`, `<ros_service type>`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RosTypeUse {
+    /// The type as written (`std_msgs/Int32`).
+    pub type_name: String,
+    /// `true` for a service type (`.srv`), `false` for a message type (`.msg`).
+    pub service: bool,
+    /// The `type` attribute.
+    pub at: Location,
 }
 
 /// One variable of a property file, observed on one message.
@@ -225,7 +239,8 @@ pub fn parse_str(text: &str, path: &Path) -> Result<PropertyFile, Diagnostics> {
         )])
     })?;
     let mut reader = read::FileReader::new(path, &lines);
-    let file = reader.read(&root);
+    let mut file = reader.read(&root);
+    file.ros_types = std::mem::take(&mut reader.ros_types);
     let mut errors = reader.into_errors();
     if errors.is_empty() {
         Ok(file)

@@ -64,6 +64,8 @@ pub(crate) struct FileReader<'p, 'a> {
     path: &'p Path,
     lines: &'p LineIndex<'a>,
     errors: Vec<PropsError>,
+    /// The ROS types ports name, in file order.
+    pub(super) ros_types: Vec<super::RosTypeUse>,
 }
 
 impl<'p, 'a> FileReader<'p, 'a> {
@@ -72,6 +74,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
             path,
             lines,
             errors: Vec::new(),
+            ros_types: Vec::new(),
         }
     }
 
@@ -289,6 +292,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
             ports: Vec::new(),
             guarantees: Vec::new(),
             assumptions: Vec::new(),
+            ros_types: Vec::new(),
         };
         if root.name != "properties" {
             self.error(

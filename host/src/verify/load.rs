@@ -268,6 +268,50 @@ fn compile_properties(
     })
 }
 
+/// Checks that every ROS type the property file's ports name is an interface the robot
+/// model `main` can see (found as the model's own are: `--interfaces`, beside and above
+/// it, the ROS workspace, the built-ins), of the port's kind; errors at the `type`
+/// attribute. A port's type is not otherwise used (its messages are found by name), so
+/// a typo here would pass silently.
+fn check_ros_types(
+    file: &props::PropertyFile,
+    main: &Path,
+    search: &crate::robot::interfaces::Search,
+) -> Result<(), String> {
+    use crate::robot::interfaces::{InterfaceKind, Interfaces};
+    if file.ros_types.is_empty() {
+        return Ok(());
+    }
+    let mut sm = crate::model::SourceMap::new();
+    // The model loaded, so its interfaces were found and checked already.
+    let Ok(interfaces) = Interfaces::discover_with(&mut sm, main, search) else {
+        return Ok(());
+    };
+    let errors: Vec<String> = file
+        .ros_types
+        .iter()
+        .filter_map(|t| {
+            let kind = if t.service {
+                InterfaceKind::Service
+            } else {
+                InterfaceKind::Message
+            };
+            let e = interfaces.get(&t.type_name, kind).err()?;
+            Some(format!(
+                "{}:{}:{}: port type: {e}",
+                file.path.display(),
+                t.at.line,
+                t.at.column
+            ))
+        })
+        .collect();
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(errors.join("\n"))
+    }
+}
+
 /// Loads a robot model: the main file and everything it names, lowered and compiled; the
 /// properties are the file given, else the first one the main file names.
 fn load_robot(
@@ -312,6 +356,7 @@ fn load_robot(
         }
     };
     let file = read_properties(&props_path, &robot.model, opts)?;
+    check_ros_types(&file, main, &search)?;
     let set = compile_properties(&file, &robot.model, Some(robot.time_unit_ns))?;
     Ok((
         Loaded {
