@@ -1,7 +1,8 @@
 //! Errors stay linear in the input (issue 28, finding 1): a file with tens of thousands
 //! of problems, or one huge line, is reported in bounded memory and output, checked
 //! with the address-space and CPU limits the harness sets on the child (`ulimit`), not
-//! by timing; and a closed output ends the program quietly, never with a panic.
+//! by timing (warnings too); and a closed output ends the program quietly, never with a
+//! panic.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -144,5 +145,34 @@ fn a_closed_output_ends_quietly() {
             .unwrap();
         assert_eq!(out.status.code(), Some(2), "{redirect}");
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn many_warnings_print_a_bounded_list() {
+    let dir = scratch("hostile-warnings");
+    let model = dir.join("museum");
+    copy_dir(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-guide"),
+        &model,
+    );
+    // 5 000 attributes AS2FM ignores on <roaml>: one warning each, the model still loads.
+    let main = model.join("main.xml");
+    let attrs: String = (0..5_000).map(|i| format!(" x{i}=\"1\"")).collect();
+    let text = std::fs::read_to_string(&main).unwrap();
+    std::fs::write(
+        &main,
+        text.replacen("<roaml>", &format!("<roaml{attrs}>"), 1),
+    )
+    .unwrap();
+    let out = limited(1024, 60, &["validate".as_ref(), model.as_os_str()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{}", &err[..err.len().min(2000)]);
+    assert!(
+        err.contains("attribute `x0` on <roaml> is ignored"),
+        "{err}"
+    );
+    assert!(err.contains("warning: ... and 4980 more warnings"), "{err}");
+    assert!(err.len() < 64 * 1024, "{} bytes of warnings", err.len());
     let _ = std::fs::remove_dir_all(&dir);
 }

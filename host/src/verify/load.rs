@@ -164,9 +164,7 @@ pub fn load_without(
     let model = &opts.model;
     let unit_ns = opts.time_unit_ns;
     let compiled = CompiledModel::load(model).map_err(|d| d.to_string())?;
-    for w in compiled.warnings() {
-        eprintln!("warning: {w}");
-    }
+    print_warnings(compiled.warnings());
     let props_path = match &opts.props {
         Some(p) => p.to_path_buf(),
         None => default_props(model, &compiled)?,
@@ -268,6 +266,22 @@ fn compile_properties(
     })
 }
 
+/// Prints a model's warnings to standard error: the first `codegen::diag::MAX_SHOWN`,
+/// then how many more (a file with thousands of ignored attributes stays readable).
+fn print_warnings<W: std::fmt::Display>(warnings: impl IntoIterator<Item = W>) {
+    let mut more = 0usize;
+    for (i, w) in warnings.into_iter().enumerate() {
+        if i < codegen::diag::MAX_SHOWN {
+            eprintln!("warning: {w}");
+        } else {
+            more += 1;
+        }
+    }
+    if more > 0 {
+        eprintln!("warning: ... and {more} more warnings");
+    }
+}
+
 /// Checks that every ROS type the property file's ports name is an interface the robot
 /// model `main` can see (found as the model's own are: `--interfaces`, beside and above
 /// it, the ROS workspace, the built-ins), of the port's kind; errors at the `type`
@@ -323,9 +337,7 @@ fn load_robot(
     let search = crate::robot::interfaces::Search::from_env(opts.interfaces.clone());
     let (robot, external) =
         crate::robot::load::load_searching(main, external, &search).map_err(|d| d.to_string())?;
-    for w in &robot.warnings {
-        eprintln!("warning: {w}");
-    }
+    print_warnings(&robot.warnings);
     if let Some(given) = opts.time_unit_ns {
         if given != robot.time_unit_ns {
             return Err(format!(
