@@ -330,6 +330,83 @@ impl SourceMap {
     }
 }
 
+/// Why `path` cannot be read as a source file, or `None` when it is a regular file
+/// (symbolic links followed): `not found`, `is a directory, not a file`, `is a FIFO
+/// (named pipe), not a regular file`, ... Decided from the file's metadata, before
+/// opening it, so a FIFO never blocks the reader and a device is never read.
+pub fn not_a_source_file(path: &Path) -> Option<String> {
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Some("not found".into()),
+        Err(e) => Some(format!("cannot read: {e}")),
+        Ok(m) if m.is_file() => None,
+        Ok(m) if m.is_dir() => Some("is a directory, not a file".into()),
+        Ok(m) => Some(format!("is {}, not a regular file", special_kind(&m))),
+    }
+}
+
+#[cfg(unix)]
+fn special_kind(m: &std::fs::Metadata) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    let t = m.file_type();
+    if t.is_fifo() {
+        "a FIFO (named pipe)"
+    } else if t.is_char_device() {
+        "a character device"
+    } else if t.is_block_device() {
+        "a block device"
+    } else if t.is_socket() {
+        "a socket"
+    } else {
+        "a special file"
+    }
+}
+
+#[cfg(not(unix))]
+fn special_kind(_: &std::fs::Metadata) -> &'static str {
+    "a special file"
+}
+
+/// Reads the source file at `path` as UTF-8 text: the one reader of every text file
+/// the project parses (models, robot models and their inputs, property files, specs,
+/// traces, ROS interfaces). A file that is not a regular file is refused before it is
+/// opened ([`not_a_source_file`]); a UTF-8 byte order mark is dropped (editors on
+/// Windows write one); a byte that is not UTF-8 is an error at its line and column
+/// (counted in characters, as every position), saying which byte. The error is about
+/// the file and shows none of its text.
+pub fn read_source(path: &Path) -> Result<String, Diagnostic> {
+    let name = || path.display().to_string();
+    if let Some(why) = not_a_source_file(path) {
+        return Err(Diagnostic::about_file(name(), why));
+    }
+    let bytes = std::fs::read(path)
+        .map_err(|e| Diagnostic::about_file(name(), format!("cannot read: {e}")))?;
+    decode_source(bytes).map_err(|(at, message)| Diagnostic::error(name(), at, message))
+}
+
+/// `bytes` as text, without a leading UTF-8 byte order mark; `Err` gives the line and
+/// column of the first byte that is not UTF-8, and what is wrong.
+pub fn decode_source(mut bytes: Vec<u8>) -> Result<String, ((u32, u32), String)> {
+    if bytes.starts_with(b"\xEF\xBB\xBF") {
+        bytes.drain(..3);
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        let bytes = e.as_bytes();
+        let valid = e.utf8_error().valid_up_to();
+        let prefix = std::str::from_utf8(&bytes[..valid]).unwrap_or_default();
+        let at = LineIndex::new(prefix).line_col(prefix, valid);
+        let why = match e.utf8_error().error_len() {
+            Some(_) => format!(
+                "not UTF-8 text: byte 0x{:02X} does not belong here (save the file as UTF-8)",
+                bytes[valid]
+            ),
+            None => {
+                "not UTF-8 text: the file ends inside a character (save it as UTF-8)".to_owned()
+            }
+        };
+        (at, why)
+    })
+}
+
 /// The file name of a span whose source is not in its map.
 const UNKNOWN: &str = "<unknown>";
 
@@ -355,19 +432,28 @@ pub fn locate_in_runs(text: &str, runs: &[PositionRun], at: usize) -> Option<(u3
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct LineIndex {
     starts: Vec<u32>,
+    /// Per line, `true` when it holds only ASCII: its columns are byte counts, found
+    /// without reading the line (so a thousand problems on one long line cost a
+    /// thousand lookups, not a thousand scans of the line).
+    ascii: Vec<bool>,
 }
 
 impl LineIndex {
     /// The index of `text`.
     pub fn new(text: &str) -> LineIndex {
         let mut starts = vec![0u32];
-        starts.extend(
-            text.bytes()
-                .enumerate()
-                .filter(|&(_, b)| b == b'\n')
-                .map(|(i, _)| u32::try_from(i + 1).unwrap_or(u32::MAX)),
-        );
-        LineIndex { starts }
+        let mut ascii = Vec::new();
+        let mut line_ascii = true;
+        for (i, b) in text.bytes().enumerate() {
+            line_ascii &= b.is_ascii();
+            if b == b'\n' {
+                starts.push(u32::try_from(i + 1).unwrap_or(u32::MAX));
+                ascii.push(line_ascii);
+                line_ascii = true;
+            }
+        }
+        ascii.push(line_ascii);
+        LineIndex { starts, ascii }
     }
 
     /// 1-based line and column of byte `offset` of `text` (the indexed text), clamped
@@ -379,7 +465,11 @@ impl LineIndex {
             .partition_point(|&s| s as usize <= offset)
             .saturating_sub(1);
         let start = self.starts.get(line).map_or(0, |&s| s as usize).min(offset);
-        let column = text.get(start..offset).map_or(0, |s| s.chars().count());
+        let column = if self.ascii.get(line) == Some(&true) {
+            offset - start
+        } else {
+            text.get(start..offset).map_or(0, |s| s.chars().count())
+        };
         (
             u32::try_from(line + 1).unwrap_or(u32::MAX),
             u32::try_from(column + 1).unwrap_or(u32::MAX),
@@ -406,18 +496,41 @@ pub struct Snippet {
 
 impl Snippet {
     /// The line of `text` holding byte `lo`, with carets under `lo..hi` (cut at the
-    /// line's end).
+    /// line's end). A line longer than [`SNIPPET_WIDTH`] characters is cut to that
+    /// many around `lo`, `...` marking each cut: the work and the text are bounded
+    /// whatever the line's length.
     pub fn of(text: &str, lo: usize, hi: usize) -> Snippet {
+        const HALF: usize = SNIPPET_WIDTH / 2;
         let lo = floor_boundary(text, lo);
         let hi = floor_boundary(text, hi.max(lo));
-        let line_start = text[..lo].rfind('\n').map_or(0, |p| p + 1);
-        let line_end = text[lo..].find('\n').map_or(text.len(), |p| lo + p);
+        // At most HALF characters before `lo` (4 bytes each at most), up to the line start.
+        let back = floor_boundary(text, lo.saturating_sub(4 * HALF));
+        let before = &text[back..lo];
+        let before = before.rfind('\n').map_or(before, |p| &before[p + 1..]);
+        let skip = before.chars().count().saturating_sub(HALF);
+        let start = lo - before.len() + before.char_indices().nth(skip).map_or(0, |(i, _)| i);
+        let cut_before = start > 0 && text.as_bytes()[start - 1] != b'\n';
+        // At most SNIPPET_WIDTH - HALF characters from `lo` on, up to the line end.
+        let ahead = &text[lo..floor_boundary(text, lo + 4 * (SNIPPET_WIDTH - HALF))];
+        let ahead = ahead.find('\n').map_or(ahead, |p| &ahead[..p]);
+        let ahead = match ahead.char_indices().nth(SNIPPET_WIDTH - HALF) {
+            Some((i, _)) => &ahead[..i],
+            None => ahead,
+        };
+        let end = lo + ahead.len();
+        let cut_after = end < text.len() && !matches!(text.as_bytes()[end], b'\n' | b'\r');
+        let mut line = String::new();
+        if cut_before {
+            line.push_str("...");
+        }
+        line.push_str(text[start..end].trim_end_matches('\r'));
+        if cut_after {
+            line.push_str("...");
+        }
         Snippet {
-            line: text[line_start..line_end]
-                .trim_end_matches('\r')
-                .to_string(),
-            caret_col: text[line_start..lo].chars().count(),
-            caret_len: text[lo..hi.min(line_end)].chars().count().max(1),
+            line,
+            caret_col: text[start..lo].chars().count() + if cut_before { 3 } else { 0 },
+            caret_len: text[lo..hi.min(end)].chars().count().max(1),
         }
     }
 
@@ -435,6 +548,32 @@ impl Snippet {
             .map_or(rest.find('\n').unwrap_or(rest.len()), |(i, _)| i);
         Snippet::of(text, start + lo, start + lo)
     }
+}
+
+/// The most characters of a source line a diagnostic shows: a longer line is cut
+/// around the problem.
+pub const SNIPPET_WIDTH: usize = 200;
+
+/// The most characters of a message a diagnostic prints: a longer one (a message
+/// quoting a huge attribute) is cut in the middle.
+pub const MESSAGE_WIDTH: usize = 1000;
+
+/// The most diagnostics a list prints; the rest are counted (`... and N more`).
+pub const MAX_SHOWN: usize = 20;
+
+/// `text`, cut in the middle to at most about `width` characters.
+fn clipped(text: &str, width: usize) -> std::borrow::Cow<'_, str> {
+    let n = text.chars().count();
+    if n <= width {
+        return text.into();
+    }
+    let head: String = text.chars().take(width / 2).collect();
+    let tail: String = text.chars().skip(n - width / 2).collect();
+    format!(
+        "{head} ... ({} characters cut) ... {tail}",
+        n - 2 * (width / 2)
+    )
+    .into()
 }
 
 /// The largest char boundary of `text` at or before byte `i` (clamped to its length).
@@ -542,30 +681,29 @@ impl<M> Diagnostic<M> {
 
 impl<M: fmt::Display> fmt::Display for Diagnostic<M> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let message = self.message.to_string();
+        let message = clipped(&message, MESSAGE_WIDTH);
+        let file = clipped(&self.file, MESSAGE_WIDTH);
         if self.line == 0 {
-            return write!(f, "{}: {}", self.file, self.message);
+            return write!(f, "{file}: {message}");
         }
-        write!(f, "{}:{}:{}: ", self.file, self.line, self.col)?;
+        write!(f, "{file}:{}:{}: ", self.line, self.col)?;
         if self.severity == Severity::Warning {
             write!(f, "{}: ", self.severity)?;
         }
-        write!(f, "{}", self.message)?;
+        write!(f, "{message}")?;
         if self.source_line.is_empty() {
             return Ok(());
         }
-        let pad: String = self
-            .source_line
+        // Snippets are cut when made; a line set by hand is cut here (at its end).
+        let line: String = self.source_line.chars().take(SNIPPET_WIDTH + 6).collect();
+        let pad: String = line
             .chars()
             .take(self.caret_col)
             .map(|c| if c == '\t' { '\t' } else { ' ' })
             .collect();
-        write!(
-            f,
-            "\n    {}\n    {}{}",
-            self.source_line,
-            pad,
-            "^".repeat(self.caret_len.max(1))
-        )
+        let carets = self.caret_len.clamp(1, SNIPPET_WIDTH + 6);
+        write!(f, "\n    {line}\n    {pad}{}", "^".repeat(carets))
     }
 }
 
@@ -649,13 +787,27 @@ impl<M> From<Diagnostic<M>> for Diagnostics<M> {
     }
 }
 
+/// The first [`MAX_SHOWN`] items, one after the other, then how many more there are
+/// (`... and 9980 more: 9980 errors, 0 warnings`).
 impl<M: fmt::Display> fmt::Display for Diagnostics<M> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, d) in self.0.iter().enumerate() {
+        for (i, d) in self.0.iter().take(MAX_SHOWN).enumerate() {
             if i > 0 {
                 writeln!(f)?;
             }
             write!(f, "{d}")?;
+        }
+        if let Some(rest) = self.0.get(MAX_SHOWN..).filter(|r| !r.is_empty()) {
+            let errors = rest
+                .iter()
+                .filter(|d| d.severity == Severity::Error)
+                .count();
+            write!(
+                f,
+                "\n... and {} more: {errors} errors, {} warnings",
+                rest.len(),
+                rest.len() - errors
+            )?;
         }
         Ok(())
     }
@@ -816,6 +968,49 @@ mod tests {
     }
 
     #[test]
+    fn long_lines_and_long_lists_are_cut() {
+        // A problem in the middle of a 100 000-character line shows 200 characters
+        // around it, the caret under the problem.
+        let mut text = "é".repeat(50_000);
+        let at = text.len();
+        text.push_str("BAD");
+        text.push_str(&"x".repeat(50_000));
+        text.push_str("\nnext");
+        let s = Snippet::of(&text, at, at + 3);
+        assert!(
+            s.line.starts_with("...é") && s.line.ends_with("x..."),
+            "{s:?}"
+        );
+        assert_eq!(s.line.chars().count(), SNIPPET_WIDTH + 6);
+        let under: String = s.line.chars().skip(s.caret_col).take(3).collect();
+        assert_eq!((under.as_str(), s.caret_len), ("BAD", 3));
+        // Short lines are whole, without marks.
+        let s = Snippet::of("ab\ncd\r\nef", 4, 4);
+        assert_eq!((s.line.as_str(), s.caret_col), ("cd", 1));
+        // Columns of a long ASCII line come without reading it.
+        let mut sm = SourceMap::new();
+        let line = format!("{}BAD", "y".repeat(70_000));
+        let file = sm.add("m.xml", line.clone());
+        assert_eq!(sm.locate(file.at(70_000)).col, 70_001);
+        // A huge message is cut in the middle.
+        let d = sm.diag(file.at(70_000), format!("bad `{line}`"));
+        let shown = d.to_string();
+        assert!(shown.len() < 3 * MESSAGE_WIDTH, "{}", shown.len());
+        assert!(shown.contains("characters cut"));
+        // A list shows its first MAX_SHOWN items and counts the rest.
+        let all: Diagnostics = (0..50)
+            .map(|i| sm.diag(file.at(i), format!("problem {i}")))
+            .collect::<Vec<_>>()
+            .into();
+        let shown = all.to_string();
+        assert!(shown.contains("problem 19") && !shown.contains("problem 20"));
+        assert!(
+            shown.ends_with("... and 30 more: 30 errors, 0 warnings"),
+            "{shown}"
+        );
+    }
+
+    #[test]
     fn runs_map_offsets_back_to_the_file() {
         // `a &lt; b` unescaped to `a < b`: the run after the entity starts at column 11.
         let runs = [
@@ -849,5 +1044,40 @@ mod tests {
         assert_eq!(locate_in_runs(text, &runs, 4), Some((4, 10)));
         assert_eq!(locate_in_runs(text, &runs, 8), Some((7, 1)));
         assert_eq!(locate_in_runs(text, &[], 1), None);
+    }
+
+    #[test]
+    fn sources_are_regular_utf8_files() {
+        let dir = std::env::temp_dir().join(format!("diag-read-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bom = dir.join("bom.txt");
+        std::fs::write(&bom, b"\xEF\xBB\xBFa\nb").unwrap();
+        assert_eq!(read_source(&bom).unwrap(), "a\nb");
+        let bad = dir.join("bad.txt");
+        std::fs::write(&bad, b"ok\nab\xC3\xA9c\xFFd").unwrap();
+        let d = read_source(&bad).unwrap_err();
+        assert_eq!((d.line, d.col), (2, 5));
+        assert!(d.message.contains("byte 0xFF"), "{d}");
+        let cut = dir.join("cut.txt");
+        std::fs::write(&cut, b"x\xC3").unwrap();
+        assert!(read_source(&cut)
+            .unwrap_err()
+            .message
+            .contains("ends inside"));
+        let d = read_source(&dir).unwrap_err();
+        assert_eq!(
+            d.to_string(),
+            format!("{}: is a directory, not a file", dir.display())
+        );
+        assert!(read_source(&dir.join("none"))
+            .unwrap_err()
+            .message
+            .contains("not found"));
+        #[cfg(unix)]
+        assert_eq!(
+            not_a_source_file(Path::new("/dev/zero")).as_deref(),
+            Some("is a character device, not a regular file")
+        );
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -48,6 +48,7 @@ pub mod ast;
 pub mod bounds;
 mod check;
 mod compile;
+pub mod csv;
 pub mod diag;
 pub mod duration;
 pub mod emit_rust;

@@ -84,7 +84,29 @@ enum Command {
     Run(cli::run::RunArgs),
 }
 
+/// Ends the process quietly (exit code 1, the documented code for I/O) when printing to
+/// standard output or error fails, as when a reader closed the pipe (`hindsight ... |
+/// head -1`): the `print!` family panics then, and a panic's message and exit code 101
+/// would claim a bug. Every other panic keeps the default report.
+fn quiet_on_closed_output() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        // std's message for a failed `print!`/`eprint!` ("failed printing to stdout: ...").
+        if message.starts_with("failed printing to std") {
+            std::process::exit(1);
+        }
+        default(info);
+    }));
+}
+
 fn main() -> ExitCode {
+    quiet_on_closed_output();
     let cli = match Cli::try_parse() {
         Ok(c) => c,
         Err(e) => {
@@ -109,7 +131,9 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("{e}");
+            // A closed standard error must not turn bad input (2) into a crash.
+            use std::io::Write;
+            let _ = writeln!(std::io::stderr(), "{e}");
             ExitCode::from(e.exit_code())
         }
     }

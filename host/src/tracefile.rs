@@ -6,7 +6,9 @@
 //! variable at that point; an empty cell leaves a state variable unchanged and an
 //! event variable false. Values: `true`/`false` (or `1`/`0`) for booleans,
 //! integers, floats, and strings (optionally in double quotes, `""` for a quote).
-//! Lines starting with `#` and blank lines are skipped.
+//! Lines starting with `#` and blank lines are skipped. Quoting is the project's one CSV
+//! grammar (`codegen::csv`, RFC 4180). A float cell must be finite: `NaN`, `inf` are
+//! refused at their `file:line:col`.
 //!
 //! The columns that `hindsight trace` and `verify --save-failing` add around the
 //! variables (`step`, `event`, `origin`, `target`, `params`, `verdict_NAME`) are skipped
@@ -27,56 +29,56 @@ pub struct TracePoint {
 }
 
 /// Parses a CSV trace against a compiled spec's variables; errors name `file:line:col`.
+/// Rows are read by the project's one CSV grammar ([`codegen::csv::records`], RFC 4180
+/// quoting, what `trace` and `verify --save-failing` write); a UTF-8 byte order mark is
+/// dropped.
 pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoint>, String> {
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
-    let Some((hline, header)) = lines.next() else {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let records =
+        codegen::csv::records(text).map_err(|(l, c, m)| format!("{file}:{l}:{c}: {m}"))?;
+    // Comments (`#` first) and blank lines are no rows.
+    let mut rows = records.into_iter().filter(|r| {
+        let first = r.fields.first().map_or("", |(f, _)| f.trim_start());
+        !(first.starts_with('#') || r.fields.iter().all(|(f, _)| f.trim().is_empty()))
+    });
+    let Some(header) = rows.next() else {
         return Err(format!(
             "{file}:1:1: empty trace: expected a header `time,VAR,...`"
         ));
     };
-    let cols = split_row(header).map_err(|(c, m)| format!("{file}:{}:{c}: {m}", hline + 1))?;
-    if cols.first().map(|(_, s)| s.trim()) != Some("time") {
-        return Err(format!(
-            "{file}:{}:1: the first column must be `time`",
-            hline + 1
-        ));
+    let hline = header.line;
+    let cols = header.fields;
+    if cols.first().map(|(s, _)| s.trim()) != Some("time") {
+        return Err(format!("{file}:{hline}:1: the first column must be `time`"));
     }
     // `None` marks a recorder column that is skipped.
     let mut vars: Vec<Option<usize>> = Vec::new();
-    for (col, name) in &cols[1..] {
+    for (name, col) in &cols[1..] {
         let name = name.trim();
         match spec.var_index(name) {
             Some(i) if !vars.contains(&Some(i)) => vars.push(Some(i)),
-            Some(_) => {
-                return Err(format!(
-                    "{file}:{}:{col}: column `{name}` repeated",
-                    hline + 1
-                ))
-            }
+            Some(_) => return Err(format!("{file}:{hline}:{col}: column `{name}` repeated")),
             None if is_recorder_column(name) => vars.push(None),
             None => {
                 return Err(format!(
-                    "{file}:{}:{col}: `{name}` is not a variable of the spec",
-                    hline + 1
+                    "{file}:{hline}:{col}: `{name}` is not a variable of the spec"
                 ))
             }
         }
     }
     let mut points = Vec::new();
     let mut last = 0u64;
-    for (lno, line) in lines {
-        let at = |c: usize, m: String| format!("{file}:{}:{c}: {m}", lno + 1);
-        let cells = split_row(line).map_err(|(c, m)| at(c, m))?;
+    for row in rows {
+        let lno = row.line;
+        let at = |c: usize, m: String| format!("{file}:{lno}:{c}: {m}");
+        let cells = row.fields;
         if cells.len() != cols.len() {
             return Err(at(
                 1,
                 format!("{} cells, the header has {}", cells.len(), cols.len()),
             ));
         }
-        let (tc, ts) = &cells[0];
+        let (ts, tc) = &cells[0];
         let time: u64 = ts.trim().parse().map_err(|_| {
             at(
                 *tc,
@@ -94,7 +96,7 @@ pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoi
         }
         last = time;
         let mut sets = Vec::new();
-        for ((col, cell), &var) in cells[1..].iter().zip(&vars) {
+        for ((cell, col), &var) in cells[1..].iter().zip(&vars) {
             let Some(var) = var else { continue };
             if cell.trim().is_empty() {
                 continue;
@@ -105,7 +107,7 @@ pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoi
         points.push(TracePoint {
             time,
             sets,
-            line: lno + 1,
+            line: lno,
         });
     }
     Ok(points)
@@ -132,46 +134,18 @@ fn parse_value(cell: &str, spec: &Compiled, var: usize) -> Result<Value, String>
             _ => Err(bad()),
         },
         Ty::Int => cell.parse().map(Value::Int).map_err(|_| bad()),
-        Ty::Float => cell.parse().map(Value::Float).map_err(|_| bad()),
+        // A trace records measurements: a NaN or an infinity is a broken sensor or
+        // logger, not a value to judge silently (every comparison with NaN is false).
+        Ty::Float => match cell.parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(Value::Float(x)),
+            Ok(_) => Err(format!(
+                "`{cell}` for `{}` is not a finite number: NaN and infinities are refused \
+                 (every comparison with NaN is false, so a verdict over it would mean nothing)",
+                decl.name
+            )),
+            Err(_) => Err(bad()),
+        },
         // Strings the spec never mentions get an id past every constant: equal to none.
         Ty::Str => Ok(Value::Str(spec.string_id(cell).unwrap_or(u32::MAX))),
     }
-}
-
-/// Splits one CSV row into `(column number, cell)`; quoted cells may hold commas.
-fn split_row(line: &str) -> Result<Vec<(usize, String)>, (usize, String)> {
-    let mut out = Vec::new();
-    let mut chars = line.char_indices().peekable();
-    let mut start_col = 1;
-    let mut cell = String::new();
-    let mut quoted = false;
-    let mut was_quoted = false;
-    while let Some((i, c)) = chars.next() {
-        match c {
-            '"' if quoted => {
-                if chars.peek().map(|&(_, c)| c) == Some('"') {
-                    chars.next();
-                    cell.push('"');
-                } else {
-                    quoted = false;
-                }
-            }
-            '"' if cell.trim().is_empty() && !was_quoted => {
-                quoted = true;
-                was_quoted = true;
-                cell.clear();
-            }
-            ',' if !quoted => {
-                out.push((start_col, std::mem::take(&mut cell)));
-                start_col = i + 2;
-                was_quoted = false;
-            }
-            c => cell.push(c),
-        }
-    }
-    if quoted {
-        return Err((start_col, "unterminated quoted cell".into()));
-    }
-    out.push((start_col, cell));
-    Ok(out)
 }

@@ -48,10 +48,31 @@ pub fn run_count(s: &str) -> Result<u64, String> {
     }
 }
 
-/// Reads a whole file, naming it in the error.
+/// Reads a whole text file (a spec, trace, study, log or config) with the project's one
+/// source reader, `codegen::diag::read_source`: a folder, FIFO or device is refused
+/// without being opened, a UTF-8 byte order mark is dropped, and a byte that is not
+/// UTF-8 is reported at its `file:line:col`.
 pub fn read_file(path: &std::path::Path) -> Result<String, CliError> {
-    std::fs::read_to_string(path)
-        .map_err(|e| CliError::Input(format!("{}: cannot read: {e}", path.display())))
+    codegen::diag::read_source(path).map_err(|d| CliError::Input(d.to_string()))
+}
+
+/// Writes `bytes` to `path` whole or not at all: into a temporary file in the same
+/// folder, then renamed over `path` (a rename within a folder is atomic), so a write
+/// that is interrupted (Ctrl-C, a full disk, a file-size limit) leaves any earlier file
+/// at `path` as it was and never a truncated one.
+pub fn write_whole(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| std::io::Error::other("not a file name"))?;
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(name);
+    tmp_name.push(format!(".tmp-{}", std::process::id()));
+    let tmp = path.with_file_name(tmp_name);
+    let written = std::fs::write(&tmp, bytes).and_then(|()| std::fs::rename(&tmp, path));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
 }
 
 /// Compiles a `.hspec` file, printing warnings to stderr.

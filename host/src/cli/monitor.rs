@@ -283,9 +283,13 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
     };
     if let Some(log) = &args.replay {
         let text = read_file(log)?;
+        let name = log.display().to_string();
+        let (text, cut) = live::record::complete_records(&text, &name);
+        if let Some(warning) = cut {
+            eprintln!("{warning}");
+        }
         let lines =
-            live::record::replay(&spec, &text, &log.display().to_string(), args.every_point)
-                .map_err(CliError::Input)?;
+            live::record::replay(&spec, text, &name, args.every_point).map_err(CliError::Input)?;
         let io = |e: std::io::Error| CliError::Failed(format!("output: {e}"));
         for l in lines {
             writeln!(out, "{l}").map_err(io)?;

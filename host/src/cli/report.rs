@@ -141,7 +141,7 @@ fn formulas_from_file(study: &mut Study) {
 }
 
 fn write(path: &Path, data: &ReportData) -> Result<(), CliError> {
-    std::fs::write(path, report::render(data))
+    super::write_whole(path, report::render(data).as_bytes())
         .map_err(|e| CliError::Failed(format!("{}: cannot write: {e}", path.display())))?;
     eprintln!("wrote {}", path.display());
     Ok(())

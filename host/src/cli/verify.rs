@@ -301,7 +301,8 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
         let shard = match &e {
             ShardError::Mismatch { shard, .. }
             | ShardError::Duplicate(shard)
-            | ShardError::Range(shard) => Some(*shard),
+            | ShardError::Range(shard)
+            | ShardError::Counts { shard, .. } => Some(*shard),
             _ => None,
         };
         match shard {
@@ -413,6 +414,28 @@ fn replay_csv(
     Ok((rec.csv, rec.culprits))
 }
 
+/// `id` as a file name inside `--out`: ids are checked where declared
+/// (`props::is_valid_id`), so this changes nothing for them; any other character (a
+/// name from elsewhere) becomes `_`, and a leading `.` too, so no name is a path
+/// (`../x`, `/etc/x`) or a hidden file.
+fn file_stem(id: &str) -> String {
+    let stem: String = id
+        .chars()
+        .enumerate()
+        .map(|(i, c)| match c {
+            'a'..='z' | 'A'..='Z' | '0'..='9' | '_' | '-' => c,
+            '.' if i > 0 => c,
+            _ => '_',
+        })
+        .take(crate::props::MAX_ID_LEN)
+        .collect();
+    if stem.is_empty() {
+        "property".to_owned()
+    } else {
+        stem
+    }
+}
+
 /// Replays each kept failing run (run k is stream k of the seed) and, with
 /// --save-failing, writes its CSV.
 fn save_failing(
@@ -430,7 +453,7 @@ fn save_failing(
     for (name, p) in set.guarantee_names().iter().zip(&result.properties) {
         for &k in &p.failing_runs {
             let (csv, culprits) = replay_csv(model, set, run_cfg, args.seed, k)?;
-            let path = args.out.join(format!("{name}-run{k}.csv"));
+            let path = args.out.join(format!("{}-run{k}.csv", file_stem(name)));
             if args.save_failing > 0 {
                 std::fs::write(&path, &csv).map_err(io)?;
                 eprintln!("wrote {}", path.display());

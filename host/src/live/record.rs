@@ -251,6 +251,26 @@ pub fn parse_log(text: &str, file: &str) -> Result<Vec<(usize, Input)>, String> 
     Ok(out)
 }
 
+/// The complete records of a log whose recorder may have been stopped mid-line (killed,
+/// out of disk): the text up to its last line break, and a warning naming the cut tail
+/// when the text ends in a partial record (no line break, not a record). A last record
+/// that is whole but lacks its line break is kept.
+pub fn complete_records<'t>(text: &'t str, file: &str) -> (&'t str, Option<String>) {
+    let start = text.rfind('\n').map_or(0, |i| i + 1);
+    let tail = &text[start..];
+    if tail.trim().is_empty() || serde_json::from_str::<Input>(tail).is_ok() {
+        return (text, None);
+    }
+    let line = text[..start].matches('\n').count() + 1;
+    (
+        &text[..start],
+        Some(format!(
+            "{file}:{line}:1: warning: the last record is cut short (the recorder stopped \
+             mid-line): replaying the complete records before it"
+        )),
+    )
+}
+
 /// Replays an input log: every verdict line, in order. Errors name `file:line`.
 pub fn replay(
     spec: &Compiled,

@@ -92,17 +92,14 @@ impl ModelSource {
     }
 
     fn read_types(&mut self, path: &Path, errs: &mut Diagnostics) {
-        match std::fs::read_to_string(path) {
+        match codegen::diag::read_source(path) {
             Ok(text) => {
                 let id = self.sources.add(path, text);
                 if let Err(ds) = self.types.read(&self.sources, id) {
                     errs.0.extend(ds);
                 }
             }
-            Err(e) => errs.push(crate::model::about_file(
-                path,
-                format!("cannot read types file: {e}"),
-            )),
+            Err(d) => errs.push(d),
         }
     }
 }
@@ -123,15 +120,12 @@ pub fn load(path: &Path) -> Result<ModelSource, Diagnostics> {
 }
 
 fn read_scxml_file(m: &mut ModelSource, path: &Path, errs: &mut Diagnostics) {
-    match std::fs::read_to_string(path) {
+    match codegen::diag::read_source(path) {
         Ok(text) => {
             let id = m.sources.add(path, text);
             m.add_machine(id, errs);
         }
-        Err(e) => errs.push(crate::model::about_file(
-            path,
-            format!("cannot read file: {e}"),
-        )),
+        Err(d) => errs.push(d),
     }
 }
 
@@ -190,8 +184,7 @@ pub fn load_dir(dir: &Path) -> Result<ModelSource, Diagnostics> {
 pub fn load_spec(path: &Path) -> Result<ModelSource, Diagnostics> {
     let mut m = ModelSource::default();
     let mut errs = Diagnostics::default();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| crate::model::about_file(path, format!("cannot read file: {e}")))?;
+    let text = codegen::diag::read_source(path)?;
     let spec_id = m.sources.add(path, text);
     let root = xml::parse(&m.sources, spec_id)?;
     let base = path.parent().unwrap_or(Path::new("."));

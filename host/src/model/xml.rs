@@ -197,6 +197,18 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
             "internal error: file not in source map",
         ));
     };
+    // A file that does not even start like XML is not the source it was named as
+    // (`src="/proc/self/environ"`, a path that reaches `/etc/passwd`): say so about the
+    // whole file, and show none of its text, which may be a secret.
+    // (At 1:1, with no excerpt; an empty file is "no root element" as before.)
+    let start = f.text().trim_start_matches('\u{feff}').trim_start();
+    if !start.is_empty() && !start.starts_with('<') {
+        return Err(Diagnostic::error(
+            f.path().display().to_string(),
+            (1, 1),
+            "not an XML file: it does not start with `<` (its text is not shown)".to_owned(),
+        ));
+    }
     parse_text(f.text(), file).map_err(|e| sm.diag(file.at(e.offset), e.to_string()))
 }
 

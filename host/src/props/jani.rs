@@ -67,8 +67,17 @@ pub fn parse_file_selected(
             kind,
         )])
     };
-    let bytes = std::fs::read(path).map_err(|e| fail(PropsErrorKind::Io(e.to_string())))?;
-    let text = String::from_utf8(bytes).map_err(|_| fail(PropsErrorKind::Encoding))?;
+    let text = match codegen::diag::read_source(path) {
+        Ok(text) => text,
+        Err(d) if d.line == 0 => return Err(fail(PropsErrorKind::Io(d.message))),
+        Err(d) => {
+            return Err(Diagnostics::from(vec![PropsError::error(
+                path.display().to_string(),
+                (d.line, d.col),
+                PropsErrorKind::Encoding,
+            )]))
+        }
+    };
     parse_str_selected(&text, path, model, keep)
 }
 
@@ -88,6 +97,18 @@ pub fn parse_str_selected(
     model: &CompiledModel,
     keep: &mut dyn FnMut(&str) -> bool,
 ) -> Result<PropertyFile, Diagnostics> {
+    // Not even the start of a JSON object: not the JANI file it was named as; its text,
+    // maybe a secret, is not shown.
+    let start = text.trim_start();
+    if !start.is_empty() && !start.starts_with('{') {
+        return Err(Diagnostics::from(vec![PropsError::error(
+            path.display().to_string(),
+            (1, 1),
+            PropsErrorKind::Json(
+                "not a JANI file: it does not start with `{` (its text is not shown)".into(),
+            ),
+        )]));
+    }
     let lines = LineIndex::new(text);
     let root = json::parse(text).map_err(|(offset, message)| {
         Diagnostics::from(vec![super::error::error_at(
@@ -142,6 +163,7 @@ pub fn parse_str_selected(
         ports: r.ports,
         guarantees,
         assumptions: Vec::new(),
+        ros_types: Vec::new(),
     })
 }
 
@@ -164,6 +186,31 @@ impl Reader<'_, '_> {
         self.lines.location(offset)
     }
 
+    /// The `op` of an operator node (empty when it has none); `None`, with an error at
+    /// it, when `op` is there but no string (`"op": 3`), so no message names an empty
+    /// operator.
+    pub(super) fn op_of(&mut self, node: &Node) -> Option<String> {
+        let Some(op) = node.get("op") else {
+            return Some(String::new());
+        };
+        if let Some(s) = op.as_str() {
+            return Some(s.to_owned());
+        }
+        let what = match &op.value {
+            Json::Null => "null".to_owned(),
+            Json::Bool(b) => b.to_string(),
+            Json::Number(n) => format!("the number {n}"),
+            Json::Str(s) => s.clone(),
+            Json::Array(_) => "an array".to_owned(),
+            Json::Object(_) => "an object".to_owned(),
+        };
+        self.jani(
+            op.offset,
+            format!("`op` must be a string naming an operator, not {what}"),
+        );
+        None
+    }
+
     fn error(&mut self, offset: usize, kind: PropsErrorKind) {
         let at = self.at(offset);
         self.errors
@@ -180,6 +227,14 @@ impl Reader<'_, '_> {
             return None;
         };
         let name = name.to_owned();
+        if !super::is_valid_id(&name) {
+            let at = node.get("name").map_or(node.offset, |n| n.offset);
+            self.jani(
+                at,
+                format!("property name `{name}` is not {}", super::ID_RULE),
+            );
+            return None;
+        }
         let Some(expr) = node.get("expression") else {
             self.jani(
                 node.offset,
@@ -198,8 +253,8 @@ impl Reader<'_, '_> {
 
     /// `filter(values, P.. (path), initial)` or `P.. (path)`.
     fn probability(&mut self, node: &Node) -> Option<SourceText> {
-        let op = node.get("op").and_then(Node::as_str).unwrap_or("");
-        match op {
+        let op = self.op_of(node)?;
+        match op.as_str() {
             "filter" => {
                 let fun = node.get("fun").and_then(Node::as_str).unwrap_or("");
                 if fun != "values" {
@@ -265,7 +320,8 @@ impl Reader<'_, '_> {
 
     fn path_formula(&mut self, node: &Node) -> Option<SourceText> {
         let at = self.at(node.offset);
-        let op = node.get("op").and_then(Node::as_str).unwrap_or("");
+        let op = self.op_of(node)?;
+        let op = op.as_str();
         if !self.check_bounds(node) {
             return None;
         }

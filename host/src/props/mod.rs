@@ -81,6 +81,20 @@ pub struct PropertyFile {
     pub guarantees: Vec<Property>,
     /// Properties that restrict runs (a run violating one is discarded), in file order.
     pub assumptions: Vec<Property>,
+    /// The ROS interface types the ports name, where each is written: checked against a
+    /// robot model's interfaces when the file is loaded with one (`verify::load`).
+    pub ros_types: Vec<RosTypeUse>,
+}
+
+/// A ROS interface type named by a port (`<ros_topic type>`, `<ros_service type>`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RosTypeUse {
+    /// The type as written (`std_msgs/Int32`).
+    pub type_name: String,
+    /// `true` for a service type (`.srv`), `false` for a message type (`.msg`).
+    pub service: bool,
+    /// The `type` attribute.
+    pub at: Location,
 }
 
 /// One variable of a property file, observed on one message.
@@ -158,6 +172,31 @@ impl PropertyFile {
     }
 }
 
+/// The longest property or port id, in characters: with `-run<k>.csv` after it, a
+/// `--save-failing` file name stays under the 255 bytes file systems allow.
+pub const MAX_ID_LEN: usize = 200;
+
+/// What an id may hold, as the error at a bad one says it.
+pub const ID_RULE: &str = "an id of ASCII letters, digits, `_`, `-` and `.`, starting with a \
+     letter, digit or `_`, at most 200 characters (ids name CSV columns and the files of \
+     `verify --save-failing`)";
+
+/// Whether `id` may name a property or a port: ASCII letters, digits, `_`, `-` and `.`,
+/// starting with a letter, digit or `_`, at most [`MAX_ID_LEN`] characters. Checked
+/// where every id is declared (SCAN, ROS and tree-form property files, JANI property
+/// names), because ids become CSV header cells and file names (`<id>-run<k>.csv`):
+/// with this rule a name is never a path (`/`, `..`), never needs CSV quoting (`,`,
+/// `"`), and means the same on every file system. Every id of the corpus (SCAN names,
+/// JANI names such as `alarm-follows-battery-low`) fits.
+pub fn is_valid_id(id: &str) -> bool {
+    let mut chars = id.chars();
+    chars
+        .next()
+        .is_some_and(|c| c.is_ascii_alphanumeric() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+        && id.len() <= MAX_ID_LEN
+}
+
 /// Reads and checks the property file at `path`.
 pub fn parse_file(path: &Path) -> Result<PropertyFile, Diagnostics> {
     let fail = |at: Location, kind| {
@@ -167,22 +206,28 @@ pub fn parse_file(path: &Path) -> Result<PropertyFile, Diagnostics> {
             kind,
         )])
     };
-    let bytes = std::fs::read(path)
-        .map_err(|error| fail(Location::new(1, 1), PropsErrorKind::Io(error.to_string())))?;
-    match String::from_utf8(bytes) {
+    // The one reader of source files: a folder, FIFO or device is refused unopened, a
+    // byte order mark dropped, a byte that is not UTF-8 located.
+    match codegen::diag::read_source(path) {
         Ok(text) => parse_str(&text, path),
-        Err(error) => {
-            let valid = error.utf8_error().valid_up_to();
-            let bytes = error.as_bytes();
-            let prefix = std::str::from_utf8(&bytes[..valid]).unwrap_or_default();
-            let at = source::LineIndex::new(prefix).location(valid);
-            Err(fail(at, PropsErrorKind::Encoding))
-        }
+        Err(d) if d.line == 0 => Err(fail(Location::new(1, 1), PropsErrorKind::Io(d.message))),
+        Err(d) => Err(fail(Location::new(d.line, d.col), PropsErrorKind::Encoding)),
     }
 }
 
 /// Reads and checks a property file's text; `path` is only used in errors.
 pub fn parse_str(text: &str, path: &Path) -> Result<PropertyFile, Diagnostics> {
+    // Not even the start of XML: not the property file it was named as (a path that
+    // reaches `/etc/passwd`); its text, maybe a secret, is not shown.
+    // (At 1:1, with no excerpt; an empty file is "no root element" as before.)
+    let start = text.trim_start();
+    if !start.is_empty() && !start.starts_with('<') {
+        return Err(Diagnostics::from(vec![PropsError::error(
+            path.display().to_string(),
+            (1, 1),
+            PropsErrorKind::Xml("it does not start with `<` (its text is not shown)".into()),
+        )]));
+    }
     let lines = source::LineIndex::new(text);
     let root = crate::model::xml::parse_text(text, crate::model::FileId(0)).map_err(|e| {
         let at = lines.location(e.offset as usize);
@@ -194,7 +239,8 @@ pub fn parse_str(text: &str, path: &Path) -> Result<PropertyFile, Diagnostics> {
         )])
     })?;
     let mut reader = read::FileReader::new(path, &lines);
-    let file = reader.read(&root);
+    let mut file = reader.read(&root);
+    file.ros_types = std::mem::take(&mut reader.ros_types);
     let mut errors = reader.into_errors();
     if errors.is_empty() {
         Ok(file)

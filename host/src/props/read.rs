@@ -64,6 +64,8 @@ pub(crate) struct FileReader<'p, 'a> {
     path: &'p Path,
     lines: &'p LineIndex<'a>,
     errors: Vec<PropsError>,
+    /// The ROS types ports name, in file order.
+    pub(super) ros_types: Vec<super::RosTypeUse>,
 }
 
 impl<'p, 'a> FileReader<'p, 'a> {
@@ -72,6 +74,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
             path,
             lines,
             errors: Vec::new(),
+            ros_types: Vec::new(),
         }
     }
 
@@ -229,6 +232,25 @@ impl<'p, 'a> FileReader<'p, 'a> {
         Some(text.to_owned())
     }
 
+    /// The id `name` declares (`id` of a property or port), checked against the id
+    /// rule ([`super::is_valid_id`]) at the attribute.
+    pub(super) fn required_id(&mut self, element: &Element) -> Option<String> {
+        let id = self.required_name(element, "id")?;
+        if !super::is_valid_id(&id) {
+            let (_, at) = self.required(element, "id")?;
+            self.error(
+                at,
+                PropsErrorKind::BadValue {
+                    attribute: "id".to_owned(),
+                    value: id,
+                    expected: super::ID_RULE.to_owned(),
+                },
+            );
+            return None;
+        }
+        Some(id)
+    }
+
     pub(super) fn unknown_child(
         &mut self,
         child: &Element,
@@ -270,6 +292,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
             ports: Vec::new(),
             guarantees: Vec::new(),
             assumptions: Vec::new(),
+            ros_types: Vec::new(),
         };
         if root.name != "properties" {
             self.error(
@@ -434,7 +457,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
                     continue;
                 }
             };
-            let id = self.required_name(var, "id");
+            let id = self.required_id(var);
             if let (Some(id), Some(kind), Some(event), Some(origin), Some(target)) =
                 (id, kind, &event, &origin, &target)
             {
@@ -483,7 +506,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
     /// `<message event [param_name expr]>`.
     fn tree_port(&mut self, element: &Element, ports: &mut Vec<Port>) {
         self.check_attrs(element, &["id", "type"]);
-        let id = self.required_name(element, "id");
+        let id = self.required_id(element);
         let ty = self.declared_type(element);
         for child in element.elements() {
             if !matches!(child.name.as_str(), "origin" | "target" | "message") {
@@ -574,7 +597,7 @@ impl<'p, 'a> FileReader<'p, 'a> {
                 );
             }
         }
-        let id = self.required_name(element, "id");
+        let id = self.required_id(element);
         let formula = self.required(element, "expr");
         let (id, (formula, _)) = (id?, formula?);
         if formula.as_str().trim().is_empty() {

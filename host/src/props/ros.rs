@@ -87,7 +87,7 @@ impl<'a> FileReader<'_, 'a> {
                 None
             }
         };
-        self.required_name(element, "type");
+        self.ros_type(element, false);
         if let Some((event, at)) = self.optional(element, "event") {
             if event.as_str() != "publish" {
                 self.bad_value(at, "event", event.as_str(), "\"publish\"");
@@ -102,7 +102,7 @@ impl<'a> FileReader<'_, 'a> {
     pub(super) fn ros_service(&mut self, element: &Element, ports: &mut Vec<Port>) {
         self.check_attrs(element, &["service_name", "type", "event"]);
         let name = self.required_name(element, "service_name");
-        self.required_name(element, "type");
+        self.ros_type(element, true);
         let response = match self.required(element, "event") {
             Some((event, _)) if event.as_str() == "request" => Some(false),
             Some((event, _)) if event.as_str() == "response" => Some(true),
@@ -114,6 +114,19 @@ impl<'a> FileReader<'_, 'a> {
         };
         if let (Some(name), Some(response)) = (name, response) {
             self.ros_variables(element, &service_event(&name, response), ports);
+        }
+    }
+
+    /// The port's `type`, kept to be checked against the model's interfaces.
+    fn ros_type(&mut self, element: &Element, service: bool) {
+        if let Some(type_name) = self.required_name(element, "type") {
+            if let Some((_, at)) = self.optional(element, "type") {
+                self.ros_types.push(super::RosTypeUse {
+                    type_name,
+                    service,
+                    at,
+                });
+            }
         }
     }
 
@@ -144,7 +157,7 @@ impl<'a> FileReader<'_, 'a> {
                     continue;
                 }
             };
-            if let (Some(id), Some(kind)) = (self.required_name(var, "id"), kind) {
+            if let (Some(id), Some(kind)) = (self.required_id(var), kind) {
                 ports.push(Port {
                     id,
                     kind,
@@ -184,7 +197,7 @@ impl<'a> FileReader<'_, 'a> {
                 "time_unit",
             ],
         );
-        let id = self.required_name(element, "id");
+        let id = self.required_id(element);
         let (pattern, pattern_at) = self.required(element, "pattern")?;
         // The condition may be an attribute or an `<event>` child; a `<scope>` child
         // may say `globally`.

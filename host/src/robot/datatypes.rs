@@ -48,10 +48,10 @@ pub fn read_data_declarations(
     let mut uses: Vec<(TypeExpr, Span)> = Vec::new();
     let mut errs = Vec::new();
     for (path, format) in files {
-        let text = match std::fs::read_to_string(path) {
+        let text = match codegen::diag::read_source(path) {
             Ok(t) => t,
-            Err(e) => {
-                errs.push(crate::model::about_file(*path, format!("cannot read: {e}")));
+            Err(d) => {
+                errs.push(d);
                 continue;
             }
         };

@@ -58,7 +58,8 @@ pub fn main_file_of(path: &Path) -> Option<PathBuf> {
 
 /// Whether the XML file's root element is a robot main file's.
 fn is_main_file(path: &Path) -> bool {
-    let Ok(text) = std::fs::read_to_string(path) else {
+    // Through the one source reader: a FIFO named `*.xml` in the folder is never opened.
+    let Ok(text) = codegen::diag::read_source(path) else {
         return false;
     };
     // The first element after the prolog and comments.
@@ -86,10 +87,10 @@ fn is_main_file(path: &Path) -> bool {
 
 /// Reads and parses one SCXML input; errors go to `errs`.
 fn read_xml(sm: &mut SourceMap, input: &Input, errs: &mut Vec<Diagnostic>) -> Option<Element> {
-    let text = match std::fs::read_to_string(&input.path) {
+    let text = match codegen::diag::read_source(&input.path) {
         Ok(t) => t,
-        Err(e) => {
-            errs.push(sm.diag(input.span, format!("cannot read {}: {e}", input.src)));
+        Err(d) => {
+            errs.push(d);
             return None;
         }
     };
@@ -411,12 +412,21 @@ fn load_full(
     // root and plugins): the ROS lowering numbers timers and clients in this order.
     let mut tree_machines = Vec::new();
     if let Some(tree) = &main.behavior_tree {
-        let file_of = |sm: &mut SourceMap, input: &Input| {
-            let text = std::fs::read_to_string(&input.path).ok()?;
-            Some(sm.add(input.path.clone(), text))
+        let file_of = |sm: &mut SourceMap, input: &Input, errs: &mut Vec<Diagnostic>| {
+            match codegen::diag::read_source(&input.path) {
+                Ok(text) => Some(sm.add(input.path.clone(), text)),
+                Err(d) => {
+                    errs.push(d);
+                    None
+                }
+            }
         };
-        let tree_id = file_of(&mut sm, &tree.tree);
-        let plugins: Option<Vec<_>> = tree.plugins.iter().map(|p| file_of(&mut sm, p)).collect();
+        let tree_id = file_of(&mut sm, &tree.tree, &mut errs);
+        let plugins: Option<Vec<_>> = tree
+            .plugins
+            .iter()
+            .map(|p| file_of(&mut sm, p, &mut errs))
+            .collect();
         match (tree_id, plugins) {
             (Some(tree_id), Some(plugins)) => {
                 let input = BtInput {

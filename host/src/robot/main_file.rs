@@ -141,8 +141,8 @@ pub struct TickRate {
     pub hz: f64,
     /// The tick period in nanoseconds, rounded to the nearest nanosecond.
     pub period_ns: u64,
-    /// True when `period_ns` is exactly `1e9 / hz` (the rate is written as a decimal whose
-    /// period is a whole number of nanoseconds, as `0.5`, `10.0` or `3e0` are not all).
+    /// True when `period_ns` is exactly `1e9 / hz`: always, since a rate whose period is
+    /// not a whole number of nanoseconds (`3`) is refused where it is written.
     pub exact: bool,
 }
 
@@ -244,8 +244,7 @@ impl MainFile {
     /// Reads the main file at `path` without looking at the files it names (for a caller
     /// that replaces some of them, such as the properties).
     pub fn parse(sm: &mut SourceMap, path: &Path) -> Result<MainFile, Vec<Diagnostic>> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| vec![crate::model::about_file(path, format!("cannot read: {e}"))])?;
+        let text = codegen::diag::read_source(path).map_err(|d| vec![d])?;
         let file = sm.add(path, text);
         MainFile::parse_file(sm, file, path)
     }
@@ -420,19 +419,16 @@ impl MainFile {
             .chain(self.properties.iter())
     }
 
-    /// An error at each `src` whose file does not exist.
+    /// An error at each `src` that names no regular file: missing, a folder, a FIFO, a
+    /// device (`codegen::diag::not_a_source_file`, which never opens it).
     pub fn missing_files(&self, sm: &SourceMap) -> Vec<Diagnostic> {
         self.inputs()
-            .filter(|i| !i.path.is_file())
-            .map(|i| {
-                sm.diag(
+            .filter_map(|i| {
+                let why = codegen::diag::not_a_source_file(&i.path)?;
+                Some(sm.diag(
                     i.span,
-                    format!(
-                        "{} file `{}` not found",
-                        i.kind.type_name(),
-                        i.path.display()
-                    ),
-                )
+                    format!("{} file `{}` {why}", i.kind.type_name(), i.path.display()),
+                ))
             })
             .collect()
     }
@@ -703,24 +699,41 @@ fn tick_rate(text: &str) -> Result<TickRate, String> {
     } else {
         None
     };
-    let period = (1e9 / hz).round();
-    if period < 1.0 {
+    let period = 1e9 / hz;
+    if period.round() < 1.0 {
         return Err(format!(
             "bt_tick_rate `{text}` is faster than one tick per nanosecond"
         ));
     }
-    Ok(match exact_ns.and_then(|n| u64::try_from(n).ok()) {
-        Some(ns) => TickRate {
+    // The tick period must fit the time unit (nanoseconds, 64 bits: about 584 years).
+    if period >= u64::MAX as f64 {
+        return Err(format!(
+            "bt_tick_rate `{text}` is slower than the slowest rate hindsight can time \
+             (one tick per 2^64 ns, about 584 years)"
+        ));
+    }
+    // A rate written otherwise (`1e1`) is exact when its period is a whole number of
+    // nanoseconds that gives the rate back.
+    let exact_ns = exact_ns
+        .and_then(|n| u64::try_from(n).ok())
+        .or_else(|| (period.fract() == 0.0 && 1e9 / period == hz).then_some(period as u64));
+    match exact_ns {
+        Some(ns) => Ok(TickRate {
             hz,
             period_ns: ns,
             exact: true,
-        },
-        None => TickRate {
-            hz,
-            period_ns: period.min(u64::MAX as f64) as u64,
-            exact: false,
-        },
-    })
+        }),
+        // The model's time step is the greatest common divisor of its periods: a period
+        // rounded to the nanosecond would make it 1 ns, and every run would end at the
+        // step limit with no verdict. Refused here, at the attribute, instead.
+        None => Err(format!(
+            "bt_tick_rate `{text}` ticks every {:.3} ns, not a whole number of \
+             nanoseconds: the model's time step would shrink to 1 ns and every run would \
+             stop at the step limit; use a rate whose period is whole, such as 2, 4, 5, \
+             10 or 0.5 ticks per second",
+            period
+        )),
+    }
 }
 
 #[cfg(test)]
@@ -733,8 +746,11 @@ mod tests {
         assert_eq!((t.period_ns, t.exact), (100_000_000, true));
         let t = tick_rate("0.5").unwrap();
         assert_eq!((t.period_ns, t.exact), (2_000_000_000, true));
-        let t = tick_rate("3").unwrap();
-        assert_eq!((t.period_ns, t.exact), (333_333_333, false));
+        let t = tick_rate("1e1").unwrap();
+        assert_eq!((t.period_ns, t.exact), (100_000_000, true));
+        // A period that is no whole number of nanoseconds, or does not fit in 64 bits.
+        assert!(tick_rate("3").unwrap_err().contains("333333333.333 ns"));
+        assert!(tick_rate("1e-12").unwrap_err().contains("584 years"));
         assert!(tick_rate("0").is_err());
         assert!(tick_rate("-1").is_err());
         assert!(tick_rate("fast").is_err());

@@ -101,6 +101,14 @@ pub enum ShardError {
     Missing(Vec<Shard>),
     /// A partial result whose run range is not its shard's.
     Range(Shard),
+    /// A partial result whose counts cannot come from its runs (more verdicts than
+    /// runs, a failing run outside its range, ...): `what` says which count.
+    Counts {
+        /// The shard.
+        shard: Shard,
+        /// What is wrong, naming the count.
+        what: String,
+    },
     /// A property's rule is invalid.
     Rule(StatsError),
 }
@@ -142,6 +150,9 @@ impl fmt::Display for ShardError {
             }
             ShardError::Range(shard) => {
                 write!(f, "shard {shard} does not cover its own range of runs")
+            }
+            ShardError::Counts { shard, what } => {
+                write!(f, "shard {shard} has counts its runs cannot give: {what}")
             }
             ShardError::Rule(error) => write!(f, "{error}"),
         }
@@ -326,6 +337,103 @@ pub struct MergedResult {
     pub runs: RunCounts,
 }
 
+/// Checks that `part`'s counts can come from its runs: every run ends one way, no more
+/// discarded runs than runs, each property's successes, failures and unknown verdicts
+/// sum (without overflow) to the runs not discarded, and its failing runs are in the
+/// shard's range, in order, no more of them than failures.
+fn check_counts(part: &PartialResult) -> Result<(), ShardError> {
+    let bad = |what: String| {
+        Err(ShardError::Counts {
+            shard: part.shard,
+            what,
+        })
+    };
+    let r = &part.runs;
+    let ends = [
+        r.quiescent,
+        r.decided,
+        r.time_horizon,
+        r.step_limit,
+        r.failed,
+    ]
+    .iter()
+    .try_fold(0u64, |sum, &n| sum.checked_add(n));
+    if ends != Some(r.runs) {
+        return bad(format!(
+            "its runs' ends (quiescent, decided, time horizon, step limit, failed) do not \
+             sum to its {} runs",
+            r.runs
+        ));
+    }
+    if r.discarded > r.runs {
+        return bad(format!("{} runs discarded of {} runs", r.discarded, r.runs));
+    }
+    let kept = r.runs - r.discarded;
+    for p in &part.properties {
+        let c = &p.counts;
+        let sum = c
+            .successes
+            .checked_add(c.failures)
+            .and_then(|s| s.checked_add(c.unknown));
+        if sum != Some(kept) {
+            return bad(format!(
+                "`{}` has {} successes, {} failures and {} unknown verdicts, which do not \
+                 sum to its {kept} runs not discarded",
+                p.id, c.successes, c.failures, c.unknown
+            ));
+        }
+        if p.failing_runs.len() as u64 > c.failures {
+            return bad(format!(
+                "`{}` lists {} failing runs but has {} failures",
+                p.id,
+                p.failing_runs.len(),
+                c.failures
+            ));
+        }
+        if let Some(k) = p
+            .failing_runs
+            .iter()
+            .find(|&&k| k < part.first_run || k >= part.end_run)
+        {
+            return bad(format!(
+                "`{}` names failing run {k}, outside the shard's runs {}..{}",
+                p.id, part.first_run, part.end_run
+            ));
+        }
+        if p.failing_runs.windows(2).any(|w| w[0] >= w[1]) {
+            return bad(format!(
+                "`{}` lists its failing runs out of order or twice",
+                p.id
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `a + b`, `None` on overflow.
+fn add_runs(a: &RunCounts, b: &RunCounts) -> Option<RunCounts> {
+    Some(RunCounts {
+        runs: a.runs.checked_add(b.runs)?,
+        discarded: a.discarded.checked_add(b.discarded)?,
+        quiescent: a.quiescent.checked_add(b.quiescent)?,
+        decided: a.decided.checked_add(b.decided)?,
+        time_horizon: a.time_horizon.checked_add(b.time_horizon)?,
+        step_limit: a.step_limit.checked_add(b.step_limit)?,
+        failed: a.failed.checked_add(b.failed)?,
+        steps: a.steps.checked_add(b.steps)?,
+        model_time: a.model_time.checked_add(b.model_time)?,
+    })
+}
+
+/// `a + b`, `None` on overflow.
+fn add_property(a: &PropertyCounts, b: &PropertyCounts) -> Option<PropertyCounts> {
+    Some(PropertyCounts {
+        successes: a.successes.checked_add(b.successes)?,
+        failures: a.failures.checked_add(b.failures)?,
+        unknown: a.unknown.checked_add(b.unknown)?,
+    })
+}
+
 /// The shards given more than once among `parts`, each with the positions (in `parts`)
 /// of its copies, in shard order.
 pub fn duplicates(parts: &[PartialResult]) -> Vec<(Shard, Vec<usize>)> {
@@ -392,11 +500,14 @@ pub fn merge(parts: &[PartialResult], keep_failing: usize) -> Result<MergedResul
         {
             return Err(ShardError::Range(shard));
         }
+        // Two different copies of a shard are named as such first: that one of them
+        // was altered is the more useful news.
         if let Some(before) = by_index.insert(shard.index, part) {
             if before.properties != part.properties || before.runs != part.runs {
                 return Err(ShardError::Duplicate(shard));
             }
         }
+        check_counts(part)?;
     }
     let missing: Vec<Shard> = (0..count)
         .filter(|i| !by_index.contains_key(i))
@@ -411,9 +522,17 @@ pub fn merge(parts: &[PartialResult], keep_failing: usize) -> Result<MergedResul
     let mut counts = vec![PropertyCounts::default(); study.properties.len()];
     let mut failing: Vec<Vec<u64>> = vec![Vec::new(); study.properties.len()];
     for part in by_index.values() {
-        runs.add(&part.runs);
+        // Every count was checked against the shard's runs, and the ranges tile the
+        // study, so only the sums of steps and model time can overflow; all sums are
+        // checked so that no forged file wraps to a clean-looking total.
+        let overflow = |what: &str| ShardError::Counts {
+            shard: part.shard,
+            what: format!("the study's total {what} does not fit in 64 bits"),
+        };
+        runs = add_runs(&runs, &part.runs).ok_or_else(|| overflow("of run counts"))?;
         for (i, property) in part.properties.iter().enumerate() {
-            counts[i].add(&property.counts);
+            counts[i] = add_property(&counts[i], &property.counts)
+                .ok_or_else(|| overflow(&format!("counts of `{}`", property.id)))?;
             failing[i].extend(&property.failing_runs);
         }
     }

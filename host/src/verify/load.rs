@@ -164,9 +164,7 @@ pub fn load_without(
     let model = &opts.model;
     let unit_ns = opts.time_unit_ns;
     let compiled = CompiledModel::load(model).map_err(|d| d.to_string())?;
-    for w in compiled.warnings() {
-        eprintln!("warning: {w}");
-    }
+    print_warnings(compiled.warnings());
     let props_path = match &opts.props {
         Some(p) => p.to_path_buf(),
         None => default_props(model, &compiled)?,
@@ -268,6 +266,66 @@ fn compile_properties(
     })
 }
 
+/// Prints a model's warnings to standard error: the first `codegen::diag::MAX_SHOWN`,
+/// then how many more (a file with thousands of ignored attributes stays readable).
+fn print_warnings<W: std::fmt::Display>(warnings: impl IntoIterator<Item = W>) {
+    let mut more = 0usize;
+    for (i, w) in warnings.into_iter().enumerate() {
+        if i < codegen::diag::MAX_SHOWN {
+            eprintln!("warning: {w}");
+        } else {
+            more += 1;
+        }
+    }
+    if more > 0 {
+        eprintln!("warning: ... and {more} more warnings");
+    }
+}
+
+/// Checks that every ROS type the property file's ports name is an interface the robot
+/// model `main` can see (found as the model's own are: `--interfaces`, beside and above
+/// it, the ROS workspace, the built-ins), of the port's kind; errors at the `type`
+/// attribute. A port's type is not otherwise used (its messages are found by name), so
+/// a typo here would pass silently.
+fn check_ros_types(
+    file: &props::PropertyFile,
+    main: &Path,
+    search: &crate::robot::interfaces::Search,
+) -> Result<(), String> {
+    use crate::robot::interfaces::{InterfaceKind, Interfaces};
+    if file.ros_types.is_empty() {
+        return Ok(());
+    }
+    let mut sm = crate::model::SourceMap::new();
+    // The model loaded, so its interfaces were found and checked already.
+    let Ok(interfaces) = Interfaces::discover_with(&mut sm, main, search) else {
+        return Ok(());
+    };
+    let errors: Vec<String> = file
+        .ros_types
+        .iter()
+        .filter_map(|t| {
+            let kind = if t.service {
+                InterfaceKind::Service
+            } else {
+                InterfaceKind::Message
+            };
+            let e = interfaces.get(&t.type_name, kind).err()?;
+            Some(format!(
+                "{}:{}:{}: port type: {e}",
+                file.path.display(),
+                t.at.line,
+                t.at.column
+            ))
+        })
+        .collect();
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(errors.join("\n"))
+    }
+}
+
 /// Loads a robot model: the main file and everything it names, lowered and compiled; the
 /// properties are the file given, else the first one the main file names.
 fn load_robot(
@@ -279,9 +337,7 @@ fn load_robot(
     let search = crate::robot::interfaces::Search::from_env(opts.interfaces.clone());
     let (robot, external) =
         crate::robot::load::load_searching(main, external, &search).map_err(|d| d.to_string())?;
-    for w in &robot.warnings {
-        eprintln!("warning: {w}");
-    }
+    print_warnings(&robot.warnings);
     if let Some(given) = opts.time_unit_ns {
         if given != robot.time_unit_ns {
             return Err(format!(
@@ -312,6 +368,7 @@ fn load_robot(
         }
     };
     let file = read_properties(&props_path, &robot.model, opts)?;
+    check_ros_types(&file, main, &search)?;
     let set = compile_properties(&file, &robot.model, Some(robot.time_unit_ns))?;
     Ok((
         Loaded {

@@ -40,13 +40,15 @@ impl<'j, 'a> Recorder<'j, 'a> {
     pub fn new(judge: &'j mut Judge<'a>, model: &'a CompiledModel) -> Self {
         let mut csv = String::from("time,step,event,origin,target,params");
         let compiled = judge.set().compiled();
+        // Names are quoted like every other field (ids are checked where declared and
+        // never need it; a spec's own names are identifiers): one grammar for the file.
         for v in compiled.vars() {
             csv.push(',');
-            csv.push_str(&v.name);
+            field(&mut csv, &v.name);
         }
         for p in compiled.property_names() {
-            csv.push_str(",verdict_");
-            csv.push_str(p);
+            csv.push(',');
+            field(&mut csv, &format!("verdict_{p}"));
         }
         csv.push('\n');
         Recorder {
@@ -143,134 +145,6 @@ impl Observer for Recorder<'_, '_> {
     }
 }
 
-/// Appends `text` as one CSV field: as it is, or quoted with `"` doubled when it holds a
-/// `,`, a `"` or a line break.
-pub fn field(out: &mut String, text: &str) {
-    if text.contains([',', '"', '\n', '\r']) {
-        out.push('"');
-        out.push_str(&text.replace('"', "\"\""));
-        out.push('"');
-    } else {
-        out.push_str(text);
-    }
-}
-
-/// One CSV record: the line it starts on (from 1) and its fields, each with the column
-/// (in characters, from 1) where it starts.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Record {
-    /// The line of the record's first character.
-    pub line: usize,
-    /// The fields, unquoted, with their starting columns.
-    pub fields: Vec<(String, usize)>,
-}
-
-/// Reads CSV text (RFC 4180: quoted fields may hold `,`, `""` and line breaks); empty
-/// lines are skipped. An unterminated quote is an error `(line, column, message)`.
-pub fn records(text: &str) -> Result<Vec<Record>, (usize, usize, String)> {
-    let mut out = Vec::new();
-    let (mut line, mut col) = (1usize, 1usize);
-    let mut chars = text.chars().peekable();
-    while chars.peek().is_some() {
-        // An empty line is no record.
-        if matches!(chars.peek(), Some('\n')) {
-            chars.next();
-            line += 1;
-            col = 1;
-            continue;
-        }
-        let mut rec = Record {
-            line,
-            fields: Vec::new(),
-        };
-        loop {
-            let start = col;
-            let mut value = String::new();
-            if chars.peek() == Some(&'"') {
-                let (open_line, open_col) = (line, col);
-                chars.next();
-                col += 1;
-                loop {
-                    match chars.next() {
-                        None => {
-                            return Err((open_line, open_col, "unterminated quoted field".into()))
-                        }
-                        Some('"') => {
-                            col += 1;
-                            if chars.peek() == Some(&'"') {
-                                chars.next();
-                                col += 1;
-                                value.push('"');
-                            } else {
-                                break;
-                            }
-                        }
-                        Some('\n') => {
-                            value.push('\n');
-                            line += 1;
-                            col = 1;
-                        }
-                        Some(c) => {
-                            value.push(c);
-                            col += 1;
-                        }
-                    }
-                }
-            }
-            // Unquoted (or after a closing quote): up to the next `,` or line end.
-            while let Some(&c) = chars.peek() {
-                if c == ',' || c == '\n' {
-                    break;
-                }
-                chars.next();
-                col += 1;
-                if c != '\r' {
-                    value.push(c);
-                }
-            }
-            rec.fields.push((value, start));
-            match chars.next() {
-                Some(',') => col += 1,
-                Some(_) => {
-                    line += 1;
-                    col = 1;
-                    break;
-                }
-                None => break,
-            }
-        }
-        out.push(rec);
-    }
-    Ok(out)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn fields_round_trip_through_quotes() {
-        let values = ["plain", "a,b", "say \"hi\"", "two\nlines", ""];
-        let mut text = String::new();
-        for (i, v) in values.iter().enumerate() {
-            if i > 0 {
-                text.push(',');
-            }
-            field(&mut text, v);
-        }
-        text.push_str("\nx,y\n");
-        let r = records(&text).unwrap();
-        assert_eq!(r.len(), 2);
-        let got: Vec<&str> = r[0].fields.iter().map(|(v, _)| v.as_str()).collect();
-        assert_eq!(got, values);
-        assert_eq!(r[1].line, 3);
-        assert_eq!(
-            r[1].fields,
-            vec![("x".to_string(), 1), ("y".to_string(), 3)]
-        );
-        assert_eq!(
-            records("a,\"open\n"),
-            Err((1, 3, "unterminated quoted field".into()))
-        );
-    }
-}
+/// The project's one CSV grammar (RFC 4180 quoting), shared with `hindsight replay`'s
+/// trace reader and the report's reader: see [`codegen::csv`].
+pub use codegen::csv::{field, records, Record};

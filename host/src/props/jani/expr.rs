@@ -55,11 +55,7 @@ impl Reader<'_, '_> {
                 Some(self.leaf(&id, ty, node.offset))
             }
             Json::Object(_) => {
-                let op = node
-                    .get("op")
-                    .and_then(Node::as_str)
-                    .unwrap_or("")
-                    .to_owned();
+                let op = self.op_of(node)?;
                 match op.as_str() {
                     "∧" | "∨" | "⇒" => {
                         let l = self.operand(node, "left");

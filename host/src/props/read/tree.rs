@@ -125,7 +125,7 @@ impl<'r, 'p, 'a, 'e> Converter<'r, 'p, 'a, 'e> {
 
     pub(super) fn tree_property(&mut self, element: &'e Element) -> Option<Property> {
         self.reader.check_attrs(element, &["id"]);
-        let id = self.reader.required_name(element, "id");
+        let id = self.reader.required_id(element);
         let body = self.only_child(element)?;
         let mut formula = self.formula(body, &element.name)?;
         // The top level needs no parentheses.

@@ -271,10 +271,10 @@ impl Interfaces {
                 else {
                     continue;
                 };
-                let text = match std::fs::read_to_string(&path) {
+                let text = match codegen::diag::read_source(&path) {
                     Ok(t) => t,
-                    Err(e) => {
-                        errs.push(crate::model::about_file(&path, format!("cannot read: {e}")));
+                    Err(d) => {
+                        errs.push(d);
                         continue;
                     }
                 };
