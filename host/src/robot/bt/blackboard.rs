@@ -571,6 +571,8 @@ fn check(ctx: &Ctx, cond: &str, reads: bool, mismatch: u8) -> Element {
             Some("wait_for_tick"),
             vec![ctx.respond(mismatch)],
         )
+    } else if ctx.btcpp {
+        b.tr(None, None, Some("check_mismatch"), vec![])
     } else {
         b.tr(None, None, Some("value_mismatch"), vec![])
     };
@@ -624,6 +626,24 @@ fn check(ctx: &Ctx, cond: &str, reads: bool, mismatch: u8) -> Element {
         ));
     }
     m.push(t);
+    if ctx.btcpp {
+        // BT.CPP halts the child only while it is RUNNING (3.8
+        // `BlackboardPreconditionNode::tick` calls `haltChild`; 4.10
+        // `decorator_node.cpp`, `DecoratorNode::resetChild`).
+        let r = ctx
+            .running_var(0)
+            .expect("BT.CPP's rules keep every child's flag");
+        m.push(
+            b.state("check_mismatch")
+                .with_child(b.tr(None, Some(&r), Some("value_mismatch"), vec![]))
+                .with_child(b.tr(
+                    None,
+                    None,
+                    Some("wait_for_tick"),
+                    vec![ctx.respond(mismatch)],
+                )),
+        );
+    }
     if ctx.effect(0) != HaltEffect::Never {
         m.push(
             b.state_entry("value_mismatch", ctx.halt_child_body(0))
