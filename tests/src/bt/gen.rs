@@ -2,7 +2,8 @@
 //! kind the oracle knows, mixed at random depth and width, in `BTCPP_format` 3 and 4;
 //! SubTrees remapped, shared or keeping an entry private; blackboard writes (constants
 //! and copies) and reads of int, double, string and bool entries; leaves with and
-//! without `<bt_halt>`; counts of -1.
+//! without `<bt_halt>`; counts of -1. With [`Options::btcpp4_nodes`], also BT.CPP 4's
+//! nodes that AS2FM has no model of.
 
 use super::oracle::Scripts;
 use super::tree::Status;
@@ -28,6 +29,18 @@ struct G<'r, R: Rng> {
     subtrees: Vec<String>,
     /// `BTCPP_format="3"`: v3 names and SubTree mapping.
     v3: bool,
+    /// What else to generate.
+    opts: Options,
+}
+
+/// What the generator writes besides the nodes both AS2FM and BT.CPP have.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Options {
+    /// BT.CPP 4's nodes AS2FM has no model of (AsyncSequence, AsyncFallback,
+    /// ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2-6), in
+    /// format-4 trees: for the real-library test only (the lowering does not take them).
+    /// Off, the generator draws exactly what it drew before they existed.
+    pub btcpp4_nodes: bool,
 }
 
 /// The int entries. `p0` is never remapped: inside a SubTree it is the instance's own
@@ -125,8 +138,50 @@ impl<R: Rng> G<'_, R> {
         (0..n).map(|_| self.node(depth + 1)).collect()
     }
 
+    /// One of BT.CPP 4's nodes AS2FM has no model of.
+    fn btcpp4_node(&mut self, depth: u32) -> String {
+        match self.below(7) {
+            0 => format!(
+                "<AsyncSequence>{}</AsyncSequence>",
+                self.children(depth, 1, 4)
+            ),
+            1 => format!(
+                "<AsyncFallback>{}</AsyncFallback>",
+                self.children(depth, 1, 4)
+            ),
+            2 => {
+                let n = 1 + self.below(3) as i64;
+                let t = 1 + self.below(n as u64) as i64;
+                let t = if self.below(3) == 0 { t - n - 1 } else { t };
+                let kids: String = (0..n).map(|_| self.node(depth + 1)).collect();
+                format!("<ParallelAll max_failures=\"{t}\">{kids}</ParallelAll>")
+            }
+            3 => format!("<WhileDoElse>{}</WhileDoElse>", self.children(depth, 2, 3)),
+            4 => format!(
+                "<KeepRunningUntilFailure>{}</KeepRunningUntilFailure>",
+                self.node(depth + 1)
+            ),
+            5 => format!(
+                "<RunOnce then_skip=\"false\">{}</RunOnce>",
+                self.node(depth + 1)
+            ),
+            _ => {
+                let n = 2 + self.below(5) as usize;
+                let cases: String = (1..=n)
+                    .map(|i| format!(" case_{i}=\"{}\"", self.pick(&["a", "b", "c"])))
+                    .collect();
+                let kids: String = (0..=n).map(|_| self.node(depth + 1)).collect();
+                format!("<Switch{n} variable=\"{{s0}}\"{cases}>{kids}</Switch{n}>")
+            }
+        }
+    }
+
     fn node(&mut self, depth: u32) -> String {
         self.budget -= 1;
+        if self.opts.btcpp4_nodes && !self.v3 && depth < 5 && self.budget > 0 && self.below(6) == 0
+        {
+            return self.btcpp4_node(depth);
+        }
         if depth >= 5 || self.budget <= 0 || self.below(10) < 3 {
             return match self.below(12) {
                 0 => "<AlwaysSuccess/>".into(),
@@ -250,12 +305,18 @@ impl<R: Rng> G<'_, R> {
 
 /// A random case of about `size` nodes.
 pub fn case<R: Rng>(rng: &mut R, size: i64) -> Case {
+    case_with(rng, size, Options::default())
+}
+
+/// A random case of about `size` nodes, with what `opts` adds.
+pub fn case_with<R: Rng>(rng: &mut R, size: i64, opts: Options) -> Case {
     let mut g = G {
         rng,
         scripts: Scripts::new(),
         budget: 0,
         subtrees: Vec::new(),
         v3: false,
+        opts,
     };
     g.v3 = g.below(3) == 0;
     let n_sub = g.below(3);

@@ -1,8 +1,9 @@
 //! BehaviorTree.CPP semantics for tests: an independent reader and reference executor
-//! ([`oracle`]), random trees and scripts ([`gen`]), and the lowering harness's model
-//! writer ([`model`]).
+//! ([`oracle`]), random trees and scripts ([`gen`]), the lowering harness's model writer
+//! ([`model`]), and the real library run through its Python bindings ([`real`]).
 
 pub mod gen;
 pub mod model;
 pub mod oracle;
+pub mod real;
 pub mod tree;

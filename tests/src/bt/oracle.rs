@@ -1,10 +1,15 @@
 //! The reference executor of BehaviorTree.CPP: a direct tick-by-tick interpreter of a
 //! [`Tree`] whose leaves follow scripts, recording every tick and halt a leaf receives.
 //!
-//! Two readings, for the nodes where AS2FM's SCXML models of the built-in nodes and
-//! BehaviorTree.CPP disagree ([`Reading`]). Each rule cites the function that decides it:
-//! BT.CPP v4.10 (`src/controls/*.cpp`, `src/decorators/*.cpp`, `control_node.cpp`,
-//! `decorator_node.cpp`) and AS2FM's `*.ascxml` node models.
+//! Three readings, for the nodes where AS2FM's SCXML models of the built-in nodes and
+//! BehaviorTree.CPP disagree ([`Reading`]), and for BT.CPP the executor's options
+//! ([`Options`]: whether nodes have the wake-up signal, `tickOnce` or
+//! `tickExactlyOnce`). Each rule cites the function that decides it: BT.CPP 4.10
+//! (`src/controls/*.cpp`, `src/decorators/*.cpp`, `control_node.cpp`,
+//! `decorator_node.cpp`, `bt_factory.cpp`), BT.CPP 3.8 (the same files of the v3
+//! sources), and AS2FM's `*.ascxml` node models. Where the library the real-library
+//! differential runs (4.8.2, `tests/tests/bt_real.rs`) differs from 4.10, the comment says
+//! so.
 
 use super::tree::{CheckType, Kind, Operand, Status, Tree};
 use std::collections::BTreeMap;
@@ -15,13 +20,72 @@ pub enum Reading {
     /// AS2FM's node models (`as2fm-bt-nodes/*.ascxml`): a parent halts every child it
     /// resets, running or not, and each halted node runs its own halt; Parallel ticks every
     /// child on every tick; Repeat halts its child after each finished attempt;
-    /// SequenceWithMemory forgets its place when halted.
+    /// SequenceWithMemory forgets its place when halted; a leaf answers every tick.
     #[default]
     As2fm,
-    /// BehaviorTree.CPP 4.10: `ControlNode::haltChild` / `DecoratorNode::resetChild` halt
+    /// BehaviorTree.CPP 4: `ControlNode::haltChild` / `DecoratorNode::resetChild` halt
     /// a child only while it is RUNNING (else they just reset its status); Parallel skips
-    /// children that finished; SequenceWithMemory keeps its place when halted.
+    /// children that finished; SequenceWithMemory keeps its place when halted; a leaf is a
+    /// `StatefulActionNode`; with [`Options::from_xml`], the wake-up yields.
     Btcpp,
+    /// BehaviorTree.CPP 3.8: as 4 without wake-ups, but `SequenceStarNode::halt` resets
+    /// its index and `ParallelNode::tick` recounts every child in child order on each tick.
+    Btcpp3,
+}
+
+/// How the executor ticks the root (BT.CPP 4 `Tree::tickOnce` / `Tree::tickExactlyOnce`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TickMode {
+    /// `tickExactlyOnce`: one `executeTick` of the root per tick.
+    #[default]
+    ExactlyOnce,
+    /// `tickOnce`: the root ticked again while it answers RUNNING and a wake-up is pending
+    /// (what `tickWhileRunning` and the ROS 2 executors call).
+    Once,
+}
+
+/// Leaf callbacks one root tick may make before it counts as a livelock.
+pub const BUDGET: usize = 1000;
+
+/// Node ticks one root tick may make before it counts as a hang (a loop no leaf is in).
+pub const HANG: usize = 2_000_000;
+
+/// The reading and, for BT.CPP 4, how the tree was built and is ticked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Options {
+    /// Whose rules.
+    pub reading: Reading,
+    /// The factory built the tree from XML (`createTreeFromText`), as opposed to nodes
+    /// built by hand as BT.CPP's own unit tests do: every node has the wake-up signal
+    /// (`Tree::initialize`, `TreeNode::requiresWakeUp`), and the entries ports name in
+    /// `{}` were created at load. BT.CPP 4 only.
+    pub from_xml: bool,
+    /// How the root is ticked.
+    pub mode: TickMode,
+    /// Leaf callbacks per root tick before [`End::Livelock`].
+    pub budget: usize,
+}
+
+impl Options {
+    /// `reading` on nodes built by hand, ticked exactly once per tick.
+    pub fn of(reading: Reading) -> Self {
+        Options {
+            reading,
+            from_xml: false,
+            mode: TickMode::ExactlyOnce,
+            budget: BUDGET,
+        }
+    }
+
+    /// BT.CPP 4 on a tree `createTreeFromText` built, ticked in `mode`.
+    pub fn xml4(mode: TickMode) -> Self {
+        Options {
+            reading: Reading::Btcpp,
+            from_xml: true,
+            mode,
+            budget: BUDGET,
+        }
+    }
 }
 
 /// What a leaf received.
@@ -37,33 +101,188 @@ pub enum LeafEvent {
 /// `script[k % len]`; halts do not move it.
 pub type Scripts = BTreeMap<String, Vec<Status>>;
 
+/// How a run ended early.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum End {
+    /// BT.CPP refuses the tree when loading it: the name of the leaf type ("ID [..]
+    /// already registered") it refuses, or the names of the 3.x-only nodes, `|` between
+    /// them ("Node not recognized", "Unknown node type": which one it names first depends
+    /// on the stage of loading that meets it).
+    Refused(String),
+    /// BT.CPP throws during root tick `tick` (from 0); `text` is part of its message.
+    Error {
+        /// The root tick.
+        tick: usize,
+        /// What the exception's message contains.
+        text: String,
+    },
+    /// Root tick `tick` makes more than [`Options::budget`] leaf callbacks (it never
+    /// returns in BT.CPP); the log stops where that tick began.
+    Livelock {
+        /// The root tick.
+        tick: usize,
+    },
+    /// Root tick `tick` loops forever with no leaf callback at all.
+    Hang {
+        /// The root tick.
+        tick: usize,
+    },
+}
+
+/// A run: root status per tick until it ended, the leaves' log, and how it ended early.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Outcome {
+    /// Root status of each finished tick.
+    pub statuses: Vec<Status>,
+    /// Every tick and halt leaves received, in order.
+    pub log: Vec<LeafEvent>,
+    /// `None` when every tick ran.
+    pub end: Option<End>,
+}
+
+/// Why a tick stopped: BT.CPP's own outcome, or a case the oracle cannot run.
+#[derive(Debug)]
+enum Stop {
+    /// BT.CPP throws.
+    Error(String),
+    /// Too many leaf callbacks.
+    Livelock,
+    /// Too many node ticks.
+    Hang,
+    /// Not a BT.CPP fact: the case is outside what the oracle knows.
+    Model(String),
+}
+
+impl From<String> for Stop {
+    fn from(s: String) -> Self {
+        Stop::Model(s)
+    }
+}
+
+/// The built-in node names BT.CPP 4 registers (`BehaviorTreeFactory`'s constructor in
+/// `bt_factory.cpp`) among those the oracle knows; the others (`SequenceStar`,
+/// `RetryUntilSuccesful`, `BlackboardCheck*`) are 3.x names that 4 refuses at load.
+const V4_NAMES: &[&str] = &[
+    "Sequence",
+    "ReactiveSequence",
+    "SequenceWithMemory",
+    "Fallback",
+    "ReactiveFallback",
+    "Parallel",
+    "IfThenElse",
+    "Inverter",
+    "ForceSuccess",
+    "ForceFailure",
+    "Repeat",
+    "RetryUntilSuccessful",
+    "AlwaysSuccess",
+    "AlwaysFailure",
+    "SetBlackboard",
+    "AsyncSequence",
+    "AsyncFallback",
+    "ParallelAll",
+    "WhileDoElse",
+    "KeepRunningUntilFailure",
+    "RunOnce",
+    "Switch2",
+    "Switch3",
+    "Switch4",
+    "Switch5",
+    "Switch6",
+];
+
+/// The other built-in nodes BT.CPP 4.8.2 registers: a scripted leaf cannot take their
+/// names (`registerBuilder`: "ID [..] already registered"). (4.10 adds `TryCatch`.)
+const V4_OTHERS: &[&str] = &[
+    "Timeout",
+    "Delay",
+    "Script",
+    "ScriptCondition",
+    "Sleep",
+    "UnsetBlackboard",
+    "SubTree",
+    "Precondition",
+    "LoopInt",
+    "LoopBool",
+    "LoopDouble",
+    "LoopString",
+    "WasEntryUpdated",
+    "SkipUnlessUpdated",
+    "WaitValueUpdate",
+];
+
+/// What BT.CPP 4's factory refuses at load, if anything: a leaf type that has the
+/// name of a built-in node of 4 (`registerBuilder`: "ID [..] already registered"; the
+/// harness registers every scripted type first), or a built-in node of 3.x only, in any
+/// `<BehaviorTree>` of the document, used or not ("Node not recognized", `VerifyXML`).
+pub fn btcpp4_refuses(tree: &Tree, scripts: &Scripts) -> Option<String> {
+    if let Some(t) = scripts
+        .keys()
+        .find(|t| V4_NAMES.contains(&t.as_str()) || V4_OTHERS.contains(&t.as_str()))
+    {
+        return Some(t.clone());
+    }
+    let known = |t: &str| {
+        super::tree::NODES
+            .iter()
+            .any(|(names, _, _)| names.contains(&t))
+    };
+    let refused: Vec<&str> = tree
+        .names
+        .iter()
+        .map(|t| t.as_str())
+        .filter(|t| known(t) && !V4_NAMES.contains(t))
+        .collect();
+    (!refused.is_empty()).then(|| refused.join("|"))
+}
+
 /// The executor's state: per node its last status (`None`: IDLE) and its variables.
 pub struct Oracle<'t> {
     tree: &'t Tree,
     scripts: &'t Scripts,
+    opts: Options,
     reading: Reading,
     status: Vec<Option<Status>>,
     /// Child index (sequences, IfThenElse) or attempt count (Repeat, Retry).
     idx: Vec<i64>,
-    /// Parallel's finished children (BT.CPP reading) and counts.
+    /// Parallel's finished children (BT.CPP readings) and counts.
     done: Vec<Vec<bool>>,
     counts: Vec<(i64, i64)>,
     /// Ticks each leaf instance received.
     leaf_ticks: Vec<usize>,
+    /// RunOnce: the status its child finished with (`returned_status_`).
+    once: Vec<Option<Status>>,
     /// Entries as the text written (BT.CPP converts where a port reads).
     bb: BTreeMap<String, String>,
+    /// Literal writes of each entry so far (BT.CPP 4 SetBlackboard copies).
+    writes: BTreeMap<String, usize>,
+    /// Entries a failed BT.CPP 4 copy created typed `BT::Any`.
+    any_typed: std::collections::BTreeSet<String>,
+    /// Entries a SetBlackboard `value` port names (BT.CPP 4 creates them at load).
+    at_load: std::collections::BTreeSet<String>,
+    /// A wake-up signal is pending (`WakeUpSignal::emitSignal`, consumed by `waitFor`).
+    pending: bool,
+    /// Leaf callbacks and node ticks in the current root tick.
+    calls: usize,
+    node_ticks: usize,
     /// Every tick and halt leaves received, in order.
     pub log: Vec<LeafEvent>,
 }
 
 impl<'t> Oracle<'t> {
-    /// A tree with every node idle.
+    /// A tree with every node idle, read as `reading` on nodes built by hand.
     pub fn new(tree: &'t Tree, scripts: &'t Scripts, reading: Reading) -> Self {
+        Self::with(tree, scripts, Options::of(reading))
+    }
+
+    /// A tree with every node idle.
+    pub fn with(tree: &'t Tree, scripts: &'t Scripts, opts: Options) -> Self {
         let n = tree.nodes.len();
         Oracle {
             tree,
             scripts,
-            reading,
+            opts,
+            reading: opts.reading,
             status: vec![None; n],
             idx: vec![0; n],
             done: tree
@@ -73,15 +292,61 @@ impl<'t> Oracle<'t> {
                 .collect(),
             counts: vec![(0, 0); n],
             leaf_ticks: vec![0; n],
+            once: vec![None; n],
             bb: BTreeMap::new(),
+            writes: BTreeMap::new(),
+            any_typed: Default::default(),
+            at_load: tree
+                .nodes
+                .iter()
+                .filter_map(|x| match &x.kind {
+                    Kind::SetBlackboard(_, Operand::Entry(e)) => Some(e.clone()),
+                    _ => None,
+                })
+                .collect(),
+            pending: false,
+            calls: 0,
+            node_ticks: 0,
             log: Vec::new(),
         }
     }
 
-    /// One tick of the root. Like `Tree::tickRoot` (v4 `bt_factory.cpp`), a finished root
-    /// is ticked again from where its own rules left it.
+    fn btcpp(&self) -> bool {
+        self.reading != Reading::As2fm
+    }
+
+    /// One tick of the root.
+    ///
+    /// AS2FM: a finished root is ticked again from where its own rules left it. BT.CPP 4
+    /// `Tree::tickRoot` (`bt_factory.cpp`): under `tickOnce` (not `tickExactlyOnce`) the
+    /// root is ticked again while it answers RUNNING and `wake_up_->waitFor(0)` finds a
+    /// signal (which it consumes); a finished root gets `rootNode()->resetStatus()` (its
+    /// own status only). A signal left pending by a tick that finished stays for the next
+    /// one. BT.CPP 3.8 `Tree::tickRoot` (`bt_factory.h`) resets a finished root's status.
     pub fn tick_root(&mut self) -> Result<Status, String> {
-        self.tick(0)
+        self.tick_root_stop().map_err(|e| match e {
+            Stop::Error(t) => format!("BT.CPP throws: {t}"),
+            Stop::Livelock => "livelock: the tick never returns".into(),
+            Stop::Hang => "hang: the tick never returns".into(),
+            Stop::Model(t) => t,
+        })
+    }
+
+    fn tick_root_stop(&mut self) -> Result<Status, Stop> {
+        self.calls = 0;
+        self.node_ticks = 0;
+        let mut s = self.tick(0)?;
+        if self.btcpp() {
+            if self.opts.mode == TickMode::Once {
+                while s == Status::Running && std::mem::take(&mut self.pending) {
+                    s = self.tick(0)?;
+                }
+            }
+            if s != Status::Running {
+                self.status[0] = None;
+            }
+        }
+        Ok(s)
     }
 
     fn child(&self, n: usize, i: usize) -> usize {
@@ -131,7 +396,13 @@ impl<'t> Oracle<'t> {
     }
 
     /// `TreeNode::executeTick`: the node's tick, its answer kept as its status.
-    fn tick(&mut self, n: usize) -> Result<Status, String> {
+    fn tick(&mut self, n: usize) -> Result<Status, Stop> {
+        if self.btcpp() {
+            self.node_ticks += 1;
+            if self.node_ticks > HANG {
+                return Err(Stop::Hang);
+            }
+        }
         let s = self.tick_inner(n)?;
         self.status[n] = Some(s);
         Ok(s)
@@ -159,24 +430,29 @@ impl<'t> Oracle<'t> {
     /// The node's own `halt()`.
     fn halt(&mut self, n: usize) {
         match &self.tree.nodes[n].kind {
+            // `StatefulActionNode::halt` calls `onHalted` (only ever reached while
+            // RUNNING in BT.CPP, see `halt_child`).
             Kind::Leaf(_) => self.log.push(LeafEvent::Halt(self.tree.nodes[n].id)),
             Kind::AlwaysSuccess | Kind::AlwaysFailure | Kind::SetBlackboard(..) => {}
             // v4 `SequenceWithMemory::halt` keeps `current_child_idx_`; AS2FM's
-            // `sequence_with_memory.ascxml` (and v3.8 `SequenceStarNode::halt`) reset it.
+            // `sequence_with_memory.ascxml` and v3.8 `SequenceStarNode::halt` reset it.
             Kind::SequenceWithMemory => {
-                if self.reading == Reading::As2fm {
+                if self.reading != Reading::Btcpp {
                     self.idx[n] = 0;
                 }
                 self.reset_children(n);
             }
-            // `ParallelNode::halt` clears; AS2FM's counts restart on every tick anyway.
-            Kind::Parallel(..) => {
+            // `ParallelNode::halt` / `ParallelAllNode::halt` clear; AS2FM's counts restart
+            // on every tick anyway.
+            Kind::Parallel(..) | Kind::ParallelAll(_) => {
                 self.done[n].iter_mut().for_each(|d| *d = false);
                 self.counts[n] = (0, 0);
                 self.reset_children(n);
             }
             // `SequenceNode::halt`, `FallbackNode::halt`, `IfThenElseNode::halt`,
-            // `RepeatNode::halt`, `RetryNode::halt`: the index or count back to 0.
+            // `RepeatNode::halt`, `RetryNode::halt`: the index or count back to 0;
+            // `SwitchNode::halt`: `running_child_ = -1`; `RunOnceNode` (DecoratorNode::halt)
+            // keeps `already_ticked_`.
             _ => {
                 self.idx[n] = 0;
                 self.reset_children(n);
@@ -185,11 +461,25 @@ impl<'t> Oracle<'t> {
         self.status[n] = None;
     }
 
-    fn tick_inner(&mut self, n: usize) -> Result<Status, String> {
+    fn tick_inner(&mut self, n: usize) -> Result<Status, Stop> {
         use Status::*;
         let kind = &self.tree.nodes[n].kind;
         match kind {
             Kind::Leaf(ty) => {
+                // BT.CPP's scripted leaf is a `StatefulActionNode` (the real-library
+                // harness registers it so): `StatefulActionNode::tick` calls `onStart`
+                // when IDLE, `onRunning` when RUNNING, and otherwise answers its last
+                // status without calling anything (a finished leaf its parent did not
+                // reset, e.g. a 2-child IfThenElse's failed condition).
+                if self.btcpp() {
+                    if let Some(s @ (Success | Failure)) = self.status[n] {
+                        return Ok(s);
+                    }
+                    self.calls += 1;
+                    if self.calls > self.opts.budget {
+                        return Err(Stop::Livelock);
+                    }
+                }
                 self.log.push(LeafEvent::Tick(self.tree.nodes[n].id));
                 let script = self
                     .scripts
@@ -200,11 +490,25 @@ impl<'t> Oracle<'t> {
                 self.leaf_ticks[n] += 1;
                 Ok(s)
             }
-            Kind::Sequence => self.sequence(n, Success, Failure),
-            Kind::Fallback => self.sequence(n, Failure, Success),
+            Kind::Sequence => self.sequence(n, Success, Failure, false),
+            Kind::Fallback => self.sequence(n, Failure, Success, false),
+            _ if !self.btcpp() && self.tree.nodes[n].kind.btcpp4_only() => Err(Stop::Model(
+                format!("{} has no AS2FM model", self.tree.nodes[n].tag),
+            )),
+            Kind::AsyncSequence => self.sequence(n, Success, Failure, true),
+            Kind::AsyncFallback => self.sequence(n, Failure, Success, true),
+            &Kind::ParallelAll(f) => self.parallel_all(n, f),
+            Kind::WhileDoElse => self.while_do_else(n),
+            Kind::KeepRunningUntilFailure => self.keep_running(n),
+            Kind::RunOnce => self.run_once(n),
+            Kind::Switch(v, cases) => {
+                let (v, cases) = (v.clone(), cases.clone());
+                self.switch(n, &v, &cases)
+            }
             Kind::SequenceWithMemory => self.sequence_with_memory(n),
             Kind::ReactiveSequence => self.reactive(n, Success, Failure),
             Kind::ReactiveFallback => self.reactive(n, Failure, Success),
+            &Kind::Parallel(s, f) if self.reading == Reading::Btcpp3 => self.parallel3(n, s, f),
             &Kind::Parallel(s, f) => self.parallel(n, s, f),
             Kind::IfThenElse => self.if_then_else(n),
             Kind::Inverter => self.decorate(n, |s| match s {
@@ -214,36 +518,86 @@ impl<'t> Oracle<'t> {
             }),
             Kind::ForceSuccess => self.decorate(n, |s| if s == Running { s } else { Success }),
             Kind::ForceFailure => self.decorate(n, |s| if s == Running { s } else { Failure }),
+            &Kind::Repeat(max) if self.btcpp() => self.repeat_btcpp(n, max, Success),
+            &Kind::Retry(max) if self.btcpp() => self.repeat_btcpp(n, max, Failure),
             &Kind::Repeat(max) => self.repeat(n, max, Success),
             &Kind::Retry(max) => self.repeat(n, max, Failure),
             Kind::AlwaysSuccess => Ok(Success),
             Kind::AlwaysFailure => Ok(Failure),
-            // v4 `SetBlackboardNode::tick`: a `{other}` value copies that entry.
-            Kind::SetBlackboard(key, v) => {
-                let v = self.value(v)?;
-                self.bb.insert(key.clone(), v);
-                Ok(Success)
-            }
-            Kind::Check(ty, a, b, mismatch) => {
-                let mismatch = *mismatch;
+            Kind::SetBlackboard(key, v) => self.set_blackboard(key, v),
+            Kind::Check(ty, a, b, mismatch, numeric) => {
+                let (ty, mut mismatch, numeric) = (*ty, *mismatch, *numeric);
                 let c = self.child(n, 0);
-                // v3.8 `BlackboardPreconditionNode::tick`; AS2FM's
-                // `blackboard_check_int.ascxml` halts the child on a mismatch.
-                if self.same(*ty, a, b)? {
+                // v3.8 `BlackboardPreconditionNode::tick`: `getInput("return_on_mismatch")`
+                // converts with `convertFromString<NodeStatus>`, which knows the names
+                // only; AS2FM's numbers fail to convert and the default FAILURE stays.
+                if numeric && self.btcpp() {
+                    mismatch = Failure;
+                }
+                if self.same(ty, a, b)? {
+                    // v3.8: `return child_node_->executeTick()`; the child is not reset.
                     self.tick(c)
                 } else {
-                    self.halt_child(c);
+                    // v3.8: `haltChild()` only if the child is RUNNING (a finished child
+                    // keeps its status). AS2FM's `blackboard_check_int.ascxml` halts the
+                    // child on every mismatch.
+                    if !self.btcpp() || self.status[c] == Some(Running) {
+                        self.halt_child(c);
+                    }
                     Ok(mismatch)
                 }
             }
         }
     }
 
+    /// `SetBlackboard`. v4 `SetBlackboardNode::tick`: a `{other}` value copies that
+    /// entry. The real library (4.8.2) breaks on the string entries `SetBlackboard`
+    /// writes, as found against it (`tests/bt/real/set_blackboard.toml`): an entry some
+    /// SetBlackboard's `value` port names in `{}` is created at load (typed for any
+    /// type); its first literal write succeeds but leaves it typed `BT::Any` and without a
+    /// value a copy can read, and every later literal write throws ("Can't convert string
+    /// [..] to type [BT::Any]", the `parseString` in `SetBlackboardNode::tick`). So a copy
+    /// always answers FAILURE (`out_value.empty()`), creating its destination typed
+    /// `BT::Any` if it did not exist (a literal write to it then throws). 3.8
+    /// `SetBlackboard::tick` copies the value (`dst_entry->value = src_entry->value`).
+    fn set_blackboard(&mut self, key: &str, v: &Operand) -> Result<Status, Stop> {
+        if self.reading == Reading::Btcpp && self.opts.from_xml {
+            let written = self.writes.get(key).copied().unwrap_or(0);
+            let at_load = self.at_load.contains(key);
+            match v {
+                Operand::Entry(_) => {
+                    if written == 0 && !at_load {
+                        self.any_typed.insert(key.to_string());
+                    }
+                    return Ok(Status::Failure);
+                }
+                Operand::Lit(_) if self.any_typed.contains(key) || (at_load && written > 0) => {
+                    return Err(Stop::Error("Can't convert string".into()));
+                }
+                Operand::Lit(_) => {}
+            }
+        }
+        let v = self.value(v)?;
+        self.bb.insert(key.to_string(), v);
+        *self.writes.entry(key.to_string()).or_default() += 1;
+        Ok(Status::Success)
+    }
+
     /// `SequenceNode::tick` (`cont` SUCCESS) and `FallbackNode::tick` (`cont` FAILURE);
-    /// AS2FM's `sequence.ascxml` / `fallback.ascxml` halt every child on finishing.
-    fn sequence(&mut self, n: usize, cont: Status, stop: Status) -> Result<Status, String> {
-        while (self.idx[n] as usize) < self.n_children(n) {
+    /// AS2FM's `sequence.ascxml` / `fallback.ascxml` halt every child on finishing. Only
+    /// the `AsyncSequence` / `AsyncFallback` registrations (`asynch_`) yield on a
+    /// wake-up, as SequenceWithMemory does.
+    fn sequence(
+        &mut self,
+        n: usize,
+        cont: Status,
+        stop: Status,
+        asynch: bool,
+    ) -> Result<Status, Stop> {
+        let len = self.n_children(n);
+        while (self.idx[n] as usize) < len {
             let c = self.child(n, self.idx[n] as usize);
+            let prev = self.status[c];
             match self.tick(c)? {
                 Status::Running => return Ok(Status::Running),
                 s if s == stop => {
@@ -251,7 +605,12 @@ impl<'t> Oracle<'t> {
                     self.idx[n] = 0;
                     return Ok(stop);
                 }
-                _ => self.idx[n] += 1,
+                _ => {
+                    self.idx[n] += 1;
+                    if asynch && (self.idx[n] as usize) < len && self.yields(prev) {
+                        return Ok(Status::Running);
+                    }
+                }
             }
         }
         self.reset_children(n);
@@ -259,14 +618,18 @@ impl<'t> Oracle<'t> {
         Ok(cont)
     }
 
-    /// `SequenceWithMemory::tick`: a failure keeps the index. v4 then halts the children
-    /// from the failed one on (`haltChild(i)` for `i >= current_child_idx_`); AS2FM's
-    /// `halt_current_child` state halts the failed child alone.
-    fn sequence_with_memory(&mut self, n: usize) -> Result<Status, String> {
+    /// `SequenceWithMemory::tick`: a failure keeps the index. BT.CPP (4 and 3.8
+    /// `SequenceStarNode::tick`) then halts the children from the failed one on
+    /// (`haltChild(i)` for `i >= current_child_idx_`); AS2FM's `halt_current_child` state
+    /// halts the failed child alone. BT.CPP 4 with the wake-up signal: a child that was
+    /// IDLE before this tick and succeeds while more children remain makes it emit the
+    /// signal and answer RUNNING (`requiresWakeUp() && prev_status == IDLE`).
+    fn sequence_with_memory(&mut self, n: usize) -> Result<Status, Stop> {
         let len = self.n_children(n);
         while (self.idx[n] as usize) < len {
             let at = self.idx[n] as usize;
             let c = self.child(n, at);
+            let prev = self.status[c];
             match self.tick(c)? {
                 Status::Running => return Ok(Status::Running),
                 Status::Failure => {
@@ -281,7 +644,12 @@ impl<'t> Oracle<'t> {
                     }
                     return Ok(Status::Failure);
                 }
-                Status::Success => self.idx[n] += 1,
+                Status::Success => {
+                    self.idx[n] += 1;
+                    if (self.idx[n] as usize) < len && self.yields(prev) {
+                        return Ok(Status::Running);
+                    }
+                }
             }
         }
         self.reset_children(n);
@@ -289,10 +657,154 @@ impl<'t> Oracle<'t> {
         Ok(Status::Success)
     }
 
+    /// Whether a node yields after a child that was `prev` before the tick finished
+    /// (BT.CPP 4 `requiresWakeUp() && prev_status == NodeStatus::IDLE`), emitting the
+    /// wake-up signal (`emitWakeUpSignal`) if so.
+    fn yields(&mut self, prev: Option<Status>) -> bool {
+        let y = self.reading == Reading::Btcpp && self.opts.from_xml && prev.is_none();
+        if y {
+            self.pending = true;
+        }
+        y
+    }
+
+    /// `ParallelAllNode::tick` (4.10): every child not yet finished is ticked; once all
+    /// have finished, `haltChildren()` and FAILURE if at least `max_failures` failed
+    /// (negative counts from the end), else SUCCESS; throws when `max_failures` exceeds
+    /// the children ("Number of children is less than threshold").
+    fn parallel_all(&mut self, n: usize, f: i64) -> Result<Status, Stop> {
+        let len = self.n_children(n);
+        let th = if f < 0 {
+            (len as i64 + f + 1).max(0)
+        } else {
+            f
+        };
+        if (len as i64) < th {
+            return Err(Stop::Error(
+                "Number of children is less than threshold".into(),
+            ));
+        }
+        for i in 0..len {
+            if self.done[n][i] {
+                continue;
+            }
+            let c = self.child(n, i);
+            match self.tick(c)? {
+                Status::Success => self.done[n][i] = true,
+                Status::Failure => {
+                    self.done[n][i] = true;
+                    self.counts[n].1 += 1;
+                }
+                Status::Running => {}
+            }
+        }
+        if self.done[n].iter().all(|d| *d) {
+            self.reset_children(n);
+            self.done[n].iter_mut().for_each(|d| *d = false);
+            let failed = self.counts[n].1 >= th;
+            self.counts[n] = (0, 0);
+            return Ok(if failed {
+                Status::Failure
+            } else {
+                Status::Success
+            });
+        }
+        Ok(Status::Running)
+    }
+
+    /// `WhileDoElseNode::tick` (4.10): the condition on every tick; SUCCESS halts the
+    /// else branch (`haltChild(2)`) and ticks the do branch, FAILURE halts the do branch
+    /// and ticks the else branch (with two children, FAILURE); a finished answer resets
+    /// every child (the condition stays as it finished while a branch runs).
+    fn while_do_else(&mut self, n: usize) -> Result<Status, Stop> {
+        let len = self.n_children(n);
+        let cond = self.child(n, 0);
+        let s = match self.tick(cond)? {
+            Status::Running => return Ok(Status::Running),
+            Status::Success => {
+                if len == 3 {
+                    let e = self.child(n, 2);
+                    self.halt_child(e);
+                }
+                let d = self.child(n, 1);
+                self.tick(d)?
+            }
+            Status::Failure if len == 3 => {
+                let d = self.child(n, 1);
+                self.halt_child(d);
+                let e = self.child(n, 2);
+                self.tick(e)?
+            }
+            Status::Failure => Status::Failure,
+        };
+        if s != Status::Running {
+            self.reset_children(n);
+        }
+        Ok(s)
+    }
+
+    /// `KeepRunningUntilFailureNode::tick` (4.10): a finished child is reset; its
+    /// SUCCESS is RUNNING, its FAILURE FAILURE.
+    fn keep_running(&mut self, n: usize) -> Result<Status, Stop> {
+        let c = self.child(n, 0);
+        let s = self.tick(c)?;
+        if s == Status::Running {
+            return Ok(s);
+        }
+        self.halt_child(c);
+        Ok(if s == Status::Success {
+            Status::Running
+        } else {
+            Status::Failure
+        })
+    }
+
+    /// `RunOnceNode::tick` (4.10) with `then_skip` false: once the child has finished
+    /// (then reset), the node answers that status for ever without ticking it; a halt
+    /// (`DecoratorNode::halt`) does not forget it.
+    fn run_once(&mut self, n: usize) -> Result<Status, Stop> {
+        if let Some(s) = self.once[n] {
+            return Ok(s);
+        }
+        let c = self.child(n, 0);
+        let s = self.tick(c)?;
+        if s != Status::Running {
+            self.once[n] = Some(s);
+            self.halt_child(c);
+        }
+        Ok(s)
+    }
+
+    /// `SwitchNode::tick` (4.10): the first `case_i` equal to `variable` picks child i,
+    /// none (or no variable) the last; a child that ran on an earlier tick and is not
+    /// the one picked is halted (`haltChild(running_child_)`); a finished answer resets
+    /// every child.
+    fn switch(&mut self, n: usize, v: &Operand, cases: &[String]) -> Result<Status, Stop> {
+        let value = self.value(v).ok();
+        let pick = value
+            .and_then(|v| cases.iter().position(|c| *c == v))
+            .unwrap_or(cases.len());
+        // `running_child_` + 1 (0: none).
+        let running = self.idx[n] - 1;
+        if running >= 0 && running as usize != pick {
+            let c = self.child(n, running as usize);
+            self.halt_child(c);
+        }
+        let c = self.child(n, pick);
+        let s = self.tick(c)?;
+        if s == Status::Running {
+            self.idx[n] = pick as i64 + 1;
+        } else {
+            self.reset_children(n);
+            self.idx[n] = 0;
+        }
+        Ok(s)
+    }
+
     /// `ReactiveSequence::tick` / `ReactiveFallback::tick` (and AS2FM's
     /// `reactive_sequence.ascxml` / `reactive_fallback.ascxml`): every tick starts at the
     /// first child; a RUNNING child halts all the others.
-    fn reactive(&mut self, n: usize, cont: Status, stop: Status) -> Result<Status, String> {
+    fn reactive(&mut self, n: usize, cont: Status, stop: Status) -> Result<Status, Stop> {
         let len = self.n_children(n);
         for i in 0..len {
             let c = self.child(n, i);
@@ -316,35 +828,43 @@ impl<'t> Oracle<'t> {
     }
 
     /// `ParallelNode::tick` (v4: finished children are not ticked again, counts build up
-    /// across ticks, FAILURE also when success can no longer be reached) against AS2FM's
-    /// `parallel.ascxml` (every child ticked on every tick, counts from zero, the
-    /// thresholds checked after each child).
-    fn parallel(&mut self, n: usize, s: i64, f: i64) -> Result<Status, String> {
+    /// across ticks, FAILURE also when success can no longer be reached, both checked
+    /// after each child) against AS2FM's `parallel.ascxml` (every child ticked on every
+    /// tick, counts from zero, the thresholds checked after each child). v4 throws when a
+    /// threshold exceeds the children ("Number of children is less than threshold").
+    fn parallel(&mut self, n: usize, s: i64, f: i64) -> Result<Status, Stop> {
         let len = self.n_children(n) as i64;
         let th = |t: i64| if t < 0 { (len + t + 1).max(0) } else { t };
         let (s, f) = (th(s), th(f));
+        if self.btcpp() && (s > len || f > len) {
+            return Err(Stop::Error(
+                "Number of children is less than threshold".into(),
+            ));
+        }
         if self.reading == Reading::As2fm {
             self.counts[n] = (0, 0);
         }
+        let btcpp = self.btcpp();
         for i in 0..len as usize {
             if !self.done[n][i] {
                 let c = self.child(n, i);
                 match self.tick(c)? {
                     Status::Success => {
                         self.counts[n].0 += 1;
-                        self.done[n][i] = self.reading == Reading::Btcpp;
+                        self.done[n][i] = btcpp;
                     }
                     Status::Failure => {
                         self.counts[n].1 += 1;
-                        self.done[n][i] = self.reading == Reading::Btcpp;
+                        self.done[n][i] = btcpp;
                     }
                     Status::Running => {}
                 }
             }
             let (sc, fc) = self.counts[n];
-            let fail = match self.reading {
-                Reading::As2fm => fc >= f,
-                Reading::Btcpp => len - fc < s || fc == f,
+            let fail = if btcpp {
+                len - fc < s || fc == f
+            } else {
+                fc >= f
             };
             if sc >= s || fail {
                 self.done[n].iter_mut().for_each(|d| *d = false);
@@ -360,10 +880,57 @@ impl<'t> Oracle<'t> {
         Ok(Status::Running)
     }
 
+    /// v3.8 `ParallelNode::tick`: every tick counts from zero over all children in
+    /// order; a child in the skip list (finished on an earlier tick) is not ticked but
+    /// counts with its kept status; after each child, SUCCESS once the successes equal
+    /// the threshold, FAILURE once the failures exceed `children - success threshold` or
+    /// equal the failure threshold.
+    fn parallel3(&mut self, n: usize, s: i64, f: i64) -> Result<Status, Stop> {
+        let len = self.n_children(n) as i64;
+        let th = |t: i64| if t < 0 { (len + t + 1).max(0) } else { t };
+        let (s, f) = (th(s), th(f));
+        if s > len || f > len {
+            return Err(Stop::Error(
+                "Number of children is less than threshold".into(),
+            ));
+        }
+        let (mut sc, mut fc) = (0, 0);
+        for i in 0..len as usize {
+            let c = self.child(n, i);
+            let st = if self.done[n][i] {
+                self.status[c].ok_or_else(|| Stop::Model("skipped child is idle".into()))?
+            } else {
+                self.tick(c)?
+            };
+            match st {
+                Status::Success => {
+                    self.done[n][i] = true;
+                    sc += 1;
+                    if sc == s {
+                        self.done[n].iter_mut().for_each(|d| *d = false);
+                        self.reset_children(n);
+                        return Ok(Status::Success);
+                    }
+                }
+                Status::Failure => {
+                    self.done[n][i] = true;
+                    fc += 1;
+                    if fc > len - s || fc == f {
+                        self.done[n].iter_mut().for_each(|d| *d = false);
+                        self.reset_children(n);
+                        return Ok(Status::Failure);
+                    }
+                }
+                Status::Running => {}
+            }
+        }
+        Ok(Status::Running)
+    }
+
     /// `IfThenElseNode::tick` (AS2FM's `if_then_else.ascxml` alike): the condition while
     /// no branch runs; a two-child node whose condition fails answers FAILURE without
     /// resetting anything.
-    fn if_then_else(&mut self, n: usize) -> Result<Status, String> {
+    fn if_then_else(&mut self, n: usize) -> Result<Status, Stop> {
         if self.idx[n] == 0 {
             let c = self.child(n, 0);
             match self.tick(c)? {
@@ -382,37 +949,38 @@ impl<'t> Oracle<'t> {
         Ok(s)
     }
 
-    /// Inverter / ForceSuccess / ForceFailure (`InverterNode::tick`, ...): v4 resets a
-    /// finished child's status (`resetChild`, no halt since it is not RUNNING); AS2FM's
+    /// Inverter / ForceSuccess / ForceFailure (`InverterNode::tick`, ...): BT.CPP resets
+    /// a finished child's status (`resetChild`, no halt since it is not RUNNING); AS2FM's
     /// models do nothing to it.
-    fn decorate(&mut self, n: usize, map: fn(Status) -> Status) -> Result<Status, String> {
+    fn decorate(&mut self, n: usize, map: fn(Status) -> Status) -> Result<Status, Stop> {
         let c = self.child(n, 0);
         let s = self.tick(c)?;
-        if s != Status::Running && self.reading == Reading::Btcpp {
+        if s != Status::Running && self.btcpp() {
             self.halt_child(c);
         }
         Ok(map(s))
     }
 
-    /// `RepeatNode::tick` (`again` SUCCESS) and `RetryNode::tick` (`again` FAILURE): the
-    /// child is ticked again in the same tick until the count is used up. v4 calls
-    /// `resetChild()` after every finished attempt (a no-op halt: the child is not
-    /// RUNNING). AS2FM's `repeat_node.ascxml` halts the child after each attempt
-    /// (`bt_halt_child` in `tick_child`); its `retry_node.ascxml` never does.
-    fn repeat(&mut self, n: usize, max: i64, again: Status) -> Result<Status, String> {
+    /// AS2FM's `repeat_node.ascxml` (`again` SUCCESS) and `retry_node.ascxml` (`again`
+    /// FAILURE): the child is ticked again in the same tick until the count is used up;
+    /// the Repeat halts the child after each attempt (`bt_halt_child` in `tick_child`),
+    /// the Retry never does.
+    fn repeat(&mut self, n: usize, max: i64, again: Status) -> Result<Status, Stop> {
         let stop = if again == Status::Success {
             Status::Failure
         } else {
             Status::Success
         };
         let c = self.child(n, 0);
-        let halts = self.reading == Reading::Btcpp || again == Status::Success;
+        let halts = again == Status::Success;
         let mut spins = 0;
         while max == -1 || self.idx[n] < max {
             // -1 repeats without end: a child that never stops would hang BT.CPP too.
             spins += 1;
             if spins > 10_000 {
-                return Err("a Repeat/Retry of -1 never stops within one tick".into());
+                return Err(Stop::Model(
+                    "a Repeat/Retry of -1 never stops within one tick".into(),
+                ));
             }
             let s = self.tick(c)?;
             if s == Status::Running {
@@ -433,9 +1001,42 @@ impl<'t> Oracle<'t> {
         self.idx[n] = 0;
         Ok(again)
     }
+
+    /// `RepeatNode::tick` (`again` SUCCESS) and `RetryNode::tick` (`again` FAILURE), 4.10
+    /// and 3.8: while the count allows (`count < max || max == -1`) the child is ticked;
+    /// `again` counts an attempt and resets the child (`resetChild`), the other finished
+    /// status resets count and child and is the answer, RUNNING is the answer. BT.CPP 4
+    /// with the wake-up signal: after an `again` from a child that was IDLE before, with
+    /// attempts left, the node emits the signal and answers RUNNING.
+    fn repeat_btcpp(&mut self, n: usize, max: i64, again: Status) -> Result<Status, Stop> {
+        let c = self.child(n, 0);
+        let mut more = self.idx[n] < max || max == -1;
+        while more {
+            let prev = self.status[c];
+            match self.tick(c)? {
+                Status::Running => return Ok(Status::Running),
+                s if s == again => {
+                    self.idx[n] += 1;
+                    more = self.idx[n] < max || max == -1;
+                    self.halt_child(c);
+                    if more && self.yields(prev) {
+                        return Ok(Status::Running);
+                    }
+                }
+                s => {
+                    self.idx[n] = 0;
+                    self.halt_child(c);
+                    return Ok(s);
+                }
+            }
+        }
+        self.idx[n] = 0;
+        Ok(again)
+    }
 }
 
-/// Runs `ticks` root ticks: the root's status at each and the leaves' log.
+/// Runs `ticks` root ticks of nodes built by hand: the root's status at each and the
+/// leaves' log; any early end is an error.
 pub fn run(
     tree: &Tree,
     scripts: &Scripts,
@@ -448,4 +1049,44 @@ pub fn run(
         out.push(o.tick_root()?);
     }
     Ok((out, o.log))
+}
+
+/// Runs up to `ticks` root ticks under `opts`, stopping where BT.CPP would throw or never
+/// return. `Err` only for a case the oracle cannot run (a leaf without a script, an entry
+/// read before it is written).
+pub fn run_with(
+    tree: &Tree,
+    scripts: &Scripts,
+    opts: Options,
+    ticks: usize,
+) -> Result<Outcome, String> {
+    let mut o = Oracle::with(tree, scripts, opts);
+    let mut statuses = Vec::with_capacity(ticks);
+    let mut end = None;
+    for tick in 0..ticks {
+        let mark = o.log.len();
+        match o.tick_root_stop() {
+            Ok(s) => statuses.push(s),
+            Err(Stop::Model(e)) => return Err(e),
+            Err(Stop::Error(text)) => {
+                end = Some(End::Error { tick, text });
+                break;
+            }
+            Err(Stop::Livelock) => {
+                o.log.truncate(mark);
+                end = Some(End::Livelock { tick });
+                break;
+            }
+            Err(Stop::Hang) => {
+                o.log.truncate(mark);
+                end = Some(End::Hang { tick });
+                break;
+            }
+        }
+    }
+    Ok(Outcome {
+        statuses,
+        log: o.log,
+        end,
+    })
 }

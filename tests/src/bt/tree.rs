@@ -105,9 +105,40 @@ pub enum Kind {
     AlwaysFailure,
     /// `SetBlackboard`: the entry and the text written, or the entry copied.
     SetBlackboard(String, Operand),
+    /// `AsyncSequence` (BT.CPP 4).
+    AsyncSequence,
+    /// `AsyncFallback` (BT.CPP 4).
+    AsyncFallback,
+    /// `ParallelAll` with `max_failures` as written (BT.CPP 4).
+    ParallelAll(i64),
+    /// `WhileDoElse` (BT.CPP 4).
+    WhileDoElse,
+    /// `KeepRunningUntilFailure` (BT.CPP 4).
+    KeepRunningUntilFailure,
+    /// `RunOnce` with `then_skip="false"` (BT.CPP 4; skipping answers SKIPPED, a status
+    /// the oracle does not model).
+    RunOnce,
+    /// `Switch2` ... `Switch6`: the `variable` and the `case_1..N` values (BT.CPP 4).
+    Switch(Operand, Vec<String>),
     /// `BlackboardCheckInt/Double/String/Bool`: `value_A`, `value_B`,
-    /// `return_on_mismatch`.
-    Check(CheckType, Operand, Operand, Status),
+    /// `return_on_mismatch`, and whether that was written as one of AS2FM's numbers.
+    Check(CheckType, Operand, Operand, Status, bool),
+}
+
+impl Kind {
+    /// A BT.CPP 4 node AS2FM has no model of (the lowering does not take it).
+    pub fn btcpp4_only(&self) -> bool {
+        matches!(
+            self,
+            Kind::AsyncSequence
+                | Kind::AsyncFallback
+                | Kind::ParallelAll(_)
+                | Kind::WhileDoElse
+                | Kind::KeepRunningUntilFailure
+                | Kind::RunOnce
+                | Kind::Switch(..)
+        )
+    }
 }
 
 /// A node of the flattened tree.
@@ -115,6 +146,12 @@ pub enum Kind {
 pub struct Node {
     /// 1000, 1001, ... in pre-order.
     pub id: u32,
+    /// The number BT.CPP 4 gives the node (`TreeNode::UID`): it counts from 1 in the order
+    /// the factory creates nodes, depth-first pre-order with each SubTree node (which the
+    /// flat tree drops) before its body.
+    pub uid: u32,
+    /// The element name as written (`SequenceStar`, `BlackboardCheckInt`, a leaf type).
+    pub tag: String,
     /// What it is.
     pub kind: Kind,
     /// Indices into [`Tree::nodes`].
@@ -126,6 +163,22 @@ pub struct Node {
 pub struct Tree {
     /// The nodes, pre-order.
     pub nodes: Vec<Node>,
+    /// Every node element's name (an `Action`'s `ID`) in every `<BehaviorTree>` of the
+    /// document, used or not, in document order: BT.CPP checks them all at load.
+    pub names: Vec<String>,
+}
+
+fn names(el: &El, out: &mut Vec<String>) {
+    let name = match el.name.as_str() {
+        "Action" | "Condition" | "Control" | "Decorator" => {
+            el.attrs.get("ID").cloned().unwrap_or_default()
+        }
+        n => n.to_string(),
+    };
+    out.push(name);
+    for c in &el.children {
+        names(c, out);
+    }
 }
 
 /// How many children a kind takes: (least, most).
@@ -168,6 +221,26 @@ pub const NODES: &[(&[&str], Arity, Make)] = &[
         (1, 1),
         |a| Ok(Kind::Retry(int(a, "num_attempts")?)),
     ),
+    (&["AsyncSequence"], (1, ANY), |_| Ok(Kind::AsyncSequence)),
+    (&["AsyncFallback"], (1, ANY), |_| Ok(Kind::AsyncFallback)),
+    (&["ParallelAll"], (1, ANY), |a| {
+        Ok(Kind::ParallelAll(int_or(a, &["max_failures"], 1)?))
+    }),
+    (&["WhileDoElse"], (2, 3), |_| Ok(Kind::WhileDoElse)),
+    (&["KeepRunningUntilFailure"], (1, 1), |_| {
+        Ok(Kind::KeepRunningUntilFailure)
+    }),
+    (&["RunOnce"], (1, 1), |a| {
+        match a.get("then_skip").map(|s| s.trim()) {
+            Some("false") => Ok(Kind::RunOnce),
+            _ => Err("RunOnce without then_skip=\"false\" answers SKIPPED, which the oracle does not model".into()),
+        }
+    }),
+    (&["Switch2"], (3, 3), |a| switch(a, 2)),
+    (&["Switch3"], (4, 4), |a| switch(a, 3)),
+    (&["Switch4"], (5, 5), |a| switch(a, 4)),
+    (&["Switch5"], (6, 6), |a| switch(a, 5)),
+    (&["Switch6"], (7, 7), |a| switch(a, 6)),
     (&["AlwaysSuccess"], (0, 0), |_| Ok(Kind::AlwaysSuccess)),
     (&["AlwaysFailure"], (0, 0), |_| Ok(Kind::AlwaysFailure)),
     (&["SetBlackboard"], (0, 0), |a| {
@@ -217,31 +290,75 @@ fn operand(a: &Attrs, k: &str) -> Result<Operand, String> {
     })
 }
 
+/// A `SwitchN` node: `variable` and `case_1` ... `case_N` (each a literal).
+fn switch(a: &Attrs, n: usize) -> Result<Kind, String> {
+    let cases = (1..=n)
+        .map(|i| {
+            let k = format!("case_{i}");
+            a.get(&k)
+                .map(|v| v.trim().to_string())
+                .ok_or(format!("missing `{k}`"))
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(Kind::Switch(operand(a, "variable")?, cases))
+}
+
 /// A `BlackboardCheck*` node. `return_on_mismatch` defaults to FAILURE (v3.8
 /// `BlackboardPreconditionNode::tick`, `default_return_status`); besides the names it
 /// takes AS2FM's numbers 1, 2, 3 (`bt_utils.py`, `BtResponse`).
 fn check(a: &Attrs, ty: CheckType) -> Result<Kind, String> {
-    let mismatch = match a.get("return_on_mismatch").map(|s| s.trim()) {
+    let raw = a.get("return_on_mismatch").map(|s| s.trim());
+    let mismatch = match raw {
         None => Status::Failure,
         Some("1") => Status::Success,
         Some("2") => Status::Failure,
         Some("3") => Status::Running,
         Some(s) => Status::parse(s).ok_or(format!("bad return_on_mismatch {s}"))?,
     };
+    let numeric = matches!(raw, Some("1" | "2" | "3"));
     Ok(Kind::Check(
         ty,
         operand(a, "value_A")?,
         operand(a, "value_B")?,
         mismatch,
+        numeric,
     ))
 }
 
 /// A bare XML element.
 #[derive(Clone, Debug, Default)]
-struct El {
-    name: String,
-    attrs: Attrs,
-    children: Vec<El>,
+pub struct El {
+    /// The element name.
+    pub name: String,
+    /// Its attributes, unescaped.
+    pub attrs: BTreeMap<String, String>,
+    /// Its child elements (text is dropped).
+    pub children: Vec<El>,
+}
+
+impl El {
+    /// The element as XML text (attribute values escaped).
+    pub fn write(&self, out: &mut String) {
+        out.push('<');
+        out.push_str(&self.name);
+        for (k, v) in &self.attrs {
+            let v = v
+                .replace('&', "&amp;")
+                .replace('<', "&lt;")
+                .replace('>', "&gt;")
+                .replace('"', "&quot;");
+            out.push_str(&format!(" {k}=\"{v}\""));
+        }
+        if self.children.is_empty() {
+            out.push_str("/>");
+            return;
+        }
+        out.push('>');
+        for c in &self.children {
+            c.write(out);
+        }
+        out.push_str(&format!("</{}>", self.name));
+    }
 }
 
 fn start(e: &BytesStart<'_>) -> Result<El, String> {
@@ -261,7 +378,8 @@ fn start(e: &BytesStart<'_>) -> Result<El, String> {
     Ok(el)
 }
 
-fn parse_xml(text: &str) -> Result<El, String> {
+/// The document's root element.
+pub fn parse_xml(text: &str) -> Result<El, String> {
     let mut r = Reader::from_str(text);
     let mut stack = vec![El::default()];
     loop {
@@ -307,9 +425,15 @@ pub fn read(text: &str) -> Result<Tree, String> {
         tree: Tree::default(),
         scopes: vec![Scope::default()],
         instances: 0,
+        uids: 0,
     };
     let body = main.children.first().ok_or("empty <BehaviorTree>")?;
     r.node(body, None)?;
+    for t in root.children.iter().filter(|c| c.name == "BehaviorTree") {
+        for c in &t.children {
+            names(c, &mut r.tree.names);
+        }
+    }
     Ok(r.tree)
 }
 
@@ -328,6 +452,8 @@ struct Flat<'a> {
     tree: Tree,
     scopes: Vec<Scope>,
     instances: usize,
+    /// BT.CPP UIDs handed out so far (SubTree nodes included).
+    uids: u32,
 }
 
 impl Flat<'_> {
@@ -375,12 +501,15 @@ impl Flat<'_> {
                 }
                 make(&attrs)?
             }
-            None if el.children.is_empty() => Kind::Leaf(ty),
+            None if el.children.is_empty() => Kind::Leaf(ty.clone()),
             None => return Err(format!("unknown node {ty}")),
         };
         let i = self.tree.nodes.len();
+        self.uids += 1;
         self.tree.nodes.push(Node {
             id: 1000 + i as u32,
+            uid: self.uids,
+            tag: ty,
             kind,
             children: Vec::new(),
         });
@@ -398,6 +527,8 @@ impl Flat<'_> {
             return Err("SubTrees nested too deep".into());
         }
         let id = el.attrs.get("ID").ok_or("SubTree without ID")?;
+        // The SubTree node itself takes a UID in BT.CPP 4 (it is a node there).
+        self.uids += 1;
         let body = *self.trees.get(id.as_str()).ok_or(format!("no tree {id}"))?;
         let mut scope = Scope {
             prefix: format!("__st{}.", self.instances),

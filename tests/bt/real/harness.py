@@ -1,0 +1,135 @@
+#!/usr/bin/env python3
+# The real BehaviorTree.CPP (the `behaviortreepy` bindings) run case by case for the
+# oracle's differential test (tests/tests/bt_real.rs, tests/src/bt/real.rs).
+#
+# Protocol: one JSON object per line on stdin, one answer per line on stdout.
+#   first line out: {"version": "<BT.CPP version>", "binding": "<behaviortreepy version>"}
+#   in:  {"xml": str, "scripts": {type: ["SUCCESS"|"FAILURE"|"RUNNING", ...]},
+#         "ticks": int, "mode": "once"|"exactly_once", "budget": int}
+#   out: {"statuses": [str], "log": [["T"|"H", uid, type], ...], "end": null |
+#         {"kind": "load"|"tick"|"livelock", "tick": int, "text": str}}
+# A scripted leaf is a stateful action: on its k-th callback (on_start or on_running)
+# it answers script[k % len]; on_halted logs a halt. `uid` is the node's TreeNode::UID
+# (BT.CPP numbers nodes from 1 in the order it creates them: depth-first pre-order with
+# each SubTree node before its body); the test maps it to the oracle's node id.
+# A root tick that makes more than `budget` leaf callbacks is a livelock: the leaves
+# then answer RUNNING without logging (so the tick can end), and the case stops there
+# with the log cut at the start of that tick.
+import ctypes
+import json
+import os
+import sys
+
+import behaviortreepy as bt
+import behaviortreepy._behaviortreepy as native
+
+STATUS = {
+    "SUCCESS": bt.NodeStatus.SUCCESS,
+    "FAILURE": bt.NodeStatus.FAILURE,
+    "RUNNING": bt.NodeStatus.RUNNING,
+}
+
+
+def library_version():
+    # BT::LibraryVersionString() is exported by the compiled module but not bound.
+    try:
+        f = ctypes.CDLL(native.__file__)._ZN2BT20LibraryVersionStringEv
+        f.restype = ctypes.c_char_p
+        return f().decode()
+    except (OSError, AttributeError):
+        return "unknown"
+
+
+class Case:
+    def __init__(self, scripts, budget):
+        self.scripts = scripts
+        self.budget = budget
+        self.calls = 0
+        self.over = False
+        self.live = True
+        self.k = {}
+        self.log = []
+
+
+cur = None
+factory = bt.BehaviorTreeFactory()
+registered = set()
+
+
+def register(name):
+    def answer(node):
+        c = cur
+        if c is None or not c.live:
+            return bt.NodeStatus.RUNNING
+        c.calls += 1
+        if c.calls > c.budget:
+            c.over = True
+            return bt.NodeStatus.RUNNING
+        uid = node.uid()
+        k = c.k.get(uid, 0)
+        c.k[uid] = k + 1
+        c.log.append(["T", uid, name])
+        s = c.scripts[name]
+        return STATUS[s[k % len(s)]]
+
+    def halted(node):
+        c = cur
+        if c is not None and c.live and not c.over:
+            c.log.append(["H", node.uid(), name])
+
+    factory.register_simple_stateful_action(name, answer, answer, halted)
+    registered.add(name)
+
+
+def run(req):
+    global cur
+    c = Case(req["scripts"], req.get("budget", 1000))
+    cur = c
+    statuses = []
+    end = None
+    tree = None
+    try:
+        for name in req["scripts"]:
+            if name not in registered:
+                register(name)  # a built-in's name is refused ("already registered")
+        tree = factory.create_tree_from_text(req["xml"])
+    except Exception as e:  # BT.CPP refuses the tree
+        end = {"kind": "load", "tick": 0, "text": str(e)}
+    if tree is not None:
+        tick = tree.tick_once if req["mode"] == "once" else tree.tick_exactly_once
+        for i in range(req["ticks"]):
+            mark = len(c.log)
+            c.calls = 0
+            try:
+                s = tick()
+            except Exception as e:
+                end = {"kind": "tick", "tick": i, "text": str(e)}
+                break
+            if c.over:
+                del c.log[mark:]
+                end = {"kind": "livelock", "tick": i, "text": "over budget"}
+                break
+            statuses.append(s.name)
+    # The tree's destructor halts what still runs: not part of the case.
+    c.live = False
+    del tree
+    cur = None
+    return {"statuses": statuses, "log": c.log, "end": end}
+
+
+def main():
+    # BT.CPP prints warnings on its C++ stdout: keep our answers on a stream of their own.
+    out = os.fdopen(os.dup(1), "w")
+    os.dup2(2, 1)
+    binding = getattr(bt, "__version__", "unknown")
+    out.write(json.dumps({"version": library_version(), "binding": binding}) + "\n")
+    out.flush()
+    for line in sys.stdin:
+        if not line.strip():
+            continue
+        out.write(json.dumps(run(json.loads(line))) + "\n")
+        out.flush()
+
+
+if __name__ == "__main__":
+    main()

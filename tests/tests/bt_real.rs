@@ -1,0 +1,485 @@
+//! The oracle's BehaviorTree.CPP 4 reading against the real library: seeded random
+//! trees (`gen::case`) and every case under `tests/bt/` run through BT.CPP (the
+//! `behaviortreepy` bindings, `tests/bt/real/harness.py`) and through the oracle, under
+//! `tickOnce` and `tickExactlyOnce`; root status per tick, every leaf tick and halt, and
+//! how a run ends (refused at load, an exception, a livelock, a hang) must agree. Trees in
+//! `BTCPP_format="3"` (names 4 does not know) run through the oracle's 3.8 reading only.
+//! And the minimal trees where AS2FM's models and BT.CPP differ (`tests/bt/real/*.toml`,
+//! the README's table) hold in both.
+//!
+//! `HINDSIGHT_BT_REAL_TREES` sets how many random format-4 trees go to the real library
+//! (default 10,000; the format-3 trees among the same seeds come on top),
+//! `HINDSIGHT_BT_SEED` the first seed. Without the Python environment the test says it
+//! was skipped (run `bash scripts/pyenv`), except under `CI=true`, where it fails.
+
+use hindsight_tests::bt::gen;
+use hindsight_tests::bt::oracle::{
+    btcpp4_refuses, run_with, End, LeafEvent, Options, Outcome, Reading, Scripts, TickMode, BUDGET,
+};
+use hindsight_tests::bt::real::{self, Real, Request};
+use hindsight_tests::bt::tree::{self, Status, Tree};
+use rand_core::SeedableRng;
+use rand_xoshiro::Xoshiro256PlusPlus;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+fn env(name: &str, default: u64) -> u64 {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+/// The harness, or `None` (after saying why) when the environment is missing.
+fn harness() -> Option<Real> {
+    let Some(py) = real::python() else {
+        let why = "skipped: no Python environment with behaviortreepy (.venv or \
+                   $HINDSIGHT_PYENV); run `bash scripts/pyenv`";
+        if std::env::var("CI").as_deref() == Ok("true") {
+            panic!("{why}");
+        }
+        eprintln!("{why}");
+        return None;
+    };
+    Some(Real::start(&py).unwrap_or_else(|e| panic!("{e}; run `bash scripts/pyenv`")))
+}
+
+/// What the oracle expects BT.CPP 4 to do with a document.
+fn expect(
+    xml: &str,
+    scripts: &Scripts,
+    ticks: usize,
+    mode: TickMode,
+) -> Result<(Option<Tree>, Outcome), String> {
+    let tree = tree::read(xml)?;
+    if let Some(why) = btcpp4_refuses(&tree, scripts) {
+        let o = Outcome {
+            statuses: Vec::new(),
+            log: Vec::new(),
+            end: Some(End::Refused(why)),
+        };
+        return Ok((Some(tree), o));
+    }
+    let o = run_with(&tree, scripts, Options::xml4(mode), ticks)?;
+    Ok((Some(tree), o))
+}
+
+/// Where the real library's outcome and the oracle's differ, or `None`.
+fn differ(want: &Outcome, got: &Outcome) -> Option<String> {
+    match (&want.end, &got.end) {
+        (Some(End::Hang { .. }), Some(End::Hang { .. })) => return None,
+        (Some(End::Refused(w)), Some(End::Refused(g))) if w.split('|').any(|n| g.contains(n)) => {
+            return None
+        }
+        (Some(End::Error { tick: a, text: w }), Some(End::Error { tick: b, text: g }))
+            if a == b && g.contains(w.as_str()) => {}
+        (a, b) if a == b => {}
+        (a, b) => return Some(format!("end: oracle {a:?}, BT.CPP {b:?}")),
+    }
+    if want.statuses != got.statuses {
+        return Some(format!(
+            "root statuses: oracle {:?}, BT.CPP {:?}\n  oracle: {:?}\n  BT.CPP: {:?}",
+            want.statuses, got.statuses, want.log, got.log
+        ));
+    }
+    if want.log != got.log {
+        let i = want
+            .log
+            .iter()
+            .zip(&got.log)
+            .position(|(a, b)| a != b)
+            .unwrap_or(want.log.len().min(got.log.len()));
+        return Some(format!(
+            "leaf events differ at {i}: oracle {:?}, BT.CPP {:?}\n  oracle: {:?}\n  BT.CPP: {:?}",
+            want.log.get(i),
+            got.log.get(i),
+            want.log,
+            got.log
+        ));
+    }
+    None
+}
+
+fn show(xml: &str, scripts: &Scripts, ticks: usize, mode: TickMode) -> String {
+    let mut s = format!("mode = {mode:?}\nticks = {ticks}\ntree = '''{xml}'''\n[scripts]\n");
+    for (k, v) in scripts {
+        let names: Vec<&str> = v.iter().map(|s| s.name()).collect();
+        s += &format!("{k} = {names:?}\n");
+    }
+    s
+}
+
+const MODES: [TickMode; 2] = [TickMode::Once, TickMode::ExactlyOnce];
+
+/// Tallies of a run.
+#[derive(Default, Debug)]
+struct Counts {
+    runs: usize,
+    ran_all: usize,
+    refused: usize,
+    errors: usize,
+    livelocks: usize,
+    hangs: usize,
+    /// Runs BT.CPP ran to the end where AS2FM's reading gives other root statuses, or
+    /// another sequence of leaf ticks (halts aside).
+    as2fm_statuses: usize,
+    as2fm_ticks: usize,
+    /// Runs AS2FM's reading could run (no BT.CPP-4-only node), among those.
+    as2fm_compared: usize,
+    /// Per entry of [`FEATURES`], the runs of trees with it that BT.CPP ran to the end.
+    features: Vec<usize>,
+}
+
+/// Node kinds that must be in trees the real library runs to the end, in at least one
+/// run in 200.
+const FEATURES: &[&str] = &[
+    "<SequenceWithMemory>",
+    "<ReactiveSequence>",
+    "<ReactiveFallback>",
+    "<Parallel ",
+    "<IfThenElse>",
+    "<Repeat ",
+    "<RetryUntilSuccessful ",
+    "<SubTree ",
+    "value=\"{",
+    "<AsyncSequence>",
+    "<AsyncFallback>",
+    "<ParallelAll ",
+    "<WhileDoElse>",
+    "<KeepRunningUntilFailure>",
+    "<RunOnce ",
+    "<Switch2 ",
+    "<Switch6 ",
+];
+
+impl Counts {
+    fn add(&mut self, o: &Outcome) {
+        self.runs += 1;
+        match o.end {
+            None => self.ran_all += 1,
+            Some(End::Refused(_)) => self.refused += 1,
+            Some(End::Error { .. }) => self.errors += 1,
+            Some(End::Livelock { .. }) => self.livelocks += 1,
+            Some(End::Hang { .. }) => self.hangs += 1,
+        }
+    }
+}
+
+/// Runs `cases` (name, xml, scripts, ticks) in both modes through BT.CPP and the oracle;
+/// the disagreements.
+fn check_all(
+    real: &mut Real,
+    cases: &[(String, String, Scripts, usize)],
+    counts: &mut Counts,
+) -> Vec<String> {
+    let mut fails = Vec::new();
+    for chunk in cases.chunks(256) {
+        let mut reqs = Vec::new();
+        let mut wants = Vec::new();
+        for (name, xml, scripts, ticks) in chunk {
+            for mode in MODES {
+                match expect(xml, scripts, *ticks, mode) {
+                    Ok(w) => wants.push((name, xml, scripts, *ticks, mode, w)),
+                    Err(e) => fails.push(format!("{name}: the oracle: {e}")),
+                }
+                reqs.push(Request {
+                    xml: xml.clone(),
+                    scripts: scripts.clone(),
+                    ticks: *ticks,
+                    mode,
+                    budget: BUDGET,
+                });
+            }
+        }
+        if wants.len() != reqs.len() {
+            continue;
+        }
+        let answers = real.run(&reqs).unwrap_or_else(|e| panic!("{e}"));
+        for ((name, xml, scripts, ticks, mode, (tree, want)), a) in wants.into_iter().zip(answers) {
+            counts.add(&want);
+            let got = match real::outcome(tree.as_ref(), &a) {
+                Ok(g) => g,
+                Err(e) => {
+                    fails.push(format!("{name}: {e}\n{}", show(xml, scripts, ticks, mode)));
+                    continue;
+                }
+            };
+            if let Some(d) = differ(&want, &got) {
+                fails.push(format!("{name}: {d}\n{}", show(xml, scripts, ticks, mode)));
+            }
+            if got.end.is_none() {
+                counts.features.resize(FEATURES.len(), 0);
+                for (f, k) in FEATURES.iter().zip(&mut counts.features) {
+                    *k += usize::from(xml.contains(f));
+                }
+            }
+            if let (None, Some(t)) = (&got.end, tree.as_ref()) {
+                if let Ok(as2) = run_with(t, scripts, Options::of(Reading::As2fm), ticks) {
+                    counts.as2fm_compared += 1;
+                    let only_ticks = |l: &[LeafEvent]| {
+                        l.iter()
+                            .filter(|e| matches!(e, LeafEvent::Tick(_)))
+                            .copied()
+                            .collect::<Vec<_>>()
+                    };
+                    counts.as2fm_statuses += usize::from(as2.statuses != got.statuses);
+                    counts.as2fm_ticks += usize::from(only_ticks(&as2.log) != only_ticks(&got.log));
+                }
+            }
+        }
+    }
+    fails
+}
+
+#[derive(Deserialize)]
+struct File {
+    case: Vec<TomlCase>,
+}
+
+/// The fields every case file under `tests/bt/` shares (the rest is for other tests,
+/// except in `tests/bt/real/`, whose fields are all here).
+#[derive(Deserialize)]
+struct TomlCase {
+    test: String,
+    tree: String,
+    #[serde(default)]
+    statuses: Vec<String>,
+    #[serde(default)]
+    ticks: Option<usize>,
+    scripts: BTreeMap<String, Vec<String>>,
+    /// `tests/bt/real/`: the tick mode the statuses are stated in (`once`,
+    /// `exactly_once`).
+    #[serde(default)]
+    mode: Option<String>,
+    /// `tests/bt/real/`: the root statuses of AS2FM's reading (where they differ).
+    #[serde(default)]
+    as2fm: Option<Vec<String>>,
+    /// `tests/bt/real/`: BT.CPP never returns from this tick (a livelock).
+    #[serde(default)]
+    livelock_at: Option<usize>,
+    /// `tests/bt/real/`: BT.CPP throws during this tick.
+    #[serde(default)]
+    error_at: Option<usize>,
+    /// `tests/bt/real/`: BT.CPP loops for ever in this tick with no leaf callback (the
+    /// harness's watchdog kills it).
+    #[serde(default)]
+    hang_at: Option<usize>,
+}
+
+fn doc(tree: &str) -> String {
+    if tree.trim_start().starts_with("<root") {
+        tree.to_string()
+    } else {
+        format!("<root BTCPP_format=\"4\"><BehaviorTree ID=\"Main\">{tree}</BehaviorTree></root>")
+    }
+}
+
+fn scripts_of(c: &TomlCase) -> Scripts {
+    c.scripts
+        .iter()
+        .map(|(k, v)| {
+            let s = v
+                .iter()
+                .map(|x| Status::parse(x).unwrap_or_else(|| panic!("{}: status {x}", c.test)))
+                .collect();
+            (k.clone(), s)
+        })
+        .collect()
+}
+
+fn load(dir: &str) -> Vec<(String, TomlCase)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    files.sort();
+    let mut out = Vec::new();
+    for p in files {
+        let text = std::fs::read_to_string(&p).expect("read");
+        let f: File = toml::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        out.extend(f.case.into_iter().map(|c| (name.clone(), c)));
+    }
+    out
+}
+
+#[test]
+fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
+    let Some(mut real) = harness() else { return };
+    let n = env("HINDSIGHT_BT_REAL_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0);
+    let start = std::time::Instant::now();
+    let mut cases = Vec::new();
+    let mut v3 = 0;
+    let mut fails = Vec::new();
+    let mut generated = 0;
+    // `n` trees for the real library; the format-3 ones among the seeds go to the 3.8
+    // reading.
+    for seed in seed0.. {
+        if cases.len() as u64 >= n {
+            break;
+        }
+        generated += 1;
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let opts = gen::Options { btcpp4_nodes: true };
+        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
+        if c.xml.contains("BTCPP_format=\"3\"") {
+            // BT.CPP 4 does not know format 3's names: the 3.8 reading must run it.
+            v3 += 1;
+            let t = tree::read(&c.xml).expect("the oracle reads its own trees");
+            if let Err(e) = run_with(&t, &c.scripts, Options::of(Reading::Btcpp3), c.ticks) {
+                fails.push(format!("seed {seed}: the 3.8 reading: {e}"));
+            }
+            continue;
+        }
+        cases.push((format!("seed {seed}"), c.xml, c.scripts, c.ticks));
+    }
+    let mut counts = Counts::default();
+    fails.extend(check_all(&mut real, &cases, &mut counts));
+    let random = counts.runs;
+    let mut files = Vec::new();
+    let mut files_v3 = 0;
+    for dir in ["bt/btcpp", "bt/regressions", "bt/real"] {
+        for (file, c) in load(dir) {
+            let ticks = c.ticks.unwrap_or(c.statuses.len()).max(1);
+            let xml = doc(&c.tree);
+            if xml.contains("BTCPP_format=\"3\"") {
+                // 3.8's cases: bt_conformance.rs holds the 3.8 reading to them.
+                files_v3 += 1;
+                continue;
+            }
+            files.push((
+                format!("{dir}/{file} {}", c.test),
+                xml,
+                scripts_of(&c),
+                ticks,
+            ));
+        }
+    }
+    fails.extend(check_all(&mut real, &files, &mut counts));
+    eprintln!(
+        "BehaviorTree.CPP {} (behaviortreepy {}): {generated} random trees, {v3} of them format 3 \
+         (the 3.8 reading only), {} to the real library and {} cases from tests/bt/ ({} more \
+         in format 3), each under tickOnce and tickExactlyOnce: {} runs ({} ran every tick, {} refused at load, \
+         {} threw, {} livelocks, {} hangs; {} harness starts) in {:.1} s; {} disagreements. \
+         Of the {} runs BT.CPP ran to the end whose nodes AS2FM has models of, AS2FM's \
+         reading gives other root statuses on {} and other leaf ticks on {}",
+        real.version,
+        real.binding,
+        random / 2,
+        files.len(),
+        files_v3,
+        counts.runs,
+        counts.ran_all,
+        counts.refused,
+        counts.errors,
+        counts.livelocks,
+        counts.hangs,
+        real.starts,
+        start.elapsed().as_secs_f64(),
+        fails.len(),
+        counts.as2fm_compared,
+        counts.as2fm_statuses,
+        counts.as2fm_ticks
+    );
+    if n >= 1000 {
+        for (f, k) in FEATURES.iter().zip(&counts.features) {
+            eprintln!("  {k:>6} runs to the end with `{f}`");
+            assert!(
+                *k as u64 >= n / 100,
+                "only {k} of {} runs have `{f}`",
+                2 * n
+            );
+        }
+    }
+    assert!(
+        fails.is_empty(),
+        "{} disagreements (first 5):\n{}",
+        fails.len(),
+        fails
+            .iter()
+            .take(
+                std::env::var("HINDSIGHT_BT_SHOW")
+                    .ok()
+                    .and_then(|v| v.parse().ok())
+                    .unwrap_or(5)
+            )
+            .cloned()
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+}
+
+/// The minimal trees of the README's table: BT.CPP's statuses in the case's mode, in the
+/// real library and the oracle; AS2FM's reading gives the `as2fm` statuses.
+#[test]
+fn where_as2fm_and_btcpp_differ() {
+    let cases = load("bt/real");
+    assert!(cases.len() >= 5, "{} cases", cases.len());
+    let mut real = harness();
+    for (file, c) in &cases {
+        let xml = doc(&c.tree);
+        let s = scripts_of(c);
+        let ticks = c.ticks.unwrap_or(c.statuses.len()).max(1);
+        assert_ne!(
+            c.as2fm.as_ref(),
+            Some(&c.statuses),
+            "{file} {}: not a difference in the root's statuses",
+            c.test
+        );
+        let mode = match c.mode.as_deref() {
+            Some("once") => TickMode::Once,
+            Some("exactly_once") | None => TickMode::ExactlyOnce,
+            Some(m) => panic!("{file} {}: mode {m}", c.test),
+        };
+        let names = |v: &[Status]| v.iter().map(|s| s.name().to_string()).collect::<Vec<_>>();
+        let (_, want) = expect(&xml, &s, ticks, mode).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(
+            names(&want.statuses),
+            c.statuses,
+            "{file} {}: the oracle",
+            c.test
+        );
+        match (c.livelock_at, c.error_at, c.hang_at, &want.end) {
+            (Some(t), _, _, Some(End::Livelock { tick })) if *tick == t => {}
+            (_, Some(t), _, Some(End::Error { tick, .. })) if *tick == t => {}
+            (_, _, Some(t), Some(End::Hang { tick })) if *tick == t => {}
+            (None, None, None, None) => {}
+            (_, _, _, e) => panic!("{file} {}: the oracle ends {e:?}", c.test),
+        }
+        let t = tree::read(&xml).expect("tree");
+        let as2 = run_with(&t, &s, Options::of(Reading::As2fm), ticks).expect("as2fm");
+        let as2_names = names(&as2.statuses);
+        match &c.as2fm {
+            Some(a) => assert_eq!(&as2_names, a, "{file} {}: AS2FM's reading", c.test),
+            None => panic!(
+                "{file} {}: say what AS2FM's reading gives (`as2fm`)",
+                c.test
+            ),
+        }
+        if let Some(r) = real.as_mut() {
+            let a = r
+                .run(&[Request {
+                    xml: xml.clone(),
+                    scripts: s.clone(),
+                    ticks,
+                    mode,
+                    budget: BUDGET,
+                }])
+                .expect("harness");
+            let got = real::outcome(Some(&t), &a[0]).expect("outcome");
+            assert_eq!(
+                names(&got.statuses),
+                c.statuses,
+                "{file} {}: BT.CPP",
+                c.test
+            );
+            if let Some(d) = differ(&want, &got) {
+                panic!("{file} {}: {d}", c.test);
+            }
+        }
+    }
+}
