@@ -10,15 +10,15 @@
 
 mod bt_common;
 
-use bt_common::Run;
+use bt_common::{diff, show, Run};
 use hindsight::expr::Value;
 use hindsight::model::source::{FileId, SourceMap};
 use hindsight::model::{xml, Diagnostics, ModelSource};
 use hindsight::robot::bt::{self, BtInput, BtSemantics, BtTick, Halts};
 use hindsight::sim::{CompiledModel, EndReason, Flow, Observer, RunConfig, SentMessage, Simulator};
-use hindsight_tests::bt::model;
-use hindsight_tests::bt::oracle::{LeafEvent, Scripts};
-use hindsight_tests::bt::tree::{self, Kind, Status};
+use hindsight_tests::bt::oracle::{self, End, LeafEvent, Options, Scripts, TickMode};
+use hindsight_tests::bt::tree::{self, Kind, Operand, Status};
+use hindsight_tests::bt::{gen, model};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::collections::BTreeSet;
@@ -30,7 +30,7 @@ enum Outcome {
     Ran(Run),
     /// An executor tick never ended (the root kept answering RUNNING with a wake-up
     /// pending): the statuses of the ticks that ended, the log until the run was cut.
-    Livelock(Vec<Status>),
+    Livelock(Run),
 }
 
 /// Records leaf ticks and halts and the driver's `tick_done` (the final status of one
@@ -152,7 +152,7 @@ fn lowered(
         bad: None,
     };
     let cfg = RunConfig {
-        max_steps: 200_000,
+        max_steps: 1_000_000,
         ..RunConfig::default()
     };
     let out =
@@ -162,7 +162,7 @@ fn lowered(
     }
     match out.end {
         EndReason::MaxSteps | EndReason::Spin(_) if w.statuses.len() < ticks => {
-            Ok(Outcome::Livelock(w.statuses))
+            Ok(Outcome::Livelock((w.statuses, w.log)))
         }
         EndReason::Error(e) => Err(format!("run-time error: {e:?}")),
         _ => Ok(Outcome::Ran((w.statuses, w.log))),
@@ -246,10 +246,13 @@ fn a_reactive_sequence_of_two_repeats_never_ends_a_tick_once() {
         "<ReactiveSequence><Repeat num_cycles=\"2\"><A/></Repeat><Repeat num_cycles=\"2\"><B/></Repeat></ReactiveSequence>",
     );
     let sc = scripts(&[("A", &[S]), ("B", &[S])]);
-    assert_eq!(
-        lowered(&t, &sc, 2, BtTick::Once).unwrap(),
-        Outcome::Livelock(vec![])
-    );
+    match lowered(&t, &sc, 2, BtTick::Once).unwrap() {
+        Outcome::Livelock((st, log)) => {
+            assert_eq!(st, vec![]);
+            assert!(log.len() > 100, "{log:?}");
+        }
+        o => panic!("{o:?}"),
+    }
     match lowered(&t, &sc, 4, BtTick::ExactlyOnce).unwrap() {
         Outcome::Ran((st, _)) => assert_eq!(st, vec![R, R, R, R]),
         o => panic!("{o:?}"),
@@ -367,4 +370,166 @@ fn a_failed_condition_leaf_of_a_two_child_if_then_else_stays_failed() {
         lowered(&t, &sc, 4, BtTick::Once).unwrap(),
         ran(&[S, F, F, F], &[T(1002), T(1003), T(1002)])
     );
+}
+
+/// Where the lowering's run and the oracle's BT.CPP 4 reading differ, or `None`; and
+/// how the oracle's run ended, for the counts.
+fn compare(want: &oracle::Outcome, got: &Outcome) -> Option<String> {
+    let (st, log) = match got {
+        Outcome::Ran(r) | Outcome::Livelock(r) => r,
+    };
+    match (&want.end, got) {
+        (None, Outcome::Ran(_)) => diff(
+            &(want.statuses.clone(), want.log.clone()),
+            &(st.clone(), log.clone()),
+        ),
+        // The executor tick that never returns: the ticks before it and what the leaves
+        // received until it began (the oracle's log stops there).
+        (Some(End::Livelock { tick } | End::Hang { tick }), Outcome::Livelock(_)) => {
+            if st.len() != *tick || *st != want.statuses {
+                Some(format!(
+                    "livelock at tick {tick}: statuses {:?} against {st:?}",
+                    want.statuses
+                ))
+            } else if log.len() < want.log.len() || log[..want.log.len()] != want.log[..] {
+                Some(format!(
+                    "livelock at tick {tick}: leaf events {:?} against {log:?}",
+                    want.log
+                ))
+            } else {
+                None
+            }
+        }
+        // BT.CPP throws (a run-time error the model has no counterpart of): the ticks
+        // before it agree.
+        (Some(End::Error { tick, .. }), _) => {
+            let n = (*tick).min(st.len());
+            (st.len() < *tick || st[..n] != want.statuses[..n.min(want.statuses.len())]).then(
+                || {
+                    format!(
+                        "before BT.CPP throws at tick {tick}: {:?} against {st:?}",
+                        want.statuses
+                    )
+                },
+            )
+        }
+        (w, _) => Some(format!("oracle ends {w:?}, lowering {got:?}")),
+    }
+}
+
+#[test]
+fn random_trees_lower_to_what_btcpp_does() {
+    let env = |name: &str, default: u64| {
+        std::env::var(name)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(default)
+    };
+    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0);
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |p| p.get())
+        .min(4) as u64;
+    let start = std::time::Instant::now();
+    use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+    // Runs compared, of which: trees BT.CPP 4 refuses at load (3.x names), executor
+    // ticks that never return, BT.CPP exceptions; trees left out.
+    let counts: [AtomicUsize; 6] = Default::default();
+    let counts = &counts;
+    let fails: Vec<String> = std::thread::scope(|s| {
+        let hs: Vec<_> = (0..threads)
+            .map(|t| {
+                s.spawn(move || {
+                    let mut fails = Vec::new();
+                    let mut i = t;
+                    while i < n && fails.len() < 3 {
+                        let seed = seed0 + i;
+                        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+                        let c = gen::case(&mut rng, 4 + (seed % 12) as i64);
+                        let t = tree::read(&c.xml).expect("the oracle reads what it generates");
+                        // BT.CPP 4 fails or throws on a SetBlackboard copy of the entries
+                        // the harness's untyped ports create (the oracle's
+                        // `set_blackboard`, `tests/bt/real/set_blackboard.toml`); the
+                        // lowering types entries and copies: not compared.
+                        if t.nodes
+                            .iter()
+                            .any(|x| matches!(x.kind, Kind::SetBlackboard(_, Operand::Entry(_))))
+                        {
+                            counts[4].fetch_add(1, Relaxed);
+                            i += threads;
+                            continue;
+                        }
+                        let refused = oracle::btcpp4_refuses(&t, &c.scripts).is_some();
+                        let mut by_mode = Vec::new();
+                        for (tick, mode) in [
+                            (BtTick::Once, TickMode::Once),
+                            (BtTick::ExactlyOnce, TickMode::ExactlyOnce),
+                        ] {
+                            counts[0].fetch_add(1, Relaxed);
+                            if refused {
+                                counts[1].fetch_add(1, Relaxed);
+                            }
+                            let problem = match (
+                                oracle::run_with(&t, &c.scripts, Options::xml4(mode), c.ticks),
+                                lowered(&c.xml, &c.scripts, c.ticks, tick),
+                            ) {
+                                (Ok(w), Ok(g)) => {
+                                    by_mode.push((w.statuses.clone(), w.log.clone()));
+                                    match w.end {
+                                        Some(End::Livelock { .. } | End::Hang { .. }) => {
+                                            counts[2].fetch_add(1, Relaxed);
+                                        }
+                                        Some(End::Error { .. }) => {
+                                            counts[3].fetch_add(1, Relaxed);
+                                        }
+                                        _ => {}
+                                    }
+                                    compare(&w, &g)
+                                }
+                                (Err(e), _) => Some(format!("oracle: {e}")),
+                                (_, Err(e)) => Some(format!("lowering: {e}")),
+                            };
+                            if let Some(p) = problem {
+                                fails.push(format!(
+                                    "seed {seed} ({tick:?}): {p}\n{}",
+                                    show(&c.xml, &c.scripts, c.ticks)
+                                ));
+                            }
+                        }
+                        if by_mode.len() == 2 && by_mode[0] != by_mode[1] {
+                            counts[5].fetch_add(1, Relaxed);
+                        }
+                        i += threads;
+                    }
+                    fails
+                })
+            })
+            .collect();
+        hs.into_iter()
+            .flat_map(|h| h.join().expect("worker"))
+            .collect()
+    });
+    let [runs, refused, livelocks, errors, copies, modes_differ] =
+        counts.each_ref().map(|c| c.load(Relaxed));
+    eprintln!(
+        "{n} random trees in {:.1} s on {threads} threads: {copies} with a SetBlackboard copy \
+         left out; {runs} runs of the others (tickOnce and tickExactlyOnce): {refused} of \
+         them on trees BT.CPP 4 refuses at load (3.x names; compared with the oracle's BT.CPP 4 \
+         rules), {livelocks} with an executor tick that never returns, {errors} where BT.CPP \
+         throws; {modes_differ} trees whose two tick modes differ",
+        start.elapsed().as_secs_f64()
+    );
+    assert!(
+        fails.is_empty(),
+        "{} disagreements:\n{}",
+        fails.len(),
+        fails.join("\n")
+    );
+    // The run covers what makes the tick modes differ: wake-up yields.
+    if n >= 1000 {
+        assert!(
+            modes_differ as u64 >= n / 100,
+            "only {modes_differ} trees run differently under the two tick modes"
+        );
+    }
 }

@@ -74,6 +74,9 @@ pub(crate) struct Ctx {
     /// `TreeNode::emitWakeUpSignal`): the root machine under `tickOnce`, `None` when no
     /// one listens (AS2FM's rules, or `tickExactlyOnce`).
     pub wake: Option<String>,
+    /// Under BT.CPP's rules, whether each child is a leaf plugin, a stateful action
+    /// (`btcpp.rs`, "Leaves"); empty under AS2FM's.
+    pub stateful: Vec<bool>,
 }
 
 impl Ctx {
@@ -91,6 +94,14 @@ impl Ctx {
             &format!("bt_{}_response", self.id),
             &self.parent,
             &[("status", &status.to_string())],
+        )
+    }
+    /// Sends `bt_<id>_response` with the status `expr` evaluates to.
+    pub fn respond_expr(&self, expr: &str) -> Element {
+        self.b.send_params(
+            &format!("bt_{}_response", self.id),
+            &self.parent,
+            &[("status", expr)],
         )
     }
     /// Sends `bt_<id>_halt_response`.

@@ -260,6 +260,14 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
             btcpp: input.semantics != BtSemantics::As2fm,
             wake: (input.semantics == BtSemantics::Btcpp { tick: BtTick::Once })
                 .then(|| root_name.clone()),
+            stateful: if input.semantics == BtSemantics::As2fm {
+                Vec::new()
+            } else {
+                n.children
+                    .iter()
+                    .map(|&c| matches!(tree.nodes[c].kind, Kind::Plugin(p) if !plugins[p].ticks_children))
+                    .collect()
+            },
         };
         let m = match n.kind {
             Kind::Plugin(i) => Some(plugin::instance(
@@ -273,11 +281,9 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
             Kind::Control(c) => {
                 // A leaf plugin is a stateful action under BT.CPP's rules (see
                 // `btcpp.rs`); only IfThenElse can tick one that was not reset.
-                let stale_condition = ctx.btcpp
-                    && c == Control::IfThenElse
+                let stale_condition = c == Control::IfThenElse
                     && n.children.len() == 2
-                    && matches!(tree.nodes[n.children[0]].kind,
-                        Kind::Plugin(p) if !plugins[p].ticks_children);
+                    && ctx.stateful.first() == Some(&true);
                 if stale_condition {
                     Some(parallel::if_then_else(&ctx, true))
                 } else {
