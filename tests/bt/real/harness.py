@@ -9,7 +9,10 @@
 #   out: {"statuses": [str], "log": [["T"|"H", uid, type], ...], "end": null |
 #         {"kind": "load"|"tick"|"livelock", "tick": int, "text": str}}
 # A scripted leaf is a stateful action: on its k-th callback (on_start or on_running)
-# it answers script[k % len]; on_halted logs a halt. `uid` is the node's TreeNode::UID
+# it answers script[k % len]; on_halted logs a halt (BT.CPP halts a child only while it
+# is RUNNING: ControlNode::haltChild, DecoratorNode::resetChild; the differential
+# confirms no other halt reaches a leaf). A finished leaf its parent did not reset is
+# not called at all when ticked again (StatefulActionNode::tick). `uid` is the node's TreeNode::UID
 # (BT.CPP numbers nodes from 1 in the order it creates them: depth-first pre-order with
 # each SubTree node before its body); the test maps it to the oracle's node id.
 # A root tick that makes more than `budget` leaf callbacks is a livelock: the leaves
