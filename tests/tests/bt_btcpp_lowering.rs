@@ -533,3 +533,82 @@ fn random_trees_lower_to_what_btcpp_does() {
         );
     }
 }
+
+/// A case of `tests/bt/real/differences.toml` (the README's table of minimal trees where
+/// AS2FM's models and BT.CPP differ, checked against the real library by `bt_real.rs`).
+#[derive(serde::Deserialize)]
+struct Difference {
+    test: String,
+    tree: String,
+    mode: String,
+    ticks: usize,
+    scripts: std::collections::BTreeMap<String, Vec<String>>,
+    statuses: Vec<String>,
+    #[serde(default)]
+    livelock_at: Option<usize>,
+    #[serde(default)]
+    hang_at: Option<usize>,
+    #[serde(default)]
+    error_at: Option<usize>,
+}
+
+#[derive(serde::Deserialize)]
+struct Differences {
+    case: Vec<Difference>,
+}
+
+#[test]
+fn the_readme_differences_lower_to_the_libraries_statuses() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("bt/real/differences.toml");
+    let text = std::fs::read_to_string(&path).expect("differences.toml");
+    let file: Differences = toml::from_str(&text).expect("differences.toml parses");
+    let mut checked = 0;
+    for c in &file.case {
+        // BT.CPP throws there (a SetBlackboard copy): nothing the lowering models.
+        if c.error_at.is_some() {
+            continue;
+        }
+        let xml = if c.tree.trim_start().starts_with("<root") {
+            c.tree.clone()
+        } else {
+            v4(&c.tree)
+        };
+        let sc: Scripts = c
+            .scripts
+            .iter()
+            .map(|(k, v)| {
+                let s = v
+                    .iter()
+                    .map(|x| Status::parse(x).expect("a status"))
+                    .collect();
+                (k.clone(), s)
+            })
+            .collect();
+        let tick = match c.mode.as_str() {
+            "once" => BtTick::Once,
+            "exactly_once" => BtTick::ExactlyOnce,
+            m => panic!("{}: mode {m}", c.test),
+        };
+        let got = lowered(&xml, &sc, c.ticks, tick).unwrap_or_else(|e| panic!("{}: {e}", c.test));
+        let names = |v: &[Status]| v.iter().map(|s| s.name().to_string()).collect::<Vec<_>>();
+        match (&got, c.livelock_at.or(c.hang_at)) {
+            (Outcome::Ran((st, _)), None) => {
+                assert_eq!(names(st), c.statuses, "{}", c.test)
+            }
+            (Outcome::Livelock((st, _)), Some(at)) => {
+                assert_eq!(
+                    (st.len(), names(st)),
+                    (at, c.statuses.clone()),
+                    "{}",
+                    c.test
+                )
+            }
+            (o, at) => panic!(
+                "{}: the lowering {o:?}, the library stops at {at:?}",
+                c.test
+            ),
+        }
+        checked += 1;
+    }
+    assert!(checked >= 10, "{checked} cases");
+}
