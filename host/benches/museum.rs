@@ -92,6 +92,8 @@ impl Case {
             model: examples().join("museum-guide"),
             out: out.clone(),
             interfaces: Vec::new(),
+            bt: Default::default(),
+            bt_tick: None,
         })
         .unwrap_or_else(|e| panic!("convert: {e:?}"));
         let args = LoadOptions {
@@ -133,6 +135,7 @@ impl Case {
             unit_ns: Some(100_000_000),
             default_max_time: Some(1001),
             events: EventSemantics::As2fm,
+            bt_notes: Vec::new(),
         };
         Some([high, Case::of("uc3 AS2FM plain (corpus)", loaded, None)])
     }
@@ -155,6 +158,7 @@ impl Case {
             unit_ns: Some(robot.time_unit_ns),
             default_max_time: Some(robot.max_time_steps),
             events: EventSemantics::As2fm,
+            bt_notes: Vec::new(),
         };
         Case::of(name, loaded, None)
     }

@@ -165,6 +165,7 @@ fn lower_with(tree: &str, halts: Halts) -> Result<Vec<String>, String> {
             tick_rate_hz: 1.0,
             tick_if_not_running: false,
             halts,
+            semantics: Default::default(),
         },
     )
     .map(|ms| ms.iter().map(write::to_xml).collect())

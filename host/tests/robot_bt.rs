@@ -82,6 +82,7 @@ fn lower_case_with(case: &Case, halts: Halts) -> (SourceMap, FileId, Vec<Element
         tick_rate_hz: case.rate,
         tick_if_not_running: case.tick_if_not_running,
         halts,
+        semantics: Default::default(),
     };
     match bt::lower(&sm, &input) {
         Ok(m) => (sm, tree, m),
@@ -800,6 +801,7 @@ fn lower_texts(
             tick_rate_hz: 2.0,
             tick_if_not_running: true,
             halts: Halts::As2fm,
+            semantics: Default::default(),
         },
     )
 }
@@ -912,6 +914,7 @@ fn the_root_machine_ticks_on_a_ros_timer_and_stops_unless_told_otherwise() {
                 tick_rate_hz: 10.0,
                 tick_if_not_running: again,
                 halts: Halts::As2fm,
+                semantics: Default::default(),
             },
         )
         .unwrap();
@@ -1082,6 +1085,7 @@ fn probabilistic_targets_in_a_plugin_split_the_runs_by_their_shares() {
             tick_rate_hz: 1.0,
             tick_if_not_running: false,
             halts: Halts::As2fm,
+            semantics: Default::default(),
         },
     )
     .unwrap();
@@ -1145,6 +1149,7 @@ fn custom_control_plugins_tick_and_hear_their_children() {
                 tick_rate_hz: 1.0,
                 tick_if_not_running: false,
                 halts: Halts::As2fm,
+                semantics: Default::default(),
             },
         )
         .unwrap_or_else(|e| panic!("{}", Diagnostics(e)));
@@ -1275,6 +1280,7 @@ fn run_small_with(body: &str, again: bool, seconds: u64, halts: Halts) -> LastVa
             tick_rate_hz: 1.0,
             tick_if_not_running: again,
             halts,
+            semantics: Default::default(),
         },
     )
     .unwrap_or_else(|e| panic!("{}", Diagnostics(e)));

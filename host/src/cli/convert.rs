@@ -8,7 +8,7 @@ use super::CliError;
 use crate::model::xml::Element;
 use crate::props::{self, PortKind, PropertyFile, ANY};
 use crate::robot::interfaces::Search;
-use crate::robot::load::{load_searching, main_file_of};
+use crate::robot::load::{load_searching_bt, main_file_of};
 use crate::robot::main_file::InputKind;
 use crate::robot::write::{escape_into, to_xml, types_xml};
 use codegen::bounds::map_bounds;
@@ -25,6 +25,14 @@ pub struct ConvertArgs {
     /// A folder of ROS interface packages, searched first (repeat for more); as for `verify`.
     #[arg(long = "interfaces", value_name = "DIR")]
     pub interfaces: Vec<PathBuf>,
+    /// Whose rules the behavior tree's machines follow: `as2fm` (the default) or `btcpp`;
+    /// as for `verify`.
+    #[arg(long = "bt", value_enum, default_value_t = super::verify::BtArg::As2fm)]
+    pub bt: super::verify::BtArg,
+    /// BehaviorTree.CPP's tick mode under --bt btcpp: `once` or `exactly-once`; as for
+    /// `verify`.
+    #[arg(long = "bt-tick", value_enum, value_name = "MODE")]
+    pub bt_tick: Option<super::verify::BtTickArg>,
 }
 
 /// Runs `hindsight convert`.
@@ -37,8 +45,23 @@ pub fn run(args: &ConvertArgs) -> Result<(), CliError> {
         ))
     })?;
     let search = Search::from_env(args.interfaces.clone());
+    let bt = match super::verify::bt_semantics(args.bt, args.bt_tick)?.as_slice() {
+        [one] => *one,
+        _ => {
+            return Err(CliError::Input(
+                "--bt both: convert writes one model; give --bt as2fm or --bt btcpp".into(),
+            ))
+        }
+    };
     let (robot, _) =
-        load_searching(&main, &[], &search).map_err(|d| CliError::Input(d.to_string()))?;
+        load_searching_bt(&main, &[], &search, bt).map_err(|d| CliError::Input(d.to_string()))?;
+    if bt != crate::robot::bt::BtSemantics::As2fm && robot.main.behavior_tree.is_none() {
+        return Err(CliError::Input(format!(
+            "--bt {}: {} has no behavior tree",
+            bt.label(),
+            main.display()
+        )));
+    }
     for w in &robot.warnings {
         eprintln!("warning: {w}");
     }

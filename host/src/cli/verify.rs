@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use super::CliError;
+use crate::robot::bt::{BtSemantics, BtTick};
 use crate::robot::load::ExternalComponent;
 use crate::sim::{CompiledModel, EventSemantics, RunConfig, Simulator};
 use crate::smc::progress::TerminalProgress;
@@ -44,6 +45,51 @@ impl From<Events> for EventSemantics {
             Events::As2fm => EventSemantics::As2fm,
         }
     }
+}
+
+/// Whose rules a robot model's behavior tree follows, as named on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum BtArg {
+    /// AS2FM's SCXML models of the nodes (the reference probabilities come from them).
+    #[default]
+    As2fm,
+    /// BehaviorTree.CPP 4 as it runs a tree loaded from XML.
+    Btcpp,
+    /// Both: `verify` runs the study under each and compares; `validate` checks both.
+    Both,
+}
+
+/// How BehaviorTree.CPP's executor ticks the root, as named on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum BtTickArg {
+    /// `Tree::tickOnce()`: ticked again at once while a wake-up is pending.
+    #[default]
+    Once,
+    /// `Tree::tickExactlyOnce()`: one tick per timer event.
+    ExactlyOnce,
+}
+
+/// The semantics `--bt` and `--bt-tick` name: one, or AS2FM's and BT.CPP's for `both`.
+/// `--bt-tick` is refused without BT.CPP's semantics.
+pub fn bt_semantics(bt: BtArg, tick: Option<BtTickArg>) -> Result<Vec<BtSemantics>, CliError> {
+    if tick.is_some() && bt == BtArg::As2fm {
+        return Err(CliError::Input(
+            "--bt-tick: only BehaviorTree.CPP's executor has tick modes; give --bt btcpp or \
+             --bt both"
+                .into(),
+        ));
+    }
+    let btcpp = BtSemantics::Btcpp {
+        tick: match tick.unwrap_or_default() {
+            BtTickArg::Once => BtTick::Once,
+            BtTickArg::ExactlyOnce => BtTick::ExactlyOnce,
+        },
+    };
+    Ok(match bt {
+        BtArg::As2fm => vec![BtSemantics::As2fm],
+        BtArg::Btcpp => vec![btcpp],
+        BtArg::Both => vec![BtSemantics::As2fm, btcpp],
+    })
 }
 
 /// Arguments of `hindsight verify`.
@@ -146,12 +192,46 @@ pub struct ModelArgs {
     /// the model, the sourced ROS workspace (AMENT_PREFIX_PATH) and the built-ins.
     #[arg(long = "interfaces", value_name = "DIR")]
     pub interfaces: Vec<PathBuf>,
+    /// Whose rules the behavior tree's built-in nodes follow (robot models): `as2fm`,
+    /// AS2FM's SCXML models of the nodes (the default); `btcpp`, BehaviorTree.CPP 4 as it
+    /// runs a tree loaded from XML (only RUNNING children halted, Parallel counting across
+    /// ticks, SequenceWithMemory keeping its place, wake-up yields); `both`: `verify`
+    /// runs the study under each and says which properties are semantics-sensitive,
+    /// `validate` checks both. On the command line only: AS2FM's main file has no
+    /// parameter for it.
+    #[arg(long = "bt", value_enum, default_value_t = BtArg::As2fm)]
+    pub bt: BtArg,
+    /// How BehaviorTree.CPP's executor ticks the root under --bt btcpp or both: `once`
+    /// (`tickOnce`, what `tickWhileRunning` and ROS 2 executors call: the root is ticked
+    /// again at once while a wake-up is pending; the default) or `exactly-once`
+    /// (`tickExactlyOnce`).
+    #[arg(long = "bt-tick", value_enum, value_name = "MODE")]
+    pub bt_tick: Option<BtTickArg>,
 }
 
 impl ModelArgs {
-    /// The library's load options for these arguments (`--time-unit` parsed).
+    /// The semantics `--bt` / `--bt-tick` name (two for `--bt both`).
+    pub fn semantics(&self) -> Result<Vec<BtSemantics>, CliError> {
+        bt_semantics(self.bt, self.bt_tick)
+    }
+
+    /// The library's load options for these arguments (`--time-unit` parsed); `--bt
+    /// both` is refused (only `verify` and `validate` take it).
     pub fn options(&self) -> Result<LoadOptions, CliError> {
+        match self.semantics()?.as_slice() {
+            [one] => self.options_with(*one),
+            _ => Err(CliError::Input(
+                "--bt both: only `verify` and `validate` compare the two semantics; give \
+                 --bt as2fm or --bt btcpp"
+                    .into(),
+            )),
+        }
+    }
+
+    /// [`ModelArgs::options`] with the behavior tree's semantics given.
+    pub fn options_with(&self, bt: BtSemantics) -> Result<LoadOptions, CliError> {
         Ok(LoadOptions {
+            bt,
             model: self.model.clone(),
             props: self.props.clone(),
             time_unit_ns: self.time_unit.as_deref().map(parse_time_unit).transpose()?,
@@ -473,6 +553,9 @@ fn save_failing(
 
 /// Runs `hindsight verify`.
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
+    if args.input.bt == BtArg::Both {
+        return run_both(args);
+    }
     let loaded = load(&args.input)?;
     let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
     let rule = RuleConfig {
@@ -551,6 +634,11 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         Vec::new()
     };
     let mut report = report(args, props_path, set, &result);
+    if let [bt] = args.input.semantics()?.as_slice() {
+        if *bt != BtSemantics::As2fm {
+            report.settings.push(("bt".into(), bt.label().into()));
+        }
+    }
     if let Some(unit) = loaded.unit_ns {
         report.step_seconds = Some(unit as f64 / 1e9);
         report.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
@@ -559,6 +647,158 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         super::report::from_verify(path, &report, &loaded, settings(), &failing)?;
     }
     print_report(&report, args.json)
+}
+
+/// `verify --bt both`: the study under AS2FM's node models and under BehaviorTree.CPP 4,
+/// each with the same seed and settings, and per property both probabilities and
+/// whether they differ beyond the precision (the two intervals are disjoint:
+/// "semantics-sensitive").
+fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
+    let refuse = |what: &str| {
+        Err(CliError::Input(format!(
+            "--bt both: not with {what} (run each semantics with --bt as2fm / --bt btcpp)"
+        )))
+    };
+    if args.shard.is_some() || args.runs.is_some() {
+        return refuse("--runs / --shard");
+    }
+    if args.report.is_some() || args.save_failing > 0 {
+        return refuse("--report / --save-failing");
+    }
+    let mut studies = Vec::new();
+    for bt in args.input.semantics()? {
+        let loaded =
+            crate::verify::load::load(&args.input.options_with(bt)?).map_err(CliError::Input)?;
+        let rule = RuleConfig {
+            kind: match (args.threshold, args.rule) {
+                (Some(threshold), _) => RuleKind::Sprt { threshold },
+                (None, Rule::Adaptive) => RuleKind::Adaptive,
+                (None, Rule::Okamoto) => RuleKind::Okamoto,
+                (None, Rule::Wilson) => RuleKind::Wilson,
+                (None, Rule::ClopperPearson) => RuleKind::ClopperPearson,
+            },
+            confidence: args.confidence,
+            precision: args.precision,
+        };
+        let run_cfg = RunConfig {
+            max_time: loaded
+                .max_time(args.max_time.as_deref())
+                .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
+            max_steps: args.max_steps,
+            events: loaded.events,
+            ..RunConfig::default()
+        };
+        let study_cfg = StudyConfig {
+            seed: args.seed,
+            threads: args.threads,
+            max_runs: args.max_runs,
+            keep_failing: 0,
+            progress_every: Duration::from_millis(200),
+        };
+        if !args.json {
+            eprintln!("--bt {}:", bt.label());
+        }
+        let result = study(
+            &loaded.model,
+            &loaded.set,
+            &run_cfg,
+            &study_cfg,
+            &rule,
+            !args.json,
+        )?;
+        let mut r = report(args, &loaded.props_path, &loaded.set, &result);
+        r.settings.push(("bt".into(), bt.label().into()));
+        if let Some(unit) = loaded.unit_ns {
+            r.step_seconds = Some(unit as f64 / 1e9);
+            r.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
+        }
+        studies.push((bt, r));
+    }
+    let [(_, a), (bt, b)] = studies.as_slice() else {
+        unreachable!("--bt both names two semantics")
+    };
+    let rows: Vec<Sensitivity> = a
+        .properties
+        .iter()
+        .zip(&b.properties)
+        .map(|(x, y)| Sensitivity::of(x, y))
+        .collect();
+    if args.json {
+        let doc = serde_json::json!({
+            "bt": "both",
+            "as2fm": a,
+            "btcpp": b,
+            "btcpp_semantics": bt.label(),
+            "properties": rows.iter().map(|r| serde_json::json!({
+                "property": r.property,
+                "as2fm": r.as2fm,
+                "btcpp": r.btcpp,
+                "difference": r.difference,
+                "semantics_sensitive": r.sensitive,
+            })).collect::<Vec<_>>(),
+        });
+        let text = serde_json::to_string_pretty(&doc)
+            .map_err(|e| CliError::Failed(format!("json: {e}")))?;
+        println!("{text}");
+        return Ok(());
+    }
+    let w = rows
+        .iter()
+        .map(|r| r.property.len())
+        .max()
+        .unwrap_or(8)
+        .max(8);
+    let p = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.4}"));
+    println!(
+        "{:<w$}  {:>8}  {:>8}  {:>10}  semantics-sensitive",
+        "property", "as2fm", "btcpp", "difference"
+    );
+    for r in &rows {
+        println!(
+            "{:<w$}  {:>8}  {:>8}  {:>10}  {}",
+            r.property,
+            p(r.as2fm),
+            p(r.btcpp),
+            r.difference.map_or("-".into(), |d| format!("{d:+.4}")),
+            if r.sensitive { "yes" } else { "no" }
+        );
+    }
+    println!(
+        "as2fm: {} runs; {}: {} runs; seed {}, confidence {}, precision {}; \
+         semantics-sensitive: the two intervals (±precision) are disjoint",
+        a.runs,
+        bt.label(),
+        b.runs,
+        args.seed,
+        args.confidence,
+        args.precision
+    );
+    Ok(())
+}
+
+/// One property under both semantics.
+struct Sensitivity {
+    property: String,
+    as2fm: Option<f64>,
+    btcpp: Option<f64>,
+    /// BT.CPP's estimate minus AS2FM's.
+    difference: Option<f64>,
+    /// The two intervals are disjoint: the difference is beyond the precision.
+    sensitive: bool,
+}
+
+impl Sensitivity {
+    fn of(a: &PropertyRow, b: &PropertyRow) -> Self {
+        let difference = a.probability.zip(b.probability).map(|(x, y)| y - x);
+        let sensitive = difference.is_some() && (a.upper < b.lower || b.upper < a.lower);
+        Sensitivity {
+            property: a.property.clone(),
+            as2fm: a.probability,
+            btcpp: b.probability,
+            difference,
+            sensitive,
+        }
+    }
 }
 
 fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -> Study {
@@ -656,18 +896,41 @@ pub struct ValidateArgs {
     pub input: ModelArgs,
 }
 
-/// Runs `hindsight validate`: loads and compiles, prints a one-line summary.
+/// Runs `hindsight validate`: loads and compiles (under each semantics `--bt` names),
+/// prints a one-line summary each, and warns where the behavior tree runs differently
+/// under AS2FM's node models and BehaviorTree.CPP 4.
 pub fn validate(args: &ValidateArgs) -> Result<(), CliError> {
-    let loaded = load(&args.input)?;
-    let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
-    println!(
-        "{}: {} machines, {} events; {}: {} guarantees, monitor state {} bytes: ok",
-        args.input.model.display(),
-        model.machine_count(),
-        model.event_count(),
-        props_path.display(),
-        set.guarantee_names().len(),
-        set.compiled().state_bytes()
-    );
+    let semantics = args.input.semantics()?;
+    for (k, &bt) in semantics.iter().enumerate() {
+        let loaded =
+            crate::verify::load::load(&args.input.options_with(bt)?).map_err(CliError::Input)?;
+        let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
+        let under = if bt == BtSemantics::As2fm && semantics.len() == 1 {
+            String::new()
+        } else {
+            format!(" (--bt {})", bt.label())
+        };
+        println!(
+            "{}{under}: {} machines, {} events; {}: {} guarantees, monitor state {} bytes: ok",
+            args.input.model.display(),
+            model.machine_count(),
+            model.event_count(),
+            props_path.display(),
+            set.guarantee_names().len(),
+            set.compiled().state_bytes()
+        );
+        if k == 0 {
+            for n in &loaded.bt_notes {
+                eprintln!("warning: {n}");
+            }
+            if !loaded.bt_notes.is_empty() {
+                eprintln!(
+                    "note: the tree's runs differ between AS2FM's node models (--bt as2fm, \
+                     the default) and BehaviorTree.CPP 4 (--bt btcpp) where warned above; \
+                     `hindsight verify --bt both` says which properties that changes"
+                );
+            }
+        }
+    }
     Ok(())
 }

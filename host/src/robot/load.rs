@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::bt::{self, BtInput, Halts};
+use super::bt::{self, BtInput, BtSemantics, Halts};
 use super::datatypes::read_main_declarations;
 use super::interfaces::{Interfaces, Search};
 use super::main_file::{Input, MainFile};
@@ -31,6 +31,10 @@ pub struct RobotModel {
     /// What was read but ignored, as AS2FM ignores it (the main file's
     /// [`MainFile::warnings`]); a command prints them.
     pub warnings: Vec<Diagnostic>,
+    /// Where the behavior tree's runs under AS2FM's node models and under
+    /// BehaviorTree.CPP 4 are known to differ ([`bt::semantics_notes`]); `validate`
+    /// prints them.
+    pub bt_notes: Vec<Diagnostic>,
 }
 
 /// The main file a path stands for: the path itself if it is an XML file whose root is
@@ -141,6 +145,7 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
         main_path,
         &[],
         Halts::default(),
+        BtSemantics::default(),
         &Search::from_env(Vec::new()),
     )
     .map(|(m, _)| m)
@@ -150,7 +155,27 @@ pub fn load(main_path: &Path) -> Result<RobotModel, Diagnostics> {
 /// [`Halts::WhenNeeded`] runs faster, with the same ROS messages under one schedule but
 /// other verdict probabilities where the model races (see [`Halts`]).
 pub fn load_with(main_path: &Path, halts: Halts) -> Result<RobotModel, Diagnostics> {
-    load_full(main_path, &[], halts, &Search::from_env(Vec::new())).map(|(m, _)| m)
+    load_full(
+        main_path,
+        &[],
+        halts,
+        BtSemantics::default(),
+        &Search::from_env(Vec::new()),
+    )
+    .map(|(m, _)| m)
+}
+
+/// [`load`] with the behavior tree lowered under `semantics` (AS2FM's node models, or
+/// BehaviorTree.CPP 4's rules and tick mode; see [`BtSemantics`]).
+pub fn load_bt(main_path: &Path, semantics: BtSemantics) -> Result<RobotModel, Diagnostics> {
+    load_full(
+        main_path,
+        &[],
+        Halts::default(),
+        semantics,
+        &Search::from_env(Vec::new()),
+    )
+    .map(|(m, _)| m)
 }
 
 /// What a node model declares that a process replacing it must speak (topics, services
@@ -379,6 +404,7 @@ pub fn load_without(
         main_path,
         external,
         Halts::default(),
+        BtSemantics::default(),
         &Search::from_env(Vec::new()),
     )
 }
@@ -390,13 +416,30 @@ pub fn load_searching(
     external: &[String],
     search: &Search,
 ) -> Result<(RobotModel, Vec<ExternalComponent>), Diagnostics> {
-    load_full(main_path, external, Halts::default(), search)
+    load_full(
+        main_path,
+        external,
+        Halts::default(),
+        BtSemantics::default(),
+        search,
+    )
+}
+
+/// [`load_searching`] with the behavior tree lowered under `semantics`.
+pub fn load_searching_bt(
+    main_path: &Path,
+    external: &[String],
+    search: &Search,
+    semantics: BtSemantics,
+) -> Result<(RobotModel, Vec<ExternalComponent>), Diagnostics> {
+    load_full(main_path, external, Halts::default(), semantics, search)
 }
 
 fn load_full(
     main_path: &Path,
     external: &[String],
     halts: Halts,
+    semantics: BtSemantics,
     search: &Search,
 ) -> Result<(RobotModel, Vec<ExternalComponent>), Diagnostics> {
     let mut sm = SourceMap::new();
@@ -411,6 +454,7 @@ fn load_full(
     // top_level_interpreter.py: the node models in main-file order, then `bt_converter`'s
     // root and plugins): the ROS lowering numbers timers and clients in this order.
     let mut tree_machines = Vec::new();
+    let mut bt_notes = Vec::new();
     if let Some(tree) = &main.behavior_tree {
         let file_of = |sm: &mut SourceMap, input: &Input, errs: &mut Vec<Diagnostic>| {
             match codegen::diag::read_source(&input.path) {
@@ -435,7 +479,9 @@ fn load_full(
                     tick_rate_hz: main.params.bt_tick_rate_hz(),
                     tick_if_not_running: main.params.tick_if_not_running(),
                     halts,
+                    semantics,
                 };
+                bt_notes = bt::semantics_notes(&sm, &input);
                 match bt::lower(&sm, &input) {
                     Ok(ms) => tree_machines = ms,
                     Err(ds) => errs.extend(ds),
@@ -520,6 +566,7 @@ fn load_full(
             time_unit_ns: unit,
             max_time_steps: max_time_ns / unit + 1,
             warnings,
+            bt_notes,
         },
         left_out,
     ))

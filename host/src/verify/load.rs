@@ -36,6 +36,9 @@ pub struct LoadOptions {
     /// before the folders beside and above the model, `AMENT_PREFIX_PATH` and the
     /// built-ins.
     pub interfaces: Vec<PathBuf>,
+    /// Whose rules a robot model's behavior tree follows (`--bt`); anything but AS2FM's
+    /// needs a robot model with a behavior tree.
+    pub bt: crate::robot::bt::BtSemantics,
 }
 
 /// The event semantics for a property file when none is asked for: AS2FM's for a JANI
@@ -99,6 +102,9 @@ pub struct Loaded {
     pub unit_ns: Option<u64>,
     /// The run length the model asks for (a robot main file's `max_time`), in steps.
     pub default_max_time: Option<u64>,
+    /// Where a robot model's behavior tree runs differently under AS2FM's node models and
+    /// BehaviorTree.CPP 4 (`file:line:col: what`), for `validate`.
+    pub bt_notes: Vec<String>,
     /// How sends are delivered.
     pub events: EventSemantics,
 }
@@ -154,6 +160,14 @@ pub fn load_without(
             opts.model.display()
         ));
     }
+    if opts.bt != crate::robot::bt::BtSemantics::As2fm {
+        return Err(format!(
+            "--bt {}: {} is not a robot model (a main file, or a folder with main.xml); \
+             only a robot model's behavior tree has a BehaviorTree.CPP semantics",
+            opts.bt.label(),
+            opts.model.display()
+        ));
+    }
     if let Some(name) = external.first() {
         return Err(format!(
             "--external {name}: {} is not a robot model (a main file, or a folder with \
@@ -181,6 +195,7 @@ pub fn load_without(
             unit_ns,
             default_max_time: None,
             events,
+            bt_notes: Vec::new(),
         },
         Vec::new(),
     ))
@@ -335,8 +350,15 @@ fn load_robot(
 ) -> Result<(Loaded, Vec<ExternalComponent>), String> {
     use crate::robot::main_file::InputKind;
     let search = crate::robot::interfaces::Search::from_env(opts.interfaces.clone());
-    let (robot, external) =
-        crate::robot::load::load_searching(main, external, &search).map_err(|d| d.to_string())?;
+    let (robot, external) = crate::robot::load::load_searching_bt(main, external, &search, opts.bt)
+        .map_err(|d| d.to_string())?;
+    if opts.bt != crate::robot::bt::BtSemantics::As2fm && robot.main.behavior_tree.is_none() {
+        return Err(format!(
+            "--bt {}: {} has no behavior tree",
+            opts.bt.label(),
+            main.display()
+        ));
+    }
     print_warnings(&robot.warnings);
     if let Some(given) = opts.time_unit_ns {
         if given != robot.time_unit_ns {
@@ -378,6 +400,7 @@ fn load_robot(
             props_path,
             unit_ns: Some(robot.time_unit_ns),
             default_max_time: Some(robot.max_time_steps),
+            bt_notes: robot.bt_notes.iter().map(|d| d.to_string()).collect(),
             // The lowering is AS2FM's translation; its sends mean what AS2FM's JANI means.
             events: opts.events.unwrap_or(EventSemantics::As2fm),
         },

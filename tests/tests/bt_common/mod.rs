@@ -85,6 +85,7 @@ pub fn lowered(
         tick_rate_hz: 1.0,
         tick_if_not_running: true,
         halts,
+        semantics: Default::default(),
     };
     let mut machines = bt::lower(&sm, &input).map_err(|ds| Diagnostics(ds).to_string())?;
     let root_name = machines[0]

@@ -19,7 +19,7 @@
 //! naming both places.
 
 use super::build::B;
-use super::control::{Ctx, HaltEffect, FAILURE, RUNNING, SUCCESS};
+use super::control::{status_code, Ctx, HaltEffect, FAILURE, RUNNING, SUCCESS};
 use super::plugin;
 use super::tree::{CheckType, Control, Kind, PortValue, Tree, TreeNode};
 use crate::model::source::{Diagnostic, SourceMap, Span};
@@ -517,6 +517,10 @@ pub(crate) fn lower_check(
         None => FAILURE,
         Some(p) => match &p.value {
             PortValue::Literal(v) => match parse_status(v) {
+                // BT.CPP converts the port with `convertFromString<NodeStatus>`, which
+                // knows the names only: AS2FM's numbers fail to convert and the default
+                // FAILURE stays (3.8 `BlackboardPreconditionNode::tick`).
+                Ok(_) if ctx.btcpp && status_code(v).is_none() => FAILURE,
                 Ok(s) => s,
                 Err(m) => {
                     errs.push(sm.diag(p.span, format!("`return_on_mismatch`: {m}")));
@@ -556,7 +560,16 @@ pub(crate) fn lower_check(
 fn check(ctx: &Ctx, cond: &str, reads: bool, mismatch: u8) -> Element {
     let b = &ctx.b;
     let mut m = b.scxml(&ctx.machine, "wait_for_tick");
-    let flags = ctx.running_data();
+    // BT.CPP: the child is not reset after it finished (3.8
+    // `BlackboardPreconditionNode::tick` returns `child_node_->executeTick()`; a mismatch
+    // halts it only while RUNNING), and a stateful leaf ticked in a finished status
+    // answers it again without running (`btcpp.rs`, "Leaves"): its status kept in
+    // `child_done` (0 while idle or running).
+    let stale = ctx.btcpp && ctx.stateful.first() == Some(&true);
+    let mut flags = ctx.running_data();
+    if stale {
+        flags.push(("child_done".into(), "int8", "0".into()));
+    }
     if !flags.is_empty() {
         let data: Vec<(&str, &str, String)> = flags
             .iter()
@@ -571,6 +584,8 @@ fn check(ctx: &Ctx, cond: &str, reads: bool, mismatch: u8) -> Element {
             Some("wait_for_tick"),
             vec![ctx.respond(mismatch)],
         )
+    } else if ctx.btcpp {
+        b.tr(None, None, Some("check_mismatch"), vec![])
     } else {
         b.tr(None, None, Some("value_mismatch"), vec![])
     };
@@ -593,15 +608,31 @@ fn check(ctx: &Ctx, cond: &str, reads: bool, mismatch: u8) -> Element {
     if reads {
         // The answer carries the entries; compare on it.
         let mut r = b.state("read_blackboard");
+        if stale {
+            r.push(b.tr(
+                Some(GET),
+                Some(&format!("({cond}) && child_done > 0")),
+                Some("wait_for_tick"),
+                vec![ctx.respond_expr("child_done")],
+            ));
+        }
         r.push(b.tr(Some(GET), Some(cond), Some("tick_child"), vec![]));
         let mut other = on_mismatch.clone();
         other.set_attr("event", GET);
         r.push(other);
         m.push(r);
     } else {
+        let mut e = b.state("exec_tick");
+        if stale {
+            e.push(b.tr(
+                None,
+                Some(&format!("({cond}) && child_done > 0")),
+                Some("wait_for_tick"),
+                vec![ctx.respond_expr("child_done")],
+            ));
+        }
         m.push(
-            b.state("exec_tick")
-                .with_child(b.tr(None, Some(cond), Some("tick_child"), vec![]))
+            e.with_child(b.tr(None, Some(cond), Some("tick_child"), vec![]))
                 .with_child(on_mismatch),
         );
     }
@@ -616,14 +647,36 @@ fn check(ctx: &Ctx, cond: &str, reads: bool, mismatch: u8) -> Element {
     );
     let mut t = b.state_entry("tick_child", vec![ctx.tick_child(0)]);
     for s in [SUCCESS, FAILURE, RUNNING] {
+        let mut body = vec![ctx.respond(s)];
+        if stale && s != RUNNING {
+            body.push(b.assign("child_done", &s.to_string()));
+        }
         t.push(b.tr(
             Some(&ctx.child_resp(0)),
             Some(&format!("_event.data.status == {s}")),
             Some("wait_for_tick"),
-            ctx.marked(0, s, vec![ctx.respond(s)]),
+            ctx.marked(0, s, body),
         ));
     }
     m.push(t);
+    if ctx.btcpp {
+        // BT.CPP halts the child only while it is RUNNING (3.8
+        // `BlackboardPreconditionNode::tick` calls `haltChild`; 4.10
+        // `decorator_node.cpp`, `DecoratorNode::resetChild`).
+        let r = ctx
+            .running_var(0)
+            .expect("BT.CPP's rules keep every child's flag");
+        m.push(
+            b.state("check_mismatch")
+                .with_child(b.tr(None, Some(&r), Some("value_mismatch"), vec![]))
+                .with_child(b.tr(
+                    None,
+                    None,
+                    Some("wait_for_tick"),
+                    vec![ctx.respond(mismatch)],
+                )),
+        );
+    }
     if ctx.effect(0) != HaltEffect::Never {
         m.push(
             b.state_entry("value_mismatch", ctx.halt_child_body(0))

@@ -65,6 +65,18 @@ pub(crate) struct Ctx {
     /// `None`: halt every child as AS2FM does. `Some`: the [`HaltEffect`] of each child;
     /// a child is halted only if that can change something.
     pub effects: Option<Vec<HaltEffect>>,
+    /// The node follows BT.CPP 4's rules ([`super::BtSemantics::Btcpp`]): every child is
+    /// `WhenRunning` in `effects` (halted only while RUNNING, BT.CPP 4.10
+    /// `control_node.cpp`, `ControlNode::haltChild`), and the nodes whose rules differ
+    /// from AS2FM's get the machines of `btcpp.rs`.
+    pub btcpp: bool,
+    /// Where a node sends the wake-up signal (`bt_wake_up`, BT.CPP 4.10 `tree_node.cpp`,
+    /// `TreeNode::emitWakeUpSignal`): the root machine under `tickOnce`, `None` when no
+    /// one listens (AS2FM's rules, or `tickExactlyOnce`).
+    pub wake: Option<String>,
+    /// Under BT.CPP's rules, whether each child is a leaf plugin, a stateful action
+    /// (`btcpp.rs`, "Leaves"); empty under AS2FM's.
+    pub stateful: Vec<bool>,
 }
 
 impl Ctx {
@@ -82,6 +94,14 @@ impl Ctx {
             &format!("bt_{}_response", self.id),
             &self.parent,
             &[("status", &status.to_string())],
+        )
+    }
+    /// Sends `bt_<id>_response` with the status `expr` evaluates to.
+    pub fn respond_expr(&self, expr: &str) -> Element {
+        self.b.send_params(
+            &format!("bt_{}_response", self.id),
+            &self.parent,
+            &[("status", expr)],
         )
     }
     /// Sends `bt_<id>_halt_response`.
@@ -105,7 +125,7 @@ impl Ctx {
     }
     /// The variable that says child `i` last answered RUNNING (kept for children whose
     /// halt matters only while they run).
-    fn running_var(&self, i: usize) -> Option<String> {
+    pub(super) fn running_var(&self, i: usize) -> Option<String> {
         (self.effect(i) == HaltEffect::WhenRunning).then(|| format!("child_{i}_running"))
     }
     /// The datamodel entries of the running flags.
@@ -226,7 +246,7 @@ pub(crate) fn machine(c: Control, ctx: &Ctx, num: &[i64]) -> Element {
         Control::ReactiveSequence => reactive(ctx, true),
         Control::ReactiveFallback => reactive(ctx, false),
         Control::Parallel => parallel(ctx, num[0], num[1]),
-        Control::IfThenElse => if_then_else(ctx),
+        Control::IfThenElse => if_then_else(ctx, false),
         Control::Inverter => decorator(ctx, [FAILURE, SUCCESS, RUNNING]),
         Control::ForceSuccess => decorator(ctx, [SUCCESS, SUCCESS, RUNNING]),
         Control::ForceFailure => decorator(ctx, [FAILURE, FAILURE, RUNNING]),
@@ -393,7 +413,7 @@ pub(crate) fn root_machine(
 }
 
 /// A rate as written in an attribute: `1.0`, `0.5`, `10.0`.
-fn format_rate(r: f64) -> String {
+pub(super) fn format_rate(r: f64) -> String {
     if r.fract() == 0.0 && r.abs() < 1e15 {
         format!("{r:.1}")
     } else {

@@ -31,9 +31,11 @@
 //! Every generated element carries the span of the tree node or plugin tag it comes from.
 
 mod blackboard;
+mod btcpp;
 mod build;
 mod control;
 mod decorators;
+mod notes;
 mod parallel;
 mod plugin;
 mod sequences;
@@ -58,8 +60,58 @@ pub struct BtInput {
     /// Whether the root is ticked again after it answered SUCCESS or FAILURE
     /// (`bt_tick_if_not_running`).
     pub tick_if_not_running: bool,
-    /// Which children the built-in control nodes halt.
+    /// Which children the built-in control nodes halt (AS2FM's semantics only; under
+    /// BT.CPP's a node halts exactly its RUNNING children).
     pub halts: Halts,
+    /// Whose rules the built-in nodes and the root machine follow.
+    pub semantics: BtSemantics,
+}
+
+/// Whose rules the tree's built-in nodes follow where AS2FM's SCXML models of them and
+/// what BehaviorTree.CPP 4 executes differ (README, "BT semantics").
+///
+/// The machines, their names and the `bt_<id>_tick` / `bt_<id>_response` /
+/// `bt_<id>_halt` events are the same under both, so traces and properties read the same
+/// names; what differs is which halts are sent, Parallel's counting, SequenceWithMemory's
+/// memory, and the wake-up yields of BT.CPP 4 (`btcpp.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BtSemantics {
+    /// AS2FM's node models (`*.ascxml` of its `bt_nodes`), one for one: the reference
+    /// probabilities of the corpus come from them.
+    #[default]
+    As2fm,
+    /// BehaviorTree.CPP 4 as it runs a tree created from XML, ticked by `tick`.
+    Btcpp {
+        /// How the executor ticks the root.
+        tick: BtTick,
+    },
+}
+
+/// How BehaviorTree.CPP's executor ticks the root (BT.CPP 4 `bt_factory.cpp`,
+/// `Tree::tickRoot`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BtTick {
+    /// `Tree::tickOnce()` (what `tickWhileRunning` and the ROS 2 executors call): while
+    /// the root answers RUNNING and a node emitted the wake-up signal since the signal was
+    /// last taken, the root is ticked again at once.
+    #[default]
+    Once,
+    /// `Tree::tickExactlyOnce()`: one tick of the root per timer event, wake-ups ignored.
+    ExactlyOnce,
+}
+
+impl BtSemantics {
+    /// The name on the command line: `as2fm`, `btcpp` (`tickOnce`) or
+    /// `btcpp-exactly-once`.
+    pub fn label(self) -> &'static str {
+        match self {
+            BtSemantics::As2fm => "as2fm",
+            BtSemantics::Btcpp { tick: BtTick::Once } => "btcpp",
+            BtSemantics::Btcpp {
+                tick: BtTick::ExactlyOnce,
+            } => "btcpp-exactly-once",
+        }
+    }
 }
 
 /// Which children a built-in control node halts when it finishes or is halted.
@@ -164,14 +216,26 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
     let root_b = B {
         at: tree.nodes[0].span,
     };
-    out.push(control::root_machine(
-        root_b,
-        &root_name,
-        &format!("{}_tick", stem(sm, input.tree)),
-        input.tick_rate_hz,
-        (tree.nodes[0].id, &tree.nodes[0].machine),
-        input.tick_if_not_running,
-    ));
+    let timer = format!("{}_tick", stem(sm, input.tree));
+    let root_node = (tree.nodes[0].id, tree.nodes[0].machine.as_str());
+    out.push(match input.semantics {
+        BtSemantics::Btcpp { tick: BtTick::Once } => btcpp::root_machine(
+            root_b,
+            &root_name,
+            &timer,
+            input.tick_rate_hz,
+            root_node,
+            input.tick_if_not_running,
+        ),
+        _ => control::root_machine(
+            root_b,
+            &root_name,
+            &timer,
+            input.tick_rate_hz,
+            root_node,
+            input.tick_if_not_running,
+        ),
+    });
     for n in &tree.nodes {
         let (parent, halt_target) = match n.parent {
             Some(p) => (tree.nodes[p].machine.clone(), tree.nodes[p].machine.clone()),
@@ -188,8 +252,22 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
                 .iter()
                 .map(|&c| (tree.nodes[c].id, tree.nodes[c].machine.clone()))
                 .collect(),
-            effects: (input.halts == Halts::WhenNeeded)
-                .then(|| n.children.iter().map(|&c| effects[c]).collect()),
+            effects: match input.semantics {
+                BtSemantics::As2fm => (input.halts == Halts::WhenNeeded)
+                    .then(|| n.children.iter().map(|&c| effects[c]).collect()),
+                BtSemantics::Btcpp { .. } => Some(vec![HaltEffect::WhenRunning; n.children.len()]),
+            },
+            btcpp: input.semantics != BtSemantics::As2fm,
+            wake: (input.semantics == BtSemantics::Btcpp { tick: BtTick::Once })
+                .then(|| root_name.clone()),
+            stateful: if input.semantics == BtSemantics::As2fm {
+                Vec::new()
+            } else {
+                n.children
+                    .iter()
+                    .map(|&c| matches!(tree.nodes[c].kind, Kind::Plugin(p) if !plugins[p].ticks_children))
+                    .collect()
+            },
         };
         let m = match n.kind {
             Kind::Plugin(i) => Some(plugin::instance(
@@ -200,7 +278,18 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
                 &mut bb,
                 &mut errs,
             )),
-            Kind::Control(c) => builtin(sm, c, n, &ctx, &mut bb, &mut errs),
+            Kind::Control(c) => {
+                // A leaf plugin is a stateful action under BT.CPP's rules (see
+                // `btcpp.rs`); only IfThenElse can tick one that was not reset.
+                let stale_condition = c == Control::IfThenElse
+                    && n.children.len() == 2
+                    && ctx.stateful.first() == Some(&true);
+                if stale_condition {
+                    Some(parallel::if_then_else(&ctx, true))
+                } else {
+                    builtin(sm, c, n, &ctx, &mut bb, &mut errs)
+                }
+            }
         };
         if let Some(m) = m {
             out.push(m);
@@ -213,6 +302,26 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
         Ok(out)
     } else {
         Err(errs)
+    }
+}
+
+/// Where the tree's runs under AS2FM's node models and under BehaviorTree.CPP 4 are known
+/// to differ (`notes.rs`): one note per construction, at the node. Empty when the tree
+/// or a plugin cannot be read ([`lower`] reports that).
+pub fn semantics_notes(sm: &SourceMap, input: &BtInput) -> Vec<Diagnostic> {
+    let mut plugins = Vec::new();
+    for &f in &input.plugins {
+        match plugin::read(sm, f) {
+            Ok(p) => plugins.push(p),
+            Err(_) => return Vec::new(),
+        }
+    }
+    let Ok(root) = xml::parse(sm, input.tree) else {
+        return Vec::new();
+    };
+    match tree::read(sm, &root, &plugins) {
+        Ok(t) => notes::notes(sm, &t, &plugins),
+        Err(_) => Vec::new(),
     }
 }
 
@@ -330,7 +439,13 @@ fn builtin(
             };
             let s = th(&["success_count", "success_threshold"], -1, "success");
             let f = th(&["failure_count", "failure_threshold"], 1, "failure");
-            (errs.len() == ok_before).then(|| control::machine(c, ctx, &[s, f]))
+            (errs.len() == ok_before).then(|| {
+                if ctx.btcpp {
+                    btcpp::parallel(ctx, s, f)
+                } else {
+                    control::machine(c, ctx, &[s, f])
+                }
+            })
         }
         Control::Repeat | Control::RetryUntilSuccessful => {
             let key = if c == Control::Repeat {
@@ -346,6 +461,9 @@ fn builtin(
                     ));
                     None
                 }
+                Some((v, _)) if ctx.btcpp => {
+                    Some(btcpp::repeat(ctx, v, c == Control::RetryUntilSuccessful))
+                }
                 Some((v, _)) => Some(control::machine(c, ctx, &[v])),
                 None => {
                     if n.port(key).is_none() {
@@ -357,6 +475,7 @@ fn builtin(
         }
         Control::SetBlackboard => blackboard::lower_set(sm, n, ctx, bb, errs),
         Control::BlackboardCheck(t) => blackboard::lower_check(sm, t, n, ctx, bb, errs),
+        Control::SequenceWithMemory if ctx.btcpp => Some(btcpp::sequence_with_memory(ctx)),
         _ => Some(control::machine(c, ctx, &[])),
     }
 }

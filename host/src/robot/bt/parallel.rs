@@ -151,7 +151,13 @@ pub(super) fn parallel(ctx: &Ctx, success: i64, failure: i64) -> Element {
 /// IfThenElse: ticks the condition (child 0) while no branch runs; SUCCESS runs child 1,
 /// FAILURE child 2 (or answers FAILURE with two children); the branch's answer is the
 /// node's, and a finished branch halts every child first.
-pub(super) fn if_then_else(ctx: &Ctx) -> Element {
+///
+/// With `stale_condition` (BT.CPP's rules, a condition that is a leaf plugin and two
+/// children), a failed condition is not reset (`IfThenElseNode::tick` returns its
+/// FAILURE without `resetChildren`), and a stateful leaf ticked again in a finished
+/// status answers that status without running (BT.CPP 4 `action_node.cpp`,
+/// `StatefulActionNode::tick`): from then on the node answers FAILURE without ticking it.
+pub(super) fn if_then_else(ctx: &Ctx, stale_condition: bool) -> Element {
     let b = &ctx.b;
     let idx = "child_idx";
     let mut m = b.scxml(&ctx.machine, "init");
@@ -163,28 +169,39 @@ pub(super) fn if_then_else(ctx: &Ctx) -> Element {
         ("children_count", "int8", n_children(ctx)),
     ];
     data.extend(flags.iter().map(|(v, t, e)| (v.as_str(), *t, e.clone())));
+    if stale_condition {
+        data.push(("condition_failed", "bool", "false".into()));
+    }
     m.push(b.datamodel(&data));
     m.push(init_state(ctx, "children_count < 2 || children_count > 3"));
+    let mut w = b.state("wait_for_tick");
+    if stale_condition {
+        w.push(b.tr(
+            Some(&ctx.tick_ev()),
+            Some(&format!("{idx} == 0 && condition_failed")),
+            Some("wait_for_tick"),
+            vec![ctx.respond(FAILURE)],
+        ));
+    }
     m.push(
-        b.state("wait_for_tick")
-            .with_child(b.tr(
-                Some(&ctx.tick_ev()),
-                Some(&format!("{idx} == 0")),
-                Some("tick_condition_child"),
-                vec![],
-            ))
-            .with_child(b.tr(
-                Some(&ctx.tick_ev()),
-                Some(&format!("{idx} > 0")),
-                Some("tick_exec_child"),
-                vec![],
-            ))
-            .with_child(b.tr(
-                Some(&ctx.halt_ev()),
-                None,
-                Some("reset_children"),
-                vec![b.assign(idx, "0")],
-            )),
+        w.with_child(b.tr(
+            Some(&ctx.tick_ev()),
+            Some(&format!("{idx} == 0")),
+            Some("tick_condition_child"),
+            vec![],
+        ))
+        .with_child(b.tr(
+            Some(&ctx.tick_ev()),
+            Some(&format!("{idx} > 0")),
+            Some("tick_exec_child"),
+            vec![],
+        ))
+        .with_child(b.tr(
+            Some(&ctx.halt_ev()),
+            None,
+            Some("reset_children"),
+            vec![b.assign(idx, "0")],
+        )),
     );
     let finish = answer_by_flags(ctx, idx, "ret_failure", "ret_success");
     m.push(reset_children(ctx, idx, finish));
@@ -212,7 +229,13 @@ pub(super) fn if_then_else(ctx: &Ctx) -> Element {
                     "_event.data.status == {FAILURE} && children_count < 3"
                 )),
                 Some("wait_for_tick"),
-                ctx.marked(0, FAILURE, vec![ctx.respond(FAILURE)]),
+                ctx.marked(0, FAILURE, {
+                    let mut v = vec![ctx.respond(FAILURE)];
+                    if stale_condition {
+                        v.push(b.assign("condition_failed", "true"));
+                    }
+                    v
+                }),
             ))
             .with_child(b.tr(
                 Some(&cond_resp),
