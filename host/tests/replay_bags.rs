@@ -230,3 +230,89 @@ fn a_spec_with_bindings() {
     assert_eq!(out.lines().collect::<Vec<_>>(), want);
     let _ = std::fs::remove_dir_all(&spec_dir);
 }
+
+/// An MCAP file of `std_msgs/Int32` messages on `/battery_level`, written with the `mcap`
+/// crate (no Python needed).
+fn int32_mcap(messages: &[Vec<u8>]) -> Vec<u8> {
+    let mut w = mcap::Writer::new(std::io::Cursor::new(Vec::new())).unwrap();
+    let s = w
+        .add_schema("std_msgs/msg/Int32", "ros2msg", b"int32 data\n")
+        .unwrap();
+    let c = w
+        .add_channel(s, "/battery_level", "cdr", &Default::default())
+        .unwrap();
+    for (i, data) in messages.iter().enumerate() {
+        let header = mcap::records::MessageHeader {
+            channel_id: c,
+            sequence: i as u32,
+            log_time: 1_000_000_000 + i as u64 * 1_000,
+            publish_time: 0,
+        };
+        w.write_to_known_channel(&header, data).unwrap();
+    }
+    w.finish().unwrap();
+    w.into_inner().into_inner()
+}
+
+/// A bad sample, a truncated file and a field the type lacks exit 2, naming the topic and
+/// the message's index (or the field and the type).
+#[test]
+fn bad_bags_exit_2_naming_topic_and_index() {
+    let dir = std::env::temp_dir().join(format!("hindsight-bad-bags-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = |v: i32| {
+        let mut m = vec![0, 1, 0, 0];
+        m.extend(v.to_le_bytes());
+        m
+    };
+    let props = data("properties.xml");
+    let check = |name: &str, bytes: &[u8], props: &Path, wants: &[&str]| {
+        let file = dir.join(name);
+        std::fs::write(&file, bytes).unwrap();
+        let out = replay(&[props.as_os_str(), file.as_os_str()]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        for w in wants {
+            assert!(err.contains(w), "{name}: `{w}` not in {err}");
+        }
+    };
+    let ok_file = int32_mcap(&[good(50), good(40)]);
+    let file = dir.join("ok.mcap");
+    std::fs::write(&file, &ok_file).unwrap();
+    let out = ok(&replay(&[props.as_os_str(), file.as_os_str()]));
+    assert_eq!(out.lines().count(), 3, "{out}");
+    check(
+        "short.mcap",
+        &int32_mcap(&[good(50), vec![0, 1, 0, 0, 7], good(30)]),
+        &props,
+        &["topic `/battery_level` message 2", "std_msgs/msg/Int32"],
+    );
+    check(
+        "huge.mcap",
+        &int32_mcap(&[good(50), good(40), vec![0, 7, 0, 0, 1, 2, 3, 4]]),
+        &props,
+        &["topic `/battery_level` message 3", "encapsulation"],
+    );
+    check(
+        "cut.mcap",
+        &ok_file[..ok_file.len() * 2 / 3],
+        &props,
+        &["cut.mcap"],
+    );
+    let wrong = dir.join("wrong.xml");
+    std::fs::write(
+        &wrong,
+        std::fs::read_to_string(&props).unwrap().replace(
+            "field=\"data\" expr=\"100\"",
+            "field=\"value\" expr=\"100\"",
+        ),
+    )
+    .unwrap();
+    check(
+        "ok2.mcap",
+        &ok_file,
+        &wrong,
+        &["/battery_level", "no field `value`", "std_msgs/Int32"],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

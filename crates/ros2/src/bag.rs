@@ -167,7 +167,7 @@ fn read_mcap(
 /// [`Recording::for_each`] gives them; `conns` collects the connections.
 ///
 /// The `mcap` crate's sans-I/O reader does the container (chunks, compression, the end
-/// magic) with a record length limit ([`record_limit`]): its convenience iterators set
+/// magic) with a record length limit (a chunk may be 4096 times the file): its convenience iterators set
 /// none, and then reserve whatever length a corrupt record inside a chunk claims.
 pub fn mcap_bytes(
     bytes: &[u8],
