@@ -26,6 +26,9 @@ const SPEC: &str =
     property every_second = H(P[1s:] true -> P[:1s] {published});\n\
     property followed_lately = P[:5s] {followed} || !P[5s:] true;\n";
 
+/// Judges one point: its time and the variables it sets.
+type Step<'a> = dyn FnMut(u64, &[(usize, Value)]) + 'a;
+
 fn arg(name: &str, default: usize) -> usize {
     let args: Vec<String> = std::env::args().collect();
     args.iter()
@@ -115,7 +118,7 @@ fn main() {
     let tick = compiled.tick_ns();
 
     // One pass: all points judged; returns (seconds, points, verdicts at the end).
-    let judge = |feed: &mut dyn FnMut(&mut dyn FnMut(u64, &[(usize, Value)]))| {
+    let judge = |feed: &mut dyn FnMut(&mut Step<'_>)| {
         let mut state = vec![0u64; monitor.state_words()];
         let mut vals = vec![Value::Bool(false); program.vars.len()];
         valuation::init(program.vars, &mut vals);

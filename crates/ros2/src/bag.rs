@@ -43,6 +43,10 @@ pub struct Message<'a> {
     pub data: &'a [u8],
 }
 
+/// What a reader calls with each message and the connections known so far; an error
+/// stops the reading.
+pub type Visit<'v> = dyn FnMut(&[Connection], Message<'_>) -> Result<(), String> + 'v;
+
 /// The files of a recording, in order, and how each is stored.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Recording {
@@ -126,10 +130,7 @@ impl Recording {
     /// Calls `visit` with every message, in order, and the connections known so far.
     /// An error from `visit` stops the reading and is returned as is; a file that does
     /// not read is an error naming it and the messages read from it so far.
-    pub fn for_each(
-        &self,
-        visit: &mut dyn FnMut(&[Connection], Message<'_>) -> Result<(), String>,
-    ) -> Result<(), String> {
+    pub fn for_each(&self, visit: &mut Visit<'_>) -> Result<(), String> {
         let mut conns = Vec::new();
         for (file, mcap) in &self.files {
             if *mcap {
@@ -156,7 +157,7 @@ fn intern(conns: &mut Vec<Connection>, c: Connection) -> usize {
 fn read_mcap(
     file: &Path,
     conns: &mut Vec<Connection>,
-    visit: &mut dyn FnMut(&[Connection], Message<'_>) -> Result<(), String>,
+    visit: &mut Visit<'_>,
 ) -> Result<(), String> {
     let shown = file.display();
     let bytes = std::fs::read(file).map_err(|e| format!("{shown}: cannot read: {e}"))?;
@@ -173,7 +174,7 @@ pub fn mcap_bytes(
     bytes: &[u8],
     shown: &str,
     conns: &mut Vec<Connection>,
-    visit: &mut dyn FnMut(&[Connection], Message<'_>) -> Result<(), String>,
+    visit: &mut Visit<'_>,
 ) -> Result<(), String> {
     use mcap::records::Record;
     use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -353,11 +354,7 @@ fn check_chunks(bytes: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
-fn read_db3(
-    file: &Path,
-    conns: &mut Vec<Connection>,
-    visit: &mut dyn FnMut(&[Connection], Message<'_>) -> Result<(), String>,
-) -> Result<(), String> {
+fn read_db3(file: &Path, conns: &mut Vec<Connection>, visit: &mut Visit<'_>) -> Result<(), String> {
     use rusqlite::{Connection as Db, OpenFlags};
     let shown = file.display();
     if !file.is_file() {

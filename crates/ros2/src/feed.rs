@@ -28,7 +28,7 @@ use std::path::Path;
 
 use monitor_core::{Ty, Value};
 
-use crate::bag::{Connection, Recording};
+use crate::bag::{Connection, Recording, Visit};
 use crate::cdr::Decoder;
 use crate::schema::{Definitions, Ros2MsgDefs, Schema};
 
@@ -113,11 +113,14 @@ pub struct Summary {
     pub topics: Vec<(String, u64)>,
 }
 
+/// One port of a connection: `(var, slot read or None for true, (slot, value) the
+/// message must have there for a service event's kind)`.
+type PortSet = (usize, Option<usize>, Option<(usize, i64)>);
+
 /// How one connection's messages set variables.
 struct Plan {
     decoder: Option<Decoder>,
-    /// `(var, what)`; `what` is `None` for `true`, else a slot.
-    sets: Vec<(usize, Option<usize>, Option<(usize, i64)>)>,
+    sets: Vec<PortSet>,
     /// Slots of `header.stamp.sec` / `nanosec`.
     stamp: Option<(usize, usize)>,
     count: u64,
@@ -168,9 +171,6 @@ pub fn replay_mcap_bytes(
         on_point,
     )
 }
-
-/// Messages visited by a reader, with the connections known so far.
-type Visit<'v> = dyn FnMut(&[Connection], crate::bag::Message<'_>) -> Result<(), String> + 'v;
 
 fn run(
     source: &mut dyn FnMut(&mut Visit<'_>) -> Result<(), String>,
