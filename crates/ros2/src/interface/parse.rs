@@ -10,7 +10,8 @@ const MAX_FIXED_LEN: u32 = 4096;
 /// Parses the text of interface file `file` (already in `sm`) as `package/kind/name`.
 ///
 /// Message types named without a package are looked for in `package`. Whether the named
-/// types exist is checked later, by [`super::Interfaces::check`].
+/// types exist is checked later, by the caller (`hindsight`'s `Interfaces::check`, or
+/// [`crate::schema::Schema::resolve`]).
 pub fn parse_interface(
     sm: &SourceMap,
     file: FileId,
