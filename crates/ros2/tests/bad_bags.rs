@@ -343,3 +343,53 @@ fn a_folder_reads_its_files_in_the_listed_order() {
     assert!(e.contains("metadata.yaml:"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--time header`: a point is at its message's `header.stamp`, counted from the first.
+#[test]
+fn header_stamps_give_the_times() {
+    let bytes = mcap(&[
+        ("/battery", battery(7, "base", 0.5, &[3.0, 3.5])),
+        ("/battery", battery(9, "base", 0.5, &[3.0, 3.25])),
+    ]);
+    let ports: Vec<Port> = ports().into_iter().skip(1).collect();
+    let mut times = Vec::new();
+    replay_mcap_bytes(
+        &bytes,
+        &ports,
+        &BuiltinDefs::new(),
+        TimeSource::Header,
+        &[],
+        &mut |p| {
+            times.push((p.time_ns, p.sets[0].1));
+            Ok(())
+        },
+    )
+    .unwrap();
+    assert_eq!(
+        times,
+        [(0, Value::Float(3.5)), (2_000_000_000, Value::Float(3.25))]
+    );
+}
+
+/// A schema that does not read is an error naming the topic and the schema's line.
+#[test]
+fn a_bad_schema_names_the_topic() {
+    let mut w = mcap::Writer::new(Cursor::new(Vec::new())).unwrap();
+    let s = w
+        .add_schema("std_msgs/msg/Int32", "ros2msg", b"int33 data\n")
+        .unwrap();
+    let c = w.add_channel(s, "/level", "cdr", &BTreeMap::new()).unwrap();
+    let header = mcap::records::MessageHeader {
+        channel_id: c,
+        sequence: 0,
+        log_time: 1,
+        publish_time: 0,
+    };
+    w.write_to_known_channel(&header, &int32(1)).unwrap();
+    w.finish().unwrap();
+    let e = run(&w.into_inner().into_inner(), &ports()).unwrap_err();
+    assert!(
+        e.contains("topic `/level`") && e.contains(":1:1") && e.contains("int33"),
+        "{e}"
+    );
+}
