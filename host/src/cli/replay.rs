@@ -326,6 +326,12 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
                 Some(f) => file_ports(f, compiled)?,
                 None => bind_ports(&args.bind, compiled)?,
             };
+            if ports.is_empty() {
+                eprintln!(
+                    "warning: {}: no variable reads the recording (a .hspec binds them with --bind VAR=/topic.field): every variable keeps its initial value",
+                    args.spec.display()
+                );
+            }
             let mut sm = codegen::diag::SourceMap::new();
             let search = crate::robot::interfaces::Search::from_env(args.interfaces.clone());
             let packages =
