@@ -99,6 +99,93 @@ fn widened(
     }
 }
 
+/// The spec a property file compiles to: one variable per port (event variables `bool`,
+/// state variables of their declared type, or what `state_type(port, param, written,
+/// declared)` makes of it), one formula per guarantee and then per assumption, and the
+/// time unit `unit_ns` (`None`: untimed). Used by [`PropertySet::with_unit`] and by
+/// `hindsight replay` over a recording, so a property file means the same to both.
+pub fn spec_input(
+    props: &PropertyFile,
+    unit_ns: Option<u64>,
+    mut state_type: impl FnMut(&crate::props::Port, &str, &str, &'static str) -> &'static str,
+) -> Result<SpecInput, String> {
+    let file = props.path.display().to_string();
+    let origin = |line: u32, col: u32| Origin {
+        file: file.clone(),
+        line,
+        col,
+    };
+    let mut errors = Vec::new();
+    let mut decls = Vec::new();
+    for p in &props.ports {
+        let at = origin(p.at.line, p.at.column);
+        let (kind, type_name, init) = match &p.kind {
+            PortKind::Event => (VarKind::Event, "bool".to_string(), None),
+            PortKind::Sent => (
+                VarKind::State,
+                "bool".to_string(),
+                Some("false".to_string()),
+            ),
+            PortKind::Part { ty, .. } => match spec_type(ty) {
+                Some(t) => (VarKind::State, t.to_string(), None),
+                None => {
+                    errors.push(format!(
+                        "{file}:{}:{}: port `{}`: unsupported type `{ty}`",
+                        p.at.line, p.at.column, p.id
+                    ));
+                    continue;
+                }
+            },
+            PortKind::State { ty, init, param } => match spec_type(ty) {
+                Some(t) => (
+                    VarKind::State,
+                    state_type(p, param, ty, t).to_string(),
+                    Some(init.as_str().to_string()),
+                ),
+                None => {
+                    errors.push(format!(
+                        "{file}:{}:{}: port `{}`: unsupported type `{ty}`",
+                        p.at.line, p.at.column, p.id
+                    ));
+                    continue;
+                }
+            },
+        };
+        decls.push(DeclInput {
+            kind,
+            name: p.id.clone(),
+            type_name,
+            init,
+            origin: at,
+        });
+    }
+    let formula = |p: &crate::props::Property, name: String| {
+        let at = p.formula.location(0);
+        FormulaInput {
+            name,
+            text: p.formula.as_str().to_string(),
+            origin: origin(at.line, at.column),
+            positions: p.formula.runs().to_vec(),
+        }
+    };
+    let mut formulas: Vec<FormulaInput> = props
+        .guarantees
+        .iter()
+        .map(|p| formula(p, p.id.clone()))
+        .collect();
+    // Assumption names cannot clash with guarantees: property ids are unique.
+    formulas.extend(props.assumptions.iter().map(|p| formula(p, p.id.clone())));
+    if !errors.is_empty() {
+        return Err(errors.join("\n"));
+    }
+    Ok(SpecInput {
+        unit: unit_ns.map(|ns| (codegen::duration::format(ns), origin(1, 1))),
+        untimed: unit_ns.is_none(),
+        decls,
+        formulas,
+    })
+}
+
 impl PropertySet {
     /// Compiles `props` and resolves its ports against `model`. Every error names the
     /// property file's line and column.
@@ -115,81 +202,11 @@ impl PropertySet {
         unit_ns: Option<u64>,
     ) -> Result<PropertySet, String> {
         let file = props.path.display().to_string();
-        let origin = |line: u32, col: u32| Origin {
-            file: file.clone(),
-            line,
-            col,
-        };
         let mut errors = Vec::new();
-        let mut decls = Vec::new();
-        for p in &props.ports {
-            let at = origin(p.at.line, p.at.column);
-            let (kind, type_name, init) = match &p.kind {
-                PortKind::Event => (VarKind::Event, "bool".to_string(), None),
-                PortKind::Sent => (
-                    VarKind::State,
-                    "bool".to_string(),
-                    Some("false".to_string()),
-                ),
-                PortKind::Part { ty, .. } => match spec_type(ty) {
-                    Some(t) => (VarKind::State, t.to_string(), None),
-                    None => {
-                        errors.push(format!(
-                            "{file}:{}:{}: port `{}`: unsupported type `{ty}`",
-                            p.at.line, p.at.column, p.id
-                        ));
-                        continue;
-                    }
-                },
-                PortKind::State { ty, init, param } => match spec_type(ty) {
-                    Some(t) => (
-                        VarKind::State,
-                        widened(model, p, param, (ty, t), &file).to_string(),
-                        Some(init.as_str().to_string()),
-                    ),
-                    None => {
-                        errors.push(format!(
-                            "{file}:{}:{}: port `{}`: unsupported type `{ty}`",
-                            p.at.line, p.at.column, p.id
-                        ));
-                        continue;
-                    }
-                },
-            };
-            decls.push(DeclInput {
-                kind,
-                name: p.id.clone(),
-                type_name,
-                init,
-                origin: at,
-            });
-        }
-        let formula = |p: &crate::props::Property, name: String| {
-            let at = p.formula.location(0);
-            FormulaInput {
-                name,
-                text: p.formula.as_str().to_string(),
-                origin: origin(at.line, at.column),
-                positions: p.formula.runs().to_vec(),
-            }
-        };
-        let mut formulas: Vec<FormulaInput> = props
-            .guarantees
-            .iter()
-            .map(|p| formula(p, p.id.clone()))
-            .collect();
-        // Assumption names cannot clash with guarantees: property ids are unique.
-        formulas.extend(props.assumptions.iter().map(|p| formula(p, p.id.clone())));
-        if !errors.is_empty() {
-            return Err(errors.join("\n"));
-        }
-        let compiled = codegen::compile_input(&SpecInput {
-            unit: unit_ns.map(|ns| (codegen::duration::format(ns), origin(1, 1))),
-            untimed: unit_ns.is_none(),
-            decls,
-            formulas,
-        })
-        .map_err(|d| d.to_string())?;
+        let input = spec_input(props, unit_ns, |p, param, written, declared| {
+            widened(model, p, param, (written, declared), &file)
+        })?;
+        let compiled = codegen::compile_input(&input).map_err(|d| d.to_string())?;
         if !compiled.warnings().is_empty() {
             eprint!("{}", compiled.warnings());
         }

@@ -12,9 +12,10 @@
 //!
 //! # Files
 //!
-//! `def.rs` the parsed types, `parse.rs` the file format, `discover.rs` where packages are
-//! looked for, `builtin.rs` with `builtin/<package>.txt` the built-in packages, and this
-//! file the store: lookups, checks and flattening.
+//! The parsed types, the file format and the built-in packages are the `hindsight-ros2`
+//! crate's (`crates/ros2/src/interface/`, re-exported here), shared with recordings;
+//! `discover.rs` is where packages are looked for, and this file the store: lookups,
+//! checks and flattening.
 //!
 //! # The file format
 //!
@@ -44,17 +45,15 @@
 //! `wstring` becomes `string`, `string<=N` becomes `string`; a fixed array `T[3]` is `T[3]`,
 //! a bounded one `T[<=5]` is `T[5]` (a maximum length), an unbounded one `T[]`.
 
-pub mod builtin;
-mod def;
 pub mod discover;
-mod parse;
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-pub use def::*;
 pub use discover::Search;
-pub use parse::parse_interface;
+/// The built-in packages: `hindsight-ros2`'s, the one `.msg` reader the project has.
+pub use ros2::interface::builtin;
+pub use ros2::interface::*;
 
 use super::types::{ActionFields, FlatField, InterfaceLookup, ServiceFields};
 use crate::model::source::{Diagnostic, SourceMap};
@@ -112,13 +111,13 @@ impl Interfaces {
         name: &str,
     ) -> Result<(), Vec<Diagnostic>> {
         let file = sm.add(path, text);
-        if !parse::valid_type_name(name) {
+        if !ros2::interface::valid_type_name(name) {
             return Err(vec![crate::model::about_file(
                 path,
                 format!("`{name}` is not a valid interface name (it must start with an upper-case letter and have only letters and digits)"),
             )]);
         }
-        let def = parse::parse_interface(sm, file, package, name, kind)?;
+        let def = parse_interface(sm, file, package, name, kind)?;
         self.insert(def);
         Ok(())
     }
@@ -514,5 +513,36 @@ mod tests {
             "[[], []]"
         );
         assert_eq!(array_default(&[ArraySize::Bounded(2)], "0"), "[]");
+    }
+
+    /// Every built-in type resolves and flattens into the leaf fields the lowering sends.
+    #[test]
+    fn every_builtin_flattens() {
+        use crate::robot::types::InterfaceLookup;
+        use codegen::diag::SourceMap;
+        let ifs = Interfaces::with_builtins();
+        assert_eq!(ifs.iter().count(), builtin::definitions().len());
+        assert_eq!(ifs.check(&SourceMap::new()), Ok(()));
+        for d in ifs.iter() {
+            let name = format!("{}/{}", d.package, d.name);
+            let r = match d.kind {
+                InterfaceKind::Message => ifs.message(&name).map(|f| f.len()),
+                InterfaceKind::Service => ifs.service(&name).map(|s| s.request.len()),
+                InterfaceKind::Action => ifs.action(&name).map(|a| a.goal.len()),
+            };
+            assert!(r.is_ok(), "{name}: {r:?}");
+        }
+        for pkg in [
+            "sensor_msgs",
+            "geometry_msgs",
+            "nav_msgs",
+            "diagnostic_msgs",
+            "shape_msgs",
+            "trajectory_msgs",
+            "visualization_msgs",
+            "unique_identifier_msgs",
+        ] {
+            assert!(ifs.iter().any(|d| d.package == pkg), "{pkg}");
+        }
     }
 }

@@ -1,8 +1,8 @@
 //! The parsed form of a ROS 2 interface file: kinds, primitive types, fields, constants,
 //! and the normalised text each prints as.
 
-use crate::model::source::{FileId, Span};
-use crate::model::types::Scalar;
+use codegen::diag::{FileId, Span};
+use codegen::scalar::Scalar;
 
 /// What an interface file defines.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -44,7 +44,8 @@ impl InterfaceKind {
         }
     }
 
-    pub(super) fn noun(self) -> &'static str {
+    /// The word for this kind in messages: `message`, `service`, `action`.
+    pub fn noun(self) -> &'static str {
         match self {
             InterfaceKind::Message => "message",
             InterfaceKind::Service => "service",
@@ -145,12 +146,13 @@ impl Primitive {
         }
     }
 
-    pub(super) fn is_string(self) -> bool {
+    /// Whether it is `string` or `wstring`.
+    pub fn is_string(self) -> bool {
         matches!(self, Primitive::String | Primitive::WString)
     }
 
     /// Inclusive range of an integer type.
-    pub(super) fn int_range(self) -> Option<(i128, i128)> {
+    pub fn int_range(self) -> Option<(i128, i128)> {
         Some(match self {
             Primitive::Byte | Primitive::Char | Primitive::UInt8 => (0, u8::MAX as i128),
             Primitive::Int8 => (i8::MIN as i128, i8::MAX as i128),

@@ -2,7 +2,7 @@
 //! line, `---` between the parts of a service or an action.
 
 use super::def::*;
-use crate::model::source::{Diagnostic, FileId, SourceMap, Span};
+use codegen::diag::{Diagnostic, FileId, SourceMap, Span};
 
 /// Largest fixed array length accepted (its default literal is written out in full).
 const MAX_FIXED_LEN: u32 = 4096;
@@ -10,7 +10,8 @@ const MAX_FIXED_LEN: u32 = 4096;
 /// Parses the text of interface file `file` (already in `sm`) as `package/kind/name`.
 ///
 /// Message types named without a package are looked for in `package`. Whether the named
-/// types exist is checked later, by [`super::Interfaces::check`].
+/// types exist is checked later, by the caller (`hindsight`'s `Interfaces::check`, or
+/// [`crate::schema::Schema::resolve`]).
 pub fn parse_interface(
     sm: &SourceMap,
     file: FileId,
@@ -19,9 +20,9 @@ pub fn parse_interface(
     kind: InterfaceKind,
 ) -> Result<InterfaceDef, Vec<Diagnostic>> {
     let Some(src) = sm.source(file) else {
-        return Err(vec![crate::model::about_file(
+        return Err(vec![Diagnostic::about_file(
             "<unknown>",
-            "internal error: interface file not in the source map",
+            "internal error: interface file not in the source map".to_string(),
         )]);
     };
     let text = src.text();
@@ -240,10 +241,19 @@ fn valid_constant_name(name: &str) -> bool {
             .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_')
 }
 
-pub(super) fn valid_type_name(name: &str) -> bool {
+/// A valid interface (file) name: an upper-case letter, then letters and digits.
+pub fn valid_type_name(name: &str) -> bool {
     let mut chars = name.chars();
     matches!(chars.next(), Some(c) if c.is_ascii_uppercase())
         && name.chars().all(|c| c.is_ascii_alphanumeric())
+}
+
+/// A type name as written in a field's type: [`valid_type_name`], or the names rosidl
+/// generates for the parts of services and actions and that embedded definitions (MCAP's
+/// `ros2msg` schemas) spell out: `AddTwoInts_Request`, `AddTwoInts_Event`,
+/// `Fibonacci_SendGoal_Request`, each `_`-separated part a valid type name.
+pub fn valid_generated_type_name(name: &str) -> bool {
+    name.split('_').all(valid_type_name)
 }
 
 fn valid_package_name(name: &str) -> bool {
@@ -330,7 +340,7 @@ fn parse_type(text: &str, base: usize, package: &str) -> Result<FieldType, LineE
             ))
         }
     };
-    if !valid_type_name(name) || !valid_package_name(pkg) {
+    if !valid_generated_type_name(name) || !valid_package_name(pkg) {
         return Err((
             base,
             format!("`{elem_name}` is not a primitive type or a message name (`package/Type`, the type starting with an upper-case letter)"),
@@ -601,7 +611,7 @@ mod tests {
             "3", "-1", "string", "p/T", "\\", ",", "\u{feff}", "1e999", "\r\n", "[]", "T",
         ];
         let (mut oks, mut errs) = (0, 0);
-        for text in crate::robot::random_text::texts(&tokens, 0x9e37_79b9_7f4a_7c15u64, 9, 20_000) {
+        for text in crate::interface::random_texts(&tokens, 0x9e37_79b9_7f4a_7c15u64, 9, 20_000) {
             for kind in [
                 InterfaceKind::Message,
                 InterfaceKind::Service,

@@ -1,0 +1,372 @@
+//! From a recording to monitor points: every message is one point, at which the ports
+//! on its topic set their variables.
+//!
+//! # Ports
+//!
+//! A [`Port`] binds a monitor variable to a topic: an event variable is true at each
+//! message of the topic, a state variable takes a field's value (a field path,
+//! [`crate::cdr::parse_path`]). A port of a service (`<ros_service service_name="/s"
+//! event="request">`) reads the service's introspection topic `/s/_service_event` and
+//! only its events of one kind ([`ServiceSide`]): the request as the server received it
+//! (`REQUEST_RECEIVED`) or the response as the server sent it (`RESPONSE_SENT`), the
+//! moments the model's `srv_<s>_request` / `srv_<s>_response` messages stand for; its
+//! field `f` is read as `request[0].f` (or `response[0].f`).
+//!
+//! # Time
+//!
+//! A point's time is the message's log time (rosbag2's receive time) or, with
+//! [`TimeSource::Header`], its `header.stamp`, in nanoseconds since the first message's
+//! time. A time before the previous point's is an error naming the message.
+//!
+//! # Errors
+//!
+//! Every error about a message names its topic and its index on that topic (from 1)
+//! and the file: a message that does not decode, a field a port reads that the type
+//! lacks, a type whose definition is not found.
+
+use std::path::Path;
+
+use monitor_core::{Ty, Value};
+
+use crate::bag::{Connection, Recording, Visit};
+use crate::cdr::Decoder;
+use crate::schema::{Definitions, Ros2MsgDefs, Schema};
+
+/// Where a point's time comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum TimeSource {
+    /// The recording's log (receive) time.
+    #[default]
+    Log,
+    /// The message's `header.stamp` (`sec`, `nanosec`).
+    Header,
+}
+
+/// Which service events a service port reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ServiceSide {
+    /// `REQUEST_RECEIVED` (1): the server got a request; fields under `request[0]`.
+    Request,
+    /// `RESPONSE_SENT` (2): the server answered; fields under `response[0]`.
+    Response,
+}
+
+/// `service_msgs/msg/ServiceEventInfo`'s event types (rosidl, `service_msgs`).
+const REQUEST_RECEIVED: i64 = 1;
+const RESPONSE_SENT: i64 = 2;
+
+/// What a port reads.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Read {
+    /// True at each message (an event variable).
+    Event,
+    /// A field's value (a state variable).
+    Field(String),
+}
+
+/// One variable bound to a topic.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Port {
+    /// The monitor variable's index.
+    pub var: usize,
+    /// Its type.
+    pub ty: Ty,
+    /// The topic (for a service port, the service's name).
+    pub topic: String,
+    /// What is read.
+    pub read: Read,
+    /// For a service port: which events.
+    pub service: Option<ServiceSide>,
+    /// The variable's name, for errors.
+    pub name: String,
+}
+
+impl Port {
+    /// The topic the port's messages are recorded on.
+    pub fn recorded_topic(&self) -> String {
+        match self.service {
+            None => self.topic.clone(),
+            Some(_) => format!("{}/_service_event", self.topic.trim_end_matches('/')),
+        }
+    }
+}
+
+/// One point: its time and the variables set.
+#[derive(Clone, Copy, Debug)]
+pub struct Point<'a> {
+    /// Nanoseconds since the first message.
+    pub time_ns: u64,
+    /// `(variable, value)` for each port that read this message.
+    pub sets: &'a [(usize, Value)],
+    /// The message's topic.
+    pub topic: &'a str,
+    /// Its index on that topic, from 1.
+    pub index: u64,
+}
+
+/// What was read.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Summary {
+    /// Messages (points) in the recording.
+    pub messages: u64,
+    /// `(topic, messages)` of every topic, in order of first appearance.
+    pub topics: Vec<(String, u64)>,
+}
+
+/// One port of a connection: `(var, slot read or None for true, (slot, value) the
+/// message must have there for a service event's kind)`.
+type PortSet = (usize, Option<usize>, Option<(usize, i64)>);
+
+/// How one connection's messages set variables.
+struct Plan {
+    decoder: Option<Decoder>,
+    sets: Vec<PortSet>,
+    /// Slots of `header.stamp.sec` / `nanosec`.
+    stamp: Option<(usize, usize)>,
+    count: u64,
+    topic: String,
+}
+
+/// Reads `input` and calls `on_point` with every message as a point.
+///
+/// `defs` gives the definitions of types the recording does not embed (a `.db3` file);
+/// `strings` are the spec's string constants (see [`Decoder::new`]).
+pub fn replay(
+    input: &Path,
+    ports: &[Port],
+    defs: &dyn Definitions,
+    time: TimeSource,
+    strings: &[String],
+    on_point: &mut dyn FnMut(Point<'_>) -> Result<(), String>,
+) -> Result<Summary, String> {
+    let rec = Recording::open(input)?;
+    let shown = input.display().to_string();
+    run(
+        &mut |visit| rec.for_each(visit),
+        &shown,
+        ports,
+        defs,
+        time,
+        strings,
+        on_point,
+    )
+}
+
+/// [`replay`] of an MCAP file held in memory (the fuzz target's and the bench's entry).
+pub fn replay_mcap_bytes(
+    bytes: &[u8],
+    ports: &[Port],
+    defs: &dyn Definitions,
+    time: TimeSource,
+    strings: &[String],
+    on_point: &mut dyn FnMut(Point<'_>) -> Result<(), String>,
+) -> Result<Summary, String> {
+    run(
+        &mut |visit| crate::bag::mcap_bytes(bytes, "<mcap>", &mut Vec::new(), visit),
+        "<mcap>",
+        ports,
+        defs,
+        time,
+        strings,
+        on_point,
+    )
+}
+
+fn run(
+    source: &mut dyn FnMut(&mut Visit<'_>) -> Result<(), String>,
+    shown: &str,
+    ports: &[Port],
+    defs: &dyn Definitions,
+    time: TimeSource,
+    strings: &[String],
+    on_point: &mut dyn FnMut(Point<'_>) -> Result<(), String>,
+) -> Result<Summary, String> {
+    let mut plans: Vec<Option<Plan>> = Vec::new();
+    let mut slots: Vec<Value> = Vec::new();
+    let mut present: Vec<bool> = Vec::new();
+    let mut sets: Vec<(usize, Value)> = Vec::new();
+    let mut first: Option<u64> = None;
+    let mut last = 0u64;
+    let mut messages = 0u64;
+    source(&mut |conns, msg| {
+        if plans.len() <= msg.conn {
+            plans.resize_with(conns.len(), || None);
+        }
+        let plan = match &mut plans[msg.conn] {
+            Some(p) => p,
+            slot => {
+                let p = plan(&conns[msg.conn], ports, defs, time, strings)
+                    .map_err(|e| format!("{shown}: topic `{}`: {e}", conns[msg.conn].topic))?;
+                slot.insert(p)
+            }
+        };
+        plan.count += 1;
+        messages += 1;
+        let at = |e: &dyn std::fmt::Display| {
+            format!(
+                "{shown}: topic `{}` message {} (type `{}`): {e}",
+                plan.topic, plan.count, conns[msg.conn].type_name
+            )
+        };
+        sets.clear();
+        let mut stamp = None;
+        if let Some(d) = &plan.decoder {
+            if slots.len() < d.slots() {
+                slots.resize(d.slots(), Value::Bool(false));
+                present.resize(d.slots(), false);
+            }
+            d.decode(msg.data, &mut slots, &mut present)
+                .map_err(|e| at(&e))?;
+            if let Some((s, n)) = plan.stamp {
+                let (Value::Int(sec), Value::Int(nsec)) = (slots[s], slots[n]) else {
+                    // Unreachable for a decoder built by `plan`: both are integers.
+                    return Err(at(&"header.stamp is not two integers"));
+                };
+                let ns = sec
+                    .checked_mul(1_000_000_000)
+                    .and_then(|x| x.checked_add(nsec))
+                    .and_then(|x| u64::try_from(x).ok());
+                let Some(ns) = ns else {
+                    return Err(at(&format!("header.stamp {sec}s {nsec}ns is before 1970")));
+                };
+                stamp = Some(ns);
+            }
+            for &(var, slot, when) in &plan.sets {
+                if let Some((s, want)) = when {
+                    if slots[s] != Value::Int(want) {
+                        continue;
+                    }
+                }
+                match slot {
+                    None => sets.push((var, Value::Bool(true))),
+                    Some(s) if present[s] => sets.push((var, slots[s])),
+                    Some(s) => {
+                        return Err(at(&format!(
+                            "`{}` is not in this message (an array on its path is shorter)",
+                            d.slot_path(s)
+                        )))
+                    }
+                }
+            }
+        } else {
+            for &(var, _, _) in &plan.sets {
+                sets.push((var, Value::Bool(true)));
+            }
+        }
+        let abs = stamp.unwrap_or(msg.log_time);
+        let origin = *first.get_or_insert(abs);
+        let Some(t) = abs.checked_sub(origin).filter(|t| *t >= last) else {
+            let what = if time == TimeSource::Header {
+                "header stamp"
+            } else {
+                "log time"
+            };
+            return Err(at(&format!(
+                "its {what} {abs} ns is before the previous message's ({} ns)",
+                origin + last
+            )));
+        };
+        last = t;
+        on_point(Point {
+            time_ns: t,
+            sets: &sets,
+            topic: &plan.topic,
+            index: plan.count,
+        })
+    })?;
+    let mut topics: Vec<(String, u64)> = Vec::new();
+    for p in plans.iter().flatten() {
+        match topics.iter_mut().find(|(t, _)| *t == p.topic) {
+            Some((_, n)) => *n += p.count,
+            None => topics.push((p.topic.clone(), p.count)),
+        }
+    }
+    Ok(Summary { messages, topics })
+}
+
+/// The plan of one connection: its decoder (when a port reads a field, a service
+/// event's kind, or the header stamp) and its ports.
+fn plan(
+    conn: &Connection,
+    ports: &[Port],
+    defs: &dyn Definitions,
+    time: TimeSource,
+    strings: &[String],
+) -> Result<Plan, String> {
+    let mine: Vec<&Port> = ports
+        .iter()
+        .filter(|p| p.recorded_topic() == conn.topic)
+        .collect();
+    let needs_decoder = time == TimeSource::Header
+        || mine
+            .iter()
+            .any(|p| p.service.is_some() || matches!(p.read, Read::Field(_)));
+    let mut out = Plan {
+        decoder: None,
+        sets: Vec::new(),
+        stamp: None,
+        count: 0,
+        topic: conn.topic.clone(),
+    };
+    if !needs_decoder {
+        out.sets = mine.iter().map(|p| (p.var, None, None)).collect();
+        return Ok(out);
+    }
+    let schema = match &conn.definition {
+        Some(text) => {
+            let local = Ros2MsgDefs::parse(&conn.type_name, text)?;
+            Schema::resolve(&conn.type_name, &local)?
+        }
+        None => Schema::resolve(&conn.type_name, defs).map_err(|e| {
+            format!(
+                "{e}: the recording does not embed the definition of `{}`; name its package's folder with --interfaces (or source its ROS workspace)",
+                conn.type_name
+            )
+        })?,
+    };
+    let mut d = Decoder::new(schema, strings);
+    if time == TimeSource::Header {
+        let sec = d.add("header.stamp.sec", Ty::Int);
+        let nsec = d.add("header.stamp.nanosec", Ty::Int);
+        match (sec, nsec) {
+            (Ok(s), Ok(n)) => out.stamp = Some((s, n)),
+            (Err(e), _) | (_, Err(e)) => {
+                return Err(format!("--time header needs a `header` field: {e}"))
+            }
+        }
+    }
+    for p in mine {
+        let when = match p.service {
+            None => None,
+            Some(side) => {
+                let s = d
+                    .add("info.event_type", Ty::Int)
+                    .map_err(|e| format!("not a service event: {e}"))?;
+                Some((
+                    s,
+                    match side {
+                        ServiceSide::Request => REQUEST_RECEIVED,
+                        ServiceSide::Response => RESPONSE_SENT,
+                    },
+                ))
+            }
+        };
+        let slot = match &p.read {
+            Read::Event => None,
+            Read::Field(f) => {
+                let path = match p.service {
+                    None => f.clone(),
+                    Some(ServiceSide::Request) => format!("request[0].{f}"),
+                    Some(ServiceSide::Response) => format!("response[0].{f}"),
+                };
+                Some(
+                    d.add(&path, p.ty)
+                        .map_err(|e| format!("port `{}`: {e}", p.name))?,
+                )
+            }
+        };
+        out.sets.push((p.var, slot, when));
+    }
+    out.decoder = Some(d);
+    Ok(out)
+}
