@@ -42,20 +42,18 @@ pub fn find() -> Option<PathBuf> {
 
 /// The corpus for a test that needs it, or `None` after noting that the calling test was
 /// skipped (one line on stderr and, when `HINDSIGHT_SKIP_LOG` names a file, one line
-/// appended to it). Under `CI=true` a missing corpus panics with the same reason.
+/// appended to it). Under `CI=true` a missing corpus panics, giving the same reason.
 pub fn corpus_or_skip() -> Option<PathBuf> {
     if let Some(dir) = find() {
         return Some(dir);
     }
     // libtest runs each test on a thread named after it.
     let test = std::thread::current().name().unwrap_or("?").to_owned();
-    let line = format!(
-        "{}::{test}: skipped: {SKIP_REASON}",
-        env!("CARGO_CRATE_NAME")
-    );
+    let test = format!("{}::{test}", env!("CARGO_CRATE_NAME"));
     if std::env::var("CI").is_ok_and(|v| v == "true") {
-        panic!("{line} (a missing corpus is a failure under CI=true)");
+        panic!("{test} {SKIP_REASON}; under CI=true a missing corpus is a failure");
     }
+    let line = format!("{test}: skipped: {SKIP_REASON}");
     eprintln!("{line}");
     if let Some(log) = std::env::var_os("HINDSIGHT_SKIP_LOG") {
         // One short write in append mode: lines from tests running at the same time
