@@ -161,10 +161,12 @@ impl Sidecar {
         (f[11].parse::<u64>().unwrap() + f[12].parse::<u64>().unwrap()) as f64 / 100.0
     }
 
-    pub fn open_fds(&self) -> usize {
+    /// The descriptors the sidecar has open.
+    pub fn open_fds(&self) -> Vec<u32> {
         std::fs::read_dir(format!("/proc/{}/fd", self.pid()))
             .unwrap()
-            .count()
+            .filter_map(|e| e.ok()?.file_name().to_str()?.parse().ok())
+            .collect()
     }
 
     /// The largest gap between two successive verdict points from line `from` on, ticks.
