@@ -167,7 +167,15 @@ fn parse(head: &[u8], limits: &Limits) -> Result<Request, Refusal> {
             }
         }
     }
-    let path = target.split('?').next().unwrap_or("/").to_string();
+    let (path, query) = target.split_once('?').unwrap_or((target, ""));
+    // `?last=N`: the page's own reconnect after an error status (`page_live.js`), where
+    // the browser sends no `Last-Event-ID`.
+    if last_id.is_none() {
+        last_id = query
+            .split('&')
+            .find_map(|kv| kv.strip_prefix("last=")?.parse().ok());
+    }
+    let path = path.to_string();
     Ok(Request {
         method: method.to_string(),
         path,
@@ -347,6 +355,14 @@ mod tests {
         c.write_all(b"GET /events?x=1 HTTP/1.1\r\nHost: localhost:80\r\nLast-Event-ID: 7\r\n\r\n")
             .unwrap();
         let r = read_request(&s, &small()).unwrap().unwrap();
+        let (s2, mut c2) = pair();
+        c2.write_all(b"GET /events?x=1&last=9 HTTP/1.1\r\nHost: localhost\r\n\r\n")
+            .unwrap();
+        let reconnect = read_request(&s2, &small()).unwrap().unwrap();
+        assert_eq!(
+            (reconnect.path.as_str(), reconnect.last_id),
+            ("/events", Some(9))
+        );
         assert_eq!(
             r,
             Request {

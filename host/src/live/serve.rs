@@ -1029,14 +1029,19 @@ mod tests {
         let mut s = TcpStream::connect(srv.addr).unwrap();
         s.write_all(b"GET /events HTTP/1.1\r\nHost: localhost\r\n\r\n")
             .unwrap();
-        // Not read until the server gave up on it.
+        // Not read until the server gave up on it (once it took it).
         let t = Instant::now();
+        while srv.connections() == 0 {
+            assert!(t.elapsed() < Duration::from_secs(20), "never accepted");
+            std::thread::sleep(Duration::from_millis(5));
+        }
         while srv.connections() > 0 {
             assert!(t.elapsed() < Duration::from_secs(20), "never closed");
             std::thread::sleep(Duration::from_millis(20));
         }
         // What was sent ends early: the connection was closed, not finished.
         let mut got = Vec::new();
+        s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
         let _ = s.read_to_end(&mut got);
         assert!(got.len() < HISTORY * 800, "{}", got.len());
         srv.hub.publish(Stream::Verdict, "{}");
