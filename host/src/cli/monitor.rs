@@ -50,9 +50,15 @@ pub struct MonitorArgs {
     /// listens on loopback only): open http://ADDR/ in a browser to watch every
     /// property's verdict and its timeline as verdicts arrive. The verdict output is
     /// written first and is complete whatever the page does. Port 0 picks a free port;
-    /// the address is printed on standard error.
+    /// the address is printed on standard error. An address beyond loopback needs
+    /// --serve-public.
     #[arg(long, value_name = "ADDR", conflicts_with_all = ["replay", "bench"])]
     pub serve: Option<String>,
+    /// Let --serve listen beyond loopback (`0.0.0.0:8080`, a LAN address): anyone who
+    /// reaches that address sees the verdicts and inputs, without a password. Requests
+    /// must name this machine (an IP address, `localhost` or its host name).
+    #[arg(long, requires = "serve")]
+    pub serve_public: bool,
     /// Write every judged input (samples, requests, heartbeats, losses) as JSON lines, for `--replay`.
     #[arg(long, value_name = "LOG")]
     pub record: Option<PathBuf>,
@@ -156,6 +162,7 @@ Examples:
   hindsight monitor --props museum.hspec --replay in.jsonl     # the same verdicts, off-line
   hindsight monitor --props museum.hspec --config museum.toml --serve 8080
       # and open http://127.0.0.1:8080/ : every verdict and its timeline, live
+      # (--serve 0.0.0.0:8080 --serve-public: the same page for the whole network)
   hindsight monitor --bench
 The museum end to end, ten times faster than real time (two shells):
   hindsight run examples/museum-guide --layout > museum.toml
@@ -276,6 +283,14 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         .map(live::serve::parse_addr)
         .transpose()
         .map_err(|m| CliError::Input(format!("--serve: {m}")))?;
+    if let Some(addr) = serve_addr.filter(|a| !a.ip().is_loopback() && !args.serve_public) {
+        return Err(CliError::Input(format!(
+            "--serve {addr}: not a loopback address, so the page (every verdict and input, \
+             without a password) would be offered to the network; add --serve-public to \
+             mean it, or give a port alone (`--serve {}`) for this machine only",
+            addr.port()
+        )));
+    }
     let spec = spec_of(args)?;
     let mut out: Box<dyn Write + Send> = match &args.output {
         Some(p) => create(p)?,
@@ -314,9 +329,22 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
             .as_ref()
             .or(args.props.as_ref())
             .map_or_else(String::new, |p| p.display().to_string());
-        let server = live::serve::serve(addr, live::serve::page(&title, &spec))
-            .map_err(|e| CliError::Failed(format!("--serve {addr}: {e}")))?;
+        let server = live::serve::serve(
+            addr,
+            live::serve::page(&title, &spec),
+            args.serve_public,
+            live::http::Limits::default(),
+        )
+        .map_err(|e| CliError::Failed(format!("--serve {addr}: {e}")))?;
         eprintln!("monitor: live page at http://{}/", server.addr);
+        if !server.addr.ip().is_loopback() {
+            eprintln!(
+                "monitor: warning: the live page is offered to the network at {} (every \
+                 interface for 0.0.0.0 or [::]): whoever reaches it sees every verdict and \
+                 input, without a password",
+                server.addr
+            );
+        }
         use live::serve::{Stream, Tee};
         out = Box::new(Tee::new(out, server.hub.clone(), Stream::Verdict));
         // The page's points are the input records: the log's own lines with `--record`

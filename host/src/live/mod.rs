@@ -15,7 +15,8 @@
 //! - [`record`]: the verdict line and input log formats; replay.
 //! - [`mod@bench`]: throughput and added latency against a plain subscriber.
 //! - [`pace`]: `hindsight run`'s observer, pacing a simulation on the same [`Clock`].
-//! - [`serve`]: the live page (`--serve`): verdict lines streamed to a browser.
+//! - [`serve`]: the live page (`--serve`): verdict lines streamed to a browser;
+//!   [`http`]: its HTTP plumbing and limits.
 //!
 //! Taps never slow a publisher: the services keep iceoryx2's safe overflow, so a
 //! full tap buffer drops the tap's oldest sample. Lost samples are found from a
@@ -26,6 +27,7 @@ pub mod bench;
 mod clock;
 pub mod config;
 pub mod engine;
+pub mod http;
 pub mod inject;
 pub mod pace;
 pub mod publish;

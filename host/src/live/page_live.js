@@ -137,10 +137,22 @@
       }
     };
     var status = document.getElementById("status");
-    var opened = Date.now(), es = new EventSource("/events");
-    es.onopen = function () { status.textContent = "live"; status.className = ""; };
-    es.onerror = function () { status.textContent = "reconnecting"; status.className = "down"; };
-    es.onmessage = function (e) {
+    var opened = Date.now(), lastId = "";
+    // The browser reconnects by itself after a dropped stream, but not after an error
+    // status (503 while the server has all the connections it takes): then a new stream
+    // is opened after 2 s, resuming after the last event had (`?last=`, as
+    // `Last-Event-ID`).
+    function connect() {
+      var es = new EventSource("/events" + (lastId ? "?last=" + encodeURIComponent(lastId) : ""));
+      es.onopen = function () { status.textContent = "live"; status.className = ""; };
+      es.onerror = function () {
+        status.textContent = "reconnecting"; status.className = "down";
+        if (es.readyState === 2) setTimeout(connect, 2000);
+      };
+      es.onmessage = message;
+    }
+    function message(e) {
+      if (e.lastEventId) lastId = e.lastEventId;
       var m = JSON.parse(e.data);
       if (m.skipped) {
         skipped += m.skipped;
@@ -156,7 +168,8 @@
       }
       bound();
       tl.grow();
-    };
+    }
+    connect();
   }
 
   var spec = document.getElementById("hindsight-live");

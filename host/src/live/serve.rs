@@ -11,11 +11,13 @@
 //! stream need no framework, and no async runtime beside the sidecar's loop).
 
 use std::collections::VecDeque;
-use std::io::{BufRead, BufReader, Write};
+use std::io::Write;
 use std::net::{SocketAddr, TcpListener, TcpStream, ToSocketAddrs};
-use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender};
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+use super::http::{self, Hosts, Limits, Refusal};
 
 /// The shortest time between two writes to one page (the page draws at most once per
 /// animation frame, about 16 ms, anyway).
@@ -25,18 +27,9 @@ const BATCH: Duration = Duration::from_millis(10);
 /// verdict file (and the input log).
 pub const HISTORY: usize = 100_000;
 
-/// Lines queued for one connection that its thread has not yet written. A connection
-/// whose browser stops reading (a laptop asleep, a frozen tab) fills its queue and is
-/// dropped: the sidecar never waits for a browser, and no browser makes the sidecar's
-/// memory grow. Its page reconnects with `Last-Event-ID` and gets what it missed from
-/// the history. About 40 bytes a line, held from the start (`sync_channel` allocates its
-/// buffer at once), so 8,192 lines are about 330 KiB per connection, and a page that
-/// reads lets through 8,192 lines per batch (800k lines a second) before it is dropped.
-pub const QUEUE: usize = 8_192;
-
-/// How long a write to a page may wait for it to read, before its connection is closed
-/// (its thread and queue then go too; the page reconnects when it reads again).
-const WRITE_TIMEOUT: Duration = Duration::from_secs(30);
+/// What one queued event counts for beyond its line (its id, time and framing), so that
+/// a queue of short lines is bounded too.
+const EVENT_OVERHEAD: usize = 64;
 
 /// What a published line is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -66,21 +59,86 @@ struct Published {
     line: Arc<str>,
 }
 
+impl Published {
+    /// What it counts for in a connection's queue.
+    fn cost(&self) -> usize {
+        self.line.len() + EVENT_OVERHEAD
+    }
+}
+
+/// The events queued for one page connection, bounded in bytes.
 #[derive(Default)]
+struct Queue {
+    items: VecDeque<Published>,
+    bytes: usize,
+    /// Dropped by the hub (its queue overflowed) or ended by its thread: nothing more is
+    /// queued, and its thread ends.
+    closed: bool,
+    /// Its thread waits for the next event (only then does publishing wake it).
+    waiting: bool,
+}
+
+/// One page connection's side of the hub.
+#[derive(Default)]
+struct Subscriber {
+    queue: Mutex<Queue>,
+    ready: Condvar,
+}
+
+impl Subscriber {
+    /// Ends the subscription (the thread is gone or the page was dropped).
+    fn close(&self) {
+        if let Ok(mut q) = self.queue.lock() {
+            q.closed = true;
+            q.items.clear();
+            q.bytes = 0;
+        }
+        self.ready.notify_one();
+    }
+}
+
 struct HubState {
     /// Verdict lines and input records, each its own history (inputs are many more).
     history: [VecDeque<Published>; 2],
     next_id: u64,
-    subscribers: Vec<SyncSender<Published>>,
+    subscribers: Vec<Arc<Subscriber>>,
+    /// Bytes a connection may have queued ([`Limits::queue_bytes`]).
+    queue_bytes: usize,
 }
 
-/// Where verdict lines meet the page's connections.
-#[derive(Default)]
+/// Where verdict lines meet the page's connections. The sidecar's judging thread
+/// publishes; locks are held only to copy or queue a few items, never across a socket's
+/// I/O, and a full queue drops its page instead of waiting for it: the judge never waits
+/// for a page.
 pub struct Hub {
     state: Mutex<HubState>,
 }
 
+impl Default for Hub {
+    fn default() -> Hub {
+        Hub::new(Limits::default().queue_bytes)
+    }
+}
+
+/// A piece of the history read by a connection: the events, and how many lines before
+/// and among them are no longer held.
+struct Piece {
+    events: Vec<Published>,
+    skipped: u64,
+}
+
 impl Hub {
+    fn new(queue_bytes: usize) -> Hub {
+        Hub {
+            state: Mutex::new(HubState {
+                history: [VecDeque::new(), VecDeque::new()],
+                next_id: 0,
+                subscribers: Vec::new(),
+                queue_bytes,
+            }),
+        }
+    }
+
     /// Publishes one line of `stream` (without its newline) to every connection.
     pub fn publish(&self, stream: Stream, line: &str) {
         let Ok(mut s) = self.state.lock() else {
@@ -98,52 +156,112 @@ impl Hub {
             history.pop_front();
         }
         history.push_back(p.clone());
-        // Never blocks: a connection that is gone drops its receiver, one whose queue is
-        // full is behind by QUEUE lines; both are forgotten. Dropping the sender ends the
-        // connection once its thread has written what is queued (`events`).
-        // (`try_send` fails with `Full` or `Disconnected`.)
-        s.subscribers.retain(|tx| tx.try_send(p.clone()).is_ok());
+        // Never waits on a page: each queue's lock is held by its thread only to take
+        // the queued events. A connection that is gone is forgotten; one whose queue
+        // would pass its bound is dropped (its queue emptied at once, its thread closes
+        // the connection, the page reconnects with `Last-Event-ID`).
+        let bound = s.queue_bytes;
+        s.subscribers.retain(|sub| {
+            let Ok(mut q) = sub.queue.lock() else {
+                return false;
+            };
+            if q.closed {
+                return false;
+            }
+            let keep = q.bytes + p.cost() <= bound;
+            if keep {
+                q.bytes += p.cost();
+                q.items.push_back(p.clone());
+            } else {
+                q.closed = true;
+                q.items.clear();
+                q.bytes = 0;
+            }
+            let wake = q.waiting || !keep;
+            drop(q);
+            if wake {
+                sub.ready.notify_one();
+            }
+            keep
+        });
     }
 
-    /// The lines after `last_id` (all with `None`) still held, how many lines after it
-    /// are no longer held (older than the history), and a receiver of the later ones.
-    fn subscribe(&self, last_id: Option<u64>) -> (Vec<Published>, u64, Receiver<Published>) {
-        let (tx, rx) = sync_channel(QUEUE);
-        let Ok(mut s) = self.state.lock() else {
-            return (Vec::new(), 0, rx);
+    /// The events after `after` (all with `None`) still held, in the order they were
+    /// published, at most `max_bytes` of them (at least one), and how many lines up to
+    /// the last of them are no longer held. When that reaches the newest line, the
+    /// connection is subscribed in the same step (nothing published in between is
+    /// missed) and its subscriber is returned too.
+    fn catch_up(
+        &self,
+        after: Option<u64>,
+        max_bytes: usize,
+    ) -> Option<(Piece, Option<Arc<Subscriber>>)> {
+        let mut s = self.state.lock().ok()?;
+        let start = after.map_or(0, |a| a.saturating_add(1));
+        let [v, i] = &s.history;
+        let (mut a, mut b) = (
+            v.partition_point(|p| p.id < start),
+            i.partition_point(|p| p.id < start),
+        );
+        let (mut events, mut bytes, mut skipped, mut next) = (Vec::new(), 0, 0u64, start);
+        loop {
+            let p = match (v.get(a), i.get(b)) {
+                (Some(x), Some(y)) if x.id < y.id => {
+                    a += 1;
+                    x
+                }
+                (_, Some(y)) => {
+                    b += 1;
+                    y
+                }
+                (Some(x), None) => {
+                    a += 1;
+                    x
+                }
+                (None, None) => break,
+            };
+            if !events.is_empty() && bytes + p.cost() > max_bytes {
+                return Some((Piece { events, skipped }, None));
+            }
+            skipped += p.id - next;
+            next = p.id + 1;
+            bytes += p.cost();
+            events.push(p.clone());
+        }
+        skipped += s.next_id.saturating_sub(next);
+        let sub = Arc::new(Subscriber::default());
+        s.subscribers.push(sub.clone());
+        Some((Piece { events, skipped }, Some(sub)))
+    }
+
+    /// The verdict lines after `after` (all with `None`) and before `end`, at most
+    /// `max_bytes` of them (at least one): the next piece of `/verdicts.jsonl`.
+    fn verdicts(&self, after: Option<u64>, end: u64, max_bytes: usize) -> Vec<Published> {
+        let Ok(s) = self.state.lock() else {
+            return Vec::new();
         };
-        // Both histories, in the order they were published.
-        let mut past: Vec<Published> = s
-            .history
-            .iter()
-            .flatten()
-            .filter(|p| last_id.is_none_or(|l| p.id > l))
+        let h = &s.history[Stream::Verdict as usize];
+        let from = h.partition_point(|p| after.is_some_and(|a| p.id <= a));
+        let mut bytes = 0;
+        h.range(from..)
+            .take_while(|p| p.id < end)
+            .take_while(|p| {
+                bytes += p.cost();
+                bytes - p.cost() == 0 || bytes <= max_bytes
+            })
             .cloned()
-            .collect();
-        past.sort_by_key(|p| p.id);
-        let after = last_id.map_or(0, |l| l.saturating_add(1)).min(s.next_id);
-        let skipped = (s.next_id - after).saturating_sub(past.len() as u64);
-        s.subscribers.push(tx);
-        (past, skipped, rx)
+            .collect()
+    }
+
+    /// The id the next line will get.
+    fn next_id(&self) -> u64 {
+        self.state.lock().map_or(0, |s| s.next_id)
     }
 
     /// How many connections are subscribed (for the tests).
     #[cfg(test)]
     fn subscribers(&self) -> usize {
         self.state.lock().map_or(0, |s| s.subscribers.len())
-    }
-
-    /// Every verdict line still held, newline-terminated.
-    fn all_lines(&self) -> String {
-        let Ok(s) = self.state.lock() else {
-            return String::new();
-        };
-        let mut out = String::new();
-        for p in &s.history[Stream::Verdict as usize] {
-            out.push_str(&p.line);
-            out.push('\n');
-        }
-        out
     }
 }
 
@@ -246,98 +364,263 @@ pub struct Server {
     pub addr: SocketAddr,
     /// The verdict lines it streams.
     pub hub: Arc<Hub>,
+    shared: Arc<Shared>,
 }
+
+impl Server {
+    /// Connections being served now.
+    pub fn connections(&self) -> usize {
+        self.shared.active.load(Ordering::SeqCst)
+    }
+}
+
+/// What every connection's thread shares.
+struct Shared {
+    hub: Arc<Hub>,
+    page: Arc<str>,
+    hosts: Hosts,
+    limits: Limits,
+    /// Connections being served.
+    active: AtomicUsize,
+    /// Connections reading the history at once (see [`Gate`]).
+    gate: Gate,
+}
+
+/// How many connections may read and format the history at once. Pages that (re)connect
+/// together, or a hundred streams opened by one client, would otherwise each copy out of
+/// the hub as fast as they can: their threads would take both cores and the hub's lock
+/// in turn, and the judging thread would wait for a core or for the lock (0.7 s measured
+/// with 64 of them). Each holds the gate only to copy and format one piece, never while
+/// writing it.
+const READERS: usize = 2;
+
+/// A counting semaphore of [`READERS`] permits.
+#[derive(Default)]
+struct Gate {
+    taken: Mutex<usize>,
+    free: Condvar,
+}
+
+/// A permit of the [`Gate`], given back when dropped.
+struct Permit<'a>(&'a Gate);
+
+impl Gate {
+    fn enter(&self) -> Option<Permit<'_>> {
+        let mut n = self.taken.lock().ok()?;
+        while *n >= READERS {
+            n = self.free.wait(n).ok()?;
+        }
+        *n += 1;
+        Some(Permit(self))
+    }
+}
+
+impl Drop for Permit<'_> {
+    fn drop(&mut self) {
+        if let Ok(mut n) = self.0.taken.lock() {
+            *n -= 1;
+        }
+        self.0.free.notify_one();
+    }
+}
+
+/// Counts a connection as served until it is dropped.
+struct Slot(Arc<Shared>);
+
+impl Drop for Slot {
+    fn drop(&mut self) {
+        self.0.active.fetch_sub(1, Ordering::SeqCst);
+    }
+}
+
+/// How long the accepting thread pauses after `accept` fails (out of descriptors, say):
+/// a failing `accept` fails again at once, and retrying in a loop would take a core.
+const ACCEPT_PAUSE: Duration = Duration::from_millis(50);
 
 /// Binds `addr` and serves `page` at `/`, the event stream at `/events` and every line
-/// held at `/verdicts.jsonl`, each connection on its own thread.
-pub fn serve(addr: SocketAddr, page: String) -> std::io::Result<Server> {
+/// held at `/verdicts.jsonl`, each connection on its own thread, within `limits`.
+/// `public`: `addr` may be beyond loopback (`--serve-public`); without it such an address
+/// is refused. Requests whose `Host` is not a name of this server are answered 421.
+pub fn serve(
+    addr: SocketAddr,
+    page: String,
+    public: bool,
+    limits: Limits,
+) -> std::io::Result<Server> {
+    if !public && !addr.ip().is_loopback() {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::PermissionDenied,
+            "not a loopback address: the page would be offered to the network (add \
+             --serve-public to mean it)",
+        ));
+    }
     let listener = TcpListener::bind(addr)?;
     let addr = listener.local_addr()?;
-    let hub = Arc::new(Hub::default());
-    let page: Arc<str> = page.into();
-    let h = hub.clone();
+    let shared = Arc::new(Shared {
+        hub: Arc::new(Hub::new(limits.queue_bytes)),
+        page: page.into(),
+        hosts: Hosts::new(addr, public),
+        limits,
+        active: AtomicUsize::new(0),
+        gate: Gate::default(),
+    });
+    let hub = shared.hub.clone();
+    let s = shared.clone();
     std::thread::Builder::new()
         .name("serve".into())
-        .spawn(move || {
-            for stream in listener.incoming().flatten() {
-                let (hub, page) = (h.clone(), page.clone());
-                let _ = std::thread::Builder::new()
-                    .name("serve-conn".into())
-                    .spawn(move || {
-                        let _ = connection(stream, &hub, &page);
-                    });
-            }
-        })?;
-    Ok(Server { addr, hub })
+        .spawn(move || accept(listener, s))?;
+    Ok(Server { addr, hub, shared })
 }
 
-/// The request line's path and the `Last-Event-ID` header, if any.
-fn read_request(stream: &TcpStream) -> std::io::Result<Option<(String, String, Option<u64>)>> {
-    stream.set_read_timeout(Some(Duration::from_secs(5)))?;
-    let mut r = BufReader::new(stream.try_clone()?);
-    let mut first = String::new();
-    if r.read_line(&mut first)? == 0 {
-        return Ok(None);
-    }
-    let mut parts = first.split_whitespace();
-    let (Some(method), Some(target)) = (parts.next(), parts.next()) else {
-        return Ok(None);
-    };
-    let mut last_id = None;
-    // Headers until the empty line; at most 100 of them.
-    for _ in 0..100 {
-        let mut h = String::new();
-        if r.read_line(&mut h)? == 0 || h.trim().is_empty() {
-            break;
-        }
-        if let Some((k, v)) = h.split_once(':') {
-            if k.trim().eq_ignore_ascii_case("last-event-id") {
-                last_id = v.trim().parse().ok();
+/// The accepting thread: a thread per connection up to `limits.connections`, beyond them
+/// a 503 written without waiting and the connection closed (no thread, no wait).
+fn accept(listener: TcpListener, shared: Arc<Shared>) {
+    loop {
+        let stream = match listener.accept() {
+            Ok((s, _)) => s,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(_) => {
+                std::thread::sleep(ACCEPT_PAUSE);
+                continue;
             }
+        };
+        if shared.active.fetch_add(1, Ordering::SeqCst) >= shared.limits.connections {
+            shared.active.fetch_sub(1, Ordering::SeqCst);
+            busy(stream);
+            continue;
         }
+        let slot = Slot(shared.clone());
+        // A thread that cannot be started drops its slot and its connection.
+        let _ = std::thread::Builder::new()
+            .name("serve-conn".into())
+            .stack_size(256 * 1024)
+            .spawn(move || {
+                let _ = connection(&stream, &slot.0);
+                drop(slot);
+            });
     }
-    let path = target.split('?').next().unwrap_or("/").to_string();
-    Ok(Some((method.to_string(), path, last_id)))
 }
 
-fn respond(mut s: &TcpStream, status: &str, ty: &str, body: &[u8]) -> std::io::Result<()> {
-    write!(
-        s,
-        "HTTP/1.1 {status}\r\nContent-Type: {ty}\r\nContent-Length: {}\r\n\
-         Cache-Control: no-store\r\nConnection: close\r\n\r\n",
+/// Answers 503 to a connection beyond the limit, without blocking the accepting thread.
+fn busy(stream: TcpStream) {
+    let body = "too many connections\n";
+    let text = format!(
+        "HTTP/1.1 503 Service Unavailable\r\nContent-Type: text/plain\r\nContent-Length: {}\r\n\
+         Retry-After: 1\r\nConnection: close\r\n\r\n{body}",
         body.len()
-    )?;
-    s.write_all(body)?;
-    s.flush()
+    );
+    if stream.set_nonblocking(true).is_ok() {
+        let _ = (&stream).write(text.as_bytes());
+        let _ = stream.shutdown(std::net::Shutdown::Write);
+    }
 }
 
-fn connection(stream: TcpStream, hub: &Hub, page: &str) -> std::io::Result<()> {
-    let Some((method, path, last_id)) = read_request(&stream)? else {
+fn connection(stream: &TcpStream, shared: &Shared) -> std::io::Result<()> {
+    let limits = &shared.limits;
+    let req = match http::read_request(stream, limits) {
+        Ok(Some(r)) => r,
+        Ok(None) => return Ok(()),
+        Err(refusal) => {
+            http::refuse(stream, &refusal, "");
+            return Ok(());
+        }
+    };
+    let Some(host) = req.host.as_deref() else {
+        http::refuse(stream, &Refusal("400 Bad Request", "no Host header"), "");
         return Ok(());
     };
-    if method != "GET" && method != "HEAD" {
-        return respond(
-            &stream,
-            "405 Method Not Allowed",
-            "text/plain",
-            b"GET only\n",
+    if !shared.hosts.allows(host) {
+        // A page of another site whose name was made to resolve to this address (DNS
+        // rebinding) names that site here.
+        http::refuse(
+            stream,
+            &Refusal("421 Misdirected Request", "not a name of this server"),
+            "",
         );
+        return Ok(());
     }
-    match path.as_str() {
+    let head_only = match req.method.as_str() {
+        "GET" => false,
+        "HEAD" => true,
+        _ => {
+            http::refuse(
+                stream,
+                &Refusal("405 Method Not Allowed", "GET or HEAD only"),
+                "Allow: GET, HEAD\r\n",
+            );
+            return Ok(());
+        }
+    };
+    match req.path.as_str() {
         "/" | "/index.html" => respond(
-            &stream,
+            stream,
             "200 OK",
             "text/html; charset=utf-8",
-            page.as_bytes(),
+            shared.page.as_bytes(),
+            head_only,
+            limits,
         ),
-        "/verdicts.jsonl" => respond(
-            &stream,
-            "200 OK",
-            "application/x-ndjson",
-            hub.all_lines().as_bytes(),
+        "/verdicts.jsonl" => verdicts(stream, shared, head_only),
+        "/events" => events(stream, shared, req.last_id, head_only),
+        _ => respond(
+            stream,
+            "404 Not Found",
+            "text/plain",
+            b"not found\n",
+            head_only,
+            limits,
         ),
-        "/events" => events(stream, hub, last_id),
-        _ => respond(&stream, "404 Not Found", "text/plain", b"not found\n"),
+    }
+}
+
+fn respond(
+    s: &TcpStream,
+    status: &str,
+    ty: &str,
+    body: &[u8],
+    head_only: bool,
+    limits: &Limits,
+) -> std::io::Result<()> {
+    http::write_chunks(
+        s,
+        http::head(status, ty, Some(body.len())).as_bytes(),
+        limits,
+    )?;
+    if !head_only {
+        http::write_chunks(s, body, limits)?;
+    }
+    Ok(())
+}
+
+/// Every verdict line held when the request came, in pieces of `limits.chunk` bytes read
+/// from the history one at a time (the body ends with the connection: lines that leave
+/// the history while a slow client reads are not sent).
+fn verdicts(s: &TcpStream, shared: &Shared, head_only: bool) -> std::io::Result<()> {
+    let (hub, limits) = (&shared.hub, &shared.limits);
+    http::write_chunks(
+        s,
+        http::head("200 OK", "application/x-ndjson", None).as_bytes(),
+        limits,
+    )?;
+    if head_only {
+        return Ok(());
+    }
+    let end = hub.next_id();
+    let mut after = None;
+    loop {
+        let permit = shared.gate.enter();
+        let piece = hub.verdicts(after, end, limits.chunk);
+        let Some(last) = piece.last() else {
+            return Ok(());
+        };
+        after = Some(last.id);
+        let mut text = String::with_capacity(limits.chunk + 256);
+        for p in &piece {
+            text.push_str(&p.line);
+            text.push('\n');
+        }
+        drop(permit);
+        http::write_chunks(s, text.as_bytes(), limits)?;
     }
 }
 
@@ -360,54 +643,132 @@ fn event(p: &Published) -> String {
     )
 }
 
-fn events(mut stream: TcpStream, hub: &Hub, last_id: Option<u64>) -> std::io::Result<()> {
-    stream.set_read_timeout(None)?;
-    stream.set_write_timeout(Some(WRITE_TIMEOUT))?;
-    write!(
-        stream,
-        "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\n\
-         Connection: keep-alive\r\n\r\nretry: 1000\n\n"
+/// Ends a subscription when its connection's thread leaves, however it leaves.
+struct Subscribed(Arc<Subscriber>);
+
+impl Drop for Subscribed {
+    fn drop(&mut self) {
+        self.0.close();
+    }
+}
+
+/// The event stream: the history after `last_id` in pieces of `limits.chunk` bytes, then
+/// each event as it is published, at most one write per [`BATCH`]. Every write has
+/// `limits.stall` to finish; a page whose queue passes `limits.queue_bytes` is dropped
+/// by the hub; either way the connection closes and the page reconnects after the last
+/// event it had.
+fn events(
+    s: &TcpStream,
+    shared: &Shared,
+    last_id: Option<u64>,
+    head_only: bool,
+) -> std::io::Result<()> {
+    let (hub, limits) = (&shared.hub, &shared.limits);
+    http::write_chunks(
+        s,
+        b"HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\n\
+          Connection: keep-alive\r\n\r\n",
+        limits,
     )?;
-    let (past, skipped, rx) = hub.subscribe(last_id);
-    let mut batch = String::new();
-    if skipped > 0 {
-        batch.push_str(&skipped_event(skipped));
+    if head_only {
+        return Ok(());
     }
-    for p in &past {
-        batch.push_str(&event(p));
-    }
-    stream.write_all(batch.as_bytes())?;
-    stream.flush()?;
-    loop {
-        match rx.recv_timeout(Duration::from_secs(15)) {
-            Ok(p) => {
-                let mut text = event(&p);
-                // Whatever else is queued goes in the same write.
-                while let Ok(more) = rx.try_recv() {
-                    text.push_str(&event(&more));
-                }
-                stream.write_all(text.as_bytes())?;
-                stream.flush()?;
-                // At most one write per BATCH: a line after a quiet spell goes out at
-                // once, a flood of input records in batches, so this thread does not
-                // wake per sample and take the sidecar's core.
-                std::thread::sleep(BATCH);
-            }
-            // A comment keeps proxies from closing an idle stream, and finds a gone peer.
-            Err(RecvTimeoutError::Timeout) => {
-                stream.write_all(b": idle\n\n")?;
-                stream.flush()?;
-            }
-            // The hub dropped this connection (its queue was full): it ends here, and the
-            // page reconnects after the last line written.
-            Err(RecvTimeoutError::Disconnected) => return Ok(()),
+    http::write_chunks(s, b"retry: 1000\n\n", limits)?;
+    let mut after = last_id;
+    let sub = loop {
+        let permit = shared.gate.enter();
+        let Some((piece, sub)) = hub.catch_up(after, limits.chunk) else {
+            return Ok(());
+        };
+        // Subscribed now: ended whatever happens to the writes below.
+        let sub = sub.map(Subscribed);
+        let mut text = String::with_capacity(limits.chunk + 256);
+        if piece.skipped > 0 {
+            text.push_str(&skipped_event(piece.skipped));
         }
+        for p in &piece.events {
+            text.push_str(&event(p));
+        }
+        if let Some(p) = piece.events.last() {
+            after = Some(p.id);
+        }
+        drop(permit);
+        http::write_chunks(s, text.as_bytes(), limits)?;
+        if let Some(sub) = sub {
+            break sub;
+        }
+    };
+    loop {
+        let items = {
+            let Ok(mut q) = sub.0.queue.lock() else {
+                return Ok(());
+            };
+            if q.items.is_empty() && !q.closed {
+                q.waiting = true;
+                let (guard, _) = sub
+                    .0
+                    .ready
+                    .wait_timeout(q, Duration::from_secs(15))
+                    .map_err(|_| std::io::Error::other("poisoned"))?;
+                q = guard;
+                q.waiting = false;
+            }
+            if q.closed {
+                // Dropped: the page reconnects and resumes from the history.
+                return Ok(());
+            }
+            q.bytes = 0;
+            std::mem::take(&mut q.items)
+        };
+        if items.is_empty() {
+            // A comment keeps proxies from closing an idle stream, and finds a gone peer.
+            http::write_chunks(s, b": idle\n\n", limits)?;
+            continue;
+        }
+        // Written in pieces, so the text held is one piece, not the whole queue.
+        let mut text = String::with_capacity(limits.chunk + 256);
+        for p in &items {
+            text.push_str(&event(p));
+            if text.len() >= limits.chunk {
+                http::write_chunks(s, text.as_bytes(), limits)?;
+                text.clear();
+            }
+        }
+        http::write_chunks(s, text.as_bytes(), limits)?;
+        // At most one write per BATCH: a line after a quiet spell goes out at once, a
+        // flood of input records in batches, so this thread does not wake per sample
+        // and take the sidecar's core.
+        std::thread::sleep(BATCH);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::io::Read;
+    use std::time::Instant;
+
+    /// Every verdict line held, newline-terminated.
+    fn all_lines(hub: &Hub) -> String {
+        hub.verdicts(None, hub.next_id(), usize::MAX)
+            .iter()
+            .map(|p| format!("{}\n", p.line))
+            .collect()
+    }
+
+    /// Subscribes after `last_id` in one piece: what was held, how much was skipped, the
+    /// subscriber.
+    fn subscribe(hub: &Hub, last_id: Option<u64>) -> (Vec<Published>, u64, Arc<Subscriber>) {
+        let (piece, sub) = hub.catch_up(last_id, usize::MAX).unwrap();
+        (piece.events, piece.skipped, sub.unwrap())
+    }
+
+    /// The ids queued for `sub`, taken.
+    fn take(sub: &Subscriber) -> Vec<u64> {
+        let mut q = sub.queue.lock().unwrap();
+        q.bytes = 0;
+        std::mem::take(&mut q.items).iter().map(|p| p.id).collect()
+    }
 
     #[test]
     fn addresses_default_to_loopback() {
@@ -432,16 +793,15 @@ mod tests {
             }
         }
         let mut tee = Tee::new(Box::new(Shared(file.clone())), hub.clone(), Stream::Verdict);
-        let (_, _, rx) = hub.subscribe(None);
+        let (_, _, sub) = subscribe(&hub, None);
         tee.write_all(b"{\"a\":1}\n{\"b\"").unwrap();
-        assert_eq!(hub.all_lines(), "{\"a\":1}\n");
+        assert_eq!(all_lines(&hub), "{\"a\":1}\n");
         tee.write_all(b":2}\n").unwrap();
-        assert_eq!(hub.all_lines(), "{\"a\":1}\n{\"b\":2}\n");
+        assert_eq!(all_lines(&hub), "{\"a\":1}\n{\"b\":2}\n");
         assert_eq!(&*file.lock().unwrap(), b"{\"a\":1}\n{\"b\":2}\n");
-        let got: Vec<u64> = rx.try_iter().map(|p| p.id).collect();
-        assert_eq!(got, vec![0, 1]);
+        assert_eq!(take(&sub), vec![0, 1]);
         // A reconnect after id 0 gets only what followed.
-        let (past, _, _) = hub.subscribe(Some(0));
+        let (past, _, _) = subscribe(&hub, Some(0));
         assert_eq!(past.len(), 1);
         assert!(event(&past[0]).starts_with("id: 1\ndata: {\"sent_ms\":"));
         assert!(event(&past[0]).ends_with(",\"verdict\":{\"b\":2}}\n\n"));
@@ -451,8 +811,8 @@ mod tests {
             .write_all(b"{\"kind\":\"tick\",\"time\":3}\n")
             .unwrap();
         tee.write_all(b"{\"c\":3}\n").unwrap();
-        assert_eq!(hub.all_lines(), "{\"a\":1}\n{\"b\":2}\n{\"c\":3}\n");
-        let (past, _, _) = hub.subscribe(Some(1));
+        assert_eq!(all_lines(&hub), "{\"a\":1}\n{\"b\":2}\n{\"c\":3}\n");
+        let (past, _, _) = subscribe(&hub, Some(1));
         let texts: Vec<String> = past.iter().map(event).collect();
         assert!(texts[0].starts_with("id: 2\n"), "{texts:?}");
         assert!(texts[0].ends_with(",\"input\":{\"kind\":\"tick\",\"time\":3}}\n\n"));
@@ -463,33 +823,66 @@ mod tests {
     }
 
     #[test]
-    fn a_connection_that_stops_reading_is_dropped_and_publishing_goes_on() {
-        let hub = Hub::default();
-        let (_, _, stalled) = hub.subscribe(None);
-        let (_, _, reading) = hub.subscribe(None);
+    fn a_connection_whose_queue_passes_its_bytes_is_dropped_and_publishing_goes_on() {
+        // Room for 10 events of 10-byte lines.
+        let hub = Hub::new(10 * (10 + EVENT_OVERHEAD));
+        let (_, _, stalled) = subscribe(&hub, None);
+        let (_, _, reading) = subscribe(&hub, None);
         let mut read = 0;
-        for i in 0..QUEUE + 10 {
-            hub.publish(Stream::Input, &format!("{{\"time\":{i}}}"));
-            read += reading.try_iter().count();
+        for i in 0..30 {
+            hub.publish(Stream::Input, &format!("{i:010}"));
+            read += take(&reading).len();
         }
-        // The stalled one was dropped when its queue was full; the reading one stays.
+        // The stalled one was dropped when its queue would have passed its bound, and its
+        // queue emptied at once (its memory goes before its thread does); the reading one
+        // stays.
         assert_eq!(hub.subscribers(), 1);
-        assert_eq!(read, QUEUE + 10);
-        // What was queued before the drop is still there for its thread to write, then
-        // the connection ends.
-        let queued: Vec<u64> = stalled.try_iter().map(|p| p.id).collect();
-        assert_eq!(queued, (0..QUEUE as u64).collect::<Vec<_>>());
-        assert!(matches!(
-            stalled.recv_timeout(Duration::from_millis(1)),
-            Err(RecvTimeoutError::Disconnected)
-        ));
-        // Publishing goes on, and the page's reconnect gets the rest from the history.
-        hub.publish(Stream::Verdict, "{\"v\":1}");
-        assert_eq!(reading.try_iter().count(), 1);
-        let (past, skipped, _) = hub.subscribe(Some(QUEUE as u64 - 1));
+        assert_eq!(read, 30);
+        let q = stalled.queue.lock().unwrap();
+        assert!(q.closed && q.items.is_empty() && q.bytes == 0);
+        drop(q);
+        // The page's reconnect gets the rest from the history.
+        let (past, skipped, _) = subscribe(&hub, Some(9));
         assert_eq!(skipped, 0);
-        assert_eq!(past.len(), 11);
-        assert_eq!(past[0].id, QUEUE as u64);
+        assert_eq!(past.len(), 20);
+        assert_eq!(past[0].id, 10);
+        // A connection whose thread ended is forgotten at the next line.
+        let (_, _, gone) = subscribe(&hub, None);
+        gone.close();
+        hub.publish(Stream::Verdict, "{}");
+        assert_eq!(hub.subscribers(), 2);
+    }
+
+    #[test]
+    fn the_history_goes_out_in_pieces_and_subscribing_misses_nothing() {
+        let hub = Hub::default();
+        for i in 0..1000 {
+            hub.publish(Stream::Input, &format!("{i:036}"));
+        }
+        // 100-event pieces (36 + 64 bytes each): never the whole history at once.
+        let (mut after, mut pieces, mut got) = (None, 0, Vec::new());
+        let sub = loop {
+            let (piece, sub) = hub.catch_up(after, 100 * 100).unwrap();
+            assert!(piece.events.len() <= 100);
+            got.extend(piece.events.iter().map(|p| p.id));
+            after = piece.events.last().map(|p| p.id).or(after);
+            pieces += 1;
+            // Published between two pieces: part of a later piece.
+            hub.publish(Stream::Verdict, "{}");
+            if let Some(sub) = sub {
+                break sub;
+            }
+        };
+        assert!(pieces >= 10, "{pieces}");
+        let last = *got.last().unwrap();
+        got.extend(take(&sub));
+        assert_eq!(got, (0..=last + 1).collect::<Vec<_>>());
+        // /verdicts.jsonl in pieces too, up to the end given.
+        let end = hub.next_id();
+        let first = hub.verdicts(None, end, 3 * (2 + EVENT_OVERHEAD));
+        assert_eq!(first.len(), 3);
+        let rest = hub.verdicts(Some(first[2].id), end, usize::MAX);
+        assert_eq!(first.len() + rest.len(), pieces);
     }
 
     #[test]
@@ -500,16 +893,159 @@ mod tests {
         }
         hub.publish(Stream::Verdict, "v");
         // Inputs 0..5 are gone; the verdict line (id HISTORY + 5) is held.
-        let (past, skipped, _) = hub.subscribe(Some(2));
+        let (past, skipped, _) = subscribe(&hub, Some(2));
         assert_eq!(skipped, 2);
         assert_eq!(past.len(), HISTORY + 1);
         assert_eq!(past[0].id, 5);
-        let (past, skipped, _) = hub.subscribe(None);
+        let (past, skipped, _) = subscribe(&hub, None);
         assert_eq!((past.len(), skipped), (HISTORY + 1, 5));
         assert_eq!(skipped_event(5), "data: {\"skipped\":5}\n\n");
         // Up to date: nothing missed.
-        let (past, skipped, _) = hub.subscribe(Some(HISTORY as u64 + 5));
+        let (past, skipped, _) = subscribe(&hub, Some(HISTORY as u64 + 5));
         assert_eq!((past.len(), skipped), (0, 0));
+    }
+
+    /// A server on a free loopback port with `limits`.
+    fn server(limits: Limits) -> Server {
+        serve(
+            "127.0.0.1:0".parse().unwrap(),
+            "<p>page</p>".into(),
+            false,
+            limits,
+        )
+        .unwrap()
+    }
+
+    /// Sends `request` and reads the answer to the end.
+    fn ask(addr: SocketAddr, request: &str) -> String {
+        let mut s = TcpStream::connect(addr).unwrap();
+        s.write_all(request.as_bytes()).unwrap();
+        s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+        let mut text = String::new();
+        let _ = s.read_to_string(&mut text);
+        text
+    }
+
+    #[test]
+    fn head_has_no_body_and_hosts_other_than_this_server_s_are_refused() {
+        let srv = server(Limits::default());
+        let get = ask(srv.addr, "GET / HTTP/1.1\r\nHost: localhost\r\n\r\n");
+        assert!(
+            get.starts_with("HTTP/1.1 200 OK") && get.ends_with("<p>page</p>"),
+            "{get}"
+        );
+        let head = ask(srv.addr, "HEAD / HTTP/1.1\r\nHost: localhost\r\n\r\n");
+        assert!(head.starts_with("HTTP/1.1 200 OK"), "{head}");
+        assert!(
+            head.contains("Content-Length: 11\r\n") && head.ends_with("\r\n\r\n"),
+            "{head}"
+        );
+        let head = ask(srv.addr, "HEAD /events HTTP/1.1\r\nHost: localhost\r\n\r\n");
+        assert!(
+            head.starts_with("HTTP/1.1 200 OK") && head.ends_with("\r\n\r\n"),
+            "{head}"
+        );
+        let rebound = ask(
+            srv.addr,
+            "GET / HTTP/1.1\r\nHost: evil.example:8080\r\n\r\n",
+        );
+        assert!(rebound.starts_with("HTTP/1.1 421 "), "{rebound}");
+        assert!(!rebound.contains("page"));
+        let no_host = ask(srv.addr, "GET / HTTP/1.0\r\n\r\n");
+        assert!(no_host.starts_with("HTTP/1.1 400 "), "{no_host}");
+        let post = ask(srv.addr, "POST / HTTP/1.1\r\nHost: localhost\r\n\r\n");
+        assert!(post.starts_with("HTTP/1.1 405 "), "{post}");
+        let long = ask(srv.addr, &format!("GET /{} HTTP/1.1\r\n", "a".repeat(9000)));
+        assert!(long.starts_with("HTTP/1.1 414 "), "{long}");
+    }
+
+    #[test]
+    fn a_public_address_needs_public() {
+        let e = serve(
+            "0.0.0.0:0".parse().unwrap(),
+            String::new(),
+            false,
+            Limits::default(),
+        )
+        .err()
+        .unwrap();
+        assert!(e.to_string().contains("--serve-public"), "{e}");
+        assert!(serve(
+            "0.0.0.0:0".parse().unwrap(),
+            String::new(),
+            true,
+            Limits::default()
+        )
+        .is_ok());
+    }
+
+    #[test]
+    fn connections_beyond_the_limit_get_503_and_slow_ones_are_closed_at_the_deadline() {
+        let srv = server(Limits {
+            connections: 2,
+            request_time: Duration::from_millis(500),
+            ..Limits::default()
+        });
+        // Two clients that send half a request and then nothing.
+        let slow: Vec<TcpStream> = (0..2)
+            .map(|_| {
+                let mut s = TcpStream::connect(srv.addr).unwrap();
+                s.write_all(b"GET / HTTP/1.1\r\n").unwrap();
+                s
+            })
+            .collect();
+        std::thread::sleep(Duration::from_millis(100));
+        let third = ask(srv.addr, "GET / HTTP/1.1\r\nHost: localhost\r\n\r\n");
+        assert!(third.starts_with("HTTP/1.1 503 "), "{third}");
+        // Each slow one is answered 408 at its deadline, and its slot is free again.
+        for mut s in slow {
+            s.set_read_timeout(Some(Duration::from_secs(10))).unwrap();
+            let mut text = String::new();
+            let _ = s.read_to_string(&mut text);
+            assert!(text.starts_with("HTTP/1.1 408 "), "{text}");
+        }
+        let t = Instant::now();
+        loop {
+            let again = ask(srv.addr, "GET / HTTP/1.1\r\nHost: localhost\r\n\r\n");
+            if again.starts_with("HTTP/1.1 200") {
+                break;
+            }
+            assert!(t.elapsed() < Duration::from_secs(10), "{again}");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    #[test]
+    fn an_events_client_that_stops_reading_is_closed_after_the_stall_time() {
+        let srv = server(Limits {
+            stall: Duration::from_millis(300),
+            ..Limits::default()
+        });
+        // More history than the socket buffers hold (80 MB of events).
+        let line = "x".repeat(800);
+        for _ in 0..HISTORY {
+            srv.hub.publish(Stream::Input, &line);
+        }
+        let mut s = TcpStream::connect(srv.addr).unwrap();
+        s.write_all(b"GET /events HTTP/1.1\r\nHost: localhost\r\n\r\n")
+            .unwrap();
+        // Not read until the server gave up on it (once it took it).
+        let t = Instant::now();
+        while srv.connections() == 0 {
+            assert!(t.elapsed() < Duration::from_secs(20), "never accepted");
+            std::thread::sleep(Duration::from_millis(5));
+        }
+        while srv.connections() > 0 {
+            assert!(t.elapsed() < Duration::from_secs(20), "never closed");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        // What was sent ends early: the connection was closed, not finished.
+        let mut got = Vec::new();
+        s.set_read_timeout(Some(Duration::from_secs(20))).unwrap();
+        let _ = s.read_to_end(&mut got);
+        assert!(got.len() < HISTORY * 800, "{}", got.len());
+        srv.hub.publish(Stream::Verdict, "{}");
+        assert_eq!(srv.hub.subscribers(), 0);
     }
 
     #[test]
