@@ -551,14 +551,9 @@ fn save_failing(
     Ok(kept)
 }
 
-/// Runs `hindsight verify`.
-pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
-    if args.input.bt == BtArg::Both {
-        return run_both(args);
-    }
-    let loaded = load(&args.input)?;
-    let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
-    let rule = RuleConfig {
+/// The stopping rule `verify`'s options ask for (`--threshold` makes it Wald's SPRT).
+fn rule_config(args: &VerifyArgs) -> RuleConfig {
+    RuleConfig {
         kind: match (args.threshold, args.rule) {
             (Some(threshold), _) => RuleKind::Sprt { threshold },
             (None, Rule::Adaptive) => RuleKind::Adaptive,
@@ -568,15 +563,30 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         },
         confidence: args.confidence,
         precision: args.precision,
-    };
-    let run_cfg = RunConfig {
+    }
+}
+
+/// How each run of `loaded` is bounded and which event semantics it follows.
+fn run_config(args: &VerifyArgs, loaded: &Loaded) -> Result<RunConfig, CliError> {
+    Ok(RunConfig {
         max_time: loaded
             .max_time(args.max_time.as_deref())
             .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
         max_steps: args.max_steps,
         events: loaded.events,
         ..RunConfig::default()
-    };
+    })
+}
+
+/// Runs `hindsight verify`.
+pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
+    if args.input.bt == BtArg::Both {
+        return run_both(args);
+    }
+    let loaded = load(&args.input)?;
+    let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
+    let rule = rule_config(args);
+    let run_cfg = run_config(args, &loaded)?;
     let study_cfg = StudyConfig {
         seed: args.seed,
         threads: args.threads,
@@ -669,25 +679,8 @@ fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
     for bt in args.input.semantics()? {
         let loaded =
             crate::verify::load::load(&args.input.options_with(bt)?).map_err(CliError::Input)?;
-        let rule = RuleConfig {
-            kind: match (args.threshold, args.rule) {
-                (Some(threshold), _) => RuleKind::Sprt { threshold },
-                (None, Rule::Adaptive) => RuleKind::Adaptive,
-                (None, Rule::Okamoto) => RuleKind::Okamoto,
-                (None, Rule::Wilson) => RuleKind::Wilson,
-                (None, Rule::ClopperPearson) => RuleKind::ClopperPearson,
-            },
-            confidence: args.confidence,
-            precision: args.precision,
-        };
-        let run_cfg = RunConfig {
-            max_time: loaded
-                .max_time(args.max_time.as_deref())
-                .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
-            max_steps: args.max_steps,
-            events: loaded.events,
-            ..RunConfig::default()
-        };
+        let rule = rule_config(args);
+        let run_cfg = run_config(args, &loaded)?;
         let study_cfg = StudyConfig {
             seed: args.seed,
             threads: args.threads,
