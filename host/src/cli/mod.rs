@@ -18,6 +18,9 @@ pub enum CliError {
     Input(String),
     /// Anything else that stopped the command (I/O on output): exit code 1.
     Failed(String),
+    /// Stopped by Ctrl-C or SIGTERM after printing what it had (`verify`'s partial
+    /// study): exit code 130, the shell's code for a SIGINT.
+    Interrupted(String),
 }
 
 impl CliError {
@@ -26,6 +29,7 @@ impl CliError {
         match self {
             CliError::Input(_) => 2,
             CliError::Failed(_) => 1,
+            CliError::Interrupted(_) => 130,
         }
     }
 }
@@ -33,7 +37,9 @@ impl CliError {
 impl fmt::Display for CliError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            CliError::Input(m) | CliError::Failed(m) => f.write_str(m.trim_end()),
+            CliError::Input(m) | CliError::Failed(m) | CliError::Interrupted(m) => {
+                f.write_str(m.trim_end())
+            }
         }
     }
 }

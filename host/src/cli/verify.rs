@@ -1,6 +1,8 @@
 //! `hindsight verify`: estimate each guarantee's probability on a plain SCXML model.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Once;
 use std::time::Duration;
 
 use super::CliError;
@@ -13,7 +15,7 @@ use crate::smc::{StudyConfig, StudyResult};
 use crate::verify::load::{LoadOptions, Loaded};
 use crate::verify::observe::{Judge, PropertySet};
 use crate::verify::result::{PropertyRow, Study};
-use crate::verify::study::Runner;
+use crate::verify::study::{study_until, Runner};
 
 /// The stopping rule, as named on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -280,6 +282,49 @@ pub fn study(
         .map_err(CliError::Input)
 }
 
+/// Set by the first Ctrl-C (SIGINT) or SIGTERM once [`interrupt_flag`] installed the
+/// handler; the sequential study checks it once per run it starts.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Installs (once) the handler that makes Ctrl-C / SIGTERM stop a sequential study
+/// cleanly, and returns its flag. The first signal sets the flag: no run is started after
+/// it, the runs in progress finish and the partial study is printed (exit code 130). A
+/// second one ends the process at once, with the same code. If the handler cannot be
+/// installed, the signals keep their default action (the process ends at once).
+fn interrupt_flag() -> &'static AtomicBool {
+    static INSTALL: Once = Once::new();
+    INSTALL.call_once(|| {
+        // ctrlc calls this on its own thread, not in the signal handler: printing and
+        // exiting are safe here.
+        let _ = ctrlc::set_handler(|| {
+            if INTERRUPTED.swap(true, Ordering::Relaxed) {
+                std::process::exit(130);
+            }
+            eprintln!(
+                "\ninterrupted: finishing the runs in progress, then printing the partial \
+                 study (interrupt again to quit at once)"
+            );
+        });
+    });
+    &INTERRUPTED
+}
+
+/// The line that heads a partial study's table.
+fn interrupted_line(runs: u64) -> String {
+    format!(
+        "interrupted after {runs} runs: the numbers below are a partial study, their \
+         intervals are those of the runs done"
+    )
+}
+
+/// The error that ends an interrupted `verify` (exit code 130), after its partial study
+/// was printed.
+fn interrupted_error(runs: u64) -> CliError {
+    CliError::Interrupted(format!(
+        "interrupted after {runs} runs: the study printed is partial"
+    ))
+}
+
 /// FNV-1a over bytes: a stable fingerprint so `merge` can refuse mixed studies.
 fn fingerprint(parts: &[&[u8]]) -> String {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
@@ -420,6 +465,7 @@ fn merged_report(m: &crate::smc::shard::MergedResult) -> Study {
         step_limit: m.runs.step_limit,
         decided: m.runs.decided,
         quiescent: m.runs.quiescent,
+        interrupted: false,
         seconds: 0.0,
         step_seconds: None,
         max_time_seconds: None,
@@ -637,8 +683,20 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         }
         return print_report(&report, args.json);
     }
-    let result = study(model, set, &run_cfg, &study_cfg, &rule, !args.json)?;
-    let failing = if args.save_failing > 0 || args.report.is_some() {
+    let result = study_until(
+        model,
+        set,
+        &run_cfg,
+        &study_cfg,
+        &rule,
+        !args.json,
+        interrupt_flag(),
+    )
+    .map_err(CliError::Input)?;
+    if result.interrupted && (args.save_failing > 0 || args.report.is_some()) {
+        eprintln!("interrupted: --save-failing and --report are not written for a partial study");
+    }
+    let failing = if !result.interrupted && (args.save_failing > 0 || args.report.is_some()) {
         save_failing(args, model, set, &run_cfg, &result)?
     } else {
         Vec::new()
@@ -653,10 +711,14 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         report.step_seconds = Some(unit as f64 / 1e9);
         report.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
     }
-    if let Some(path) = &args.report {
+    if let Some(path) = args.report.as_ref().filter(|_| !result.interrupted) {
         super::report::from_verify(path, &report, &loaded, settings(), &failing)?;
     }
-    print_report(&report, args.json)
+    print_report(&report, args.json)?;
+    if report.interrupted {
+        return Err(interrupted_error(report.runs));
+    }
+    Ok(())
 }
 
 /// `verify --bt both`: the study under AS2FM's node models and under BehaviorTree.CPP 4,
@@ -676,6 +738,7 @@ fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
         return refuse("--report / --save-failing");
     }
     let mut studies = Vec::new();
+    let stop = interrupt_flag();
     for bt in args.input.semantics()? {
         let loaded =
             crate::verify::load::load(&args.input.options_with(bt)?).map_err(CliError::Input)?;
@@ -691,14 +754,17 @@ fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
         if !args.json {
             eprintln!("--bt {}:", bt.label());
         }
-        let result = study(
+        // Once interrupted, the next semantics' study starts no run (0 runs, no estimate).
+        let result = study_until(
             &loaded.model,
             &loaded.set,
             &run_cfg,
             &study_cfg,
             &rule,
             !args.json,
-        )?;
+            stop,
+        )
+        .map_err(CliError::Input)?;
         let mut r = report(args, &loaded.props_path, &loaded.set, &result);
         r.settings.push(("bt".into(), bt.label().into()));
         if let Some(unit) = loaded.unit_ns {
@@ -716,8 +782,10 @@ fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
         .zip(&b.properties)
         .map(|(x, y)| Sensitivity::of(x, y))
         .collect();
+    let interrupted = a.interrupted || b.interrupted;
+    let done = a.runs + b.runs;
     if args.json {
-        let doc = serde_json::json!({
+        let mut doc = serde_json::json!({
             "bt": "both",
             "as2fm": a,
             "btcpp": b,
@@ -730,10 +798,20 @@ fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
                 "semantics_sensitive": r.sensitive,
             })).collect::<Vec<_>>(),
         });
+        if interrupted {
+            doc["interrupted"] = true.into();
+        }
         let text = serde_json::to_string_pretty(&doc)
             .map_err(|e| CliError::Failed(format!("json: {e}")))?;
         println!("{text}");
-        return Ok(());
+        return if interrupted {
+            Err(interrupted_error(done))
+        } else {
+            Ok(())
+        };
+    }
+    if interrupted {
+        println!("{}", interrupted_line(done));
     }
     let w = rows
         .iter()
@@ -766,6 +844,9 @@ fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
         args.confidence,
         args.precision
     );
+    if interrupted {
+        return Err(interrupted_error(done));
+    }
     Ok(())
 }
 
@@ -809,6 +890,7 @@ fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -
         step_limit: r.runs.step_limit,
         decided: r.runs.decided,
         quiescent: r.runs.quiescent,
+        interrupted: r.interrupted,
         seconds: r.elapsed.as_secs_f64(),
         settings: Vec::new(),
         properties: set
@@ -840,6 +922,9 @@ fn print_table(r: &Study) {
         .max()
         .unwrap_or(8)
         .max(8);
+    if r.interrupted {
+        println!("{}", interrupted_line(r.runs));
+    }
     println!(
         "{:<w$}  {:>11}  {:>17}  {:>7}  {:>9}  decision",
         "property", "probability", "interval", "runs", "cut short"

@@ -27,8 +27,8 @@ pub mod shard;
 pub mod stats;
 
 pub use runner::{
-    run_range, run_study, stream, Progress, PropertyCounts, PropertyResult, RangeCounts, RunCounts,
-    RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict,
+    run_range, run_study, run_study_until, stream, Progress, PropertyCounts, PropertyResult,
+    RangeCounts, RunCounts, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict,
 };
 pub use shard::{
     merge, run_fixed_study, run_shard, FixedStudy, MergedProperty, MergedResult, PartialProperty,

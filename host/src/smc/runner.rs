@@ -42,10 +42,20 @@
 //! Every property has its own rule. A property's counts are frozen at the run where its
 //! rule becomes done (that run's index is [`PropertyResult::stopped_at`]); the study
 //! goes on until every rule is done or [`StudyConfig::max_runs`] runs were consumed.
+//!
+//! # Interruption
+//!
+//! [`run_study_until`] also takes a stop flag (set by `verify`'s Ctrl-C handler). Once it
+//! is set, no worker takes a new run index (one atomic load per run handed out, none per
+//! step); the runs already started finish and are consumed in index order like any
+//! others, so the partial study is the study of runs `0..n` for some `n`, and
+//! [`StudyResult::interrupted`] says it stopped early. When the flag is never set, the
+//! study is exactly [`run_study`]'s.
 
 use std::collections::BTreeMap;
 use std::ops::{ControlFlow, Range};
 use std::panic::{self, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::sync::{Condvar, Mutex, PoisonError};
 use std::thread;
@@ -323,8 +333,13 @@ pub struct StudyResult {
     pub properties: Vec<PropertyResult>,
     /// Counts over every run consumed.
     pub runs: RunCounts,
-    /// Whether the study stopped at [`StudyConfig::max_runs`] with some rule not done.
+    /// Whether the study stopped at [`StudyConfig::max_runs`] with some rule not done
+    /// (or was interrupted with some rule not done).
     pub capped: bool,
+    /// Whether the stop flag of [`run_study_until`] ended the study before every rule was
+    /// done: the counts are those of the runs consumed, a partial study.
+    #[serde(default)]
+    pub interrupted: bool,
     /// Wall-clock time (not deterministic, unlike everything else).
     pub elapsed: Duration,
 }
@@ -388,6 +403,22 @@ pub fn run_study<F>(
 where
     F: Fn(u64, &mut Xoshiro256PlusPlus) -> RunOutcome + Sync,
 {
+    run_study_until(config, rules, run, progress, &AtomicBool::new(false))
+}
+
+/// [`run_study`] that also stops when `stop` is set (see the module doc, Interruption):
+/// no run is started after that, the runs in progress are finished and consumed in index
+/// order, and the result has [`StudyResult::interrupted`] set if some rule was not done.
+pub fn run_study_until<F>(
+    config: &StudyConfig,
+    rules: &[Box<dyn StoppingRule>],
+    run: F,
+    progress: &mut dyn FnMut(&Progress<'_>),
+    stop: &AtomicBool,
+) -> StudyResult
+where
+    F: Fn(u64, &mut Xoshiro256PlusPlus) -> RunOutcome + Sync,
+{
     let start = Instant::now();
     let mut trackers: Vec<Tracker> = rules
         .iter()
@@ -434,6 +465,7 @@ where
             config.thread_count(),
             0,
             end,
+            stop,
             &run,
             |index, outcome| {
                 runs.record(&outcome);
@@ -477,6 +509,11 @@ where
     }
     report(&trackers, runs.runs, true);
     let capped = !all_done(&trackers);
+    // Stopped by the flag, not by the rules, the cap or a failed run.
+    let interrupted = capped
+        && stop.load(Ordering::Relaxed)
+        && runs.failed == 0
+        && end.is_none_or(|end| runs.runs < end);
     StudyResult {
         seed: config.seed,
         properties: rules
@@ -486,6 +523,7 @@ where
             .collect(),
         runs,
         capped,
+        interrupted,
         elapsed: start.elapsed(),
     }
 }
@@ -544,6 +582,7 @@ where
             config.thread_count(),
             range.start,
             Some(range.end),
+            &AtomicBool::new(false),
             &run,
             |index, outcome| {
                 counts.runs.record(&outcome);
@@ -597,16 +636,28 @@ type Finished = (u64, thread::Result<RunOutcome>);
 /// breaks or the range is exhausted. `consume` continues with its estimate of the runs
 /// still needed (`u64::MAX` for "unknown"): workers start at most that many runs (plus
 /// one per thread) past the last consumed one, so few runs are wasted at the end.
-fn drive<F, C>(seed: u64, threads: usize, start: u64, end: Option<u64>, run: &F, mut consume: C)
-where
+///
+/// Once `stop` is set no new index is handed out; the runs already started finish and
+/// are consumed in order (they form a contiguous range, so none is lost).
+fn drive<F, C>(
+    seed: u64,
+    threads: usize,
+    start: u64,
+    end: Option<u64>,
+    stop: &AtomicBool,
+    run: &F,
+    mut consume: C,
+) where
     F: Fn(u64, &mut Xoshiro256PlusPlus) -> RunOutcome + Sync,
     C: FnMut(u64, RunOutcome) -> ControlFlow<(), u64>,
 {
     let mut rng = stream(seed, start);
     let past_end = |index: u64| end.is_some_and(|end| index >= end);
+    // One relaxed load per run handed out: the flag only has to be seen soon, not at once.
+    let stopped = || stop.load(Ordering::Relaxed);
     if threads <= 1 {
         let mut index = start;
-        while !past_end(index) {
+        while !past_end(index) && !stopped() {
             let mut own = rng.clone();
             rng.jump();
             let outcome = run(index, &mut own);
@@ -638,7 +689,7 @@ where
                 let (index, mut own) = {
                     let mut guard = shared.lock().unwrap_or_else(PoisonError::into_inner);
                     loop {
-                        if guard.stop || past_end(guard.next) {
+                        if guard.stop || past_end(guard.next) || stopped() {
                             return;
                         }
                         if guard.next < guard.window_end {

@@ -34,6 +34,10 @@ pub struct Study {
     pub decided: u64,
     /// Runs that ended because nothing could move.
     pub quiescent: u64,
+    /// Whether Ctrl-C / SIGTERM stopped the study before its rules were done: the
+    /// numbers are those of the runs done (left out of the JSON when false).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub interrupted: bool,
     /// Wall-clock seconds (0 for a merged study).
     #[serde(default)]
     pub seconds: f64,

@@ -4,6 +4,7 @@
 //! shares: `verify`, `sweep`, shards, the benches); [`study`] hands it to
 //! [`crate::smc::run_study`] with one stopping rule per guarantee.
 
+use std::sync::atomic::AtomicBool;
 use std::sync::Mutex;
 
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -12,7 +13,7 @@ use super::observe::{Judge, PropertySet};
 use crate::sim::{CompiledModel, EndReason, RunConfig, Simulator};
 use crate::smc::progress::TerminalProgress;
 use crate::smc::stats::RuleConfig;
-use crate::smc::{run_study, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
+use crate::smc::{run_study_until, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
 
 /// Runs a study of `set` on `model`: the function `verify` and `sweep` share.
 pub fn study(
@@ -22,6 +23,28 @@ pub fn study(
     study_cfg: &StudyConfig,
     rule: &RuleConfig,
     show_progress: bool,
+) -> Result<StudyResult, String> {
+    study_until(
+        model,
+        set,
+        run_cfg,
+        study_cfg,
+        rule,
+        show_progress,
+        &AtomicBool::new(false),
+    )
+}
+
+/// [`study`] that stops early, with a partial result, once `stop` is set (see
+/// [`run_study_until`]): `verify` sets it on Ctrl-C.
+pub fn study_until(
+    model: &CompiledModel,
+    set: &PropertySet,
+    run_cfg: &RunConfig,
+    study_cfg: &StudyConfig,
+    rule: &RuleConfig,
+    show_progress: bool,
+    stop: &AtomicBool,
 ) -> Result<StudyResult, String> {
     let rules = set
         .guarantee_names()
@@ -35,9 +58,13 @@ pub fn study(
     } else {
         TerminalProgress::hidden()
     };
-    let result = run_study(study_cfg, &rules, |k, rng| runner.run(k, rng), &mut |p| {
-        bar.update(p)
-    });
+    let result = run_study_until(
+        study_cfg,
+        &rules,
+        |k, rng| runner.run(k, rng),
+        &mut |p| bar.update(p),
+        stop,
+    );
     runner.finish()?;
     Ok(result)
 }
