@@ -5,6 +5,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Once;
 use std::time::Duration;
 
+mod both;
+
 use super::CliError;
 use crate::robot::bt::{BtSemantics, BtTick};
 use crate::robot::load::ExternalComponent;
@@ -627,7 +629,7 @@ fn run_config(args: &VerifyArgs, loaded: &Loaded) -> Result<RunConfig, CliError>
 /// Runs `hindsight verify`.
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     if args.input.bt == BtArg::Both {
-        return run_both(args);
+        return both::run_both(args);
     }
     let loaded = load(&args.input)?;
     let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
@@ -719,160 +721,6 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         return Err(interrupted_error(report.runs));
     }
     Ok(())
-}
-
-/// `verify --bt both`: the study under AS2FM's node models and under BehaviorTree.CPP 4,
-/// each with the same seed and settings, and per property both probabilities and
-/// whether they differ beyond the precision (the two intervals are disjoint:
-/// "semantics-sensitive").
-fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
-    let refuse = |what: &str| {
-        Err(CliError::Input(format!(
-            "--bt both: not with {what} (run each semantics with --bt as2fm / --bt btcpp)"
-        )))
-    };
-    if args.shard.is_some() || args.runs.is_some() {
-        return refuse("--runs / --shard");
-    }
-    if args.report.is_some() || args.save_failing > 0 {
-        return refuse("--report / --save-failing");
-    }
-    let mut studies = Vec::new();
-    let stop = interrupt_flag();
-    for bt in args.input.semantics()? {
-        let loaded =
-            crate::verify::load::load(&args.input.options_with(bt)?).map_err(CliError::Input)?;
-        let rule = rule_config(args);
-        let run_cfg = run_config(args, &loaded)?;
-        let study_cfg = StudyConfig {
-            seed: args.seed,
-            threads: args.threads,
-            max_runs: args.max_runs,
-            keep_failing: 0,
-            progress_every: Duration::from_millis(200),
-        };
-        if !args.json {
-            eprintln!("--bt {}:", bt.label());
-        }
-        // Once interrupted, the next semantics' study starts no run (0 runs, no estimate).
-        let result = study_until(
-            &loaded.model,
-            &loaded.set,
-            &run_cfg,
-            &study_cfg,
-            &rule,
-            !args.json,
-            stop,
-        )
-        .map_err(CliError::Input)?;
-        let mut r = report(args, &loaded.props_path, &loaded.set, &result);
-        r.settings.push(("bt".into(), bt.label().into()));
-        if let Some(unit) = loaded.unit_ns {
-            r.step_seconds = Some(unit as f64 / 1e9);
-            r.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
-        }
-        studies.push((bt, r));
-    }
-    let [(_, a), (bt, b)] = studies.as_slice() else {
-        unreachable!("--bt both names two semantics")
-    };
-    let rows: Vec<Sensitivity> = a
-        .properties
-        .iter()
-        .zip(&b.properties)
-        .map(|(x, y)| Sensitivity::of(x, y))
-        .collect();
-    let interrupted = a.interrupted || b.interrupted;
-    let done = a.runs + b.runs;
-    if args.json {
-        let mut doc = serde_json::json!({
-            "bt": "both",
-            "as2fm": a,
-            "btcpp": b,
-            "btcpp_semantics": bt.label(),
-            "properties": rows.iter().map(|r| serde_json::json!({
-                "property": r.property,
-                "as2fm": r.as2fm,
-                "btcpp": r.btcpp,
-                "difference": r.difference,
-                "semantics_sensitive": r.sensitive,
-            })).collect::<Vec<_>>(),
-        });
-        if interrupted {
-            doc["interrupted"] = true.into();
-        }
-        let text = serde_json::to_string_pretty(&doc)
-            .map_err(|e| CliError::Failed(format!("json: {e}")))?;
-        println!("{text}");
-        return if interrupted {
-            Err(interrupted_error(done))
-        } else {
-            Ok(())
-        };
-    }
-    if interrupted {
-        println!("{}", interrupted_line(done));
-    }
-    let w = rows
-        .iter()
-        .map(|r| r.property.len())
-        .max()
-        .unwrap_or(8)
-        .max(8);
-    let p = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.4}"));
-    println!(
-        "{:<w$}  {:>8}  {:>8}  {:>10}  semantics-sensitive",
-        "property", "as2fm", "btcpp", "difference"
-    );
-    for r in &rows {
-        println!(
-            "{:<w$}  {:>8}  {:>8}  {:>10}  {}",
-            r.property,
-            p(r.as2fm),
-            p(r.btcpp),
-            r.difference.map_or("-".into(), |d| format!("{d:+.4}")),
-            if r.sensitive { "yes" } else { "no" }
-        );
-    }
-    println!(
-        "as2fm: {} runs; {}: {} runs; seed {}, confidence {}, precision {}; \
-         semantics-sensitive: the two intervals (±precision) are disjoint",
-        a.runs,
-        bt.label(),
-        b.runs,
-        args.seed,
-        args.confidence,
-        args.precision
-    );
-    if interrupted {
-        return Err(interrupted_error(done));
-    }
-    Ok(())
-}
-
-/// One property under both semantics.
-struct Sensitivity {
-    property: String,
-    as2fm: Option<f64>,
-    btcpp: Option<f64>,
-    /// BT.CPP's estimate minus AS2FM's.
-    difference: Option<f64>,
-    /// The two intervals are disjoint: the difference is beyond the precision.
-    sensitive: bool,
-}
-
-impl Sensitivity {
-    fn of(a: &PropertyRow, b: &PropertyRow) -> Self {
-        let difference = a.probability.zip(b.probability).map(|(x, y)| y - x);
-        let sensitive = difference.is_some() && (a.upper < b.lower || b.upper < a.lower);
-        Sensitivity {
-            property: a.property.clone(),
-            as2fm: a.probability,
-            btcpp: b.probability,
-            difference,
-            sensitive,
-        }
-    }
 }
 
 fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -> Study {
