@@ -10,18 +10,14 @@
 
 mod bt_common;
 
-use bt_common::{diff, show, Run};
-use hindsight::expr::Value;
-use hindsight::model::source::{FileId, SourceMap};
-use hindsight::model::{xml, Diagnostics, ModelSource};
-use hindsight::robot::bt::{self, BtInput, BtSemantics, BtTick, Halts};
-use hindsight::sim::{CompiledModel, EndReason, Flow, Observer, RunConfig, SentMessage, Simulator};
+use bt_common::{diff, lower_and_run, show, Drive, Run};
+use hindsight::robot::bt::{BtSemantics, BtTick, Halts};
+use hindsight::sim::EndReason;
+use hindsight_tests::bt::gen;
 use hindsight_tests::bt::oracle::{self, End, LeafEvent, Options, Scripts, TickMode};
 use hindsight_tests::bt::tree::{self, Kind, Operand, Status};
-use hindsight_tests::bt::{gen, model};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
-use std::collections::BTreeSet;
 
 /// What a run of the lowered tree gave.
 #[derive(Debug, PartialEq)]
@@ -35,44 +31,6 @@ enum Outcome {
 
 /// Records leaf ticks and halts and the driver's `tick_done` (the final status of one
 /// executor tick).
-struct Watch<'a> {
-    leaves: &'a BTreeSet<u32>,
-    statuses: Vec<Status>,
-    log: Vec<LeafEvent>,
-    bad: Option<String>,
-}
-
-impl Observer for Watch<'_> {
-    fn on_send(&mut self, _time: u64, msg: &SentMessage<'_>) -> Flow {
-        let ev = msg.event_name();
-        if ev == "tick_done" {
-            let s = match msg.param(0) {
-                Some(Value::Int(1)) => Status::Success,
-                Some(Value::Int(2)) => Status::Failure,
-                Some(Value::Int(3)) => Status::Running,
-                other => {
-                    self.bad = Some(format!("root answered {other:?}"));
-                    return Flow::Stop;
-                }
-            };
-            self.statuses.push(s);
-            return Flow::Continue;
-        }
-        let Some((id, what)) = ev.strip_prefix("bt_").and_then(|r| r.split_once('_')) else {
-            return Flow::Continue;
-        };
-        let Ok(id) = id.parse::<u32>() else {
-            return Flow::Continue;
-        };
-        match what {
-            "tick" if self.leaves.contains(&id) => self.log.push(LeafEvent::Tick(id)),
-            "halt" if self.leaves.contains(&id) => self.log.push(LeafEvent::Halt(id)),
-            _ => {}
-        }
-        Flow::Continue
-    }
-}
-
 /// The executor standing in for the root machine `name`: `ticks` executor ticks of node
 /// 1000 (machine `root`), each reported as `tick_done` with the root's final status.
 /// Under `tickOnce` it re-ticks the root while it answers RUNNING with a wake-up pending,
@@ -107,65 +65,21 @@ fn lowered(
     ticks: usize,
     tick: BtTick,
 ) -> Result<Outcome, String> {
-    let tree = tree::read(xml_text)?;
-    let leaves: BTreeSet<u32> = tree
-        .nodes
-        .iter()
-        .filter(|n| matches!(n.kind, Kind::Leaf(_)))
-        .map(|n| n.id)
-        .collect();
-    let mut sm = SourceMap::new();
-    let tree_id = sm.add("t.xml", xml_text.to_string());
-    let plugins = model::plugins(scripts)
-        .into_iter()
-        .map(|(n, text)| sm.add(format!("{n}.ascxml"), text))
-        .collect();
-    let input = BtInput {
-        tree: tree_id,
-        plugins,
-        tick_rate_hz: 1.0,
-        tick_if_not_running: true,
+    let drv = |root: &str, node: &str| driver(root, node, ticks, tick);
+    let drive = Drive {
         halts: Halts::As2fm,
         semantics: BtSemantics::Btcpp { tick },
-    };
-    let mut machines = bt::lower(&sm, &input).map_err(|ds| Diagnostics(ds).to_string())?;
-    let name = |m: &xml::Element| m.attr_value("name").unwrap_or_default().to_string();
-    let (root_name, node_name) = (name(&machines[0]), name(&machines[1]));
-    let drv = sm.add("driver.scxml", driver(&root_name, &node_name, ticks, tick));
-    machines[0] = xml::parse(&sm, drv).map_err(|d| d.to_string())?;
-    let mut src = ModelSource {
-        sources: sm,
-        ..ModelSource::default()
-    };
-    let mut errs = Diagnostics::default();
-    for m in &machines {
-        src.add_machine_tree(m, FileId(0), &mut errs);
-    }
-    if !errs.is_empty() {
-        return Err(errs.to_string());
-    }
-    let compiled = CompiledModel::compile(src).map_err(|e| e.to_string())?;
-    let mut w = Watch {
-        leaves: &leaves,
-        statuses: Vec::new(),
-        log: Vec::new(),
-        bad: None,
-    };
-    let cfg = RunConfig {
+        driver: &drv,
+        status_event: Some("tick_done"),
         max_steps: 1_000_000,
-        ..RunConfig::default()
     };
-    let out =
-        Simulator::new(&compiled).run(&mut Xoshiro256PlusPlus::seed_from_u64(1), &cfg, &mut w);
-    if let Some(b) = w.bad {
-        return Err(b);
-    }
-    match out.end {
-        EndReason::MaxSteps | EndReason::Spin(_) if w.statuses.len() < ticks => {
-            Ok(Outcome::Livelock((w.statuses, w.log)))
+    let ((statuses, log), end) = lower_and_run(xml_text, scripts, &drive)?;
+    match end {
+        EndReason::MaxSteps | EndReason::Spin(_) if statuses.len() < ticks => {
+            Ok(Outcome::Livelock((statuses, log)))
         }
         EndReason::Error(e) => Err(format!("run-time error: {e:?}")),
-        _ => Ok(Outcome::Ran((w.statuses, w.log))),
+        _ => Ok(Outcome::Ran((statuses, log))),
     }
 }
 

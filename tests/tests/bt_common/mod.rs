@@ -7,8 +7,8 @@
 use hindsight::expr::Value;
 use hindsight::model::source::{FileId, SourceMap};
 use hindsight::model::{xml, Diagnostics, ModelSource};
-use hindsight::robot::bt::{self, BtInput, Halts};
-use hindsight::sim::{CompiledModel, Flow, Observer, RunConfig, SentMessage, Simulator};
+use hindsight::robot::bt::{self, BtInput, BtSemantics, Halts};
+use hindsight::sim::{CompiledModel, EndReason, Flow, Observer, RunConfig, SentMessage, Simulator};
 use hindsight_tests::bt::model;
 use hindsight_tests::bt::oracle::{self, LeafEvent, Reading, Scripts};
 use hindsight_tests::bt::tree::{self, Kind, Status, Tree};
@@ -19,16 +19,39 @@ use std::collections::BTreeSet;
 /// Root statuses, one per root tick, and what the leaves received.
 pub type Run = (Vec<Status>, Vec<LeafEvent>);
 
+/// Records the root's status per tick and the leaves' ticks and halts. The root's status
+/// is the parameter of `status_event` when one is given (a driver that reports executor
+/// ticks), else of node 1000's answer to the root machine.
 struct Watch<'a> {
     leaves: &'a BTreeSet<u32>,
+    status_event: Option<&'a str>,
     statuses: Vec<Status>,
     log: Vec<LeafEvent>,
     bad: Option<String>,
 }
 
+impl Watch<'_> {
+    fn status(&mut self, msg: &SentMessage<'_>) -> Flow {
+        let s = match msg.param(0) {
+            Some(Value::Int(1)) => Status::Success,
+            Some(Value::Int(2)) => Status::Failure,
+            Some(Value::Int(3)) => Status::Running,
+            other => {
+                self.bad = Some(format!("root answered {other:?}"));
+                return Flow::Stop;
+            }
+        };
+        self.statuses.push(s);
+        Flow::Continue
+    }
+}
+
 impl Observer for Watch<'_> {
     fn on_send(&mut self, _time: u64, msg: &SentMessage<'_>) -> Flow {
         let ev = msg.event_name();
+        if self.status_event == Some(ev) {
+            return self.status(msg);
+        }
         let Some(rest) = ev.strip_prefix("bt_") else {
             return Flow::Continue;
         };
@@ -41,17 +64,12 @@ impl Observer for Watch<'_> {
         match what {
             "tick" if self.leaves.contains(&id) => self.log.push(LeafEvent::Tick(id)),
             "halt" if self.leaves.contains(&id) => self.log.push(LeafEvent::Halt(id)),
-            "response" if id == 1000 && msg.target_name().starts_with("bt_root_fsm") => {
-                let s = match msg.param(0) {
-                    Some(Value::Int(1)) => Status::Success,
-                    Some(Value::Int(2)) => Status::Failure,
-                    Some(Value::Int(3)) => Status::Running,
-                    other => {
-                        self.bad = Some(format!("root answered {other:?}"));
-                        return Flow::Stop;
-                    }
-                };
-                self.statuses.push(s);
+            "response"
+                if self.status_event.is_none()
+                    && id == 1000
+                    && msg.target_name().starts_with("bt_root_fsm") =>
+            {
+                return self.status(msg);
             }
             _ => {}
         }
@@ -59,13 +77,28 @@ impl Observer for Watch<'_> {
     }
 }
 
-/// Lowers `xml` with one plugin per leaf type, ticks the root `ticks` times.
-pub fn lowered(
+/// How [`lower_and_run`] drives the lowered tree.
+pub struct Drive<'a> {
+    /// Which children the control nodes halt.
+    pub halts: Halts,
+    /// Whose rules the tree follows.
+    pub semantics: BtSemantics,
+    /// The text of the machine that replaces the root machine, given the root machine's
+    /// name and node 1000's machine name.
+    pub driver: &'a dyn Fn(&str, &str) -> String,
+    /// The event whose parameter is the root's status (`None`: node 1000's answers).
+    pub status_event: Option<&'a str>,
+    /// The run's step limit.
+    pub max_steps: u64,
+}
+
+/// Lowers `xml` with one plugin per leaf type, replaces the root machine by the driver,
+/// runs it once (seed 1): what the harness saw, and how the run ended.
+pub fn lower_and_run(
     xml_text: &str,
     scripts: &Scripts,
-    ticks: usize,
-    halts: Halts,
-) -> Result<Run, String> {
+    drive: &Drive<'_>,
+) -> Result<(Run, EndReason), String> {
     let tree = tree::read(xml_text)?;
     let leaves: BTreeSet<u32> = tree
         .nodes
@@ -84,19 +117,13 @@ pub fn lowered(
         plugins,
         tick_rate_hz: 1.0,
         tick_if_not_running: true,
-        halts,
-        semantics: Default::default(),
+        halts: drive.halts,
+        semantics: drive.semantics,
     };
     let mut machines = bt::lower(&sm, &input).map_err(|ds| Diagnostics(ds).to_string())?;
-    let root_name = machines[0]
-        .attr_value("name")
-        .unwrap_or_default()
-        .to_string();
-    let node_name = machines[1]
-        .attr_value("name")
-        .unwrap_or_default()
-        .to_string();
-    let drv = sm.add("driver.scxml", model::driver(&root_name, &node_name, ticks));
+    let name = |m: &xml::Element| m.attr_value("name").unwrap_or_default().to_string();
+    let (root_name, node_name) = (name(&machines[0]), name(&machines[1]));
+    let drv = sm.add("driver.scxml", (drive.driver)(&root_name, &node_name));
     machines[0] = xml::parse(&sm, drv).map_err(|d| d.to_string())?;
     let mut src = ModelSource {
         sources: sm,
@@ -112,19 +139,40 @@ pub fn lowered(
     let compiled = CompiledModel::compile(src).map_err(|e| e.to_string())?;
     let mut w = Watch {
         leaves: &leaves,
+        status_event: drive.status_event,
         statuses: Vec::new(),
         log: Vec::new(),
         bad: None,
     };
     let cfg = RunConfig {
-        max_steps: 5_000_000,
+        max_steps: drive.max_steps,
         ..RunConfig::default()
     };
-    Simulator::new(&compiled).run(&mut Xoshiro256PlusPlus::seed_from_u64(1), &cfg, &mut w);
+    let out =
+        Simulator::new(&compiled).run(&mut Xoshiro256PlusPlus::seed_from_u64(1), &cfg, &mut w);
     if let Some(b) = w.bad {
         return Err(b);
     }
-    Ok((w.statuses, w.log))
+    Ok(((w.statuses, w.log), out.end))
+}
+
+/// Lowers `xml` (AS2FM's semantics) with one plugin per leaf type, ticks the root `ticks`
+/// times.
+pub fn lowered(
+    xml_text: &str,
+    scripts: &Scripts,
+    ticks: usize,
+    halts: Halts,
+) -> Result<Run, String> {
+    let driver = |root: &str, node: &str| model::driver(root, node, ticks);
+    let drive = Drive {
+        halts,
+        semantics: BtSemantics::default(),
+        driver: &driver,
+        status_event: None,
+        max_steps: 5_000_000,
+    };
+    lower_and_run(xml_text, scripts, &drive).map(|(run, _)| run)
 }
 
 /// The oracle's run of the same case.
