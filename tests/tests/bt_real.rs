@@ -9,7 +9,9 @@
 //!
 //! `HINDSIGHT_BT_REAL_TREES` sets how many random format-4 trees go to the real library
 //! (default 10,000; the format-3 trees among the same seeds come on top),
-//! `HINDSIGHT_BT_SEED` the first seed. Without the Python environment the test says it
+//! `HINDSIGHT_BT_REAL_SCRIPT_TREES` how many more with BT.CPP 4's script language and
+//! pre/post conditions (`gen::Options::scripts`; default half as many), whose final script
+//! entries must agree too, `HINDSIGHT_BT_SEED` the first seed. Without the Python environment the test says it
 //! was skipped (run `bash scripts/pyenv`), except under `CI=true`, where it fails.
 
 use hindsight_tests::bt::gen;
@@ -64,6 +66,7 @@ fn expect(
             statuses: Vec::new(),
             log: Vec::new(),
             end: Some(End::Refused(why)),
+            vars: BTreeMap::new(),
         };
         return Ok((Some(tree), o));
     }
@@ -87,6 +90,12 @@ fn differ(want: &Outcome, got: &Outcome) -> Option<String> {
         return Some(format!(
             "root statuses: oracle {:?}, BT.CPP {:?}\n  oracle: {:?}\n  BT.CPP: {:?}",
             want.statuses, got.statuses, want.log, got.log
+        ));
+    }
+    if want.end.is_none() && want.vars != got.vars {
+        return Some(format!(
+            "script entries at the end: oracle {:?}, BT.CPP {:?}",
+            want.vars, got.vars
         ));
     }
     if want.log != got.log {
@@ -157,6 +166,17 @@ const FEATURES: &[&str] = &[
     "<RunOnce ",
     "<Switch2 ",
     "<Switch6 ",
+    "<Script ",
+    "<ScriptCondition ",
+    "<Precondition ",
+    "_skipIf=",
+    "_while=",
+    "_successIf=",
+    "_failureIf=",
+    "_onSuccess=",
+    "_onFailure=",
+    "_onHalted=",
+    "_post=",
 ];
 
 impl Counts {
@@ -185,8 +205,12 @@ fn check_all(
         let mut wants = Vec::new();
         for (name, xml, scripts, ticks) in chunk {
             for mode in MODES {
+                let mut read = Vec::new();
                 match expect(xml, scripts, *ticks, mode) {
-                    Ok(w) => wants.push((name, xml, scripts, *ticks, mode, w)),
+                    Ok(w) => {
+                        read = w.1.vars.keys().cloned().collect();
+                        wants.push((name, xml, scripts, *ticks, mode, w))
+                    }
                     Err(e) => fails.push(format!("{name}: the oracle: {e}")),
                 }
                 reqs.push(Request {
@@ -195,6 +219,7 @@ fn check_all(
                     ticks: *ticks,
                     mode,
                     budget: BUDGET,
+                    read,
                 });
             }
         }
@@ -330,7 +355,10 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
         }
         generated += 1;
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let opts = gen::Options { btcpp4_nodes: true };
+        let opts = gen::Options {
+            btcpp4_nodes: true,
+            scripts: false,
+        };
         let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
         if c.xml.contains("BTCPP_format=\"3\"") {
             // BT.CPP 4 does not know format 3's names: the 3.8 reading must run it.
@@ -342,6 +370,24 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
             continue;
         }
         cases.push((format!("seed {seed}"), c.xml, c.scripts, c.ticks));
+    }
+    // And trees with scripts and pre/post conditions (format 4 only), from seeds of their
+    // own so that the trees above stay comparable with AS2FM's reading.
+    let n_scripts = env("HINDSIGHT_BT_REAL_SCRIPT_TREES", n / 2);
+    let first = cases.len();
+    for seed in (seed0 + 1_000_000).. {
+        if (cases.len() - first) as u64 >= n_scripts {
+            break;
+        }
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let opts = gen::Options {
+            btcpp4_nodes: true,
+            scripts: true,
+        };
+        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
+        if c.xml.contains("<Script ") {
+            cases.push((format!("script seed {seed}"), c.xml, c.scripts, c.ticks));
+        }
     }
     let mut counts = Counts::default();
     fails.extend(check_all(&mut real, &cases, &mut counts));
@@ -368,7 +414,7 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
     fails.extend(check_all(&mut real, &files, &mut counts));
     eprintln!(
         "BehaviorTree.CPP {} (behaviortreepy {}): {generated} random trees, {v3} of them format 3 \
-         (the 3.8 reading only), {} to the real library and {} cases from tests/bt/ ({} more \
+         (the 3.8 reading only), {} to the real library ({n_scripts} of them with scripts and pre/post conditions) and {} cases from tests/bt/ ({} more \
          in format 3), each under tickOnce and tickExactlyOnce: {} runs ({} ran every tick, {} refused at load, \
          {} threw, {} livelocks, {} hangs; {} harness starts) in {:.1} s; {} disagreements. \
          Of the {} runs BT.CPP ran to the end whose nodes AS2FM has models of, AS2FM's \
@@ -474,6 +520,7 @@ fn where_as2fm_and_btcpp_differ() {
                     ticks,
                     mode,
                     budget: BUDGET,
+                    read: want.vars.keys().cloned().collect(),
                 }])
                 .expect("harness");
             let got = real::outcome(Some(&t), &a[0]).expect("outcome");

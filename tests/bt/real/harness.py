@@ -5,9 +5,12 @@
 # Protocol: one JSON object per line on stdin, one answer per line on stdout.
 #   first line out: {"version": "<BT.CPP version>", "binding": "<behaviortreepy version>"}
 #   in:  {"xml": str, "scripts": {type: ["SUCCESS"|"FAILURE"|"RUNNING", ...]},
-#         "ticks": int, "mode": "once"|"exactly_once", "budget": int}
+#         "ticks": int, "mode": "once"|"exactly_once", "budget": int, "read": [entry]}
 #   out: {"statuses": [str], "log": [["T"|"H", uid, type], ...], "end": null |
-#         {"kind": "load"|"tick"|"livelock", "tick": int, "text": str}}
+#         {"kind": "load"|"tick"|"livelock", "tick": int, "text": str},
+#         "vars": {entry: int | null}}
+# `read` (optional) names root blackboard entries to read as integers after the last
+# tick (a boolean reads as 0 or 1; null: missing or not a number).
 # A scripted leaf is a stateful action: on its k-th callback (on_start or on_running)
 # it answers script[k % len]; on_halted logs a halt (BT.CPP halts a child only while it
 # is RUNNING: ControlNode::haltChild, DecoratorNode::resetChild; the differential
@@ -113,11 +116,35 @@ def run(req):
                 end = {"kind": "livelock", "tick": i, "text": "over budget"}
                 break
             statuses.append(s.name)
-    # The tree's destructor halts what still runs: not part of the case.
+    vars = {}
+    if tree is not None:
+        bb = tree.root_blackboard()
+        for k in req.get("read", []):
+            try:
+                vars[k] = bb.get_int(k)
+            except Exception:
+                vars[k] = None
+    # Halting what still runs is not part of the case. Halt it here, where a throwing
+    # `_onHalted` script is a Python exception: the destructor halts again, and a throw
+    # there aborts the process.
+    # `Tree::haltTree` halts every node, running or not, so every `_onHalted` script
+    # runs: the entries `read` names are made to exist first (the generator's statements
+    # cannot throw otherwise), as a throw from the destructor ends the process.
     c.live = False
+    if tree is not None:
+        for k in req.get("read", []):
+            if vars.get(k) is None:
+                try:
+                    bb.set_int(k, 0)
+                except Exception:
+                    pass
+        try:
+            tree.halt_tree()
+        except Exception:
+            pass
     del tree
     cur = None
-    return {"statuses": statuses, "log": c.log, "end": end}
+    return {"statuses": statuses, "log": c.log, "end": end, "vars": vars}
 
 
 def main():

@@ -3,7 +3,9 @@
 //! SubTrees remapped, shared or keeping an entry private; blackboard writes (constants
 //! and copies) and reads of int, double, string and bool entries; leaves with and
 //! without `<bt_halt>`; counts of -1. With [`Options::btcpp4_nodes`], also BT.CPP 4's
-//! nodes that AS2FM has no model of.
+//! nodes that AS2FM has no model of; with [`Options::scripts`], BT.CPP 4's script
+//! language (`Script`, `ScriptCondition`, `Precondition`) and pre/post conditions on
+//! nodes, over the integer entries `x`, `y` and the boolean `f`.
 
 use super::oracle::Scripts;
 use super::tree::Status;
@@ -41,7 +43,19 @@ pub struct Options {
     /// format-4 trees: for the real-library test only (the lowering does not take them).
     /// Off, the generator draws exactly what it drew before they existed.
     pub btcpp4_nodes: bool,
+    /// Scripts (format-4 trees only): `Script` and `ScriptCondition` leaves,
+    /// `Precondition`, and the `_failureIf` ... `_post` attributes on any node but a
+    /// SubTree; `_skipIf` / `_while` only on a child other than the first of a sequence,
+    /// fallback or parallel (so SKIPPED never reaches any other parent: a control whose
+    /// first child is never skipped is never skipped itself). Scripts keep the integers
+    /// small (no product of two entries), so nothing overflows. Off, the generator draws
+    /// what it drew before.
+    pub scripts: bool,
 }
+
+/// The script entries: `x`, `y` integers, `f` a boolean, all written first by the main
+/// tree and remapped into every SubTree.
+const SCRIPT_INIT: &str = "x:=0; y:=1; f:=true";
 
 /// The int entries. `p0` is never remapped: inside a SubTree it is the instance's own
 /// (unless the whole blackboard is shared), which each SubTree body writes first.
@@ -133,6 +147,166 @@ impl<R: Rng> G<'_, R> {
         )
     }
 
+    fn scripts_on(&self) -> bool {
+        self.opts.scripts && !self.v3
+    }
+
+    /// An integer expression over `x` and `y`.
+    fn int_expr(&mut self, d: u32) -> String {
+        if d == 0 {
+            return match self.below(5) {
+                0 | 1 => self.pick(&["x", "y"]).to_string(),
+                2 => format!("-{}", self.pick(&["x", "1"])),
+                _ => self.below(4).to_string(),
+            };
+        }
+        match self.below(6) {
+            0 => format!("{} + {}", self.int_expr(d - 1), self.int_expr(d - 1)),
+            1 => format!("{} - {}", self.int_expr(d - 1), self.int_expr(0)),
+            2 => format!(
+                "({}) * {}",
+                self.int_expr(d - 1),
+                self.pick(&["-1", "0", "1"])
+            ),
+            3 => format!(
+                "({} ? {} : ({}))",
+                self.bool_expr(0, false),
+                self.int_expr(0),
+                self.int_expr(0)
+            ),
+            _ => self.int_expr(0),
+        }
+    }
+
+    /// A boolean expression (a value 0 or 1); `risky`: with now and then one that throws
+    /// (`Implicit casting`, `Logic operators`) when `x` is not 0 or 1. Statements never
+    /// throw (the real-library harness relies on it: `Tree::haltTree` runs every
+    /// `_onHalted` script, and a throw from the tree's destructor aborts).
+    fn bool_expr(&mut self, d: u32, risky: bool) -> String {
+        let c = |g: &mut Self| {
+            let op = g.pick(&["==", "!=", "<", "<=", ">", ">="]);
+            format!("{} {op} {}", g.int_expr(0), g.int_expr(0))
+        };
+        if d == 0 {
+            return match self.below(6) {
+                0 => "f".into(),
+                1 => "!f".into(),
+                2 => self.pick(&["true", "false"]).into(),
+                _ => c(self),
+            };
+        }
+        // `!` and arithmetic do not mix in one expression (see `script.rs`): operands of
+        // `&&` / `||` are parenthesized, except comparisons (which have no `!`).
+        match self.below(8) {
+            0 => format!(
+                "({}) && ({})",
+                self.bool_expr(d - 1, risky),
+                self.bool_expr(d - 1, risky)
+            ),
+            1 => format!(
+                "({}) || ({})",
+                self.bool_expr(d - 1, risky),
+                self.bool_expr(0, risky)
+            ),
+            2 => format!("{} && {} || f", c(self), c(self)),
+            3 => format!("!({})", self.bool_expr(d - 1, risky)),
+            4 => format!("({}) == f", c(self)),
+            5 if risky && self.below(4) == 0 => "x".into(),
+            _ => self.bool_expr(0, risky),
+        }
+    }
+
+    /// One to three statements.
+    fn script(&mut self) -> String {
+        let n = 1 + self.below(3);
+        let stmts: Vec<String> = (0..n)
+            .map(|_| match self.below(7) {
+                0 => format!("x := {}", self.int_expr(1)),
+                1 => format!("y = {}", self.int_expr(1)),
+                2 => format!("x += {}", self.below(3)),
+                3 => format!("y -= {}", self.below(3)),
+                4 => format!("f := {}", self.bool_expr(1, false)),
+                5 => "f = !f".into(),
+                _ => format!("x {} y", self.pick(&["+", "-"])),
+            })
+            .collect();
+        stmts.join("; ")
+    }
+
+    /// A script leaf, or a Precondition over a node.
+    fn script_node(&mut self, depth: u32) -> String {
+        match self.below(3) {
+            0 => format!("<Script code=\"{}\"/>", esc(&self.script())),
+            1 => format!(
+                "<ScriptCondition code=\"{}\"/>",
+                esc(&self.bool_expr(1, true))
+            ),
+            _ => {
+                let e = self.pick(&["SUCCESS", "FAILURE", "RUNNING"]);
+                let cond = esc(&self.bool_expr(1, true));
+                let child = self.node(depth + 1);
+                format!("<Precondition if=\"{cond}\" else=\"{e}\">{child}</Precondition>")
+            }
+        }
+    }
+
+    /// `node` with now and then a pre/post-condition attribute (never on a SubTree);
+    /// `skip` allows `_skipIf` and `_while`.
+    fn with_conds(&mut self, node: String, skip: bool) -> String {
+        if !self.scripts_on() || node.starts_with("<SubTree") || self.below(4) != 0 {
+            return node;
+        }
+        let names: &[&str] = if skip {
+            &[
+                "_skipIf",
+                "_while",
+                "_skipIf",
+                "_while",
+                "_failureIf",
+                "_successIf",
+                "_onSuccess",
+                "_onFailure",
+                "_post",
+                "_onHalted",
+            ]
+        } else {
+            &[
+                "_failureIf",
+                "_successIf",
+                "_onSuccess",
+                "_onFailure",
+                "_post",
+                "_onHalted",
+            ]
+        };
+        let name = self.pick(names);
+        let code = if name.starts_with("_on") || name == "_post" {
+            self.script()
+        } else {
+            self.bool_expr(1, true)
+        };
+        let at = node[1..]
+            .find([' ', '/', '>'])
+            .map_or(node.len(), |i| i + 1);
+        let head = &node[..node.find('>').unwrap_or(node.len())];
+        if head.contains(&format!(" {name}=")) {
+            return node;
+        }
+        format!("{} {name}=\"{}\"{}", &node[..at], esc(&code), &node[at..])
+    }
+
+    /// Children of a sequence, fallback or parallel: with scripts, those after the first
+    /// may be skipped.
+    fn children_skip(&mut self, depth: u32, lo: u64, hi: u64) -> String {
+        let n = lo + self.below(hi - lo + 1);
+        (0..n)
+            .map(|i| {
+                let c = self.node(depth + 1);
+                self.with_conds(c, i > 0)
+            })
+            .collect()
+    }
+
     fn children(&mut self, depth: u32, lo: u64, hi: u64) -> String {
         let n = lo + self.below(hi - lo + 1);
         (0..n).map(|_| self.node(depth + 1)).collect()
@@ -143,17 +317,17 @@ impl<R: Rng> G<'_, R> {
         match self.below(7) {
             0 => format!(
                 "<AsyncSequence>{}</AsyncSequence>",
-                self.children(depth, 1, 4)
+                self.children_skip(depth, 1, 4)
             ),
             1 => format!(
                 "<AsyncFallback>{}</AsyncFallback>",
-                self.children(depth, 1, 4)
+                self.children_skip(depth, 1, 4)
             ),
             2 => {
                 let n = 1 + self.below(3) as i64;
                 let t = 1 + self.below(n as u64) as i64;
                 let t = if self.below(3) == 0 { t - n - 1 } else { t };
-                let kids: String = (0..n).map(|_| self.node(depth + 1)).collect();
+                let kids = self.kids_skip(depth, n);
                 format!("<ParallelAll max_failures=\"{t}\">{kids}</ParallelAll>")
             }
             3 => format!("<WhileDoElse>{}</WhileDoElse>", self.children(depth, 2, 3)),
@@ -176,11 +350,30 @@ impl<R: Rng> G<'_, R> {
         }
     }
 
+    /// `n` children of a parallel (with scripts, those after the first may be skipped).
+    fn kids_skip(&mut self, depth: u32, n: i64) -> String {
+        (0..n)
+            .map(|i| {
+                let c = self.node(depth + 1);
+                self.with_conds(c, i > 0)
+            })
+            .collect()
+    }
+
+    /// A node, with now and then a condition (see [`Options::scripts`]).
     fn node(&mut self, depth: u32) -> String {
+        let n = self.node_bare(depth);
+        self.with_conds(n, false)
+    }
+
+    fn node_bare(&mut self, depth: u32) -> String {
         self.budget -= 1;
         if self.opts.btcpp4_nodes && !self.v3 && depth < 5 && self.budget > 0 && self.below(6) == 0
         {
             return self.btcpp4_node(depth);
+        }
+        if self.scripts_on() && depth < 5 && self.below(6) == 0 {
+            return self.script_node(depth);
         }
         if depth >= 5 || self.budget <= 0 || self.below(10) < 3 {
             return match self.below(12) {
@@ -192,15 +385,15 @@ impl<R: Rng> G<'_, R> {
             };
         }
         match self.below(18) {
-            0 | 1 => format!("<Sequence>{}</Sequence>", self.children(depth, 1, 4)),
-            2 | 3 => format!("<Fallback>{}</Fallback>", self.children(depth, 1, 4)),
+            0 | 1 => format!("<Sequence>{}</Sequence>", self.children_skip(depth, 1, 4)),
+            2 | 3 => format!("<Fallback>{}</Fallback>", self.children_skip(depth, 1, 4)),
             4 => format!(
                 "<ReactiveSequence>{}</ReactiveSequence>",
-                self.children(depth, 1, 3)
+                self.children_skip(depth, 1, 3)
             ),
             5 => format!(
                 "<ReactiveFallback>{}</ReactiveFallback>",
-                self.children(depth, 1, 3)
+                self.children_skip(depth, 1, 3)
             ),
             6 | 7 => {
                 // BT.CPP 4 knows `SequenceStar` only under USE_BTCPP3_OLD_NAMES.
@@ -209,7 +402,7 @@ impl<R: Rng> G<'_, R> {
                 } else {
                     "SequenceWithMemory"
                 };
-                format!("<{tag}>{}</{tag}>", self.children(depth, 1, 4))
+                format!("<{tag}>{}</{tag}>", self.children_skip(depth, 1, 4))
             }
             8 => {
                 let n = 1 + self.below(3) as i64;
@@ -222,7 +415,7 @@ impl<R: Rng> G<'_, R> {
                     }
                 };
                 let (s, f) = (th(self), th(self));
-                let kids: String = (0..n).map(|_| self.node(depth + 1)).collect();
+                let kids = self.kids_skip(depth, n);
                 let (sn, fna) = if self.v3 {
                     ("success_threshold", "failure_threshold")
                 } else {
@@ -280,6 +473,11 @@ impl<R: Rng> G<'_, R> {
                 e.to_string()
             }
         };
+        let more = if self.scripts_on() {
+            " x=\"{x}\" y=\"{y}\" f=\"{f}\""
+        } else {
+            ""
+        };
         let remap = match self.below(3) {
             0 => format!("{flag}=\"true\""),
             1 => format!(
@@ -299,7 +497,7 @@ impl<R: Rng> G<'_, R> {
                 v("b0")
             ),
         };
-        format!("<{tag} ID=\"S{i}\" {remap}/>")
+        format!("<{tag} ID=\"S{i}\" {remap}{more}/>")
     }
 }
 
@@ -334,13 +532,18 @@ pub fn case_with<R: Rng>(rng: &mut R, size: i64, opts: Options) -> Case {
     g.budget = size;
     let body = g.node(0);
     let format = if g.v3 { 3 } else { 4 };
+    let init = if g.scripts_on() {
+        format!("<Script code=\"{SCRIPT_INIT}\"/>")
+    } else {
+        String::new()
+    };
     // Every entry written first, so each has a value and a type.
     let xml = format!(
         "<root BTCPP_format=\"{format}\" main_tree_to_execute=\"Main\"><BehaviorTree ID=\"Main\"><Sequence>\
 <SetBlackboard output_key=\"k0\" value=\"0\"/><SetBlackboard output_key=\"k1\" value=\"1\"/>\
 <SetBlackboard output_key=\"p0\" value=\"2\"/><SetBlackboard output_key=\"d0\" value=\"1.5\"/>\
 <SetBlackboard output_key=\"s0\" value=\"a\"/><SetBlackboard output_key=\"b0\" value=\"true\"/>\
-{body}</Sequence></BehaviorTree>{defs}</root>"
+{init}{body}</Sequence></BehaviorTree>{defs}</root>"
     );
     let ticks = 4 + g.below(7) as usize;
     Case {
@@ -348,4 +551,12 @@ pub fn case_with<R: Rng>(rng: &mut R, size: i64, opts: Options) -> Case {
         scripts: g.scripts,
         ticks,
     }
+}
+
+/// A script as an attribute value.
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
 }

@@ -6,4 +6,5 @@ pub mod gen;
 pub mod model;
 pub mod oracle;
 pub mod real;
+pub mod script;
 pub mod tree;

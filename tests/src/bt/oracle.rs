@@ -11,6 +11,7 @@
 //! differential runs (4.8.2, `tests/tests/bt_real.rs`) differs from 4.10, the comment says
 //! so.
 
+use super::script::{Fault, Program};
 use super::tree::{CheckType, Kind, Operand, Status, Tree};
 use std::collections::BTreeMap;
 
@@ -138,6 +139,9 @@ pub struct Outcome {
     pub log: Vec<LeafEvent>,
     /// `None` when every tick ran.
     pub end: Option<End>,
+    /// The script entries at the end (BT.CPP 4; booleans as 0 and 1), the SubTrees'
+    /// private ones left out.
+    pub vars: BTreeMap<String, i64>,
 }
 
 /// Why a tick stopped: BT.CPP's own outcome, or a case the oracle cannot run.
@@ -189,6 +193,9 @@ const V4_NAMES: &[&str] = &[
     "Switch4",
     "Switch5",
     "Switch6",
+    "Script",
+    "ScriptCondition",
+    "Precondition",
 ];
 
 /// The other built-in nodes BT.CPP 4.8.2 registers: a scripted leaf cannot take their
@@ -196,12 +203,9 @@ const V4_NAMES: &[&str] = &[
 const V4_OTHERS: &[&str] = &[
     "Timeout",
     "Delay",
-    "Script",
-    "ScriptCondition",
     "Sleep",
     "UnsetBlackboard",
     "SubTree",
-    "Precondition",
     "LoopInt",
     "LoopBool",
     "LoopDouble",
@@ -267,6 +271,23 @@ pub struct Oracle<'t> {
     node_ticks: usize,
     /// Every tick and halt leaves received, in order.
     pub log: Vec<LeafEvent>,
+    /// The entries scripts read and write (booleans as 0 and 1).
+    pub vars: BTreeMap<String, i64>,
+    /// Sequences and fallbacks: children skipped so far (`skipped_count_`).
+    skipped: Vec<usize>,
+    /// A script a halt ran threw: surfaced when the tick returns.
+    fault: Option<String>,
+    /// Precondition: its child has started (`_children_running`).
+    memo: Vec<bool>,
+}
+
+impl From<Fault> for Stop {
+    fn from(f: Fault) -> Self {
+        match f {
+            Fault::Throws(t) => Stop::Error(t),
+            Fault::Model(t) => Stop::Model(t),
+        }
+    }
 }
 
 impl<'t> Oracle<'t> {
@@ -308,6 +329,10 @@ impl<'t> Oracle<'t> {
             calls: 0,
             node_ticks: 0,
             log: Vec::new(),
+            vars: BTreeMap::new(),
+            skipped: vec![0; n],
+            fault: None,
+            memo: vec![false; n],
         }
     }
 
@@ -403,9 +428,115 @@ impl<'t> Oracle<'t> {
                 return Err(Stop::Hang);
             }
         }
-        let s = self.tick_inner(n)?;
-        self.status[n] = Some(s);
+        let conds = &self.tree.nodes[n].conds;
+        if conds.any() && self.reading != Reading::Btcpp {
+            return Err(Stop::Model("pre/post conditions are BT.CPP 4's".into()));
+        }
+        let s = match self.pre_conditions(n)? {
+            Some(s) => s,
+            None => {
+                let s = self.tick_inner(n)?;
+                if s == Status::Skipped {
+                    // Every control and decorator that can answer SKIPPED set itself
+                    // RUNNING first (`setStatus(NodeStatus::RUNNING)` in their `tick`),
+                    // and `executeTick` does not store SKIPPED: it stays RUNNING.
+                    self.status[n] = Some(Status::Running);
+                }
+                s
+            }
+        };
+        if let Some(f) = self.fault.take() {
+            return Err(Stop::Model(format!(
+                "a script a halt ran threw ({f}): not modelled"
+            )));
+        }
+        // `TreeNode::checkPostConditions`, for a finished answer only
+        // (`isStatusCompleted`): `_onSuccess` or `_onFailure`, then `_post`.
+        let post = &self.tree.nodes[n].conds.post;
+        if matches!(s, Status::Success | Status::Failure) {
+            let which = if s == Status::Success { 2 } else { 1 };
+            for p in [&post[which], &post[3]].into_iter().flatten() {
+                p.run(&mut self.vars)?;
+            }
+        }
+        if s == Status::Skipped && !self.takes_skipped(n) {
+            return Err(Stop::Model(format!(
+                "SKIPPED reaches the parent of {}, which the oracle does not model for it",
+                self.tree.nodes[n].id
+            )));
+        }
+        // "preserve the IDLE state if skipped" (`TreeNode::executeTick`).
+        if s != Status::Skipped {
+            self.status[n] = Some(s);
+        }
         Ok(s)
+    }
+
+    /// `TreeNode::checkPreConditions` (4.10 and 4.8.2): in the order `_failureIf`,
+    /// `_successIf`, `_skipIf`, `_while`; the first three only while the node is IDLE (a
+    /// true one answers FAILURE, SUCCESS, SKIPPED without ticking it), `_while` also
+    /// while RUNNING: false when IDLE skips the node, false when RUNNING halts it
+    /// (`haltNode`, so its `_onHalted` runs) and answers SKIPPED.
+    fn pre_conditions(&mut self, n: usize) -> Result<Option<Status>, Stop> {
+        let tree = self.tree;
+        for (i, p) in tree.nodes[n].conds.pre.iter().enumerate() {
+            let Some(p) = p else { continue };
+            match self.status[n] {
+                None => {
+                    let holds = p.holds(&mut self.vars)?;
+                    match (i, holds) {
+                        (0, true) => return Ok(Some(Status::Failure)),
+                        (1, true) => return Ok(Some(Status::Success)),
+                        (2, true) | (3, false) => return Ok(Some(Status::Skipped)),
+                        _ => {}
+                    }
+                }
+                Some(Status::Running) if i == 3 => {
+                    let holds = p.holds(&mut self.vars)?;
+                    if !holds {
+                        self.halt_node(n);
+                        return Ok(Some(Status::Skipped));
+                    }
+                }
+                _ => {}
+            }
+        }
+        Ok(None)
+    }
+
+    /// Whether node `n`'s parent (if any) is one whose handling of a SKIPPED child the
+    /// oracle models: the sequences, fallbacks and parallels.
+    fn takes_skipped(&self, n: usize) -> bool {
+        let parent = self.tree.nodes.iter().find(|p| p.children.contains(&n));
+        parent.is_none_or(|p| {
+            matches!(
+                p.kind,
+                Kind::Sequence
+                    | Kind::Fallback
+                    | Kind::SequenceWithMemory
+                    | Kind::AsyncSequence
+                    | Kind::AsyncFallback
+                    | Kind::ReactiveSequence
+                    | Kind::ReactiveFallback
+                    | Kind::Parallel(..)
+                    | Kind::ParallelAll(_)
+            )
+        })
+    }
+
+    /// `TreeNode::haltNode`: the node's `halt()`, then its `_onHalted` script.
+    fn halt_node(&mut self, n: usize) {
+        self.halt(n);
+        if let Some(p) = &self.tree.nodes[n].conds.post[0] {
+            if let Err(f) = p.run(&mut self.vars) {
+                self.fault.get_or_insert(format!("{f:?}"));
+            }
+        }
+    }
+
+    /// A script node's program run once over the entries.
+    fn script(&mut self, p: &Program) -> Result<i64, Stop> {
+        Ok(p.run(&mut self.vars)?)
     }
 
     /// `ControlNode::haltChild` / `DecoratorNode::resetChild`: BT.CPP halts the child
@@ -413,7 +544,7 @@ impl<'t> Oracle<'t> {
     /// whatever it last answered.
     fn halt_child(&mut self, c: usize) {
         if self.reading == Reading::As2fm || self.status[c] == Some(Status::Running) {
-            self.halt(c);
+            self.halt_node(c);
         }
         self.status[c] = None;
     }
@@ -433,7 +564,11 @@ impl<'t> Oracle<'t> {
             // `StatefulActionNode::halt` calls `onHalted` (only ever reached while
             // RUNNING in BT.CPP, see `halt_child`).
             Kind::Leaf(_) => self.log.push(LeafEvent::Halt(self.tree.nodes[n].id)),
-            Kind::AlwaysSuccess | Kind::AlwaysFailure | Kind::SetBlackboard(..) => {}
+            Kind::AlwaysSuccess
+            | Kind::AlwaysFailure
+            | Kind::SetBlackboard(..)
+            | Kind::Script(_)
+            | Kind::ScriptCondition(_) => {}
             // v4 `SequenceWithMemory::halt` keeps `current_child_idx_`; AS2FM's
             // `sequence_with_memory.ascxml` and v3.8 `SequenceStarNode::halt` reset it.
             Kind::SequenceWithMemory => {
@@ -455,6 +590,7 @@ impl<'t> Oracle<'t> {
             // keeps `already_ticked_`.
             _ => {
                 self.idx[n] = 0;
+                self.skipped[n] = 0;
                 self.reset_children(n);
             }
         }
@@ -514,7 +650,7 @@ impl<'t> Oracle<'t> {
             Kind::Inverter => self.decorate(n, |s| match s {
                 Success => Failure,
                 Failure => Success,
-                Running => Running,
+                s => s,
             }),
             Kind::ForceSuccess => self.decorate(n, |s| if s == Running { s } else { Success }),
             Kind::ForceFailure => self.decorate(n, |s| if s == Running { s } else { Failure }),
@@ -524,6 +660,24 @@ impl<'t> Oracle<'t> {
             &Kind::Retry(max) => self.repeat(n, max, Failure),
             Kind::AlwaysSuccess => Ok(Success),
             Kind::AlwaysFailure => Ok(Failure),
+            // `ScriptNode::tick`: runs the code, SUCCESS.
+            Kind::Script(p) => {
+                self.script(p)?;
+                Ok(Success)
+            }
+            // `ScriptCondition::tick`: `cast<bool>` of the code's value.
+            Kind::ScriptCondition(p) => {
+                let v = self.script(p)?;
+                Ok(if super::script::truth(v)? {
+                    Success
+                } else {
+                    Failure
+                })
+            }
+            Kind::Precondition(p, otherwise) => {
+                let otherwise = *otherwise;
+                self.precondition(n, p, otherwise)
+            }
             Kind::SetBlackboard(key, v) => self.set_blackboard(key, v),
             Kind::Check(ty, a, b, mismatch, numeric) => {
                 let (ty, mut mismatch, numeric) = (*ty, *mismatch, *numeric);
@@ -548,6 +702,27 @@ impl<'t> Oracle<'t> {
                 }
             }
         }
+    }
+
+    /// `PreconditionNode::tick` (4.10; 4.8.2 alike, as the real-library differential
+    /// finds): the `if` script only while the child has not started
+    /// (`_children_running`); false answers `else`; true ticks the child, and a finished
+    /// child is reset and the script is due again. A halt (`DecoratorNode::halt`) does
+    /// not clear `_children_running`: after one, the next tick skips the script.
+    fn precondition(&mut self, n: usize, p: &Program, otherwise: Status) -> Result<Status, Stop> {
+        if !self.memo[n] {
+            self.memo[n] = p.holds(&mut self.vars)?;
+        }
+        if !self.memo[n] {
+            return Ok(otherwise);
+        }
+        let c = self.child(n, 0);
+        let s = self.tick(c)?;
+        if matches!(s, Status::Success | Status::Failure) {
+            self.halt_child(c);
+            self.memo[n] = false;
+        }
+        Ok(s)
     }
 
     /// `SetBlackboard`. v4 `SetBlackboardNode::tick`: a `{other}` value copies that
@@ -595,6 +770,12 @@ impl<'t> Oracle<'t> {
         asynch: bool,
     ) -> Result<Status, Stop> {
         let len = self.n_children(n);
+        // 4.10 `SequenceNode::tick`: the count of skipped children restarts when the node
+        // was not active (`!isStatusActive(status())`: IDLE); a skipped child is passed
+        // over; every child skipped answers SKIPPED.
+        if self.status[n].is_none() {
+            self.skipped[n] = 0;
+        }
         while (self.idx[n] as usize) < len {
             let c = self.child(n, self.idx[n] as usize);
             let prev = self.status[c];
@@ -605,6 +786,10 @@ impl<'t> Oracle<'t> {
                     self.idx[n] = 0;
                     return Ok(stop);
                 }
+                Status::Skipped => {
+                    self.idx[n] += 1;
+                    self.skipped[n] += 1;
+                }
                 _ => {
                     self.idx[n] += 1;
                     if asynch && (self.idx[n] as usize) < len && self.yields(prev) {
@@ -613,9 +798,11 @@ impl<'t> Oracle<'t> {
                 }
             }
         }
+        let all_skipped = self.skipped[n] == len;
         self.reset_children(n);
         self.idx[n] = 0;
-        Ok(cont)
+        self.skipped[n] = 0;
+        Ok(if all_skipped { Status::Skipped } else { cont })
     }
 
     /// `SequenceWithMemory::tick`: a failure keeps the index. BT.CPP (4 and 3.8
@@ -626,6 +813,10 @@ impl<'t> Oracle<'t> {
     /// signal and answer RUNNING (`requiresWakeUp() && prev_status == IDLE`).
     fn sequence_with_memory(&mut self, n: usize) -> Result<Status, Stop> {
         let len = self.n_children(n);
+        // Skipped children as in `sequence` (4.10 `SequenceWithMemory::tick`).
+        if self.status[n].is_none() {
+            self.skipped[n] = 0;
+        }
         while (self.idx[n] as usize) < len {
             let at = self.idx[n] as usize;
             let c = self.child(n, at);
@@ -650,11 +841,21 @@ impl<'t> Oracle<'t> {
                         return Ok(Status::Running);
                     }
                 }
+                Status::Skipped => {
+                    self.idx[n] += 1;
+                    self.skipped[n] += 1;
+                }
             }
         }
+        let all_skipped = self.skipped[n] == len;
         self.reset_children(n);
         self.idx[n] = 0;
-        Ok(Status::Success)
+        self.skipped[n] = 0;
+        Ok(if all_skipped {
+            Status::Skipped
+        } else {
+            Status::Success
+        })
     }
 
     /// Whether a node yields after a child that was `prev` before the tick finished
@@ -684,6 +885,9 @@ impl<'t> Oracle<'t> {
                 "Number of children is less than threshold".into(),
             ));
         }
+        // A skipped child counts as finished for this tick only (`skipped_count`); all
+        // skipped: SKIPPED, nothing cleared.
+        let mut skipped = 0;
         for i in 0..len {
             if self.done[n][i] {
                 continue;
@@ -696,9 +900,13 @@ impl<'t> Oracle<'t> {
                     self.counts[n].1 += 1;
                 }
                 Status::Running => {}
+                Status::Skipped => skipped += 1,
             }
         }
-        if self.done[n].iter().all(|d| *d) {
+        if skipped == len {
+            return Ok(Status::Skipped);
+        }
+        if skipped + self.done[n].iter().filter(|d| **d).count() >= len {
             self.reset_children(n);
             self.done[n].iter_mut().for_each(|d| *d = false);
             let failed = self.counts[n].1 >= th;
@@ -720,6 +928,7 @@ impl<'t> Oracle<'t> {
         let len = self.n_children(n);
         let cond = self.child(n, 0);
         let s = match self.tick(cond)? {
+            Status::Skipped => return Err(Stop::Model("SKIPPED: not modelled here".into())),
             Status::Running => return Ok(Status::Running),
             Status::Success => {
                 if len == 3 {
@@ -806,9 +1015,15 @@ impl<'t> Oracle<'t> {
     /// first child; a RUNNING child halts all the others.
     fn reactive(&mut self, n: usize, cont: Status, stop: Status) -> Result<Status, Stop> {
         let len = self.n_children(n);
+        // 4.10 `ReactiveSequence::tick`: a skipped child is reset (`haltChild`, so it
+        // can be skipped again); every child skipped answers SKIPPED.
+        let mut all_skipped = true;
         for i in 0..len {
             let c = self.child(n, i);
-            match self.tick(c)? {
+            let s = self.tick(c)?;
+            all_skipped &= s == Status::Skipped;
+            match s {
+                Status::Skipped => self.halt_child(c),
                 Status::Running => {
                     for j in (0..len).filter(|&j| j != i) {
                         let o = self.child(n, j);
@@ -824,7 +1039,7 @@ impl<'t> Oracle<'t> {
             }
         }
         self.reset_children(n);
-        Ok(cont)
+        Ok(if all_skipped { Status::Skipped } else { cont })
     }
 
     /// `ParallelNode::tick` (v4: finished children are not ticked again, counts build up
@@ -833,6 +1048,7 @@ impl<'t> Oracle<'t> {
     /// tick, counts from zero, the thresholds checked after each child). v4 throws when a
     /// threshold exceeds the children ("Number of children is less than threshold").
     fn parallel(&mut self, n: usize, s: i64, f: i64) -> Result<Status, Stop> {
+        let raw_s = s;
         let len = self.n_children(n) as i64;
         let th = |t: i64| if t < 0 { (len + t + 1).max(0) } else { t };
         let (s, f) = (th(s), th(f));
@@ -845,6 +1061,9 @@ impl<'t> Oracle<'t> {
             self.counts[n] = (0, 0);
         }
         let btcpp = self.btcpp();
+        // 4.10 `ParallelNode::tick`: children skipped in this tick count towards a
+        // success threshold written negative; every child skipped answers SKIPPED.
+        let mut skipped = 0;
         for i in 0..len as usize {
             if !self.done[n][i] {
                 let c = self.child(n, i);
@@ -858,9 +1077,11 @@ impl<'t> Oracle<'t> {
                         self.done[n][i] = btcpp;
                     }
                     Status::Running => {}
+                    Status::Skipped => skipped += 1,
                 }
             }
             let (sc, fc) = self.counts[n];
+            let sc = if raw_s < 0 { sc + skipped } else { sc };
             let fail = if btcpp {
                 len - fc < s || fc == f
             } else {
@@ -877,7 +1098,11 @@ impl<'t> Oracle<'t> {
                 });
             }
         }
-        Ok(Status::Running)
+        Ok(if skipped == len {
+            Status::Skipped
+        } else {
+            Status::Running
+        })
     }
 
     /// v3.8 `ParallelNode::tick`: every tick counts from zero over all children in
@@ -903,6 +1128,7 @@ impl<'t> Oracle<'t> {
                 self.tick(c)?
             };
             match st {
+                Status::Skipped => return Err(Stop::Model("SKIPPED: not modelled here".into())),
                 Status::Success => {
                     self.done[n][i] = true;
                     sc += 1;
@@ -934,6 +1160,7 @@ impl<'t> Oracle<'t> {
         if self.idx[n] == 0 {
             let c = self.child(n, 0);
             match self.tick(c)? {
+                Status::Skipped => return Err(Stop::Model("SKIPPED: not modelled here".into())),
                 Status::Running => return Ok(Status::Running),
                 Status::Success => self.idx[n] = 1,
                 Status::Failure if self.n_children(n) == 3 => self.idx[n] = 2,
@@ -1084,9 +1311,15 @@ pub fn run_with(
             }
         }
     }
+    let vars = o
+        .vars
+        .into_iter()
+        .filter(|(k, _)| !k.starts_with("__st"))
+        .collect();
     Ok(Outcome {
         statuses,
         log: o.log,
         end,
+        vars,
     })
 }

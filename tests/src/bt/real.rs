@@ -51,6 +51,8 @@ pub struct Request {
     pub mode: TickMode,
     /// Leaf callbacks per root tick before the harness calls it a livelock.
     pub budget: usize,
+    /// Root blackboard entries to read (as integers) after the last tick.
+    pub read: Vec<String>,
 }
 
 /// What the real library did, leaves named by BT.CPP's UIDs.
@@ -63,6 +65,8 @@ pub struct Answer {
     /// How it ended early: `(kind, tick, text)` with kind `load`, `tick`, `livelock` or
     /// `hang` (the watchdog's).
     pub end: Option<(String, usize, String)>,
+    /// The entries [`Request::read`] named, those that hold a number.
+    pub vars: std::collections::BTreeMap<String, i64>,
 }
 
 /// A running harness.
@@ -173,6 +177,7 @@ impl Real {
         };
         let v = serde_json::json!({
             "xml": r.xml, "scripts": scripts, "ticks": r.ticks, "mode": mode, "budget": r.budget,
+            "read": r.read,
         });
         format!("{v}\n")
     }
@@ -200,7 +205,20 @@ impl Real {
                 e["text"].as_str().unwrap_or("").to_string(),
             )),
         };
-        Ok(Answer { statuses, log, end })
+        let vars = v["vars"]
+            .as_object()
+            .map(|m| {
+                m.iter()
+                    .filter_map(|(k, x)| Some((k.clone(), x.as_i64()?)))
+                    .collect()
+            })
+            .unwrap_or_default();
+        Ok(Answer {
+            statuses,
+            log,
+            end,
+            vars,
+        })
     }
 
     /// Runs the cases (streamed: all written, then all read); a case that takes longer
@@ -222,6 +240,7 @@ impl Real {
                         statuses: Vec::new(),
                         log: Vec::new(),
                         end: Some(("hang".into(), 0, "no answer in time".into())),
+                        vars: Default::default(),
                     });
                     self.restart()?;
                     sent = out.len();
@@ -285,5 +304,6 @@ pub fn outcome(tree: Option<&Tree>, a: &Answer) -> Result<Outcome, String> {
         statuses: a.statuses.clone(),
         log,
         end,
+        vars: a.vars.clone(),
     })
 }

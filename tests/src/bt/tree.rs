@@ -4,6 +4,7 @@
 //! Written independently of hindsight's reader: it uses quick-xml directly and knows the
 //! built-in nodes only through [`NODES`], the one table to extend for a new node kind.
 
+use super::script::{self, Program};
 use quick_xml::events::{BytesStart, Event};
 use quick_xml::Reader;
 use std::collections::BTreeMap;
@@ -17,6 +18,9 @@ pub enum Status {
     Failure,
     /// RUNNING.
     Running,
+    /// SKIPPED (BT.CPP 4: a pre-condition skipped the node, or every child of a control
+    /// was skipped; `TreeNode::executeTick` keeps the node's own status as it was).
+    Skipped,
 }
 
 impl Status {
@@ -26,6 +30,7 @@ impl Status {
             "SUCCESS" | "S" => Some(Status::Success),
             "FAILURE" | "F" => Some(Status::Failure),
             "RUNNING" | "R" => Some(Status::Running),
+            "SKIPPED" => Some(Status::Skipped),
             _ => None,
         }
     }
@@ -35,14 +40,17 @@ impl Status {
             Status::Success => "SUCCESS",
             Status::Failure => "FAILURE",
             Status::Running => "RUNNING",
+            Status::Skipped => "SKIPPED",
         }
     }
-    /// The code AS2FM's translation sends: 1, 2, 3.
+    /// The code AS2FM's translation sends: 1, 2, 3 (and 4 for SKIPPED, which AS2FM
+    /// does not have).
     pub fn code(self) -> i64 {
         match self {
             Status::Success => 1,
             Status::Failure => 2,
             Status::Running => 3,
+            Status::Skipped => 4,
         }
     }
 }
@@ -123,6 +131,12 @@ pub enum Kind {
     /// `BlackboardCheckInt/Double/String/Bool`: `value_A`, `value_B`,
     /// `return_on_mismatch`, and whether that was written as one of AS2FM's numbers.
     Check(CheckType, Operand, Operand, Status, bool),
+    /// `Script` with its `code` (BT.CPP 4).
+    Script(Program),
+    /// `ScriptCondition` with its `code` (BT.CPP 4).
+    ScriptCondition(Program),
+    /// `Precondition` with its `if` script and `else` status (BT.CPP 4).
+    Precondition(Program, Status),
 }
 
 impl Kind {
@@ -137,6 +151,9 @@ impl Kind {
                 | Kind::KeepRunningUntilFailure
                 | Kind::RunOnce
                 | Kind::Switch(..)
+                | Kind::Script(_)
+                | Kind::ScriptCondition(_)
+                | Kind::Precondition(..)
         )
     }
 }
@@ -156,6 +173,31 @@ pub struct Node {
     pub kind: Kind,
     /// Indices into [`Tree::nodes`].
     pub children: Vec<usize>,
+    /// Its pre- and post-condition scripts (BT.CPP 4).
+    pub conds: Conds,
+}
+
+/// The scripts of a node's pre/post-condition attributes (BT.CPP 4 `tree_node.h`,
+/// `PreCondNames` and `PostCondNames`, in the order `TreeNode::checkPreConditions` checks
+/// them and the enum `PostCond` numbers them).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Conds {
+    /// `_failureIf`, `_successIf`, `_skipIf`, `_while`.
+    pub pre: [Option<Program>; 4],
+    /// `_onHalted`, `_onFailure`, `_onSuccess`, `_post`.
+    pub post: [Option<Program>; 4],
+}
+
+/// The pre-condition attributes, in [`Conds::pre`] order.
+pub const PRE: [&str; 4] = ["_failureIf", "_successIf", "_skipIf", "_while"];
+/// The post-condition attributes, in [`Conds::post`] order.
+pub const POST: [&str; 4] = ["_onHalted", "_onFailure", "_onSuccess", "_post"];
+
+impl Conds {
+    /// Whether the node has any.
+    pub fn any(&self) -> bool {
+        self.pre.iter().chain(&self.post).any(|p| p.is_some())
+    }
 }
 
 /// A flattened tree; node 0 is the root.
@@ -241,6 +283,18 @@ pub const NODES: &[(&[&str], Arity, Make)] = &[
     (&["Switch4"], (5, 5), |a| switch(a, 4)),
     (&["Switch5"], (6, 6), |a| switch(a, 5)),
     (&["Switch6"], (7, 7), |a| switch(a, 6)),
+    (&["Script"], (0, 0), |a| Ok(Kind::Script(code(a, "code")?))),
+    (&["ScriptCondition"], (0, 0), |a| {
+        Ok(Kind::ScriptCondition(code(a, "code")?))
+    }),
+    // `PreconditionNode::providedPorts`: `else` defaults to FAILURE.
+    (&["Precondition"], (1, 1), |a| {
+        let e = match a.get("else") {
+            None => Status::Failure,
+            Some(s) => Status::parse(s).ok_or(format!("bad else {s}"))?,
+        };
+        Ok(Kind::Precondition(code(a, "if")?, e))
+    }),
     (&["AlwaysSuccess"], (0, 0), |_| Ok(Kind::AlwaysSuccess)),
     (&["AlwaysFailure"], (0, 0), |_| Ok(Kind::AlwaysFailure)),
     (&["SetBlackboard"], (0, 0), |a| {
@@ -266,6 +320,12 @@ pub const NODES: &[(&[&str], Arity, Make)] = &[
 
 fn entry(v: &str) -> Option<&str> {
     v.trim().strip_prefix('{')?.strip_suffix('}')
+}
+
+/// A script port: the text parsed (entries renamed to the caller's by [`Flat::node`]).
+fn code(a: &Attrs, k: &str) -> Result<Program, String> {
+    let v = a.get(k).ok_or(format!("missing `{k}`"))?;
+    script::parse(v).map_err(|e| format!("`{k}`: {e}"))
 }
 
 fn int(a: &Attrs, k: &str) -> Result<i64, String> {
@@ -504,6 +564,24 @@ impl Flat<'_> {
             None if el.children.is_empty() => Kind::Leaf(ty.clone()),
             None => return Err(format!("unknown node {ty}")),
         };
+        // Script entries are named in the SubTree's terms: rename them as `{entry}` ports
+        // are (BT.CPP 4 `Blackboard::getEntry` / `createEntry` follow the remapping).
+        let rename = |p: &mut Program| p.rename(&|v: &str| self.global(v, depth));
+        let mut kind = kind;
+        match &mut kind {
+            Kind::Script(p) | Kind::ScriptCondition(p) | Kind::Precondition(p, _) => rename(p),
+            _ => {}
+        }
+        let mut conds = Conds::default();
+        for (names, slots) in [(&PRE, &mut conds.pre), (&POST, &mut conds.post)] {
+            for (name, slot) in names.iter().zip(slots.iter_mut()) {
+                if let Some(v) = el.attrs.get(*name) {
+                    let mut p = script::parse(v).map_err(|e| format!("{name}: {e}"))?;
+                    rename(&mut p);
+                    *slot = Some(p);
+                }
+            }
+        }
         let i = self.tree.nodes.len();
         self.uids += 1;
         self.tree.nodes.push(Node {
@@ -512,6 +590,7 @@ impl Flat<'_> {
             tag: ty,
             kind,
             children: Vec::new(),
+            conds,
         });
         if let Some(p) = parent {
             self.tree.nodes[p].children.push(i);

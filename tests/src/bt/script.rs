@@ -1,0 +1,521 @@
+//! The oracle's own reading of BehaviorTree.CPP 4's script language (`Script`,
+//! `ScriptCondition`, `Precondition`, the `_skipIf` ... `_post` attributes) over integer
+//! and boolean blackboard entries: a parser and an evaluator written from the language's
+//! rules, independently of hindsight's lowering.
+//!
+//! The rules, as BT.CPP 4 states them (`src/script_parser.cpp`, the grammar `Grammar::stmt`
+//! / `Grammar::Expression`; `include/behaviortree_cpp/scripting/operators.hpp`, the
+//! `Ast::Expr*::evaluate` functions) and as the real library (4.8.2, the real-library
+//! differential `tests/tests/bt_real.rs`) answers them:
+//! - a script is statements separated by `;` (a trailing `;` is a syntax error); its value
+//!   is the last statement's;
+//! - a statement is an assignment `name := e` (creates the entry), `name = e` (the entry
+//!   must exist: "doesn't exist, yet"), `name += e`, `-=`, `*=`, or an expression;
+//! - precedence, loosest first: `? :`, `||`, `&&`, comparisons (`== != < <= > >=`; a
+//!   chain `a < b < c` means `a < b && b < c`), `+ -`, `*`, unary `- !`;
+//! - `true`/`false` are the numbers 1 and 0 in arithmetic (`-true` is -1, `a:=1; a+=true`
+//!   gives 2); comparisons give a boolean; `!x` is `x == 0` for any number;
+//! - `&&`/`||` refuse an operand other than 0 or 1 ("Logic operators are not allowed if one
+//!   of the operands is not castable to bool"), and a condition (`ScriptCondition`, a
+//!   pre-condition) whose value is another number throws "Implicit casting to bool is not
+//!   allowed" (`Any::cast<bool>`; 4.8.2 says "Value is negative and can't be converted to
+//!   unsigned" for a negative one);
+//! - reading a missing entry throws "Variable not found";
+//! - `!` does not mix with the arithmetic operators (unary `-`, `+`, `-`, `*`) in one
+//!   expression: BT.CPP's grammar puts them in different operator groups (lexy's
+//!   `dsl::groups`), and `!f || x > -1` is a syntax error ("operator cannot be mixed with
+//!   previous operators") where `!f || (x > -1)` and `x + 1 > y || f` are not. Parentheses
+//!   and the `a` of `c ? a : b` start a new expression; `b` continues `c`'s (`!f ? -1 : 2`
+//!   is a script, `!f ? 1 : -x` is not).
+//!
+//! Division (`/` gives a double in BT.CPP), `%` (not in the language), strings, reals and
+//! the bit operators are outside the subset: the parser refuses them.
+
+use std::collections::BTreeMap;
+
+/// An expression of the subset.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Expr {
+    /// An integer literal, or `true` (1) / `false` (0).
+    Num(i64),
+    /// A blackboard entry.
+    Var(String),
+    /// `-e`.
+    Neg(Box<Expr>),
+    /// `!e`.
+    Not(Box<Expr>),
+    /// `a + b`, `a - b`, `a * b`.
+    Arith(char, Box<Expr>, Box<Expr>),
+    /// A comparison chain: operands and the operators between them.
+    Cmp(Vec<Expr>, Vec<&'static str>),
+    /// `a && b` (`true`) or `a || b` (`false`).
+    Logic(bool, Box<Expr>, Box<Expr>),
+    /// `c ? a : b`.
+    Ite(Box<Expr>, Box<Expr>, Box<Expr>),
+    /// `name op e` with op one of `:=`, `=`, `+=`, `-=`, `*=`.
+    Assign(String, &'static str, Box<Expr>),
+}
+
+/// A parsed script: its statements.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Program(pub Vec<Expr>);
+
+/// Why a script stopped: BT.CPP throws (`text` is part of its message), or the case is
+/// outside what the oracle knows.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// BT.CPP throws an exception whose message contains this.
+    Throws(String),
+    /// Not modelled (an overflow, an entry of another type).
+    Model(String),
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum Tok {
+    Num(i64),
+    Id(String),
+    Op(&'static str),
+}
+
+const OPS: [&str; 21] = [
+    ":=", "+=", "-=", "*=", "==", "!=", "<=", ">=", "&&", "||", "=", "<", ">", "+", "-", "*", "!",
+    "(", ")", "?", ":",
+];
+
+fn lex(src: &str) -> Result<Vec<(Tok, usize)>, String> {
+    let b = src.as_bytes();
+    let mut i = 0;
+    let mut out = Vec::new();
+    while i < b.len() {
+        let c = b[i];
+        if c.is_ascii_whitespace() {
+            i += 1;
+        } else if c == b';' {
+            out.push((Tok::Op(";"), i));
+            i += 1;
+        } else if c.is_ascii_digit() {
+            let s = i;
+            while i < b.len() && b[i].is_ascii_digit() {
+                i += 1;
+            }
+            if i < b.len() && (b[i] == b'.' || b[i].is_ascii_alphabetic()) {
+                return Err(format!("column {}: only integer literals", s + 1));
+            }
+            let v = src[s..i]
+                .parse()
+                .map_err(|_| format!("column {}: number too large", s + 1))?;
+            out.push((Tok::Num(v), s));
+        } else if c.is_ascii_alphabetic() || c == b'_' {
+            let s = i;
+            while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
+                i += 1;
+            }
+            out.push((Tok::Id(src[s..i].to_string()), s));
+        } else if let Some(op) = OPS.iter().find(|o| src[i..].starts_with(**o)) {
+            out.push((Tok::Op(op), i));
+            i += op.len();
+        } else {
+            return Err(format!(
+                "column {}: `{}` is not in the script subset",
+                i + 1,
+                src[i..].chars().next().unwrap_or(' ')
+            ));
+        }
+    }
+    Ok(out)
+}
+
+struct P {
+    toks: Vec<(Tok, usize)>,
+    at: usize,
+    len: usize,
+    /// Per open expression: whether it has a `!`, an arithmetic operator.
+    groups: Vec<(bool, bool)>,
+}
+
+impl P {
+    fn peek(&self) -> Option<&Tok> {
+        self.toks.get(self.at).map(|t| &t.0)
+    }
+    fn col(&self) -> usize {
+        self.toks.get(self.at).map_or(self.len, |t| t.1) + 1
+    }
+    fn eat(&mut self, op: &str) -> bool {
+        let hit = matches!(self.peek(), Some(Tok::Op(o)) if *o == op);
+        self.at += usize::from(hit);
+        hit
+    }
+    /// Notes an operator of the group `!` (`not`) or arithmetic at the token just
+    /// eaten; mixing the two in one expression is a syntax error there.
+    fn group(&mut self, not: bool) -> Result<(), String> {
+        let g = self.groups.last_mut().expect("inside an expression");
+        let clash = if not { g.1 } else { g.0 };
+        if not {
+            g.0 = true;
+        } else {
+            g.1 = true;
+        }
+        if clash {
+            self.at -= 1;
+            return self.err("operator cannot be mixed with previous operators");
+        }
+        Ok(())
+    }
+
+    fn err<T>(&self, what: &str) -> Result<T, String> {
+        Err(format!("column {}: {what}", self.col()))
+    }
+
+    fn stmt(&mut self) -> Result<Expr, String> {
+        if let (Some(Tok::Id(name)), Some((Tok::Op(op), _))) =
+            (self.peek().cloned(), self.toks.get(self.at + 1))
+        {
+            if matches!(*op, ":=" | "=" | "+=" | "-=" | "*=") {
+                let op = *op;
+                self.at += 2;
+                let e = self.expr()?;
+                return Ok(Expr::Assign(name, op, Box::new(e)));
+            }
+        }
+        self.expr()
+    }
+
+    fn expr(&mut self) -> Result<Expr, String> {
+        self.groups.push((false, false));
+        let r = self.expr_in();
+        self.groups.pop();
+        r
+    }
+
+    fn expr_in(&mut self) -> Result<Expr, String> {
+        let c = self.or()?;
+        if self.eat("?") {
+            let a = self.expr()?;
+            if !self.eat(":") {
+                return self.err("expected ':'");
+            }
+            // The else part continues the condition's expression (its operator groups).
+            let b = self.expr_in()?;
+            return Ok(Expr::Ite(Box::new(c), Box::new(a), Box::new(b)));
+        }
+        Ok(c)
+    }
+
+    fn or(&mut self) -> Result<Expr, String> {
+        let mut a = self.and()?;
+        while self.eat("||") {
+            let b = self.and()?;
+            a = Expr::Logic(false, Box::new(a), Box::new(b));
+        }
+        Ok(a)
+    }
+
+    fn and(&mut self) -> Result<Expr, String> {
+        let mut a = self.cmp()?;
+        while self.eat("&&") {
+            let b = self.cmp()?;
+            a = Expr::Logic(true, Box::new(a), Box::new(b));
+        }
+        Ok(a)
+    }
+
+    fn cmp(&mut self) -> Result<Expr, String> {
+        let first = self.add()?;
+        let mut xs = vec![first];
+        let mut ops = Vec::new();
+        while let Some(Tok::Op(op @ ("==" | "!=" | "<" | "<=" | ">" | ">="))) = self.peek() {
+            ops.push(*op);
+            self.at += 1;
+            xs.push(self.add()?);
+        }
+        Ok(if ops.is_empty() {
+            xs.pop().expect("one operand")
+        } else {
+            Expr::Cmp(xs, ops)
+        })
+    }
+
+    fn add(&mut self) -> Result<Expr, String> {
+        let mut a = self.mul()?;
+        loop {
+            let op = if self.eat("+") {
+                '+'
+            } else if self.eat("-") {
+                '-'
+            } else {
+                return Ok(a);
+            };
+            self.group(false)?;
+            let b = self.mul()?;
+            a = Expr::Arith(op, Box::new(a), Box::new(b));
+        }
+    }
+
+    fn mul(&mut self) -> Result<Expr, String> {
+        let mut a = self.unary()?;
+        while self.eat("*") {
+            self.group(false)?;
+            let b = self.unary()?;
+            a = Expr::Arith('*', Box::new(a), Box::new(b));
+        }
+        Ok(a)
+    }
+
+    fn unary(&mut self) -> Result<Expr, String> {
+        if self.eat("-") {
+            self.group(false)?;
+            return Ok(Expr::Neg(Box::new(self.unary()?)));
+        }
+        if self.eat("!") {
+            self.group(true)?;
+            return Ok(Expr::Not(Box::new(self.unary()?)));
+        }
+        match self.peek().cloned() {
+            Some(Tok::Num(v)) => {
+                self.at += 1;
+                Ok(Expr::Num(v))
+            }
+            Some(Tok::Id(id)) => {
+                self.at += 1;
+                Ok(match id.as_str() {
+                    "true" => Expr::Num(1),
+                    "false" => Expr::Num(0),
+                    _ => Expr::Var(id),
+                })
+            }
+            Some(Tok::Op("(")) => {
+                self.at += 1;
+                let e = self.expr()?;
+                if !self.eat(")") {
+                    return self.err("expected ')'");
+                }
+                Ok(e)
+            }
+            _ => self.err("expected operand"),
+        }
+    }
+}
+
+/// Parses a script; the error names the column (from 1) where it stopped.
+pub fn parse(src: &str) -> Result<Program, String> {
+    let toks = lex(src)?;
+    let mut p = P {
+        toks,
+        at: 0,
+        len: src.len(),
+        groups: Vec::new(),
+    };
+    let mut out = vec![p.stmt()?];
+    while p.eat(";") {
+        if p.peek().is_none() {
+            return p.err("unexpected trailing separator");
+        }
+        out.push(p.stmt()?);
+    }
+    if p.peek().is_some() {
+        return p.err("expected ';'");
+    }
+    Ok(Program(out))
+}
+
+impl Expr {
+    /// Renames every entry (a SubTree's remapping).
+    pub fn rename(&mut self, f: &dyn Fn(&str) -> String) {
+        match self {
+            Expr::Num(_) => {}
+            Expr::Var(v) => *v = f(v),
+            Expr::Neg(a) | Expr::Not(a) => a.rename(f),
+            Expr::Arith(_, a, b) | Expr::Logic(_, a, b) => {
+                a.rename(f);
+                b.rename(f);
+            }
+            Expr::Cmp(xs, _) => xs.iter_mut().for_each(|x| x.rename(f)),
+            Expr::Ite(c, a, b) => {
+                c.rename(f);
+                a.rename(f);
+                b.rename(f);
+            }
+            Expr::Assign(v, _, e) => {
+                *v = f(v);
+                e.rename(f);
+            }
+        }
+    }
+
+    fn eval(&self, env: &mut BTreeMap<String, i64>) -> Result<i64, Fault> {
+        let over = || Fault::Model("integer overflow in a script".into());
+        Ok(match self {
+            Expr::Num(v) => *v,
+            Expr::Var(v) => *env
+                .get(v)
+                .ok_or_else(|| Fault::Throws(format!("Variable not found: {v}")))?,
+            Expr::Neg(a) => a.eval(env)?.checked_neg().ok_or_else(over)?,
+            Expr::Not(a) => i64::from(a.eval(env)? == 0),
+            Expr::Arith(op, a, b) => {
+                let (a, b) = (a.eval(env)?, b.eval(env)?);
+                match op {
+                    '+' => a.checked_add(b),
+                    '-' => a.checked_sub(b),
+                    _ => a.checked_mul(b),
+                }
+                .ok_or_else(over)?
+            }
+            Expr::Cmp(xs, ops) => {
+                // Each operand once, left to right; the chain holds where every pair does.
+                let vals = xs
+                    .iter()
+                    .map(|x| x.eval(env))
+                    .collect::<Result<Vec<_>, _>>()?;
+                let all = ops.iter().enumerate().all(|(i, op)| {
+                    let (a, b) = (vals[i], vals[i + 1]);
+                    match *op {
+                        "==" => a == b,
+                        "!=" => a != b,
+                        "<" => a < b,
+                        "<=" => a <= b,
+                        ">" => a > b,
+                        _ => a >= b,
+                    }
+                });
+                i64::from(all)
+            }
+            Expr::Logic(and, a, b) => {
+                let (a, b) = (a.eval(env)?, b.eval(env)?);
+                if !(0..=1).contains(&a) || !(0..=1).contains(&b) {
+                    return Err(Fault::Throws(
+                        "Logic operators are not allowed if one of the operands is not castable to bool".into(),
+                    ));
+                }
+                if *and {
+                    a & b
+                } else {
+                    a | b
+                }
+            }
+            Expr::Ite(c, a, b) => {
+                if truth(c.eval(env)?)? {
+                    a.eval(env)?
+                } else {
+                    b.eval(env)?
+                }
+            }
+            Expr::Assign(v, op, e) => {
+                let x = e.eval(env)?;
+                let old = env.get(v).copied();
+                let new = match (*op, old) {
+                    (":=", _) => x,
+                    (_, None) => {
+                        return Err(Fault::Throws(format!(
+                            "The blackboard entry [{v}] doesn't exist"
+                        )))
+                    }
+                    ("=", Some(_)) => x,
+                    ("+=", Some(o)) => o.checked_add(x).ok_or_else(over)?,
+                    ("-=", Some(o)) => o.checked_sub(x).ok_or_else(over)?,
+                    (_, Some(o)) => o.checked_mul(x).ok_or_else(over)?,
+                };
+                env.insert(v.clone(), new);
+                new
+            }
+        })
+    }
+}
+
+/// `Any::cast<bool>` of a script's value: 0 and 1 only.
+pub fn truth(v: i64) -> Result<bool, Fault> {
+    match v {
+        0 => Ok(false),
+        1 => Ok(true),
+        // 4.8.2's message for a negative number (`Any::convert` through an unsigned).
+        ..0 => Err(Fault::Throws(
+            "Value is negative and can't be converted to unsigned".into(),
+        )),
+        _ => Err(Fault::Throws(
+            "Implicit casting to bool is not allowed".into(),
+        )),
+    }
+}
+
+impl Program {
+    /// Renames every entry.
+    pub fn rename(&mut self, f: &dyn Fn(&str) -> String) {
+        self.0.iter_mut().for_each(|e| e.rename(f));
+    }
+
+    /// Runs the statements in order over the entries; the last one's value.
+    pub fn run(&self, env: &mut BTreeMap<String, i64>) -> Result<i64, Fault> {
+        let mut last = 0;
+        for s in &self.0 {
+            last = s.eval(env)?;
+        }
+        Ok(last)
+    }
+
+    /// Runs it as a condition (`cast<bool>` of its value).
+    pub fn holds(&self, env: &mut BTreeMap<String, i64>) -> Result<bool, Fault> {
+        truth(self.run(env)?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(src: &str) -> Result<(i64, BTreeMap<String, i64>), Fault> {
+        let mut env = BTreeMap::new();
+        let v = parse(src).expect("parses").run(&mut env)?;
+        Ok((v, env))
+    }
+
+    #[test]
+    fn the_real_library_s_answers() {
+        // Each answer below is what BT.CPP 4.8.2 gave for the same script.
+        let (_, e) = run("a:=3; b:=a*2+1; c:= a<b").unwrap();
+        assert_eq!((e["a"], e["b"], e["c"]), (3, 7, 1));
+        assert_eq!(run("a:=true; b:=a+1").unwrap().1["b"], 2);
+        assert_eq!(run("a:=2; b:=a==2==true").unwrap().1["b"], 0);
+        assert_eq!(run("a:=!3").unwrap().0, 0);
+        assert_eq!(run("a:=-true").unwrap().0, -1);
+        assert_eq!(run("a:=1; b:=(a<2)+(a>0)").unwrap().0, 2);
+        assert_eq!(run("a:=1; a+=2; b:=a; b-=5; c:=b; c*=3").unwrap().0, -6);
+        assert_eq!(run("a:= true ? 1 : 2").unwrap().0, 1);
+        assert!(matches!(run("a:=3 && 1"), Err(Fault::Throws(t)) if t.contains("Logic operators")));
+        assert!(matches!(run("a:=x"), Err(Fault::Throws(t)) if t.contains("Variable not found")));
+        assert!(matches!(run("b=2"), Err(Fault::Throws(t)) if t.contains("doesn't exist")));
+        let mut env = BTreeMap::new();
+        assert!(parse("3").unwrap().holds(&mut env).is_err());
+        assert!(parse("5-5").unwrap().holds(&mut env) == Ok(false));
+    }
+
+    #[test]
+    fn syntax_errors_name_the_column() {
+        assert_eq!(
+            parse("a:=1;").unwrap_err(),
+            "column 6: unexpected trailing separator"
+        );
+        assert_eq!(parse("a:=1 a:=2").unwrap_err(), "column 6: expected ';'");
+        assert_eq!(parse("1 + ").unwrap_err(), "column 5: expected operand");
+        assert!(parse("a:=5/2").unwrap_err().starts_with("column 5"));
+        // Where BT.CPP 4.8.2 put its caret.
+        let mixed = "operator cannot be mixed with previous operators";
+        assert_eq!(
+            parse("a:= !true || -1 < 0").unwrap_err(),
+            format!("column 14: {mixed}")
+        );
+        assert_eq!(
+            parse("a:= -1 < 0 || !true").unwrap_err(),
+            format!("column 15: {mixed}")
+        );
+        assert_eq!(
+            parse("a:= !true + 1").unwrap_err(),
+            format!("column 11: {mixed}")
+        );
+        assert!(parse("a:= !true || (-1 < 0)").is_ok());
+        assert!(parse("a:= !true ? -1 : 2").is_ok());
+        assert_eq!(
+            parse("x := (!f ? -1 : -x)").unwrap_err(),
+            format!("column 17: {mixed}")
+        );
+        assert!(parse("a:= 1 < -2 && 2 > 1").is_ok());
+    }
+}
