@@ -44,10 +44,10 @@ pub struct Options {
     /// Off, the generator draws exactly what it drew before they existed.
     pub btcpp4_nodes: bool,
     /// Scripts (format-4 trees only): `Script` and `ScriptCondition` leaves,
-    /// `Precondition`, and the `_failureIf` ... `_post` attributes on any node but a
-    /// SubTree; `_skipIf` / `_while` only on a child other than the first of a sequence,
-    /// fallback or parallel (so SKIPPED never reaches any other parent: a control whose
-    /// first child is never skipped is never skipped itself). Scripts keep the integers
+    /// `Precondition`, and the `_failureIf` ... `_post` attributes (`_skipIf` and `_while`
+    /// among them, so SKIPPED reaches every kind of parent) on any node but a SubTree;
+    /// children of sequences, fallbacks and parallels after the first get a second
+    /// chance of `_skipIf` / `_while`. Scripts keep the integers
     /// small (no product of two entries), so nothing overflows. Off, the generator draws
     /// what it drew before.
     pub scripts: bool,
@@ -296,7 +296,7 @@ impl<R: Rng> G<'_, R> {
     }
 
     /// Children of a sequence, fallback or parallel: with scripts, those after the first
-    /// may be skipped.
+    /// have a second chance of a condition.
     fn children_skip(&mut self, depth: u32, lo: u64, hi: u64) -> String {
         let n = lo + self.below(hi - lo + 1);
         (0..n)
@@ -350,7 +350,7 @@ impl<R: Rng> G<'_, R> {
         }
     }
 
-    /// `n` children of a parallel (with scripts, those after the first may be skipped).
+    /// `n` children of a parallel (as [`Self::children_skip`]).
     fn kids_skip(&mut self, depth: u32, n: i64) -> String {
         (0..n)
             .map(|i| {
@@ -363,7 +363,7 @@ impl<R: Rng> G<'_, R> {
     /// A node, with now and then a condition (see [`Options::scripts`]).
     fn node(&mut self, depth: u32) -> String {
         let n = self.node_bare(depth);
-        self.with_conds(n, false)
+        self.with_conds(n, true)
     }
 
     fn node_bare(&mut self, depth: u32) -> String {

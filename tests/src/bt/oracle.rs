@@ -237,6 +237,9 @@ pub fn btcpp4_refuses(tree: &Tree, scripts: &Scripts) -> Option<String> {
         .map(|t| t.as_str())
         .filter(|t| known(t) && !V4_NAMES.contains(t))
         .collect();
+    if refused.is_empty() && tree.reactive_async {
+        return Some("A ReactiveSequence cannot have more than one async child".into());
+    }
     (!refused.is_empty()).then(|| refused.join("|"))
 }
 
@@ -367,7 +370,8 @@ impl<'t> Oracle<'t> {
                     s = self.tick(0)?;
                 }
             }
-            if s != Status::Running {
+            // `Tree::tickRoot`: only a finished root is reset.
+            if matches!(s, Status::Success | Status::Failure) {
                 self.status[0] = None;
             }
         }
@@ -436,10 +440,15 @@ impl<'t> Oracle<'t> {
             Some(s) => s,
             None => {
                 let s = self.tick_inner(n)?;
-                if s == Status::Skipped {
-                    // Every control and decorator that can answer SKIPPED set itself
-                    // RUNNING first (`setStatus(NodeStatus::RUNNING)` in their `tick`),
-                    // and `executeTick` does not store SKIPPED: it stays RUNNING.
+                let sets_running = !matches!(
+                    self.tree.nodes[n].kind,
+                    Kind::Precondition(..) | Kind::Switch(..)
+                );
+                if s == Status::Skipped && sets_running {
+                    // The controls and decorators set themselves RUNNING first
+                    // (`setStatus(NodeStatus::RUNNING)` in their `tick`; not
+                    // `PreconditionNode` nor `SwitchNode`), and `executeTick` does not
+                    // store SKIPPED: such a node stays RUNNING (and a reset halts it).
                     self.status[n] = Some(Status::Running);
                 }
                 s
@@ -505,23 +514,10 @@ impl<'t> Oracle<'t> {
     }
 
     /// Whether node `n`'s parent (if any) is one whose handling of a SKIPPED child the
-    /// oracle models: the sequences, fallbacks and parallels.
+    /// oracle models: every BT.CPP 4 node (`BlackboardCheck*` is 3.x's).
     fn takes_skipped(&self, n: usize) -> bool {
         let parent = self.tree.nodes.iter().find(|p| p.children.contains(&n));
-        parent.is_none_or(|p| {
-            matches!(
-                p.kind,
-                Kind::Sequence
-                    | Kind::Fallback
-                    | Kind::SequenceWithMemory
-                    | Kind::AsyncSequence
-                    | Kind::AsyncFallback
-                    | Kind::ReactiveSequence
-                    | Kind::ReactiveFallback
-                    | Kind::Parallel(..)
-                    | Kind::ParallelAll(_)
-            )
-        })
+        parent.is_none_or(|p| !matches!(p.kind, Kind::Check(..)))
     }
 
     /// `TreeNode::haltNode`: the node's `halt()`, then its `_onHalted` script.
@@ -652,8 +648,14 @@ impl<'t> Oracle<'t> {
                 Failure => Success,
                 s => s,
             }),
-            Kind::ForceSuccess => self.decorate(n, |s| if s == Running { s } else { Success }),
-            Kind::ForceFailure => self.decorate(n, |s| if s == Running { s } else { Failure }),
+            Kind::ForceSuccess => self.decorate(n, |s| match s {
+                Running | Skipped => s,
+                _ => Success,
+            }),
+            Kind::ForceFailure => self.decorate(n, |s| match s {
+                Running | Skipped => s,
+                _ => Failure,
+            }),
             &Kind::Repeat(max) if self.btcpp() => self.repeat_btcpp(n, max, Success),
             &Kind::Retry(max) if self.btcpp() => self.repeat_btcpp(n, max, Failure),
             &Kind::Repeat(max) => self.repeat(n, max, Success),
@@ -928,7 +930,14 @@ impl<'t> Oracle<'t> {
         let len = self.n_children(n);
         let cond = self.child(n, 0);
         let s = match self.tick(cond)? {
-            Status::Skipped => return Err(Stop::Model("SKIPPED: not modelled here".into())),
+            // 4.10 `WhileDoElseNode::tick`: a skipped condition leaves the answer IDLE;
+            // the children are reset and `executeTick`'s `setStatus(IDLE)` throws.
+            Status::Skipped => {
+                self.reset_children(n);
+                return Err(Stop::Error(
+                    "you are not allowed to set manually the status to IDLE".into(),
+                ));
+            }
             Status::Running => return Ok(Status::Running),
             Status::Success => {
                 if len == 3 {
@@ -957,8 +966,9 @@ impl<'t> Oracle<'t> {
     fn keep_running(&mut self, n: usize) -> Result<Status, Stop> {
         let c = self.child(n, 0);
         let s = self.tick(c)?;
-        if s == Status::Running {
-            return Ok(s);
+        // A skipped child: `return status()`, the RUNNING it set itself.
+        if matches!(s, Status::Running | Status::Skipped) {
+            return Ok(Status::Running);
         }
         self.halt_child(c);
         Ok(if s == Status::Success {
@@ -977,7 +987,8 @@ impl<'t> Oracle<'t> {
         }
         let c = self.child(n, 0);
         let s = self.tick(c)?;
-        if s != Status::Running {
+        // A skipped child is not a finished one (`isStatusCompleted`).
+        if matches!(s, Status::Success | Status::Failure) {
             self.once[n] = Some(s);
             self.halt_child(c);
         }
@@ -1001,7 +1012,10 @@ impl<'t> Oracle<'t> {
         }
         let c = self.child(n, pick);
         let s = self.tick(c)?;
-        if s == Status::Running {
+        if s == Status::Skipped {
+            // 4.10 `SwitchNode::tick`: `running_child_ = -1`, SKIPPED, nothing reset.
+            self.idx[n] = 0;
+        } else if s == Status::Running {
             self.idx[n] = pick as i64 + 1;
         } else {
             self.reset_children(n);
@@ -1160,7 +1174,12 @@ impl<'t> Oracle<'t> {
         if self.idx[n] == 0 {
             let c = self.child(n, 0);
             match self.tick(c)? {
-                Status::Skipped => return Err(Stop::Model("SKIPPED: not modelled here".into())),
+                // 4.10 `IfThenElseNode::tick`: a skipped condition reaches its last line.
+                Status::Skipped => {
+                    return Err(Stop::Error(
+                        "Something unexpected happened in IfThenElseNode".into(),
+                    ))
+                }
                 Status::Running => return Ok(Status::Running),
                 Status::Success => self.idx[n] = 1,
                 Status::Failure if self.n_children(n) == 3 => self.idx[n] = 2,
@@ -1182,7 +1201,9 @@ impl<'t> Oracle<'t> {
     fn decorate(&mut self, n: usize, map: fn(Status) -> Status) -> Result<Status, Stop> {
         let c = self.child(n, 0);
         let s = self.tick(c)?;
-        if s != Status::Running && self.btcpp() {
+        // 4.10 `InverterNode::tick`, `ForceSuccessNode::tick`: SKIPPED passes through,
+        // the child not reset.
+        if matches!(s, Status::Success | Status::Failure) && self.btcpp() {
             self.halt_child(c);
         }
         Ok(map(s))
@@ -1249,6 +1270,12 @@ impl<'t> Oracle<'t> {
                     if more && self.yields(prev) {
                         return Ok(Status::Running);
                     }
+                }
+                // 4.10 `RepeatNode::tick` / `RetryNode::tick`: a skipped child is reset
+                // and the node is skipped too, its count kept.
+                Status::Skipped => {
+                    self.halt_child(c);
+                    return Ok(Status::Skipped);
                 }
                 s => {
                     self.idx[n] = 0;

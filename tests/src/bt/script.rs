@@ -308,6 +308,8 @@ pub fn parse(src: &str) -> Result<Program, String> {
     let mut out = vec![p.stmt()?];
     while p.eat(";") {
         if p.peek().is_none() {
+            // BT.CPP points at the `;`.
+            p.at -= 1;
             return p.err("unexpected trailing separator");
         }
         out.push(p.stmt()?);
@@ -491,7 +493,7 @@ mod tests {
     fn syntax_errors_name_the_column() {
         assert_eq!(
             parse("a:=1;").unwrap_err(),
-            "column 6: unexpected trailing separator"
+            "column 5: unexpected trailing separator"
         );
         assert_eq!(parse("a:=1 a:=2").unwrap_err(), "column 6: expected ';'");
         assert_eq!(parse("1 + ").unwrap_err(), "column 5: expected operand");

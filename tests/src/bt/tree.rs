@@ -208,6 +208,19 @@ pub struct Tree {
     /// Every node element's name (an `Action`'s `ID`) in every `<BehaviorTree>` of the
     /// document, used or not, in document order: BT.CPP checks them all at load.
     pub names: Vec<String>,
+    /// Some `<ReactiveSequence>` of the document has two `<AsyncSequence>` children,
+    /// which BT.CPP 4.8.2 refuses at load ("A ReactiveSequence cannot have more than one
+    /// async child", found against the real library).
+    pub reactive_async: bool,
+}
+
+fn reactive_async(el: &El) -> bool {
+    let asyncs = el
+        .children
+        .iter()
+        .filter(|c| c.name == "AsyncSequence")
+        .count();
+    (el.name == "ReactiveSequence" && asyncs > 1) || el.children.iter().any(reactive_async)
 }
 
 fn names(el: &El, out: &mut Vec<String>) {
@@ -492,6 +505,7 @@ pub fn read(text: &str) -> Result<Tree, String> {
     for t in root.children.iter().filter(|c| c.name == "BehaviorTree") {
         for c in &t.children {
             names(c, &mut r.tree.names);
+            r.tree.reactive_async |= reactive_async(c);
         }
     }
     Ok(r.tree)
