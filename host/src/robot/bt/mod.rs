@@ -38,6 +38,7 @@ mod decorators;
 mod notes;
 mod parallel;
 mod plugin;
+mod script;
 mod sequences;
 mod tree;
 

@@ -574,6 +574,11 @@ impl Reader<'_> {
             None => match Control::from_name(&type_name) {
                 Some(c) => Kind::Control(c),
                 None if UNSUPPORTED.iter().any(|(n, _)| *n == type_name) => {
+                    for a in &el.attrs {
+                        if let Some(m) = super::script::port_error(&type_name, &a.name, &a.value) {
+                            self.err(a.value_span, m);
+                        }
+                    }
                     let why = UNSUPPORTED
                         .iter()
                         .find(|(n, _)| *n == type_name)
@@ -617,13 +622,17 @@ impl Reader<'_> {
                 continue;
             }
             if a.name.starts_with('_') {
-                self.err(
-                    a.name_span,
-                    format!(
-                        "`{}` (a BehaviorTree.cpp script attribute) is not supported",
-                        a.name
+                match super::script::condition_error(&a.name, &a.value) {
+                    Some(Ok(m)) => self.err(a.name_span, m),
+                    Some(Err(m)) => self.err(a.value_span, m),
+                    None => self.err(
+                        a.name_span,
+                        format!(
+                            "`{}` (a BehaviorTree.cpp script attribute) is not supported",
+                            a.name
+                        ),
                     ),
-                );
+                }
                 continue;
             }
             if let Kind::Control(c) = kind {

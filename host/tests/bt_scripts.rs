@@ -1,0 +1,79 @@
+//! BehaviorTree.CPP 4's script language in a tree: a malformed script (`Script`'s `code`,
+//! `Precondition`'s `if`, a `_skipIf` ... `_post` attribute) is an error at its
+//! attribute's file:line:col naming the column in the script; a well-formed one is
+//! refused, under both semantics, saying that AS2FM has no model of it and that the
+//! BT.CPP semantics does not lower scripts yet.
+
+use hindsight::model::source::SourceMap;
+use hindsight::model::Diagnostics;
+use hindsight::robot::bt::{self, BtInput, BtSemantics, BtTick, Halts};
+
+const LEAF: &str = r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="Act">
+<state id="s"><bt_tick target="s"><bt_return_status status="SUCCESS"/></bt_tick></state>
+</ascxml>"#;
+
+/// The errors lowering `body` gives under `semantics`.
+fn errors(body: &str, semantics: BtSemantics) -> String {
+    let tree = format!(
+        "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n{body}\n</BehaviorTree>\n</root>\n"
+    );
+    let mut sm = SourceMap::new();
+    let t = sm.add("tree.xml", tree);
+    let plugins = vec![sm.add("act.ascxml", LEAF.to_string())];
+    match bt::lower(
+        &sm,
+        &BtInput {
+            tree: t,
+            plugins,
+            tick_rate_hz: 1.0,
+            tick_if_not_running: false,
+            halts: Halts::As2fm,
+            semantics,
+        },
+    ) {
+        Ok(_) => panic!("lowered: {body}"),
+        Err(ds) => Diagnostics(ds).to_string(),
+    }
+}
+
+const BOTH: [BtSemantics; 2] = [
+    BtSemantics::As2fm,
+    BtSemantics::Btcpp { tick: BtTick::Once },
+];
+
+#[test]
+fn a_malformed_script_is_an_error_at_its_attribute() {
+    for sem in BOTH {
+        // Line 4 is the body's second line; the value starts after `code="`.
+        let e = errors("<Sequence>\n<Script code=\"a:=1;\"/>\n</Sequence>", sem);
+        assert!(
+            e.contains("tree.xml:4:15: `code` of <Script>: script syntax error at column 5 of the script: unexpected trailing `;`"),
+            "{e}"
+        );
+        let e = errors(
+            "<Sequence>\n<Act _skipIf=\"!f || x > -1\"/>\n</Sequence>",
+            sem,
+        );
+        assert!(
+            e.contains("tree.xml:4:15: `_skipIf`: script syntax error at column 11 of the script: operator cannot be mixed with previous operators"),
+            "{e}"
+        );
+        let e = errors("<Precondition if=\"x +\">\n<Act/>\n</Precondition>", sem);
+        assert!(
+            e.contains("tree.xml:3:19: `if` of <Precondition>: script syntax error at column 4"),
+            "{e}"
+        );
+    }
+}
+
+#[test]
+fn a_well_formed_condition_is_refused_saying_why() {
+    for sem in BOTH {
+        let e = errors("<Sequence>\n<Act _onSuccess=\"x += 1\"/>\n</Sequence>", sem);
+        assert!(
+            e.contains("tree.xml:4:6: `_onSuccess` (a BehaviorTree.CPP 4 pre/post condition) is not supported: AS2FM has no model"),
+            "{e}"
+        );
+        assert!(e.contains("`--bt btcpp`"), "{e}");
+    }
+}
