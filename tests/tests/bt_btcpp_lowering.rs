@@ -346,6 +346,40 @@ fn keep_running_run_once_and_parallel_all() {
     );
 }
 
+#[test]
+fn switch_halts_the_child_it_no_longer_picks() {
+    // The IfThenElse writes `s` = a, then b: the Switch halts A, running, before ticking
+    // B (`haltChild(running_child_)`). Checked against the real library.
+    let t = v4(
+        "<ReactiveSequence><IfThenElse><C/><SetBlackboard output_key=\"s\" value=\"a\"/>\
+         <SetBlackboard output_key=\"s\" value=\"b\"/></IfThenElse>\
+         <Switch2 variable=\"{s}\" case_1=\"a\" case_2=\"b\"><A/><B/><D/></Switch2></ReactiveSequence>",
+    );
+    let sc = scripts(&[("C", &[S, F, F]), ("A", &[R]), ("B", &[R, S]), ("D", &[S])]);
+    assert_eq!(
+        lowered(&t, &sc, 3, BtTick::Once).unwrap(),
+        ran(
+            &[R, R, S],
+            &[
+                T(1002),
+                T(1006),
+                T(1002),
+                H(1006),
+                T(1007),
+                T(1002),
+                T(1007)
+            ]
+        )
+    );
+    // A constant `variable` compares as BT.CPP's `CheckStringEquality`: `2` is `2.0`.
+    let t = v4("<Switch2 variable=\"2\" case_1=\"a\" case_2=\"2.0\"><A/><B/><D/></Switch2>");
+    let sc = scripts(&[("A", &[S]), ("B", &[F]), ("D", &[S])]);
+    assert_eq!(
+        lowered(&t, &sc, 1, BtTick::Once).unwrap(),
+        ran(&[F], &[T(1002)])
+    );
+}
+
 /// Where the lowering's run and the oracle's BT.CPP 4 reading differ, or `None`; and
 /// how the oracle's run ended, for the counts.
 fn compare(want: &oracle::Outcome, got: &Outcome) -> Option<String> {
