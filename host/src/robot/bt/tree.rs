@@ -233,9 +233,18 @@ pub(crate) const UNSUPPORTED: &[(&str, &str)] = &[
         "ManualSelector",
         "it asks a person at a terminal which child to run",
     ),
-    ("Timeout", "it needs a wall-clock timer inside the tree"),
-    ("Delay", "it needs a wall-clock timer inside the tree"),
-    ("Sleep", "it needs a wall-clock timer inside the tree"),
+    (
+        "Timeout",
+        "it needs a wall-clock timer inside the tree; not modelled in model time yet",
+    ),
+    (
+        "Delay",
+        "it needs a wall-clock timer inside the tree; not modelled in model time yet",
+    ),
+    (
+        "Sleep",
+        "it needs a wall-clock timer inside the tree; not modelled in model time yet",
+    ),
     ("Script", "it runs BT.CPP's script language"),
     ("ScriptCondition", "it runs BT.CPP's script language"),
     ("Precondition", "it runs BT.CPP's script language"),
