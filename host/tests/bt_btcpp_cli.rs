@@ -257,3 +257,78 @@ fn validate_is_quiet_where_the_semantics_agree() {
     assert!(!err.contains("warning"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn btcpp4_nodes_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
+    // RunOnce keeps its child's first answer: FailOnce fails once, so the tree fails on
+    // every tick (the child is never ticked again).
+    let dir = scratch(
+        "btcpp4",
+        &v4("<RunOnce then_skip=\"false\">\n  <FailOnce/>\n</RunOnce>"),
+    );
+    let (code, out, err) = hindsight(
+        &dir,
+        &[
+            "verify",
+            "main.xml",
+            "--json",
+            "--max-runs",
+            "20",
+            "--bt",
+            "btcpp",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(doc["properties"][0]["property"], "tree_success");
+    assert_eq!(doc["properties"][0]["probability"].as_f64(), Some(0.0));
+    assert_eq!(doc["properties"][1]["probability"].as_f64(), Some(1.0));
+    let _ = std::fs::remove_dir_all(&dir);
+
+    // Refused, each at its place: the node under AS2FM's rules, bad ports under BT.CPP's.
+    for (name, bt, tree, needle, words) in [
+        (
+            "as2fm",
+            "as2fm",
+            "<Sequence>\n  <WhileDoElse>\n    <FailOnce/>\n    <AlwaysSuccess/>\n  </WhileDoElse>\n</Sequence>",
+            "<WhileDoElse>",
+            "`WhileDoElse` is a BehaviorTree.CPP 4 node that AS2FM has no model of",
+        ),
+        (
+            "skip",
+            "btcpp",
+            "<RunOnce>\n  <FailOnce/>\n</RunOnce>",
+            "<RunOnce>",
+            "answers SKIPPED",
+        ),
+        (
+            "case",
+            "btcpp",
+            "<Sequence>\n  <SetBlackboard output_key=\"mode\" value=\"a\"/>\n  <Switch2 variable=\"{mode}\" case_1=\"1\" case_2=\"b\">\n    <FailOnce/>\n    <FailOnce/>\n    <AlwaysSuccess/>\n  </Switch2>\n</Sequence>",
+            "1\" case_2",
+            "`case_1` of Switch2 is the number `1`",
+        ),
+        (
+            "failures",
+            "btcpp",
+            "<ParallelAll max_failures=\"3\">\n  <FailOnce/>\n  <AlwaysSuccess/>\n</ParallelAll>",
+            "3\">",
+            "`max_failures` 3 is more than the 2 children",
+        ),
+    ] {
+        let tree = v4(tree);
+        let dir = scratch(name, &tree);
+        let (code, out, err) = hindsight(&dir, &["validate", "main.xml", "--bt", bt]);
+        assert_eq!(code, 2, "{name}: {out} {err}");
+        let (l, c) = pos(&tree, needle);
+        let at = format!("tree.xml:{l}:{c}: ");
+        assert!(
+            err.lines().any(|x| x.contains(&at) && x.contains(words)),
+            "{name}: expected `{at}` ... `{words}` in:\n{err}"
+        );
+        if bt == "as2fm" {
+            assert!(err.contains("use `--bt btcpp`"), "{err}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

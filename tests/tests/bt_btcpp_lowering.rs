@@ -7,6 +7,11 @@
 //!
 //! `HINDSIGHT_BT_TREES` sets how many random trees (default 10,000); `HINDSIGHT_BT_SEED`
 //! the first seed.
+//!
+//! Then the lowering straight against the real library on a sample of random format-4
+//! trees with BT.CPP 4's own nodes (`HINDSIGHT_BT_REAL_LOWERING_TREES`, default 2,000),
+//! through the same harness as `bt_real.rs`: without the Python environment that test
+//! says it was skipped (run `bash scripts/pyenv`), except under `CI=true`, where it fails.
 
 mod bt_common;
 
@@ -15,6 +20,7 @@ use hindsight::robot::bt::{BtSemantics, BtTick, Halts};
 use hindsight::sim::EndReason;
 use hindsight_tests::bt::gen;
 use hindsight_tests::bt::oracle::{self, End, LeafEvent, Options, Scripts, TickMode};
+use hindsight_tests::bt::real;
 use hindsight_tests::bt::tree::{self, Kind, Operand, Status};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -286,6 +292,94 @@ fn a_failed_condition_leaf_of_a_two_child_if_then_else_stays_failed() {
     );
 }
 
+#[test]
+fn while_do_else_keeps_a_leaf_condition_as_it_finished_while_a_branch_runs() {
+    // This test and the two below: each run checked against the real library
+    // (`tests/bt/real/harness.py`, BT.CPP 4.8.2) while writing them.
+    // `WhileDoElseNode::tick` resets its children only when it finishes: while A runs,
+    // the stateful leaf C answers its SUCCESS again without running; once A succeeds,
+    // C runs again (FAILURE) and the else branch B answers.
+    let t = v4("<WhileDoElse><C/><A/><B/></WhileDoElse>");
+    let sc = scripts(&[("C", &[S, F]), ("A", &[R, R, S]), ("B", &[S])]);
+    let log = [T(1001), T(1002), T(1002), T(1002), T(1001), T(1003)];
+    for tick in [BtTick::Once, BtTick::ExactlyOnce] {
+        assert_eq!(lowered(&t, &sc, 4, tick).unwrap(), ran(&[R, R, S, S], &log));
+    }
+}
+
+#[test]
+fn async_sequence_yields_between_children() {
+    let t = v4("<AsyncSequence><A/><B/></AsyncSequence>");
+    let sc = scripts(&[("A", &[S]), ("B", &[S])]);
+    assert_eq!(
+        lowered(&t, &sc, 2, BtTick::ExactlyOnce).unwrap(),
+        ran(&[R, S], &[T(1001), T(1002)])
+    );
+    assert_eq!(
+        lowered(&t, &sc, 1, BtTick::Once).unwrap(),
+        ran(&[S], &[T(1001), T(1002)])
+    );
+}
+
+#[test]
+fn keep_running_run_once_and_parallel_all() {
+    let keep = v4("<KeepRunningUntilFailure><A/></KeepRunningUntilFailure>");
+    let sc = scripts(&[("A", &[S, S, F])]);
+    assert_eq!(
+        lowered(&keep, &sc, 3, BtTick::Once).unwrap(),
+        ran(&[R, R, F], &[T(1001), T(1001), T(1001)])
+    );
+    // RunOnce answers its child's first finished status for ever.
+    let once = v4("<RunOnce then_skip=\"false\"><A/></RunOnce>");
+    let sc = scripts(&[("A", &[R, S, F])]);
+    assert_eq!(
+        lowered(&once, &sc, 4, BtTick::Once).unwrap(),
+        ran(&[R, S, S, S], &[T(1001), T(1001)])
+    );
+    // ParallelAll waits for every child, not ticking finished ones again, then counts
+    // the failures.
+    let all = v4("<ParallelAll max_failures=\"1\"><A/><B/></ParallelAll>");
+    let sc = scripts(&[("A", &[F]), ("B", &[R, S])]);
+    assert_eq!(
+        lowered(&all, &sc, 2, BtTick::Once).unwrap(),
+        ran(&[R, F], &[T(1001), T(1002), T(1002)])
+    );
+}
+
+#[test]
+fn switch_halts_the_child_it_no_longer_picks() {
+    // The IfThenElse writes `s` = a, then b: the Switch halts A, running, before ticking
+    // B (`haltChild(running_child_)`). Checked against the real library.
+    let t = v4(
+        "<ReactiveSequence><IfThenElse><C/><SetBlackboard output_key=\"s\" value=\"a\"/>\
+         <SetBlackboard output_key=\"s\" value=\"b\"/></IfThenElse>\
+         <Switch2 variable=\"{s}\" case_1=\"a\" case_2=\"b\"><A/><B/><D/></Switch2></ReactiveSequence>",
+    );
+    let sc = scripts(&[("C", &[S, F, F]), ("A", &[R]), ("B", &[R, S]), ("D", &[S])]);
+    assert_eq!(
+        lowered(&t, &sc, 3, BtTick::Once).unwrap(),
+        ran(
+            &[R, R, S],
+            &[
+                T(1002),
+                T(1006),
+                T(1002),
+                H(1006),
+                T(1007),
+                T(1002),
+                T(1007)
+            ]
+        )
+    );
+    // A constant `variable` compares as BT.CPP's `CheckStringEquality`: `2` is `2.0`.
+    let t = v4("<Switch2 variable=\"2\" case_1=\"a\" case_2=\"2.0\"><A/><B/><D/></Switch2>");
+    let sc = scripts(&[("A", &[S]), ("B", &[F]), ("D", &[S])]);
+    assert_eq!(
+        lowered(&t, &sc, 1, BtTick::Once).unwrap(),
+        ran(&[F], &[T(1002)])
+    );
+}
+
 /// Where the lowering's run and the oracle's BT.CPP 4 reading differ, or `None`; and
 /// how the oracle's run ended, for the counts.
 fn compare(want: &oracle::Outcome, got: &Outcome) -> Option<String> {
@@ -331,14 +425,54 @@ fn compare(want: &oracle::Outcome, got: &Outcome) -> Option<String> {
     }
 }
 
+fn env(name: &str, default: u64) -> u64 {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
 #[test]
 fn random_trees_lower_to_what_btcpp_does() {
-    let env = |name: &str, default: u64| {
-        std::env::var(name)
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(default)
-    };
+    random_trees(gen::Options::default());
+}
+
+/// The same with BT.CPP 4's nodes AS2FM has no model of (AsyncSequence, AsyncFallback,
+/// ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2-6) in the
+/// format-4 trees.
+#[test]
+fn random_trees_with_btcpp4_nodes_lower_to_what_btcpp_does() {
+    random_trees(gen::Options { btcpp4_nodes: true });
+}
+
+/// The kinds of BT.CPP 4's own nodes, as the coverage check names them.
+const BTCPP4_KINDS: [&str; 7] = [
+    "AsyncSequence",
+    "AsyncFallback",
+    "ParallelAll",
+    "WhileDoElse",
+    "KeepRunningUntilFailure",
+    "RunOnce",
+    "Switch",
+];
+
+/// Which of [`BTCPP4_KINDS`] node kind `k` is.
+fn btcpp4_kind(k: &Kind) -> Option<usize> {
+    Some(match k {
+        Kind::AsyncSequence => 0,
+        Kind::AsyncFallback => 1,
+        Kind::ParallelAll(_) => 2,
+        Kind::WhileDoElse => 3,
+        Kind::KeepRunningUntilFailure => 4,
+        Kind::RunOnce => 5,
+        Kind::Switch(..) => 6,
+        _ => return None,
+    })
+}
+
+/// `HINDSIGHT_BT_TREES` random trees from `HINDSIGHT_BT_SEED`, each lowered under both
+/// tick modes and compared with the oracle's BT.CPP 4 reading.
+fn random_trees(opts: gen::Options) {
     let n = env("HINDSIGHT_BT_TREES", 10_000);
     let seed0 = env("HINDSIGHT_BT_SEED", 0);
     let threads = std::thread::available_parallelism()
@@ -350,6 +484,9 @@ fn random_trees_lower_to_what_btcpp_does() {
     // ticks that never return, BT.CPP exceptions; trees left out.
     let counts: [AtomicUsize; 6] = Default::default();
     let counts = &counts;
+    // Trees compared that hold each of BT.CPP 4's own node kinds.
+    let kinds: [AtomicUsize; 7] = Default::default();
+    let kinds = &kinds;
     let fails: Vec<String> = std::thread::scope(|s| {
         let hs: Vec<_> = (0..threads)
             .map(|t| {
@@ -359,7 +496,7 @@ fn random_trees_lower_to_what_btcpp_does() {
                     while i < n && fails.len() < 3 {
                         let seed = seed0 + i;
                         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-                        let c = gen::case(&mut rng, 4 + (seed % 12) as i64);
+                        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
                         let t = tree::read(&c.xml).expect("the oracle reads what it generates");
                         // BT.CPP 4 fails or throws on a SetBlackboard copy of the entries
                         // the harness's untyped ports create (the oracle's
@@ -374,6 +511,17 @@ fn random_trees_lower_to_what_btcpp_does() {
                             continue;
                         }
                         let refused = oracle::btcpp4_refuses(&t, &c.scripts).is_some();
+                        let mut seen = [false; 7];
+                        for x in &t.nodes {
+                            if let Some(k) = btcpp4_kind(&x.kind) {
+                                seen[k] = true;
+                            }
+                        }
+                        for (k, s) in seen.iter().enumerate() {
+                            if *s {
+                                kinds[k].fetch_add(1, Relaxed);
+                            }
+                        }
                         let mut by_mode = Vec::new();
                         for (tick, mode) in [
                             (BtTick::Once, TickMode::Once),
@@ -425,13 +573,26 @@ fn random_trees_lower_to_what_btcpp_does() {
     });
     let [runs, refused, livelocks, errors, copies, modes_differ] =
         counts.each_ref().map(|c| c.load(Relaxed));
+    let kinds = kinds.each_ref().map(|c| c.load(Relaxed));
     eprintln!(
-        "{n} random trees in {:.1} s on {threads} threads: {copies} with a SetBlackboard copy \
+        "{n} random trees{} in {:.1} s on {threads} threads: {copies} with a SetBlackboard copy \
          left out; {runs} runs of the others (tickOnce and tickExactlyOnce): {refused} of \
          them on trees BT.CPP 4 refuses at load (3.x names; compared with the oracle's BT.CPP 4 \
          rules), {livelocks} with an executor tick that never returns, {errors} where BT.CPP \
-         throws; {modes_differ} trees whose two tick modes differ",
-        start.elapsed().as_secs_f64()
+         throws; {modes_differ} trees whose two tick modes differ; trees with BT.CPP 4's own \
+         nodes: {}",
+        if opts.btcpp4_nodes {
+            " (BT.CPP 4's own nodes included)"
+        } else {
+            ""
+        },
+        start.elapsed().as_secs_f64(),
+        BTCPP4_KINDS
+            .iter()
+            .zip(kinds)
+            .map(|(k, c)| format!("{k} {c}"))
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     assert!(
         fails.is_empty(),
@@ -445,6 +606,14 @@ fn random_trees_lower_to_what_btcpp_does() {
             modes_differ as u64 >= n / 100,
             "only {modes_differ} trees run differently under the two tick modes"
         );
+        // With BT.CPP 4's own nodes on, each kind is in at least one tree in 100.
+        for (k, c) in BTCPP4_KINDS.iter().zip(kinds) {
+            if opts.btcpp4_nodes {
+                assert!(c as u64 >= n / 100, "only {c} compared trees with {k}");
+            } else {
+                assert_eq!(c, 0, "{k} generated with btcpp4_nodes off");
+            }
+        }
     }
 }
 
@@ -525,4 +694,156 @@ fn the_readme_differences_lower_to_the_libraries_statuses() {
         checked += 1;
     }
     assert!(checked >= 10, "{checked} cases");
+}
+
+/// The real library's harness, or `None` (after saying why) when the Python environment
+/// is missing; under `CI=true` that is a failure (`.ci/run` creates the environment).
+fn harness() -> Option<real::Real> {
+    let started = match real::python() {
+        None => Err("no Python environment (.venv or $HINDSIGHT_PYENV)".to_string()),
+        Some(py) => real::Real::start(&py),
+    };
+    match started {
+        Ok(r) => Some(r),
+        Err(e) => {
+            let why = format!("skipped: {e}; run `bash scripts/pyenv`");
+            if std::env::var("CI").as_deref() == Ok("true") {
+                panic!("{why}");
+            }
+            eprintln!("{why}");
+            None
+        }
+    }
+}
+
+#[test]
+fn random_trees_with_btcpp4_nodes_lower_to_what_the_real_library_does() {
+    let Some(mut lib) = harness() else { return };
+    let n = env("HINDSIGHT_BT_REAL_LOWERING_TREES", 2_000) as usize;
+    let seed0 = env("HINDSIGHT_BT_SEED", 0) + 700_000;
+    let start = std::time::Instant::now();
+    // Format-4 trees the library loads and whose SetBlackboard nodes write constants
+    // (a copy fails or throws in 4.8.2; the lowering copies, see above).
+    let mut cases = Vec::new();
+    let mut kinds = [0usize; 7];
+    for seed in seed0.. {
+        if cases.len() >= n {
+            break;
+        }
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let c = gen::case_with(
+            &mut rng,
+            4 + (seed % 12) as i64,
+            gen::Options { btcpp4_nodes: true },
+        );
+        if c.xml.contains("BTCPP_format=\"3\"") {
+            continue;
+        }
+        let t = tree::read(&c.xml).expect("the oracle reads what it generates");
+        if oracle::btcpp4_refuses(&t, &c.scripts).is_some()
+            || t.nodes
+                .iter()
+                .any(|x| matches!(x.kind, Kind::SetBlackboard(_, Operand::Entry(_))))
+        {
+            continue;
+        }
+        let mut seen = [false; 7];
+        for x in &t.nodes {
+            if let Some(k) = btcpp4_kind(&x.kind) {
+                seen[k] = true;
+            }
+        }
+        for (k, s) in seen.iter().enumerate() {
+            kinds[k] += usize::from(*s);
+        }
+        cases.push((seed, c, t));
+    }
+    let modes = [
+        (BtTick::Once, TickMode::Once),
+        (BtTick::ExactlyOnce, TickMode::ExactlyOnce),
+    ];
+    let reqs: Vec<real::Request> = cases
+        .iter()
+        .flat_map(|(_, c, _)| {
+            modes.iter().map(move |(_, mode)| real::Request {
+                xml: c.xml.clone(),
+                scripts: c.scripts.clone(),
+                ticks: c.ticks,
+                mode: *mode,
+                budget: oracle::BUDGET,
+            })
+        })
+        .collect();
+    let mut answers = Vec::with_capacity(reqs.len());
+    for chunk in reqs.chunks(256) {
+        answers.extend(lib.run(chunk).unwrap_or_else(|e| panic!("{e}")));
+    }
+    let mut fails = Vec::new();
+    let (mut runs, mut ended_early) = (0, 0);
+    for (i, a) in answers.iter().enumerate() {
+        let (seed, c, t) = &cases[i / 2];
+        let (tick, _) = modes[i % 2];
+        let want = match real::outcome(Some(t), a) {
+            Ok(w) => w,
+            Err(e) => {
+                fails.push(format!("seed {seed}: the library's answer: {e}"));
+                continue;
+            }
+        };
+        runs += 1;
+        let got = match lowered(&c.xml, &c.scripts, c.ticks, tick) {
+            Ok(g) => g,
+            Err(e) => {
+                fails.push(format!("seed {seed} ({tick:?}): lowering: {e}"));
+                continue;
+            }
+        };
+        let problem = match &want.end {
+            None => compare(&want, &got),
+            Some(End::Refused(e)) => Some(format!("the library refused the tree: {e}")),
+            // The watchdog's hang: the tick is unknown, the lowering's run never ends
+            // a tick either.
+            Some(End::Hang { .. }) => {
+                ended_early += 1;
+                (!matches!(got, Outcome::Livelock(_)))
+                    .then(|| format!("the library hangs, the lowering {got:?}"))
+            }
+            Some(_) => {
+                ended_early += 1;
+                compare(&want, &got)
+            }
+        };
+        if let Some(p) = problem {
+            fails.push(format!(
+                "seed {seed} ({tick:?}): {p}\n{}",
+                show(&c.xml, &c.scripts, c.ticks)
+            ));
+        }
+    }
+    eprintln!(
+        "{} format-4 random trees with BT.CPP 4's own nodes in BehaviorTree.CPP {} ({}) and \
+         the lowering, {runs} runs (tickOnce and tickExactlyOnce), {ended_early} ending early \
+         (a livelock, a hang or an exception) in {:.1} s; trees with {}",
+        cases.len(),
+        lib.version,
+        lib.binding,
+        start.elapsed().as_secs_f64(),
+        BTCPP4_KINDS
+            .iter()
+            .zip(kinds)
+            .map(|(k, c)| format!("{k} {c}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    assert!(
+        fails.is_empty(),
+        "{} disagreements with the library:\n{}",
+        fails.len(),
+        fails.iter().take(5).cloned().collect::<Vec<_>>().join("\n")
+    );
+    if n >= 500 {
+        for (k, c) in BTCPP4_KINDS.iter().zip(kinds) {
+            assert!(c >= n / 100, "only {c} trees with {k}");
+        }
+    }
 }

@@ -40,7 +40,8 @@ struct G<'r, R: Rng> {
 pub struct Options {
     /// BT.CPP 4's nodes AS2FM has no model of (AsyncSequence, AsyncFallback,
     /// ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2-6), in
-    /// format-4 trees: for the real-library test only (the lowering does not take them).
+    /// format-4 trees: for the real-library test and the BT.CPP lowering's test
+    /// (AS2FM's lowering refuses them).
     /// Off, the generator draws exactly what it drew before they existed.
     pub btcpp4_nodes: bool,
     /// Scripts (format-4 trees only): `Script` and `ScriptCondition` leaves,

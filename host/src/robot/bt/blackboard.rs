@@ -273,6 +273,16 @@ pub(crate) fn type_entries(
                     }
                 }
             }
+            // BT.CPP 4.10 `switch_node.h`, `SwitchNode::providedPorts`:
+            // `InputPort<std::string>("variable")`.
+            Kind::Control(Control::Btcpp4(super::tree::Btcpp4::Switch(k))) => {
+                if let Some(PortValue::Blackboard(b)) = n.port("variable").map(|p| &p.value) {
+                    let span = n.port("variable").map_or(n.span, |p| p.span);
+                    let why =
+                        format!("port `variable` of Switch{k}, which hindsight compares as text");
+                    register(sm, bb, b, "string", span, &why, errs);
+                }
+            }
             Kind::Control(_) => {}
         }
     }

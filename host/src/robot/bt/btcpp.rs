@@ -41,13 +41,13 @@ const WAKE_PENDING: &str = "wake_pending";
 
 /// The variable naming child `i`'s RUNNING flag (every child has one under BT.CPP's
 /// rules).
-fn running(ctx: &Ctx, i: usize) -> String {
+pub(super) fn running(ctx: &Ctx, i: usize) -> String {
     ctx.running_var(i)
         .expect("under BT.CPP's rules every child is WhenRunning")
 }
 
 /// Answers RUNNING after emitting the wake-up signal (sent only when someone listens).
-fn yield_running(ctx: &Ctx) -> Vec<Element> {
+pub(super) fn yield_running(ctx: &Ctx) -> Vec<Element> {
     let mut v: Vec<Element> = ctx
         .wake
         .iter()
@@ -61,7 +61,7 @@ fn yield_running(ctx: &Ctx) -> Vec<Element> {
 /// that last answered RUNNING and resets the others' flags (BT.CPP 4.10
 /// `control_node.cpp`, `ControlNode::haltChildren(first)` / `haltChild`), then goes to
 /// `wait_for_tick` doing `finish`. Whoever enters it sets `var` first.
-fn halting_state(ctx: &Ctx, name: &str, var: &str, finish: Vec<Element>) -> Element {
+pub(super) fn halting_state(ctx: &Ctx, name: &str, var: &str, finish: Vec<Element>) -> Element {
     let b = &ctx.b;
     let mut entry = ctx.skip_idle(var, None);
     entry.push(b.if_then(

@@ -257,6 +257,7 @@ pub(crate) fn machine(c: Control, ctx: &Ctx, num: &[i64]) -> Element {
         Control::BlackboardCheck(_) | Control::SetBlackboard => {
             unreachable!("blackboard nodes are built in blackboard.rs")
         }
+        Control::Btcpp4(_) => unreachable!("BT.CPP 4's own nodes are built in btcpp4.rs"),
     }
 }
 

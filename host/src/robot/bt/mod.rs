@@ -32,6 +32,7 @@
 
 mod blackboard;
 mod btcpp;
+mod btcpp4;
 mod build;
 mod control;
 mod decorators;
@@ -270,6 +271,10 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
                     .collect()
             },
         };
+        if let (Kind::Control(Control::Btcpp4(k)), BtSemantics::As2fm) = (n.kind, input.semantics) {
+            errs.push(sm.diag(n.span, btcpp4::as2fm_refusal(k)));
+            continue;
+        }
         let m = match n.kind {
             Kind::Plugin(i) => Some(plugin::instance(
                 sm,
@@ -362,6 +367,8 @@ fn halt_effects(tree: &tree::Tree, plugins: &[plugin::Plugin]) -> Vec<HaltEffect
                 // changes anything), so when idle its child is idle too.
                 Control::BlackboardCheck(_) => worst,
                 Control::SequenceWithMemory => HaltEffect::Always,
+                // Refused under AS2FM's rules, the only ones that read this.
+                Control::Btcpp4(_) => HaltEffect::Always,
                 Control::Sequence
                 | Control::Fallback
                 | Control::ReactiveSequence
@@ -477,6 +484,7 @@ fn builtin(
         Control::SetBlackboard => blackboard::lower_set(sm, n, ctx, bb, errs),
         Control::BlackboardCheck(t) => blackboard::lower_check(sm, t, n, ctx, bb, errs),
         Control::SequenceWithMemory if ctx.btcpp => Some(btcpp::sequence_with_memory(ctx)),
+        Control::Btcpp4(k) => btcpp4::lower(sm, k, n, ctx, bb, errs),
         _ => Some(control::machine(c, ctx, &[])),
     }
 }

@@ -42,7 +42,29 @@ pub(crate) enum Control {
     /// `BlackboardPreconditionNode<T>`, AS2FM's `blackboard_check_int.ascxml`).
     BlackboardCheck(CheckType),
     SetBlackboard,
+    /// BehaviorTree.CPP 4's nodes AS2FM has no model of, lowered under `--bt btcpp`
+    /// only (`btcpp4.rs`): AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse,
+    /// KeepRunningUntilFailure, RunOnce, and Switch2 ... Switch6 (the number of cases).
+    Btcpp4(Btcpp4),
 }
+
+/// The built-in nodes of BehaviorTree.CPP 4 that only `--bt btcpp` lowers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Btcpp4 {
+    AsyncSequence,
+    AsyncFallback,
+    ParallelAll,
+    WhileDoElse,
+    KeepRunningUntilFailure,
+    RunOnce,
+    /// `Switch<n>`, n in 2..=6.
+    Switch(u8),
+}
+
+/// The ports of `Switch6`; `Switch<n>` takes the first `n + 1`.
+const SWITCH_PORTS: [&str; 7] = [
+    "variable", "case_1", "case_2", "case_3", "case_4", "case_5", "case_6",
+];
 
 /// The value type a BlackboardCheck node compares.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -116,6 +138,17 @@ impl Control {
             "BlackboardCheckString" => Control::BlackboardCheck(CheckType::String),
             "BlackboardCheckBool" => Control::BlackboardCheck(CheckType::Bool),
             "SetBlackboard" => Control::SetBlackboard,
+            "AsyncSequence" => Control::Btcpp4(Btcpp4::AsyncSequence),
+            "AsyncFallback" => Control::Btcpp4(Btcpp4::AsyncFallback),
+            "ParallelAll" => Control::Btcpp4(Btcpp4::ParallelAll),
+            "WhileDoElse" => Control::Btcpp4(Btcpp4::WhileDoElse),
+            "KeepRunningUntilFailure" => Control::Btcpp4(Btcpp4::KeepRunningUntilFailure),
+            "RunOnce" => Control::Btcpp4(Btcpp4::RunOnce),
+            "Switch2" => Control::Btcpp4(Btcpp4::Switch(2)),
+            "Switch3" => Control::Btcpp4(Btcpp4::Switch(3)),
+            "Switch4" => Control::Btcpp4(Btcpp4::Switch(4)),
+            "Switch5" => Control::Btcpp4(Btcpp4::Switch(5)),
+            "Switch6" => Control::Btcpp4(Btcpp4::Switch(6)),
             _ => return None,
         })
     }
@@ -130,6 +163,16 @@ impl Control {
             Inverter | ForceSuccess | ForceFailure | Repeat | RetryUntilSuccessful
             | BlackboardCheck(_) => (1, 1),
             AlwaysSuccess | AlwaysFailure | SetBlackboard => (0, 0),
+            Btcpp4(b) => match b {
+                self::Btcpp4::AsyncSequence
+                | self::Btcpp4::AsyncFallback
+                | self::Btcpp4::ParallelAll => (1, usize::MAX),
+                self::Btcpp4::WhileDoElse => (2, 3),
+                self::Btcpp4::KeepRunningUntilFailure | self::Btcpp4::RunOnce => (1, 1),
+                // The cases and the default (BT.CPP 4.10 `switch_node.h`,
+                // `SwitchNode::tick`: `NUM_CASES + 1` children).
+                self::Btcpp4::Switch(n) => (n as usize + 1, n as usize + 1),
+            },
         }
     }
 
@@ -147,6 +190,9 @@ impl Control {
             RetryUntilSuccessful => &["num_attempts"],
             BlackboardCheck(_) => &["value_A", "value_B", "return_on_mismatch"],
             SetBlackboard => &["value", "output_key"],
+            Btcpp4(self::Btcpp4::ParallelAll) => &["max_failures"],
+            Btcpp4(self::Btcpp4::RunOnce) => &["then_skip"],
+            Btcpp4(self::Btcpp4::Switch(n)) => &SWITCH_PORTS[..=n as usize],
             _ => &[],
         }
     }
@@ -175,55 +221,30 @@ const SUPPORTED: &[&str] = &[
     "BlackboardCheckBool",
     "SubTree",
     "SubTreePlus (format 3)",
+    "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6 (with `--bt btcpp`)",
 ];
 
 /// BehaviorTree.CPP's other built-in nodes (the ones its `BehaviorTreeFactory`
 /// registers in 4.10 or 3.8, and the queue nodes its headers ship), each with why
 /// hindsight refuses it. README lists the same.
 pub(crate) const UNSUPPORTED: &[(&str, &str)] = &[
-    (
-        "AsyncSequence",
-        "it answers RUNNING between children to yield; not modelled yet",
-    ),
-    (
-        "AsyncFallback",
-        "it answers RUNNING between children to yield; not modelled yet",
-    ),
-    ("ParallelAll", "no AS2FM model; not modelled yet"),
-    ("WhileDoElse", "no AS2FM model; not modelled yet"),
     ("TryCatch", "no AS2FM model; not modelled yet"),
-    (
-        "Switch2",
-        "it compares blackboard strings case by case; not modelled yet",
-    ),
-    (
-        "Switch3",
-        "it compares blackboard strings case by case; not modelled yet",
-    ),
-    (
-        "Switch4",
-        "it compares blackboard strings case by case; not modelled yet",
-    ),
-    (
-        "Switch5",
-        "it compares blackboard strings case by case; not modelled yet",
-    ),
-    (
-        "Switch6",
-        "it compares blackboard strings case by case; not modelled yet",
-    ),
     (
         "ManualSelector",
         "it asks a person at a terminal which child to run",
     ),
     (
-        "KeepRunningUntilFailure",
-        "no AS2FM model; not modelled yet",
+        "Timeout",
+        "it needs a wall-clock timer inside the tree; not modelled in model time yet",
     ),
-    ("Timeout", "it needs a wall-clock timer inside the tree"),
-    ("Delay", "it needs a wall-clock timer inside the tree"),
-    ("Sleep", "it needs a wall-clock timer inside the tree"),
-    ("RunOnce", "no AS2FM model; not modelled yet"),
+    (
+        "Delay",
+        "it needs a wall-clock timer inside the tree; not modelled in model time yet",
+    ),
+    (
+        "Sleep",
+        "it needs a wall-clock timer inside the tree; not modelled in model time yet",
+    ),
     ("Script", "it runs BT.CPP's script language"),
     ("ScriptCondition", "it runs BT.CPP's script language"),
     ("Precondition", "it runs BT.CPP's script language"),
