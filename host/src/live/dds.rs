@@ -3,7 +3,7 @@
 //! One DDS participant ([`ros2::dds::Participant`]) reads every topic a port names
 //! (`rt/<topic>`, ROS 2's type names and default QoS); each sample is CDR-decoded by the
 //! recordings' reader ([`ros2::feed::TopicFeed`]), stamped with the iceoryx2 sidecar's
-//! [`Clock`](super::Clock) and judged by the same [`Run`](super) steps, so the verdict
+//! [`Clock`] and judged by the same steps as an iceoryx2 sample (`Run`), so the verdict
 //! lines, the input log for `--serve`, heartbeats, losses and restarts are the
 //! sidecar's:
 //!
