@@ -10,7 +10,8 @@
 #       malformed std_msgs/Int32MultiArray),
 #       ["sleep", seconds]]; prints "matched /topic" and "sent N" lines.
 #   cyclone.py read_mcap FILE              prints one JSON line per message:
-#       {"topic", "schema", "encoding", "data"} (data decoded with mcap-ros2-support).
+#       {"topic", "schema", "encoding", "message_encoding", "log_time", and "data"
+#       decoded with mcap-ros2-support, or "error" when it does not decode}.
 import json
 import sys
 import time
@@ -93,17 +94,27 @@ def read_mcap(path):
     from mcap.reader import make_reader
     from mcap_ros2.decoder import DecoderFactory
 
+    factory = DecoderFactory()
+    decoders = {}
     with open(path, "rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        for schema, channel, message, decoded in reader.iter_decoded_messages():
-            print(json.dumps({
+        reader = make_reader(f)
+        for schema, channel, message in reader.iter_messages():
+            if channel.id not in decoders:
+                decoders[channel.id] = factory.decoder_for(channel.message_encoding, schema)
+            line = {
                 "topic": channel.topic,
                 "schema": schema.name,
                 "encoding": schema.encoding,
                 "message_encoding": channel.message_encoding,
-                "data": decoded.data,
                 "log_time": message.log_time,
-            }), flush=True)
+            }
+            # A sample the monitor found malformed is recorded as it came: it does not
+            # decode here either.
+            try:
+                line["data"] = decoders[channel.id](message.data).data
+            except Exception as e:  # noqa: BLE001 (any decoding failure)
+                line["error"] = str(e) or type(e).__name__
+            print(json.dumps(line), flush=True)
 
 
 if __name__ == "__main__":
