@@ -127,6 +127,107 @@ struct Plan {
     topic: String,
 }
 
+impl Plan {
+    /// Decodes one message into `sets` (cleared first); returns its header stamp in
+    /// nanoseconds when the plan reads it. Errors say what is wrong with the message
+    /// (the caller names the topic and the message).
+    fn read(
+        &self,
+        data: &[u8],
+        slots: &mut Vec<Value>,
+        present: &mut Vec<bool>,
+        sets: &mut Vec<(usize, Value)>,
+    ) -> Result<Option<u64>, String> {
+        sets.clear();
+        let Some(d) = &self.decoder else {
+            for &(var, _, _) in &self.sets {
+                sets.push((var, Value::Bool(true)));
+            }
+            return Ok(None);
+        };
+        if slots.len() < d.slots() {
+            slots.resize(d.slots(), Value::Bool(false));
+            present.resize(d.slots(), false);
+        }
+        d.decode(data, slots, present).map_err(|e| e.to_string())?;
+        let mut stamp = None;
+        if let Some((s, n)) = self.stamp {
+            let (Value::Int(sec), Value::Int(nsec)) = (slots[s], slots[n]) else {
+                // Unreachable for a decoder built by `plan`: both are integers.
+                return Err("header.stamp is not two integers".into());
+            };
+            let ns = sec
+                .checked_mul(1_000_000_000)
+                .and_then(|x| x.checked_add(nsec))
+                .and_then(|x| u64::try_from(x).ok());
+            let Some(ns) = ns else {
+                return Err(format!("header.stamp {sec}s {nsec}ns is before 1970"));
+            };
+            stamp = Some(ns);
+        }
+        for &(var, slot, when) in &self.sets {
+            if let Some((s, want)) = when {
+                if slots[s] != Value::Int(want) {
+                    continue;
+                }
+            }
+            match slot {
+                None => sets.push((var, Value::Bool(true))),
+                Some(s) if present[s] => sets.push((var, slots[s])),
+                Some(s) => {
+                    return Err(format!(
+                        "`{}` is not in this message (an array on its path is shorter)",
+                        d.slot_path(s)
+                    ))
+                }
+            }
+        }
+        Ok(stamp)
+    }
+}
+
+/// One topic's messages turned into variable sets, one message at a time: the live
+/// path (`hindsight monitor --ros2`), where messages come from DDS instead of a file.
+pub struct TopicFeed {
+    plan: Plan,
+    slots: Vec<Value>,
+    present: Vec<bool>,
+    sets: Vec<(usize, Value)>,
+}
+
+impl TopicFeed {
+    /// The feed of the ports of `ports` that read `topic` (as recorded: a service port
+    /// reads `/s/_service_event`), whose messages are of type `type_name` defined by
+    /// `defs`. Errors name the port or the type.
+    pub fn new(
+        topic: &str,
+        type_name: &str,
+        ports: &[Port],
+        defs: &dyn Definitions,
+        strings: &[String],
+    ) -> Result<TopicFeed, String> {
+        let conn = Connection {
+            topic: topic.to_string(),
+            type_name: type_name.to_string(),
+            definition: None,
+        };
+        Ok(TopicFeed {
+            plan: plan(&conn, ports, defs, TimeSource::Log, strings)?,
+            slots: Vec::new(),
+            present: Vec::new(),
+            sets: Vec::new(),
+        })
+    }
+
+    /// The variables one message sets (its CDR bytes with their 4-byte header). An
+    /// error says what is wrong with the message; the caller names topic and index.
+    pub fn read(&mut self, data: &[u8]) -> Result<&[(usize, Value)], String> {
+        self.plan
+            .read(data, &mut self.slots, &mut self.present, &mut self.sets)?;
+        Ok(&self.sets)
+    }
+}
+
 /// Reads `input` and calls `on_point` with every message as a point.
 ///
 /// `defs` gives the definitions of types the recording does not embed (a `.db3` file);
@@ -208,51 +309,9 @@ fn run(
                 plan.topic, plan.count, conns[msg.conn].type_name
             )
         };
-        sets.clear();
-        let mut stamp = None;
-        if let Some(d) = &plan.decoder {
-            if slots.len() < d.slots() {
-                slots.resize(d.slots(), Value::Bool(false));
-                present.resize(d.slots(), false);
-            }
-            d.decode(msg.data, &mut slots, &mut present)
-                .map_err(|e| at(&e))?;
-            if let Some((s, n)) = plan.stamp {
-                let (Value::Int(sec), Value::Int(nsec)) = (slots[s], slots[n]) else {
-                    // Unreachable for a decoder built by `plan`: both are integers.
-                    return Err(at(&"header.stamp is not two integers"));
-                };
-                let ns = sec
-                    .checked_mul(1_000_000_000)
-                    .and_then(|x| x.checked_add(nsec))
-                    .and_then(|x| u64::try_from(x).ok());
-                let Some(ns) = ns else {
-                    return Err(at(&format!("header.stamp {sec}s {nsec}ns is before 1970")));
-                };
-                stamp = Some(ns);
-            }
-            for &(var, slot, when) in &plan.sets {
-                if let Some((s, want)) = when {
-                    if slots[s] != Value::Int(want) {
-                        continue;
-                    }
-                }
-                match slot {
-                    None => sets.push((var, Value::Bool(true))),
-                    Some(s) if present[s] => sets.push((var, slots[s])),
-                    Some(s) => {
-                        return Err(at(&format!(
-                            "`{}` is not in this message (an array on its path is shorter)",
-                            d.slot_path(s)
-                        )))
-                    }
-                }
-            }
-        } else {
-            for &(var, _, _) in &plan.sets {
-                sets.push((var, Value::Bool(true)));
-            }
-        }
+        let stamp = plan
+            .read(msg.data, &mut slots, &mut present, &mut sets)
+            .map_err(|e| at(&e))?;
         let abs = stamp.unwrap_or(msg.log_time);
         let origin = *first.get_or_insert(abs);
         let Some(t) = abs.checked_sub(origin).filter(|t| *t >= last) else {

@@ -1,6 +1,7 @@
 //! hindsight's ROS 2 layer: interface definitions (`.msg` / `.srv` / `.action`, and the
 //! standard packages built in), the CDR reader, and rosbag2 recordings (MCAP files and
-//! SQLite `.db3` files, alone or as a folder with `metadata.yaml`).
+//! SQLite `.db3` files, alone or as a folder with `metadata.yaml`), and live topics over
+//! DDS (module `dds`, cargo feature `dds`).
 //!
 //! The pipeline from a recording to a monitor's input:
 //!
@@ -16,6 +17,9 @@
 
 pub mod bag;
 pub mod cdr;
+#[cfg(feature = "dds")]
+pub mod dds;
 pub mod feed;
 pub mod interface;
 pub mod schema;
+pub mod write;

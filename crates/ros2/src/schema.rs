@@ -101,6 +101,45 @@ impl Schema {
     }
 }
 
+impl Schema {
+    /// The type in MCAP's `ros2msg` format (see the module docs): the root's fields, then
+    /// every type it uses after a separator line and `MSG: package/Type`. What
+    /// `monitor --ros2 --record` embeds, so any MCAP reader can decode the messages.
+    /// Constants and default values are not kept (a decoder needs neither).
+    pub fn ros2msg_text(&self) -> String {
+        let mut out = String::new();
+        for (i, t) in self.types.iter().enumerate() {
+            if i > 0 {
+                out.push_str(&"=".repeat(80));
+                out.push_str("\nMSG: ");
+                out.push_str(&t.name);
+                out.push('\n');
+            }
+            for f in &t.fields {
+                match f.elem {
+                    Elem::Prim(p) => {
+                        out.push_str(p.msg_name());
+                        if let Some(n) = f.string_bound {
+                            out.push_str(&format!("<={n}"));
+                        }
+                    }
+                    Elem::Msg(m) => out.push_str(&self.types[m].name),
+                }
+                match f.array {
+                    ArraySize::Scalar => {}
+                    ArraySize::Fixed(n) => out.push_str(&format!("[{n}]")),
+                    ArraySize::Bounded(n) => out.push_str(&format!("[<={n}]")),
+                    ArraySize::Unbounded => out.push_str("[]"),
+                }
+                out.push(' ');
+                out.push_str(&f.name);
+                out.push('\n');
+            }
+        }
+        out
+    }
+}
+
 /// `pkg/Type` or `pkg/msg/Type` (also `srv`, `action`) -> `(pkg, Type)`.
 pub fn split_type_name(type_name: &str) -> Result<(String, String), String> {
     let parts: Vec<&str> = type_name.trim().split('/').collect();
@@ -360,6 +399,22 @@ mod tests {
         assert_eq!(s.root().fields[1].name, "voltage");
         assert_eq!(s.root().fields[0].elem, Elem::Msg(1));
         assert_eq!(s.types[2].name, "builtin_interfaces/Time");
+    }
+
+    #[test]
+    fn ros2msg_text_reads_back_as_the_same_schema() {
+        let s = Schema::resolve("sensor_msgs/msg/BatteryState", &BuiltinDefs::new()).unwrap();
+        let text = s.ros2msg_text();
+        assert!(
+            text.starts_with("std_msgs/Header header\nfloat32 voltage\n"),
+            "{text}"
+        );
+        assert!(text.contains("\nMSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"));
+        let back = Ros2MsgDefs::parse("sensor_msgs/msg/BatteryState", &text).unwrap();
+        assert_eq!(
+            Schema::resolve("sensor_msgs/msg/BatteryState", &back).unwrap(),
+            s
+        );
     }
 
     #[test]

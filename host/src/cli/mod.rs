@@ -3,6 +3,7 @@
 pub mod compile;
 pub mod convert;
 pub mod monitor;
+pub mod monitor_ros2;
 pub mod replay;
 pub mod report;
 pub mod run;

@@ -18,7 +18,7 @@ use crate::verify::observe::PropertySet;
 pub struct MonitorArgs {
     /// The properties: a spec (`.hspec`) whose unit is the clock's tick. A folder or an
     /// `.xml` file here is read as a model, as with --model.
-    #[arg(long, value_name = "SPEC", required_unless_present_any = ["bench", "model"], conflicts_with = "model")]
+    #[arg(long, value_name = "SPEC", required_unless_present_any = ["bench", "model", "ros2"], conflicts_with_all = ["model", "ros2"])]
     pub props: Option<PathBuf>,
     /// Monitor the guarantees of a model's property file, compiled exactly as `verify`
     /// compiles them (variables: the ports' ids; tick: the model's time unit). MODEL is a
@@ -34,12 +34,29 @@ pub struct MonitorArgs {
     /// for more); as for `verify`.
     #[arg(long = "interfaces", value_name = "DIR")]
     pub interfaces: Vec<PathBuf>,
-    /// With a plain SCXML --model: the length of one model time step (`100ms`).
+    /// With a plain SCXML --model: the length of one model time step (`100ms`). With
+    /// --ros2 and a property file: the monitor's tick (default 1ms), to which the bounds
+    /// are converted exactly.
     #[arg(long, value_name = "DURATION")]
     pub time_unit: Option<String>,
     /// The sidecar config (TOML): topics to tap, services to proxy, payload layouts.
-    #[arg(long, value_name = "FILE", required_unless_present_any = ["replay", "bench"])]
+    #[arg(long, value_name = "FILE", required_unless_present_any = ["replay", "bench", "ros2"])]
     pub config: Option<PathBuf>,
+    /// Live ROS 2 over DDS: judge PROPS (a property file over ROS names, as `replay`
+    /// reads it, or a `.hspec` with --bind and --topic-type) on the topics it names, as
+    /// a plain DDS participant (no ROS install): topics `rt/<name>`, ROS 2's type names
+    /// and default QoS (reliable, volatile, keep last 10), the domain of ROS_DOMAIN_ID.
+    /// --record FILE.mcap writes what was received as an MCAP file that `replay` reads.
+    #[arg(long, value_name = "PROPS", conflicts_with_all = ["model", "config", "replay", "bench"])]
+    pub ros2: Option<PathBuf>,
+    /// With --ros2 and a `.hspec`: bind variable VAR to `/topic.field.path`, `/topic`
+    /// (true at each message) or `/service:request.field` (`:response`), as for `replay`.
+    #[arg(long = "bind", value_name = "VAR=SOURCE", requires = "ros2")]
+    pub bind: Vec<String>,
+    /// With --ros2 and --bind: the ROS type of a topic (`/battery=std_msgs/msg/Int32`;
+    /// for a service, its `.srv` type); repeat for more.
+    #[arg(long = "topic-type", value_name = "TOPIC=TYPE", requires = "ros2")]
+    pub topic_type: Vec<String>,
     /// Off-line: replay an input log written by `--record` and print its verdicts.
     #[arg(long, value_name = "LOG", conflicts_with_all = ["config", "record", "bench"])]
     pub replay: Option<PathBuf>,
@@ -59,7 +76,9 @@ pub struct MonitorArgs {
     /// must name this machine (an IP address, `localhost` or its host name).
     #[arg(long, requires = "serve")]
     pub serve_public: bool,
-    /// Write every judged input (samples, requests, heartbeats, losses) as JSON lines, for `--replay`.
+    /// Write every judged input (samples, requests, heartbeats, losses) as JSON lines, for
+    /// `--replay`. With --ros2: every sample received, as an MCAP file (ROS 2 profile)
+    /// that `hindsight replay PROPS FILE.mcap` and the MCAP tools read.
     #[arg(long, value_name = "LOG")]
     pub record: Option<PathBuf>,
     /// The monitored system runs S times faster than real time (as `hindsight run --speed
@@ -172,9 +191,17 @@ The museum end to end, ten times faster than real time (two shells):
   hindsight monitor --model examples/museum-guide --replay run.jsonl
   hindsight sweep examples/museum-guide --online run.jsonl --from 0.1s --to 7s
 
-Exit codes: 0 stopped by a signal, or replay/bench done; 2 bad spec, config or log; 1 iceoryx2 or I/O failure.";
+Live ROS 2 over DDS (--ros2): the same verdicts, losses (gaps in a writer's
+  sequence numbers, samples that do not decode), restarts (a new writer) and
+  heartbeats, on the topics a property file names:
+  hindsight monitor --ros2 examples/museum-guide/properties.xml --record run.mcap
+  hindsight replay examples/museum-guide/properties.xml run.mcap  # then, off-line
+  hindsight monitor --ros2 spec.hspec --bind level=/battery.data \\
+      --topic-type /battery=std_msgs/msg/Int32
 
-fn create(path: &PathBuf) -> Result<Box<dyn Write + Send>, CliError> {
+Exit codes: 0 stopped by a signal, or replay/bench done; 2 bad spec, config or log; 1 iceoryx2, DDS or I/O failure.";
+
+pub(crate) fn create(path: &PathBuf) -> Result<Box<dyn Write + Send>, CliError> {
     let f = std::fs::File::create(path)
         .map_err(|e| CliError::Failed(format!("{}: cannot write: {e}", path.display())))?;
     Ok(Box::new(std::io::BufWriter::new(f)))
@@ -290,6 +317,9 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
              mean it, or give a port alone (`--serve {}`) for this machine only",
             addr.port()
         )));
+    }
+    if let Some(props) = &args.ros2 {
+        return super::monitor_ros2::run(args, props, serve_addr);
     }
     let spec = spec_of(args)?;
     let mut out: Box<dyn Write + Send> = match &args.output {

@@ -87,32 +87,49 @@ fn is_recording(path: &Path) -> bool {
 }
 
 /// The compiled properties and, for a property file, its ports.
-struct Props {
-    compiled: Compiled,
-    file: Option<PropertyFile>,
+pub(crate) struct Props {
+    pub(crate) compiled: Compiled,
+    pub(crate) file: Option<PropertyFile>,
 }
 
 fn load_props(args: &ReplayArgs) -> Result<Props, CliError> {
-    let hspec = args.spec.extension().is_some_and(|e| e == "hspec");
+    load_props_at(
+        &args.spec,
+        args.time_unit.as_deref(),
+        1,
+        !args.bind.is_empty(),
+    )
+}
+
+/// Loads `PROPS` (a `.hspec` or a property file over ROS names). A property file's unit
+/// is `time_unit`, else `default_unit_ns`; `bind` says `--bind` was given (only for a
+/// `.hspec`). Shared by `replay` and `monitor --ros2`.
+pub(crate) fn load_props_at(
+    spec: &Path,
+    time_unit: Option<&str>,
+    default_unit_ns: u64,
+    bind: bool,
+) -> Result<Props, CliError> {
+    let hspec = spec.extension().is_some_and(|e| e == "hspec");
     if hspec {
-        if args.time_unit.is_some() {
+        if time_unit.is_some() {
             return Err(CliError::Input(
                 "--time-unit is for a property file; a .hspec names its unit with a `unit` line"
                     .into(),
             ));
         }
         return Ok(Props {
-            compiled: compile_spec_file(&args.spec)?,
+            compiled: compile_spec_file(spec)?,
             file: None,
         });
     }
-    if !args.bind.is_empty() {
+    if bind {
         return Err(CliError::Input(
             "--bind is for a .hspec spec; a property file's ports name their topics".into(),
         ));
     }
-    let unit_ns = match args.time_unit.as_deref() {
-        None => 1,
+    let unit_ns = match time_unit {
+        None => default_unit_ns,
         Some(t) => match codegen::duration::parse(t) {
             Ok(ns) if ns > 0 => ns,
             Ok(_) => {
@@ -123,7 +140,7 @@ fn load_props(args: &ReplayArgs) -> Result<Props, CliError> {
             Err(m) => return Err(CliError::Input(format!("--time-unit {t}: {m}"))),
         },
     };
-    let file = crate::props::parse_file(&args.spec).map_err(|d| CliError::Input(d.to_string()))?;
+    let file = crate::props::parse_file(spec).map_err(|d| CliError::Input(d.to_string()))?;
     let input = crate::verify::observe::spec_input(&file, Some(unit_ns), |_, _, _, t| t)
         .map_err(CliError::Input)?;
     let compiled = codegen::compile_input(&input).map_err(|d| CliError::Input(d.to_string()))?;
@@ -143,7 +160,10 @@ fn ros_name(mangled: &str) -> String {
 }
 
 /// The recording ports of a property file's ROS ports.
-fn file_ports(file: &PropertyFile, compiled: &Compiled) -> Result<Vec<BagPort>, CliError> {
+pub(crate) fn file_ports(
+    file: &PropertyFile,
+    compiled: &Compiled,
+) -> Result<Vec<BagPort>, CliError> {
     let shown = file.path.display();
     let mut out = Vec::new();
     for p in &file.ports {
@@ -200,7 +220,7 @@ fn file_ports(file: &PropertyFile, compiled: &Compiled) -> Result<Vec<BagPort>, 
 }
 
 /// The recording ports of `--bind VAR=SOURCE` options.
-fn bind_ports(binds: &[String], compiled: &Compiled) -> Result<Vec<BagPort>, CliError> {
+pub(crate) fn bind_ports(binds: &[String], compiled: &Compiled) -> Result<Vec<BagPort>, CliError> {
     let mut out: Vec<BagPort> = Vec::new();
     for b in binds {
         let bad = |m: &str| CliError::Input(format!("--bind {b}: {m}"));
@@ -268,7 +288,7 @@ fn bind_ports(binds: &[String], compiled: &Compiled) -> Result<Vec<BagPort>, Cli
 
 /// The interface packages for types a recording does not embed: `--interfaces`, the
 /// folders beside and above PROPS, the sourced workspace, the built-ins.
-struct Packages(crate::robot::interfaces::Interfaces);
+pub(crate) struct Packages(pub(crate) crate::robot::interfaces::Interfaces);
 
 impl ros2::schema::Definitions for Packages {
     fn message(&self, package: &str, name: &str) -> Option<ros2::interface::MessageDef> {

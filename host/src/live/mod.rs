@@ -14,6 +14,7 @@
 //! - [`engine`]: five-valued verdicts and the loss rule (see its docs).
 //! - [`record`]: the verdict line and input log formats; replay.
 //! - [`mod@bench`]: throughput and added latency against a plain subscriber.
+//! - [`dds`]: the same judging over a live ROS 2 graph (DDS), `monitor --ros2`.
 //! - [`pace`]: `hindsight run`'s observer, pacing a simulation on the same [`Clock`].
 //! - [`serve`]: the live page (`--serve`): verdict lines streamed to a browser;
 //!   [`http`]: its HTTP plumbing and limits.
@@ -26,6 +27,7 @@
 pub mod bench;
 mod clock;
 pub mod config;
+pub mod dds;
 pub mod engine;
 pub mod http;
 pub mod inject;
@@ -125,6 +127,8 @@ pub enum LiveError {
     Ipc(String),
     /// Writing an output failed.
     Io(String),
+    /// The DDS participant, a reader or a writer could not be created.
+    Dds(String),
     /// The engine rejected a point (a bug: the config checks types).
     Engine(String),
 }
@@ -134,6 +138,7 @@ impl std::fmt::Display for LiveError {
         match self {
             LiveError::Ipc(m) => write!(f, "iceoryx2: {m}"),
             LiveError::Io(m) => write!(f, "output: {m}"),
+            LiveError::Dds(m) => f.write_str(m),
             LiveError::Engine(m) => write!(f, "monitor: {m}"),
         }
     }

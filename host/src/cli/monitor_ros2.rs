@@ -1,0 +1,249 @@
+//! `hindsight monitor --ros2 PROPS`: the properties `replay` checks on a recording,
+//! judged live on a ROS 2 graph over DDS (see [`crate::live::dds`]).
+//!
+//! `PROPS` is what `replay` takes: a property file over ROS names (its `<ros_topic>` /
+//! `<ros_service>` ports name topic and type), or a `.hspec` spec with `--bind
+//! VAR=/topic.field` and `--topic-type /topic=pkg/msg/Type` (DDS needs the type to
+//! subscribe). A service port reads the service's introspection events
+//! (`/<service>/_service_event`), as it does in a recording.
+
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Once;
+use std::time::Duration;
+
+use ros2::feed::{Port as BagPort, TopicFeed};
+
+use super::monitor::MonitorArgs;
+use super::replay::{bind_ports, file_ports, load_props_at, Packages};
+use super::CliError;
+use crate::live::dds::{Settings, TopicSource};
+use crate::live::{self, Options};
+use crate::props::PropertyFile;
+
+/// A property file's tick on DDS when `--time-unit` does not name one: 1 ms.
+const DEFAULT_UNIT_NS: u64 = 1_000_000;
+
+/// Set by SIGINT / SIGTERM: the monitor flushes its outputs and exits 0.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+fn stop_flag() -> &'static AtomicBool {
+    static INSTALL: Once = Once::new();
+    INSTALL.call_once(|| {
+        // ctrlc runs this on its own thread: only the flag is set here.
+        let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed));
+    });
+    &STOP
+}
+
+/// A ROS type as DDS and the recordings name it: `pkg/msg/Type`, or for a service port
+/// the service's event type `pkg/srv/Name_Event`.
+fn full_type(written: &str, service: bool) -> Result<String, String> {
+    let (pkg, name) = ros2::schema::split_type_name(written)?;
+    Ok(if service {
+        format!("{pkg}/srv/{name}_Event")
+    } else {
+        format!("{pkg}/msg/{name}")
+    })
+}
+
+/// The type of each port of a property file: the `type` of the `<ros_topic>` or
+/// `<ros_service>` element that declares it. The reader records one type per element,
+/// at its start tag, before the element's variables: a port's type is the last one
+/// written before it.
+fn file_types(file: &PropertyFile) -> Vec<Option<(String, bool)>> {
+    file.ports
+        .iter()
+        .map(|p| {
+            let at = (p.at.line, p.at.column);
+            file.ros_types
+                .iter()
+                .rev()
+                .find(|t| (t.at.line, t.at.column) < at)
+                .map(|t| (t.type_name.clone(), t.service))
+        })
+        .collect()
+}
+
+/// Runs `hindsight monitor --ros2 PROPS`.
+pub fn run(
+    args: &MonitorArgs,
+    props_path: &Path,
+    serve: Option<std::net::SocketAddr>,
+) -> Result<(), CliError> {
+    let input = |m: String| CliError::Input(m);
+    if args.config.is_some() {
+        return Err(input(
+            "--config is for iceoryx2 topics; --ros2 reads the topics PROPS names".into(),
+        ));
+    }
+    let props = load_props_at(
+        props_path,
+        args.time_unit.as_deref(),
+        DEFAULT_UNIT_NS,
+        !args.bind.is_empty(),
+    )?;
+    let spec = &props.compiled;
+    // Each port and its topic's type.
+    let (ports, types): (Vec<BagPort>, Vec<Option<String>>) = match &props.file {
+        Some(file) => {
+            let ports = file_ports(file, spec)?;
+            let types = file_types(file)
+                .into_iter()
+                .zip(&ports)
+                .map(|(t, p)| {
+                    t.map(|(name, service)| full_type(&name, service || p.service.is_some()))
+                        .transpose()
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(input)?;
+            (ports, types)
+        }
+        None => {
+            if !args.topic_type.is_empty() && args.bind.is_empty() {
+                return Err(input("--topic-type goes with --bind".into()));
+            }
+            let ports = bind_ports(&args.bind, spec)?;
+            let mut named: BTreeMap<String, String> = BTreeMap::new();
+            for t in &args.topic_type {
+                let Some((topic, ty)) = t.split_once('=') else {
+                    return Err(input(format!(
+                        "--topic-type {t}: expected /topic=pkg/msg/Type"
+                    )));
+                };
+                named.insert(topic.trim().to_string(), ty.trim().to_string());
+            }
+            let types = ports
+                .iter()
+                .map(|p| match named.get(&p.topic) {
+                    Some(t) => full_type(t, p.service.is_some())
+                        .map(Some)
+                        .map_err(|e| format!("--topic-type {}={t}: {e}", p.topic)),
+                    None => Err(format!(
+                        "--bind: DDS needs the type of `{}`: add --topic-type {}=pkg/msg/Type",
+                        p.topic, p.topic
+                    )),
+                })
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(input)?;
+            (ports, types)
+        }
+    };
+    if ports.is_empty() {
+        return Err(input(format!(
+            "{}: no variable reads a topic, so there is nothing to monitor",
+            props_path.display()
+        )));
+    }
+    // One reader per topic as recorded, with one type.
+    let mut topics: Vec<(String, String)> = Vec::new();
+    for (p, t) in ports.iter().zip(&types) {
+        let topic = p.recorded_topic();
+        let Some(t) = t else {
+            return Err(input(format!("port `{}`: its type is not written", p.name)));
+        };
+        match topics.iter().find(|(name, _)| *name == topic) {
+            Some((_, other)) if other != t => {
+                return Err(input(format!(
+                    "topic `{topic}` is read as `{other}` and as `{t}`: one topic has one type"
+                )))
+            }
+            Some(_) => {}
+            None => topics.push((topic, t.clone())),
+        }
+    }
+    let mut sm = codegen::diag::SourceMap::new();
+    let search = crate::robot::interfaces::Search::from_env(args.interfaces.clone());
+    let packages = crate::robot::interfaces::Interfaces::discover_with(
+        &mut sm, props_path, &search,
+    )
+    .map_err(|errs| {
+        CliError::Input(
+            errs.iter()
+                .map(|d| d.to_string())
+                .collect::<Vec<_>>()
+                .join("\n"),
+        )
+    })?;
+    let defs = Packages(packages);
+    let mut sources = Vec::new();
+    for (topic, type_name) in topics {
+        let feed = TopicFeed::new(&topic, &type_name, &ports, &defs, spec.strings())
+            .map_err(|e| input(format!("topic `{topic}`: {e}")))?;
+        let schema = ros2::schema::Schema::resolve(&type_name, &defs).map_err(|e| {
+            input(format!(
+                "topic `{topic}`: {e}: name its package's folder with --interfaces"
+            ))
+        })?;
+        let vars = ports
+            .iter()
+            .filter(|p| p.recorded_topic() == topic)
+            .map(|p| p.name.clone())
+            .collect();
+        sources.push(TopicSource {
+            topic,
+            type_name,
+            feed,
+            vars,
+            schema_text: schema.ros2msg_text(),
+        });
+    }
+    let domain = ros2::dds::domain_id().map_err(input)?;
+    let speed = match args.speed {
+        Some(s) => live::check_speed(s).map_err(|m| input(format!("--speed: {m}")))?,
+        None => 1.0,
+    };
+    // A heartbeat every tick, but not more often than every millisecond of real time.
+    let tick = spec.tick_ns().max(1);
+    let heartbeat = (1_000_000f64 * speed / tick as f64).ceil().max(1.0) as u64;
+    let settings = Settings {
+        domain,
+        heartbeat,
+        speed,
+        from_first_message: args.from_first_message,
+    };
+    let mcap = args
+        .record
+        .as_deref()
+        .map(ros2::write::McapWriter::create)
+        .transpose()
+        .map_err(CliError::Failed)?;
+    let mut out: Box<dyn Write + Send> = match &args.output {
+        Some(p) => super::monitor::create(p)?,
+        None => Box::new(std::io::stdout()),
+    };
+    let mut record: Option<Box<dyn Write + Send>> = None;
+    if let Some(addr) = serve {
+        let title = props_path.display().to_string();
+        let server = live::serve::serve(
+            addr,
+            live::serve::page(&title, spec),
+            args.serve_public,
+            live::http::Limits::default(),
+        )
+        .map_err(|e| CliError::Failed(format!("--serve {addr}: {e}")))?;
+        eprintln!("monitor: live page at http://{}/", server.addr);
+        use live::serve::{Stream, Tee};
+        out = Box::new(Tee::new(out, server.hub.clone(), Stream::Verdict));
+        // The page's points are the input records, written for the page alone.
+        record = Some(Box::new(Tee::new(
+            Box::new(std::io::sink()),
+            server.hub,
+            Stream::Input,
+        )));
+    }
+    let mut opts = Options {
+        verdicts: out,
+        record,
+        every_point: args.every_point,
+        poll: Duration::from_micros(args.poll_us),
+        log: Box::new(std::io::stderr()),
+        probe: None,
+        progress: None,
+    };
+    live::dds::run(spec, sources, &settings, &mut opts, mcap, stop_flag())
+        .map(|_| ())
+        .map_err(|e| CliError::Failed(e.to_string()))
+}

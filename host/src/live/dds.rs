@@ -1,0 +1,283 @@
+//! On-line monitoring of a live ROS 2 graph over DDS: `hindsight monitor --ros2 PROPS`.
+//!
+//! One DDS participant ([`ros2::dds::Participant`]) reads every topic a port names
+//! (`rt/<topic>`, ROS 2's type names and default QoS); each sample is CDR-decoded by the
+//! recordings' reader ([`ros2::feed::TopicFeed`]), stamped with the iceoryx2 sidecar's
+//! [`Clock`] and judged by the same steps as an iceoryx2 sample (`Run`), so the verdict
+//! lines, the input log for `--serve`, heartbeats, losses and restarts are the
+//! sidecar's:
+//!
+//! - **loss**: a gap in a writer's RTPS sequence numbers counts the samples missed
+//!   exactly (a reliable writer whose keep-last history dropped them, a best-effort
+//!   one); a sample that does not decode is one loss, with the topic and index;
+//! - **restart**: a sample from a writer (GUID) not seen before, after another, is a
+//!   restart with the gap since the last sample;
+//! - **heartbeats** every `heartbeat` ticks keep a silent topic's bounded properties
+//!   failing on time;
+//! - **never blocked**: samples are taken without waiting; a slow or dead publisher
+//!   only means no samples.
+//!
+//! With `--record FILE.mcap` every received sample is written, as it came, to an MCAP
+//! file (ROS 2 profile: `ros2msg` schemas, `cdr` messages, log time = receive time),
+//! which `hindsight replay` and any MCAP tool read.
+
+use std::io::Write;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, SystemTime};
+
+use codegen::Compiled;
+use ros2::dds::{Participant, Qos, Reader, Received};
+use ros2::feed::TopicFeed;
+use ros2::write::McapWriter;
+
+use super::engine::Engine;
+use super::record::Input;
+use super::{Clock, LiveError, Options, Report, Run, SourceStats};
+
+/// One topic to read and what its samples set.
+pub struct TopicSource {
+    /// The ROS topic as recorded (`/battery`; a service port's `/s/_service_event`).
+    pub topic: String,
+    /// Its ROS type (`std_msgs/msg/Int32`, `pkg/srv/Name_Event`).
+    pub type_name: String,
+    /// Decodes a sample into variable sets.
+    pub feed: TopicFeed,
+    /// The names of the variables it sets (what a loss makes unknown).
+    pub vars: Vec<String>,
+    /// The type in `ros2msg` form, for `--record`.
+    pub schema_text: String,
+}
+
+/// How the monitor runs.
+pub struct Settings {
+    /// The DDS domain.
+    pub domain: u16,
+    /// A heartbeat point every this many ticks without a sample (0: none).
+    pub heartbeat: u64,
+    /// The system runs this many times faster than real time.
+    pub speed: f64,
+    /// No heartbeat before the first sample.
+    pub from_first_message: bool,
+}
+
+struct Tap {
+    source: TopicSource,
+    reader: Reader,
+    /// Writers seen, with the last sequence number of each.
+    writers: Vec<([u8; 16], i64)>,
+    last_sample: Option<u64>,
+    /// Samples received on the topic (the index errors name, from 1).
+    received: u64,
+    channel: Option<u16>,
+    stats: SourceStats,
+}
+
+/// Reads the topics until `stop` is set, judging every sample; then flushes every
+/// output (and finishes the MCAP file).
+pub fn run(
+    spec: &Compiled,
+    sources: Vec<TopicSource>,
+    settings: &Settings,
+    opts: &mut Options,
+    mut mcap: Option<McapWriter>,
+    stop: &AtomicBool,
+) -> Result<Report, LiveError> {
+    let dds = LiveError::Dds;
+    let participant = Participant::new(settings.domain).map_err(dds)?;
+    let mut taps = Vec::new();
+    for source in sources {
+        let reader = participant
+            .reader(&source.topic, &source.type_name, Qos::ros_default())
+            .map_err(dds)?;
+        let channel = match &mut mcap {
+            None => None,
+            Some(m) => Some(
+                m.add_topic(&source.topic, &source.type_name, &source.schema_text)
+                    .map_err(LiveError::Io)?,
+            ),
+        };
+        taps.push(Tap {
+            stats: SourceStats {
+                service: source.topic.clone(),
+                ..SourceStats::default()
+            },
+            source,
+            reader,
+            writers: Vec::new(),
+            last_sample: None,
+            received: 0,
+            channel,
+        });
+    }
+    let engine = Engine::new(spec, opts.every_point).map_err(LiveError::Engine)?;
+    let poll = opts.poll;
+    let mut run = Run {
+        spec,
+        engine,
+        opts,
+        clock: Clock::with_speed(spec.tick_ns(), settings.speed),
+        changes: Vec::new(),
+        verdict_pub: None,
+        points: 0,
+        lines: 0,
+        probed: Vec::new(),
+        started: false,
+        anchor_pending: settings.from_first_message,
+    };
+    run.write_record(&Input::Start {
+        unit_ns: spec.tick_ns(),
+        speed: settings.speed,
+    })?;
+    run.note(format!(
+        "ready: {} topics read on DDS domain {}",
+        taps.len(),
+        settings.domain
+    ));
+    let _ = run.opts.log.flush();
+    let mut buf: Vec<Received> = Vec::new();
+    let mut idle_since_flush = false;
+    let result = loop {
+        if stop.load(Ordering::Relaxed) {
+            break Ok(());
+        }
+        let mut busy = false;
+        for tap in &mut taps {
+            if let Err(m) = tap.reader.take(&mut buf) {
+                run.note(format!("{}: {m}", tap.source.topic));
+            }
+            busy |= !buf.is_empty();
+            for r in buf.drain(..) {
+                sample(&mut run, tap, &r, mcap.as_mut())?;
+            }
+        }
+        if settings.heartbeat > 0 && (run.started || !settings.from_first_message) {
+            let now = run.clock.now();
+            let due = run
+                .engine
+                .last_time()
+                .is_none_or(|l| now >= l + settings.heartbeat);
+            if due {
+                let time = run.now();
+                run.feed(Input::Tick { time })?;
+            }
+        }
+        if busy {
+            idle_since_flush = false;
+            continue;
+        }
+        if !idle_since_flush {
+            let _ = run.opts.verdicts.flush();
+            idle_since_flush = true;
+        }
+        std::thread::sleep(if poll.is_zero() {
+            Duration::from_micros(10)
+        } else {
+            poll
+        });
+    };
+    let flush = |w: &mut dyn Write| w.flush().map_err(|e| LiveError::Io(e.to_string()));
+    flush(&mut run.opts.verdicts)?;
+    if let Some(r) = run.opts.record.as_mut() {
+        flush(r)?;
+    }
+    if let Some(m) = mcap {
+        m.finish().map_err(LiveError::Io)?;
+    }
+    let sources: Vec<SourceStats> = taps.iter().map(|t| t.stats.clone()).collect();
+    for s in &sources {
+        let _ = writeln!(
+            run.opts.log,
+            "monitor: {}: {} judged, {} lost, {} malformed, {} restarts",
+            s.service, s.samples, s.lost, s.malformed, s.restarts
+        );
+    }
+    let _ = run.opts.log.flush();
+    result.map(|()| Report {
+        sources,
+        points: run.points,
+        verdict_lines: run.lines,
+        probed: run.probed,
+    })
+}
+
+/// Judges one sample of `tap`: restart and loss first, then its variables.
+fn sample(
+    run: &mut Run<'_, '_>,
+    tap: &mut Tap,
+    r: &Received,
+    mcap: Option<&mut McapWriter>,
+) -> Result<(), LiveError> {
+    let time = run.now();
+    tap.received += 1;
+    let topic = tap.source.topic.clone();
+    let idx = match tap.writers.iter().position(|(w, _)| *w == r.writer) {
+        Some(i) => i,
+        None => {
+            if !tap.writers.is_empty() {
+                let gap = time - tap.last_sample.unwrap_or(time).min(time);
+                tap.stats.restarts += 1;
+                run.note(format!("{topic}: new publisher after a gap of {gap} ticks"));
+                run.feed(Input::Restart {
+                    time,
+                    source: topic.clone(),
+                    gap,
+                })?;
+                // A restarted writer never comes back: keep the list small.
+                if tap.writers.len() >= 8 {
+                    tap.writers.remove(0);
+                }
+            }
+            // The first sample of a writer: nothing before it is counted as lost (a
+            // volatile reader joining late never had the earlier ones).
+            tap.writers.push((r.writer, r.seq - 1));
+            tap.writers.len() - 1
+        }
+    };
+    let prev = tap.writers[idx].1;
+    if r.seq > prev + 1 {
+        let lost = (r.seq - prev - 1) as u64;
+        tap.stats.lost += lost;
+        run.loss(
+            time,
+            &topic,
+            &tap.source.vars,
+            lost,
+            "sequence gap",
+            format!(
+                "{lost} samples lost before sample {} (writer sequence {} after {prev})",
+                tap.received, r.seq
+            ),
+        )?;
+    }
+    tap.writers[idx].1 = tap.writers[idx].1.max(r.seq);
+    tap.last_sample = Some(time);
+    if let (Some(m), Some(channel)) = (mcap, tap.channel) {
+        let now = SystemTime::now()
+            .duration_since(SystemTime::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos() as u64);
+        m.write(channel, tap.received as u32, now, &r.data)
+            .map_err(LiveError::Io)?;
+    }
+    match tap.source.feed.read(&r.data) {
+        Ok(sets) => {
+            tap.stats.samples += 1;
+            run.judge(time, &topic, sets, None)?;
+        }
+        Err(m) => {
+            tap.stats.malformed += 1;
+            let note = format!(
+                "sample {} (type `{}`) is malformed: {m}",
+                tap.received, tap.source.type_name
+            );
+            run.loss(
+                time,
+                &topic,
+                &tap.source.vars,
+                1,
+                &format!("malformed: {m}"),
+                note,
+            )?;
+        }
+    }
+    Ok(())
+}
