@@ -442,7 +442,10 @@ fn random_trees_lower_to_what_btcpp_does() {
 /// format-4 trees.
 #[test]
 fn random_trees_with_btcpp4_nodes_lower_to_what_btcpp_does() {
-    random_trees(gen::Options { btcpp4_nodes: true });
+    random_trees(gen::Options {
+        btcpp4_nodes: true,
+        scripts: false,
+    });
 }
 
 /// The kinds of BT.CPP 4's own nodes, as the coverage check names them.
@@ -734,7 +737,10 @@ fn random_trees_with_btcpp4_nodes_lower_to_what_the_real_library_does() {
         let c = gen::case_with(
             &mut rng,
             4 + (seed % 12) as i64,
-            gen::Options { btcpp4_nodes: true },
+            gen::Options {
+                btcpp4_nodes: true,
+                scripts: false,
+            },
         );
         if c.xml.contains("BTCPP_format=\"3\"") {
             continue;
@@ -771,6 +777,7 @@ fn random_trees_with_btcpp4_nodes_lower_to_what_the_real_library_does() {
                 ticks: c.ticks,
                 mode: *mode,
                 budget: oracle::BUDGET,
+                read: Vec::new(),
             })
         })
         .collect();
