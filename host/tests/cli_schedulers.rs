@@ -116,7 +116,9 @@ fn a_witness_replays_its_bound_in_verify_trace_and_sweep() {
             "--runs",
             "40",
         ];
-        args.extend(scheduler.map(|s| ["--scheduler", s]).into_iter().flatten());
+        if let Some(s) = scheduler {
+            args.extend(["--scheduler", s]);
+        }
         let (code, out, err) = hindsight(&args);
         assert_eq!(code, 0, "{err}");
         out

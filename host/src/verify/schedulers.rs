@@ -129,6 +129,7 @@ pub enum Stage<'a> {
 /// `stop` was set before the end. `study_cfg` gives the seed and threads (its `max_runs`
 /// caps each fresh estimate), `rule` the stopping rule and the confidence split over the
 /// candidates.
+#[allow(clippy::too_many_arguments)]
 pub fn bounds(
     model: &CompiledModel,
     set: &PropertySet,
@@ -146,7 +147,7 @@ pub fn bounds(
         .map(|i| Scheduler::Sampled(sampled(seed, i, opts.memory)))
         .collect();
     let runner = Runner::new(model, set, run_cfg);
-    let quiet = |_: &crate::smc::Progress<'_>| {};
+    let mut quiet = |_: &crate::smc::Progress<'_>| {};
 
     // Selection: successive halving per property and side.
     let select_cfg = StudyConfig {
@@ -180,7 +181,7 @@ pub fn bounds(
                 done[i]..per,
                 props,
                 |k, rng| runner.run_under(k, rng, scheds[i]),
-                &mut quiet.clone(),
+                &mut quiet,
             );
             for (c, g) in counts[i].iter_mut().zip(&got.properties) {
                 c.add(g);
@@ -254,7 +255,7 @@ pub fn bounds(
             &estimate_cfg,
             &rules,
             |k, rng| runner.run_under(k, rng, scheds[i]),
-            &mut quiet.clone(),
+            &mut quiet,
             stop,
         );
         if r.runs.failed > 0 {
