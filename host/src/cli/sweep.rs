@@ -74,6 +74,9 @@ pub struct SweepArgs {
     /// A run ends when model time reaches this, as for `verify`.
     #[arg(long, value_name = "T")]
     pub max_time: Option<String>,
+    /// Run every run under this scheduler (a witness `verify --schedulers` printed).
+    #[arg(long, value_name = "ID", value_parser = super::verify::parse_scheduler)]
+    pub scheduler: Option<crate::sim::Scheduler>,
     /// Also write an SVG chart of success rate against the bound to this file.
     #[arg(long)]
     pub svg: Option<PathBuf>,
@@ -348,6 +351,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             .max_time(args.max_time.as_deref())
             .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
         events: loaded.events,
+        scheduler: args.scheduler.unwrap_or_default(),
         ..RunConfig::default()
     };
     let study_cfg = StudyConfig {

@@ -6,11 +6,14 @@ use std::sync::Once;
 use std::time::Duration;
 
 mod both;
+mod schedulers;
+
+pub use schedulers::{parse_scheduler, MemoryArg};
 
 use super::CliError;
 use crate::robot::bt::{BtSemantics, BtTick};
 use crate::robot::load::ExternalComponent;
-use crate::sim::{CompiledModel, EventSemantics, RunConfig, Simulator};
+use crate::sim::{CompiledModel, EventSemantics, RunConfig, Scheduler, Simulator};
 use crate::smc::progress::TerminalProgress;
 use crate::smc::stats::{RuleConfig, RuleKind};
 use crate::smc::{StudyConfig, StudyResult};
@@ -163,6 +166,24 @@ pub struct VerifyArgs {
     /// else one per property).
     #[arg(long, value_name = "FILE", conflicts_with = "shard")]
     pub report: Option<PathBuf>,
+    /// Also bound each probability over N sampled deterministic schedulers (lightweight
+    /// scheduler sampling): the smallest and largest probability found, each with an
+    /// interval valid although it was selected, the witness schedulers, and which
+    /// properties are order-sensitive (max - min > 2 x precision).
+    #[arg(long, value_name = "N", value_parser = super::run_count)]
+    pub schedulers: Option<u64>,
+    /// What a sampled scheduler's choices depend on: `memoryless` (the model's current
+    /// state) or `history` (every state and choice so far in the run).
+    #[arg(long, value_enum, default_value_t = MemoryArg::Memoryless)]
+    pub scheduler_memory: MemoryArg,
+    /// Runs per sampled scheduler in the first selection round of --schedulers (later
+    /// rounds give the survivors more).
+    #[arg(long, value_name = "R", default_value_t = 16, value_parser = super::run_count)]
+    pub selection_runs: u64,
+    /// Run every run under this scheduler: `uniform` (the default) or a witness that
+    /// --schedulers printed (`memoryless:ID`, `history:ID`).
+    #[arg(long, value_name = "ID", value_parser = parse_scheduler)]
+    pub scheduler: Option<Scheduler>,
 }
 
 /// The model and property arguments every command that loads a model takes.
@@ -353,13 +374,18 @@ fn run_shard_cli(
 ) -> Result<crate::smc::shard::PartialResult, CliError> {
     use crate::smc::shard::{run_shard, FixedStudy, PropertySpec};
     let props_text = std::fs::read(props_path).unwrap_or_default();
-    let model_desc = format!(
+    let mut model_desc = format!(
         "{} machines, {} events, max_time {}, max_steps {}",
         model.machine_count(),
         model.event_count(),
         run_cfg.max_time,
         run_cfg.max_steps
     );
+    // Shards under different schedulers are different studies: `merge` refuses to mix
+    // them (the uniform scheduler's description is unchanged).
+    if run_cfg.scheduler != Scheduler::Uniform {
+        model_desc.push_str(&format!(", scheduler {}", run_cfg.scheduler));
+    }
     let fixed = FixedStudy {
         seed: args.seed,
         study_runs: runs,
@@ -468,6 +494,7 @@ fn merged_report(m: &crate::smc::shard::MergedResult) -> Study {
         decided: m.runs.decided,
         quiescent: m.runs.quiescent,
         interrupted: false,
+        scheduler: None,
         seconds: 0.0,
         step_seconds: None,
         max_time_seconds: None,
@@ -498,6 +525,9 @@ pub struct TraceArgs {
     /// A run is cut at this many steps.
     #[arg(long, default_value_t = 100_000_000)]
     pub max_steps: u64,
+    /// Replay the run under this scheduler (a witness `verify --schedulers` printed).
+    #[arg(long, value_name = "ID", value_parser = parse_scheduler)]
+    pub scheduler: Option<Scheduler>,
     /// Output CSV file; standard output when absent.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -513,6 +543,7 @@ pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
             .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
         max_steps: args.max_steps,
         events: loaded.events,
+        scheduler: args.scheduler.unwrap_or_default(),
         ..RunConfig::default()
     };
     let (csv, _) = replay_csv(model, set, &run_cfg, args.seed, args.run)?;
@@ -622,12 +653,14 @@ fn run_config(args: &VerifyArgs, loaded: &Loaded) -> Result<RunConfig, CliError>
             .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
         max_steps: args.max_steps,
         events: loaded.events,
+        scheduler: args.scheduler.unwrap_or_default(),
         ..RunConfig::default()
     })
 }
 
 /// Runs `hindsight verify`.
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
+    schedulers::check(args)?;
     if args.input.bt == BtArg::Both {
         return both::run_both(args);
     }
@@ -654,7 +687,12 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             ("events", format!("{:?}", run_cfg.events).to_lowercase()),
         ]
         .map(|(k, v)| (k.to_string(), v))
-        .to_vec()
+        .into_iter()
+        .chain(
+            args.scheduler
+                .map(|s| ("scheduler".to_string(), s.to_string())),
+        )
+        .collect::<Vec<_>>()
     };
     if let Some(runs) = args.runs {
         // A fixed-size study: one shard of it, or all of it (shard 0/1) reported as
@@ -704,6 +742,19 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         Vec::new()
     };
     let mut report = report(args, props_path, set, &result);
+    if !result.interrupted
+        && !schedulers::add_bounds(
+            args,
+            &loaded,
+            &run_cfg,
+            &study_cfg,
+            &mut report,
+            interrupt_flag(),
+        )?
+    {
+        eprintln!("interrupted: the bounds over schedulers are left out");
+        report.interrupted = true;
+    }
     if let [bt] = args.input.semantics()?.as_slice() {
         if *bt != BtSemantics::As2fm {
             report.settings.push(("bt".into(), bt.label().into()));
@@ -739,6 +790,7 @@ fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -
         decided: r.runs.decided,
         quiescent: r.runs.quiescent,
         interrupted: r.interrupted,
+        scheduler: args.scheduler.map(|s| s.to_string()),
         seconds: r.elapsed.as_secs_f64(),
         settings: Vec::new(),
         properties: set
@@ -758,6 +810,7 @@ fn print_report(report: &Study, json: bool) -> Result<(), CliError> {
         println!("{text}");
     } else {
         print_table(report);
+        schedulers::print_bounds(report);
     }
     Ok(())
 }

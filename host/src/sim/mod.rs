@@ -32,7 +32,8 @@
 //! - `delay="n"` blocks the sending machine for `n` time units, then sends
 //!   (SCAN's timed location); parameters are evaluated when the message is
 //!   sent.
-//! - Scheduling: uniformly at random among machines that can move; a step
+//! - Scheduling: uniformly at random among machines that can move (or as the run's
+//!   [`Scheduler`] says: one sampled deterministic scheduler, see `run/sched.rs`); a step
 //!   runs one machine up to and including its next communication (send or
 //!   receive). Time advances by one unit only when no machine can move and a
 //!   delayed send is pending; with nothing pending the run is quiescent.
@@ -56,7 +57,7 @@ pub use compiled::CompiledModel;
 pub use ids::{EventId, MachineId, StateId};
 pub use observer::{Flow, Inbox, Observer, Scalar, SentMessage, EXTERNAL};
 pub use run::{
-    EndReason, EventSemantics, Quiescence, RunConfig, RunError, RunOutcome, Simulator, SpinKind,
-    SpinReport, TransitionChoice,
+    mix, EndReason, EventSemantics, Memory, Quiescence, RunConfig, RunError, RunOutcome, Sampled,
+    Scheduler, Simulator, SpinKind, SpinReport, TransitionChoice,
 };
 pub use trace::{TraceRecorder, TraceRow};

@@ -12,6 +12,7 @@ use std::collections::VecDeque;
 
 mod config;
 mod deliver;
+mod sched;
 mod send;
 mod stop;
 
@@ -19,6 +20,7 @@ pub use config::{
     EndReason, EventSemantics, Quiescence, RunConfig, RunError, RunOutcome, SpinKind, SpinReport,
     TransitionChoice,
 };
+pub use sched::{mix, Memory, Sampled, Scheduler};
 
 const IDLE: u32 = u32::MAX;
 const NO_MSG: u32 = u32::MAX;
@@ -129,6 +131,8 @@ pub struct Simulator<'m> {
     /// Per receiver of each event: the transition it fires on the pending event
     /// (`NO_TRANS`: it discards it, `CANNOT_TAKE`: not now), as of `checked`.
     choice_kept: Vec<u32>,
+    /// [`Memory::History`]: the hash of the run's states and choices so far.
+    history: u64,
 }
 
 const NO_TRANS: u32 = u32::MAX;
@@ -350,6 +354,7 @@ impl<'m> Simulator<'m> {
                     .map(|d| d.receivers.len())
                     .sum::<usize>()
             ],
+            history: 0,
         }
     }
 
@@ -417,6 +422,7 @@ impl<'m> Simulator<'m> {
         self.time = 0;
         self.steps = 0;
         self.instant_steps = 0;
+        self.history = 0;
         for f in &mut self.free {
             f.clear();
         }
@@ -634,7 +640,7 @@ impl<'m> Simulator<'m> {
             } else {
                 0
             };
-            let k = below(rng, (self.runnable.len() + n_deliver) as u32) as usize;
+            let k = self.choose_step((self.runnable.len() + n_deliver) as u32, rng, cfg) as usize;
             if k >= self.runnable.len() {
                 let e = self.deliverable[k - self.runnable.len()];
                 if self.deliver(e, rng, cfg, obs)? == Flow::Stop {
@@ -689,7 +695,10 @@ impl<'m> Simulator<'m> {
         match self.enabled.len() {
             0 => Ok(None),
             1 => Ok(Some(self.enabled[0])),
-            n => Ok(Some(self.enabled[below(rng, n as u32) as usize])),
+            n => {
+                let k = self.choose_transition(m, n as u32, rng, cfg);
+                Ok(Some(self.enabled[k as usize]))
+            }
         }
     }
 

@@ -4,4 +4,5 @@ pub mod load;
 pub mod observe;
 pub mod record;
 pub mod result;
+pub mod schedulers;
 pub mod study;

@@ -38,6 +38,10 @@ pub struct Study {
     /// numbers are those of the runs done (left out of the JSON when false).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub interrupted: bool,
+    /// The scheduler every run was under, when `--scheduler` named one (left out of the
+    /// JSON otherwise: the uniform scheduler).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scheduler: Option<String>,
     /// Wall-clock seconds (0 for a merged study).
     #[serde(default)]
     pub seconds: f64,
@@ -82,6 +86,10 @@ pub struct PropertyRow {
     /// (report page only).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compiled: Option<String>,
+    /// With `verify --schedulers N`: the smallest and largest probability among the
+    /// sampled schedulers, their witnesses, and whether the property is order-sensitive.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub schedulers: Option<crate::verify::schedulers::SchedulerBounds>,
 }
 
 impl PropertyRow {
@@ -103,6 +111,7 @@ impl PropertyRow {
             decision: estimate.decision.map(|d| format!("{d:?}").to_lowercase()),
             formula: None,
             compiled: None,
+            schedulers: None,
         }
     }
 }

@@ -10,7 +10,7 @@ use std::sync::Mutex;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::observe::{Judge, PropertySet};
-use crate::sim::{CompiledModel, EndReason, RunConfig, Simulator};
+use crate::sim::{CompiledModel, EndReason, RunConfig, Scheduler, Simulator};
 use crate::smc::progress::TerminalProgress;
 use crate::smc::stats::RuleConfig;
 use crate::smc::{run_study_until, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
@@ -95,6 +95,16 @@ impl<'m> Runner<'m> {
 
     /// Run `k` with its stream.
     pub fn run(&self, k: u64, rng: &mut Xoshiro256PlusPlus) -> RunOutcome {
+        self.run_under(k, rng, self.run_cfg.scheduler)
+    }
+
+    /// Run `k` with its stream under `scheduler` instead of the configuration's.
+    pub fn run_under(
+        &self,
+        k: u64,
+        rng: &mut Xoshiro256PlusPlus,
+        scheduler: Scheduler,
+    ) -> RunOutcome {
         let popped = self.pool.lock().ok().and_then(|mut p| p.pop());
         let (mut sim, mut judge) = match popped {
             Some(pair) => pair,
@@ -113,7 +123,17 @@ impl<'m> Runner<'m> {
         let outcome = if judge.start() == crate::sim::Flow::Stop && judge.error.is_some() {
             unknown(RunEnd::Failed)
         } else {
-            let out = sim.run(rng, self.run_cfg, &mut judge);
+            let out = if scheduler == self.run_cfg.scheduler {
+                sim.run(rng, self.run_cfg, &mut judge)
+            } else {
+                let cfg = RunConfig {
+                    scheduler,
+                    ..self.run_cfg.clone()
+                };
+                sim.run(rng, &cfg, &mut judge)
+            };
+            // A failure names the scheduler when it is not the uniform one.
+            let k = RunName(k, scheduler);
             let end = match &out.end {
                 EndReason::Quiescent => Some(RunEnd::Quiescent),
                 EndReason::MaxTime => Some(RunEnd::TimeHorizon),
@@ -155,5 +175,18 @@ impl<'m> Runner<'m> {
 fn record(slot: &Mutex<Option<String>>, msg: String) {
     if let Ok(mut s) = slot.lock() {
         s.get_or_insert(msg);
+    }
+}
+
+/// A run as a failure message names it: its index, and its scheduler unless uniform
+/// (formatted only when a failure is recorded).
+struct RunName(u64, Scheduler);
+
+impl std::fmt::Display for RunName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.1 {
+            Scheduler::Uniform => write!(f, "{}", self.0),
+            s => write!(f, "{} (scheduler {s})", self.0),
+        }
     }
 }

@@ -27,6 +27,9 @@ pub(super) fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
     if args.report.is_some() || args.save_failing > 0 {
         return refuse("--report / --save-failing");
     }
+    if args.schedulers.is_some() {
+        return refuse("--schedulers");
+    }
     let mut studies = Vec::new();
     let stop = interrupt_flag();
     for bt in args.input.semantics()? {

@@ -86,6 +86,8 @@ pub struct RunConfig {
     pub quiescence: Quiescence,
     /// How sends are delivered.
     pub events: EventSemantics,
+    /// Who resolves the choices the model leaves open (uniformly at random by default).
+    pub scheduler: Scheduler,
 }
 
 impl Default for RunConfig {
@@ -98,6 +100,7 @@ impl Default for RunConfig {
             transitions: TransitionChoice::DocumentOrder,
             quiescence: Quiescence::Stop,
             events: EventSemantics::Queues,
+            scheduler: Scheduler::Uniform,
         }
     }
 }

@@ -1,0 +1,183 @@
+//! `hindsight verify --schedulers N`: per property, the probability under the uniform
+//! scheduler beside the smallest and largest found among N sampled deterministic
+//! schedulers, and which properties are order-sensitive.
+
+use super::{CliError, VerifyArgs};
+use crate::sim::{Memory, Scheduler};
+use crate::smc::stats::RuleKind;
+use crate::verify::load::Loaded;
+use crate::verify::result::Study;
+use crate::verify::schedulers::{bounds, SchedulerOptions, Stage};
+
+/// What a sampled scheduler's choices depend on, as named on the command line.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum MemoryArg {
+    /// The model's current state only (memoryless).
+    #[default]
+    Memoryless,
+    /// The current state and every state and choice before it in the run.
+    History,
+}
+
+impl From<MemoryArg> for Memory {
+    fn from(m: MemoryArg) -> Self {
+        match m {
+            MemoryArg::Memoryless => Memory::Memoryless,
+            MemoryArg::History => Memory::History,
+        }
+    }
+}
+
+/// Parses `--scheduler`: `uniform`, `memoryless:ID` or `history:ID`.
+pub fn parse_scheduler(text: &str) -> Result<Scheduler, String> {
+    text.parse()
+}
+
+/// Refuses combinations `--schedulers` does not support, with the reason.
+pub(super) fn check(args: &VerifyArgs) -> Result<(), CliError> {
+    let refuse = |what: &str, why: &str| {
+        Err(CliError::Input(format!(
+            "--schedulers: not with {what}: {why}"
+        )))
+    };
+    if args.schedulers.is_none() {
+        return Ok(());
+    }
+    if args.shard.is_some() || args.runs.is_some() {
+        return refuse(
+            "--runs / --shard",
+            "the candidates are selected and re-estimated by sequential studies, which a \
+             fixed-size shard cannot split (run --schedulers on one machine)",
+        );
+    }
+    if args.threshold.is_some() {
+        return refuse(
+            "--threshold",
+            "the bounds are estimates with intervals; ask the threshold question of a \
+             witness with --scheduler ID --threshold",
+        );
+    }
+    if args.scheduler.is_some() {
+        return refuse(
+            "--scheduler",
+            "the study's own estimate is the uniform scheduler's; --scheduler replays one \
+             witness alone",
+        );
+    }
+    Ok(())
+}
+
+/// Runs the bounds of `--schedulers` and adds them to `report`'s rows; `Ok(false)` when
+/// interrupted.
+pub(super) fn add_bounds(
+    args: &VerifyArgs,
+    loaded: &Loaded,
+    run_cfg: &crate::sim::RunConfig,
+    study_cfg: &crate::smc::StudyConfig,
+    report: &mut Study,
+    stop: &std::sync::atomic::AtomicBool,
+) -> Result<bool, CliError> {
+    let Some(count) = args.schedulers else {
+        return Ok(true);
+    };
+    let rule = super::rule_config(args);
+    debug_assert!(!matches!(rule.kind, RuleKind::Sprt { .. }));
+    let opts = SchedulerOptions {
+        count,
+        memory: args.scheduler_memory.into(),
+        selection_runs: args.selection_runs,
+    };
+    let show = !args.json;
+    let mut progress = |s: Stage<'_>| {
+        if !show {
+            return;
+        }
+        match s {
+            Stage::Round { alive, runs } => {
+                eprintln!("schedulers: selecting among {alive}, {runs} runs each")
+            }
+            Stage::Estimate {
+                index,
+                of,
+                scheduler,
+            } => eprintln!("schedulers: fresh estimate {index}/{of} ({scheduler})"),
+        }
+    };
+    let found = bounds(
+        &loaded.model,
+        &loaded.set,
+        run_cfg,
+        study_cfg,
+        &rule,
+        &opts,
+        stop,
+        &mut progress,
+    )
+    .map_err(CliError::Input)?;
+    let Some(found) = found else {
+        return Ok(false);
+    };
+    for (row, b) in report.properties.iter_mut().zip(found) {
+        row.schedulers = Some(b);
+    }
+    Ok(true)
+}
+
+/// The table of bounds under the study's table (nothing without `--schedulers`).
+pub(super) fn print_bounds(r: &Study) {
+    let rows: Vec<_> = r
+        .properties
+        .iter()
+        .filter_map(|p| p.schedulers.as_ref().map(|b| (p, b)))
+        .collect();
+    let Some((_, first)) = rows.first() else {
+        return;
+    };
+    let w = rows
+        .iter()
+        .map(|(p, _)| p.property.len())
+        .max()
+        .unwrap_or(8)
+        .max(8);
+    println!();
+    println!(
+        "bounds over {} sampled {} schedulers (each interval holds the witness's probability; \
+         together at confidence {}):",
+        first.sampled, first.memory, r.confidence
+    );
+    println!(
+        "{:<w$}  {:>7}  {:>7}  {:>17}  {:>7}  {:>17}  order",
+        "property", "uniform", "min", "interval", "max", "interval"
+    );
+    let num = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.4}"));
+    for (p, b) in &rows {
+        let iv = |i: [f64; 2]| format!("[{:.4}, {:.4}]", i[0], i[1]);
+        println!(
+            "{:<w$}  {:>7}  {:>7}  {:>17}  {:>7}  {:>17}  {}",
+            p.property,
+            num(p.probability),
+            num(b.min.probability),
+            iv(b.min.interval),
+            num(b.max.probability),
+            iv(b.max.interval),
+            if b.order_sensitive {
+                "order-sensitive"
+            } else {
+                "-"
+            }
+        );
+    }
+    println!("witnesses (replay with --scheduler ID on verify, trace or sweep):");
+    for (p, b) in &rows {
+        println!(
+            "  {:<w$}  min {}  max {}",
+            p.property, b.min.scheduler, b.max.scheduler
+        );
+    }
+    let sensitive = rows.iter().filter(|(_, b)| b.order_sensitive).count();
+    println!(
+        "{sensitive} of {} properties order-sensitive (max - min > 2 x precision {})",
+        rows.len(),
+        r.precision
+    );
+}

@@ -1,0 +1,316 @@
+//! Bounds over schedulers (`verify --schedulers N`): the smallest and largest probability
+//! of each property among N sampled deterministic schedulers, each with an interval that
+//! stays valid although the scheduler was selected for being extreme.
+//!
+//! # Method
+//!
+//! Smart sampling (D'Argenio, Legay, Sedwards, Traonouez, "Smart sampling for lightweight
+//! verification of Markov decision processes", STTT 17(4), 2015, Algorithm 1), with the
+//! selection and the estimate kept apart:
+//!
+//! 1. **Schedulers.** Scheduler `i` of a study with seed `s` has the id
+//!    `mix(mix(s, IDS), i)` ([`crate::sim::mix`]); its choices are those of
+//!    [`crate::sim::Sampled`] (memoryless or history-dependent, `--scheduler-memory`).
+//! 2. **Selection.** Every scheduler runs `R` runs (`--selection-runs`); then, for each
+//!    property, the half of the survivors with the lowest estimate is kept as min
+//!    candidates and the half with the highest as max candidates, and the survivors get
+//!    more runs so that every round costs about the same (`N * R` runs), until
+//!    [`CANDIDATES`] remain per property and side. Runs of the selection use the streams
+//!    of a seed of their own (`mix(s, SELECT)`), the same run indices for every scheduler.
+//! 3. **Estimate.** Each remaining candidate is estimated afresh, by the study's stopping
+//!    rule on the streams of another seed (`mix(s, ESTIMATE)`), none of which the
+//!    selection saw: a candidate is a fixed scheduler for these runs, so its interval is
+//!    an ordinary one. Per property, the min (max) reported is the candidate of its min
+//!    (max) side with the lowest (highest) fresh estimate.
+//! 4. **Confidence.** Per property, `2 * CANDIDATES` intervals are computed, each at
+//!    confidence `1 - (1 - c) / (2 * CANDIDATES)`: by Bonferroni's inequality they all
+//!    hold together with probability at least `c`, so the two reported ones do, whichever
+//!    was picked.
+//!
+//! The guarantee: with confidence `c`, the min interval holds the probability of the
+//! property under the min witness scheduler, and the max interval that under the max
+//! witness. Hence the true minimum over all schedulers is at most the min interval's upper
+//! end, and the true maximum at least the max interval's lower end. Sampling finds
+//! extremes only as well as N schedulers reach them: a smaller true minimum (larger
+//! maximum) may exist that no sampled scheduler reaches.
+//!
+//! Results depend on the seed, N, R and the rule, never on the thread count (every batch
+//! is a [`run_range`] or [`run_study_until`], which consume runs in index order).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use serde::{Deserialize, Serialize};
+
+use super::observe::PropertySet;
+use super::study::Runner;
+use crate::sim::{mix, CompiledModel, Memory, RunConfig, Sampled, Scheduler};
+use crate::smc::stats::RuleConfig;
+use crate::smc::{run_range, run_study_until, PropertyCounts, StudyConfig};
+
+/// Candidates kept per property and side (min, max) for the fresh estimate.
+pub const CANDIDATES: usize = 2;
+
+/// Salts of the seeds derived from the study seed.
+const IDS: u64 = 0x5c4e_d01e_0000_0001;
+const SELECT: u64 = 0x5c4e_d01e_0000_0002;
+const ESTIMATE: u64 = 0x5c4e_d01e_0000_0003;
+
+/// What `--schedulers` asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SchedulerOptions {
+    /// Schedulers sampled (at least 1).
+    pub count: u64,
+    /// What their choices depend on.
+    pub memory: Memory,
+    /// Runs per scheduler in the first selection round (at least 1).
+    pub selection_runs: u64,
+}
+
+/// Scheduler `i` of a study with `seed`.
+pub fn sampled(seed: u64, i: u64, memory: Memory) -> Sampled {
+    Sampled {
+        id: mix(mix(seed, IDS), i),
+        memory,
+    }
+}
+
+/// One bound: the witness scheduler, its fresh estimate and interval.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Bound {
+    /// The estimate under the witness (`null` with no judged run).
+    pub probability: Option<f64>,
+    /// Its interval, `[lower, upper]`, at the study's confidence (see the module doc).
+    pub interval: [f64; 2],
+    /// The witness: what `--scheduler` replays.
+    pub scheduler: String,
+    /// Judged runs of the fresh estimate.
+    pub runs: u64,
+    /// Of which satisfied the property.
+    pub successes: u64,
+}
+
+/// A property's bounds over the sampled schedulers (`"schedulers"` in `verify --json`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SchedulerBounds {
+    /// Schedulers sampled.
+    pub sampled: u64,
+    /// `memoryless` or `history`.
+    pub memory: String,
+    /// The smallest probability found.
+    pub min: Bound,
+    /// The largest probability found.
+    pub max: Bound,
+    /// `max - min` exceeds twice the precision: the probability depends on an order the
+    /// model leaves open.
+    pub order_sensitive: bool,
+}
+
+/// What happened, for progress lines.
+pub enum Stage<'a> {
+    /// A selection round starts: survivors and runs each will have.
+    Round {
+        /// Schedulers still in the running.
+        alive: usize,
+        /// Runs each will have after the round.
+        runs: u64,
+    },
+    /// The fresh estimate of candidate `index` of `of` starts.
+    Estimate {
+        /// 1-based.
+        index: usize,
+        /// Candidates in all.
+        of: usize,
+        /// The scheduler.
+        scheduler: &'a Scheduler,
+    },
+}
+
+/// Bounds over `opts.count` sampled schedulers, one per guarantee of `set`, or `None` when
+/// `stop` was set before the end. `study_cfg` gives the seed and threads (its `max_runs`
+/// caps each fresh estimate), `rule` the stopping rule and the confidence split over the
+/// candidates.
+#[allow(clippy::too_many_arguments)]
+pub fn bounds(
+    model: &CompiledModel,
+    set: &PropertySet,
+    run_cfg: &RunConfig,
+    study_cfg: &StudyConfig,
+    rule: &RuleConfig,
+    opts: &SchedulerOptions,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(Stage<'_>),
+) -> Result<Option<Vec<SchedulerBounds>>, String> {
+    let props = set.guarantee_names().len();
+    let n = opts.count.max(1) as usize;
+    let seed = study_cfg.seed;
+    let scheds: Vec<Scheduler> = (0..n as u64)
+        .map(|i| Scheduler::Sampled(sampled(seed, i, opts.memory)))
+        .collect();
+    let runner = Runner::new(model, set, run_cfg);
+    let mut quiet = |_: &crate::smc::Progress<'_>| {};
+
+    // Selection: successive halving per property and side.
+    let select_cfg = StudyConfig {
+        seed: mix(seed, SELECT),
+        keep_failing: 0,
+        max_runs: None,
+        ..study_cfg.clone()
+    };
+    let mut counts = vec![vec![PropertyCounts::default(); props]; n];
+    let mut done = vec![0u64; n];
+    let all: Vec<usize> = (0..n).collect();
+    // Per property: (min side, max side).
+    let mut sides: Vec<[Vec<usize>; 2]> = vec![[all.clone(), all.clone()]; props];
+    let budget = (n as u64).saturating_mul(opts.selection_runs.max(1));
+    let mut alive = all;
+    loop {
+        let per = (budget / alive.len().max(1) as u64).max(opts.selection_runs.max(1));
+        progress(Stage::Round {
+            alive: alive.len(),
+            runs: per,
+        });
+        for &i in &alive {
+            if stop.load(Ordering::Relaxed) {
+                return Ok(None);
+            }
+            if done[i] >= per {
+                continue;
+            }
+            let got = run_range(
+                &select_cfg,
+                done[i]..per,
+                props,
+                |k, rng| runner.run_under(k, rng, scheds[i]),
+                &mut quiet,
+            );
+            for (c, g) in counts[i].iter_mut().zip(&got.properties) {
+                c.add(g);
+            }
+            done[i] = per;
+            if got.runs.failed > 0 {
+                runner.finish()?;
+                return Err("a selection run failed without a message".into());
+            }
+        }
+        let size = sides.first().map_or(0, |s| s[0].len());
+        if size <= CANDIDATES {
+            break;
+        }
+        let keep = (size / 2).max(CANDIDATES);
+        for (p, [low, high]) in sides.iter_mut().enumerate() {
+            let rate = |i: &usize| {
+                let c = &counts[*i][p];
+                match c.judged() {
+                    0 => None,
+                    j => Some(c.successes as f64 / j as f64),
+                }
+            };
+            // Unjudged schedulers go last on both sides; ties by index.
+            low.sort_by(|a, b| {
+                let (x, y) = (
+                    rate(a).unwrap_or(f64::INFINITY),
+                    rate(b).unwrap_or(f64::INFINITY),
+                );
+                x.total_cmp(&y).then(a.cmp(b))
+            });
+            high.sort_by(|a, b| {
+                let (x, y) = (rate(a).unwrap_or(-1.0), rate(b).unwrap_or(-1.0));
+                y.total_cmp(&x).then(a.cmp(b))
+            });
+            low.truncate(keep);
+            high.truncate(keep);
+        }
+        let mut next: Vec<usize> = sides
+            .iter()
+            .flat_map(|s| s.iter().flatten().copied())
+            .collect();
+        next.sort_unstable();
+        next.dedup();
+        alive = next;
+    }
+
+    // Fresh estimates of the candidates, confidence split over each property's 2K.
+    let per_side = sides.first().map_or(1, |s| s[0].len().max(1));
+    let split = RuleConfig {
+        confidence: 1.0 - (1.0 - rule.confidence) / (2 * per_side) as f64,
+        ..*rule
+    };
+    let rules = (0..props)
+        .map(|_| split.build())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| format!("statistics: {e}"))?;
+    let estimate_cfg = StudyConfig {
+        seed: mix(seed, ESTIMATE),
+        keep_failing: 0,
+        ..study_cfg.clone()
+    };
+    let mut fresh = vec![None; n];
+    for (j, &i) in alive.iter().enumerate() {
+        progress(Stage::Estimate {
+            index: j + 1,
+            of: alive.len(),
+            scheduler: &scheds[i],
+        });
+        let r = run_study_until(
+            &estimate_cfg,
+            &rules,
+            |k, rng| runner.run_under(k, rng, scheds[i]),
+            &mut quiet,
+            stop,
+        );
+        if r.runs.failed > 0 {
+            runner.finish()?;
+            return Err("an estimate run failed without a message".into());
+        }
+        if r.interrupted {
+            return Ok(None);
+        }
+        fresh[i] = Some(r.properties);
+    }
+    runner.finish()?;
+
+    let bound = |i: usize, p: usize| -> Bound {
+        let r = &fresh[i].as_ref().expect("every candidate was estimated")[p];
+        Bound {
+            probability: r.estimate.estimate,
+            interval: [r.interval.lower, r.interval.upper],
+            scheduler: scheds[i].to_string(),
+            runs: r.counts.judged(),
+            successes: r.counts.successes,
+        }
+    };
+    let value = |i: &usize, p: usize| fresh[*i].as_ref().and_then(|r| r[p].estimate.estimate);
+    let mut out = Vec::with_capacity(props);
+    for (p, [low, high]) in sides.iter().enumerate() {
+        let lo = *low
+            .iter()
+            .min_by(|a, b| {
+                let (x, y) = (
+                    value(a, p).unwrap_or(f64::INFINITY),
+                    value(b, p).unwrap_or(f64::INFINITY),
+                );
+                x.total_cmp(&y).then(a.cmp(b))
+            })
+            .expect("at least one candidate");
+        let hi = *high
+            .iter()
+            .min_by(|a, b| {
+                let (x, y) = (value(a, p).unwrap_or(-1.0), value(b, p).unwrap_or(-1.0));
+                y.total_cmp(&x).then(a.cmp(b))
+            })
+            .expect("at least one candidate");
+        let (min, max) = (bound(lo, p), bound(hi, p));
+        let order_sensitive = match (min.probability, max.probability) {
+            (Some(a), Some(b)) => b - a > 2.0 * rule.precision,
+            _ => false,
+        };
+        out.push(SchedulerBounds {
+            sampled: n as u64,
+            memory: opts.memory.label().to_string(),
+            min,
+            max,
+            order_sensitive,
+        });
+    }
+    Ok(Some(out))
+}
