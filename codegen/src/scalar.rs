@@ -59,8 +59,15 @@ impl Scalar {
             "int" => Scalar::I32,
             "float" => Scalar::F32,
             "double" => Scalar::F64,
-            _ => return Scalar::ALL.into_iter().find(|s| s.name() == name),
+            _ => return Scalar::from_exact_name(name),
         })
+    }
+
+    /// The scalar whose [`name`](Scalar::name) is exactly `name`, without the other
+    /// spellings `from_name` takes (`int`, `float`, `double`, `boolean`): the names ROS
+    /// interfaces and behavior-tree ports use.
+    pub fn from_exact_name(name: &str) -> Option<Scalar> {
+        Scalar::ALL.into_iter().find(|s| s.name() == name)
     }
 
     /// The scalar the spec language (and a sidecar layout) names: `bool`, `i8` ...
@@ -136,6 +143,8 @@ mod tests {
         assert_eq!(Scalar::from_name("int"), Some(Scalar::I32));
         assert_eq!(Scalar::from_name("double"), Some(Scalar::F64));
         assert_eq!(Scalar::from_name("integer"), None);
+        assert_eq!(Scalar::from_exact_name("float64"), Some(Scalar::F64));
+        assert_eq!(Scalar::from_exact_name("double"), None);
         assert_eq!(Scalar::from_spec_name("int32"), None);
         assert_eq!(Scalar::U8.int_range(), Some((0, 255)));
         assert_eq!(Scalar::F32.int_range(), None);

@@ -1,13 +1,17 @@
 //! ARCHITECTURE.md's layering invariant of `host`, checked on the source: a module uses only
 //! modules before it in the pipeline, `tracefile` serves `cli` only, `live/` does not use
 //! `verify/`, and nothing outside `cli/` takes clap types.
+//!
+//! `crate::expr` and `crate::smc` are re-exports of the crates `hindsight-expr` and
+//! `hindsight-smc` (`crates/`): Cargo checks that they import nothing of `host`, and any
+//! module may use them, as any module may use `codegen`.
 
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 /// The pipeline's order: a module may use the ones before it (and itself).
-const ORDER: [&str; 10] = [
-    "expr", "model", "sim", "robot", "props", "smc", "verify", "report", "live", "cli",
+const ORDER: [&str; 8] = [
+    "model", "sim", "robot", "props", "verify", "report", "live", "cli",
 ];
 
 fn src() -> PathBuf {
@@ -78,6 +82,7 @@ fn every_module_uses_only_modules_before_it() {
             match (from.as_str(), to.as_str()) {
                 (a, b) if a == b => {}
                 ("lib" | "main", _) => {}
+                (_, "expr" | "smc") => {}
                 (a, "tracefile") if a != "cli" => {
                     broken.push(format!("{where_}: {a} uses tracefile (cli only)"))
                 }
@@ -96,7 +101,7 @@ fn every_module_uses_only_modules_before_it() {
     }
     assert!(broken.is_empty(), "layering broken:\n{}", broken.join("\n"));
     // The scan saw real uses: it is not vacuously true.
-    for m in ["expr", "model", "sim", "verify"] {
+    for m in ["model", "sim", "robot", "verify"] {
         assert!(seen.contains(m), "no use of crate::{m} found: {seen:?}");
     }
 }

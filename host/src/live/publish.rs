@@ -72,9 +72,9 @@ impl WireTy {
     /// The name the sidecar's config uses.
     pub fn name(self) -> &'static str {
         match self {
-            WireTy::Bool => "bool",
-            WireTy::I64 => "i64",
-            WireTy::F64 => "f64",
+            WireTy::Bool => codegen::scalar::Scalar::Bool.spec_name(),
+            WireTy::I64 => codegen::scalar::Scalar::I64.spec_name(),
+            WireTy::F64 => codegen::scalar::Scalar::F64.spec_name(),
         }
     }
 }

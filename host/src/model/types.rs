@@ -59,11 +59,16 @@ impl TypeExpr {
             None => (text, ""),
         };
         let base = base.trim();
-        // The shared scalar names, then the spellings only SCXML data declarations accept.
+        // The shared scalar names, the spec language's float names, then the spellings
+        // only SCXML data declarations accept.
+        let spec_float = matches!(
+            Scalar::from_spec_name(base),
+            Some(Scalar::F32 | Scalar::F64)
+        );
         let mut ty = match (Scalar::from_name(base), base) {
             (Some(scalar), _) => TypeExpr::Base(scalar.into()),
+            (None, _) if spec_float => TypeExpr::Base(BaseType::Float),
             (None, "integer") => TypeExpr::Base(BaseType::Int),
-            (None, "f64" | "f32") => TypeExpr::Base(BaseType::Float),
             (None, "URI" | "str") => TypeExpr::Base(BaseType::Str),
             (None, "") => return Err(format!("missing type name in `{text}`")),
             (None, name) => {

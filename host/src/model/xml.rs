@@ -362,9 +362,49 @@ fn attach(stack: &mut [Element], root: &mut Option<Element>, el: Element) -> Res
     }
 }
 
+/// Appends `text` escaped for markup: XML or HTML text, or an attribute value in double
+/// quotes. `&`, `<`, `>` and `"` become entities; tab, line feed and carriage return
+/// become character references, so that an attribute value keeps them (an XML reader
+/// turns a literal one into a space: XML 1.0, 3.3.3 Attribute-Value Normalization). The
+/// one markup escaper: `hindsight convert`'s XML, the report's HTML and SVG, the live page.
+pub fn escape_into(text: &str, out: &mut String) {
+    for c in text.chars() {
+        match c {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            '\n' => out.push_str("&#10;"),
+            '\t' => out.push_str("&#9;"),
+            '\r' => out.push_str("&#13;"),
+            c => out.push(c),
+        }
+    }
+}
+
+/// `text` escaped by [`escape_into`].
+pub fn escape(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    escape_into(text, &mut out);
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The report's two escapers left line breaks and tabs as they were: in an SVG (XML)
+    /// attribute a reader turns them into spaces. The one escaper keeps every character.
+    #[test]
+    fn escaped_text_reads_back_as_written() {
+        let text = "a<b & c>\"d\" 'e'\nf\tg\r\nh";
+        let e = escape(text);
+        assert!(!e.contains(['<', '>', '"', '\n', '\t', '\r']), "{e}");
+        let root = doc(&format!("<a v=\"{e}\">{e}</a>")).unwrap();
+        assert_eq!(root.attr("v").unwrap().value, text);
+        assert_eq!(escape("plain text"), "plain text");
+        assert_eq!(escape("x&amp;"), "x&amp;amp;");
+    }
 
     fn doc(text: &str) -> Result<Element, Diagnostic> {
         let mut sm = SourceMap::new();

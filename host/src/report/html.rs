@@ -6,21 +6,9 @@ use std::fmt::Write;
 use super::data::{bound_axis, ReportData, Run, Study, Sweep};
 use super::plot;
 
-/// Escapes text for HTML content and attribute values.
-pub fn esc(s: &str) -> String {
-    let mut o = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => o.push_str("&amp;"),
-            '<' => o.push_str("&lt;"),
-            '>' => o.push_str("&gt;"),
-            '"' => o.push_str("&quot;"),
-            '\'' => o.push_str("&#39;"),
-            c => o.push(c),
-        }
-    }
-    o
-}
+/// Escapes text for HTML content and attribute values (every attribute the page writes
+/// is double-quoted): the one markup escaper, `model::xml::escape`.
+pub use crate::model::xml::escape as esc;
 
 /// An id fragment for a name: letters, digits, `-` and `_` kept, anything else `_`.
 pub fn anchor(name: &str) -> String {

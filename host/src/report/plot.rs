@@ -2,6 +2,8 @@
 
 use std::fmt::Write;
 
+use crate::model::xml::escape as esc;
+
 /// One measured point of a curve.
 #[derive(Clone, Debug)]
 pub struct Point {
@@ -38,14 +40,6 @@ const BOTTOM: f64 = 60.0;
 const COLOURS: [&str; 8] = [
     "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000", "#F0E442",
 ];
-
-/// Escapes text for SVG content and attribute values.
-fn esc(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
 
 /// Rounds a tick step to 1, 2 or 5 times a power of ten.
 fn nice_step(span: f64, ticks: f64) -> f64 {

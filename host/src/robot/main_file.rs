@@ -46,6 +46,7 @@ use std::path::{Path, PathBuf};
 
 use crate::model::source::{Diagnostic, FileId, SourceMap, Span};
 use crate::model::xml::{self, Element, Node};
+use crate::robot::rate::{self, RateError, RatePeriod};
 use codegen::duration;
 
 use super::main_ignored::{close_to, Notes, PARAMETERS, SECTIONS};
@@ -675,63 +676,35 @@ impl<'a> Reader<'a> {
 }
 
 fn tick_rate(text: &str) -> Result<TickRate, String> {
-    let bad =
-        || format!("bt_tick_rate must be a positive number of ticks per second, not `{text}`");
-    let hz: f64 = text.parse().map_err(|_| bad())?;
-    if !(hz.is_finite() && hz > 0.0) {
-        return Err(bad());
-    }
-    // Exact period when the rate is a plain decimal m / 10^k: 1e9 * 10^k / m.
-    let (int, frac) = text.split_once('.').unwrap_or((text, ""));
-    let frac = frac.trim_end_matches('0');
-    let exact_ns = if int.bytes().all(|b| b.is_ascii_digit())
-        && frac.bytes().all(|b| b.is_ascii_digit())
-        && frac.len() <= 18
-    {
-        format!("{int}{frac}")
-            .parse::<u128>()
-            .ok()
-            .filter(|m| *m > 0)
-            .and_then(|m| {
-                let n = 1_000_000_000u128 * 10u128.pow(frac.len() as u32);
-                (n % m == 0).then(|| n / m)
-            })
-    } else {
-        None
-    };
-    let period = 1e9 / hz;
-    if period.round() < 1.0 {
-        return Err(format!(
-            "bt_tick_rate `{text}` is faster than one tick per nanosecond"
-        ));
-    }
-    // The tick period must fit the time unit (nanoseconds, 64 bits: about 584 years).
-    if period >= u64::MAX as f64 {
-        return Err(format!(
-            "bt_tick_rate `{text}` is slower than the slowest rate hindsight can time \
-             (one tick per 2^64 ns, about 584 years)"
-        ));
-    }
-    // A rate written otherwise (`1e1`) is exact when its period is a whole number of
-    // nanoseconds that gives the rate back.
-    let exact_ns = exact_ns
-        .and_then(|n| u64::try_from(n).ok())
-        .or_else(|| (period.fract() == 0.0 && 1e9 / period == hz).then_some(period as u64));
-    match exact_ns {
-        Some(ns) => Ok(TickRate {
+    match rate::period(text) {
+        Ok(RatePeriod {
             hz,
-            period_ns: ns,
+            period_ns,
+            exact: true,
+        }) => Ok(TickRate {
+            hz,
+            period_ns,
             exact: true,
         }),
         // The model's time step is the greatest common divisor of its periods: a period
         // rounded to the nanosecond would make it 1 ns, and every run would end at the
         // step limit with no verdict. Refused here, at the attribute, instead.
-        None => Err(format!(
+        Ok(p) => Err(format!(
             "bt_tick_rate `{text}` ticks every {:.3} ns, not a whole number of \
              nanoseconds: the model's time step would shrink to 1 ns and every run would \
              stop at the step limit; use a rate whose period is whole, such as 2, 4, 5, \
              10 or 0.5 ticks per second",
-            period
+            1e9 / p.hz
+        )),
+        Err(RateError::NotPositive) => Err(format!(
+            "bt_tick_rate must be a positive number of ticks per second, not `{text}`"
+        )),
+        Err(RateError::FasterThanNs) => Err(format!(
+            "bt_tick_rate `{text}` is faster than one tick per nanosecond"
+        )),
+        Err(RateError::TooSlow) => Err(format!(
+            "bt_tick_rate `{text}` is slower than the slowest rate hindsight can time \
+             (one tick per 2^64 ns, about 584 years)"
         )),
     }
 }

@@ -27,6 +27,7 @@ pub mod main_file;
 mod main_ignored;
 #[cfg(test)]
 mod random_text;
+pub mod rate;
 pub mod ros;
 pub mod types;
 pub mod write;

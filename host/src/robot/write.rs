@@ -116,21 +116,7 @@ fn write_element(el: &Element, depth: usize, out: &mut String) {
     out.push_str(">\n");
 }
 
-/// Appends `text` escaped for an attribute value in double quotes.
-pub fn escape_into(text: &str, out: &mut String) {
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\n' => out.push_str("&#10;"),
-            '\t' => out.push_str("&#9;"),
-            '\r' => out.push_str("&#13;"),
-            c => out.push(c),
-        }
-    }
-}
+pub use crate::model::xml::escape_into;
 
 #[cfg(test)]
 mod tests {

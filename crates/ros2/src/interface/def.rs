@@ -90,25 +90,27 @@ pub enum Primitive {
 }
 
 impl Primitive {
-    /// The primitive called `name` in a `.msg` file.
+    /// The primitive called `name` in a `.msg` file: ROS's `byte`, `char` and `wstring`,
+    /// or a name of the one scalar table (`codegen::scalar`).
     pub fn from_name(name: &str) -> Option<Primitive> {
         Some(match name {
-            "bool" => Primitive::Bool,
             "byte" => Primitive::Byte,
             "char" => Primitive::Char,
-            "float32" => Primitive::Float32,
-            "float64" => Primitive::Float64,
-            "int8" => Primitive::Int8,
-            "uint8" => Primitive::UInt8,
-            "int16" => Primitive::Int16,
-            "uint16" => Primitive::UInt16,
-            "int32" => Primitive::Int32,
-            "uint32" => Primitive::UInt32,
-            "int64" => Primitive::Int64,
-            "uint64" => Primitive::UInt64,
-            "string" => Primitive::String,
             "wstring" => Primitive::WString,
-            _ => return None,
+            _ => match Scalar::from_exact_name(name)? {
+                Scalar::Bool => Primitive::Bool,
+                Scalar::F32 => Primitive::Float32,
+                Scalar::F64 => Primitive::Float64,
+                Scalar::I8 => Primitive::Int8,
+                Scalar::U8 => Primitive::UInt8,
+                Scalar::I16 => Primitive::Int16,
+                Scalar::U16 => Primitive::UInt16,
+                Scalar::I32 => Primitive::Int32,
+                Scalar::U32 => Primitive::UInt32,
+                Scalar::I64 => Primitive::Int64,
+                Scalar::U64 => Primitive::UInt64,
+                Scalar::Str => Primitive::String,
+            },
         })
     }
 
@@ -151,19 +153,9 @@ impl Primitive {
         matches!(self, Primitive::String | Primitive::WString)
     }
 
-    /// Inclusive range of an integer type.
+    /// Inclusive range of an integer type (its scalar's).
     pub fn int_range(self) -> Option<(i128, i128)> {
-        Some(match self {
-            Primitive::Byte | Primitive::Char | Primitive::UInt8 => (0, u8::MAX as i128),
-            Primitive::Int8 => (i8::MIN as i128, i8::MAX as i128),
-            Primitive::Int16 => (i16::MIN as i128, i16::MAX as i128),
-            Primitive::UInt16 => (0, u16::MAX as i128),
-            Primitive::Int32 => (i32::MIN as i128, i32::MAX as i128),
-            Primitive::UInt32 => (0, u32::MAX as i128),
-            Primitive::Int64 => (i64::MIN as i128, i64::MAX as i128),
-            Primitive::UInt64 => (0, u64::MAX as i128),
-            _ => return None,
-        })
+        self.scalar().int_range()
     }
 }
 

@@ -23,6 +23,7 @@ use super::control::{status_code, Ctx, HaltEffect, FAILURE, RUNNING, SUCCESS};
 use super::plugin;
 use super::tree::{CheckType, Control, Kind, PortValue, Tree, TreeNode};
 use crate::model::source::{Diagnostic, SourceMap, Span};
+use crate::model::types::Scalar;
 use crate::model::xml::Element;
 
 /// The blackboard machine's name.
@@ -117,16 +118,15 @@ impl Blackboard {
 pub(crate) fn default_value(ty: &str) -> String {
     let t = ty.trim();
     if t.ends_with(']') {
-        "[]".into()
-    } else if t == "bool" || t == "boolean" {
-        "false".into()
-    } else if t == "string" {
-        "''".into()
-    } else if t.starts_with("float") || t == "double" {
-        "0.0".into()
-    } else {
-        "0".into()
+        return "[]".into();
     }
+    match Scalar::from_name(t) {
+        Some(Scalar::Bool) => "false",
+        Some(Scalar::Str) => "''",
+        Some(Scalar::F32 | Scalar::F64) => "0.0",
+        _ => "0",
+    }
+    .into()
 }
 
 /// SetBlackboard: on every tick writes `value` (an expression) to `entry`, answers
@@ -182,9 +182,9 @@ pub(crate) fn literal_type(v: &str) -> &'static str {
     let digits = t.strip_prefix(['-', '+']).unwrap_or(t);
     if !digits.is_empty() && digits.chars().all(|c| c.is_ascii_digit()) {
         return if t.parse::<i32>().is_ok() {
-            "int32"
+            Scalar::I32.name()
         } else {
-            "int64"
+            Scalar::I64.name()
         };
     }
     let numeric = digits
@@ -195,11 +195,11 @@ pub(crate) fn literal_type(v: &str) -> &'static str {
             .chars()
             .all(|c| c.is_ascii_digit() || matches!(c, '.' | 'e' | 'E' | '-' | '+'));
     if numeric && t.parse::<f64>().is_ok_and(|f| f.is_finite()) {
-        return "float64";
+        return Scalar::F64.name();
     }
     match t {
-        "true" | "false" => "bool",
-        _ => "string",
+        "true" | "false" => Scalar::Bool.name(),
+        _ => Scalar::Str.name(),
     }
 }
 
@@ -307,14 +307,16 @@ pub(crate) fn type_entries(
     }
     for (entry, vs) in consts {
         let kinds: Vec<&str> = vs.iter().map(|(v, _)| literal_type(v)).collect();
-        let numeric = |k: &str| matches!(k, "int32" | "int64" | "float64");
+        let scalar = |k: &str| Scalar::from_exact_name(k);
+        let int = |k: &str| scalar(k).is_some_and(|s| s.int_range().is_some());
+        let numeric = |k: &str| int(k) || scalar(k) == Some(Scalar::F64);
         // Integers and decimals together make a float; other mixtures are conflicts.
-        let ty = if kinds.iter().all(|k| *k == "int32") {
-            "int32"
-        } else if kinds.iter().all(|k| k.starts_with("int")) {
-            "int64"
+        let ty = if kinds.iter().all(|k| scalar(k) == Some(Scalar::I32)) {
+            Scalar::I32.name()
+        } else if kinds.iter().all(|k| int(k)) {
+            Scalar::I64.name()
         } else if kinds.iter().all(|k| numeric(k)) {
-            "float64"
+            Scalar::F64.name()
         } else {
             kinds[0]
         };

@@ -12,7 +12,7 @@ use super::build::B;
 use super::control::{status_code, Ctx};
 use super::tree::{PortValue, TreeNode};
 use crate::model::source::{Diagnostic, FileId, SourceMap, Span};
-use crate::model::types::{BaseType, TypeExpr};
+use crate::model::types::{BaseType, Scalar, TypeExpr};
 use crate::model::xml::{self, Element, Node};
 
 /// A port's direction.
@@ -77,24 +77,8 @@ fn port_type_ok(ty: &str) -> bool {
         let d = d.trim().trim_start_matches('[').trim_start_matches("<=");
         d.is_empty() || d.parse::<u32>().is_ok()
     });
-    dims_ok
-        && matches!(
-            base,
-            "bool"
-                | "byte"
-                | "char"
-                | "int8"
-                | "int16"
-                | "int32"
-                | "int64"
-                | "uint8"
-                | "uint16"
-                | "uint32"
-                | "uint64"
-                | "float32"
-                | "float64"
-                | "string"
-        )
+    // The scalar names, plus ROS's `byte` and `char` (not `wstring`).
+    dims_ok && (matches!(base, "byte" | "char") || Scalar::from_exact_name(base).is_some())
 }
 
 fn contains_tag(el: &Element, tag: &str) -> bool {
@@ -261,16 +245,10 @@ fn int_fits(ty: &str, v: &str) -> bool {
     let Ok(n) = v.parse::<i128>() else {
         return false;
     };
-    let (lo, hi): (i128, i128) = match ty {
-        "int8" => (i8::MIN.into(), i8::MAX.into()),
-        "int16" => (i16::MIN.into(), i16::MAX.into()),
-        "int32" => (i32::MIN.into(), i32::MAX.into()),
-        "uint8" => (0, u8::MAX.into()),
-        "uint16" => (0, u16::MAX.into()),
-        "uint32" => (0, u32::MAX.into()),
-        "uint64" => (0, u64::MAX.into()),
-        _ => (i64::MIN.into(), i64::MAX.into()),
-    };
+    // Any other type holds what the simulator's integers hold.
+    let (lo, hi) = Scalar::from_exact_name(ty)
+        .and_then(Scalar::int_range)
+        .unwrap_or((i64::MIN.into(), i64::MAX.into()));
     (lo..=hi).contains(&n)
 }
 

@@ -410,16 +410,24 @@ impl Cx<'_> {
                             self.err(el.span, msg);
                             continue;
                         }
-                        match rate.trim().parse::<f64>() {
-                            Ok(r) if r > 0.0 && r.is_finite() && (1e9 / r).round() >= 1.0 => {
+                        // The one rate rule (`robot::rate`): exact when the period is whole;
+                        // otherwise rounded to the nanosecond, as before.
+                        match crate::robot::rate::period(rate.trim()) {
+                            Ok(p) => {
                                 self.timers.push(Timer {
                                     name: tname.clone(),
-                                    period_ns: (1e9 / r).round() as u64,
+                                    period_ns: p.period_ns,
                                     span: rspan,
                                 });
                                 d.timers.push((tname, self.timers.len() - 1));
                             }
-                            _ => self.err(
+                            Err(crate::robot::rate::RateError::TooSlow) => self.err(
+                                rspan,
+                                format!(
+                                    "`rate_hz` `{rate}` is slower than the slowest rate hindsight can time (one tick per 2^64 ns, about 584 years)"
+                                ),
+                            ),
+                            Err(_) => self.err(
                                 rspan,
                                 format!(
                                     "`rate_hz` must be a positive number of hertz, not `{rate}`"

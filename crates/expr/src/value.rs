@@ -131,7 +131,7 @@ impl TypeTable {
     }
 
     /// The default (initial) value of a type.
-    pub(crate) fn default_cell(&self, ty: &Ty) -> Cell {
+    pub fn default_cell(&self, ty: &Ty) -> Cell {
         match ty {
             Ty::Bool => Cell::Bool(false),
             Ty::Int | Ty::Unknown => Cell::Int(0),
@@ -150,17 +150,22 @@ impl TypeTable {
 
 /// Run-time storage of one value. Arrays and structs are lists of cells.
 #[derive(Debug, PartialEq)]
-pub(crate) enum Cell {
+pub enum Cell {
+    /// A boolean.
     Bool(bool),
+    /// An integer of any declared width.
     Int(i64),
+    /// A float of either declared width.
     Float(f64),
+    /// An interned string.
     Str(StrId),
+    /// An array, or a struct's fields in declaration order.
     List(List),
 }
 
 impl Cell {
     /// A list cell holding `items`.
-    pub(crate) fn list(items: Vec<Cell>) -> Cell {
+    pub fn list(items: Vec<Cell>) -> Cell {
         Cell::List(List::from(items))
     }
 }
@@ -194,7 +199,7 @@ impl Clone for Cell {
 /// allocate once it has been as long before. Reads see only the live elements (the list
 /// derefs to a slice of them).
 #[derive(Default)]
-pub(crate) struct List {
+pub struct List {
     /// Live elements first, then set-aside ones.
     items: Vec<Cell>,
     /// Number of live elements (at most `items.len()`).
@@ -242,12 +247,12 @@ impl std::ops::DerefMut for List {
 
 impl List {
     /// Keeps the first `n` elements; the others are set aside for reuse.
-    pub(crate) fn truncate(&mut self, n: usize) {
+    pub fn truncate(&mut self, n: usize) {
         self.len = self.len.min(n);
     }
 
     /// Appends a copy of `value`, into a set-aside element when there is one.
-    pub(crate) fn push_copy(&mut self, value: &Cell) {
+    pub fn push_copy(&mut self, value: &Cell) {
         match self.items.get_mut(self.len) {
             Some(c) => c.clone_from(value),
             None => self.items.push(value.clone()),
@@ -257,7 +262,7 @@ impl List {
 
     /// Grows to `n` elements with whatever set-aside elements hold (each is overwritten
     /// by the caller), then `Int(0)`s; or shrinks to `n`.
-    pub(crate) fn set_len(&mut self, n: usize) {
+    pub fn set_len(&mut self, n: usize) {
         while self.items.len() < n {
             self.items.push(Cell::Int(0));
         }
@@ -265,7 +270,7 @@ impl List {
     }
 
     /// Shrinks to `n`, or grows to `n` with copies of `fill`.
-    pub(crate) fn resize(&mut self, n: usize, fill: &Cell) {
+    pub fn resize(&mut self, n: usize, fill: &Cell) {
         self.truncate(n);
         while self.len < n {
             self.push_copy(fill);
@@ -273,7 +278,7 @@ impl List {
     }
 
     /// Becomes a copy of `src`, reusing its own elements' buffers.
-    pub(crate) fn assign(&mut self, src: &List) {
+    pub fn assign(&mut self, src: &List) {
         self.truncate(src.len());
         let live = self.len;
         for (d, s) in self.iter_mut().zip(src.iter()) {
@@ -306,7 +311,7 @@ pub enum Value<'a> {
 
 /// The elements of an array (or fields of a struct) in a [`Value::List`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ListRef<'a>(pub(crate) &'a [Cell]);
+pub struct ListRef<'a>(pub &'a [Cell]);
 
 impl<'a> ListRef<'a> {
     /// Number of elements.
@@ -331,7 +336,8 @@ impl<'a> ListRef<'a> {
 }
 
 impl<'a> Value<'a> {
-    pub(crate) fn of(c: &'a Cell) -> Value<'a> {
+    /// A view of a cell.
+    pub fn of(c: &'a Cell) -> Value<'a> {
         match c {
             Cell::Bool(b) => Value::Bool(*b),
             Cell::Int(v) => Value::Int(*v),

@@ -13,7 +13,7 @@ mod place;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use place::{compile_place, Place};
+pub use place::{compile_place, Place};
 
 /// Source of randomness for `Math.random()`: any [`rand_core::Rng`].
 pub trait Entropy {
@@ -28,12 +28,12 @@ impl<R: rand_core::Rng + ?Sized> Entropy for R {
 }
 
 /// A uniform float in `[0, 1)` with 53 random bits.
-pub(crate) fn unit_f64(rng: &mut dyn Entropy) -> f64 {
+pub fn unit_f64(rng: &mut dyn Entropy) -> f64 {
     (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
 /// What an expression can read while it is evaluated.
-pub(crate) struct Env<'a> {
+pub struct Env<'a> {
     /// The machine's datamodel, by slot.
     pub vars: &'a [Cell],
     /// The current event's parameters, by index (empty when there is none).
@@ -50,26 +50,37 @@ pub(crate) struct Env<'a> {
 
 /// Why an evaluation failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum EvalErrorKind {
+pub enum EvalErrorKind {
     /// Integer `%` by zero.
     DivByZero,
     /// Array index out of range (reads), or negative (writes).
-    Index { index: i64, len: usize },
+    Index {
+        /// The index used.
+        index: i64,
+        /// The array's length.
+        len: usize,
+    },
     /// An array would grow past its declared maximum length.
-    TooLong { bound: u32 },
+    TooLong {
+        /// The declared maximum length.
+        bound: u32,
+    },
     /// A value did not have its static type (a compiler bug, reported not panicked).
     Internal,
 }
 
 /// An evaluation error at a byte offset of the expression text.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct EvalError {
+pub struct EvalError {
+    /// Byte offset (as mapped by [`Scope::abs`]).
     pub at: u32,
+    /// What went wrong.
     pub kind: EvalErrorKind,
 }
 
 impl EvalError {
-    pub(crate) fn message(&self) -> String {
+    /// The error as a sentence, without its position.
+    pub fn message(&self) -> String {
         match self.kind {
             EvalErrorKind::DivByZero => "integer remainder by zero".into(),
             EvalErrorKind::Index { index, len } => {
@@ -92,32 +103,42 @@ fn internal(at: u32) -> EvalError {
     }
 }
 
-pub(crate) type BoolFn = Box<dyn Fn(&mut Env<'_>) -> Res<bool> + Send + Sync>;
-pub(crate) type IntFn = Box<dyn Fn(&mut Env<'_>) -> Res<i64> + Send + Sync>;
-pub(crate) type FloatFn = Box<dyn Fn(&mut Env<'_>) -> Res<f64> + Send + Sync>;
-pub(crate) type StrFn = Box<dyn Fn(&mut Env<'_>) -> Res<StrId> + Send + Sync>;
+/// Compiled code of a boolean expression.
+pub type BoolFn = Box<dyn Fn(&mut Env<'_>) -> Res<bool> + Send + Sync>;
+/// Compiled code of an integer expression.
+pub type IntFn = Box<dyn Fn(&mut Env<'_>) -> Res<i64> + Send + Sync>;
+/// Compiled code of a float expression.
+pub type FloatFn = Box<dyn Fn(&mut Env<'_>) -> Res<f64> + Send + Sync>;
+/// Compiled code of a string expression (an interned id).
+pub type StrFn = Box<dyn Fn(&mut Env<'_>) -> Res<StrId> + Send + Sync>;
 /// Writes a value (of any type) into a caller-owned cell, reusing its buffers.
-pub(crate) type CellFn = Box<dyn Fn(&mut Env<'_>, &mut Cell) -> Res<()> + Send + Sync>;
+pub type CellFn = Box<dyn Fn(&mut Env<'_>, &mut Cell) -> Res<()> + Send + Sync>;
 
 /// Compiled code of one expression, by result type.
-pub(crate) enum Code {
+pub enum Code {
+    /// A boolean.
     Bool(BoolFn),
+    /// An integer (every width is `i64`).
     Int(IntFn),
+    /// A float (`float32` and `float64` are `f64`).
     Float(FloatFn),
+    /// A string.
     Str(StrFn),
     /// Arrays and structs.
     Comp(CellFn),
 }
 
 /// A compiled expression and its static type.
-pub(crate) struct Typed {
+pub struct Typed {
+    /// The static type.
     pub ty: Ty,
+    /// The code, by result type.
     pub code: Code,
 }
 
 impl Typed {
     /// A closure that writes the value into a cell, whatever its type.
-    pub(crate) fn into_cell_fn(self) -> CellFn {
+    pub fn into_cell_fn(self) -> CellFn {
         match self.code {
             Code::Bool(f) => Box::new(move |e, d| {
                 *d = Cell::Bool(f(e)?);
@@ -142,8 +163,10 @@ impl Typed {
 
 /// A compile error at a byte offset of the expression text.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub(crate) struct CompileError {
+pub struct CompileError {
+    /// Byte offset in the expression text.
     pub at: u32,
+    /// The message, without its position.
     pub msg: String,
     /// The error is only that an event parameter's type is not known yet
     /// (type inference of parameters retries these).
@@ -155,7 +178,7 @@ pub(crate) struct CompileError {
 
 /// The message of a read of a parameter whose type is not known: the model compiler
 /// matches it to the parameter's own report.
-pub(crate) fn unknown_param_type(field: &str, event: &str) -> String {
+pub fn unknown_param_type(field: &str, event: &str) -> String {
     format!("type of parameter `{field}` of event `{event}` is not known")
 }
 
@@ -178,18 +201,20 @@ fn cerr(at: u32, msg: impl Into<String>) -> CompileError {
 
 /// The event whose `_event` an expression may read.
 #[derive(Clone, Copy)]
-pub(crate) enum EventScope<'a> {
+pub enum EventScope<'a> {
     /// No event (eventless transitions, `<onentry>`, `<datamodel>`).
     None,
     /// A triggering event: its name and parameters (`None` type: not inferred yet).
     Event {
+        /// The event's name.
         name: &'a str,
+        /// Its parameters, by index.
         params: &'a [(String, Option<Ty>)],
     },
 }
 
 /// Names an expression can refer to.
-pub(crate) struct Scope<'a> {
+pub struct Scope<'a> {
     /// The machine's datamodel: slot `i` is `vars[i]`.
     pub vars: &'a [(String, Ty)],
     /// The current event.
@@ -202,7 +227,7 @@ pub(crate) struct Scope<'a> {
 }
 
 /// Maximum number of `[i]`/`.f` steps in one access path.
-pub(crate) const MAX_PATH: usize = 8;
+pub const MAX_PATH: usize = 8;
 
 enum Root {
     Var(u32),
@@ -260,7 +285,7 @@ impl Path {
 }
 
 /// Compiles `expr`; `expect` types array literals (and lets `[]` take the declared type).
-pub(crate) fn compile(
+pub fn compile(
     expr: &Expr,
     scope: &Scope<'_>,
     strings: &mut Strings,
@@ -271,7 +296,7 @@ pub(crate) fn compile(
 }
 
 /// Compiles `expr` and converts it to `target` (int to float, `[]` to any array).
-pub(crate) fn compile_as(
+pub fn compile_as(
     expr: &Expr,
     scope: &Scope<'_>,
     strings: &mut Strings,
@@ -292,7 +317,7 @@ pub(crate) fn compile_as(
 }
 
 /// Converts to `target` when allowed; `Err(found type)` otherwise.
-pub(crate) fn coerce(t: Typed, target: &Ty, types: &TypeTable) -> Result<Typed, Ty> {
+pub fn coerce(t: Typed, target: &Ty, types: &TypeTable) -> Result<Typed, Ty> {
     if assignable(&t.ty, target) {
         return Ok(match (t.code, target) {
             (Code::Int(f), Ty::Float) => Typed {
@@ -310,7 +335,7 @@ pub(crate) fn coerce(t: Typed, target: &Ty, types: &TypeTable) -> Result<Typed, 
 }
 
 /// True when a value of type `from` may be stored where `to` is expected.
-pub(crate) fn assignable(from: &Ty, to: &Ty) -> bool {
+pub fn assignable(from: &Ty, to: &Ty) -> bool {
     match (from, to) {
         (a, b) if a == b => true,
         (Ty::Int, Ty::Float) => true,
@@ -330,7 +355,7 @@ fn array_elem_assignable(a: &Ty, b: &Ty) -> bool {
 }
 
 /// The common type of two branches or array items.
-pub(crate) fn unify(a: &Ty, b: &Ty) -> Option<Ty> {
+pub fn unify(a: &Ty, b: &Ty) -> Option<Ty> {
     match (a, b) {
         (x, y) if x == y => Some(x.clone()),
         (Ty::Int, Ty::Float) | (Ty::Float, Ty::Int) => Some(Ty::Float),

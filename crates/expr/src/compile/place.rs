@@ -35,7 +35,7 @@ pub(super) fn project(p: Path, fi: u32, ty: Ty) -> Typed {
 }
 
 /// An assignable location: a variable, then indices and fields.
-pub(crate) struct Place {
+pub struct Place {
     /// Variable slot.
     pub var: u32,
     steps: Vec<PlaceStep>,
@@ -188,7 +188,7 @@ impl Place {
 }
 
 /// Compiles the left-hand side of an `<assign>`.
-pub(crate) fn compile_place(
+pub fn compile_place(
     e: &Expr,
     scope: &Scope<'_>,
     strings: &mut Strings,

@@ -11,6 +11,44 @@
 //!
 //! A fixed-size study does not stop early: every property sees all `N` runs, and the
 //! rule only provides the interval (and, for Wald's test, the answer on those counts).
+//!
+//! ```
+//! use hindsight_smc::{
+//!     merge, run_fixed_study, run_shard, FixedStudy, PartialResult, PropertySpec, RuleConfig,
+//!     RunEnd, RunOutcome, Shard, StudyConfig, Verdict,
+//! };
+//! use rand_core::Rng;
+//!
+//! let study = FixedStudy {
+//!     seed: 3,
+//!     study_runs: 100,
+//!     model: "model hash".into(),
+//!     properties_fingerprint: "properties hash".into(),
+//!     properties: vec![PropertySpec { id: "p".into(), rule: RuleConfig::default() }],
+//!     paths: None,
+//! };
+//! let run = |_: u64, rng: &mut rand_xoshiro::Xoshiro256PlusPlus| RunOutcome {
+//!     verdicts: vec![if rng.next_u64() % 2 == 0 { Verdict::True } else { Verdict::False }],
+//!     assumptions: Verdict::True,
+//!     end: RunEnd::Quiescent,
+//!     steps: 1,
+//!     time: 0,
+//! };
+//! let config = StudyConfig::default();
+//! // Two machines each run one half and write JSON...
+//! let parts: Vec<PartialResult> = ["0/2", "1/2"]
+//!     .iter()
+//!     .map(|s| run_shard(&config, &study, s.parse::<Shard>().unwrap(), run, &mut |_| {}))
+//!     .map(|part| PartialResult::from_json(&part.to_json()).unwrap())
+//!     .collect();
+//! // ...and the merge counts exactly what one machine counts.
+//! let merged = merge(&parts, 0).unwrap();
+//! let whole = run_fixed_study(&config, &study, run, &mut |_| {}).unwrap();
+//! assert_eq!(merged.properties[0].counts, whole.properties[0].counts);
+//! assert_eq!(merged.properties[0].counts.judged(), 100);
+//! // A shard missing is an error, not a smaller study.
+//! assert!(merge(&parts[..1], 0).is_err());
+//! ```
 
 use std::collections::BTreeMap;
 use std::fmt;

@@ -12,7 +12,7 @@ use super::runner::Progress;
 /// so that a long study is never silent.
 ///
 /// ```no_run
-/// # use hindsight::smc::progress::TerminalProgress;
+/// # use hindsight_smc::progress::TerminalProgress;
 /// let mut bar = TerminalProgress::stderr();
 /// // run_study(&config, &rules, run, &mut |p| bar.update(p));
 /// ```
