@@ -12,6 +12,8 @@
 //! Every test uses its own random ROS_DOMAIN_ID, so tests running in parallel (and other
 //! DDS traffic on the machine) do not meet.
 
+mod common;
+
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
@@ -29,26 +31,12 @@ fn data(name: &str) -> PathBuf {
     repo().join("host/tests/data/dds").join(name)
 }
 
-/// The Python of the project's environment, if it has Cyclone DDS and the MCAP reader.
+/// The Python of the project's environment, if it has what these tests need.
 fn python() -> Option<PathBuf> {
-    let env = std::env::var_os("HINDSIGHT_PYENV")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join(".venv"));
-    let py = env.join("bin/python");
-    let ok = Command::new(&py)
-        .args(["-c", "import cyclonedds.domain, mcap, mcap_ros2"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if ok {
-        return Some(py);
-    }
-    let why = format!(
-        "skipped: no Python environment with cyclonedds, mcap and mcap-ros2-support at {}: run `bash scripts/pyenv`",
-        env.display()
-    );
-    assert!(std::env::var("CI").as_deref() != Ok("true"), "{why}");
-    eprintln!("{why}");
-    None
+    common::pyenv::python_with(
+        &["cyclonedds.domain", "mcap", "mcap_ros2"],
+        "cyclonedds, mcap and mcap-ros2-support",
+    )
 }
 
 /// A domain for one test: random, from the process, the test and the clock.

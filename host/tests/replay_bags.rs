@@ -7,6 +7,8 @@
 //! `$HINDSIGHT_PYENV` or `.venv`). Without it these tests say they were skipped and pass,
 //! except under `CI=true`, where `.ci/run` has created it and they fail.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
@@ -22,26 +24,12 @@ fn data(name: &str) -> PathBuf {
     repo().join("host/tests/data/ros2").join(name)
 }
 
-/// The Python of the project's environment, if it has the writers.
+/// The Python of the project's environment, if it has what these tests need.
 fn python() -> Option<PathBuf> {
-    let env = std::env::var_os("HINDSIGHT_PYENV")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| repo().join(".venv"));
-    let py = env.join("bin/python");
-    let ok = Command::new(&py)
-        .args(["-c", "import rosbags, mcap, mcap_ros2"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if ok {
-        return Some(py);
-    }
-    let why = format!(
-        "skipped: no Python environment with rosbags, mcap and mcap-ros2-support at {}: run `bash scripts/pyenv`",
-        env.display()
-    );
-    assert!(std::env::var("CI").as_deref() != Ok("true"), "{why}");
-    eprintln!("{why}");
-    None
+    common::pyenv::python_with(
+        &["rosbags", "mcap", "mcap_ros2"],
+        "rosbags, mcap and mcap-ros2-support",
+    )
 }
 
 /// The recordings and the CSV, written once per test process.
