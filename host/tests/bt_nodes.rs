@@ -499,9 +499,17 @@ fn bad_trees_exit_2_with_their_position() {
     // A BT.CPP node hindsight does not support: named as such, with the reason.
     refused(
         "unsupported",
+        &v4("<Sequence>\n<ManualSelector>\n<AlwaysSuccess/>\n</ManualSelector>\n</Sequence>"),
+        "<ManualSelector",
+        "BehaviorTree.CPP built-in node `ManualSelector` is not supported by hindsight: it asks a person",
+    );
+    // A timed node has no AS2FM model: the default semantics refuses it, naming the one
+    // that lowers it.
+    refused(
+        "timed",
         &v4("<Sequence>\n<Delay delay_msec=\"10\">\n<AlwaysSuccess/>\n</Delay>\n</Sequence>"),
         "<Delay",
-        "BehaviorTree.CPP built-in node `Delay` is not supported by hindsight: it needs a wall-clock timer",
+        "`Delay` is a BehaviorTree.CPP 4 node that AS2FM has no model of, so the default semantics (`--bt as2fm`) cannot lower it: use `--bt btcpp`",
     );
     // `hindsight verify` refuses the same way.
     let t = v4("<Sequence>\n  <Frobnicate/>\n</Sequence>");

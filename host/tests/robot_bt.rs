@@ -955,14 +955,14 @@ fn unknown_nodes_and_plugins_are_errors_at_their_position() {
         "<Frobnicate",
         "unknown node `Frobnicate`",
     );
-    let t = wrap("<Timeout msec=\"10\">\n<AlwaysSuccess/>\n</Timeout>");
+    let t = wrap("<ManualSelector>\n<AlwaysSuccess/>\n</ManualSelector>");
     one_error(
         &t,
         &[],
         "t.xml",
         &t,
-        "<Timeout",
-        "`Timeout` is not supported",
+        "<ManualSelector",
+        "`ManualSelector` is not supported",
     );
     let t = wrap("<Action ID=\"Nope\" n=\"1\"/>");
     one_error(&t, &[COUNT], "t.xml", &t, "Nope", "plugins: Count");

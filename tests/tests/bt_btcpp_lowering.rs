@@ -15,7 +15,7 @@
 
 mod bt_common;
 
-use bt_common::{diff, lower_and_run, show, Drive, Run};
+use bt_common::{diff, lower_and_run, lower_and_run_clocked, show, Drive, Run};
 use hindsight::robot::bt::{BtSemantics, BtTick, Halts};
 use hindsight::sim::EndReason;
 use hindsight_tests::bt::gen;
@@ -80,6 +80,31 @@ fn lowered(
         max_steps: 1_000_000,
     };
     let ((statuses, log), end) = lower_and_run(xml_text, scripts, &drive)?;
+    match end {
+        EndReason::MaxSteps | EndReason::Spin(_) if statuses.len() < ticks => {
+            Ok(Outcome::Livelock((statuses, log)))
+        }
+        EndReason::Error(e) => Err(format!("run-time error: {e:?}")),
+        _ => Ok(Outcome::Ran((statuses, log))),
+    }
+}
+
+/// Lowers `xml` under BT.CPP's rules and runs `ticks` executor ticks with the lowered
+/// root machine itself (it keeps the timers of Timeout, Delay and Sleep) at 10 Hz in
+/// model time (`bt_common::lower_and_run_clocked`), the oracle's default period.
+fn lowered_clocked(
+    xml_text: &str,
+    scripts: &Scripts,
+    ticks: usize,
+    tick: BtTick,
+) -> Result<Outcome, String> {
+    let ((statuses, log), end) = lower_and_run_clocked(
+        xml_text,
+        scripts,
+        BtSemantics::Btcpp { tick },
+        ticks,
+        1_000_000,
+    )?;
     match end {
         EndReason::MaxSteps | EndReason::Spin(_) if statuses.len() < ticks => {
             Ok(Outcome::Livelock((statuses, log)))
@@ -445,11 +470,24 @@ fn random_trees_with_btcpp4_nodes_lower_to_what_btcpp_does() {
     random_trees(gen::Options {
         btcpp4_nodes: true,
         scripts: false,
+        ..Default::default()
     });
 }
 
-/// The kinds of BT.CPP 4's own nodes, as the coverage check names them.
-const BTCPP4_KINDS: [&str; 7] = [
+/// The same with BT.CPP 4's timed nodes (Timeout, Delay, Sleep) and 4.10's TryCatch,
+/// run by the lowered root machine in model time at 10 Hz (the oracle's default period).
+#[test]
+fn random_trees_with_time_nodes_lower_to_what_btcpp_does() {
+    random_trees(gen::Options {
+        time_nodes: true,
+        try_catch: true,
+        ..Default::default()
+    });
+}
+
+/// The kinds of BT.CPP 4's own nodes, as the coverage check names them: those of
+/// `gen::Options::btcpp4_nodes`, then those of `time_nodes` and `try_catch`.
+const BTCPP4_KINDS: [&str; 11] = [
     "AsyncSequence",
     "AsyncFallback",
     "ParallelAll",
@@ -457,6 +495,10 @@ const BTCPP4_KINDS: [&str; 7] = [
     "KeepRunningUntilFailure",
     "RunOnce",
     "Switch",
+    "Timeout",
+    "Delay",
+    "Sleep",
+    "TryCatch",
 ];
 
 /// Which of [`BTCPP4_KINDS`] node kind `k` is.
@@ -469,6 +511,10 @@ fn btcpp4_kind(k: &Kind) -> Option<usize> {
         Kind::KeepRunningUntilFailure => 4,
         Kind::RunOnce => 5,
         Kind::Switch(..) => 6,
+        Kind::Timeout(_) => 7,
+        Kind::Delay(_) => 8,
+        Kind::Sleep(_) => 9,
+        Kind::TryCatch(_) => 10,
         _ => return None,
     })
 }
@@ -477,6 +523,7 @@ fn btcpp4_kind(k: &Kind) -> Option<usize> {
 /// tick modes and compared with the oracle's BT.CPP 4 reading.
 fn random_trees(opts: gen::Options) {
     let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let timed = opts.time_nodes || opts.try_catch;
     let seed0 = env("HINDSIGHT_BT_SEED", 0);
     let threads = std::thread::available_parallelism()
         .map_or(1, |p| p.get())
@@ -488,7 +535,7 @@ fn random_trees(opts: gen::Options) {
     let counts: [AtomicUsize; 6] = Default::default();
     let counts = &counts;
     // Trees compared that hold each of BT.CPP 4's own node kinds.
-    let kinds: [AtomicUsize; 7] = Default::default();
+    let kinds: [AtomicUsize; 11] = Default::default();
     let kinds = &kinds;
     let fails: Vec<String> = std::thread::scope(|s| {
         let hs: Vec<_> = (0..threads)
@@ -514,7 +561,7 @@ fn random_trees(opts: gen::Options) {
                             continue;
                         }
                         let refused = oracle::btcpp4_refuses(&t, &c.scripts).is_some();
-                        let mut seen = [false; 7];
+                        let mut seen = [false; 11];
                         for x in &t.nodes {
                             if let Some(k) = btcpp4_kind(&x.kind) {
                                 seen[k] = true;
@@ -536,7 +583,11 @@ fn random_trees(opts: gen::Options) {
                             }
                             let problem = match (
                                 oracle::run_with(&t, &c.scripts, Options::xml4(mode), c.ticks),
-                                lowered(&c.xml, &c.scripts, c.ticks, tick),
+                                if timed {
+                                    lowered_clocked(&c.xml, &c.scripts, c.ticks, tick)
+                                } else {
+                                    lowered(&c.xml, &c.scripts, c.ticks, tick)
+                                },
                             ) {
                                 (Ok(w), Ok(g)) => {
                                     by_mode.push((w.statuses.clone(), w.log.clone()));
@@ -610,8 +661,13 @@ fn random_trees(opts: gen::Options) {
             "only {modes_differ} trees run differently under the two tick modes"
         );
         // With BT.CPP 4's own nodes on, each kind is in at least one tree in 100.
-        for (k, c) in BTCPP4_KINDS.iter().zip(kinds) {
-            if opts.btcpp4_nodes {
+        for (i, (k, c)) in BTCPP4_KINDS.iter().zip(kinds).enumerate() {
+            let on = match i {
+                0..=6 => opts.btcpp4_nodes,
+                7..=9 => opts.time_nodes,
+                _ => opts.try_catch,
+            };
+            if on {
                 assert!(c as u64 >= n / 100, "only {c} compared trees with {k}");
             } else {
                 assert_eq!(c, 0, "{k} generated with btcpp4_nodes off");
@@ -728,7 +784,7 @@ fn random_trees_with_btcpp4_nodes_lower_to_what_the_real_library_does() {
     // Format-4 trees the library loads and whose SetBlackboard nodes write constants
     // (a copy fails or throws in 4.8.2; the lowering copies, see above).
     let mut cases = Vec::new();
-    let mut kinds = [0usize; 7];
+    let mut kinds = [0usize; 11];
     for seed in seed0.. {
         if cases.len() >= n {
             break;
@@ -740,6 +796,7 @@ fn random_trees_with_btcpp4_nodes_lower_to_what_the_real_library_does() {
             gen::Options {
                 btcpp4_nodes: true,
                 scripts: false,
+                ..Default::default()
             },
         );
         if c.xml.contains("BTCPP_format=\"3\"") {
@@ -753,7 +810,7 @@ fn random_trees_with_btcpp4_nodes_lower_to_what_the_real_library_does() {
         {
             continue;
         }
-        let mut seen = [false; 7];
+        let mut seen = [false; 11];
         for x in &t.nodes {
             if let Some(k) = btcpp4_kind(&x.kind) {
                 seen[k] = true;
@@ -849,7 +906,7 @@ fn random_trees_with_btcpp4_nodes_lower_to_what_the_real_library_does() {
         fails.iter().take(5).cloned().collect::<Vec<_>>().join("\n")
     );
     if n >= 500 {
-        for (k, c) in BTCPP4_KINDS.iter().zip(kinds) {
+        for (k, c) in BTCPP4_KINDS.iter().zip(kinds).take(7) {
             assert!(c >= n / 100, "only {c} trees with {k}");
         }
     }

@@ -358,6 +358,7 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
         let opts = gen::Options {
             btcpp4_nodes: true,
             scripts: false,
+            ..Default::default()
         };
         let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
         if c.xml.contains("BTCPP_format=\"3\"") {
@@ -383,6 +384,7 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
         let opts = gen::Options {
             btcpp4_nodes: true,
             scripts: true,
+            ..Default::default()
         };
         let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
         if c.xml.contains("<Script ") {
@@ -535,4 +537,195 @@ fn where_as2fm_and_btcpp_differ() {
             }
         }
     }
+}
+
+/// The executor period of [`timed_nodes_agree_with_the_real_library`], in the real
+/// library's wall-clock milliseconds; the oracle runs the same trees at its default
+/// 100 ms with every duration scaled by 100/60.
+const REAL_PERIOD_MS: u64 = 60;
+
+/// The `msec` / `delay_msec` values of a generated tree: `(attribute, value)`.
+fn durations(xml: &str) -> Vec<(&'static str, u64)> {
+    let mut out = Vec::new();
+    for key in ["delay_msec", "msec"] {
+        let pat = format!(" {key}=\"");
+        let mut rest = xml;
+        while let Some(i) = rest.find(&pat) {
+            rest = &rest[i + pat.len()..];
+            let end = rest.find('"').unwrap_or(0);
+            out.push((key, rest[..end].parse().unwrap_or(u64::MAX)));
+        }
+    }
+    out
+}
+
+/// BT.CPP 4's Timeout, Delay and Sleep against the real library, with wall-clock timers:
+/// random format-4 trees with timed nodes (`gen::Options::time_nodes`), ticked every
+/// [`REAL_PERIOD_MS`] ms by the harness (`Real::run_paced`), both tick modes, against the
+/// oracle's virtual time at 100 ms per tick (durations scaled alike).
+///
+/// The comparison needs margins, since the library's timers run on other threads on
+/// wall-clock time: only durations that are an odd number of half periods are kept
+/// (30, 90, 150, 210 ms at 60 ms), so that every timer, started by a tick, falls half a
+/// period from any tick; a timer due at a tick (a multiple of the period, or a Delay of
+/// 0 ms, whose callback races with the rest of its own tick) is a race in the library
+/// and such trees are left out. The harness ends a case as "late" when a tick ends more
+/// than a quarter period after its time (the machine too loaded for the margins): such
+/// a case, and one that disagrees, is run again, up to twice; what still disagrees
+/// fails the test. `HINDSIGHT_BT_REAL_TIME_TREES` sets the count (default 60).
+#[test]
+fn timed_nodes_agree_with_the_real_library() {
+    let Some(first) = harness() else { return };
+    let n = env("HINDSIGHT_BT_REAL_TIME_TREES", 60) as usize;
+    let seed0 = env("HINDSIGHT_BT_SEED", 0) + 3_000_000;
+    let start = std::time::Instant::now();
+    // (name, oracle's xml, library's xml, scripts, ticks)
+    let mut cases = Vec::new();
+    for seed in seed0.. {
+        if cases.len() >= n {
+            break;
+        }
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let opts = gen::Options {
+            time_nodes: true,
+            ..Default::default()
+        };
+        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
+        let ds = durations(&c.xml);
+        if c.xml.contains("BTCPP_format=\"3\"")
+            || ds.is_empty()
+            || ds
+                .iter()
+                .any(|&(k, d)| d % 100 == 0 && (d > 0 || k == "delay_msec"))
+        {
+            continue;
+        }
+        let mut lib_xml = c.xml.clone();
+        for d in [50u64, 150, 250, 350] {
+            let scaled = d * REAL_PERIOD_MS / 100;
+            lib_xml = lib_xml.replace(&format!("msec=\"{d}\""), &format!("msec=\"{scaled}\""));
+        }
+        cases.push((
+            format!("time seed {seed}"),
+            c.xml,
+            lib_xml,
+            c.scripts,
+            c.ticks,
+        ));
+    }
+    let mut wants = Vec::new();
+    let mut reqs = Vec::new();
+    let mut fails = Vec::new();
+    for (name, xml, lib_xml, scripts, ticks) in &cases {
+        for mode in MODES {
+            match expect(xml, scripts, *ticks, mode) {
+                Ok(w) => {
+                    wants.push((name.clone(), xml.clone(), scripts.clone(), *ticks, mode, w));
+                    reqs.push(Request {
+                        xml: lib_xml.clone(),
+                        scripts: scripts.clone(),
+                        ticks: *ticks,
+                        mode,
+                        budget: BUDGET,
+                        read: Vec::new(),
+                    });
+                }
+                Err(e) => fails.push(format!("{name}: the oracle: {e}")),
+            }
+        }
+    }
+    // Paced runs mostly sleep: a few harnesses side by side.
+    let threads = 3;
+    let chunk = reqs.len().div_ceil(threads).max(1);
+    let mut libs = vec![first];
+    let answers: Vec<real::Answer> = std::thread::scope(|s| {
+        while libs.len() < reqs.chunks(chunk).len() {
+            let py = real::python().expect("the first harness started");
+            libs.push(Real::start(&py).expect("a second harness"));
+        }
+        let hs: Vec<_> = libs
+            .iter_mut()
+            .zip(reqs.chunks(chunk))
+            .map(|(lib, part)| s.spawn(move || lib.run_paced(part, REAL_PERIOD_MS)))
+            .collect();
+        hs.into_iter()
+            .flat_map(|h| h.join().expect("worker").unwrap_or_else(|e| panic!("{e}")))
+            .collect()
+    });
+    let judge = |i: usize, a: &real::Answer| -> Result<Option<String>, ()> {
+        if a.end.as_ref().is_some_and(|e| e.0 == "late") {
+            return Err(());
+        }
+        let (name, xml, scripts, ticks, mode, (tree, want)) = &wants[i];
+        Ok(match real::outcome(tree.as_ref(), a) {
+            Err(e) => Some(format!("{name}: {e}")),
+            Ok(got) => differ(want, &got)
+                .map(|d| format!("{name}: {d}\n{}", show(xml, scripts, *ticks, *mode))),
+        })
+    };
+    let mut pending: Vec<usize> = Vec::new();
+    let mut late = 0;
+    for (i, a) in answers.iter().enumerate() {
+        match judge(i, a) {
+            Ok(None) => {}
+            Ok(Some(_)) | Err(()) => pending.push(i),
+        }
+    }
+    let first_pass = pending.len();
+    let mut last = Vec::new();
+    for _round in 0..2 {
+        if pending.is_empty() {
+            break;
+        }
+        let again: Vec<Request> = pending.iter().map(|&i| reqs[i].clone()).collect();
+        let answers = libs[0]
+            .run_paced(&again, REAL_PERIOD_MS)
+            .unwrap_or_else(|e| panic!("{e}"));
+        last.clear();
+        let mut still = Vec::new();
+        late = 0;
+        for (&i, a) in pending.iter().zip(&answers) {
+            match judge(i, a) {
+                Ok(None) => {}
+                Ok(Some(d)) => {
+                    still.push(i);
+                    last.push(d);
+                }
+                Err(()) => {
+                    still.push(i);
+                    late += 1;
+                }
+            }
+        }
+        pending = still;
+    }
+    let counts = wants.iter().fold(Counts::default(), |mut c, w| {
+        c.add(&w.5 .1);
+        c
+    });
+    eprintln!(
+        "{} random trees with Timeout, Delay or Sleep, {} runs (tickOnce and tickExactlyOnce) \
+         in BT.CPP {} (behaviortreepy {}), ticked every {REAL_PERIOD_MS} ms, against the \
+         oracle's virtual time: {} ran every tick; {first_pass} run again (late or \
+         disagreeing on the first pass), {} still disagreeing, {late} still late; {:.1} s",
+        cases.len(),
+        reqs.len(),
+        libs[0].version,
+        libs[0].binding,
+        counts.ran_all,
+        last.len(),
+        start.elapsed().as_secs_f64(),
+    );
+    fails.extend(last);
+    assert!(
+        fails.is_empty(),
+        "{} disagreements:\n{}",
+        fails.len(),
+        fails.join("\n")
+    );
+    assert!(
+        late * 10 <= reqs.len(),
+        "{late} of {} runs could not keep their ticks on time",
+        reqs.len()
+    );
 }

@@ -5,10 +5,15 @@
 # Protocol: one JSON object per line on stdin, one answer per line on stdout.
 #   first line out: {"version": "<BT.CPP version>", "binding": "<behaviortreepy version>"}
 #   in:  {"xml": str, "scripts": {type: ["SUCCESS"|"FAILURE"|"RUNNING", ...]},
-#         "ticks": int, "mode": "once"|"exactly_once", "budget": int, "read": [entry]}
+#         "ticks": int, "mode": "once"|"exactly_once", "budget": int, "read": [entry],
+#         "period_ms": int (optional)}
 #   out: {"statuses": [str], "log": [["T"|"H", uid, type], ...], "end": null |
 #         {"kind": "load"|"tick"|"livelock", "tick": int, "text": str},
 #         "vars": {entry: int | null}}
+# `period_ms` (optional) paces the ticks: tick i begins at i * period_ms after the first,
+# as an executor on a timer does (the timers of Timeout, Delay and Sleep run on wall-clock
+# time); a tick that begins or ends more than a quarter period after its time ends the
+# case as {"kind": "late"} (the machine was too loaded for the margins the test relies on).
 # `read` (optional) names root blackboard entries to read as integers after the last
 # tick (a boolean reads as 0 or 1; null: missing or not a number).
 # A scripted leaf is a stateful action: on its k-th callback (on_start or on_running)
@@ -25,6 +30,7 @@ import ctypes
 import json
 import os
 import sys
+import time
 
 import behaviortreepy as bt
 import behaviortreepy._behaviortreepy as native
@@ -103,14 +109,26 @@ def run(req):
         end = {"kind": "load", "tick": 0, "text": str(e)}
     if tree is not None:
         tick = tree.tick_once if req["mode"] == "once" else tree.tick_exactly_once
+        period = req.get("period_ms")
+        t0 = time.monotonic()
         for i in range(req["ticks"]):
             mark = len(c.log)
             c.calls = 0
+            if period:
+                due = t0 + i * period / 1000.0
+                wait = due - time.monotonic()
+                if wait > 0:
+                    time.sleep(wait)
             try:
                 s = tick()
             except Exception as e:
                 end = {"kind": "tick", "tick": i, "text": str(e)}
                 break
+            if period:
+                late = (time.monotonic() - due) * 1000.0
+                if late > period / 4.0:
+                    end = {"kind": "late", "tick": i, "text": "tick %d ended %.1f ms after its time" % (i, late)}
+                    break
             if c.over:
                 del c.log[mark:]
                 end = {"kind": "livelock", "tick": i, "text": "over budget"}

@@ -52,6 +52,15 @@ pub struct Options {
     /// small (no product of two entries), so nothing overflows. Off, the generator draws
     /// what it drew before.
     pub scripts: bool,
+    /// BT.CPP 4's timed nodes (format-4 trees only): Timeout, Delay and Sleep, with
+    /// durations that are multiples of half the oracle's default period (0 to 350 ms at
+    /// 100 ms), so that timers fall between ticks and on them. Off, the generator draws
+    /// what it drew before.
+    pub time_nodes: bool,
+    /// TryCatch (BT.CPP 4.10 only, not in the 4.8.2 library), with and without
+    /// `catch_on_halt` (format-4 trees only). Off, the generator draws what it drew
+    /// before.
+    pub try_catch: bool,
 }
 
 /// The script entries: `x`, `y` integers, `f` a boolean, all written first by the main
@@ -351,6 +360,38 @@ impl<R: Rng> G<'_, R> {
         }
     }
 
+    /// A timed node ([`Options::time_nodes`]) or a TryCatch ([`Options::try_catch`]).
+    fn time_node(&mut self, depth: u32) -> String {
+        let kinds: &[u64] = match (self.opts.time_nodes, self.opts.try_catch) {
+            (true, true) => &[0, 1, 2, 3],
+            (true, false) => &[0, 1, 2],
+            _ => &[3],
+        };
+        let ms = ["0", "50", "100", "150", "250", "350"];
+        match kinds[self.below(kinds.len() as u64) as usize] {
+            0 => {
+                let d = self.pick(&ms);
+                format!("<Timeout msec=\"{d}\">{}</Timeout>", self.node(depth + 1))
+            }
+            1 => {
+                let d = self.pick(&ms);
+                format!("<Delay delay_msec=\"{d}\">{}</Delay>", self.node(depth + 1))
+            }
+            2 => format!("<Sleep msec=\"{}\"/>", self.pick(&ms)),
+            _ => {
+                let on_halt = if self.below(2) == 0 {
+                    " catch_on_halt=\"true\""
+                } else {
+                    ""
+                };
+                format!(
+                    "<TryCatch{on_halt}>{}</TryCatch>",
+                    self.children(depth, 2, 4)
+                )
+            }
+        }
+    }
+
     /// `n` children of a parallel (as [`Self::children_skip`]).
     fn kids_skip(&mut self, depth: u32, n: i64) -> String {
         (0..n)
@@ -369,6 +410,14 @@ impl<R: Rng> G<'_, R> {
 
     fn node_bare(&mut self, depth: u32) -> String {
         self.budget -= 1;
+        if (self.opts.time_nodes || self.opts.try_catch)
+            && !self.v3
+            && depth < 5
+            && self.budget > 0
+            && self.below(5) == 0
+        {
+            return self.time_node(depth);
+        }
         if self.opts.btcpp4_nodes && !self.v3 && depth < 5 && self.budget > 0 && self.below(6) == 0
         {
             return self.btcpp4_node(depth);

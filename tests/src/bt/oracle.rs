@@ -51,6 +51,9 @@ pub const BUDGET: usize = 1000;
 /// Node ticks one root tick may make before it counts as a hang (a loop no leaf is in).
 pub const HANG: usize = 2_000_000;
 
+/// The executor's period unless an [`Options`] says otherwise: 100 ms (10 Hz).
+pub const PERIOD_MS: u64 = 100;
+
 /// The reading and, for BT.CPP 4, how the tree was built and is ticked.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Options {
@@ -65,6 +68,9 @@ pub struct Options {
     pub mode: TickMode,
     /// Leaf callbacks per root tick before [`End::Livelock`].
     pub budget: usize,
+    /// The executor's period in milliseconds: root tick `k` (from 0) begins at virtual
+    /// time `k * period_ms`, the clock of the timers of Timeout, Delay and Sleep.
+    pub period_ms: u64,
 }
 
 impl Options {
@@ -75,6 +81,7 @@ impl Options {
             from_xml: false,
             mode: TickMode::ExactlyOnce,
             budget: BUDGET,
+            period_ms: PERIOD_MS,
         }
     }
 
@@ -85,6 +92,7 @@ impl Options {
             from_xml: true,
             mode,
             budget: BUDGET,
+            period_ms: PERIOD_MS,
         }
     }
 }
@@ -196,14 +204,14 @@ const V4_NAMES: &[&str] = &[
     "Script",
     "ScriptCondition",
     "Precondition",
+    "Timeout",
+    "Delay",
+    "Sleep",
 ];
 
 /// The other built-in nodes BT.CPP 4.8.2 registers: a scripted leaf cannot take their
 /// names (`registerBuilder`: "ID [..] already registered"). (4.10 adds `TryCatch`.)
 const V4_OTHERS: &[&str] = &[
-    "Timeout",
-    "Delay",
-    "Sleep",
     "UnsetBlackboard",
     "SubTree",
     "LoopInt",
@@ -282,6 +290,18 @@ pub struct Oracle<'t> {
     fault: Option<String>,
     /// Precondition: its child has started (`_children_running`).
     memo: Vec<bool>,
+    /// Virtual time in milliseconds: the start of the current root tick.
+    now: u64,
+    /// Root ticks begun.
+    root_ticks: u64,
+    /// Timeout, Delay, Sleep: when the node's timer is due, if one is running.
+    due: Vec<Option<u64>>,
+    /// Timeout `child_halted_`, Delay `delay_complete_`, Sleep `timer_waiting_`.
+    flag: Vec<bool>,
+    /// Timeout `timeout_started_`, Delay `delay_started_`.
+    started: Vec<bool>,
+    /// TryCatch `in_catch_`.
+    in_catch: Vec<bool>,
 }
 
 impl From<Fault> for Stop {
@@ -336,6 +356,12 @@ impl<'t> Oracle<'t> {
             skipped: vec![0; n],
             fault: None,
             memo: vec![false; n],
+            now: 0,
+            root_ticks: 0,
+            due: vec![None; n],
+            flag: vec![false; n],
+            started: vec![false; n],
+            in_catch: vec![false; n],
         }
     }
 
@@ -352,12 +378,71 @@ impl<'t> Oracle<'t> {
     /// own status only). A signal left pending by a tick that finished stays for the next
     /// one. BT.CPP 3.8 `Tree::tickRoot` (`bt_factory.h`) resets a finished root's status.
     pub fn tick_root(&mut self) -> Result<Status, String> {
+        self.begin_tick();
         self.tick_root_stop().map_err(|e| match e {
             Stop::Error(t) => format!("BT.CPP throws: {t}"),
             Stop::Livelock => "livelock: the tick never returns".into(),
             Stop::Hang => "hang: the tick never returns".into(),
             Stop::Model(t) => t,
         })
+    }
+
+    /// Moves the virtual clock to the start of the next root tick (`k * period_ms` for
+    /// root tick `k`), firing first, in order, every timer due by then (ties in node
+    /// order).
+    ///
+    /// The rule (docs/SEMANTICS.md, "Timers of the tree"): BT.CPP's `TimerQueue` runs a
+    /// timer's callback on its own thread at the wall-clock time it is due, between the
+    /// executor's ticks, and the callback's effects (Delay's `delay_complete_`, Sleep's
+    /// `timer_waiting_`, Timeout halting its RUNNING child, each emitting the wake-up
+    /// signal) are what the next tick sees. A timer due exactly at a tick races with it
+    /// in the real library; here it fires first.
+    fn begin_tick(&mut self) {
+        let t = self.root_ticks * self.opts.period_ms;
+        self.root_ticks += 1;
+        while let Some(n) = (0..self.due.len())
+            .filter(|&n| self.due[n].is_some_and(|d| d <= t))
+            .min_by_key(|&n| (self.due[n], n))
+        {
+            self.now = self.due[n].unwrap_or(t);
+            self.fire(n);
+        }
+        self.now = t;
+    }
+
+    /// Node `n`'s timer callback (`aborted` false).
+    fn fire(&mut self, n: usize) {
+        self.due[n] = None;
+        match self.tree.nodes[n].kind {
+            // `DelayNode::tick`'s callback: `delay_complete_ = true`, wake-up.
+            Kind::Delay(_) => {
+                self.flag[n] = true;
+                self.wake_up();
+            }
+            // `SleepNode::onStart`'s callback: wake-up, `timer_waiting_ = false`.
+            Kind::Sleep(_) => {
+                self.flag[n] = false;
+                self.wake_up();
+            }
+            // `TimeoutNode::tick`'s callback: a RUNNING child is halted (`haltChild`, on
+            // the timer's thread), `child_halted_` set, wake-up; otherwise nothing.
+            Kind::Timeout(_) => {
+                let c = self.child(n, 0);
+                if self.status[c] == Some(Status::Running) {
+                    self.flag[n] = true;
+                    self.halt_child(c);
+                    self.wake_up();
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// `TreeNode::emitWakeUpSignal`: only nodes of a tree built from XML have the signal.
+    fn wake_up(&mut self) {
+        if self.opts.from_xml {
+            self.pending = true;
+        }
     }
 
     fn tick_root_stop(&mut self) -> Result<Status, Stop> {
@@ -573,6 +658,19 @@ impl<'t> Oracle<'t> {
                 }
                 self.reset_children(n);
             }
+            // `TimeoutNode::halt`, `DelayNode::halt`: not started, every timer cancelled
+            // (`cancelAll`), then `DecoratorNode::halt` resets the child.
+            Kind::Timeout(_) | Kind::Delay(_) => {
+                self.started[n] = false;
+                self.due[n] = None;
+                self.reset_children(n);
+            }
+            // `SleepNode::onHalted`: not waiting, the timer cancelled.
+            Kind::Sleep(_) => {
+                self.flag[n] = false;
+                self.due[n] = None;
+            }
+            &Kind::TryCatch(catch_on_halt) => self.halt_try_catch(n, catch_on_halt),
             // `ParallelNode::halt` / `ParallelAllNode::halt` clear; AS2FM's counts restart
             // on every tick anyway.
             Kind::Parallel(..) | Kind::ParallelAll(_) => {
@@ -627,6 +725,18 @@ impl<'t> Oracle<'t> {
             _ if !self.btcpp() && self.tree.nodes[n].kind.btcpp4_only() => Err(Stop::Model(
                 format!("{} has no AS2FM model", self.tree.nodes[n].tag),
             )),
+            Kind::Timeout(_) | Kind::Delay(_) | Kind::Sleep(_) | Kind::TryCatch(_)
+                if self.reading != Reading::Btcpp =>
+            {
+                Err(Stop::Model(format!(
+                    "{} is modelled in BT.CPP 4's reading only",
+                    self.tree.nodes[n].tag
+                )))
+            }
+            &Kind::Timeout(ms) => self.timeout(n, ms),
+            &Kind::Delay(ms) => self.delay(n, ms),
+            &Kind::Sleep(ms) => Ok(self.sleep(n, ms)),
+            Kind::TryCatch(_) => self.try_catch(n),
             Kind::AsyncSequence => self.sequence(n, Success, Failure, true),
             Kind::AsyncFallback => self.sequence(n, Failure, Success, true),
             &Kind::ParallelAll(f) => self.parallel_all(n, f),
@@ -959,6 +1069,152 @@ impl<'t> Oracle<'t> {
             self.reset_children(n);
         }
         Ok(s)
+    }
+
+    /// `TimeoutNode::tick` (4.10 `decorators/timeout_node.cpp`): the first tick starts the
+    /// timer (none when `msec` is 0) and clears `child_halted_`; once the timer halted the
+    /// child the tick answers FAILURE without ticking it; otherwise the child's answer,
+    /// a finished one cancelling the timer and resetting the child.
+    fn timeout(&mut self, n: usize, ms: u64) -> Result<Status, Stop> {
+        if !self.started[n] {
+            self.started[n] = true;
+            self.flag[n] = false;
+            if ms > 0 {
+                self.due[n] = Some(self.now + ms);
+            }
+        }
+        if self.flag[n] {
+            self.started[n] = false;
+            return Ok(Status::Failure);
+        }
+        let c = self.child(n, 0);
+        let s = self.tick(c)?;
+        if matches!(s, Status::Success | Status::Failure) {
+            self.started[n] = false;
+            self.due[n] = None;
+            self.halt_child(c);
+        }
+        Ok(s)
+    }
+
+    /// `DelayNode::tick` (4.10 `decorators/delay_node.cpp`): the first tick starts the
+    /// timer and answers RUNNING; once it fired (`delay_complete_`) every tick ticks the
+    /// child, a finished answer ending the delay and resetting the child.
+    /// (`delay_aborted_` is never set in 4.10: its branch is dead.)
+    fn delay(&mut self, n: usize, ms: u64) -> Result<Status, Stop> {
+        if !self.started[n] {
+            self.flag[n] = false;
+            self.started[n] = true;
+            self.due[n] = Some(self.now + ms);
+        }
+        if !self.flag[n] {
+            return Ok(Status::Running);
+        }
+        let c = self.child(n, 0);
+        let s = self.tick(c)?;
+        if matches!(s, Status::Success | Status::Failure) {
+            self.started[n] = false;
+            self.halt_child(c);
+        }
+        Ok(s)
+    }
+
+    /// `SleepNode` (4.10 `actions/sleep_node.cpp`), a `StatefulActionNode`: `onStart`
+    /// answers SUCCESS for 0 ms, else starts the timer and answers RUNNING; `onRunning`
+    /// answers RUNNING until the timer fired, then SUCCESS; a finished Sleep its parent
+    /// did not reset answers that status again (`StatefulActionNode::tick`).
+    fn sleep(&mut self, n: usize, ms: u64) -> Status {
+        match self.status[n] {
+            Some(s @ (Status::Success | Status::Failure)) => s,
+            Some(Status::Running) if self.flag[n] => Status::Running,
+            Some(Status::Running) => Status::Success,
+            _ if ms == 0 => Status::Success,
+            _ => {
+                self.flag[n] = true;
+                self.due[n] = Some(self.now + ms);
+                Status::Running
+            }
+        }
+    }
+
+    /// `TryCatchNode::tick` (4.10 `controls/try_catch_node.cpp`): the children but the
+    /// last are a Sequence (the try block); a FAILURE there resets the children and ticks
+    /// the last child (the catch) in the same tick, which keeps being ticked while
+    /// RUNNING and whose finished answer (either) resets the children and answers
+    /// FAILURE. The whole try block skipped answers SKIPPED.
+    fn try_catch(&mut self, n: usize) -> Result<Status, Stop> {
+        use Status::*;
+        let len = self.n_children(n);
+        // `if(!isStatusActive(status()))`: a node its parent reset starts afresh.
+        if self.status[n].is_none() {
+            self.skipped[n] = 0;
+            self.in_catch[n] = false;
+        }
+        self.status[n] = Some(Running);
+        let tries = len as i64 - 1;
+        loop {
+            if self.in_catch[n] {
+                let c = self.child(n, len - 1);
+                if self.tick(c)? == Running {
+                    return Ok(Running);
+                }
+                self.reset_children(n);
+                self.idx[n] = 0;
+                self.in_catch[n] = false;
+                return Ok(Failure);
+            }
+            while self.idx[n] < tries {
+                let c = self.child(n, self.idx[n] as usize);
+                match self.tick(c)? {
+                    Running => return Ok(Running),
+                    Success => self.idx[n] += 1,
+                    Skipped => {
+                        self.idx[n] += 1;
+                        self.skipped[n] += 1;
+                    }
+                    // `return tick()`: into the catch at once.
+                    Failure => {
+                        self.reset_children(n);
+                        self.idx[n] = 0;
+                        self.in_catch[n] = true;
+                        break;
+                    }
+                }
+            }
+            if self.in_catch[n] {
+                continue;
+            }
+            let all_skipped = self.skipped[n] as i64 == tries;
+            self.reset_children(n);
+            self.idx[n] = 0;
+            self.skipped[n] = 0;
+            return Ok(if all_skipped { Skipped } else { Success });
+        }
+    }
+
+    /// `TryCatchNode::halt` (4.10): with `catch_on_halt`, halted while in the try block,
+    /// it halts the try children, ticks the catch child once (halting it if it answers
+    /// RUNNING); then forgets its place and `ControlNode::halt` resets the children.
+    fn halt_try_catch(&mut self, n: usize, catch_on_halt: bool) {
+        let len = self.n_children(n);
+        if catch_on_halt && !self.in_catch[n] && self.status[n].is_some() && len >= 2 {
+            for i in 0..len - 1 {
+                let c = self.child(n, i);
+                self.halt_child(c);
+            }
+            let c = self.child(n, len - 1);
+            match self.tick(c) {
+                Ok(Status::Running) => self.halt_child(c),
+                Ok(_) => {}
+                Err(e) => {
+                    self.fault.get_or_insert(format!("{e:?}"));
+                }
+            }
+        }
+        self.idx[n] = 0;
+        self.skipped[n] = 0;
+        self.in_catch[n] = false;
+        self.reset_children(n);
     }
 
     /// `KeepRunningUntilFailureNode::tick` (4.10): a finished child is reset; its
@@ -1318,6 +1574,7 @@ pub fn run_with(
     let mut statuses = Vec::with_capacity(ticks);
     let mut end = None;
     for tick in 0..ticks {
+        o.begin_tick();
         let mark = o.log.len();
         match o.tick_root_stop() {
             Ok(s) => statuses.push(s),

@@ -83,6 +83,9 @@ pub struct Real {
     pub timeout: Duration,
     /// Harness processes started (1 + hangs).
     pub starts: usize,
+    /// Ticks paced this many milliseconds apart ([`Real::run_paced`]), or as fast as
+    /// they go.
+    pace: Option<u64>,
 }
 
 fn spawn(python: &Path) -> Result<(Child, Sender<String>, Receiver<String>), String> {
@@ -133,6 +136,7 @@ impl Real {
             binding: String::new(),
             timeout: Duration::from_secs(5),
             starts: 1,
+            pace: None,
         };
         r.hello()?;
         r.timeout = Duration::from_secs(2);
@@ -162,7 +166,7 @@ impl Real {
         self.hello()
     }
 
-    fn line(r: &Request) -> String {
+    fn line(r: &Request, pace: Option<u64>) -> String {
         let scripts: serde_json::Map<String, serde_json::Value> = r
             .scripts
             .iter()
@@ -175,10 +179,13 @@ impl Real {
             TickMode::Once => "once",
             TickMode::ExactlyOnce => "exactly_once",
         };
-        let v = serde_json::json!({
+        let mut v = serde_json::json!({
             "xml": r.xml, "scripts": scripts, "ticks": r.ticks, "mode": mode, "budget": r.budget,
             "read": r.read,
         });
+        if let Some(p) = pace {
+            v["period_ms"] = p.into();
+        }
         format!("{v}\n")
     }
 
@@ -228,7 +235,7 @@ impl Real {
         let mut sent = 0;
         while out.len() < reqs.len() {
             while sent < reqs.len() {
-                if self.to.send(Self::line(&reqs[sent])).is_err() {
+                if self.to.send(Self::line(&reqs[sent], self.pace)).is_err() {
                     return Err("the harness's stdin closed".into());
                 }
                 sent += 1;
@@ -255,6 +262,23 @@ impl Real {
             }
         }
         Ok(out)
+    }
+}
+
+impl Real {
+    /// Runs the cases as [`Real::run`] does, each tick `period_ms` after the one before
+    /// (the harness's `period_ms`): the wall-clock timers of Timeout, Delay and Sleep then
+    /// fire between the ticks as the durations say. A case whose ticks the harness could
+    /// not keep within a quarter period of their time ends as `("late", tick, ..)`.
+    pub fn run_paced(&mut self, reqs: &[Request], period_ms: u64) -> Result<Vec<Answer>, String> {
+        let (pace, timeout) = (self.pace, self.timeout);
+        self.pace = Some(period_ms);
+        let longest = reqs.iter().map(|r| r.ticks as u64).max().unwrap_or(0) * period_ms;
+        self.timeout = timeout + Duration::from_millis(2 * longest);
+        let out = self.run(reqs);
+        self.pace = pace;
+        self.timeout = timeout;
+        out
     }
 }
 

@@ -137,6 +137,14 @@ pub enum Kind {
     ScriptCondition(Program),
     /// `Precondition` with its `if` script and `else` status (BT.CPP 4).
     Precondition(Program, Status),
+    /// `Timeout` with `msec` (BT.CPP 4; a timer in virtual time, see the oracle).
+    Timeout(u64),
+    /// `Delay` with `delay_msec` (BT.CPP 4).
+    Delay(u64),
+    /// `Sleep` with `msec` (BT.CPP 4).
+    Sleep(u64),
+    /// `TryCatch` with `catch_on_halt` (BT.CPP 4.10 only: 4.8.2 does not know it).
+    TryCatch(bool),
 }
 
 impl Kind {
@@ -154,6 +162,10 @@ impl Kind {
                 | Kind::Script(_)
                 | Kind::ScriptCondition(_)
                 | Kind::Precondition(..)
+                | Kind::Timeout(_)
+                | Kind::Delay(_)
+                | Kind::Sleep(_)
+                | Kind::TryCatch(_)
         )
     }
 }
@@ -308,6 +320,28 @@ pub const NODES: &[(&[&str], Arity, Make)] = &[
         };
         Ok(Kind::Precondition(code(a, "if")?, e))
     }),
+    // The ports are `unsigned` milliseconds (`TimeoutNode::providedPorts`,
+    // `DelayNode::providedPorts`, `SleepNode::providedPorts`).
+    (&["Timeout"], (1, 1), |a| {
+        Ok(Kind::Timeout(msec(a, "msec")?))
+    }),
+    (&["Delay"], (1, 1), |a| {
+        Ok(Kind::Delay(msec(a, "delay_msec")?))
+    }),
+    // Without `msec`, BT.CPP's own unit tests' `Sleep` test node (a scripted leaf here;
+    // the built-in would throw "Missing parameter [msec]" at its first tick).
+    (&["Sleep"], (0, 0), |a| match a.contains_key("msec") {
+        true => Ok(Kind::Sleep(msec(a, "msec")?)),
+        false => Ok(Kind::Leaf("Sleep".into())),
+    }),
+    // `TryCatchNode::providedPorts`: `catch_on_halt` defaults to false.
+    (&["TryCatch"], (2, ANY), |a| {
+        match a.get("catch_on_halt").map(|s| s.trim()) {
+            None | Some("false") => Ok(Kind::TryCatch(false)),
+            Some("true") => Ok(Kind::TryCatch(true)),
+            Some(v) => Err(format!("bad catch_on_halt {v}")),
+        }
+    }),
     (&["AlwaysSuccess"], (0, 0), |_| Ok(Kind::AlwaysSuccess)),
     (&["AlwaysFailure"], (0, 0), |_| Ok(Kind::AlwaysFailure)),
     (&["SetBlackboard"], (0, 0), |a| {
@@ -346,6 +380,12 @@ fn int(a: &Attrs, k: &str) -> Result<i64, String> {
     v.trim()
         .parse()
         .map_err(|_| format!("`{k}` is not a number: {v}"))
+}
+
+/// A duration port in milliseconds (an `unsigned` in BT.CPP).
+fn msec(a: &Attrs, k: &str) -> Result<u64, String> {
+    let v = int(a, k)?;
+    u64::try_from(v).map_err(|_| format!("`{k}` is negative: {v}"))
 }
 
 fn int_or(a: &Attrs, ks: &[&str], d: i64) -> Result<i64, String> {

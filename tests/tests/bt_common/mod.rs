@@ -250,3 +250,148 @@ pub fn show(xml_text: &str, scripts: &Scripts, ticks: usize) -> String {
     }
     s
 }
+
+/// The tick rate of [`lower_and_run_clocked`]: 10 Hz, the oracle's default period
+/// (`oracle::PERIOD_MS`).
+pub const CLOCKED_RATE_HZ: f64 = 10.0;
+
+/// Lowers `xml` under `semantics` (BT.CPP's) and runs `ticks` executor ticks with the
+/// lowered root machine itself, the keeper of the timers of Timeout, Delay and Sleep
+/// (`host/src/robot/bt/btcpp4_time.rs`), ticking at [`CLOCKED_RATE_HZ`] in model time.
+///
+/// The ROS lowering is not run here, so its timer tags become plain SCXML: each
+/// `<ros_rate_callback name="x">` a transition on `ros_time_rate.x`, and a ticker machine
+/// plays the global timer, once per unit of the tree's clock (its period, or the tick
+/// period without timers) sending the clock's event and then, every tick period, the
+/// tick's, `ticks` times. Each answer of the root that ends an executor tick is also sent
+/// as `tick_done` (observed as the tick's status).
+pub fn lower_and_run_clocked(
+    xml_text: &str,
+    scripts: &Scripts,
+    semantics: BtSemantics,
+    ticks: usize,
+    max_steps: u64,
+) -> Result<(Run, EndReason), String> {
+    let tree = tree::read(xml_text)?;
+    let leaves: BTreeSet<u32> = tree
+        .nodes
+        .iter()
+        .filter(|n| matches!(n.kind, Kind::Leaf(_)))
+        .map(|n| n.id)
+        .collect();
+    let mut sm = SourceMap::new();
+    let tree_id = sm.add("t.xml", xml_text.to_string());
+    let plugins = model::plugins(scripts)
+        .into_iter()
+        .map(|(n, text)| sm.add(format!("{n}.ascxml"), text))
+        .collect();
+    let input = BtInput {
+        tree: tree_id,
+        plugins,
+        tick_rate_hz: CLOCKED_RATE_HZ,
+        tick_if_not_running: true,
+        halts: Halts::As2fm,
+        semantics,
+    };
+    let mut machines = bt::lower(&sm, &input).map_err(|ds| Diagnostics(ds).to_string())?;
+    let root = &mut machines[0];
+    let root_name = root.attr_value("name").unwrap_or_default().to_string();
+    // The timers: (name, period in ns); the clock's name ends in `_timers`.
+    let mut timers: Vec<(String, u64)> = Vec::new();
+    root.children.retain(|c| match c {
+        xml::Node::Element(e) if e.name == "ros_time_rate" => {
+            let p = hindsight::robot::rate::period(e.attr_value("rate_hz").unwrap_or_default())
+                .map(|p| p.period_ns)
+                .unwrap_or(0);
+            timers.push((e.attr_value("name").unwrap_or_default().to_string(), p));
+            false
+        }
+        _ => true,
+    });
+    fn plain(e: &mut xml::Element) {
+        if e.name == "ros_rate_callback" {
+            let name = e.remove_attr("name").map(|a| a.value).unwrap_or_default();
+            e.name = "transition".into();
+            e.set_attr("event", format!("ros_time_rate.{name}"));
+        }
+        for c in e.elements_mut() {
+            plain(c);
+        }
+    }
+    plain(root);
+    for st in root.elements_mut().filter(|e| e.name == "state") {
+        if st.attr_value("id") != Some("wait_tick_res") {
+            continue;
+        }
+        for t in st.elements_mut() {
+            if t.name == "transition"
+                && t.attr_value("event") == Some("bt_1000_response")
+                && t.attr_value("target") != Some("wait_tick_res")
+            {
+                let mut s = xml::Element::new("send", t.span);
+                s.set_attr("event", "tick_done");
+                s.set_attr("target", root_name.clone());
+                let mut p = xml::Element::new("param", t.span);
+                p.set_attr("name", "status");
+                p.set_attr("expr", "_event.data.status");
+                s.push(p);
+                t.push(s);
+            }
+        }
+    }
+    let tick = timers
+        .iter()
+        .find(|t| t.0.ends_with("_tick"))
+        .cloned()
+        .ok_or("no tick timer")?;
+    let clock = timers.iter().find(|t| t.0.ends_with("_timers")).cloned();
+    let unit = clock.as_ref().map_or(tick.1, |c| c.1);
+    let per = tick.1 / unit;
+    let clock_send = clock.map_or(String::new(), |c| {
+        format!(
+            r#"<send event="ros_time_rate.{}" target="{root_name}"/>"#,
+            c.0
+        )
+    });
+    let ticker = format!(
+        r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" version="1.0" name="bt_test_ticker" initial="run">
+<datamodel><data id="k" type="int32" expr="0"/><data id="n" type="int32" expr="0"/></datamodel>
+<state id="run">
+<onentry><send event="bt_test_step" target="bt_test_ticker" delay="1"/></onentry>
+<transition event="bt_test_step" cond="n &lt; {ticks}" target="run"><assign location="k" expr="k + 1"/>{clock_send}<if cond="k % {per} == 0"><assign location="n" expr="n + 1"/><send event="ros_time_rate.{}" target="{root_name}"/></if></transition>
+</state>
+</scxml>"#,
+        tick.0
+    );
+    let tk = sm.add("ticker.scxml", ticker);
+    machines.push(xml::parse(&sm, tk).map_err(|d| d.to_string())?);
+    let mut src = ModelSource {
+        sources: sm,
+        ..ModelSource::default()
+    };
+    let mut errs = Diagnostics::default();
+    for m in &machines {
+        src.add_machine_tree(m, FileId(0), &mut errs);
+    }
+    if !errs.is_empty() {
+        return Err(errs.to_string());
+    }
+    let compiled = CompiledModel::compile(src).map_err(|e| e.to_string())?;
+    let mut w = Watch {
+        leaves: &leaves,
+        status_event: Some("tick_done"),
+        statuses: Vec::new(),
+        log: Vec::new(),
+        bad: None,
+    };
+    let cfg = RunConfig {
+        max_steps,
+        ..RunConfig::default()
+    };
+    let out =
+        Simulator::new(&compiled).run(&mut Xoshiro256PlusPlus::seed_from_u64(1), &cfg, &mut w);
+    if let Some(b) = w.bad {
+        return Err(b);
+    }
+    Ok(((w.statuses, w.log), out.end))
+}

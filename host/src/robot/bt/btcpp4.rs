@@ -30,6 +30,10 @@ pub(super) fn node_name(k: Btcpp4) -> String {
         Btcpp4::KeepRunningUntilFailure => "KeepRunningUntilFailure".into(),
         Btcpp4::RunOnce => "RunOnce".into(),
         Btcpp4::Switch(n) => format!("Switch{n}"),
+        Btcpp4::Timeout => "Timeout".into(),
+        Btcpp4::Delay => "Delay".into(),
+        Btcpp4::Sleep => "Sleep".into(),
+        Btcpp4::TryCatch => "TryCatch".into(),
     }
 }
 
@@ -113,6 +117,8 @@ pub(super) fn lower(
                 }
             }
         }
+        // `mod.rs` lowers them with `btcpp4_time.rs`, which needs the tree's clock.
+        Btcpp4::Timeout | Btcpp4::Delay | Btcpp4::Sleep | Btcpp4::TryCatch => None,
         Btcpp4::Switch(cases) => {
             let pick = switch_pick(sm, k, cases as usize, n, bb, errs)?;
             if matches!(pick, SwitchPick::Entry(..)) {

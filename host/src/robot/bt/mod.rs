@@ -33,6 +33,7 @@
 mod blackboard;
 mod btcpp;
 mod btcpp4;
+mod btcpp4_time;
 mod build;
 mod control;
 mod decorators;
@@ -214,6 +215,16 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
     // constants), so every node knows the type of what it reads and writes.
     blackboard::type_entries(sm, &tree, &plugins, &mut bb, &mut errs);
     let effects = halt_effects(&tree, &plugins);
+    // The clock of the timed nodes (Timeout, Delay, Sleep), kept by the root machine.
+    let clock = match input.semantics {
+        BtSemantics::As2fm => None,
+        BtSemantics::Btcpp { .. } => btcpp4_time::clock(
+            sm,
+            &tree,
+            &control::format_rate(input.tick_rate_hz),
+            &mut errs,
+        ),
+    };
     let mut out = Vec::with_capacity(tree.nodes.len() + 2);
     let root_b = B {
         at: tree.nodes[0].span,
@@ -267,13 +278,24 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
             } else {
                 n.children
                     .iter()
-                    .map(|&c| matches!(tree.nodes[c].kind, Kind::Plugin(p) if !plugins[p].ticks_children))
+                    .map(|&c| match tree.nodes[c].kind {
+                        Kind::Plugin(p) => !plugins[p].ticks_children,
+                        // `SleepNode` is a `StatefulActionNode` too.
+                        Kind::Control(c) => c == Control::Btcpp4(tree::Btcpp4::Sleep),
+                    })
                     .collect()
             },
         };
         if let (Kind::Control(Control::Btcpp4(k)), BtSemantics::As2fm) = (n.kind, input.semantics) {
             errs.push(sm.diag(n.span, btcpp4::as2fm_refusal(k)));
             continue;
+        }
+        if let Kind::Control(Control::Btcpp4(k)) = n.kind {
+            if btcpp4_time::handles(k) {
+                let m = btcpp4_time::lower(sm, k, n, &ctx, &root_name, clock.as_ref(), &mut errs);
+                out.extend(m);
+                continue;
+            }
         }
         let m = match n.kind {
             Kind::Plugin(i) => Some(plugin::instance(
@@ -300,6 +322,10 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
         if let Some(m) = m {
             out.push(m);
         }
+    }
+    if let Some(c) = &clock {
+        let stem = stem(sm, input.tree);
+        btcpp4_time::add_clock(root_b, &mut out[0], c, &format!("{stem}_timers"), &timer);
     }
     if let Some(m) = bb.machine(root_b) {
         out.push(m);

@@ -59,6 +59,13 @@ pub(crate) enum Btcpp4 {
     RunOnce,
     /// `Switch<n>`, n in 2..=6.
     Switch(u8),
+    /// `Timeout` (`msec`), `Delay` (`delay_msec`), `Sleep` (`msec`): timers in model time
+    /// (`btcpp4_time.rs`).
+    Timeout,
+    Delay,
+    Sleep,
+    /// `TryCatch` (BT.CPP 4.10; `catch_on_halt`).
+    TryCatch,
 }
 
 /// The ports of `Switch6`; `Switch<n>` takes the first `n + 1`.
@@ -149,6 +156,10 @@ impl Control {
             "Switch4" => Control::Btcpp4(Btcpp4::Switch(4)),
             "Switch5" => Control::Btcpp4(Btcpp4::Switch(5)),
             "Switch6" => Control::Btcpp4(Btcpp4::Switch(6)),
+            "Timeout" => Control::Btcpp4(Btcpp4::Timeout),
+            "Delay" => Control::Btcpp4(Btcpp4::Delay),
+            "Sleep" => Control::Btcpp4(Btcpp4::Sleep),
+            "TryCatch" => Control::Btcpp4(Btcpp4::TryCatch),
             _ => return None,
         })
     }
@@ -168,7 +179,13 @@ impl Control {
                 | self::Btcpp4::AsyncFallback
                 | self::Btcpp4::ParallelAll => (1, usize::MAX),
                 self::Btcpp4::WhileDoElse => (2, 3),
-                self::Btcpp4::KeepRunningUntilFailure | self::Btcpp4::RunOnce => (1, 1),
+                self::Btcpp4::KeepRunningUntilFailure
+                | self::Btcpp4::RunOnce
+                | self::Btcpp4::Timeout
+                | self::Btcpp4::Delay => (1, 1),
+                self::Btcpp4::Sleep => (0, 0),
+                // The try block and the catch child (`TryCatchNode::tick`: at least 2).
+                self::Btcpp4::TryCatch => (2, usize::MAX),
                 // The cases and the default (BT.CPP 4.10 `switch_node.h`,
                 // `SwitchNode::tick`: `NUM_CASES + 1` children).
                 self::Btcpp4::Switch(n) => (n as usize + 1, n as usize + 1),
@@ -193,6 +210,9 @@ impl Control {
             Btcpp4(self::Btcpp4::ParallelAll) => &["max_failures"],
             Btcpp4(self::Btcpp4::RunOnce) => &["then_skip"],
             Btcpp4(self::Btcpp4::Switch(n)) => &SWITCH_PORTS[..=n as usize],
+            Btcpp4(self::Btcpp4::Timeout | self::Btcpp4::Sleep) => &["msec"],
+            Btcpp4(self::Btcpp4::Delay) => &["delay_msec"],
+            Btcpp4(self::Btcpp4::TryCatch) => &["catch_on_halt"],
             _ => &[],
         }
     }
@@ -221,29 +241,16 @@ const SUPPORTED: &[&str] = &[
     "BlackboardCheckBool",
     "SubTree",
     "SubTreePlus (format 3)",
-    "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6 (with `--bt btcpp`)",
+    "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6, Timeout, Delay, Sleep, TryCatch (with `--bt btcpp`)",
 ];
 
 /// BehaviorTree.CPP's other built-in nodes (the ones its `BehaviorTreeFactory`
 /// registers in 4.10 or 3.8, and the queue nodes its headers ship), each with why
 /// hindsight refuses it. README lists the same.
 pub(crate) const UNSUPPORTED: &[(&str, &str)] = &[
-    ("TryCatch", "no AS2FM model; not modelled yet"),
     (
         "ManualSelector",
         "it asks a person at a terminal which child to run",
-    ),
-    (
-        "Timeout",
-        "it needs a wall-clock timer inside the tree; not modelled in model time yet",
-    ),
-    (
-        "Delay",
-        "it needs a wall-clock timer inside the tree; not modelled in model time yet",
-    ),
-    (
-        "Sleep",
-        "it needs a wall-clock timer inside the tree; not modelled in model time yet",
     ),
     ("Script", "it runs BT.CPP's script language"),
     ("ScriptCondition", "it runs BT.CPP's script language"),
