@@ -151,12 +151,22 @@ fn timed_nodes_are_refused_by_the_default_semantics_and_checked_under_btcpp() {
     let (code, _, err) = hindsight(&dir, &["validate", "main.xml", "--bt", "btcpp"]);
     assert_eq!(code, 2, "{err}");
     assert!(
-        err.contains("tree.xml:3:15: `msec` must be a whole number of milliseconds"),
+        err.contains("tree.xml:3:14: `msec` must be a whole number of milliseconds"),
         "{err}"
     );
     let _ = std::fs::remove_dir_all(&dir);
-    // A duration whose clock would need more than 1000 events per tick period.
+    // A clock of more than 1000 events per tick period: a period of 2^20 ns (953.674...
+    // Hz) shares only 64 ns with 1 ms.
     let dir = scratch("fine", "<Sleep msec=\"1\"/>");
+    let main = std::fs::read_to_string(dir.join("main.xml")).unwrap();
+    std::fs::write(
+        dir.join("main.xml"),
+        main.replace(
+            "<bt_tick_rate value=\"1.0\"/>",
+            "<bt_tick_rate value=\"953.67431640625\"/>",
+        ),
+    )
+    .unwrap();
     let (code, _, err) = hindsight(&dir, &["validate", "main.xml", "--bt", "btcpp"]);
     assert_eq!(code, 2, "{err}");
     assert!(
