@@ -6,7 +6,9 @@
 //! agree.
 //!
 //! `HINDSIGHT_BT_TREES` sets how many random trees (default 10,000); `HINDSIGHT_BT_SEED`
-//! the first seed.
+//! the first seed. Trees with Timeout, Delay, Sleep and TryCatch run with the lowered root
+//! machine itself, which keeps the timers' clock in model time
+//! (`bt_common::lower_and_run_clocked`, 10 Hz, the oracle's default period).
 //!
 //! Then the lowering straight against the real library on a sample of random format-4
 //! trees with BT.CPP 4's own nodes (`HINDSIGHT_BT_REAL_LOWERING_TREES`, default 2,000),

@@ -5,7 +5,8 @@
 //! without `<bt_halt>`; counts of -1. With [`Options::btcpp4_nodes`], also BT.CPP 4's
 //! nodes that AS2FM has no model of; with [`Options::scripts`], BT.CPP 4's script
 //! language (`Script`, `ScriptCondition`, `Precondition`) and pre/post conditions on
-//! nodes, over the integer entries `x`, `y` and the boolean `f`.
+//! nodes, over the integer entries `x`, `y` and the boolean `f`; with [`Options::time_nodes`]
+//! and [`Options::try_catch`], Timeout, Delay, Sleep and TryCatch.
 
 use super::oracle::Scripts;
 use super::tree::Status;

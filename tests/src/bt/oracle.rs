@@ -10,6 +10,10 @@
 //! sources), and AS2FM's `*.ascxml` node models. Where the library the real-library
 //! differential runs (4.8.2, `tests/tests/bt_real.rs`) differs from 4.10, the comment says
 //! so.
+//!
+//! Timeout, Delay and Sleep run their timers on a virtual clock: root tick `k` begins at
+//! `k * Options::period_ms` ms, and a timer due by then fires first
+//! (`Oracle::begin_tick`; docs/SEMANTICS.md, "Timers of the tree").
 
 use super::script::{Fault, Program};
 use super::tree::{CheckType, Kind, Operand, Status, Tree};

@@ -18,7 +18,9 @@
 //!   Parallel, IfThenElse, Inverter, ForceSuccess, ForceFailure, Repeat,
 //!   RetryUntilSuccessful, AlwaysSuccess, AlwaysFailure, SetBlackboard,
 //!   BlackboardCheckInt / Double / String / Bool) are generated (`control.rs` and the
-//!   files it dispatches to, `blackboard.rs`); leaves are instances of their plugin
+//!   files it dispatches to, `blackboard.rs`; under BT.CPP's rules also BT.CPP 4's own
+//!   nodes, `btcpp4.rs`, and Timeout, Delay, Sleep and TryCatch, `btcpp4_time.rs`, whose
+//!   timers the root machine keeps); leaves are instances of their plugin
 //!   (`plugin.rs`) and keep their ROS tags for the ROS lowering.
 //! - `bt_blackboard_fsm` when the tree names `{entries}`.
 //!
