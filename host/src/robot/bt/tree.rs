@@ -59,6 +59,20 @@ pub(crate) enum Btcpp4 {
     RunOnce,
     /// `Switch<n>`, n in 2..=6.
     Switch(u8),
+    /// `Script`, `ScriptCondition`, `Precondition`: BT.CPP 4's script language
+    /// (`btcpp4_script.rs`).
+    Script(ScriptNode),
+}
+
+/// The nodes that run a script.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ScriptNode {
+    /// `Script`: runs `code`, SUCCESS.
+    Script,
+    /// `ScriptCondition`: SUCCESS if `code` is true, else FAILURE.
+    Condition,
+    /// `Precondition`: ticks its child if `if` is true, else answers `else`.
+    Precondition,
 }
 
 /// The ports of `Switch6`; `Switch<n>` takes the first `n + 1`.
@@ -149,6 +163,9 @@ impl Control {
             "Switch4" => Control::Btcpp4(Btcpp4::Switch(4)),
             "Switch5" => Control::Btcpp4(Btcpp4::Switch(5)),
             "Switch6" => Control::Btcpp4(Btcpp4::Switch(6)),
+            "Script" => Control::Btcpp4(Btcpp4::Script(ScriptNode::Script)),
+            "ScriptCondition" => Control::Btcpp4(Btcpp4::Script(ScriptNode::Condition)),
+            "Precondition" => Control::Btcpp4(Btcpp4::Script(ScriptNode::Precondition)),
             _ => return None,
         })
     }
@@ -172,6 +189,8 @@ impl Control {
                 // The cases and the default (BT.CPP 4.10 `switch_node.h`,
                 // `SwitchNode::tick`: `NUM_CASES + 1` children).
                 self::Btcpp4::Switch(n) => (n as usize + 1, n as usize + 1),
+                self::Btcpp4::Script(ScriptNode::Precondition) => (1, 1),
+                self::Btcpp4::Script(_) => (0, 0),
             },
         }
     }
@@ -193,6 +212,8 @@ impl Control {
             Btcpp4(self::Btcpp4::ParallelAll) => &["max_failures"],
             Btcpp4(self::Btcpp4::RunOnce) => &["then_skip"],
             Btcpp4(self::Btcpp4::Switch(n)) => &SWITCH_PORTS[..=n as usize],
+            Btcpp4(self::Btcpp4::Script(ScriptNode::Precondition)) => &["if", "else"],
+            Btcpp4(self::Btcpp4::Script(_)) => &["code"],
             _ => &[],
         }
     }
@@ -221,7 +242,7 @@ const SUPPORTED: &[&str] = &[
     "BlackboardCheckBool",
     "SubTree",
     "SubTreePlus (format 3)",
-    "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6 (with `--bt btcpp`)",
+    "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6, Script, ScriptCondition, Precondition (with `--bt btcpp`)",
 ];
 
 /// BehaviorTree.CPP's other built-in nodes (the ones its `BehaviorTreeFactory`
@@ -245,9 +266,6 @@ pub(crate) const UNSUPPORTED: &[(&str, &str)] = &[
         "Sleep",
         "it needs a wall-clock timer inside the tree; not modelled in model time yet",
     ),
-    ("Script", "it runs BT.CPP's script language"),
-    ("ScriptCondition", "it runs BT.CPP's script language"),
-    ("Precondition", "it runs BT.CPP's script language"),
     (
         "UnsetBlackboard",
         "entries in hindsight's blackboard always hold a value",
@@ -340,6 +358,26 @@ pub(crate) struct TreeNode {
     pub children: Vec<usize>,
     /// Index of the parent; `None` for the root.
     pub parent: Option<usize>,
+    /// For a node that runs a script: each entry name its script uses, and what it is in
+    /// the whole tree's terms (a SubTree remaps or prefixes its names).
+    pub script_names: Vec<(String, PortValue)>,
+    /// Its pre/post conditions (`_failureIf`, ... `_post`), syntax checked, in the order
+    /// written (`btcpp4_conds.rs`).
+    pub conds: Vec<Cond>,
+}
+
+/// A pre/post-condition attribute of a node.
+#[derive(Clone, Debug)]
+pub(crate) struct Cond {
+    /// `_failureIf`, `_successIf`, `_skipIf`, `_while`, `_onHalted`, `_onFailure`,
+    /// `_onSuccess` or `_post`.
+    pub attr: String,
+    /// The script.
+    pub code: String,
+    /// Where the attribute's name is.
+    pub name_span: Span,
+    /// Where its value is.
+    pub span: Span,
 }
 
 impl TreeNode {
@@ -509,6 +547,14 @@ fn is_ident(s: &str) -> bool {
         && cs.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
+/// A port value as text (an entry as `{entry}`).
+fn lit(v: &PortValue) -> String {
+    match v {
+        PortValue::Literal(s) => s.clone(),
+        PortValue::Blackboard(b) => format!("{{{b}}}"),
+    }
+}
+
 impl Reader<'_> {
     fn err(&mut self, span: Span, msg: impl Into<String>) {
         self.errs.push(self.sm.diag(span, msg));
@@ -635,6 +681,7 @@ impl Reader<'_> {
             _ => sanitize(&type_name),
         };
         let mut ports = Vec::new();
+        let mut conds: Vec<Cond> = Vec::new();
         for a in &el.attrs {
             if a.name == "name"
                 || a.name == "_description"
@@ -644,7 +691,12 @@ impl Reader<'_> {
             }
             if a.name.starts_with('_') {
                 match super::script::condition_error(&a.name, &a.value) {
-                    Some(Ok(m)) => self.err(a.name_span, m),
+                    Some(Ok(_)) => conds.push(Cond {
+                        attr: a.name.clone(),
+                        code: a.value.clone(),
+                        name_span: a.name_span,
+                        span: a.value_span,
+                    }),
                     Some(Err(m)) => self.err(a.value_span, m),
                     None => self.err(
                         a.name_span,
@@ -712,6 +764,30 @@ impl Reader<'_> {
                 span: a.value_span,
             });
         }
+        let mut script_names: Vec<(String, PortValue)> = Vec::new();
+        for c in &conds {
+            for name in super::script::names(&c.code) {
+                if !script_names.iter().any(|(n, _)| *n == name) {
+                    let v = self.resolve_bb(&name, self.scopes.len());
+                    script_names.push((name, v));
+                }
+            }
+        }
+        if let Kind::Control(Control::Btcpp4(Btcpp4::Script(_))) = kind {
+            for p in &ports {
+                if let Some(m) = super::script::port_error(&type_name, &p.key, &lit(&p.value)) {
+                    self.err(p.span, m);
+                }
+                if let (PortValue::Literal(code), "code" | "if") = (&p.value, p.key.as_str()) {
+                    for name in super::script::names(code) {
+                        if !script_names.iter().any(|(n, _)| *n == name) {
+                            let v = self.resolve_bb(&name, self.scopes.len());
+                            script_names.push((name, v));
+                        }
+                    }
+                }
+            }
+        }
         self.nodes.push(TreeNode {
             id,
             kind,
@@ -720,6 +796,8 @@ impl Reader<'_> {
             ports,
             children: Vec::new(),
             parent,
+            script_names,
+            conds,
         });
         if let Some(p) = parent {
             self.nodes[p].children.push(idx);
