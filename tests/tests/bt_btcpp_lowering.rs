@@ -382,6 +382,7 @@ fn switch_halts_the_child_it_no_longer_picks() {
 
 #[test]
 fn scripts_assign_and_conditions_read_the_entries() {
+    // This test and the next: each run checked against the real library (BT.CPP 4.8.2).
     // `x := 1; x += 1` makes 2, so the condition holds and A runs; `y` was never
     // written, so `y == 0` throws in BT.CPP ("Variable not found") and the tree stops.
     let t = v4("<Sequence><Script code=\"x := 1; x += 1; f := x &gt; 1\"/>\
@@ -411,15 +412,17 @@ fn pre_and_post_conditions_run_around_the_node() {
         lowered(&t, &sc, 2, BtTick::Once).unwrap(),
         ran(&[S, S], &[T(1003), T(1003)])
     );
-    // A Precondition keeps a running child going without evaluating `if` again.
-    let t = v4(
-        "<Sequence><Script code=\"go := true\"/><Precondition if=\"go\" else=\"FAILURE\">\
-         <A _onSuccess=\"go := false\"/></Precondition></Sequence>",
-    );
+    // A Precondition keeps a running child going without evaluating `if` again: the
+    // Parallel's Script makes `go` false while A runs, and A still gets its second tick
+    // (`PreconditionNode::tick`, `_children_running`); `else` would answer FAILURE.
+    let t = v4("<Sequence><Script code=\"go := true\"/>\
+         <Parallel success_count=\"2\" failure_count=\"1\">\
+         <Precondition if=\"go\" else=\"FAILURE\"><A/></Precondition>\
+         <Script code=\"go := false\"/></Parallel></Sequence>");
     let sc = scripts(&[("A", &[R, S])]);
     assert_eq!(
-        lowered(&t, &sc, 3, BtTick::Once).unwrap(),
-        ran(&[R, S, F], &[T(1003), T(1003)])
+        lowered(&t, &sc, 2, BtTick::Once).unwrap(),
+        ran(&[R, S], &[T(1004), T(1004)])
     );
 }
 
