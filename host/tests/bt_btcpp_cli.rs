@@ -332,3 +332,115 @@ fn btcpp4_nodes_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+#[test]
+fn scripts_and_conditions_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
+    // Every tick: `failures := 0`; FailOnce fails on the first tick only, its
+    // `_onFailure` counts it, and AlwaysFailure's `_successIf` then answers SUCCESS
+    // without ticking it: the tree succeeds on every tick and never fails. Without the
+    // post-condition the `_successIf` script would read an entry that holds no value
+    // (BT.CPP throws) and the tree would stop.
+    let tree = v4("<Sequence>\n  <Script code=\"failures := 0\"/>\n  <Fallback>\n    <FailOnce _onFailure=\"failures += 1\"/>\n    <AlwaysFailure _successIf=\"failures == 1\"/>\n  </Fallback>\n</Sequence>");
+    let dir = scratch("script", &tree);
+    let (code, out, err) = hindsight(
+        &dir,
+        &[
+            "verify",
+            "main.xml",
+            "--json",
+            "--max-runs",
+            "20",
+            "--bt",
+            "btcpp",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(doc["properties"][0]["property"], "tree_success");
+    assert_eq!(doc["properties"][0]["probability"].as_f64(), Some(1.0));
+    assert_eq!(doc["properties"][1]["probability"].as_f64(), Some(0.0));
+    let _ = std::fs::remove_dir_all(&dir);
+
+    // Refused, each at its place: the script nodes and conditions under AS2FM's rules,
+    // what BT.CPP's lowering does not model yet under BT.CPP's.
+    for (name, bt, tree, needle, words) in [
+        (
+            "as2fm-script",
+            "as2fm",
+            "<Sequence>\n  <Script code=\"x := 1\"/>\n  <FailOnce/>\n</Sequence>",
+            "<Script",
+            "`Script` is a BehaviorTree.CPP 4 node that AS2FM has no model of",
+        ),
+        (
+            "as2fm-cond",
+            "as2fm",
+            "<Sequence>\n  <FailOnce _skipIf=\"true\"/>\n</Sequence>",
+            "_skipIf",
+            "`_skipIf` (a BehaviorTree.CPP 4 pre/post condition) is not supported: AS2FM has no model",
+        ),
+        (
+            "skip",
+            "btcpp",
+            "<Sequence>\n  <FailOnce _skipIf=\"true\"/>\n</Sequence>",
+            "_skipIf",
+            "answer SKIPPED, a status hindsight does not model yet",
+        ),
+        (
+            "string",
+            "btcpp",
+            "<Sequence>\n  <Script code=\"msg := 'hi'\"/>\n</Sequence>",
+            "msg := 'hi'",
+            "strings in scripts are not modelled yet (at column 8 of the script)",
+        ),
+        (
+            "real",
+            "btcpp",
+            "<Sequence>\n  <Script code=\"r := 1.5\"/>\n</Sequence>",
+            "r := 1.5",
+            "the number `1.5`",
+        ),
+        (
+            "division",
+            "btcpp",
+            "<Sequence>\n  <Script code=\"x := 4; x /= 2\"/>\n</Sequence>",
+            "x := 4; x /= 2",
+            "`/=`: BT.CPP divides in floating point",
+        ),
+        (
+            "text",
+            "btcpp",
+            "<Sequence>\n  <SetBlackboard output_key=\"n\" value=\"1\"/>\n  <ScriptCondition code=\"n == 1\"/>\n</Sequence>",
+            "n == 1",
+            "which a SetBlackboard writes",
+        ),
+        (
+            "else",
+            "btcpp",
+            "<Precondition if=\"true\" else=\"SKIPPED\">\n  <FailOnce/>\n</Precondition>",
+            "SKIPPED\"",
+            "SKIPPED is not modelled yet",
+        ),
+        (
+            "stale",
+            "btcpp",
+            "<IfThenElse>\n  <FailOnce _onFailure=\"x := 1\"/>\n  <AlwaysSuccess/>\n</IfThenElse>",
+            "_onFailure",
+            "without resetting it",
+        ),
+    ] {
+        let tree = v4(tree);
+        let dir = scratch(name, &tree);
+        let (code, out, err) = hindsight(&dir, &["validate", "main.xml", "--bt", bt]);
+        assert_eq!(code, 2, "{name}: {out} {err}");
+        let (l, c) = pos(&tree, needle);
+        let at = format!("tree.xml:{l}:{c}: ");
+        assert!(
+            err.lines().any(|x| x.contains(&at) && x.contains(words)),
+            "{name}: expected `{at}` ... `{words}` in:\n{err}"
+        );
+        if bt == "as2fm" {
+            assert!(err.contains("`--bt btcpp`"), "{err}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

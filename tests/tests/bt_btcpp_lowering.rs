@@ -407,6 +407,52 @@ fn switch_halts_the_child_it_no_longer_picks() {
     );
 }
 
+#[test]
+fn scripts_assign_and_conditions_read_the_entries() {
+    // This test and the next: each run checked against the real library (BT.CPP 4.8.2).
+    // `x := 1; x += 1` makes 2, so the condition holds and A runs; `y` was never
+    // written, so `y == 0` throws in BT.CPP ("Variable not found") and the tree stops.
+    let t = v4("<Sequence><Script code=\"x := 1; x += 1; f := x &gt; 1\"/>\
+         <ScriptCondition code=\"x == 2 &amp;&amp; f\"/><A/></Sequence>");
+    let sc = scripts(&[("A", &[S])]);
+    assert_eq!(
+        lowered(&t, &sc, 2, BtTick::Once).unwrap(),
+        ran(&[S, S], &[T(1003), T(1003)])
+    );
+    let t = v4("<Sequence><A/><ScriptCondition code=\"y == 0\"/><A/></Sequence>");
+    assert_eq!(
+        lowered(&t, &sc, 2, BtTick::Once).unwrap(),
+        ran(&[], &[T(1001)])
+    );
+}
+
+#[test]
+fn pre_and_post_conditions_run_around_the_node() {
+    // A fails on its first tick: `_onFailure` counts it, and B's `_successIf` answers
+    // SUCCESS without ticking B. On the second tick A succeeds.
+    let t = v4(
+        "<Sequence><Script code=\"n := 0\"/><Fallback><A _onFailure=\"n += 1\"/>\
+         <B _successIf=\"n == 1\"/></Fallback></Sequence>",
+    );
+    let sc = scripts(&[("A", &[F, S]), ("B", &[F])]);
+    assert_eq!(
+        lowered(&t, &sc, 2, BtTick::Once).unwrap(),
+        ran(&[S, S], &[T(1003), T(1003)])
+    );
+    // A Precondition keeps a running child going without evaluating `if` again: the
+    // Parallel's Script makes `go` false while A runs, and A still gets its second tick
+    // (`PreconditionNode::tick`, `_children_running`); `else` would answer FAILURE.
+    let t = v4("<Sequence><Script code=\"go := true\"/>\
+         <Parallel success_count=\"2\" failure_count=\"1\">\
+         <Precondition if=\"go\" else=\"FAILURE\"><A/></Precondition>\
+         <Script code=\"go := false\"/></Parallel></Sequence>");
+    let sc = scripts(&[("A", &[R, S])]);
+    assert_eq!(
+        lowered(&t, &sc, 2, BtTick::Once).unwrap(),
+        ran(&[R, S], &[T(1004), T(1004)])
+    );
+}
+
 /// Where the lowering's run and the oracle's BT.CPP 4 reading differ, or `None`; and
 /// how the oracle's run ended, for the counts.
 fn compare(want: &oracle::Outcome, got: &Outcome) -> Option<String> {
@@ -464,6 +510,18 @@ fn random_trees_lower_to_what_btcpp_does() {
     random_trees(gen::Options::default());
 }
 
+/// The same with BT.CPP 4's own nodes and its script language (`Script`,
+/// `ScriptCondition`, `Precondition`; no pre/post-condition attributes yet) in the
+/// format-4 trees.
+#[test]
+fn random_trees_with_scripts_lower_to_what_btcpp_does() {
+    random_trees(gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        ..Default::default()
+    });
+}
+
 /// The same with BT.CPP 4's nodes AS2FM has no model of (AsyncSequence, AsyncFallback,
 /// ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2-6) in the
 /// format-4 trees.
@@ -488,8 +546,9 @@ fn random_trees_with_time_nodes_lower_to_what_btcpp_does() {
 }
 
 /// The kinds of BT.CPP 4's own nodes, as the coverage check names them: those of
-/// `gen::Options::btcpp4_nodes`, then those of `time_nodes` and `try_catch`.
-const BTCPP4_KINDS: [&str; 11] = [
+/// `gen::Options::btcpp4_nodes`, then those of `time_nodes` and `try_catch`, then the
+/// script language's (`scripts`).
+const BTCPP4_KINDS: [&str; 14] = [
     "AsyncSequence",
     "AsyncFallback",
     "ParallelAll",
@@ -501,7 +560,13 @@ const BTCPP4_KINDS: [&str; 11] = [
     "Delay",
     "Sleep",
     "TryCatch",
+    "Script",
+    "ScriptCondition",
+    "Precondition",
 ];
+
+/// The first of [`BTCPP4_KINDS`] that the script language makes.
+const SCRIPT_KINDS: usize = 11;
 
 /// Which of [`BTCPP4_KINDS`] node kind `k` is.
 fn btcpp4_kind(k: &Kind) -> Option<usize> {
@@ -517,8 +582,32 @@ fn btcpp4_kind(k: &Kind) -> Option<usize> {
         Kind::Delay(_) => 8,
         Kind::Sleep(_) => 9,
         Kind::TryCatch(_) => 10,
+        Kind::Script(_) => 11,
+        Kind::ScriptCondition(_) => 12,
+        Kind::Precondition(..) => 13,
         _ => return None,
     })
+}
+
+/// Whether the lowering refuses the tree's pre/post conditions as not modelled yet
+/// (`btcpp4_conds.rs`): `_skipIf` / `_while` (SKIPPED), conditions on the root, or on a
+/// node BT.CPP may tick again without resetting it (the condition of a two-child
+/// IfThenElse or of a WhileDoElse, the child of a BlackboardCheck).
+fn conds_refused(t: &tree::Tree) -> bool {
+    let skips = t
+        .nodes
+        .iter()
+        .any(|x| x.conds.pre[2].is_some() || x.conds.pre[3].is_some());
+    let stale = t.nodes.iter().any(|p| {
+        let kids: &[usize] = match p.kind {
+            Kind::IfThenElse if p.children.len() == 2 => &p.children[..1],
+            Kind::WhileDoElse => &p.children[..1],
+            Kind::Check(..) => &p.children[..],
+            _ => &[],
+        };
+        kids.iter().any(|&c| t.nodes[c].conds.any())
+    });
+    skips || stale || t.nodes[0].conds.any()
 }
 
 /// `HINDSIGHT_BT_TREES` random trees from `HINDSIGHT_BT_SEED`, each lowered under both
@@ -534,10 +623,11 @@ fn random_trees(opts: gen::Options) {
     use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
     // Runs compared, of which: trees BT.CPP 4 refuses at load (3.x names), executor
     // ticks that never return, BT.CPP exceptions; trees left out.
-    let counts: [AtomicUsize; 6] = Default::default();
+    // Trees left out for conditions not modelled yet; trees compared with conditions.
+    let counts: [AtomicUsize; 8] = Default::default();
     let counts = &counts;
     // Trees compared that hold each of BT.CPP 4's own node kinds.
-    let kinds: [AtomicUsize; 11] = Default::default();
+    let kinds: [AtomicUsize; 14] = Default::default();
     let kinds = &kinds;
     let fails: Vec<String> = std::thread::scope(|s| {
         let hs: Vec<_> = (0..threads)
@@ -548,7 +638,12 @@ fn random_trees(opts: gen::Options) {
                     while i < n && fails.len() < 3 {
                         let seed = seed0 + i;
                         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-                        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
+                        let c = gen::case_with_conds(
+                            &mut rng,
+                            4 + (seed % 12) as i64,
+                            opts,
+                            gen::Conditions::WithoutSkip,
+                        );
                         let t = tree::read(&c.xml).expect("the oracle reads what it generates");
                         // BT.CPP 4 fails or throws on a SetBlackboard copy of the entries
                         // the harness's untyped ports create (the oracle's
@@ -562,8 +657,16 @@ fn random_trees(opts: gen::Options) {
                             i += threads;
                             continue;
                         }
+                        if conds_refused(&t) {
+                            counts[6].fetch_add(1, Relaxed);
+                            i += threads;
+                            continue;
+                        }
+                        if t.nodes.iter().any(|x| x.conds.any()) {
+                            counts[7].fetch_add(1, Relaxed);
+                        }
                         let refused = oracle::btcpp4_refuses(&t, &c.scripts).is_some();
-                        let mut seen = [false; 11];
+                        let mut seen = [false; 14];
                         for x in &t.nodes {
                             if let Some(k) = btcpp4_kind(&x.kind) {
                                 seen[k] = true;
@@ -627,20 +730,21 @@ fn random_trees(opts: gen::Options) {
             .flat_map(|h| h.join().expect("worker"))
             .collect()
     });
-    let [runs, refused, livelocks, errors, copies, modes_differ] =
+    let [runs, refused, livelocks, errors, copies, modes_differ, not_modelled, with_conds] =
         counts.each_ref().map(|c| c.load(Relaxed));
     let kinds = kinds.each_ref().map(|c| c.load(Relaxed));
     eprintln!(
         "{n} random trees{} in {:.1} s on {threads} threads: {copies} with a SetBlackboard copy \
-         left out; {runs} runs of the others (tickOnce and tickExactlyOnce): {refused} of \
+         and {not_modelled} with pre/post conditions not modelled yet left out, \
+         {with_conds} compared with pre/post conditions; {runs} runs of the others (tickOnce and tickExactlyOnce): {refused} of \
          them on trees BT.CPP 4 refuses at load (3.x names; compared with the oracle's BT.CPP 4 \
          rules), {livelocks} with an executor tick that never returns, {errors} where BT.CPP \
          throws; {modes_differ} trees whose two tick modes differ; trees with BT.CPP 4's own \
          nodes: {}",
-        if opts.btcpp4_nodes {
-            " (BT.CPP 4's own nodes included)"
-        } else {
-            ""
+        match (opts.btcpp4_nodes, opts.scripts) {
+            (true, true) => " (BT.CPP 4's own nodes and scripts included)",
+            (true, false) => " (BT.CPP 4's own nodes included)",
+            _ => "",
         },
         start.elapsed().as_secs_f64(),
         BTCPP4_KINDS
@@ -662,17 +766,24 @@ fn random_trees(opts: gen::Options) {
             modes_differ as u64 >= n / 100,
             "only {modes_differ} trees run differently under the two tick modes"
         );
+        if opts.scripts {
+            assert!(
+                with_conds as u64 >= n / 10,
+                "only {with_conds} compared trees with pre/post conditions"
+            );
+        }
         // With BT.CPP 4's own nodes on, each kind is in at least one tree in 100.
         for (i, (k, c)) in BTCPP4_KINDS.iter().zip(kinds).enumerate() {
             let on = match i {
                 0..=6 => opts.btcpp4_nodes,
                 7..=9 => opts.time_nodes,
-                _ => opts.try_catch,
+                10 => opts.try_catch,
+                _ => opts.scripts,
             };
             if on {
                 assert!(c as u64 >= n / 100, "only {c} compared trees with {k}");
             } else {
-                assert_eq!(c, 0, "{k} generated with btcpp4_nodes off");
+                assert_eq!(c, 0, "{k} generated while off");
             }
         }
     }
@@ -779,40 +890,54 @@ fn harness() -> Option<real::Real> {
 
 #[test]
 fn random_trees_with_btcpp4_nodes_lower_to_what_the_real_library_does() {
+    real_library(false, 2_000, 700_000);
+}
+
+/// The same with scripts (`Script`, `ScriptCondition`, `Precondition`) in the trees.
+#[test]
+fn random_trees_with_scripts_lower_to_what_the_real_library_does() {
+    real_library(true, 1_000, 800_000);
+}
+
+/// `HINDSIGHT_BT_REAL_LOWERING_TREES` (default `default_n`) random format-4 trees with
+/// BT.CPP 4's own nodes (and scripts when `scripts`) run in the real library and lowered.
+fn real_library(scripts: bool, default_n: u64, offset: u64) {
     let Some(mut lib) = harness() else { return };
-    let n = env("HINDSIGHT_BT_REAL_LOWERING_TREES", 2_000) as usize;
-    let seed0 = env("HINDSIGHT_BT_SEED", 0) + 700_000;
+    let n = env("HINDSIGHT_BT_REAL_LOWERING_TREES", default_n) as usize;
+    let seed0 = env("HINDSIGHT_BT_SEED", 0) + offset;
     let start = std::time::Instant::now();
     // Format-4 trees the library loads and whose SetBlackboard nodes write constants
     // (a copy fails or throws in 4.8.2; the lowering copies, see above).
     let mut cases = Vec::new();
-    let mut kinds = [0usize; 11];
+    let mut kinds = [0usize; 14];
     for seed in seed0.. {
         if cases.len() >= n {
             break;
         }
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let c = gen::case_with(
+        let c = gen::case_with_conds(
             &mut rng,
             4 + (seed % 12) as i64,
             gen::Options {
                 btcpp4_nodes: true,
-                scripts: false,
+                scripts,
                 ..Default::default()
             },
+            gen::Conditions::WithoutSkip,
         );
         if c.xml.contains("BTCPP_format=\"3\"") {
             continue;
         }
         let t = tree::read(&c.xml).expect("the oracle reads what it generates");
         if oracle::btcpp4_refuses(&t, &c.scripts).is_some()
+            || conds_refused(&t)
             || t.nodes
                 .iter()
                 .any(|x| matches!(x.kind, Kind::SetBlackboard(_, Operand::Entry(_))))
         {
             continue;
         }
-        let mut seen = [false; 11];
+        let mut seen = [false; 14];
         for x in &t.nodes {
             if let Some(k) = btcpp4_kind(&x.kind) {
                 seen[k] = true;
@@ -908,8 +1033,10 @@ fn random_trees_with_btcpp4_nodes_lower_to_what_the_real_library_does() {
         fails.iter().take(5).cloned().collect::<Vec<_>>().join("\n")
     );
     if n >= 500 {
-        for (k, c) in BTCPP4_KINDS.iter().zip(kinds).take(7) {
-            assert!(c >= n / 100, "only {c} trees with {k}");
+        for (i, (k, c)) in BTCPP4_KINDS.iter().zip(kinds).enumerate() {
+            if i < 7 || (i >= SCRIPT_KINDS && scripts) {
+                assert!(c >= n / 100, "only {c} trees with {k}");
+            }
         }
     }
 }

@@ -34,6 +34,19 @@ struct G<'r, R: Rng> {
     v3: bool,
     /// What else to generate.
     opts: Options,
+    /// With scripts: which pre/post-condition attributes.
+    conds: Conditions,
+}
+
+/// Which pre/post-condition attributes [`Options::scripts`] writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Conditions {
+    /// None.
+    Off,
+    /// All but `_skipIf` and `_while` (no SKIPPED).
+    WithoutSkip,
+    /// All of them.
+    All,
 }
 
 /// What the generator writes besides the nodes both AS2FM and BT.CPP have.
@@ -264,10 +277,14 @@ impl<R: Rng> G<'_, R> {
     /// `node` with now and then a pre/post-condition attribute (never on a SubTree);
     /// `skip` allows `_skipIf` and `_while`.
     fn with_conds(&mut self, node: String, skip: bool) -> String {
-        if !self.scripts_on() || node.starts_with("<SubTree") || self.below(4) != 0 {
+        if !self.scripts_on()
+            || self.conds == Conditions::Off
+            || node.starts_with("<SubTree")
+            || self.below(4) != 0
+        {
             return node;
         }
-        let names: &[&str] = if skip {
+        let names: &[&str] = if skip && self.conds == Conditions::All {
             &[
                 "_skipIf",
                 "_while",
@@ -559,6 +576,12 @@ pub fn case<R: Rng>(rng: &mut R, size: i64) -> Case {
 
 /// A random case of about `size` nodes, with what `opts` adds.
 pub fn case_with<R: Rng>(rng: &mut R, size: i64, opts: Options) -> Case {
+    case_with_conds(rng, size, opts, Conditions::All)
+}
+
+/// As [`case_with`], with [`Options::scripts`] writing the pre/post-condition attributes
+/// `conds` says.
+pub fn case_with_conds<R: Rng>(rng: &mut R, size: i64, opts: Options, conds: Conditions) -> Case {
     let mut g = G {
         rng,
         scripts: Scripts::new(),
@@ -566,6 +589,7 @@ pub fn case_with<R: Rng>(rng: &mut R, size: i64, opts: Options) -> Case {
         subtrees: Vec::new(),
         v3: false,
         opts,
+        conds,
     };
     g.v3 = g.below(3) == 0;
     let n_sub = g.below(3);

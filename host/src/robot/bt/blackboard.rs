@@ -60,6 +60,13 @@ pub(crate) struct Blackboard {
     pub readers: Vec<String>,
     /// Entries whose constants already conflict (reported once, not again per node).
     pub conflicted: Vec<String>,
+    /// Entries a SetBlackboard writes (BT.CPP 4 stores its value as text).
+    pub texts: Vec<String>,
+    /// Entries scripts read or write: the machine keeps whether each holds a value
+    /// (`btcpp4_script.rs`).
+    pub script_entries: Vec<String>,
+    /// The transitions that run the tree's scripts (`btcpp4_script.rs`).
+    pub scripts: Vec<Element>,
 }
 
 impl Blackboard {
@@ -77,24 +84,48 @@ impl Blackboard {
 
     /// The blackboard machine, or `None` when the tree uses no entry.
     pub fn machine(&self, b: B) -> Option<Element> {
-        if self.entries.is_empty() {
+        if self.entries.is_empty() && self.scripts.is_empty() {
             return None;
         }
         let mut m = b.scxml(MACHINE, "idle");
-        let vars: Vec<(&str, &str, String)> = self
+        let flags: Vec<String> = self
+            .script_entries
+            .iter()
+            .map(|e| super::btcpp4_script::has(e))
+            .collect();
+        let mut vars: Vec<(&str, &str, String)> = self
             .entries
             .iter()
             .map(|e| (e.name.as_str(), e.ty.as_str(), default_value(&e.ty)))
             .collect();
+        vars.extend(
+            flags
+                .iter()
+                .map(|f| (f.as_str(), "bool", "false".to_string())),
+        );
+        if !self.scripts.is_empty() {
+            vars.push((super::btcpp4_script::FAULT, "bool", "false".to_string()));
+        }
         m.push(b.datamodel(&vars));
         let mut idle = b.state("idle");
         for e in &self.entries {
+            let mut body = vec![b.assign(&e.name, "_event.data.value")];
+            if self.script_entries.contains(&e.name) {
+                body.push(b.assign(&super::btcpp4_script::has(&e.name), "true"));
+            }
+            idle.push(b.tr(Some(&set_event(&e.name)), None, Some("idle"), body));
+        }
+        // A script that threw stops the tree (`btcpp4_script.rs`).
+        if !self.scripts.is_empty() {
             idle.push(b.tr(
-                Some(&set_event(&e.name)),
                 None,
-                Some("idle"),
-                vec![b.assign(&e.name, "_event.data.value")],
+                Some(super::btcpp4_script::FAULT),
+                Some("error"),
+                vec![],
             ));
+            for t in &self.scripts {
+                idle.push(t.clone());
+            }
         }
         if !self.readers.is_empty() {
             let params: Vec<(&str, &str)> = self
@@ -110,6 +141,9 @@ impl Blackboard {
             idle.push(b.tr(Some(REQ), None, Some("idle"), sends));
         }
         m.push(idle);
+        if !self.scripts.is_empty() {
+            m.push(b.state("error"));
+        }
         Some(m)
     }
 }
@@ -287,6 +321,16 @@ pub(crate) fn type_entries(
         }
     }
     let by_ports: Vec<String> = bb.entries.iter().map(|e| e.name.clone()).collect();
+    for n in &tree.nodes {
+        if let Some((entry, _)) = (n.kind == Kind::Control(Control::SetBlackboard))
+            .then(|| set_ports(n))
+            .flatten()
+        {
+            if !bb.texts.contains(&entry) {
+                bb.texts.push(entry);
+            }
+        }
+    }
     let sets: Vec<(String, &super::tree::Port)> = tree
         .nodes
         .iter()

@@ -16,7 +16,7 @@
 use super::blackboard::Blackboard;
 use super::btcpp::{halting_state, running, yield_running};
 use super::control::{init_state, n_children, Ctx, FAILURE, RUNNING, SUCCESS};
-use super::tree::{Btcpp4, PortValue, TreeNode};
+use super::tree::{Btcpp4, PortValue, ScriptNode, TreeNode};
 use crate::model::source::{Diagnostic, SourceMap};
 use crate::model::xml::Element;
 
@@ -34,6 +34,11 @@ pub(super) fn node_name(k: Btcpp4) -> String {
         Btcpp4::Delay => "Delay".into(),
         Btcpp4::Sleep => "Sleep".into(),
         Btcpp4::TryCatch => "TryCatch".into(),
+        Btcpp4::Script(s) => match s {
+            ScriptNode::Script => "Script".into(),
+            ScriptNode::Condition => "ScriptCondition".into(),
+            ScriptNode::Precondition => "Precondition".into(),
+        },
     }
 }
 
@@ -119,6 +124,7 @@ pub(super) fn lower(
         }
         // `mod.rs` lowers them with `btcpp4_time.rs`, which needs the tree's clock.
         Btcpp4::Timeout | Btcpp4::Delay | Btcpp4::Sleep | Btcpp4::TryCatch => None,
+        Btcpp4::Script(s) => super::btcpp4_script::lower(sm, s, n, ctx, bb, errs),
         Btcpp4::Switch(cases) => {
             let pick = switch_pick(sm, k, cases as usize, n, bb, errs)?;
             if matches!(pick, SwitchPick::Entry(..)) {

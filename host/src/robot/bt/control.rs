@@ -60,8 +60,9 @@ pub(crate) struct Ctx {
     pub parent: String,
     /// Who gets `bt_<id>_halt_response`: the parent's machine, or `NONE` for the root.
     pub halt_target: String,
-    /// The children: id and machine.
-    pub children: Vec<(u32, String)>,
+    /// The children: the stem of their events (`bt_<stem>_tick`: the id, or
+    /// `<id>_cond` for a node with pre/post conditions, `btcpp4_conds.rs`) and machine.
+    pub children: Vec<(String, String)>,
     /// `None`: halt every child as AS2FM does. `Some`: the [`HaltEffect`] of each child;
     /// a child is halted only if that can change something.
     pub effects: Option<Vec<HaltEffect>>,

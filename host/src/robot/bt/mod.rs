@@ -36,6 +36,8 @@ mod blackboard;
 mod btcpp;
 mod btcpp4;
 mod btcpp4_time;
+mod btcpp4_conds;
+mod btcpp4_script;
 mod build;
 mod control;
 mod decorators;
@@ -251,10 +253,26 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
             input.tick_if_not_running,
         ),
     });
-    for n in &tree.nodes {
+    let btcpp = input.semantics != BtSemantics::As2fm;
+    // Under BT.CPP's rules a node with pre/post conditions talks to its parent through
+    // its conditions' machine (`btcpp4_conds.rs`).
+    let wrapped = |i: usize| btcpp && btcpp4_conds::wrapped(&tree, i);
+    for (idx, n) in tree.nodes.iter().enumerate() {
+        let refused = btcpp4_conds::refusals(sm, &tree, idx, btcpp);
+        if !refused.is_empty() {
+            errs.extend(refused);
+            continue;
+        }
         let (parent, halt_target) = match n.parent {
             Some(p) => (tree.nodes[p].machine.clone(), tree.nodes[p].machine.clone()),
             None => (root_name.clone(), "NONE".to_string()),
+        };
+        let outer = (parent.clone(), halt_target.clone());
+        let (parent, halt_target) = if wrapped(idx) {
+            let w = btcpp4_conds::machine_name(n);
+            (w.clone(), w)
+        } else {
+            (parent, halt_target)
         };
         let ctx = Ctx {
             b: B { at: n.span },
@@ -265,7 +283,16 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
             children: n
                 .children
                 .iter()
-                .map(|&c| (tree.nodes[c].id, tree.nodes[c].machine.clone()))
+                .map(|&c| {
+                    if wrapped(c) {
+                        (
+                            btcpp4_conds::stem(&tree.nodes[c]),
+                            btcpp4_conds::machine_name(&tree.nodes[c]),
+                        )
+                    } else {
+                        (tree.nodes[c].id.to_string(), tree.nodes[c].machine.clone())
+                    }
+                })
                 .collect(),
             effects: match input.semantics {
                 BtSemantics::As2fm => (input.halts == Halts::WhenNeeded)
@@ -323,6 +350,16 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
         };
         if let Some(m) = m {
             out.push(m);
+        }
+        if wrapped(idx) {
+            let outer = Ctx {
+                parent: outer.0,
+                halt_target: outer.1,
+                ..ctx.clone()
+            };
+            if let Some(w) = btcpp4_conds::wrapper(sm, n, &outer, &mut bb, &mut errs) {
+                out.push(w);
+            }
         }
     }
     if let Some(c) = &clock {

@@ -12,8 +12,11 @@
 //! operators in one expression ("operator cannot be mixed with previous operators");
 //! parentheses and the middle part of `c ? a : b` start a new one.
 //!
-//! hindsight has no model of the language yet: AS2FM has none, and the BT.CPP semantics
-//! (`--bt btcpp`) does not lower scripts; [`check`] only finds syntax errors.
+//! [`parse`] gives the statements as a tree ([`Stmt`], [`Ex`]); `&&` and `||` are one
+//! level, read left to right (BT.CPP 4.8.2: `true || false && false` is false), and
+//! `c ? a : b ? ...` is refused ("operator cannot be chained"), as the real library
+//! does. AS2FM has no model of the language; the BT.CPP semantics (`--bt btcpp`) lowers
+//! its integer and boolean part (`btcpp4_script.rs`).
 
 /// A syntax error: the byte offset in the script (from 0) and what is wrong.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -22,6 +25,49 @@ pub(crate) struct SyntaxError {
     pub at: usize,
     /// What was expected or refused.
     pub what: String,
+}
+
+/// An expression and the byte offset (in the script) where it starts.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Ex {
+    /// Byte offset of its first token.
+    pub at: usize,
+    /// What it is.
+    pub k: K,
+}
+
+/// The kinds of expression.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum K {
+    /// A decimal integer literal.
+    Int(i64),
+    /// `true` / `false`.
+    Bool(bool),
+    /// Another number literal (real, hexadecimal, too large), as written.
+    Number(String),
+    /// A `'string'`.
+    Str,
+    /// A blackboard entry.
+    Name(String),
+    /// A prefix operator (`-`, `!`, `~`) and its operand.
+    Un(&'static str, Box<Ex>),
+    /// A binary operator (`+ - * / | & ^ && ||`).
+    Bin(&'static str, Box<Ex>, Box<Ex>),
+    /// A comparison chain: operands and the operators between them (`a < b < c` is
+    /// `a < b && b < c`).
+    Cmp(Vec<Ex>, Vec<&'static str>),
+    /// `c ? a : b`.
+    Ite(Box<Ex>, Box<Ex>, Box<Ex>),
+}
+
+/// A statement: an optional assignment (`entry`, operator, offset of the entry) and its
+/// expression.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Stmt {
+    /// `Some((entry, ":=" | "=" | "+=" | "-=" | "*=" | "/=", offset))` for an assignment.
+    pub assign: Option<(String, &'static str, usize)>,
+    /// The expression (the right-hand side of an assignment).
+    pub e: Ex,
 }
 
 /// The pre/post-condition attributes BT.CPP 4 reads on every node (`tree_node.h`,
@@ -114,6 +160,7 @@ struct Parser<'s> {
     toks: Vec<(T<'s>, usize)>,
     pos: usize,
     end: usize,
+    src: &'s str,
     /// Per open expression: it has a `!`; it has an arithmetic operator.
     open: Vec<[bool; 2]>,
 }
@@ -144,102 +191,204 @@ impl<'s> Parser<'s> {
         Ok(())
     }
 
-    fn statement(&mut self) -> Result<(), SyntaxError> {
-        if let (Some((T::Name(_), _)), Some((T::Sym(op), _))) =
+    fn statement(&mut self) -> Result<Stmt, SyntaxError> {
+        let mut assign = None;
+        if let (Some((T::Name(n), at)), Some((T::Sym(op), _))) =
             (self.toks.get(self.pos), self.toks.get(self.pos + 1))
         {
-            if [":=", "=", "+=", "-=", "*=", "/="].contains(op) {
+            if let Some(op) = [":=", "=", "+=", "-=", "*=", "/="]
+                .into_iter()
+                .find(|o| o == op)
+            {
+                assign = Some((n.to_string(), op, *at));
                 self.pos += 2;
             }
         }
-        self.expression()
+        let e = self.expression()?;
+        Ok(Stmt { assign, e })
     }
 
-    fn expression(&mut self) -> Result<(), SyntaxError> {
+    fn expression(&mut self) -> Result<Ex, SyntaxError> {
         self.open.push([false; 2]);
         let r = self.expression_rest();
         self.open.pop();
         r
     }
 
-    /// `binary(0) [? expression : expression_rest]`, in the open expression.
-    fn expression_rest(&mut self) -> Result<(), SyntaxError> {
-        self.binary(0)?;
-        if self.next_is("?") {
-            self.pos += 1;
-            self.expression()?;
-            if !self.next_is(":") {
-                return self.fail("expected `:`");
-            }
-            self.pos += 1;
-            self.expression_rest()?;
+    /// `binary(0) [? expression : binary(0)]`, in the open expression; a second `?`
+    /// is refused as BT.CPP refuses it ("operator cannot be chained").
+    fn expression_rest(&mut self) -> Result<Ex, SyntaxError> {
+        let c = self.binary(0)?;
+        if !self.next_is("?") {
+            return Ok(c);
         }
-        Ok(())
+        self.pos += 1;
+        let a = self.expression()?;
+        if !self.next_is(":") {
+            return self.fail("expected `:`");
+        }
+        self.pos += 1;
+        let b = self.binary(0)?;
+        if self.next_is("?") {
+            return self.fail("operator cannot be chained");
+        }
+        let at = c.at;
+        Ok(Ex {
+            at,
+            k: K::Ite(Box::new(c), Box::new(a), Box::new(b)),
+        })
     }
 
-    fn binary(&mut self, level: usize) -> Result<(), SyntaxError> {
+    fn binary(&mut self, level: usize) -> Result<Ex, SyntaxError> {
         if LEVELS[level].is_empty() {
             return self.prefix();
         }
-        self.binary(level + 1)?;
+        let first = self.binary(level + 1)?;
+        let at = first.at;
+        let mut acc = first;
+        let mut chain: Vec<Ex> = Vec::new();
+        let mut ops: Vec<&'static str> = Vec::new();
         while let Some((T::Sym(op), _)) = self.toks.get(self.pos) {
-            if !LEVELS[level].contains(op) {
+            let Some(op) = LEVELS[level].iter().copied().find(|o| o == op) else {
                 break;
-            }
+            };
             if level >= 3 {
                 self.note(1)?;
             }
             self.pos += 1;
-            self.binary(level + 1)?;
+            let rhs = self.binary(level + 1)?;
+            if level == 1 {
+                // Comparisons chain.
+                if chain.is_empty() {
+                    chain.push(acc.clone());
+                }
+                chain.push(rhs);
+                ops.push(op);
+            } else {
+                acc = Ex {
+                    at,
+                    k: K::Bin(op, Box::new(acc), Box::new(rhs)),
+                };
+            }
         }
-        Ok(())
+        if !ops.is_empty() {
+            return Ok(Ex {
+                at,
+                k: K::Cmp(chain, ops),
+            });
+        }
+        Ok(acc)
     }
 
-    fn prefix(&mut self) -> Result<(), SyntaxError> {
+    fn prefix(&mut self) -> Result<Ex, SyntaxError> {
+        let at = self.at();
         match self.toks.get(self.pos).map(|t| t.0) {
             Some(T::Sym(op @ ("-" | "!" | "~"))) => {
                 self.note(usize::from(op != "!"))?;
                 self.pos += 1;
-                self.prefix()
+                let e = self.prefix()?;
+                Ok(Ex {
+                    at,
+                    k: K::Un(op, Box::new(e)),
+                })
             }
-            Some(T::Num | T::Str | T::Name(_)) => {
+            Some(T::Num) => {
                 self.pos += 1;
-                Ok(())
+                let end = self.toks.get(self.pos).map_or(self.end, |t| t.1);
+                let text = self.src[at..end].trim();
+                let k = if text.bytes().all(|c| c.is_ascii_digit()) {
+                    text.parse::<i64>()
+                        .map_or_else(|_| K::Number(text.to_string()), K::Int)
+                } else {
+                    K::Number(text.to_string())
+                };
+                Ok(Ex { at, k })
+            }
+            Some(T::Str) => {
+                self.pos += 1;
+                Ok(Ex { at, k: K::Str })
+            }
+            Some(T::Name(n)) => {
+                self.pos += 1;
+                let k = match n {
+                    "true" => K::Bool(true),
+                    "false" => K::Bool(false),
+                    _ => K::Name(n.to_string()),
+                };
+                Ok(Ex { at, k })
             }
             Some(T::Sym("(")) => {
                 self.pos += 1;
-                self.expression()?;
+                let e = self.expression()?;
                 if !self.next_is(")") {
                     return self.fail("expected `)`");
                 }
                 self.pos += 1;
-                Ok(())
+                Ok(e)
             }
             _ => self.fail("expected an operand"),
         }
     }
 }
 
-/// Checks a script's syntax.
-pub(crate) fn check(script: &str) -> Result<(), SyntaxError> {
+/// Parses a script into its statements.
+pub(crate) fn parse(script: &str) -> Result<Vec<Stmt>, SyntaxError> {
     let mut p = Parser {
         toks: tokens(script)?,
         pos: 0,
         end: script.len(),
+        src: script,
         open: Vec::new(),
     };
-    p.statement()?;
+    let mut out = vec![p.statement()?];
     while p.next_is(";") {
         if p.pos + 1 == p.toks.len() {
             return p.fail("unexpected trailing `;`");
         }
         p.pos += 1;
-        p.statement()?;
+        out.push(p.statement()?);
     }
     if p.pos < p.toks.len() {
         return p.fail("expected `;`");
     }
-    Ok(())
+    Ok(out)
+}
+
+/// The entry names a well-formed script uses, in order of first use (none for a
+/// malformed one).
+pub(crate) fn names(script: &str) -> Vec<String> {
+    fn walk(e: &Ex, out: &mut Vec<String>) {
+        match &e.k {
+            K::Name(n) if !out.contains(n) => out.push(n.clone()),
+            K::Un(_, a) => walk(a, out),
+            K::Bin(_, a, b) => {
+                walk(a, out);
+                walk(b, out);
+            }
+            K::Cmp(xs, _) => xs.iter().for_each(|x| walk(x, out)),
+            K::Ite(c, a, b) => {
+                walk(c, out);
+                walk(a, out);
+                walk(b, out);
+            }
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    for s in parse(script).unwrap_or_default() {
+        if let Some((n, _, _)) = &s.assign {
+            if !out.contains(n) {
+                out.push(n.clone());
+            }
+        }
+        walk(&s.e, &mut out);
+    }
+    out
+}
+
+/// Checks a script's syntax.
+pub(crate) fn check(script: &str) -> Result<(), SyntaxError> {
+    parse(script).map(|_| ())
 }
 
 /// The error for script port `port` of built-in node `node` (`Script` / `ScriptCondition`
@@ -257,25 +406,19 @@ pub(crate) fn port_error(node: &str, port: &str, value: &str) -> Option<String> 
     ))
 }
 
-/// For a pre/post-condition attribute (`_skipIf`, ...): `Ok(refusal)` for a well-formed
-/// script (not modelled), `Err(syntax error)` for a malformed one; `None` for another
-/// attribute.
-pub(crate) fn condition_error(attr: &str, value: &str) -> Option<Result<String, String>> {
+/// For a pre/post-condition attribute (`_skipIf`, ...): `Ok(())` for a well-formed
+/// script, `Err(syntax error)` for a malformed one; `None` for another attribute.
+pub(crate) fn condition_error(attr: &str, value: &str) -> Option<Result<(), String>> {
     if !CONDITION_ATTRS.contains(&attr) {
         return None;
     }
-    Some(match check(value) {
-        Ok(()) => Ok(format!(
-            "`{attr}` (a BehaviorTree.CPP 4 pre/post condition) is not supported: AS2FM has no \
-             model of BT.CPP's script language, and the BT.CPP semantics (`--bt btcpp`) does \
-             not lower scripts yet"
-        )),
-        Err(e) => Err(format!(
+    Some(check(value).map_err(|e| {
+        format!(
             "`{attr}`: script syntax error at column {} of the script: {}",
             e.at + 1,
             e.what
-        )),
-    })
+        )
+    }))
 }
 
 #[cfg(test)]
@@ -315,5 +458,23 @@ mod tests {
         assert_eq!(at("a:= !true + 1"), 10);
         assert_eq!(at("x := (!f ? -1 : -x)"), 16);
         assert_eq!(at("a := 'open"), 5);
+    }
+
+    #[test]
+    fn and_and_or_are_one_level_read_left_to_right() {
+        // BT.CPP 4.8.2: `true || false && false` is false, so it reads
+        // `(true || false) && false`.
+        let s = parse("a := true || false && false").unwrap();
+        let K::Bin("&&", l, _) = &s[0].e.k else {
+            panic!("{:?}", s[0].e)
+        };
+        assert!(matches!(l.k, K::Bin("||", ..)));
+        assert_eq!(s[0].assign.as_ref().map(|a| a.1), Some(":="));
+        // Comparisons chain; `?:` does not ("operator cannot be chained", at the second
+        // `?`).
+        let s = parse("1 < x <= 3").unwrap();
+        assert!(matches!(&s[0].e.k, K::Cmp(xs, ops) if xs.len() == 3 && ops == &["<", "<="]));
+        assert_eq!(at("x := 2 ? 3 : 4 ? 5 : 6"), 15);
+        assert_eq!(names("y := x + 1; f = !g"), ["y", "x", "f", "g"]);
     }
 }

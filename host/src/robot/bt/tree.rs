@@ -66,6 +66,20 @@ pub(crate) enum Btcpp4 {
     Sleep,
     /// `TryCatch` (BT.CPP 4.10; `catch_on_halt`).
     TryCatch,
+    /// `Script`, `ScriptCondition`, `Precondition`: BT.CPP 4's script language
+    /// (`btcpp4_script.rs`).
+    Script(ScriptNode),
+}
+
+/// The nodes that run a script.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ScriptNode {
+    /// `Script`: runs `code`, SUCCESS.
+    Script,
+    /// `ScriptCondition`: SUCCESS if `code` is true, else FAILURE.
+    Condition,
+    /// `Precondition`: ticks its child if `if` is true, else answers `else`.
+    Precondition,
 }
 
 /// The ports of `Switch6`; `Switch<n>` takes the first `n + 1`.
@@ -160,6 +174,9 @@ impl Control {
             "Delay" => Control::Btcpp4(Btcpp4::Delay),
             "Sleep" => Control::Btcpp4(Btcpp4::Sleep),
             "TryCatch" => Control::Btcpp4(Btcpp4::TryCatch),
+            "Script" => Control::Btcpp4(Btcpp4::Script(ScriptNode::Script)),
+            "ScriptCondition" => Control::Btcpp4(Btcpp4::Script(ScriptNode::Condition)),
+            "Precondition" => Control::Btcpp4(Btcpp4::Script(ScriptNode::Precondition)),
             _ => return None,
         })
     }
@@ -189,6 +206,8 @@ impl Control {
                 // The cases and the default (BT.CPP 4.10 `switch_node.h`,
                 // `SwitchNode::tick`: `NUM_CASES + 1` children).
                 self::Btcpp4::Switch(n) => (n as usize + 1, n as usize + 1),
+                self::Btcpp4::Script(ScriptNode::Precondition) => (1, 1),
+                self::Btcpp4::Script(_) => (0, 0),
             },
         }
     }
@@ -213,6 +232,8 @@ impl Control {
             Btcpp4(self::Btcpp4::Timeout | self::Btcpp4::Sleep) => &["msec"],
             Btcpp4(self::Btcpp4::Delay) => &["delay_msec"],
             Btcpp4(self::Btcpp4::TryCatch) => &["catch_on_halt"],
+            Btcpp4(self::Btcpp4::Script(ScriptNode::Precondition)) => &["if", "else"],
+            Btcpp4(self::Btcpp4::Script(_)) => &["code"],
             _ => &[],
         }
     }
@@ -241,7 +262,7 @@ const SUPPORTED: &[&str] = &[
     "BlackboardCheckBool",
     "SubTree",
     "SubTreePlus (format 3)",
-    "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6, Timeout, Delay, Sleep, TryCatch (with `--bt btcpp`)",
+    "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6, Timeout, Delay, Sleep, TryCatch, Script, ScriptCondition, Precondition (with `--bt btcpp`)",
 ];
 
 /// BehaviorTree.CPP's other built-in nodes (the ones its `BehaviorTreeFactory`
@@ -252,9 +273,6 @@ pub(crate) const UNSUPPORTED: &[(&str, &str)] = &[
         "ManualSelector",
         "it asks a person at a terminal which child to run",
     ),
-    ("Script", "it runs BT.CPP's script language"),
-    ("ScriptCondition", "it runs BT.CPP's script language"),
-    ("Precondition", "it runs BT.CPP's script language"),
     (
         "UnsetBlackboard",
         "entries in hindsight's blackboard always hold a value",
@@ -347,6 +365,26 @@ pub(crate) struct TreeNode {
     pub children: Vec<usize>,
     /// Index of the parent; `None` for the root.
     pub parent: Option<usize>,
+    /// For a node that runs a script: each entry name its script uses, and what it is in
+    /// the whole tree's terms (a SubTree remaps or prefixes its names).
+    pub script_names: Vec<(String, PortValue)>,
+    /// Its pre/post conditions (`_failureIf`, ... `_post`), syntax checked, in the order
+    /// written (`btcpp4_conds.rs`).
+    pub conds: Vec<Cond>,
+}
+
+/// A pre/post-condition attribute of a node.
+#[derive(Clone, Debug)]
+pub(crate) struct Cond {
+    /// `_failureIf`, `_successIf`, `_skipIf`, `_while`, `_onHalted`, `_onFailure`,
+    /// `_onSuccess` or `_post`.
+    pub attr: String,
+    /// The script.
+    pub code: String,
+    /// Where the attribute's name is.
+    pub name_span: Span,
+    /// Where its value is.
+    pub span: Span,
 }
 
 impl TreeNode {
@@ -516,6 +554,14 @@ fn is_ident(s: &str) -> bool {
         && cs.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
+/// A port value as text (an entry as `{entry}`).
+fn lit(v: &PortValue) -> String {
+    match v {
+        PortValue::Literal(s) => s.clone(),
+        PortValue::Blackboard(b) => format!("{{{b}}}"),
+    }
+}
+
 impl Reader<'_> {
     fn err(&mut self, span: Span, msg: impl Into<String>) {
         self.errs.push(self.sm.diag(span, msg));
@@ -642,6 +688,7 @@ impl Reader<'_> {
             _ => sanitize(&type_name),
         };
         let mut ports = Vec::new();
+        let mut conds: Vec<Cond> = Vec::new();
         for a in &el.attrs {
             if a.name == "name"
                 || a.name == "_description"
@@ -651,7 +698,12 @@ impl Reader<'_> {
             }
             if a.name.starts_with('_') {
                 match super::script::condition_error(&a.name, &a.value) {
-                    Some(Ok(m)) => self.err(a.name_span, m),
+                    Some(Ok(_)) => conds.push(Cond {
+                        attr: a.name.clone(),
+                        code: a.value.clone(),
+                        name_span: a.name_span,
+                        span: a.value_span,
+                    }),
                     Some(Err(m)) => self.err(a.value_span, m),
                     None => self.err(
                         a.name_span,
@@ -719,6 +771,30 @@ impl Reader<'_> {
                 span: a.value_span,
             });
         }
+        let mut script_names: Vec<(String, PortValue)> = Vec::new();
+        for c in &conds {
+            for name in super::script::names(&c.code) {
+                if !script_names.iter().any(|(n, _)| *n == name) {
+                    let v = self.resolve_bb(&name, self.scopes.len());
+                    script_names.push((name, v));
+                }
+            }
+        }
+        if let Kind::Control(Control::Btcpp4(Btcpp4::Script(_))) = kind {
+            for p in &ports {
+                if let Some(m) = super::script::port_error(&type_name, &p.key, &lit(&p.value)) {
+                    self.err(p.span, m);
+                }
+                if let (PortValue::Literal(code), "code" | "if") = (&p.value, p.key.as_str()) {
+                    for name in super::script::names(code) {
+                        if !script_names.iter().any(|(n, _)| *n == name) {
+                            let v = self.resolve_bb(&name, self.scopes.len());
+                            script_names.push((name, v));
+                        }
+                    }
+                }
+            }
+        }
         self.nodes.push(TreeNode {
             id,
             kind,
@@ -727,6 +803,8 @@ impl Reader<'_> {
             ports,
             children: Vec::new(),
             parent,
+            script_names,
+            conds,
         });
         if let Some(p) = parent {
             self.nodes[p].children.push(idx);
