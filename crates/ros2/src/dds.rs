@@ -324,6 +324,19 @@ impl Reader {
 }
 
 impl Writer {
+    /// How many readers on the graph this writer is matched with (discovery found them
+    /// and their QoS is compatible).
+    pub fn matched(&self) -> usize {
+        self.writer.get_matched_subscriptions().len()
+    }
+
+    /// Waits up to `max_wait` until every matched reader acknowledged every sample
+    /// written (reliable QoS), so a process that ends next loses none in flight; `false`
+    /// when some were still unacknowledged.
+    pub fn wait_acked(&self, max_wait: std::time::Duration) -> bool {
+        matches!(self.writer.wait_for_acknowledgments(max_wait), Ok(true))
+    }
+
     /// Writes one sample: little-endian CDR with its 4-byte header (never waits for a
     /// reader: keep-last history drops the oldest unacknowledged sample).
     pub fn write(&self, cdr: &[u8]) -> Result<(), String> {
