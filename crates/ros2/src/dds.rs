@@ -208,8 +208,13 @@ impl Qos {
     }
 }
 
+/// The pause between two writers of one participant (see [`Participant::writer`]).
+pub const WRITER_PACE: std::time::Duration = std::time::Duration::from_millis(50);
+
 /// A DDS participant on one domain, with one subscriber and one publisher.
 pub struct Participant {
+    /// Writers created so far.
+    writers: std::cell::Cell<usize>,
     // Readers and writers hold their own handles; the participant outlives them in use.
     dp: DomainParticipant,
     subscriber: rustdds::Subscriber,
@@ -237,6 +242,8 @@ pub struct Reader {
 /// A keyless writer of one ROS topic.
 pub struct Writer {
     writer: DataWriter<Raw, RawAdapter>,
+    /// Readers matched, from the last publication-matched status.
+    matched: std::cell::Cell<usize>,
     /// The DDS topic name.
     pub dds_topic: String,
 }
@@ -258,6 +265,7 @@ impl Participant {
             .create_publisher(&qos)
             .map_err(dds_err("publisher".into()))?;
         Ok(Participant {
+            writers: std::cell::Cell::new(0),
             dp,
             subscriber,
             publisher,
@@ -286,7 +294,17 @@ impl Participant {
     }
 
     /// A writer of ROS topic `ros_topic` of type `ros_type`.
+    ///
+    /// Writers are created at most one per [`WRITER_PACE`]: rustdds 0.13's
+    /// `create_datawriter` holds its discovery database's write lock while it hands the
+    /// writer to the participant's event loop over a channel of 10, and that loop takes
+    /// the same lock to drain it; creating writers faster than the loop drains them
+    /// deadlocks the process (seen with the museum's 21 writers on a loaded machine).
     pub fn writer(&self, ros_topic: &str, ros_type: &str, qos: Qos) -> Result<Writer, String> {
+        if self.writers.get() > 0 {
+            std::thread::sleep(WRITER_PACE);
+        }
+        self.writers.set(self.writers.get() + 1);
         let topic = self.topic(ros_topic, ros_type, qos)?;
         let writer = self
             .publisher
@@ -294,6 +312,7 @@ impl Participant {
             .map_err(dds_err(format!("writer of `{}`", topic_name(ros_topic))))?;
         Ok(Writer {
             writer,
+            matched: std::cell::Cell::new(0),
             dds_topic: topic_name(ros_topic),
         })
     }
@@ -324,6 +343,28 @@ impl Reader {
 }
 
 impl Writer {
+    /// How many readers on the graph this writer is matched with (discovery found them
+    /// and their QoS is compatible).
+    pub fn matched(&self) -> usize {
+        // rustdds 0.13 leaves `get_matched_subscriptions` unimplemented (`todo!`): the
+        // count comes from the writer's publication-matched status events instead.
+        use rustdds::StatusEvented;
+        while let Some(s) = self.writer.try_recv_status() {
+            if let rustdds::DataWriterStatus::PublicationMatched { current, .. } = s {
+                self.matched
+                    .set(usize::try_from(current.count()).unwrap_or(0));
+            }
+        }
+        self.matched.get()
+    }
+
+    /// Waits up to `max_wait` until every matched reader acknowledged every sample
+    /// written (reliable QoS), so a process that ends next loses none in flight; `false`
+    /// when some were still unacknowledged.
+    pub fn wait_acked(&self, max_wait: std::time::Duration) -> bool {
+        matches!(self.writer.wait_for_acknowledgments(max_wait), Ok(true))
+    }
+
     /// Writes one sample: little-endian CDR with its 4-byte header (never waits for a
     /// reader: keep-last history drops the oldest unacknowledged sample).
     pub fn write(&self, cdr: &[u8]) -> Result<(), String> {

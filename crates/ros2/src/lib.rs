@@ -1,5 +1,5 @@
 //! hindsight's ROS 2 layer: interface definitions (`.msg` / `.srv` / `.action`, and the
-//! standard packages built in), the CDR reader, and rosbag2 recordings (MCAP files and
+//! standard packages built in), the CDR reader and writer (`cdr`, `cdr_write`), and rosbag2 recordings (MCAP files and
 //! SQLite `.db3` files, alone or as a folder with `metadata.yaml`), and live topics over
 //! DDS (module `dds`, cargo feature `dds`).
 //!
@@ -17,6 +17,7 @@
 
 pub mod bag;
 pub mod cdr;
+pub mod cdr_write;
 #[cfg(feature = "dds")]
 pub mod dds;
 pub mod feed;

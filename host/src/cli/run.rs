@@ -1,6 +1,8 @@
-//! `hindsight run`: one seeded simulation of a model, paced in wall-clock time, its ROS topics published over iceoryx2.
+//! `hindsight run`: one seeded simulation of a model, paced in wall-clock time, its ROS topics published over iceoryx2 (or, with `--ros2`, on DDS as a ROS 2 robot publishes them: [`crate::live::publish_dds`]).
 
 use std::io::IsTerminal;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Once;
 use std::time::Instant;
 
 use iceoryx2::prelude::*;
@@ -16,6 +18,7 @@ use crate::live::pace::Paced;
 use crate::live::publish::{
     layout_of, layout_toml, layouts, name_from_ports, TopicLayout, TopicPublisher, WireKind,
 };
+use crate::live::publish_dds::{declared_types, plan, DdsPaced, DdsPublisher};
 use crate::live::{check_speed, Clock};
 use crate::props::ros::{action_event, service_client_event, service_event, topic_event};
 use crate::sim::{EndReason, EventSemantics, Quiescence, RunConfig, Simulator};
@@ -54,6 +57,17 @@ pub struct RunArgs {
     /// for several).
     #[arg(long, value_name = "NAME")]
     pub external: Vec<String>,
+    /// Publish on ROS 2 over DDS instead of iceoryx2: topic `/a/b` on DDS topic `rt/a/b`
+    /// with type `pkg::msg::dds_::Type_`, CDR-encoded, ROS 2's default QoS, domain
+    /// `ROS_DOMAIN_ID`; services as their introspection events `/<service>/_service_event`.
+    #[arg(long)]
+    pub ros2: bool,
+    /// With --ros2: before the first step, wait (up to 60 s) until a reader on the graph
+    /// subscribes to TOPIC (a ROS name, `/a/b` or `/<service>/_service_event`), then 5 s
+    /// for discovery to finish on the reader's side, so that it gets the run from its
+    /// first message (repeat for several).
+    #[arg(long, value_name = "TOPIC", requires = "ros2")]
+    pub wait_match: Vec<String>,
 }
 
 const AFTER_HELP: &str = "\
@@ -102,10 +116,36 @@ Monitoring it (--layout names `event` and `var` after the property file's
   hindsight monitor --props examples/specs/museum.hspec --config museum.toml &
   hindsight run examples/museum-guide --speed 10
 
+On ROS 2 over DDS (--ros2), no ROS install needed:
+  The run joins DDS domain ROS_DOMAIN_ID (0 when unset) as a plain DDS participant
+  and publishes what a ROS 2 robot running the model would: topic /a/b on DDS topic
+  rt/a/b, type pkg/msg/T as pkg::msg::dds_::T_, the message CDR-encoded from its
+  .msg definition (the model's fields set, every other field zero), with ROS 2's
+  default QoS (reliable, volatile, keep last 10). Each service the model serves is
+  published as ROS 2's service introspection publishes it: on /<service>/_service_event
+  (type pkg/srv/Name_Event), a REQUEST_RECEIVED event with the request, then a
+  RESPONSE_SENT event with the response, one sequence_number for both. A ROS 2 node
+  (`ros2 topic echo`, `ros2 bag record`) or `hindsight monitor --ros2` listens to it.
+  Not supported over DDS (refused or warned, never silent): answering service calls
+  from ROS 2 clients, actions (their goals, feedback and results are not published),
+  --external (a ROS 2 node standing in for a component) and --layout (iceoryx2 only).
+  --wait-match TOPIC holds the first step until a subscriber to TOPIC is matched,
+  then 5 s more for the subscriber's side of DDS discovery, so a monitor started
+  first sees the run from its first message.
+
+The museum guide's properties.xml, checked live on DDS and on the recording:
+  hindsight monitor --ros2 examples/museum-guide/properties.xml --speed 2 \
+      --from-first-message --record museum.mcap &
+  hindsight run examples/museum-guide --ros2 --speed 2 --duration 80s \
+      --wait-match /BatteryComponent/battery_level
+  kill -INT %1
+  hindsight replay examples/museum-guide/properties.xml museum.mcap --time-unit 1ms --changes
+
 Progress goes to stderr; SIGINT/SIGTERM end the run cleanly (exit 0).
 Plain SCXML models need --time-unit (e.g. 100ms) to be paced.
 
-Exit codes: 0 the run ended (or was stopped); 2 bad model or argument; 1 iceoryx2 failure.";
+Exit codes: 0 the run ended (or was stopped); 2 bad model or argument; 1 iceoryx2 or DDS
+failure.";
 
 /// The layouts of the topics the external components publish, taken out of `topics` (the
 /// run does not publish them: their processes do).
@@ -297,6 +337,9 @@ fn goal_routes(
 
 /// Runs `hindsight run`.
 pub fn run(args: &RunArgs) -> Result<(), CliError> {
+    if args.ros2 {
+        return run_ros2(args);
+    }
     iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
     check_speed(args.speed).map_err(|m| CliError::Input(format!("--speed: {m}")))?;
     let (loaded, external) = load_without(&args.input, &args.external)?;
@@ -416,6 +459,173 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     }
     if let Some(e) = &live.inbound_error {
         eprintln!("warning: reading from external components failed: {e}");
+    }
+    let how = if live.stopped {
+        "stopped by a signal".to_string()
+    } else {
+        match &outcome.end {
+            EndReason::MaxTime => "reached the duration".to_string(),
+            other => format!("{other:?}"),
+        }
+    };
+    eprintln!("run: ended at model step {}: {how}", outcome.time);
+    Ok(())
+}
+
+/// Set by SIGINT / SIGTERM during `run --ros2`: the run stops at its next step, exit 0.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+fn stop_flag() -> &'static AtomicBool {
+    static INSTALL: Once = Once::new();
+    INSTALL.call_once(|| {
+        // ctrlc runs this on its own thread: only the flag is set here.
+        let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed));
+    });
+    &STOP
+}
+
+/// How long `--wait-match` waits after the writers matched their subscribers, for the
+/// subscribers to match the writers (measured: up to 2.6 s between the two on a loaded
+/// 2-core machine with the museum's 21 writers).
+const SETTLE: std::time::Duration = std::time::Duration::from_secs(5);
+
+/// Runs `hindsight run --ros2`: the run's topics and service events on DDS.
+fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
+    let input = CliError::Input;
+    check_speed(args.speed).map_err(|m| input(format!("--speed: {m}")))?;
+    if !args.external.is_empty() {
+        return Err(input(
+            "--external with --ros2 is not supported: a ROS 2 node cannot yet stand in for a \
+             component over DDS (publish into the run, serve or call its services); \
+             --external works over iceoryx2 (leave out --ros2)"
+                .into(),
+        ));
+    }
+    if args.layout {
+        return Err(input(
+            "--layout prints the iceoryx2 payload layout; with --ros2 the payload is the \
+             message's CDR (its .msg definition)"
+                .into(),
+        ));
+    }
+    let domain = ros2::dds::domain_id().map_err(input)?;
+    let Some(main_path) = crate::robot::load::main_file_of(&args.input.model) else {
+        return Err(input(format!(
+            "{}: --ros2 needs a robot model (a main file whose node models declare their \
+             ROS topics and services with types)",
+            args.input.model.display()
+        )));
+    };
+    let (loaded, _) = load_without(&args.input, &[])?;
+    let model = &loaded.model;
+    let diags = |errs: Vec<crate::model::Diagnostic>| {
+        CliError::Input(
+            errs.iter()
+                .map(|d| d.to_string())
+                .collect::<Vec<_>>()
+                .join("\n"),
+        )
+    };
+    let mut sm = crate::model::SourceMap::new();
+    let main = crate::robot::main_file::MainFile::read(&mut sm, &main_path).map_err(diags)?;
+    let types = declared_types(&main);
+    let search = crate::robot::interfaces::Search::from_env(args.input.interfaces.clone());
+    let packages =
+        crate::robot::interfaces::Interfaces::discover_with(&mut sm, &main_path, &search)
+            .map_err(diags)?;
+    let (routes, warnings) = plan(model, &types, &super::replay::Packages(packages));
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    let Some(unit_ns) = loaded.unit_ns else {
+        return Err(input(format!(
+            "{}: the model has no time unit; give --time-unit (e.g. 100ms) to pace it",
+            args.input.model.display()
+        )));
+    };
+    let max_time = loaded
+        .max_time(args.duration.as_deref())
+        .map_err(|m| input(format!("--duration: {m}")))?;
+    let publisher = DdsPublisher::new(domain, model, routes, ros2::dds::Qos::ros_default())
+        .map_err(CliError::Failed)?;
+    let topics: Vec<&str> = publisher.topics().collect();
+    for t in &args.wait_match {
+        if !topics.contains(&t.as_str()) {
+            return Err(input(format!(
+                "--wait-match {t}: the run does not publish it (it publishes {})",
+                topics.join(", ")
+            )));
+        }
+    }
+    eprintln!(
+        "run: publishing {} topics on DDS domain {domain}: {}",
+        topics.len(),
+        topics.join(", ")
+    );
+    let stop = stop_flag();
+    let start = Instant::now();
+    loop {
+        let missing = publisher.unmatched(&args.wait_match);
+        if missing.is_empty() {
+            break;
+        }
+        if stop.load(Ordering::Relaxed) {
+            return Ok(());
+        }
+        if start.elapsed() > std::time::Duration::from_secs(60) {
+            return Err(CliError::Failed(format!(
+                "--wait-match: no reader subscribed to {} within 60 s on DDS domain {domain}",
+                missing.join(", ")
+            )));
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    if !args.wait_match.is_empty() {
+        // A writer matches a reader when it learns of the reader; the reader learns of
+        // the writer separately, and what is written before that is lost to it (a
+        // volatile reader). Give the subscribers' side of discovery time to finish.
+        eprintln!(
+            "run: subscribers matched; starting in {} s",
+            SETTLE.as_secs()
+        );
+        let start = Instant::now();
+        while start.elapsed() < SETTLE {
+            if stop.load(Ordering::Relaxed) {
+                return Ok(());
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+    }
+    let cfg = RunConfig {
+        max_time,
+        events: loaded.events,
+        quiescence: Quiescence::AdvanceTime,
+        ..RunConfig::default()
+    };
+    let mut live = DdsPaced {
+        model,
+        publisher,
+        clock: Clock::with_speed(unit_ns, args.speed),
+        unit_ns,
+        stop,
+        stopped: false,
+        last_progress: Instant::now(),
+        tty: std::io::stderr().is_terminal(),
+    };
+    let mut rng = crate::smc::runner::stream(args.seed, args.run);
+    let outcome = Simulator::new(model).run(&mut rng, &cfg, &mut live);
+    live.progress(outcome.time, true);
+    if live.tty {
+        eprintln!();
+    }
+    // Reliable delivery of the last messages before the participant goes.
+    live.publisher.flush(std::time::Duration::from_secs(2));
+    let (failed, why) = live.publisher.failed();
+    if failed > 0 {
+        eprintln!(
+            "warning: {failed} samples could not be published (last: {})",
+            why.unwrap_or("?")
+        );
     }
     let how = if live.stopped {
         "stopped by a signal".to_string()

@@ -18,8 +18,11 @@
 //!   only means no samples.
 //!
 //! With `--record FILE.mcap` every received sample is written, as it came, to an MCAP
-//! file (ROS 2 profile: `ros2msg` schemas, `cdr` messages, log time = receive time),
-//! which `hindsight replay` and any MCAP tool read.
+//! file (ROS 2 profile: `ros2msg` schemas, `cdr` messages), which `hindsight replay` and
+//! any MCAP tool read. A sample's log time is when it was received and judged, on the
+//! system's clock: the wall-clock time of the first sample recorded plus the monitor's
+//! time since it (at `--speed S`, S times the wall-clock time), so that `replay` with the
+//! monitor's unit judges every sample at the time the live monitor did.
 
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -135,6 +138,9 @@ pub fn run(
     ));
     let _ = run.opts.log.flush();
     let mut buf: Vec<Received> = Vec::new();
+    // The recording's clock: the wall-clock time of the first sample recorded, minus its
+    // judged time (see `sample`).
+    let mut record_base: Option<u64> = None;
     let mut idle_since_flush = false;
     let result = loop {
         if stop.load(Ordering::Relaxed) {
@@ -147,7 +153,12 @@ pub fn run(
             }
             busy |= !buf.is_empty();
             for r in buf.drain(..) {
-                sample(&mut run, tap, &r, mcap.as_mut())?;
+                sample(
+                    &mut run,
+                    tap,
+                    &r,
+                    mcap.as_mut().map(|m| (m, &mut record_base)),
+                )?;
             }
         }
         if settings.heartbeat > 0 && (run.started || !settings.from_first_message) {
@@ -205,7 +216,7 @@ fn sample(
     run: &mut Run<'_, '_>,
     tap: &mut Tap,
     r: &Received,
-    mcap: Option<&mut McapWriter>,
+    mcap: Option<(&mut McapWriter, &mut Option<u64>)>,
 ) -> Result<(), LiveError> {
     let time = run.now();
     tap.received += 1;
@@ -251,12 +262,25 @@ fn sample(
     }
     tap.writers[idx].1 = tap.writers[idx].1.max(r.seq);
     tap.last_sample = Some(time);
-    if let (Some(m), Some(channel)) = (mcap, tap.channel) {
-        let now = SystemTime::now()
-            .duration_since(SystemTime::UNIX_EPOCH)
-            .map_or(0, |d| d.as_nanos() as u64);
-        m.write(channel, tap.received as u32, now, &r.data)
-            .map_err(LiveError::Io)?;
+    if let (Some((m, base)), Some(channel)) = (mcap, tap.channel) {
+        // A sample's log time is the time it is judged at, on the system's clock: the
+        // wall-clock time of the first sample recorded, plus the judged time since it (at
+        // --speed S, S times the wall-clock time since). `replay` with the monitor's unit
+        // then puts every sample at the time it was judged live.
+        let at = time.saturating_mul(run.spec.tick_ns());
+        let base = *base.get_or_insert_with(|| {
+            SystemTime::now()
+                .duration_since(SystemTime::UNIX_EPOCH)
+                .map_or(0, |d| d.as_nanos() as u64)
+                .saturating_sub(at)
+        });
+        m.write(
+            channel,
+            tap.received as u32,
+            base.saturating_add(at),
+            &r.data,
+        )
+        .map_err(LiveError::Io)?;
     }
     match tap.source.feed.read(&r.data) {
         Ok(sets) => {

@@ -33,6 +33,7 @@ pub mod http;
 pub mod inject;
 pub mod pace;
 pub mod publish;
+pub mod publish_dds;
 pub mod record;
 pub mod serve;
 

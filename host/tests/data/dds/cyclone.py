@@ -9,6 +9,10 @@
 #       ["int32", "/topic", value], ["bool", "/topic", value], ["bad", "/topic"] (a
 #       malformed std_msgs/Int32MultiArray),
 #       ["sleep", seconds]]; prints "matched /topic" and "sent N" lines.
+#   cyclone.py subscribe DOMAIN SPEC_JSON  SPEC: {"topics": [["/topic", "TYPE"], ...],
+#       "count": N, "seconds": S}: reads the topics (TYPE: a key of ros_types()) with ROS
+#       2's default QoS, prints "ready" once its readers exist, then one JSON line per
+#       sample {"topic", "data": the sample's fields} until N samples or S seconds.
 #   cyclone.py read_mcap FILE              prints one JSON line per message:
 #       {"topic", "schema", "encoding", "message_encoding", "log_time", and "data"
 #       decoded with mcap-ros2-support, or "error" when it does not decode}.
@@ -90,6 +94,122 @@ def publish(domain, steps):
     print(f"sent {sent}", flush=True)
 
 
+def ros_types():
+    """rosidl's generated IDL of the types the tests read, with rmw_cyclonedds's type names
+    (`pkg::msg::dds_::Type_`, a service's event `pkg::srv::dds_::Name_Event_`)."""
+    from cyclonedds.idl import IdlStruct
+    from cyclonedds.idl.types import array, float32, int8, int32, int64, sequence, uint8, uint32
+
+    @dataclass
+    class Int32_(IdlStruct, typename="std_msgs::msg::dds_::Int32_"):
+        data: int32
+
+    @dataclass
+    class Bool_(IdlStruct, typename="std_msgs::msg::dds_::Bool_"):
+        data: bool
+
+    @dataclass
+    class Time_(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
+        sec: int32
+        nanosec: uint32
+
+    @dataclass
+    class Header_(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
+        stamp: Time_
+        frame_id: str
+
+    @dataclass
+    class BatteryState_(IdlStruct, typename="sensor_msgs::msg::dds_::BatteryState_"):
+        header: Header_
+        voltage: float32
+        temperature: float32
+        current: float32
+        charge: float32
+        capacity: float32
+        design_capacity: float32
+        percentage: float32
+        power_supply_status: uint8
+        power_supply_health: uint8
+        power_supply_technology: uint8
+        present: bool
+        cell_voltage: sequence[float32]
+        cell_temperature: sequence[float32]
+        location: str
+        serial_number: str
+
+    @dataclass
+    class ServiceEventInfo_(IdlStruct, typename="service_msgs::msg::dds_::ServiceEventInfo_"):
+        event_type: uint8
+        stamp: Time_
+        client_gid: array[uint8, 16]
+        sequence_number: int64
+
+    @dataclass
+    class SetPoi_Request_(IdlStruct, typename="scheduler_interfaces_dummy::srv::dds_::SetPoi_Request_"):
+        poi_number: int32
+
+    @dataclass
+    class SetPoi_Response_(IdlStruct, typename="scheduler_interfaces_dummy::srv::dds_::SetPoi_Response_"):
+        is_ok: bool
+
+    @dataclass
+    class SetPoi_Event_(IdlStruct, typename="scheduler_interfaces_dummy::srv::dds_::SetPoi_Event_"):
+        info: ServiceEventInfo_
+        request: sequence[SetPoi_Request_, 1]
+        response: sequence[SetPoi_Response_, 1]
+
+    @dataclass
+    class NavigationStatus_(IdlStruct, typename="navigation_interfaces_dummy::msg::dds_::NavigationStatus_"):
+        status: int8
+
+    return {
+        "int32": Int32_,
+        "bool": Bool_,
+        "battery_state": BatteryState_,
+        "set_poi_event": SetPoi_Event_,
+        "navigation_status": NavigationStatus_,
+    }
+
+
+def subscribe(domain, spec):
+    import dataclasses
+
+    from cyclonedds.core import Policy, Qos
+    from cyclonedds.domain import DomainParticipant
+    from cyclonedds.sub import DataReader
+    from cyclonedds.topic import Topic
+    from cyclonedds.util import duration
+
+    types = ros_types()
+    qos = Qos(
+        Policy.Reliability.Reliable(duration(milliseconds=100)),
+        Policy.Durability.Volatile,
+        Policy.History.KeepLast(10),
+    )
+    dp = DomainParticipant(domain)
+    readers = []
+    for topic, kind in spec["topics"]:
+        t = Topic(dp, "rt" + topic, types[kind], qos=qos)
+        readers.append((topic, DataReader(dp, t, qos=qos)))
+    print("ready", flush=True)
+    end = time.time() + spec["seconds"]
+    got = 0
+    while got < spec["count"] and time.time() < end:
+        idle = True
+        for topic, r in readers:
+            for sample in r.take(N=64):
+                idle = False
+                # Not data: the writer's unregistration when its participant leaves.
+                if not sample.sample_info.valid_data:
+                    continue
+                got += 1
+                line = {"topic": topic, "data": dataclasses.asdict(sample)}
+                # A uint8 array (client_gid) comes as bytes: as a list of numbers.
+                print(json.dumps(line, default=list), flush=True)
+        if idle:
+            time.sleep(0.005)
+
+
 def read_mcap(path):
     from mcap.reader import make_reader
     from mcap_ros2.decoder import DecoderFactory
@@ -120,6 +240,8 @@ def read_mcap(path):
 if __name__ == "__main__":
     if sys.argv[1] == "publish":
         publish(int(sys.argv[2]), json.loads(sys.argv[3]))
+    elif sys.argv[1] == "subscribe":
+        subscribe(int(sys.argv[2]), json.loads(sys.argv[3]))
     elif sys.argv[1] == "read_mcap":
         read_mcap(sys.argv[2])
     else:
