@@ -123,6 +123,9 @@ pub struct SchedulerBounds {
     pub sources: Vec<Source>,
 }
 
+/// An estimate of a source and its interval.
+type Estimated = (Option<f64>, [f64; 2]);
+
 /// One witness re-estimated with one kind of choice put back to uniform.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Source {
@@ -455,9 +458,9 @@ pub fn bounds(
                 continue;
             };
             let base = fresh[i].as_ref().and_then(|r| r[p].estimate.estimate);
-            let mut estimate = |uniform: PutBack| -> Result<Option<(Option<f64>, [f64; 2])>, ()> {
+            let mut estimate = |uniform: PutBack| -> Result<Option<Estimated>, ()> {
                 let sched = Scheduler::Sampled(Sampled { uniform, ..w });
-                if !cache.contains_key(&sched) {
+                if let std::collections::hash_map::Entry::Vacant(slot) = cache.entry(sched) {
                     let r = run_study_until(
                         &estimate_cfg,
                         &rules,
@@ -471,7 +474,7 @@ pub fn bounds(
                     if r.interrupted {
                         return Ok(None);
                     }
-                    cache.insert(sched, r.properties);
+                    slot.insert(r.properties);
                 }
                 let r = &cache[&sched][p];
                 Ok(Some((
