@@ -608,6 +608,12 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         report.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
     }
     if let Some(path) = args.report.as_ref().filter(|_| !result.interrupted) {
+        // With --schedulers: a failing run under each order-sensitive property's min
+        // witness beside one under the uniform scheduler.
+        let mut failing = failing;
+        if !report.interrupted {
+            failing.extend(schedulers::witness_runs(args, &loaded, &run_cfg, &report)?);
+        }
         super::report::from_verify(path, &report, &loaded, settings(), &failing)?;
     }
     print_report(&report, args.json)?;

@@ -75,6 +75,7 @@ pub fn page(data: &ReportData) -> String {
     o.push_str("</ul></nav>\n<main>\n");
     if let Some(s) = &data.study {
         study(&mut o, s, &data.runs);
+        bounds(&mut o, s);
     }
     for (i, s) in data.sweeps.iter().enumerate() {
         sweep(&mut o, i, s);
@@ -107,11 +108,71 @@ pub fn page(data: &ReportData) -> String {
     o
 }
 
+/// A run's title: `property: run k`, or its name when that says the scheduler it ran
+/// under (`verify --schedulers --report`: `p under the min witness ID, run k`).
 fn run_title(r: &Run) -> String {
     match (&r.property, r.run) {
-        (Some(p), Some(k)) => format!("{p}: run {k}"),
+        (Some(p), Some(k)) if !r.name.contains(" under the ") => format!("{p}: run {k}"),
         _ => r.name.clone(),
     }
+}
+
+/// `verify --schedulers`: per property the uniform estimate beside the min and max over
+/// the sampled schedulers, their witnesses, and where an order-sensitive property's
+/// order comes from (nothing without `--schedulers`).
+fn bounds(o: &mut String, s: &Study) {
+    let rows: Vec<_> = s
+        .properties
+        .iter()
+        .filter_map(|p| p.schedulers.as_ref().map(|b| (p, b)))
+        .collect();
+    let Some((_, first)) = rows.first() else {
+        return;
+    };
+    let _ = writeln!(
+        o,
+        "<section id=\"schedulers\">\n<h2>Orders the model leaves open</h2>\n<p>Bounds over \
+         {} sampled {} schedulers: each interval holds its witness's probability, together \
+         at confidence {}; order-sensitive: max - min &gt; 2 x precision. Replay a witness \
+         with <code>--scheduler ID</code>.</p>",
+        first.sampled,
+        esc(&first.memory),
+        plot::label(s.confidence)
+    );
+    o.push_str(
+        "<table class=\"props\">\n<thead><tr><th>property</th><th>uniform</th><th>min</th>\
+         <th>max</th><th>order</th><th>where the order comes from</th></tr></thead>\n<tbody>\n",
+    );
+    let num = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.4}"));
+    for (p, b) in rows {
+        let side = |x: &crate::verify::schedulers::Bound| {
+            format!(
+                "{} [{:.4}, {:.4}]<br><code>{}</code>",
+                num(x.probability),
+                x.interval[0],
+                x.interval[1],
+                esc(&x.scheduler)
+            )
+        };
+        let why = crate::verify::schedulers::explain(&b.sources, s.precision).unwrap_or_default();
+        let _ = writeln!(
+            o,
+            "<tr class=\"{}\"><td><b>{}</b></td><td class=\"prob\">{}</td><td>{}</td><td>{}</td>\
+             <td>{}</td><td>{}</td></tr>",
+            if b.order_sensitive { "bad" } else { "ok" },
+            esc(&p.property),
+            num(p.probability),
+            side(&b.min),
+            side(&b.max),
+            if b.order_sensitive {
+                "order-sensitive"
+            } else {
+                "-"
+            },
+            esc(&why)
+        );
+    }
+    o.push_str("</tbody></table>\n</section>\n");
 }
 
 fn study(o: &mut String, s: &Study, runs: &[Run]) {
@@ -204,9 +265,10 @@ fn study(o: &mut String, s: &Study, runs: &[Run]) {
                 let _ = write!(
                     o,
                     " <a href=\"#run-{i}\">{}</a>",
-                    esc(&runs[i]
-                        .run
-                        .map_or(runs[i].name.clone(), |k| format!("run {k}")))
+                    esc(&match runs[i].run {
+                        Some(k) if !runs[i].name.contains(" under the ") => format!("run {k}"),
+                        _ => runs[i].name.clone(),
+                    })
                 );
             }
             o.push_str("</div>");

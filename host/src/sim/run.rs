@@ -20,7 +20,7 @@ pub use config::{
     EndReason, EventSemantics, Quiescence, RunConfig, RunError, RunOutcome, SpinKind, SpinReport,
     TransitionChoice,
 };
-pub use sched::{mix, Memory, Sampled, Scheduler};
+pub use sched::{mix, Memory, PutBack, Sampled, Scheduler};
 
 const IDLE: u32 = u32::MAX;
 const NO_MSG: u32 = u32::MAX;

@@ -27,6 +27,16 @@
 //!    hold together with probability at least `c`, so the two reported ones do, whichever
 //!    was picked.
 //!
+//! 5. **Sources** (order-sensitive properties only). Each witness is estimated again,
+//!    on the same streams as its fresh estimate, with one kind of choice put back to
+//!    uniform at a time ([`crate::sim::PutBack`]): which machine moves, which pending
+//!    event is delivered, which enabled transition fires. For a kind that moves the
+//!    probability by more than twice the precision, each machine's (event's) position
+//!    alone is put back too. The kinds and machines whose change moves the probability
+//!    most are where the order comes from ([`Source`]). These intervals are each at the
+//!    study's confidence on their own: they describe the witnesses, and no bound rests
+//!    on them.
+//!
 //! The guarantee: with confidence `c`, the min interval holds the probability of the
 //! property under the min witness scheduler, and the max interval that under the max
 //! witness. Hence the true minimum over all schedulers is at most the min interval's upper
@@ -43,7 +53,10 @@ use serde::{Deserialize, Serialize};
 
 use super::observe::PropertySet;
 use super::study::Runner;
-use crate::sim::{mix, CompiledModel, Memory, RunConfig, Sampled, Scheduler};
+use crate::sim::{
+    mix, CompiledModel, EventId, EventSemantics, MachineId, Memory, PutBack, RunConfig, Sampled,
+    Scheduler, TransitionChoice,
+};
 use crate::smc::stats::RuleConfig;
 use crate::smc::{run_range, run_study_until, PropertyCounts, StudyConfig};
 
@@ -71,6 +84,7 @@ pub fn sampled(seed: u64, i: u64, memory: Memory) -> Sampled {
     Sampled {
         id: mix(mix(seed, IDS), i),
         memory,
+        uniform: PutBack::default(),
     }
 }
 
@@ -103,6 +117,107 @@ pub struct SchedulerBounds {
     /// `max - min` exceeds twice the precision: the probability depends on an order the
     /// model leaves open.
     pub order_sensitive: bool,
+    /// Where the order comes from (order-sensitive properties only): each witness with
+    /// one kind of choice, or one machine's or event's position, put back to uniform.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sources: Vec<Source>,
+}
+
+/// An estimate of a source and its interval.
+type Estimated = (Option<f64>, [f64; 2]);
+
+/// One witness re-estimated with one kind of choice put back to uniform.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Source {
+    /// `min` or `max`: whose witness.
+    pub witness: String,
+    /// The choice put back: `machine` (which machine moves), `delivery` (which pending
+    /// event is delivered), `transition` (which enabled transition fires); with
+    /// `machine` or `event` set, that one machine's (event's) position only.
+    pub choice: String,
+    /// The machine whose position is put back.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machine: Option<String>,
+    /// The event whose position is put back.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub event: Option<String>,
+    /// The estimate (`null` with no judged run).
+    pub probability: Option<f64>,
+    /// Its interval at the study's confidence (on its own).
+    pub interval: [f64; 2],
+    /// `probability` minus the witness's probability.
+    pub shift: f64,
+    /// What `--scheduler` replays.
+    pub scheduler: String,
+}
+
+impl Source {
+    /// Whether the change moved the witness's probability by more than `2 * precision`.
+    pub fn matters(&self, precision: f64) -> bool {
+        self.shift.abs() > 2.0 * precision
+    }
+}
+
+/// One line saying where a property's order comes from, e.g. "depends on whether a or b
+/// moves first", from its [`Source`]s (`None` when there are none).
+pub fn explain(sources: &[Source], precision: f64) -> Option<String> {
+    if sources.is_empty() {
+        return None;
+    }
+    let biggest = |choice: &str, items: bool| -> Vec<&Source> {
+        let mut v: Vec<&Source> = sources
+            .iter()
+            .filter(|s| {
+                s.choice == choice
+                    && (s.machine.is_some() || s.event.is_some()) == items
+                    && s.matters(precision)
+            })
+            .collect();
+        v.sort_by(|a, b| b.shift.abs().total_cmp(&a.shift.abs()));
+        v
+    };
+    let mut kinds: Vec<&Source> = ["machine", "delivery", "transition"]
+        .iter()
+        .flat_map(|k| biggest(k, false))
+        .collect();
+    kinds.sort_by(|a, b| b.shift.abs().total_cmp(&a.shift.abs()));
+    let Some(top) = kinds.first() else {
+        return Some(
+            "no one kind of choice moves it alone: the order comes from several kinds at once"
+                .to_string(),
+        );
+    };
+    let mut names: Vec<&str> = Vec::new();
+    for s in biggest(&top.choice, true) {
+        let n = s.machine.as_deref().or(s.event.as_deref()).unwrap_or("");
+        if !names.contains(&n) {
+            names.push(n);
+        }
+    }
+    let (verb, kind) = match top.choice.as_str() {
+        "machine" => ("moves", "which machine moves first"),
+        "delivery" => ("is delivered", "which pending event is delivered first"),
+        _ => ("fires", "which enabled transition fires"),
+    };
+    let mut line = match names.as_slice() {
+        [] => format!("depends on {kind}"),
+        [one] => format!("depends on when {one} {verb} ({kind})"),
+        [a, b] => format!("depends on whether {a} or {b} {verb} first"),
+        [a, b, rest @ ..] => format!(
+            "depends on whether {a} or {b} {verb} first (also {})",
+            rest.iter().take(3).copied().collect::<Vec<_>>().join(", ")
+        ),
+    };
+    let others: Vec<&str> = kinds
+        .iter()
+        .skip(1)
+        .map(|s| s.choice.as_str())
+        .filter(|c| *c != top.choice)
+        .collect();
+    if let Some(o) = others.first() {
+        line.push_str(&format!("; {o} order matters too"));
+    }
+    Some(line)
 }
 
 /// What happened, for progress lines.
@@ -113,6 +228,11 @@ pub enum Stage<'a> {
         alive: usize,
         /// Runs each will have after the round.
         runs: u64,
+    },
+    /// The sources of an order-sensitive property are estimated.
+    Sources {
+        /// The property.
+        property: &'a str,
     },
     /// The fresh estimate of candidate `index` of `of` starts.
     Estimate {
@@ -267,7 +387,6 @@ pub fn bounds(
         }
         fresh[i] = Some(r.properties);
     }
-    runner.finish()?;
 
     let bound = |i: usize, p: usize| -> Bound {
         let r = &fresh[i].as_ref().expect("every candidate was estimated")[p];
@@ -281,6 +400,7 @@ pub fn bounds(
     };
     let value = |i: &usize, p: usize| fresh[*i].as_ref().and_then(|r| r[p].estimate.estimate);
     let mut out = Vec::with_capacity(props);
+    let mut witnesses = Vec::with_capacity(props);
     for (p, [low, high]) in sides.iter().enumerate() {
         let lo = *low
             .iter()
@@ -310,7 +430,160 @@ pub fn bounds(
             min,
             max,
             order_sensitive,
+            sources: Vec::new(),
         });
+        witnesses.push([lo, hi]);
     }
+
+    // Sources: the witnesses again with one kind of choice put back to uniform, on the
+    // streams of their fresh estimate. Every property's estimate comes from each study,
+    // so a study serves every property whose witness it replays.
+    let rules = (0..props)
+        .map(|_| rule.build())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| format!("statistics: {e}"))?;
+    let mut cache: std::collections::HashMap<Scheduler, Vec<crate::smc::PropertyResult>> =
+        Default::default();
+    let names = set.guarantee_names();
+    for p in 0..props {
+        if !out[p].order_sensitive {
+            continue;
+        }
+        progress(Stage::Sources {
+            property: &names[p],
+        });
+        let mut sources = Vec::new();
+        for (side, &i) in ["min", "max"].iter().zip(&witnesses[p]) {
+            let Scheduler::Sampled(w) = scheds[i] else {
+                continue;
+            };
+            let base = fresh[i].as_ref().and_then(|r| r[p].estimate.estimate);
+            let mut estimate = |uniform: PutBack| -> Result<Option<Estimated>, ()> {
+                let sched = Scheduler::Sampled(Sampled { uniform, ..w });
+                if let std::collections::hash_map::Entry::Vacant(slot) = cache.entry(sched) {
+                    let r = run_study_until(
+                        &estimate_cfg,
+                        &rules,
+                        |k, rng| runner.run_under(k, rng, sched),
+                        &mut quiet,
+                        stop,
+                    );
+                    if r.runs.failed > 0 {
+                        return Err(());
+                    }
+                    if r.interrupted {
+                        return Ok(None);
+                    }
+                    slot.insert(r.properties);
+                }
+                let r = &cache[&sched][p];
+                Ok(Some((
+                    r.estimate.estimate,
+                    [r.interval.lower, r.interval.upper],
+                )))
+            };
+            let mut kinds = vec![(
+                "machine",
+                PutBack {
+                    machines: true,
+                    ..PutBack::default()
+                },
+            )];
+            if run_cfg.events == EventSemantics::As2fm {
+                kinds.push((
+                    "delivery",
+                    PutBack {
+                        events: true,
+                        ..PutBack::default()
+                    },
+                ));
+            }
+            if run_cfg.transitions == TransitionChoice::Random {
+                kinds.push((
+                    "transition",
+                    PutBack {
+                        transitions: true,
+                        ..PutBack::default()
+                    },
+                ));
+            }
+            for (choice, uniform) in kinds {
+                let (probability, interval) = match estimate(uniform) {
+                    Ok(Some(x)) => x,
+                    Ok(None) => return Ok(None),
+                    Err(()) => {
+                        runner.finish()?;
+                        return Err("a run of the sources failed without a message".into());
+                    }
+                };
+                let source = Source {
+                    witness: side.to_string(),
+                    choice: choice.to_string(),
+                    machine: None,
+                    event: None,
+                    probability,
+                    interval,
+                    shift: probability.unwrap_or(0.0) - base.unwrap_or(0.0),
+                    scheduler: Scheduler::Sampled(Sampled { uniform, ..w }).to_string(),
+                };
+                let deeper = source.matters(rule.precision);
+                sources.push(source);
+                if !deeper || choice == "transition" {
+                    continue;
+                }
+                // One machine's (event's) position at a time.
+                let items: Vec<(PutBack, Option<String>, Option<String>)> = if choice == "machine" {
+                    (0..model.machine_count() as u32)
+                        .map(|m| {
+                            (
+                                PutBack {
+                                    machine: Some(m),
+                                    ..PutBack::default()
+                                },
+                                Some(model.machine_name(MachineId(m)).to_string()),
+                                None,
+                            )
+                        })
+                        .collect()
+                } else {
+                    (0..model.event_count() as u32)
+                        .filter(|&e| model.event_receivers(EventId(e)).next().is_some())
+                        .map(|e| {
+                            (
+                                PutBack {
+                                    event: Some(e),
+                                    ..PutBack::default()
+                                },
+                                None,
+                                Some(model.event_name(EventId(e)).to_string()),
+                            )
+                        })
+                        .collect()
+                };
+                for (uniform, machine, event) in items {
+                    let (probability, interval) = match estimate(uniform) {
+                        Ok(Some(x)) => x,
+                        Ok(None) => return Ok(None),
+                        Err(()) => {
+                            runner.finish()?;
+                            return Err("a run of the sources failed without a message".into());
+                        }
+                    };
+                    sources.push(Source {
+                        witness: side.to_string(),
+                        choice: choice.to_string(),
+                        machine,
+                        event,
+                        probability,
+                        interval,
+                        shift: probability.unwrap_or(0.0) - base.unwrap_or(0.0),
+                        scheduler: Scheduler::Sampled(Sampled { uniform, ..w }).to_string(),
+                    });
+                }
+            }
+        }
+        out[p].sources = sources;
+    }
+    runner.finish()?;
     Ok(Some(out))
 }

@@ -27,9 +27,6 @@ pub(super) fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
     if args.report.is_some() || args.save_failing > 0 {
         return refuse("--report / --save-failing");
     }
-    if args.schedulers.is_some() {
-        return refuse("--schedulers");
-    }
     let mut studies = Vec::new();
     let stop = interrupt_flag();
     for bt in args.input.semantics()? {
@@ -63,6 +60,13 @@ pub(super) fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
         if let Some(unit) = loaded.unit_ns {
             r.step_seconds = Some(unit as f64 / 1e9);
             r.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
+        }
+        // `--schedulers`: the bounds under each semantics, on the same seed.
+        if !result.interrupted
+            && !super::schedulers::add_bounds(args, &loaded, &run_cfg, &study_cfg, &mut r, stop)?
+        {
+            eprintln!("interrupted: the bounds over schedulers are left out");
+            r.interrupted = true;
         }
         studies.push((bt, r));
     }
@@ -137,6 +141,13 @@ pub(super) fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
         args.confidence,
         args.precision
     );
+    for (bt, s) in &studies {
+        if s.properties.iter().any(|p| p.schedulers.is_some()) {
+            println!();
+            println!("--bt {}:", bt.label());
+            super::schedulers::print_bounds(s);
+        }
+    }
     if interrupted {
         return Err(interrupted_error(done));
     }

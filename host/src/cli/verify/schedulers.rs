@@ -7,7 +7,7 @@ use crate::sim::{Memory, Scheduler};
 use crate::smc::stats::RuleKind;
 use crate::verify::load::Loaded;
 use crate::verify::result::Study;
-use crate::verify::schedulers::{bounds, SchedulerOptions, Stage};
+use crate::verify::schedulers::{bounds, explain, SchedulerOptions, Stage};
 
 /// What a sampled scheduler's choices depend on, as named on the command line.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -46,15 +46,22 @@ pub(super) fn check(args: &VerifyArgs) -> Result<(), CliError> {
     if args.shard.is_some() || args.runs.is_some() {
         return refuse(
             "--runs / --shard",
-            "the candidates are selected and re-estimated by sequential studies, which a \
-             fixed-size shard cannot split (run --schedulers on one machine)",
+            "a scheduler study is not one fixed-size study: after each selection round it \
+             ranks all N schedulers on their counts so far (successive halving) and gives \
+             only the survivors more runs, and the fresh estimates run on the candidates \
+             chosen by the last round; a shard would need every other shard's counts \
+             between rounds, and `merge` adds counts of one fixed study. Run --schedulers \
+             on one machine (the result does not depend on --threads), then shard the \
+             witnesses it prints: --scheduler ID --runs N --shard I/K",
         );
     }
     if args.threshold.is_some() {
         return refuse(
             "--threshold",
-            "the bounds are estimates with intervals; ask the threshold question of a \
-             witness with --scheduler ID --threshold",
+            "the selection ranks schedulers by estimated probability and the bounds are \
+             estimates with intervals, while --threshold runs Wald's sequential test, \
+             which gives a verdict, not an estimate to rank or bound; ask the threshold \
+             question of each witness: --scheduler ID --threshold THETA",
         );
     }
     if args.scheduler.is_some() {
@@ -101,6 +108,10 @@ pub(super) fn add_bounds(
                 of,
                 scheduler,
             } => eprintln!("schedulers: fresh estimate {index}/{of} ({scheduler})"),
+            Stage::Sources { property } => eprintln!(
+                "schedulers: where the order of {property} comes from (choices put back to \
+                 uniform one kind at a time)"
+            ),
         }
     };
     let found = bounds(
@@ -174,10 +185,93 @@ pub(super) fn print_bounds(r: &Study) {
             p.property, b.min.scheduler, b.max.scheduler
         );
     }
+    let explained: Vec<_> = rows
+        .iter()
+        .filter_map(|(p, b)| explain(&b.sources, r.precision).map(|line| (p, b, line)))
+        .collect();
+    if !explained.is_empty() {
+        println!(
+            "where the order comes from (each witness with one kind of choice put back to \
+             uniform; --json lists every estimate):"
+        );
+    }
+    for (p, b, line) in explained {
+        println!("  {:<w$}  {line}", p.property);
+        let mut top: Vec<_> = b.sources.iter().collect();
+        top.sort_by(|x, y| y.shift.abs().total_cmp(&x.shift.abs()));
+        for s in top.iter().take(4).filter(|s| s.matters(r.precision)) {
+            let what = match (&s.machine, &s.event) {
+                (Some(m), _) => format!("machine {m}'s position"),
+                (_, Some(e)) => format!("event {e}'s position"),
+                _ => format!("{} order", s.choice),
+            };
+            let base = if s.witness == "min" {
+                b.min.probability
+            } else {
+                b.max.probability
+            };
+            println!(
+                "  {:<w$}    {} witness {} -> {} with {what} uniform",
+                "",
+                s.witness,
+                num(base),
+                num(s.probability)
+            );
+        }
+    }
     let sensitive = rows.iter().filter(|(_, b)| b.order_sensitive).count();
     println!(
         "{sensitive} of {} properties order-sensitive (max - min > 2 x precision {})",
         rows.len(),
         r.precision
     );
+}
+
+/// Runs searched for a failing one under each scheduler ([`witness_runs`]).
+const SEARCH: u64 = 500;
+
+/// For `--report` with `--schedulers`: per order-sensitive property, the first failing run
+/// of the study's seed under its minimising witness and the first under the uniform
+/// scheduler, one after the other, named by their scheduler, so that the page shows how
+/// the witness's order fails the property beside how a uniformly random one does.
+/// `verify --scheduler ID --save-failing 1` writes the same runs (run k is stream k of
+/// the seed whatever the scheduler). A scheduler with no failing run among the first
+/// [`SEARCH`] adds none.
+pub(super) fn witness_runs(
+    args: &VerifyArgs,
+    loaded: &Loaded,
+    run_cfg: &crate::sim::RunConfig,
+    report: &Study,
+) -> Result<Vec<crate::cli::report::Failing>, CliError> {
+    let mut out = Vec::new();
+    for row in &report.properties {
+        let Some(b) = row.schedulers.as_ref().filter(|b| b.order_sensitive) else {
+            continue;
+        };
+        let min: Scheduler = b.min.scheduler.parse().map_err(CliError::Failed)?;
+        for (label, scheduler) in [
+            (format!("min witness {min}"), min),
+            ("uniform scheduler".to_string(), Scheduler::Uniform),
+        ] {
+            let cfg = crate::sim::RunConfig {
+                scheduler,
+                ..run_cfg.clone()
+            };
+            for k in 0..SEARCH {
+                let (csv, culprits) =
+                    super::replay_csv(&loaded.model, &loaded.set, &cfg, args.seed, k)?;
+                if culprits.iter().any(|c| c.property == row.property) {
+                    out.push(crate::cli::report::Failing {
+                        property: row.property.clone(),
+                        run: k,
+                        file: format!("{} under the {label}, run {k}", row.property),
+                        csv,
+                        culprits,
+                    });
+                    break;
+                }
+            }
+        }
+    }
+    Ok(out)
 }

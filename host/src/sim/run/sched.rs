@@ -19,6 +19,28 @@
 //! choices (`Math.random()`) see the same stream whatever the scheduler does, and a
 //! scheduler id plus a run index reproduces a run exactly.
 //!
+//! # Choices put back to uniform
+//!
+//! [`Sampled::uniform`] puts one kind of choice back to the uniform scheduler, to see
+//! which choices a sampled scheduler's probability comes from (`verify --schedulers`
+//! names them). The scheduler first picks as it would; if its pick is of an overridden
+//! kind, the choice within that kind is redrawn from the run's stream:
+//! - [`PutBack::machines`]: when a machine step is picked, which machine moves is uniform
+//!   among the runnable machines;
+//! - [`PutBack::events`]: when a delivery is picked, which pending event is delivered is
+//!   uniform among the deliverable events ([`EventSemantics::As2fm`]);
+//! - [`PutBack::transitions`]: which enabled transition fires is uniform;
+//! - [`PutBack::machine`] (`m`): when a machine step is picked and `m` is one of `k`
+//!   runnable machines, `m` moves with probability `1/k`, as under the uniform
+//!   scheduler, and otherwise the scheduler picks among the others: machine `m`'s
+//!   position in the order is uniform, the rest of the order the scheduler's;
+//! - [`PutBack::event`] (`e`): the same for pending event `e` among the deliveries.
+//!
+//! Whether a machine moves or an event is delivered stays the scheduler's choice. A
+//! choice the override does not touch draws nothing, so the runs are the witness's own
+//! until the first overridden choice. Under [`Memory::History`] the history records the
+//! scheduler's own pick.
+//!
 //! The state a memoryless scheduler sees: every machine's state, position in its
 //! executable content, flags, the time left on its delay, its variables, the message it
 //! is processing and its queues (events, origins, targets and parameters), and the
@@ -45,6 +67,30 @@ pub struct Sampled {
     pub id: u64,
     /// What a choice depends on besides the id.
     pub memory: Memory,
+    /// Choices put back to uniform (none: the scheduler decides every choice).
+    pub uniform: PutBack,
+}
+
+/// Which choices of a [`Sampled`] scheduler are put back to uniform (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub struct PutBack {
+    /// Which runnable machine moves.
+    pub machines: bool,
+    /// Which deliverable event is delivered.
+    pub events: bool,
+    /// Which enabled transition of a machine fires.
+    pub transitions: bool,
+    /// This machine's position among the machines that move.
+    pub machine: Option<u32>,
+    /// This event's position among the deliveries.
+    pub event: Option<u32>,
+}
+
+impl PutBack {
+    /// Whether nothing is put back.
+    pub fn is_none(&self) -> bool {
+        *self == PutBack::default()
+    }
 }
 
 /// What a sampled scheduler's choice depends on.
@@ -68,12 +114,32 @@ impl Memory {
 }
 
 impl std::fmt::Display for Scheduler {
-    /// `uniform`, or `memoryless:ID` / `history:ID` with the id as 16 hex digits: the
-    /// text `--scheduler` reads back.
+    /// `uniform`, or `memoryless:ID` / `history:ID` with the id as 16 hex digits, then
+    /// what is put back to uniform (`+machines`, `+events`, `+transitions`,
+    /// `+machine=M`, `+event=E`, by index): the text `--scheduler` reads back.
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Scheduler::Uniform => f.write_str("uniform"),
-            Scheduler::Sampled(s) => write!(f, "{}:{:016x}", s.memory.label(), s.id),
+            Scheduler::Sampled(s) => {
+                write!(f, "{}:{:016x}", s.memory.label(), s.id)?;
+                let u = &s.uniform;
+                for (on, word) in [
+                    (u.machines, "+machines"),
+                    (u.events, "+events"),
+                    (u.transitions, "+transitions"),
+                ] {
+                    if on {
+                        f.write_str(word)?;
+                    }
+                }
+                if let Some(m) = u.machine {
+                    write!(f, "+machine={m}")?;
+                }
+                if let Some(e) = u.event {
+                    write!(f, "+event={e}")?;
+                }
+                Ok(())
+            }
         }
     }
 }
@@ -86,6 +152,28 @@ impl std::str::FromStr for Scheduler {
         let t = text.trim();
         if t == "uniform" {
             return Ok(Scheduler::Uniform);
+        }
+        let mut parts = t.split('+');
+        let t = parts.next().unwrap_or_default();
+        let mut uniform = PutBack::default();
+        for part in parts {
+            let index = |v: &str| {
+                v.parse::<u32>()
+                    .map_err(|_| format!("`{text}`: `+{part}`: `{v}` is not an index"))
+            };
+            match part.split_once('=') {
+                None if part == "machines" => uniform.machines = true,
+                None if part == "events" => uniform.events = true,
+                None if part == "transitions" => uniform.transitions = true,
+                Some(("machine", v)) => uniform.machine = Some(index(v)?),
+                Some(("event", v)) => uniform.event = Some(index(v)?),
+                _ => {
+                    return Err(format!(
+                        "`{text}`: unknown override `+{part}` (expected `+machines`, \
+                         `+events`, `+transitions`, `+machine=M` or `+event=E`)"
+                    ))
+                }
+            }
         }
         let (memory, hex) = match t.split_once(':') {
             Some(("memoryless", h)) => (Memory::Memoryless, h),
@@ -107,7 +195,11 @@ impl std::str::FromStr for Scheduler {
         }
         let id = u64::from_str_radix(hex, 16)
             .map_err(|_| format!("`{text}`: the id `{hex}` is not hexadecimal"))?;
-        Ok(Scheduler::Sampled(Sampled { id, memory }))
+        Ok(Scheduler::Sampled(Sampled {
+            id,
+            memory,
+            uniform,
+        }))
     }
 }
 
@@ -151,23 +243,68 @@ impl Simulator<'_> {
     pub(super) fn choose_step(&mut self, n: u32, rng: &mut dyn Entropy, cfg: &RunConfig) -> u32 {
         match cfg.scheduler {
             Scheduler::Uniform => below(rng, n),
-            Scheduler::Sampled(s) => self.sampled_step(s, n),
+            Scheduler::Sampled(s) => self.sampled_step(s, n, rng),
         }
     }
 
     /// [`Simulator::choose_step`] under a sampled scheduler, kept out of line so that the
     /// uniform path stays as small as it was.
     #[inline(never)]
-    fn sampled_step(&mut self, s: Sampled, n: u32) -> u32 {
+    fn sampled_step(&mut self, s: Sampled, n: u32, rng: &mut dyn Entropy) -> u32 {
         let runnable = self.runnable.len();
-        self.choose(s, n, |sim, k| {
+        let key = |sim: &Self, k: u32| {
             let k = k as usize;
             if k < runnable {
                 sim.runnable[k] as u64
             } else {
                 KEY_EVENT | sim.deliverable[k - runnable] as u64
             }
-        })
+        };
+        let (pick, context) = self.choose(s, n, key);
+        let u = s.uniform;
+        if u.is_none() {
+            return pick;
+        }
+        // The kind the scheduler picked: machines `0..runnable` or events `runnable..n`.
+        let runnable = runnable as u32;
+        let (group, all, one) = if pick < runnable {
+            (0..runnable, u.machines, u.machine.map(|m| m as u64))
+        } else {
+            (runnable..n, u.events, u.event.map(|e| KEY_EVENT | e as u64))
+        };
+        let back = |sim: &Self, k: u32| all || one == Some(key(sim, k));
+        self.put_back(pick, context, group, back, key, rng)
+    }
+
+    /// The choice in `group` (which holds the scheduler's `pick`) once the options for
+    /// which `back` holds are put back to uniform: each of them is taken with probability
+    /// `1 / group.len()`, as under the uniform scheduler; otherwise the scheduler's
+    /// favourite (largest hash with `context`) among the others is.
+    fn put_back(
+        &self,
+        pick: u32,
+        context: u64,
+        group: std::ops::Range<u32>,
+        back: impl Fn(&Self, u32) -> bool,
+        key: impl Fn(&Self, u32) -> u64,
+        rng: &mut dyn Entropy,
+    ) -> u32 {
+        let size = group.len() as u32;
+        let uniform: Vec<u32> = group.clone().filter(|&k| back(self, k)).collect();
+        if size < 2 || uniform.is_empty() {
+            return pick;
+        }
+        let u = below(rng, size) as usize;
+        if let Some(&k) = uniform.get(u) {
+            return k;
+        }
+        if !back(self, pick) {
+            return pick;
+        }
+        group
+            .filter(|&k| !back(self, k))
+            .max_by_key(|&k| (mix(context, key(self, k)), std::cmp::Reverse(k)))
+            .unwrap_or(pick)
     }
 
     /// Which of the `n` enabled transitions of machine `m` (in `self.enabled`) fires.
@@ -181,22 +318,27 @@ impl Simulator<'_> {
     ) -> u32 {
         match cfg.scheduler {
             Scheduler::Uniform => below(rng, n),
-            Scheduler::Sampled(s) => self.sampled_transition(s, m, n),
+            Scheduler::Sampled(s) => self.sampled_transition(s, m, n, rng),
         }
     }
 
     #[inline(never)]
-    fn sampled_transition(&mut self, s: Sampled, m: usize, n: u32) -> u32 {
-        self.choose(s, n, |sim, k| {
+    fn sampled_transition(&mut self, s: Sampled, m: usize, n: u32, rng: &mut dyn Entropy) -> u32 {
+        let (pick, _) = self.choose(s, n, |sim, k| {
             KEY_TRANSITION | (m as u64) << 40 | sim.enabled[k as usize] as u64
-        })
+        });
+        if s.uniform.transitions && n > 1 {
+            return below(rng, n);
+        }
+        pick
     }
 
     /// The option in `0..n` whose key (`key(self, k)`) has the largest hash with the
     /// scheduler's id and context: independent of the order options are listed in.
-    fn choose(&mut self, s: Sampled, n: u32, key: impl Fn(&Self, u32) -> u64) -> u32 {
+    /// Returns it and the context (`0` when there was no choice).
+    fn choose(&mut self, s: Sampled, n: u32, key: impl Fn(&Self, u32) -> u64) -> (u32, u64) {
         if n <= 1 {
-            return 0;
+            return (0, 0);
         }
         let state = self.state_hash();
         let context = match s.memory {
@@ -214,7 +356,7 @@ impl Simulator<'_> {
         if s.memory == Memory::History {
             self.history = mix(mix(self.history, state), best.2);
         }
-        best.0
+        (best.0, context)
     }
 
     /// A hash of the model's current state (see the module doc for what it covers).

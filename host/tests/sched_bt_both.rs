@@ -1,0 +1,106 @@
+//! `verify --bt both --schedulers N`: the bounds over schedulers under each semantics, on
+//! a tree whose outcome the two semantics decide differently and no order changes
+//! (the IfThenElse over a condition that fails once, as in `bt_btcpp_cli.rs`).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn hindsight(dir: &Path, args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_hindsight"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("run hindsight");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Fails on its first tick, succeeds on every later one.
+const FAIL_ONCE: &str = r#"<ascxml name="FailOnce" initial="first">
+  <state id="first">
+    <bt_tick target="later"><bt_return_status status="FAILURE"/></bt_tick>
+    <bt_halt target="first"><bt_return_halted/></bt_halt>
+  </state>
+  <state id="later">
+    <bt_tick target="later"><bt_return_status status="SUCCESS"/></bt_tick>
+    <bt_halt target="later"><bt_return_halted/></bt_halt>
+  </state>
+</ascxml>"#;
+
+const PROPS: &str = r#"{"properties": [
+  {"name": "tree_success", "expression": {"op": "filter", "fun": "values",
+    "values": {"op": "Pmin", "exp": {"op": "F", "exp": {"op": "=",
+      "left": "bt_1000_response__status", "right": 1}}}, "states": {"op": "initial"}}}
+]}"#;
+
+const TREE: &str = "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree \
+                    ID=\"Main\">\n<IfThenElse>\n  <FailOnce/>\n  <AlwaysSuccess/>\n</IfThenElse>\
+                    \n</BehaviorTree>\n</root>\n";
+
+fn scratch() -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hindsight-sched-bt-both-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("tree.xml"), TREE).unwrap();
+    std::fs::write(dir.join("fail_once.ascxml"), FAIL_ONCE).unwrap();
+    std::fs::write(dir.join("properties.jani"), PROPS).unwrap();
+    std::fs::write(
+        dir.join("main.xml"),
+        r#"<roaml>
+  <parameters>
+    <max_time value="5" unit="s"/>
+    <bt_tick_rate value="1.0"/>
+    <bt_tick_if_not_running value="true"/>
+  </parameters>
+  <behavior_tree>
+    <input type="bt.cpp-xml" src="./tree.xml"/>
+    <input type="bt-plugin-ascxml" src="./fail_once.ascxml"/>
+  </behavior_tree>
+  <properties><input type="jani" src="./properties.jani"/></properties>
+</roaml>"#,
+    )
+    .unwrap();
+    dir
+}
+
+#[test]
+fn bt_both_bounds_each_semantics_over_the_same_schedulers() {
+    let dir = scratch();
+    let args = [
+        "verify",
+        "main.xml",
+        "--bt",
+        "both",
+        "--schedulers",
+        "4",
+        "--selection-runs",
+        "2",
+        "--precision",
+        "0.05",
+        "--threads",
+        "2",
+    ];
+    let mut json = args.to_vec();
+    json.push("--json");
+    let (code, out, err) = hindsight(&dir, &json);
+    assert_eq!(code, 0, "{err}");
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    // AS2FM's IfThenElse succeeds at the second tick, BT.CPP 4's never: under every
+    // scheduler, so min = max and nothing is order-sensitive.
+    for (semantics, p) in [("as2fm", 1.0), ("btcpp", 0.0)] {
+        let s = &doc[semantics]["properties"][0]["schedulers"];
+        assert_eq!(s["sampled"], 4, "{semantics}: {s}");
+        assert_eq!(s["min"]["probability"], p, "{semantics}: {s}");
+        assert_eq!(s["max"]["probability"], p, "{semantics}: {s}");
+        assert_eq!(s["order_sensitive"], false);
+    }
+    let (code, table, err) = hindsight(&dir, &args);
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(code, 0, "{err}");
+    assert!(table.contains("--bt as2fm:"), "{table}");
+    assert!(table.contains("--bt btcpp:"), "{table}");
+    assert_eq!(table.matches("bounds over 4 sampled").count(), 2, "{table}");
+}
