@@ -183,6 +183,7 @@ impl Simulator<'_> {
         match target {
             Some(t) => {
                 self.ms[t as usize].extq.push_back(slot);
+                self.touch(t as usize);
                 self.refresh(t as usize);
             }
             None => self.free_slot(slot),
