@@ -64,6 +64,8 @@ struct MachineRt {
     moves: u32,
     /// The scheduler iteration it last changed in (state, variables, position, flags).
     changed: u64,
+    /// Its cached state hash is stale (it is in [`Simulator::dirty`]); see `run/sched.rs`.
+    dirty: bool,
 }
 
 /// Runs a compiled model; reuse one simulator for many runs (buffers are kept).
@@ -133,6 +135,16 @@ pub struct Simulator<'m> {
     choice_kept: Vec<u32>,
     /// [`Memory::History`]: the hash of the run's states and choices so far.
     history: u64,
+    /// The current run is under a sampled scheduler: the state hash is kept up to date.
+    sampled: bool,
+    /// Machines whose cached hash ([`Simulator::mhash`]) is stale. Under the uniform
+    /// scheduler every machine stays stale all run, so marking one costs one test.
+    dirty: Vec<u32>,
+    /// Per machine: the hash of its record (all but the time left on its delay), as of
+    /// the last choice it was not stale at.
+    mhash: Vec<u64>,
+    /// The wrapping sum of `mhash`: the machines' part of the state hash.
+    mhash_sum: u64,
 }
 
 const NO_TRANS: u32 = u32::MAX;
@@ -149,6 +161,7 @@ impl std::fmt::Debug for Simulator<'_> {
 
 /// The expression environment of machine `m`: its variables and its current event.
 /// A function over the two fields (not a method) so callers may hold other fields mutably.
+#[inline(always)]
 fn env<'s>(
     ms: &'s [MachineRt],
     pool: &'s [Slot],
@@ -166,7 +179,7 @@ fn env<'s>(
 }
 
 /// Machine record `r`'s environment, `params` being its current message's parameters.
-#[inline]
+#[inline(always)]
 fn env_of<'s>(
     r: &'s MachineRt,
     params: &'s [Cell],
@@ -266,6 +279,7 @@ impl<'m> Simulator<'m> {
                     rpos: NOT_RUNNABLE,
                     moves: 0,
                     changed: 0,
+                    dirty: false,
                 })
                 .collect(),
             // Under EventSemantics::As2fm, slot `e` is event `e`'s global buffer, and
@@ -355,6 +369,10 @@ impl<'m> Simulator<'m> {
                     .sum::<usize>()
             ],
             history: 0,
+            sampled: false,
+            dirty: Vec::with_capacity(n),
+            mhash: vec![0; n],
+            mhash_sum: 0,
         }
     }
 
@@ -380,6 +398,10 @@ impl<'m> Simulator<'m> {
         self.ms.get(m.0 as usize)?.vars.get(slot).map(Value::of)
     }
 
+    /// Keeps machine `m`'s place in [`Simulator::runnable`] true to whether it can move.
+    /// Called after nearly every step and delivery (on UC3 about 4 times per step), so
+    /// always inlined: the call itself cost a third of it.
+    #[inline(always)]
     fn refresh(&mut self, m: usize) {
         let r = &self.ms[m];
         let can =
@@ -433,10 +455,15 @@ impl<'m> Simulator<'m> {
             }
         }
         self.runnable.clear();
-        for r in &mut self.ms {
+        self.dirty.clear();
+        for (m, r) in self.ms.iter_mut().enumerate() {
             r.rpos = NOT_RUNNABLE;
             r.moves = 0;
+            r.dirty = true;
+            self.dirty.push(m as u32);
         }
+        self.mhash.iter_mut().for_each(|h| *h = 0);
+        self.mhash_sum = 0;
         self.delayed.clear();
         let model = self.model;
         for (m, def) in model.machines.iter().enumerate() {
@@ -553,6 +580,7 @@ impl<'m> Simulator<'m> {
         self.as2fm = cfg.events == EventSemantics::As2fm;
         self.keep_choices =
             self.as2fm && self.pure_guards && cfg.transitions == TransitionChoice::DocumentOrder;
+        self.sampled = matches!(cfg.scheduler, Scheduler::Sampled(_));
         self.reset(rng)?;
         loop {
             self.clock += 1;
@@ -609,6 +637,7 @@ impl<'m> Simulator<'m> {
                     if self.ms[m].wake <= self.time {
                         self.ms[m].waiting = false;
                         self.ms[m].changed = self.clock;
+                        self.touch(m);
                         self.delayed.swap_remove(i);
                         self.refresh(m);
                     } else {
@@ -652,7 +681,9 @@ impl<'m> Simulator<'m> {
             let r = &mut self.ms[m];
             r.changed = self.clock;
             r.moves = r.moves.saturating_add(1);
-            if self.step(m, rng, cfg, obs)? == Flow::Stop {
+            let flow = self.step(m, rng, cfg, obs)?;
+            self.touch(m);
+            if flow == Flow::Stop {
                 return Ok(EndReason::Stopped);
             }
         }

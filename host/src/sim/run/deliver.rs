@@ -71,6 +71,7 @@ impl Simulator<'_> {
     #[inline]
     fn take_current(&mut self, m: usize, slot: u32, event: u32, origin: u32) {
         let model = self.model;
+        self.touch(m);
         let r = &mut self.ms[m];
         r.cur = slot;
         r.cur_event = model
@@ -244,6 +245,7 @@ impl Simulator<'_> {
                 self.ms[m].pc = model.machines[m].trans[t as usize].pc;
                 self.refresh(m);
             }
+            self.touch(m);
         }
         self.pending[e as usize] = false;
         if let Some(i) = self.pending_list.iter().position(|&x| x == e) {
@@ -263,6 +265,7 @@ impl Simulator<'_> {
                 self.ms[m].changed = self.clock;
                 self.ms[m].blocked = false;
                 self.ms[m].awaiting = NO_MSG;
+                self.touch(m);
                 self.blocked_list.swap_remove(i);
                 self.refresh(m);
             } else {
@@ -312,6 +315,7 @@ impl Simulator<'_> {
             }
             slot.origin = EXTERNAL.0;
             slot.target = u32::MAX;
+            self.touch_readers(e);
             self.steps += 1;
             self.instant_steps += 1;
             let f = obs.on_send(
@@ -387,6 +391,7 @@ impl Simulator<'_> {
         };
         self.pool[e].origin = m as u32;
         self.pool[e].target = declared;
+        self.touch_readers(e);
         self.steps += 1;
         self.instant_steps += 1;
         let flow = obs.on_send(

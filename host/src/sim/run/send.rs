@@ -5,6 +5,7 @@ use super::*;
 /// Pool slot `w`, to write a message into, and the parameters of slot `cur` (a machine's
 /// current message, `NO_MSG`: none), which the message's expressions read meanwhile.
 /// A free slot is never a current message; if it were, it would read as empty.
+#[inline(always)]
 fn write_and_read(pool: &mut [Slot], w: usize, cur: u32) -> (&mut Slot, &[Cell]) {
     let c = cur as usize;
     if cur == NO_MSG || c == w {
@@ -21,7 +22,7 @@ fn write_and_read(pool: &mut [Slot], w: usize, cur: u32) -> (&mut Slot, &[Cell])
 impl Simulator<'_> {
     /// Starts the delay of a delayed send not yet delayed: the machine waits `n` units
     /// (true), or the send goes on now (false: no delay, or the delay is over).
-    #[inline]
+    #[inline(always)]
     pub(super) fn start_delay(
         &mut self,
         m: usize,
@@ -183,6 +184,7 @@ impl Simulator<'_> {
         match target {
             Some(t) => {
                 self.ms[t as usize].extq.push_back(slot);
+                self.touch(t as usize);
                 self.refresh(t as usize);
             }
             None => self.free_slot(slot),
