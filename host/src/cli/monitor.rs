@@ -282,9 +282,10 @@ pub fn guarantees_spec(args: &ModelArgs) -> Result<Compiled, CliError> {
     );
     let mut file = loaded.file;
     file.assumptions.clear();
-    PropertySet::with_unit(&file, &loaded.model, Some(unit_ns))
-        .map(|set| set.compiled().clone())
-        .map_err(CliError::Input)
+    // The guarantees' warnings are among the whole file's, which the load printed.
+    Ok(PropertySet::with_unit(&file, &loaded.model, Some(unit_ns))?
+        .compiled()
+        .clone())
 }
 
 /// Runs `hindsight monitor`.

@@ -141,8 +141,7 @@ pub(crate) fn load_props_at(
         },
     };
     let file = crate::props::parse_file(spec).map_err(|d| CliError::Input(d.to_string()))?;
-    let input = crate::verify::observe::spec_input(&file, Some(unit_ns), |_, _, _, t| t)
-        .map_err(CliError::Input)?;
+    let input = crate::verify::observe::spec_input(&file, Some(unit_ns), |_, _, _, t| t)?;
     let compiled = codegen::compile_input(&input).map_err(|d| CliError::Input(d.to_string()))?;
     if !compiled.warnings().is_empty() {
         eprint!("{}", compiled.warnings());
