@@ -406,8 +406,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
                 ));
             }
             let text = read_file(&args.trace)?;
-            let trace = tracefile::parse_csv(&text, &args.trace.display().to_string(), compiled)
-                .map_err(CliError::Input)?;
+            let trace = tracefile::parse_csv(&text, &args.trace.display().to_string(), compiled)?;
             start = Instant::now();
             for (i, p) in trace.iter().enumerate() {
                 step(p.time, &p.sets).map_err(|e| {
