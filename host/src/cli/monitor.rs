@@ -300,7 +300,7 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
             args.bench_rate,
             args.bench_flood,
         )
-        .map_err(CliError::Failed)?;
+        .map_err(|e| CliError::Failed(e.to_string()))?;
         print!("{r}");
         return Ok(());
     }
@@ -346,8 +346,7 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         return Err(CliError::Input("--config FILE is required".into()));
     };
     let text = read_file(config_path)?;
-    let mut config =
-        Config::parse(&text, &config_path.display().to_string(), &spec).map_err(CliError::Input)?;
+    let mut config = Config::parse(&text, &config_path.display().to_string(), &spec)?;
     config.from_first_message |= args.from_first_message;
     if let Some(s) = args.speed {
         config.speed =
