@@ -39,51 +39,98 @@ fn scaled_ns(t: &TimeLit, unit_ns: u64) -> Option<(u128, u128)> {
     crate::duration::scaled_decimal(&t.int, &t.frac, unit_ns)
 }
 
+/// Why a bound end is not a tick count, or a `unit` statement's literal not a time
+/// unit; each quotes the literal as written and displays as the checker's message.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) enum TimeLitError {
+    /// A bound without a unit that has a fraction (`2.5`).
+    FractionalTicks(String),
+    /// A bound past `u64::MAX` ticks.
+    TooManyTicks(String),
+    /// A bound with a unit that is not a whole number of ticks of `tick_ns`.
+    NotWholeTicks(String, u64),
+    /// A `unit` statement without a suffix.
+    UnitWithoutSuffix(String),
+    /// A `unit` statement past `u64::MAX` nanoseconds.
+    UnitTooLarge(String),
+    /// A `unit` statement finer than a nanosecond.
+    UnitFinerThanNanosecond(String),
+    /// A `unit` statement of zero.
+    ZeroUnit,
+}
+
+impl std::fmt::Display for TimeLitError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TimeLitError::FractionalTicks(text) => write!(
+                f,
+                "`{text}` is not a whole number of ticks; write an integer or give a unit (like `{text}s`)"
+            ),
+            TimeLitError::TooManyTicks(text) => {
+                write!(f, "`{text}` is too large for a 64-bit tick count")
+            }
+            TimeLitError::NotWholeTicks(text, tick_ns) => write!(
+                f,
+                "`{text}` is not a whole number of ticks (the time unit is {})",
+                crate::duration::format(*tick_ns)
+            ),
+            TimeLitError::UnitWithoutSuffix(text) => write!(
+                f,
+                "the time unit needs a unit suffix, like `{text}ms` or `{text}s`"
+            ),
+            TimeLitError::UnitTooLarge(text) => write!(f, "time unit `{text}` is too large"),
+            TimeLitError::UnitFinerThanNanosecond(text) => write!(
+                f,
+                "time unit `{text}` is not a whole number of nanoseconds"
+            ),
+            TimeLitError::ZeroUnit => f.write_str("the time unit must be longer than zero"),
+        }
+    }
+}
+
+/// The message, for the checker's [`Sink`].
+impl From<TimeLitError> for String {
+    fn from(e: TimeLitError) -> String {
+        e.to_string()
+    }
+}
+
 /// Converts a bound end to ticks of `tick_ns` exactly.
-pub(crate) fn lit_ticks(t: &TimeLit, tick_ns: u64) -> Result<u64, String> {
+pub(crate) fn lit_ticks(t: &TimeLit, tick_ns: u64) -> Result<u64, TimeLitError> {
     let text = lit_text(t);
     let Some(unit) = t.unit else {
         if !t.frac.is_empty() {
-            return Err(format!(
-                "`{text}` is not a whole number of ticks; write an integer or give a unit (like `{text}s`)"
-            ));
+            return Err(TimeLitError::FractionalTicks(text));
         }
         return t
             .int
             .parse::<u64>()
-            .map_err(|_| format!("`{text}` is too large for a 64-bit tick count"));
+            .map_err(|_| TimeLitError::TooManyTicks(text));
     };
-    let too_large = || format!("`{text}` is too large for a 64-bit tick count");
+    let too_large = || TimeLitError::TooManyTicks(text.clone());
     let (ns_scaled, scale) = scaled_ns(t, unit.nanos()).ok_or_else(too_large)?;
     let denom = scale.checked_mul(tick_ns as u128).ok_or_else(too_large)?;
     if denom == 0 || ns_scaled % denom != 0 {
-        return Err(format!(
-            "`{text}` is not a whole number of ticks (the time unit is {})",
-            crate::duration::format(tick_ns)
-        ));
+        return Err(TimeLitError::NotWholeTicks(text, tick_ns));
     }
     u64::try_from(ns_scaled / denom).map_err(|_| too_large())
 }
 
 /// The length in ns of a `unit` statement's literal.
-fn unit_ns(t: &TimeLit) -> Result<u64, String> {
+fn unit_ns(t: &TimeLit) -> Result<u64, TimeLitError> {
     let text = lit_text(t);
     let Some(unit) = t.unit else {
-        return Err(format!(
-            "the time unit needs a unit suffix, like `{text}ms` or `{text}s`"
-        ));
+        return Err(TimeLitError::UnitWithoutSuffix(text));
     };
     let (ns_scaled, scale) =
-        scaled_ns(t, unit.nanos()).ok_or_else(|| format!("time unit `{text}` is too large"))?;
+        scaled_ns(t, unit.nanos()).ok_or_else(|| TimeLitError::UnitTooLarge(text.clone()))?;
     if ns_scaled % scale != 0 {
-        return Err(format!(
-            "time unit `{text}` is not a whole number of nanoseconds"
-        ));
+        return Err(TimeLitError::UnitFinerThanNanosecond(text));
     }
     match u64::try_from(ns_scaled / scale) {
-        Ok(0) => Err("the time unit must be longer than zero".into()),
+        Ok(0) => Err(TimeLitError::ZeroUnit),
         Ok(ns) => Ok(ns),
-        Err(_) => Err(format!("time unit `{text}` is too large")),
+        Err(_) => Err(TimeLitError::UnitTooLarge(text)),
     }
 }
 

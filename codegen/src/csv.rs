@@ -1,9 +1,13 @@
 //! The project's one CSV grammar: RFC 4180 quoting, written by `hindsight trace` and `verify --save-failing` and read by `hindsight report` and `hindsight replay`.
 //!
 //! A field holding `,`, `"` or a line break is quoted, a `"` inside doubled
-//! ([`field`]); [`records`] reads such text back, so every value round-trips. It lives
-//! in the foundation crate so that every reader and writer of the host (recorder,
-//! report, trace replay) names this one module.
+//! ([`field`]); [`records`] reads such text back, so every value round-trips, and
+//! [`rows`] is what every reader of a file calls: the same records, with a UTF-8 byte
+//! order mark dropped and comment lines (`#` first) and blank rows skipped, an error as a
+//! located [`Diagnostic`]. It lives in the foundation crate so that every reader and
+//! writer of the host (recorder, report, trace replay) names this one module.
+
+use crate::diag::Diagnostic;
 
 /// Appends `text` as one CSV field: as it is, or quoted with `"` doubled when it holds a
 /// `,`, a `"` or a line break.
@@ -106,6 +110,24 @@ pub fn records(text: &str) -> Result<Vec<Record>, (usize, usize, String)> {
     Ok(out)
 }
 
+/// The rows of the CSV file `file` (its name, for errors) with text `text`: its
+/// [`records`], after a UTF-8 byte order mark, without comment lines (a first field
+/// starting with `#`) and rows whose every field is blank. The one reader of CSV files:
+/// what `hindsight trace` and `verify --save-failing` write, `replay` and `report` read.
+/// An unterminated quote is an error at its `file:line:col`.
+pub fn rows(file: &str, text: &str) -> Result<Vec<Record>, Diagnostic> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let all = records(text)
+        .map_err(|(line, col, m)| Diagnostic::error(file, (line as u32, col as u32), m))?;
+    Ok(all
+        .into_iter()
+        .filter(|r| {
+            let first = r.fields.first().map_or("", |(f, _)| f.trim_start());
+            !(first.starts_with('#') || r.fields.iter().all(|(f, _)| f.trim().is_empty()))
+        })
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -133,6 +155,20 @@ mod tests {
         assert_eq!(
             records("a,\"open\n"),
             Err((1, 3, "unterminated quoted field".into()))
+        );
+    }
+
+    #[test]
+    fn rows_skip_the_mark_comments_and_blank_rows() {
+        let r = rows("t.csv", "\u{feff}time,x\n# a comment\n , \n\n1,\"#not\"\n").unwrap();
+        let got: Vec<(usize, Vec<&str>)> = r
+            .iter()
+            .map(|r| (r.line, r.fields.iter().map(|(f, _)| f.as_str()).collect()))
+            .collect();
+        assert_eq!(got, [(1, vec!["time", "x"]), (5, vec!["1", "#not"])]);
+        assert_eq!(
+            rows("t.csv", "a\n\"open").unwrap_err().to_string(),
+            "t.csv:2:1: unterminated quoted field"
         );
     }
 }

@@ -291,6 +291,16 @@ impl SourceMap {
         }
     }
 
+    /// The source line of `line`:`col` (1-based, in characters) of the whole file `id`
+    /// and a caret under that column, for a problem found as a position rather than a
+    /// span (empty when the file or line is not there).
+    pub fn snippet_at(&self, id: FileId, line: u32, col: u32) -> Snippet {
+        match self.source(id) {
+            Some(src) => Snippet::at_line_col(&src.text, &src.lines, line, col),
+            None => Snippet::default(),
+        }
+    }
+
     /// Renders one problem at `span`, carets under the span (cut at its line's end);
     /// a problem about the whole of an `<unknown>` file when the span's source is
     /// not in the map.

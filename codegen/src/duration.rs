@@ -86,24 +86,77 @@ pub fn scaled_decimal(int: &str, frac: &str, scale: u64) -> Option<(u128, u128)>
     Some((num, pow))
 }
 
+/// Why a duration (or a count of model steps) could not be read; each quotes the text
+/// it is about and displays as one sentence. Returned by [`decimal_times`], [`parse`] and
+/// [`parse_steps_or_duration`]; a caller puts its flag or file position in front.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum DurationError {
+    /// Not a plain non-negative decimal number (`-1`, `1e3`, `.`, empty).
+    NotDecimal(String),
+    /// More precise than a nanosecond (`0.5ns`).
+    FinerThanNanosecond(String),
+    /// Does not fit in 64 bits (of nanoseconds or of steps).
+    TooLarge(String),
+    /// A number without a unit where a duration is required.
+    NoUnit(String),
+    /// A suffix that is not one of [`TimeUnit::ALL`].
+    UnknownUnit(String),
+    /// Neither a whole number of steps nor a number with a unit.
+    NotStepsOrDuration(String),
+    /// A fraction without a unit, where a plain number counts steps (`2.5`).
+    FractionWithoutUnit(String),
+}
+
+impl std::fmt::Display for DurationError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            DurationError::NotDecimal(t) => write!(
+                f,
+                "`{t}` is not a non-negative decimal number (write `100` or `2.5`)"
+            ),
+            DurationError::FinerThanNanosecond(t) => write!(f, "`{t}` is finer than a nanosecond"),
+            DurationError::TooLarge(t) => write!(f, "`{t}` is too large"),
+            DurationError::NoUnit(t) => write!(f, "`{t}` has no time unit ({UNITS_TEXT})"),
+            DurationError::UnknownUnit(u) => {
+                write!(f, "unknown time unit `{u}` (use {UNITS_TEXT})")
+            }
+            DurationError::NotStepsOrDuration(t) => write!(
+                f,
+                "`{t}` is not a number of steps or a duration (write `62`, `6.2s` or `100ms`)"
+            ),
+            DurationError::FractionWithoutUnit(t) => {
+                write!(f, "`{t}` has a fraction but no time unit ({UNITS_TEXT})")
+            }
+        }
+    }
+}
+
+impl std::error::Error for DurationError {}
+
+/// The message, for a [`crate::diag::Diagnostic`] (`sm.diag(span, e)`).
+impl From<DurationError> for String {
+    fn from(e: DurationError) -> String {
+        e.to_string()
+    }
+}
+
 /// The decimal `text` (`100`, `2.5`, `.5`) times `scale` nanoseconds, exactly; an error
 /// when it is negative, not a plain decimal, not a whole number of nanoseconds or too
 /// large for `u64`.
-pub fn decimal_times(text: &str, scale: u64) -> Result<u64, String> {
+pub fn decimal_times(text: &str, scale: u64) -> Result<u64, DurationError> {
     let (int, frac) = text.split_once('.').unwrap_or((text, ""));
     let digits = |s: &str| s.bytes().all(|b| b.is_ascii_digit());
     if (int.is_empty() && frac.is_empty()) || !digits(int) || !digits(frac) {
-        return Err(format!(
-            "`{text}` is not a non-negative decimal number (write `100` or `2.5`)"
-        ));
+        return Err(DurationError::NotDecimal(text.to_owned()));
     }
+    let finer = || DurationError::FinerThanNanosecond(text.to_owned());
     if frac.trim_end_matches('0').len() > 19 {
-        return Err(format!("`{text}` is finer than a nanosecond"));
+        return Err(finer());
     }
-    let too_big = || format!("`{text}` is too large");
+    let too_big = || DurationError::TooLarge(text.to_owned());
     let (num, pow) = scaled_decimal(int, frac, scale).ok_or_else(too_big)?;
     if num % pow != 0 {
-        return Err(format!("`{text}` is finer than a nanosecond"));
+        return Err(finer());
     }
     u64::try_from(num / pow).map_err(|_| too_big())
 }
@@ -118,13 +171,13 @@ pub fn split(text: &str) -> (&str, &str) {
 }
 
 /// Parses a duration with its unit (`100ms`, `2.5s`, `1min`) into nanoseconds, exactly.
-pub fn parse(text: &str) -> Result<u64, String> {
+pub fn parse(text: &str) -> Result<u64, DurationError> {
     let (number, suffix) = split(text);
     let Some(unit) = TimeUnit::from_suffix(suffix) else {
         return Err(if suffix.is_empty() {
-            format!("`{}` has no time unit ({UNITS_TEXT})", text.trim())
+            DurationError::NoUnit(text.trim().to_owned())
         } else {
-            format!("unknown time unit `{suffix}` (use {UNITS_TEXT})")
+            DurationError::UnknownUnit(suffix.to_owned())
         });
     };
     decimal_times(number, unit.nanos())
@@ -160,11 +213,10 @@ pub enum StepsOrDuration {
 }
 
 /// Parses `62` (steps) or `6.2s`, `100ms`, `1.5min` (a duration, exactly).
-pub fn parse_steps_or_duration(text: &str) -> Result<StepsOrDuration, String> {
+pub fn parse_steps_or_duration(text: &str) -> Result<StepsOrDuration, DurationError> {
     let t = text.trim();
     let (num, unit) = split(t);
-    let bad =
-        || format!("`{t}` is not a number of steps or a duration (write `62`, `6.2s` or `100ms`)");
+    let bad = || DurationError::NotStepsOrDuration(t.to_owned());
     if num.is_empty() || num.starts_with('.') || num.ends_with('.') {
         return Err(bad());
     }
@@ -177,11 +229,9 @@ pub fn parse_steps_or_duration(text: &str) -> Result<StepsOrDuration, String> {
             return int
                 .parse()
                 .map(StepsOrDuration::Steps)
-                .map_err(|_| format!("`{t}` is too large"));
+                .map_err(|_| DurationError::TooLarge(t.to_owned()));
         }
-        return Err(format!(
-            "`{t}` has a fraction but no time unit ({UNITS_TEXT})"
-        ));
+        return Err(DurationError::FractionWithoutUnit(t.to_owned()));
     }
     parse(t).map(StepsOrDuration::Nanos)
 }
@@ -196,7 +246,7 @@ mod tests {
         assert_eq!(parse_steps_or_duration("62"), Ok(Steps(62)));
         assert_eq!(parse_steps_or_duration(" 6.2s"), Ok(Nanos(6_200_000_000)));
         assert_eq!(parse_steps_or_duration("1.5min"), Ok(Nanos(90_000_000_000)));
-        let err = |t| parse_steps_or_duration(t).unwrap_err();
+        let err = |t| parse_steps_or_duration(t).unwrap_err().to_string();
         assert!(
             err("2.5").contains("fraction but no time unit"),
             "{}",
@@ -238,6 +288,17 @@ mod tests {
         for bad in ["5", "5µs", "5sec", "5h", "ms", "1.5ns", "-1s"] {
             assert!(parse(bad).is_err(), "{bad}");
         }
+        // The error says which rule the text broke; callers match on it.
+        assert_eq!(parse(" 5 "), Err(DurationError::NoUnit("5".into())));
+        assert_eq!(parse("5h"), Err(DurationError::UnknownUnit("h".into())));
+        assert_eq!(
+            parse("1.5ns"),
+            Err(DurationError::FinerThanNanosecond("1.5".into()))
+        );
+        assert_eq!(
+            String::from(parse("5h").unwrap_err()),
+            "unknown time unit `h` (use ns, us, ms, s or min)"
+        );
         for ns in [
             0,
             1,

@@ -136,6 +136,7 @@ impl Case {
             default_max_time: Some(1001),
             events: EventSemantics::As2fm,
             bt_notes: Vec::new(),
+            warnings: Default::default(),
         };
         Some([high, Case::of("uc3 AS2FM plain (corpus)", loaded, None)])
     }
@@ -159,6 +160,7 @@ impl Case {
             default_max_time: Some(robot.max_time_steps),
             events: EventSemantics::As2fm,
             bt_notes: Vec::new(),
+            warnings: Default::default(),
         };
         Case::of(name, loaded, None)
     }

@@ -14,6 +14,7 @@
 //! variables (`step`, `event`, `origin`, `target`, `params`, `verdict_NAME`) are skipped
 //! unless the spec declares a variable of that name, so a recorded run replays as is.
 
+use codegen::diag::Diagnostic;
 use codegen::Compiled;
 use monitor_core::{Ty, Value};
 
@@ -32,24 +33,22 @@ pub struct TracePoint {
 /// Rows are read by the project's one CSV grammar ([`codegen::csv::records`], RFC 4180
 /// quoting, what `trace` and `verify --save-failing` write); a UTF-8 byte order mark is
 /// dropped.
-pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoint>, String> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let records =
-        codegen::csv::records(text).map_err(|(l, c, m)| format!("{file}:{l}:{c}: {m}"))?;
+pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoint>, Diagnostic> {
+    let err =
+        |line: usize, col: usize, m: String| Diagnostic::error(file, (line as u32, col as u32), m);
     // Comments (`#` first) and blank lines are no rows.
-    let mut rows = records.into_iter().filter(|r| {
-        let first = r.fields.first().map_or("", |(f, _)| f.trim_start());
-        !(first.starts_with('#') || r.fields.iter().all(|(f, _)| f.trim().is_empty()))
-    });
+    let mut rows = codegen::csv::rows(file, text)?.into_iter();
     let Some(header) = rows.next() else {
-        return Err(format!(
-            "{file}:1:1: empty trace: expected a header `time,VAR,...`"
+        return Err(err(
+            1,
+            1,
+            "empty trace: expected a header `time,VAR,...`".into(),
         ));
     };
     let hline = header.line;
     let cols = header.fields;
     if cols.first().map(|(s, _)| s.trim()) != Some("time") {
-        return Err(format!("{file}:{hline}:1: the first column must be `time`"));
+        return Err(err(hline, 1, "the first column must be `time`".into()));
     }
     // `None` marks a recorder column that is skipped.
     let mut vars: Vec<Option<usize>> = Vec::new();
@@ -57,11 +56,13 @@ pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoi
         let name = name.trim();
         match spec.var_index(name) {
             Some(i) if !vars.contains(&Some(i)) => vars.push(Some(i)),
-            Some(_) => return Err(format!("{file}:{hline}:{col}: column `{name}` repeated")),
+            Some(_) => return Err(err(hline, *col, format!("column `{name}` repeated"))),
             None if is_recorder_column(name) => vars.push(None),
             None => {
-                return Err(format!(
-                    "{file}:{hline}:{col}: `{name}` is not a variable of the spec"
+                return Err(err(
+                    hline,
+                    *col,
+                    format!("`{name}` is not a variable of the spec"),
                 ))
             }
         }
@@ -70,7 +71,7 @@ pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoi
     let mut last = 0u64;
     for row in rows {
         let lno = row.line;
-        let at = |c: usize, m: String| format!("{file}:{lno}:{c}: {m}");
+        let at = |c: usize, m: String| err(lno, c, m);
         let cells = row.fields;
         if cells.len() != cols.len() {
             return Err(at(

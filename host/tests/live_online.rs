@@ -275,7 +275,7 @@ fn the_config_clock_speed_is_read_and_checked() {
     assert_eq!(parse("").unwrap().speed, 1.0);
     assert_eq!(parse("[clock]\nspeed = 10\n").unwrap().speed, 10.0);
     assert_eq!(parse("[clock]\nspeed = 0.5\n").unwrap().speed, 0.5);
-    let err = parse("[clock]\nspeed = 0\n").unwrap_err();
+    let err = parse("[clock]\nspeed = 0\n").unwrap_err().to_string();
     assert!(
         err.starts_with("c.toml:2:9: speed 0: must be a number"),
         "{err}"

@@ -183,6 +183,8 @@ fn ros_named_requirements_in_seconds_judge_like_the_step_bounded_ones() {
 <guarantees><property id="p" pattern="recurrence" event="b" within="150" time_unit="ms"/></guarantees>"#,
     );
     let odd = parse_file(&path).unwrap();
-    let err = PropertySet::with_unit(&odd, &model, Some(100_000_000)).unwrap_err();
+    let err = PropertySet::with_unit(&odd, &model, Some(100_000_000))
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("odd.xml"), "{err}");
 }

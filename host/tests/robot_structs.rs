@@ -580,7 +580,7 @@ fn property_ports_read_struct_fields() {
         assert_eq!(format!("{v:?}"), "[True, False]", "run {k}");
     }
     let file = parse_str(&props("point.z"), Path::new("structs.xml")).unwrap();
-    let err = PropertySet::new(&file, &m.model).unwrap_err();
+    let err = PropertySet::new(&file, &m.model).unwrap_err().to_string();
     assert!(
         err.contains("structs.xml:3:") && err.contains("no parameter `point.z`"),
         "{err}"

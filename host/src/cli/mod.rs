@@ -10,7 +10,13 @@ pub mod run;
 pub mod sweep;
 pub mod verify;
 
+use std::collections::BTreeSet;
 use std::fmt;
+
+use codegen::diag::{Diagnostic, Diagnostics, Severity};
+
+use crate::robot::load::ExternalComponent;
+use crate::verify::load::{LoadError, LoadOptions, Loaded};
 
 /// How a subcommand failed, mapped to the documented exit codes.
 #[derive(Debug)]
@@ -43,6 +49,88 @@ impl fmt::Display for CliError {
             }
         }
     }
+}
+
+/// Errors in the files read: exit code 2.
+impl From<Diagnostics> for CliError {
+    fn from(d: Diagnostics) -> CliError {
+        CliError::Input(d.to_string())
+    }
+}
+
+/// An error in a file read: exit code 2.
+impl From<Diagnostic> for CliError {
+    fn from(d: Diagnostic) -> CliError {
+        CliError::Input(d.to_string())
+    }
+}
+
+/// A model or property file that does not load, or an option that does not fit it:
+/// exit code 2.
+impl From<LoadError> for CliError {
+    fn from(e: LoadError) -> CliError {
+        CliError::Input(e.to_string())
+    }
+}
+
+/// Prints warnings to standard error, each as `warning: file:line:col: message` and its
+/// source line: the first `codegen::diag::MAX_SHOWN`, then how many more (a file with
+/// thousands of ignored attributes stays readable). The libraries return warnings;
+/// this is where the commands print them.
+pub fn print_warnings(warnings: &Diagnostics) {
+    print_new_warnings(warnings, &mut BTreeSet::new());
+}
+
+/// [`print_warnings`] for those not in `said` (their printed text), adding them to it: a
+/// command that compiles the same file more than once (`sweep`, once per property) says
+/// each warning once.
+pub fn print_new_warnings(warnings: &Diagnostics, said: &mut BTreeSet<String>) {
+    let mut shown = 0usize;
+    let mut more = 0usize;
+    for w in warnings {
+        let text = warning_text(w);
+        if !said.insert(text.clone()) {
+            continue;
+        }
+        if shown < codegen::diag::MAX_SHOWN {
+            eprintln!("warning: {text}");
+            shown += 1;
+        } else {
+            more += 1;
+        }
+    }
+    if more > 0 {
+        eprintln!("warning: ... and {more} more warnings");
+    }
+}
+
+/// A warning as [`print_new_warnings`] prints it after `warning: ` (and keeps it in
+/// `said`): the position first, then the message and its source line.
+pub fn warning_text(w: &Diagnostic) -> String {
+    Diagnostic {
+        severity: Severity::Error,
+        ..w.clone()
+    }
+    .to_string()
+}
+
+/// Loads a model and its properties ([`crate::verify::load::load`]) and prints the
+/// warnings found on the way.
+pub fn load_model(opts: &LoadOptions) -> Result<Loaded, CliError> {
+    let loaded = crate::verify::load::load(opts)?;
+    print_warnings(&loaded.warnings);
+    Ok(loaded)
+}
+
+/// [`load_model`] without the node models named in `external`
+/// ([`crate::verify::load::load_without`]).
+pub fn load_model_without(
+    opts: &LoadOptions,
+    external: &[String],
+) -> Result<(Loaded, Vec<ExternalComponent>), CliError> {
+    let (loaded, components) = crate::verify::load::load_without(opts, external)?;
+    print_warnings(&loaded.warnings);
+    Ok((loaded, components))
 }
 
 /// A count of runs given on the command line: a whole number, at least 1 (a study of

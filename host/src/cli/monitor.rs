@@ -282,9 +282,10 @@ pub fn guarantees_spec(args: &ModelArgs) -> Result<Compiled, CliError> {
     );
     let mut file = loaded.file;
     file.assumptions.clear();
-    PropertySet::with_unit(&file, &loaded.model, Some(unit_ns))
-        .map(|set| set.compiled().clone())
-        .map_err(CliError::Input)
+    // The guarantees' warnings are among the whole file's, which the load printed.
+    Ok(PropertySet::with_unit(&file, &loaded.model, Some(unit_ns))?
+        .compiled()
+        .clone())
 }
 
 /// Runs `hindsight monitor`.
@@ -299,7 +300,7 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
             args.bench_rate,
             args.bench_flood,
         )
-        .map_err(CliError::Failed)?;
+        .map_err(|e| CliError::Failed(e.to_string()))?;
         print!("{r}");
         return Ok(());
     }
@@ -345,8 +346,7 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         return Err(CliError::Input("--config FILE is required".into()));
     };
     let text = read_file(config_path)?;
-    let mut config =
-        Config::parse(&text, &config_path.display().to_string(), &spec).map_err(CliError::Input)?;
+    let mut config = Config::parse(&text, &config_path.display().to_string(), &spec)?;
     config.from_first_message |= args.from_first_message;
     if let Some(s) = args.speed {
         config.speed =

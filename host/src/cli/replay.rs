@@ -141,8 +141,7 @@ pub(crate) fn load_props_at(
         },
     };
     let file = crate::props::parse_file(spec).map_err(|d| CliError::Input(d.to_string()))?;
-    let input = crate::verify::observe::spec_input(&file, Some(unit_ns), |_, _, _, t| t)
-        .map_err(CliError::Input)?;
+    let input = crate::verify::observe::spec_input(&file, Some(unit_ns), |_, _, _, t| t)?;
     let compiled = codegen::compile_input(&input).map_err(|d| CliError::Input(d.to_string()))?;
     if !compiled.warnings().is_empty() {
         eprint!("{}", compiled.warnings());
@@ -407,8 +406,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
                 ));
             }
             let text = read_file(&args.trace)?;
-            let trace = tracefile::parse_csv(&text, &args.trace.display().to_string(), compiled)
-                .map_err(CliError::Input)?;
+            let trace = tracefile::parse_csv(&text, &args.trace.display().to_string(), compiled)?;
             start = Instant::now();
             for (i, p) in trace.iter().enumerate() {
                 step(p.time, &p.sets).map_err(|e| {

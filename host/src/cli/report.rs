@@ -106,7 +106,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     };
     for path in run_files(&args.runs)? {
         let text = super::read_file(&path)?;
-        let mut run = Run::from_csv(&path.display().to_string(), &text).map_err(CliError::Input)?;
+        let mut run = Run::from_csv(&path.display().to_string(), &text)?;
         run.step_seconds = step_seconds;
         data.runs.push(run);
     }
@@ -186,7 +186,8 @@ pub fn from_verify(
         ..ReportData::default()
     };
     for f in failing {
-        let mut run = Run::from_csv(&f.file, &f.csv).map_err(CliError::Failed)?;
+        let mut run =
+            Run::from_csv(&f.file, &f.csv).map_err(|d| CliError::Failed(d.to_string()))?;
         run.property = Some(f.property.clone());
         run.run = Some(f.run);
         run.step_seconds = study.step_seconds;

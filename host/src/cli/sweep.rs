@@ -259,6 +259,12 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         return Err(CliError::Input("sweep: --runs must be at least 1".into()));
     }
     let loaded = load(&args.input)?;
+    // Each property is compiled again below: the load printed the file's warnings.
+    let mut said: std::collections::BTreeSet<String> = loaded
+        .warnings
+        .iter()
+        .map(crate::cli::warning_text)
+        .collect();
     let (model, file, props_path) = (&loaded.model, &loaded.file, &loaded.props_path);
     let targets: Vec<props::Property> = if args.properties.is_empty() {
         file.guarantees
@@ -309,8 +315,8 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             let mut one = variants(file, target, &values);
             // The sidecar monitors guarantees only.
             one.assumptions.clear();
-            let set =
-                PropertySet::with_unit(&one, model, loaded.unit_ns).map_err(CliError::Input)?;
+            let set = PropertySet::with_unit(&one, model, loaded.unit_ns)?;
+            crate::cli::print_new_warnings(set.warnings(), &mut said);
             let mut counts = vec![PropertyCounts::default(); values.len()];
             for (name, records) in &logs {
                 let finals = live::record::final_verdicts(set.compiled(), records, name)
@@ -368,7 +374,8 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     let mut curves = Vec::new();
     for target in &targets {
         let one = variants(file, target, &values);
-        let set = PropertySet::with_unit(&one, model, loaded.unit_ns).map_err(CliError::Input)?;
+        let set = PropertySet::with_unit(&one, model, loaded.unit_ns)?;
+        crate::cli::print_new_warnings(set.warnings(), &mut said);
         let r = study(model, &set, &run_cfg, &study_cfg, &rule, show_progress)?;
         let points: Vec<SweepPoint> = values
             .iter()

@@ -283,7 +283,7 @@ fn parse_time_unit(text: &str) -> Result<u64, CliError> {
 
 /// [`crate::verify::load::load`] with the command line's arguments.
 pub fn load(args: &ModelArgs) -> Result<Loaded, CliError> {
-    crate::verify::load::load(&args.options()?).map_err(CliError::Input)
+    super::load_model(&args.options()?)
 }
 
 /// [`crate::verify::load::load_without`] with the command line's arguments.
@@ -291,7 +291,7 @@ pub fn load_without(
     args: &ModelArgs,
     external: &[String],
 ) -> Result<(Loaded, Vec<ExternalComponent>), CliError> {
-    crate::verify::load::load_without(&args.options()?, external).map_err(CliError::Input)
+    super::load_model_without(&args.options()?, external)
 }
 
 /// [`crate::verify::study::study`], its failure a bad-input error.
@@ -408,7 +408,7 @@ fn replay_csv(
     seed: u64,
     k: u64,
 ) -> Result<(String, Vec<crate::verify::record::Culprit>), CliError> {
-    let mut judge = Judge::new(set).map_err(CliError::Failed)?;
+    let mut judge = Judge::new(set).map_err(|e| CliError::Failed(e.to_string()))?;
     let mut rec = crate::verify::record::Recorder::new(&mut judge, model);
     rec.start();
     let mut rng = crate::smc::runner::stream(seed, k);
@@ -730,8 +730,7 @@ pub struct ValidateArgs {
 pub fn validate(args: &ValidateArgs) -> Result<(), CliError> {
     let semantics = args.input.semantics()?;
     for (k, &bt) in semantics.iter().enumerate() {
-        let loaded =
-            crate::verify::load::load(&args.input.options_with(bt)?).map_err(CliError::Input)?;
+        let loaded = super::load_model(&args.input.options_with(bt)?)?;
         let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
         let under = if bt == BtSemantics::As2fm && semantics.len() == 1 {
             String::new()

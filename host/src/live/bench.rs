@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use iceoryx2::prelude::*;
 
 use super::config::Config;
-use super::{Options, Probe, Sidecar};
+use super::{LiveError, Options, Probe, Sidecar};
 
 /// The spec the benchmark monitors: the museum's battery requirements.
 pub const SPEC: &str =
@@ -107,44 +107,47 @@ struct Phase {
     send_secs: f64,
 }
 
-fn phase(service: &str, n: u64, rate: Option<f64>) -> Result<Phase, String> {
-    let spec = codegen::compile_spec(SPEC, "bench.hspec").map_err(|d| d.to_string())?;
-    let config = Config::parse(&config_text(service), "bench.toml", &spec)?;
+fn phase(service: &str, n: u64, rate: Option<f64>) -> Result<Phase, LiveError> {
+    // The benchmark's own spec and config: an error in either is a bug.
+    let spec =
+        codegen::compile_spec(SPEC, "bench.hspec").map_err(|d| LiveError::Engine(d.to_string()))?;
+    let config = Config::parse(&config_text(service), "bench.toml", &spec)
+        .map_err(|d| LiveError::Engine(d.to_string()))?;
     let epoch = Instant::now();
     let stop = Arc::new(AtomicBool::new(false));
     let ready = Arc::new(AtomicU64::new(0));
     let node = NodeBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<ipc::Service>()
-        .map_err(|e| format!("{e:?}"))?;
-    let name = super::service_name(service).map_err(|e| e.to_string())?;
+        .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
+    let name = super::service_name(service)?;
     let factory = node
         .service_builder(&name)
         .publish_subscribe::<[u8]>()
         .subscriber_max_buffer_size(1024)
         .open_or_create()
-        .map_err(|e| format!("{e:?}"))?;
+        .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
     let publisher = factory
         .publisher_builder()
         .initial_max_slice_len(24)
         .create()
-        .map_err(|e| format!("{e:?}"))?;
+        .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
     let plain = {
         let (stop, ready, service) = (stop.clone(), ready.clone(), service.to_string());
-        std::thread::spawn(move || -> Result<Vec<u64>, String> {
+        std::thread::spawn(move || -> Result<Vec<u64>, LiveError> {
             let node = NodeBuilder::new()
                 .signal_handling_mode(SignalHandlingMode::Disabled)
                 .create::<ipc::Service>()
-                .map_err(|e| format!("{e:?}"))?;
+                .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
             let f = node
-                .service_builder(&super::service_name(&service).map_err(|e| e.to_string())?)
+                .service_builder(&super::service_name(&service)?)
                 .publish_subscribe::<[u8]>()
                 .open()
-                .map_err(|e| format!("{e:?}"))?;
+                .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
             let sub = f
                 .subscriber_builder()
                 .create()
-                .map_err(|e| format!("{e:?}"))?;
+                .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
             ready.fetch_add(1, Ordering::SeqCst);
             let mut lat = Vec::new();
             while !stop.load(Ordering::Relaxed) {
@@ -161,8 +164,8 @@ fn phase(service: &str, n: u64, rate: Option<f64>) -> Result<Phase, String> {
     };
     let side = {
         let (stop, ready) = (stop.clone(), ready.clone());
-        std::thread::spawn(move || -> Result<super::Report, String> {
-            let sidecar = Sidecar::new(&config, &spec, false).map_err(|e| e.to_string())?;
+        std::thread::spawn(move || -> Result<super::Report, LiveError> {
+            let sidecar = Sidecar::new(&config, &spec, false)?;
             ready.fetch_add(1, Ordering::SeqCst);
             let mut opts = Options {
                 verdicts: Box::new(std::io::sink()),
@@ -173,9 +176,7 @@ fn phase(service: &str, n: u64, rate: Option<f64>) -> Result<Phase, String> {
                 probe: Some(Probe { offset: 16, epoch }),
                 progress: None,
             };
-            sidecar
-                .run(&config, &spec, &mut opts, &stop)
-                .map_err(|e| e.to_string())
+            sidecar.run(&config, &spec, &mut opts, &stop)
         })
     };
     while ready.load(Ordering::SeqCst) < 2 {
@@ -198,18 +199,20 @@ fn phase(service: &str, n: u64, rate: Option<f64>) -> Result<Phase, String> {
         buf[16..24].copy_from_slice(&(epoch.elapsed().as_nanos() as u64).to_le_bytes());
         let s = publisher
             .loan_slice_uninit(24)
-            .map_err(|e| format!("{e:?}"))?;
+            .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
         s.write_from_slice(&buf)
             .send()
-            .map_err(|e| format!("{e:?}"))?;
+            .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
     }
     let send_secs = start.elapsed().as_secs_f64();
     std::thread::sleep(Duration::from_millis(300));
     stop.store(true, Ordering::SeqCst);
     let plain = plain
         .join()
-        .map_err(|_| "plain subscriber panicked".to_string())??;
-    let report = side.join().map_err(|_| "sidecar panicked".to_string())??;
+        .map_err(|_| LiveError::Engine("the plain subscriber panicked".into()))??;
+    let report = side
+        .join()
+        .map_err(|_| LiveError::Engine("the sidecar panicked".into()))??;
     let st = &report.sources[0];
     Ok(Phase {
         plain,
@@ -221,7 +224,7 @@ fn phase(service: &str, n: u64, rate: Option<f64>) -> Result<Phase, String> {
 }
 
 /// Runs both phases on fresh service names derived from `prefix`.
-pub fn run(prefix: &str, paced: u64, rate: f64, flood: u64) -> Result<BenchReport, String> {
+pub fn run(prefix: &str, paced: u64, rate: f64, flood: u64) -> Result<BenchReport, LiveError> {
     let a = phase(&format!("{prefix}/paced"), paced, Some(rate))?;
     let mut plain = a.plain;
     let mut side: Vec<u64> = a

@@ -20,15 +20,29 @@ pub struct Clock {
 /// The slowest and fastest speeds a [`Clock`] takes.
 pub const SPEED_RANGE: (f64, f64) = (1e-6, 1e9);
 
+/// A speed outside [`SPEED_RANGE`] (or not a number); the caller names its flag or
+/// file position in front.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpeedError(pub f64);
+
+impl std::fmt::Display for SpeedError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "speed {}: must be a number from {} to {} (1: real time)",
+            self.0, SPEED_RANGE.0, SPEED_RANGE.1
+        )
+    }
+}
+
+impl std::error::Error for SpeedError {}
+
 /// Checks a speed for [`Clock::with_speed`]: finite, within [`SPEED_RANGE`].
-pub fn check_speed(speed: f64) -> Result<f64, String> {
+pub fn check_speed(speed: f64) -> Result<f64, SpeedError> {
     if speed.is_finite() && speed >= SPEED_RANGE.0 && speed <= SPEED_RANGE.1 {
         Ok(speed)
     } else {
-        Err(format!(
-            "speed {speed}: must be a number from {} to {} (1: real time)",
-            SPEED_RANGE.0, SPEED_RANGE.1
-        ))
+        Err(SpeedError(speed))
     }
 }
 

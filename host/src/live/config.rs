@@ -38,6 +38,8 @@
 
 use std::ops::Range;
 
+use codegen::diag::{Diagnostic, Diagnostics, FileId, SourceMap};
+
 use codegen::Compiled;
 use monitor_core::{Ty, Value, VarKind};
 use serde::Deserialize;
@@ -340,28 +342,18 @@ struct RawService {
     field: Vec<RawField>,
 }
 
-/// `file:line:col` of byte `at` in `src`.
-pub fn position(file: &str, src: &str, at: usize) -> String {
-    let at = at.min(src.len());
-    let before = &src[..at];
-    let line = before.matches('\n').count() + 1;
-    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    format!("{file}:{line}:{col}")
-}
-
 struct Checker<'a> {
-    file: &'a str,
-    src: &'a str,
+    /// The config file in the one source map, for positions and carets.
+    map: SourceMap,
+    id: FileId,
     spec: &'a Compiled,
-    errors: Vec<String>,
+    errors: Vec<Diagnostic>,
 }
 
 impl Checker<'_> {
     fn err(&mut self, span: Range<usize>, msg: String) {
-        self.errors.push(format!(
-            "{}: {msg}",
-            position(self.file, self.src, span.start)
-        ));
+        let at = self.id.at(u32::try_from(span.start).unwrap_or(u32::MAX));
+        self.errors.push(self.map.diag(at, msg));
     }
 
     fn service_name(&mut self, s: &Spanned<String>) -> String {
@@ -476,15 +468,17 @@ impl Checker<'_> {
 
 impl Config {
     /// Parses and checks `src` (named `file` in errors) against `spec`.
-    /// Errors are `file:line:col: message` lines, every one found.
-    pub fn parse(src: &str, file: &str, spec: &Compiled) -> Result<Config, String> {
+    /// Errors are every problem found, each at its `file:line:col`.
+    pub fn parse(src: &str, file: &str, spec: &Compiled) -> Result<Config, Diagnostics> {
+        let mut map = SourceMap::new();
+        let id = map.add(file, src.to_owned());
         let raw: RawConfig = toml::from_str(src).map_err(|e| {
             let at = e.span().map_or(0, |s| s.start);
-            format!("{}: {}", position(file, src, at), e.message())
+            map.diag(id.at(u32::try_from(at).unwrap_or(u32::MAX)), e.message())
         })?;
         let mut c = Checker {
-            file,
-            src,
+            map,
+            id,
             spec,
             errors: Vec::new(),
         };
@@ -590,12 +584,12 @@ impl Config {
         let speed = match raw.clock.as_ref().and_then(|k| k.speed.as_ref()) {
             None => 1.0,
             Some(s) => super::check_speed(*s.get_ref()).unwrap_or_else(|m| {
-                c.err(s.span(), m);
+                c.err(s.span(), m.to_string());
                 1.0
             }),
         };
         if !c.errors.is_empty() {
-            return Err(c.errors.join("\n"));
+            return Err(Diagnostics(c.errors));
         }
         Ok(Config {
             topics,

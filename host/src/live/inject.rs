@@ -22,6 +22,7 @@ use iceoryx2::port::subscriber::Subscriber;
 use iceoryx2::prelude::*;
 
 use super::publish::TopicLayout;
+use super::LiveError;
 use crate::sim::{Inbox, SentMessage, EXTERNAL};
 
 type Ipc = ipc::Service;
@@ -76,13 +77,13 @@ impl TopicSubscriber {
     }
 
     /// Takes every sample waiting on every topic and queues it in `inbox`.
-    pub fn poll(&mut self, inbox: &mut Inbox) -> Result<(), String> {
+    pub fn poll(&mut self, inbox: &mut Inbox) -> Result<(), LiveError> {
         for (layout, sub, stats, last_seq) in &mut self.topics {
             loop {
                 let sample = match sub.receive() {
                     Ok(Some(s)) => s,
                     Ok(None) => break,
-                    Err(e) => return Err(format!("iceoryx2: {}: {e:?}", stats.service)),
+                    Err(e) => return Err(LiveError::Ipc(format!("{}: {e:?}", stats.service))),
                 };
                 match layout.decode(sample.payload()) {
                     Some((params, seq)) => {
@@ -160,18 +161,24 @@ impl<T> Outgoing<T> {
     }
 
     /// Sends `msg` in `layout`; without a server it counts as unanswered.
-    fn send(&mut self, layout: &TopicLayout, msg: &SentMessage<'_>, keep: T) -> Result<(), String> {
+    fn send(
+        &mut self,
+        layout: &TopicLayout,
+        msg: &SentMessage<'_>,
+        keep: T,
+    ) -> Result<(), LiveError> {
         let seq = self.seq;
         self.seq += 1;
         let service = &self.stats.service;
         let pending = self
             .client
             .loan_slice_uninit(layout.size)
-            .map_err(|e| format!("iceoryx2: {service}: {e:?}"))
+            .map_err(|e| LiveError::Ipc(format!("{service}: {e:?}")))
             .and_then(|r| {
                 let mut r = r.write_from_fn(|_| 0u8);
                 layout.encode(msg, seq, r.payload_mut());
-                r.send().map_err(|e| format!("iceoryx2: {service}: {e:?}"))
+                r.send()
+                    .map_err(|e| LiveError::Ipc(format!("{service}: {e:?}")))
             })?;
         self.stats.requests += 1;
         if pending.number_of_server_connections() == 0 {
@@ -264,7 +271,7 @@ impl ServiceBridge {
     }
 
     /// Sends `msg` to its process if it is a request of a bridged service.
-    pub fn forward(&mut self, msg: &SentMessage<'_>) -> Result<(), String> {
+    pub fn forward(&mut self, msg: &SentMessage<'_>) -> Result<(), LiveError> {
         if msg.origin() == EXTERNAL {
             return Ok(());
         }
@@ -397,7 +404,7 @@ impl ServiceServers {
 
     /// Answers the oldest waiting request with `msg` if it is the model's answer to a
     /// bridged client.
-    pub fn answer(&mut self, msg: &SentMessage<'_>) -> Result<(), String> {
+    pub fn answer(&mut self, msg: &SentMessage<'_>) -> Result<(), LiveError> {
         let Some(s) = self.services.of(msg) else {
             return Ok(());
         };
@@ -413,7 +420,7 @@ impl ServiceServers {
         }
         let response = &s.response;
         req.loan_slice_uninit(response.size())
-            .map_err(|e| format!("iceoryx2: {}: {e:?}", s.stats.service))
+            .map_err(|e| LiveError::Ipc(format!("{}: {e:?}", s.stats.service)))
             .and_then(|r| {
                 let mut r = r.write_from_fn(|_| 0u8);
                 let out = r.payload_mut();
@@ -425,7 +432,7 @@ impl ServiceServers {
                     }
                 }
                 r.send()
-                    .map_err(|e| format!("iceoryx2: {}: {e:?}", s.stats.service))
+                    .map_err(|e| LiveError::Ipc(format!("{}: {e:?}", s.stats.service)))
             })?;
         s.stats.answered += 1;
         Ok(())
@@ -484,7 +491,7 @@ impl GoalBridge {
     }
 
     /// Sends `msg` to its process if it is a goal of a bridged action.
-    pub fn forward(&mut self, msg: &SentMessage<'_>) -> Result<(), String> {
+    pub fn forward(&mut self, msg: &SentMessage<'_>) -> Result<(), LiveError> {
         if msg.origin() == EXTERNAL {
             return Ok(());
         }

@@ -32,7 +32,7 @@ pub struct Paced<'n> {
     /// Action goals forwarded to processes.
     pub goals: GoalBridge,
     /// The first error talking to processes.
-    pub inbound_error: Option<String>,
+    pub inbound_error: Option<super::LiveError>,
     /// Model time on the wall clock (the sidecar's clock, at the run's speed).
     pub clock: Clock,
     /// Nanoseconds per model time unit (for the progress line).

@@ -341,9 +341,34 @@ pub fn page(title: &str, spec: &codegen::Compiled) -> String {
         .replace("__TITLE__", &crate::report::html::esc(title))
 }
 
+/// Why `--serve ADDR` names no address: the text as given, and what the resolver said
+/// (`None`: it resolved to no address).
+#[derive(Debug)]
+pub struct AddrError {
+    /// The text as given.
+    pub text: String,
+    /// The resolver's error.
+    pub error: Option<std::io::Error>,
+}
+
+impl std::fmt::Display for AddrError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.error {
+            Some(e) => write!(
+                f,
+                "`{}`: {e} (expected PORT, :PORT or HOST:PORT)",
+                self.text
+            ),
+            None => write!(f, "`{}`: no address", self.text),
+        }
+    }
+}
+
+impl std::error::Error for AddrError {}
+
 /// Resolves `--serve ADDR`: a bare port (`8080`) or `:8080` means loopback, so the page
 /// is not offered to the network unless an address says so (`0.0.0.0:8080`).
-pub fn parse_addr(text: &str) -> Result<SocketAddr, String> {
+pub fn parse_addr(text: &str) -> Result<SocketAddr, AddrError> {
     let t = text.trim();
     let full = if t.parse::<u16>().is_ok() {
         format!("127.0.0.1:{t}")
@@ -352,10 +377,14 @@ pub fn parse_addr(text: &str) -> Result<SocketAddr, String> {
     } else {
         t.to_string()
     };
+    let error = |error| AddrError {
+        text: text.to_owned(),
+        error,
+    };
     full.to_socket_addrs()
-        .map_err(|e| format!("`{text}`: {e} (expected PORT, :PORT or HOST:PORT)"))?
+        .map_err(|e| error(Some(e)))?
         .next()
-        .ok_or_else(|| format!("`{text}`: no address"))
+        .ok_or_else(|| error(None))
 }
 
 /// The page's server: bound, accepting on its own thread.
@@ -775,7 +804,10 @@ mod tests {
         assert_eq!(parse_addr("8080").unwrap().to_string(), "127.0.0.1:8080");
         assert_eq!(parse_addr(":0").unwrap().to_string(), "127.0.0.1:0");
         assert_eq!(parse_addr("0.0.0.0:9").unwrap().to_string(), "0.0.0.0:9");
-        assert!(parse_addr("nowhere").unwrap_err().contains("expected PORT"));
+        assert!(parse_addr("nowhere")
+            .unwrap_err()
+            .to_string()
+            .contains("expected PORT"));
     }
 
     #[test]

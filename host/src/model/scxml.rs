@@ -2,7 +2,7 @@
 
 use super::ast::*;
 use super::source::{unescaped_offset, Diagnostic, FileId, SourceMap, Span};
-use super::types::{parse_type_comment, TypeAnn, TypeExpr};
+use super::types::{parse_type_comment, TypeAnn, TypeError, TypeExpr};
 use super::xml::{self, Element, Node};
 
 /// Reads the SCXML file `file` (already in `sm`) into a machine.
@@ -44,7 +44,7 @@ struct Reader<'a> {
 const RAND: &str = "__RAND__";
 
 /// A pending `<!-- TYPE name:type -->` annotation.
-type Pending = Option<(String, Result<TypeExpr, String>, Span)>;
+type Pending = Option<(String, Result<TypeExpr, TypeError>, Span)>;
 
 impl Reader<'_> {
     fn err(&mut self, span: Span, msg: impl Into<String>) {
@@ -234,7 +234,7 @@ impl Reader<'_> {
         }
     }
 
-    fn type_ann(&mut self, t: Result<TypeExpr, String>, span: Span) -> Option<TypeAnn> {
+    fn type_ann(&mut self, t: Result<TypeExpr, TypeError>, span: Span) -> Option<TypeAnn> {
         match t {
             Ok(ty) => Some(TypeAnn { ty, span }),
             Err(m) => {

@@ -47,12 +47,50 @@ pub enum TypeExpr {
     Array(Box<TypeExpr>, Option<u32>),
 }
 
+/// Why a type name does not parse; each quotes the text and displays as one sentence.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum TypeError {
+    /// Nothing before the dimensions (`[3]`).
+    MissingName(String),
+    /// A base name with characters no type name has.
+    NotATypeName(String),
+    /// Dimensions that are not `[N]` or `[]`.
+    MalformedArray(String),
+    /// A length that is not a number (the length, the whole type).
+    BadLength(String, String),
+    /// More than 16 dimensions.
+    TooManyDimensions(String),
+}
+
+impl std::fmt::Display for TypeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TypeError::MissingName(text) => write!(f, "missing type name in `{text}`"),
+            TypeError::NotATypeName(name) => write!(f, "`{name}` is not a type name"),
+            TypeError::MalformedArray(text) => write!(f, "malformed array type `{text}`"),
+            TypeError::BadLength(n, text) => write!(f, "bad array length `{n}` in `{text}`"),
+            TypeError::TooManyDimensions(text) => {
+                write!(f, "too many array dimensions in `{text}`")
+            }
+        }
+    }
+}
+
+impl std::error::Error for TypeError {}
+
+/// The message, for a diagnostic at the type's position.
+impl From<TypeError> for String {
+    fn from(e: TypeError) -> String {
+        e.to_string()
+    }
+}
+
 impl TypeExpr {
     /// Parses `int32`, `float64[]`, `string[3][]`, `MyStruct`, ...
     ///
     /// Named types are accepted syntactically; whether they exist is checked
     /// against the [`TypeDefs`] when the model is compiled.
-    pub fn parse(text: &str) -> Result<TypeExpr, String> {
+    pub fn parse(text: &str) -> Result<TypeExpr, TypeError> {
         let text = text.trim();
         let (base, dims) = match text.find('[') {
             Some(i) => (&text[..i], &text[i..]),
@@ -70,7 +108,7 @@ impl TypeExpr {
             (None, _) if spec_float => TypeExpr::Base(BaseType::Float),
             (None, "integer") => TypeExpr::Base(BaseType::Int),
             (None, "URI" | "str") => TypeExpr::Base(BaseType::Str),
-            (None, "") => return Err(format!("missing type name in `{text}`")),
+            (None, "") => return Err(TypeError::MissingName(text.to_owned())),
             (None, name) => {
                 if name
                     .chars()
@@ -78,7 +116,7 @@ impl TypeExpr {
                 {
                     TypeExpr::Named(name.to_string())
                 } else {
-                    return Err(format!("`{name}` is not a type name"));
+                    return Err(TypeError::NotATypeName(name.to_owned()));
                 }
             }
         };
@@ -87,10 +125,10 @@ impl TypeExpr {
         let mut rest = dims.trim();
         while !rest.is_empty() {
             let Some(inner) = rest.strip_prefix('[') else {
-                return Err(format!("malformed array type `{text}`"));
+                return Err(TypeError::MalformedArray(text.to_owned()));
             };
             let Some(close) = inner.find(']') else {
-                return Err(format!("malformed array type `{text}`"));
+                return Err(TypeError::MalformedArray(text.to_owned()));
             };
             let n = inner[..close].trim();
             sizes.push(if n.is_empty() {
@@ -98,11 +136,11 @@ impl TypeExpr {
             } else {
                 Some(
                     n.parse::<u32>()
-                        .map_err(|_| format!("bad array length `{n}` in `{text}`"))?,
+                        .map_err(|_| TypeError::BadLength(n.to_owned(), text.to_owned()))?,
                 )
             });
             if sizes.len() > 16 {
-                return Err(format!("too many array dimensions in `{text}`"));
+                return Err(TypeError::TooManyDimensions(text.to_owned()));
             }
             rest = inner[close + 1..].trim_start();
         }
@@ -266,7 +304,7 @@ impl TypeDefs {
 }
 
 /// Parses a `TYPE name:type` comment body; `None` when the comment is not an annotation.
-pub(crate) fn parse_type_comment(text: &str) -> Option<(String, Result<TypeExpr, String>)> {
+pub(crate) fn parse_type_comment(text: &str) -> Option<(String, Result<TypeExpr, TypeError>)> {
     let body = text.trim().strip_prefix("TYPE")?;
     if !body.starts_with(char::is_whitespace) {
         return None;
@@ -314,7 +352,14 @@ mod tests {
             TypeExpr::parse("int32[][][][]").unwrap().to_string(),
             "int[][][][]"
         );
-        assert!(TypeExpr::parse("int32[x]").is_err());
+        assert_eq!(
+            TypeExpr::parse("int32[x]"),
+            Err(TypeError::BadLength("x".into(), "int32[x]".into()))
+        );
+        assert_eq!(
+            TypeExpr::parse("a b").unwrap_err().to_string(),
+            "`a b` is not a type name"
+        );
         assert!(TypeExpr::parse("int32[").is_err());
         assert!(TypeExpr::parse("").is_err());
         assert_eq!(TypeExpr::parse("Pose"), Ok(TypeExpr::Named("Pose".into())));

@@ -6,7 +6,7 @@
 
 use std::fmt;
 
-use super::source::{LineIndex, Location};
+use super::source::{Location, SourceFile};
 
 /// What is wrong, without the position.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -177,7 +177,7 @@ pub type Diagnostics = codegen::diag::Diagnostics<PropsErrorKind>;
 /// An error at `at` of the file `path` whose text `lines` indexes, showing its line.
 pub(crate) fn error_at(
     path: &std::path::Path,
-    lines: &LineIndex<'_>,
+    lines: &SourceFile<'_>,
     at: Location,
     kind: PropsErrorKind,
 ) -> PropsError {

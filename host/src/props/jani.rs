@@ -38,7 +38,7 @@
 use std::path::Path;
 
 use super::error::{Diagnostics, PropsError, PropsErrorKind};
-use super::source::{LineIndex, Location, SourceText};
+use super::source::{Location, SourceFile, SourceText};
 use super::{Port, PortKind, Property, PropertyFile, ANY};
 use crate::expr::value::Ty;
 use crate::model::json::{self, Json, Node};
@@ -109,7 +109,7 @@ pub fn parse_str_selected(
             ),
         )]));
     }
-    let lines = LineIndex::new(text);
+    let lines = SourceFile::new(path, text);
     let root = json::parse(text).map_err(|(offset, message)| {
         Diagnostics::from(vec![super::error::error_at(
             path,
@@ -175,7 +175,7 @@ enum Var {
 
 struct Reader<'r, 'a> {
     path: &'r Path,
-    lines: &'r LineIndex<'a>,
+    lines: &'r SourceFile<'a>,
     model: &'r CompiledModel,
     ports: Vec<Port>,
     errors: Vec<PropsError>,

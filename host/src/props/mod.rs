@@ -228,7 +228,7 @@ pub fn parse_str(text: &str, path: &Path) -> Result<PropertyFile, Diagnostics> {
             PropsErrorKind::Xml("it does not start with `<` (its text is not shown)".into()),
         )]));
     }
-    let lines = source::LineIndex::new(text);
+    let lines = source::SourceFile::new(path, text);
     let root = crate::model::xml::parse_text(text, crate::model::FileId(0)).map_err(|e| {
         let at = lines.location(e.offset as usize);
         Diagnostics::from(vec![error::error_at(

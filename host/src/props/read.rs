@@ -5,7 +5,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use super::error::{PropsError, PropsErrorKind};
-use super::source::{unescape_attribute, LineIndex, Location, SourceText};
+use super::source::{unescape_attribute, Location, SourceFile, SourceText};
 use super::{Port, PortKind, Property, PropertyFile};
 use crate::model::source::Span;
 use crate::model::xml::{Attr, Element, Node};
@@ -62,14 +62,14 @@ const TYPES: &str = "one of bool, boolean, int, int8..int64, uint8..uint64, floa
 
 pub(crate) struct FileReader<'p, 'a> {
     path: &'p Path,
-    lines: &'p LineIndex<'a>,
+    lines: &'p SourceFile<'a>,
     errors: Vec<PropsError>,
     /// The ROS types ports name, in file order.
     pub(super) ros_types: Vec<super::RosTypeUse>,
 }
 
 impl<'p, 'a> FileReader<'p, 'a> {
-    pub(crate) fn new(path: &'p Path, lines: &'p LineIndex<'a>) -> FileReader<'p, 'a> {
+    pub(crate) fn new(path: &'p Path, lines: &'p SourceFile<'a>) -> FileReader<'p, 'a> {
         FileReader {
             path,
             lines,

@@ -1,11 +1,13 @@
-//! Source positions for property files: [`Location`] (line, column), a line index over a
-//! file's text, and [`SourceText`], a piece of text (formula, initial value) that maps
-//! each of its offsets back to where it came from in the file. Lines, columns and the
-//! position map are codegen's ([`codegen::diag`]), the one source foundation.
+//! Source positions for property files: [`Location`] (line, column), the file as the one
+//! [`SourceMap`] holds it, and [`SourceText`], a piece of text (formula, initial value)
+//! that maps each of its offsets back to where it came from in the file. Lines, columns,
+//! carets and the position map are codegen's ([`codegen::diag`]), the one source
+//! foundation every reader positions through.
 
 use std::fmt;
+use std::path::Path;
 
-use codegen::diag::{locate_in_runs, PositionRun, Snippet};
+use codegen::diag::{locate_in_runs, FileId, PositionRun, Snippet, SourceMap};
 
 /// A position in a file: 1-based line and column, columns counted in characters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -29,35 +31,37 @@ impl fmt::Display for Location {
     }
 }
 
-/// A file's text with its line index ([`codegen::diag::LineIndex`]), to turn byte
-/// offsets into [`Location`]s and locations into carets.
+/// A property file's text in the project's one [`SourceMap`] (as its only source,
+/// [`FileId`] 0, the id the XML tree's spans carry): byte offsets become [`Location`]s
+/// and locations carets through the map, as for every other reader.
 #[derive(Clone, Debug)]
-pub(crate) struct LineIndex<'a> {
+pub(crate) struct SourceFile<'a> {
     text: &'a str,
-    index: codegen::diag::LineIndex,
+    map: SourceMap,
+    id: FileId,
 }
 
-impl<'a> LineIndex<'a> {
-    pub(crate) fn new(text: &'a str) -> LineIndex<'a> {
-        LineIndex {
-            text,
-            index: codegen::diag::LineIndex::new(text),
-        }
+impl<'a> SourceFile<'a> {
+    pub(crate) fn new(path: &Path, text: &'a str) -> SourceFile<'a> {
+        let mut map = SourceMap::new();
+        let id = map.add(path, text.to_owned());
+        SourceFile { text, map, id }
     }
 
     /// The location of byte `offset` (clamped to the text; a position inside a multi-byte
     /// character counts as that character).
     pub(crate) fn location(&self, offset: usize) -> Location {
-        let (line, column) = self.index.line_col(self.text, offset);
-        Location::new(line, column)
+        let offset = u32::try_from(offset).unwrap_or(u32::MAX);
+        let at = self.map.locate(self.id.at(offset));
+        Location::new(at.line, at.col)
     }
 
     /// The source line and caret of location `at`.
     pub(crate) fn snippet(&self, at: Location) -> Snippet {
-        Snippet::at_line_col(self.text, &self.index, at.line, at.column)
+        self.map.snippet_at(self.id, at.line, at.column)
     }
 
-    /// The indexed text.
+    /// The file's text.
     pub(crate) fn text(&self) -> &'a str {
         self.text
     }
@@ -209,7 +213,7 @@ impl fmt::Display for SourceText {
 pub(crate) fn unescape_attribute(
     raw: &str,
     offset: usize,
-    lines: &LineIndex<'_>,
+    lines: &SourceFile<'_>,
 ) -> Result<SourceText, (usize, String)> {
     let mut out = SourceText::empty();
     let mut rest = raw;
@@ -250,7 +254,7 @@ mod tests {
         let file = "<p formula=\"{a}\r\n  S {b}\tor\n{c}&#10;\"/>";
         let start = file.find('{').unwrap();
         let raw = &file[start..file.rfind('"').unwrap()];
-        let lines = LineIndex::new(file);
+        let lines = SourceFile::new(Path::new("p.xml"), file);
         let out = unescape_attribute(raw, start, &lines).unwrap();
         // `\r\n` is one line break: one space, not two; `&#10;` stays a line break.
         assert_eq!(out.as_str(), "{a}   S {b} or {c}\n");

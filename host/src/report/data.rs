@@ -4,6 +4,7 @@
 //! Every type reads the JSON those commands print (extra fields ignored, new ones
 //! optional), so `hindsight report` and `verify --report` build the same [`ReportData`].
 
+use codegen::diag::Diagnostic;
 use serde::{Deserialize, Serialize};
 
 pub use crate::verify::result::{PropertyRow, Study};
@@ -141,21 +142,27 @@ impl Run {
     /// Reads a CSV written by `verify --save-failing` or `trace`; `name` (the file) goes
     /// in errors as `name:line:col`. A file named `PROPERTY-runK.csv` gives the property
     /// and run index.
-    pub fn from_csv(name: &str, text: &str) -> Result<Run, String> {
+    pub fn from_csv(name: &str, text: &str) -> Result<Run, Diagnostic> {
         const FIXED: [&str; 6] = ["time", "step", "event", "origin", "target", "params"];
-        let records = crate::verify::record::records(text)
-            .map_err(|(line, col, m)| format!("{name}:{line}:{col}: {m}"))?;
-        let mut records = records.into_iter();
+        let err = |line: usize, col: usize, m: String| {
+            Diagnostic::error(name, (line as u32, col as u32), m)
+        };
+        // The project's one CSV reader, as `replay` reads a trace.
+        let mut records = codegen::csv::rows(name, text)?.into_iter();
         let header_rec = records
             .next()
-            .ok_or_else(|| format!("{name}:1:1: empty file: expected a CSV header"))?;
+            .ok_or_else(|| err(1, 1, "empty file: expected a CSV header".into()))?;
         let header: Vec<&str> = header_rec.fields.iter().map(|(f, _)| f.as_str()).collect();
         for (i, want) in FIXED.iter().enumerate() {
             if header.get(i) != Some(want) {
-                return Err(format!(
-                    "{name}:1:1: expected the header of `verify --save-failing` or `trace` \
-                     (time,step,event,origin,target,params,...), found `{}`",
-                    text.lines().next().unwrap_or_default()
+                return Err(err(
+                    header_rec.line,
+                    1,
+                    format!(
+                        "expected the header of `verify --save-failing` or `trace` \
+                         (time,step,event,origin,target,params,...), found `{}`",
+                        header.join(",")
+                    ),
                 ));
             }
         }
@@ -196,23 +203,22 @@ impl Run {
             let i = rec.line - 1;
             let cells: Vec<&str> = rec.fields.iter().map(|(f, _)| f.as_str()).collect();
             if cells.len() != header.len() {
-                return Err(format!(
-                    "{name}:{}:1: {} fields, the header has {}",
+                return Err(err(
                     i + 1,
-                    cells.len(),
-                    header.len()
+                    1,
+                    format!("{} fields, the header has {}", cells.len(), header.len()),
                 ));
             }
             let col = |c: usize| rec.fields[c].1;
             let time: u64 = cells[0].parse().map_err(|_| {
-                format!(
-                    "{name}:{}:1: time `{}` is not a whole number",
+                err(
                     i + 1,
-                    cells[0]
+                    1,
+                    format!("time `{}` is not a whole number", cells[0]),
                 )
             })?;
             if run.time.last().is_some_and(|&t| t > time) {
-                return Err(format!("{name}:{}:1: time {time} goes backwards", i + 1));
+                return Err(err(i + 1, 1, format!("time {time} goes backwards")));
             }
             run.time.push(time);
             let names = &mut run.names;
@@ -229,10 +235,10 @@ impl Run {
                     "true" => '1',
                     "false" => '0',
                     other => {
-                        return Err(format!(
-                            "{name}:{}:{}: verdict `{other}`: expected true or false",
+                        return Err(err(
                             i + 1,
-                            col(split + j)
+                            col(split + j),
+                            format!("verdict `{other}`: expected true or false"),
                         ))
                     }
                 });
@@ -338,29 +344,40 @@ mod tests {
         assert_eq!(r.values[0][1], serde_json::json!("two\nlines"));
         assert_eq!(r.params[1], "msg=x, \"y\"");
         assert_eq!(r.verdicts, ["10"]);
-        let e = Run::from_csv("q.csv", &text.replace("\"a,b\"", "\"a,b")).unwrap_err();
+        let e = Run::from_csv("q.csv", &text.replace("\"a,b\"", "\"a,b"))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("q.csv:"), "{e}");
     }
 
     #[test]
     fn bad_runs_name_the_line_and_column() {
-        let e = Run::from_csv("f.csv", "a,b\n").unwrap_err();
-        assert!(e.starts_with("f.csv:1:1: expected the header"), "{e}");
+        let e = |text: &str| Run::from_csv("f.csv", text).unwrap_err().to_string();
+        let e1 = e("a,b\n");
+        assert!(e1.starts_with("f.csv:1:1: expected the header"), "{e1}");
+        // The one CSV reader: a byte order mark and comment lines are no rows.
+        let r = Run::from_csv("f.csv", &format!("\u{feff}# saved by hand\n{CSV}")).unwrap();
+        assert_eq!(r.time, [0, 3, 3, 7]);
         let bad = CSV.replace(
             "3,receive,go,a,b,n=1,2.5,true,false",
             "3,receive,go,a,b,n=1,2.5,true,maybe",
         );
-        let e = Run::from_csv("f.csv", &bad).unwrap_err();
-        assert_eq!(e, "f.csv:4:31: verdict `maybe`: expected true or false");
-        let e = Run::from_csv("f.csv", &CSV.replace("7,time", "2,time")).unwrap_err();
-        assert_eq!(e, "f.csv:5:1: time 2 goes backwards");
-        let e = Run::from_csv("f.csv", &CSV.replace("n=1,2.5,true,true", "n=1,2.5")).unwrap_err();
+        assert_eq!(
+            e(&bad),
+            "f.csv:4:31: verdict `maybe`: expected true or false"
+        );
+        assert_eq!(
+            e(&CSV.replace("7,time", "2,time")),
+            "f.csv:5:1: time 2 goes backwards"
+        );
+        let e = e(&CSV.replace("n=1,2.5,true,true", "n=1,2.5"));
         assert!(
             e.starts_with("f.csv:3:1: 8 fields, the header has 10"),
             "{e}"
         );
         assert!(Run::from_csv("f.csv", "")
             .unwrap_err()
+            .to_string()
             .contains("empty file"));
     }
 

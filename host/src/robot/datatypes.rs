@@ -329,8 +329,8 @@ fn json_type(v: &JsonNode) -> Result<TypeExpr, JsonError> {
     Ok(match t {
         "string" => TypeExpr::Base(BaseType::Str),
         "boolean" => TypeExpr::Base(BaseType::Bool),
-        "integer" => TypeExpr::parse("int32").map_err(|m| (tat, m))?,
-        "number" => TypeExpr::parse("float32").map_err(|m| (tat, m))?,
+        "integer" => TypeExpr::parse("int32").map_err(|m| (tat, m.into()))?,
+        "number" => TypeExpr::parse("float32").map_err(|m| (tat, m.into()))?,
         "array" => {
             let items = v
                 .get("items")

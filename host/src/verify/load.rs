@@ -5,8 +5,16 @@
 //! through the robot pipeline, anything else is read as plain SCXML; the property
 //! file (given, named by the model, or found beside it) is read, filtered by
 //! `only` / `skip`, and compiled against the model into a [`PropertySet`].
+//!
+//! Nothing here prints: a failure is a [`LoadError`] (the files' located
+//! [`Diagnostics`], or an option that does not fit the model), and the warnings of every
+//! reader on the way are returned in [`Loaded::warnings`] for the command to print.
 
+use std::fmt;
 use std::path::{Path, PathBuf};
+
+use codegen::diag::{Diagnostic, Diagnostics};
+use codegen::duration::DurationError;
 
 use super::observe::PropertySet;
 use crate::props;
@@ -56,8 +64,112 @@ fn is_jani(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("jani"))
 }
 
+/// Why a model and its properties could not be loaded.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum LoadError {
+    /// What is wrong in the files (model, main file, property file), each problem
+    /// located at its `file:line:col` (or its file), with what the user can do about it
+    /// when there is something (`--skip`, `--time-unit`).
+    Files {
+        /// The problems, in the order found.
+        diagnostics: Diagnostics,
+        /// One line of advice printed after them, without its `hint: `.
+        hint: Option<&'static str>,
+    },
+    /// An option that does not fit the model (`--bt`, `--only`, `--time-unit`, ...).
+    Option {
+        /// The option as given (`--only p9`).
+        flag: String,
+        /// Why it does not fit.
+        message: String,
+    },
+}
+
+impl LoadError {
+    fn option(flag: impl Into<String>, message: impl Into<String>) -> LoadError {
+        LoadError::Option {
+            flag: flag.into(),
+            message: message.into(),
+        }
+    }
+
+    fn about_file(path: &Path, message: impl Into<String>) -> LoadError {
+        Diagnostic::about_file(path.display().to_string(), message.into()).into()
+    }
+}
+
+impl From<Diagnostics> for LoadError {
+    fn from(diagnostics: Diagnostics) -> LoadError {
+        LoadError::Files {
+            diagnostics,
+            hint: None,
+        }
+    }
+}
+
+impl From<Diagnostic> for LoadError {
+    fn from(d: Diagnostic) -> LoadError {
+        Diagnostics::from(d).into()
+    }
+}
+
+/// `file:line:col: message` for each problem (then `hint: ...`), or `FLAG: message`.
+impl fmt::Display for LoadError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LoadError::Files { diagnostics, hint } => {
+                write!(f, "{diagnostics}")?;
+                match hint {
+                    Some(h) => write!(f, "\nhint: {h}"),
+                    None => Ok(()),
+                }
+            }
+            LoadError::Option { flag, message } => write!(f, "{flag}: {message}"),
+        }
+    }
+}
+
+impl std::error::Error for LoadError {}
+
+/// Why a run length ([`Loaded::max_time`]) is not a number of model steps; the caller
+/// names its flag in front.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum MaxTimeError {
+    /// Neither steps nor a duration.
+    Unreadable(DurationError),
+    /// A duration that is not a whole number of the model's steps (of `unit_ns`).
+    NotWholeSteps {
+        /// The duration as written.
+        text: String,
+        /// The model's step in nanoseconds.
+        unit_ns: u64,
+    },
+    /// A duration for a model without a time unit.
+    NoTimeUnit(String),
+}
+
+impl fmt::Display for MaxTimeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MaxTimeError::Unreadable(e) => write!(f, "{e}"),
+            MaxTimeError::NotWholeSteps { text, unit_ns } => write!(
+                f,
+                "{text} is not a whole number of model steps of {}",
+                codegen::duration::format(*unit_ns)
+            ),
+            MaxTimeError::NoTimeUnit(text) => write!(
+                f,
+                "{text} is a duration but the model has no time unit (give --time-unit, \
+                 or the length in steps)"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for MaxTimeError {}
+
 /// Finds the property file for a model when none is given.
-fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, String> {
+fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, LoadError> {
     if let Some(p) = compiled.properties_path() {
         return Ok(p.to_path_buf());
     }
@@ -81,10 +193,12 @@ fn default_props(model: &Path, compiled: &CompiledModel) -> Result<PathBuf, Stri
     if jani.len() == 1 {
         return Ok(jani.remove(0));
     }
-    Err(format!(
-        "{}: no property file given and none found (looked for {} and a single .jani file)",
-        model.display(),
-        p.display()
+    Err(LoadError::about_file(
+        model,
+        format!(
+            "no property file given and none found (looked for {} and a single .jani file)",
+            p.display()
+        ),
     ))
 }
 
@@ -107,31 +221,30 @@ pub struct Loaded {
     pub bt_notes: Vec<String>,
     /// How sends are delivered.
     pub events: EventSemantics,
+    /// What the readers found questionable without refusing it (attributes AS2FM
+    /// ignores, an integer port read as a float, ...), in the order found: the command
+    /// prints them.
+    pub warnings: Diagnostics,
 }
 
 impl Loaded {
     /// The run length in model steps: `arg` is model steps (`500`), or a duration
     /// (`100s`) when the model has a time unit; by default the main file's `max_time`,
     /// else 10,000 steps. The caller names its flag in front of an error.
-    pub fn max_time(&self, arg: Option<&str>) -> Result<u64, String> {
+    pub fn max_time(&self, arg: Option<&str>) -> Result<u64, MaxTimeError> {
         use codegen::duration::StepsOrDuration;
         let Some(text) = arg else {
             return Ok(self.default_max_time.unwrap_or(10_000));
         };
-        match codegen::duration::parse_steps_or_duration(text)? {
+        match codegen::duration::parse_steps_or_duration(text).map_err(MaxTimeError::Unreadable)? {
             StepsOrDuration::Steps(v) => Ok(v),
             StepsOrDuration::Nanos(ns) => match self.unit_ns {
                 Some(unit) if ns % unit == 0 => Ok(ns / unit),
-                Some(unit) => Err(format!(
-                    "{} is not a whole number of model steps of {}",
-                    text.trim(),
-                    codegen::duration::format(unit)
-                )),
-                None => Err(format!(
-                    "{} is a duration but the model has no time unit (give --time-unit, \
-                     or the length in steps)",
-                    text.trim()
-                )),
+                Some(unit_ns) => Err(MaxTimeError::NotWholeSteps {
+                    text: text.trim().to_owned(),
+                    unit_ns,
+                }),
+                None => Err(MaxTimeError::NoTimeUnit(text.trim().to_owned())),
             },
         }
     }
@@ -139,7 +252,7 @@ impl Loaded {
 
 /// Loads the model and its properties: a robot model (a main file, or a folder holding
 /// `main.xml`) through the robot pipeline, anything else as plain SCXML.
-pub fn load(opts: &LoadOptions) -> Result<Loaded, String> {
+pub fn load(opts: &LoadOptions) -> Result<Loaded, LoadError> {
     load_without(opts, &[]).map(|(l, _)| l)
 }
 
@@ -148,43 +261,51 @@ pub fn load(opts: &LoadOptions) -> Result<Loaded, String> {
 pub fn load_without(
     opts: &LoadOptions,
     external: &[String],
-) -> Result<(Loaded, Vec<ExternalComponent>), String> {
+) -> Result<(Loaded, Vec<ExternalComponent>), LoadError> {
     if let Some(main) = crate::robot::load::main_file_of(&opts.model) {
         return load_robot(opts, &main, external);
     }
     if let Some(dir) = opts.interfaces.first() {
-        return Err(format!(
-            "--interfaces {}: {} is not a robot model (a main file, or a folder with \
-             main.xml); only a robot model reads ROS interfaces",
-            dir.display(),
-            opts.model.display()
+        return Err(LoadError::option(
+            format!("--interfaces {}", dir.display()),
+            format!(
+                "{} is not a robot model (a main file, or a folder with main.xml); only a \
+                 robot model reads ROS interfaces",
+                opts.model.display()
+            ),
         ));
     }
     if opts.bt != crate::robot::bt::BtSemantics::As2fm {
-        return Err(format!(
-            "--bt {}: {} is not a robot model (a main file, or a folder with main.xml); \
-             only a robot model's behavior tree has a BehaviorTree.CPP semantics",
-            opts.bt.label(),
-            opts.model.display()
+        return Err(LoadError::option(
+            format!("--bt {}", opts.bt.label()),
+            format!(
+                "{} is not a robot model (a main file, or a folder with main.xml); only a \
+                 robot model's behavior tree has a BehaviorTree.CPP semantics",
+                opts.model.display()
+            ),
         ));
     }
     if let Some(name) = external.first() {
-        return Err(format!(
-            "--external {name}: {} is not a robot model (a main file, or a folder with \
-             main.xml); only a robot model's node models can be replaced by processes",
-            opts.model.display()
+        return Err(LoadError::option(
+            format!("--external {name}"),
+            format!(
+                "{} is not a robot model (a main file, or a folder with main.xml); only a \
+                 robot model's node models can be replaced by processes",
+                opts.model.display()
+            ),
         ));
     }
     let model = &opts.model;
     let unit_ns = opts.time_unit_ns;
-    let compiled = CompiledModel::load(model).map_err(|d| d.to_string())?;
-    print_warnings(compiled.warnings());
+    let compiled = CompiledModel::load(model)?;
+    let mut warnings = as_warnings(compiled.warnings());
     let props_path = match &opts.props {
         Some(p) => p.to_path_buf(),
         None => default_props(model, &compiled)?,
     };
     let file = read_properties(&props_path, &compiled, opts)?;
     let set = compile_properties(&file, &compiled, unit_ns)?;
+    warnings.extend(set.warnings().clone());
     let events = opts.events.unwrap_or_else(|| default_events(&props_path));
     Ok((
         Loaded {
@@ -196,6 +317,7 @@ pub fn load_without(
             default_max_time: None,
             events,
             bt_notes: Vec::new(),
+            warnings,
         },
         Vec::new(),
     ))
@@ -207,7 +329,7 @@ fn read_properties(
     path: &Path,
     model: &CompiledModel,
     opts: &LoadOptions,
-) -> Result<props::PropertyFile, String> {
+) -> Result<props::PropertyFile, LoadError> {
     let wanted = |name: &str| {
         (opts.only.is_empty() || opts.only.iter().any(|o| o == name))
             && !opts.skip.iter().any(|s| s == name)
@@ -215,10 +337,13 @@ fn read_properties(
     let unknown_name = |names: &[String]| {
         for (option, given) in [("--only", &opts.only), ("--skip", &opts.skip)] {
             if let Some(missing) = given.iter().find(|n| !names.contains(n)) {
-                return Err(format!(
-                    "{option} {missing}: {} has no property `{missing}` (properties: {})",
-                    path.display(),
-                    names.join(", ")
+                return Err(LoadError::option(
+                    format!("{option} {missing}"),
+                    format!(
+                        "{} has no property `{missing}` (properties: {})",
+                        path.display(),
+                        names.join(", ")
+                    ),
                 ));
             }
         }
@@ -237,26 +362,28 @@ fn read_properties(
             unknown_name(&names)?;
         }
         read.map_err(|d| {
-            let text = d.to_string();
             // A property using what is not supported need not stop the others.
-            let hint = if text.contains("not supported") {
-                "\nhint: --skip NAME leaves a property out, --only NAME checks just that one"
-            } else {
-                ""
-            };
-            format!("{text}{hint}")
+            let hint = d
+                .to_string()
+                .contains("not supported")
+                .then_some("--skip NAME leaves a property out, --only NAME checks just that one");
+            LoadError::Files {
+                diagnostics: props_diagnostics(d),
+                hint,
+            }
         })?
     } else {
-        let mut file = props::parse_file(path).map_err(|d| d.to_string())?;
+        let mut file =
+            props::parse_file(path).map_err(|d| LoadError::from(props_diagnostics(d)))?;
         let names: Vec<String> = file.guarantees.iter().map(|g| g.id.clone()).collect();
         unknown_name(&names)?;
         file.guarantees.retain(|g| wanted(&g.id));
         file
     };
     if file.guarantees.is_empty() && !(opts.only.is_empty() && opts.skip.is_empty()) {
-        return Err(format!(
-            "--only/--skip leave no property of {} to check",
-            path.display()
+        return Err(LoadError::option(
+            "--only/--skip",
+            format!("no property of {} is left to check", path.display()),
         ));
     }
     Ok(file)
@@ -268,33 +395,38 @@ fn compile_properties(
     file: &props::PropertyFile,
     model: &CompiledModel,
     unit_ns: Option<u64>,
-) -> Result<PropertySet, String> {
-    PropertySet::with_unit(file, model, unit_ns).map_err(|e| {
-        if unit_ns.is_none() && e.contains("no known duration") {
-            format!(
-                "{e}\nhint: give the length of one model step with --time-unit (for example \
-                 --time-unit 100ms)"
-            )
-        } else {
-            e
+) -> Result<PropertySet, LoadError> {
+    PropertySet::with_unit(file, model, unit_ns).map_err(|diagnostics| {
+        let no_unit = unit_ns.is_none()
+            && diagnostics
+                .iter()
+                .any(|d| d.message.contains("no known duration"));
+        LoadError::Files {
+            diagnostics,
+            hint: no_unit.then_some(
+                "give the length of one model step with --time-unit (for example \
+                 --time-unit 100ms)",
+            ),
         }
     })
 }
 
-/// Prints a model's warnings to standard error: the first `codegen::diag::MAX_SHOWN`,
-/// then how many more (a file with thousands of ignored attributes stays readable).
-fn print_warnings<W: std::fmt::Display>(warnings: impl IntoIterator<Item = W>) {
-    let mut more = 0usize;
-    for (i, w) in warnings.into_iter().enumerate() {
-        if i < codegen::diag::MAX_SHOWN {
-            eprintln!("warning: {w}");
-        } else {
-            more += 1;
-        }
-    }
-    if more > 0 {
-        eprintln!("warning: ... and {more} more warnings");
-    }
+/// A property reader's errors, their kinds as messages.
+fn props_diagnostics(d: props::Diagnostics) -> Diagnostics {
+    d.into_iter()
+        .map(|e| e.map(|kind| kind.to_string()))
+        .collect::<Vec<_>>()
+        .into()
+}
+
+/// A reader's warnings (kept as diagnostics of their own) as warnings.
+fn as_warnings(found: &[Diagnostic]) -> Diagnostics {
+    found
+        .iter()
+        .cloned()
+        .map(Diagnostic::warning)
+        .collect::<Vec<_>>()
+        .into()
 }
 
 /// Checks that every ROS type the property file's ports name is an interface the robot
@@ -306,7 +438,7 @@ fn check_ros_types(
     file: &props::PropertyFile,
     main: &Path,
     search: &crate::robot::interfaces::Search,
-) -> Result<(), String> {
+) -> Result<(), Diagnostics> {
     use crate::robot::interfaces::{InterfaceKind, Interfaces};
     if file.ros_types.is_empty() {
         return Ok(());
@@ -316,7 +448,7 @@ fn check_ros_types(
     let Ok(interfaces) = Interfaces::discover_with(&mut sm, main, search) else {
         return Ok(());
     };
-    let errors: Vec<String> = file
+    let errors: Vec<Diagnostic> = file
         .ros_types
         .iter()
         .filter_map(|t| {
@@ -326,19 +458,14 @@ fn check_ros_types(
                 InterfaceKind::Message
             };
             let e = interfaces.get(&t.type_name, kind).err()?;
-            Some(format!(
-                "{}:{}:{}: port type: {e}",
-                file.path.display(),
-                t.at.line,
-                t.at.column
+            Some(Diagnostic::error(
+                file.path.display().to_string(),
+                (t.at.line, t.at.column),
+                format!("port type: {e}"),
             ))
         })
         .collect();
-    if errors.is_empty() {
-        Ok(())
-    } else {
-        Err(errors.join("\n"))
-    }
+    Diagnostics(errors).into_result(())
 }
 
 /// Loads a robot model: the main file and everything it names, lowered and compiled; the
@@ -347,26 +474,27 @@ fn load_robot(
     opts: &LoadOptions,
     main: &Path,
     external: &[String],
-) -> Result<(Loaded, Vec<ExternalComponent>), String> {
+) -> Result<(Loaded, Vec<ExternalComponent>), LoadError> {
     use crate::robot::main_file::InputKind;
     let search = crate::robot::interfaces::Search::from_env(opts.interfaces.clone());
-    let (robot, external) = crate::robot::load::load_searching_bt(main, external, &search, opts.bt)
-        .map_err(|d| d.to_string())?;
+    let (robot, external) =
+        crate::robot::load::load_searching_bt(main, external, &search, opts.bt)?;
     if opts.bt != crate::robot::bt::BtSemantics::As2fm && robot.main.behavior_tree.is_none() {
-        return Err(format!(
-            "--bt {}: {} has no behavior tree",
-            opts.bt.label(),
-            main.display()
+        return Err(LoadError::option(
+            format!("--bt {}", opts.bt.label()),
+            format!("{} has no behavior tree", main.display()),
         ));
     }
-    print_warnings(&robot.warnings);
+    let mut warnings = as_warnings(&robot.warnings);
     if let Some(given) = opts.time_unit_ns {
         if given != robot.time_unit_ns {
-            return Err(format!(
-                "--time-unit {}: {} steps by {}, from its timers and max_time",
-                codegen::duration::seconds(given),
-                main.display(),
-                codegen::duration::seconds(robot.time_unit_ns)
+            return Err(LoadError::option(
+                format!("--time-unit {}", codegen::duration::seconds(given)),
+                format!(
+                    "{} steps by {}, from its timers and max_time",
+                    main.display(),
+                    codegen::duration::seconds(robot.time_unit_ns)
+                ),
             ));
         }
     }
@@ -374,24 +502,25 @@ fn load_robot(
         (Some(p), _) => p.clone(),
         (None, Some(input)) => {
             if input.kind == InputKind::Hspec {
-                return Err(format!(
-                    "{}: an .hspec file names no messages of the model; write the \
-                     properties over ROS names (XML) or give them on the command line",
-                    input.path.display()
+                return Err(LoadError::about_file(
+                    &input.path,
+                    "an .hspec file names no messages of the model; write the properties \
+                     over ROS names (XML) or give them on the command line",
                 ));
             }
             input.path.clone()
         }
         (None, None) => {
-            return Err(format!(
-                "{}: the main file names no property file; give one after the model",
-                main.display()
+            return Err(LoadError::about_file(
+                main,
+                "the main file names no property file; give one after the model",
             ))
         }
     };
     let file = read_properties(&props_path, &robot.model, opts)?;
     check_ros_types(&file, main, &search)?;
     let set = compile_properties(&file, &robot.model, Some(robot.time_unit_ns))?;
+    warnings.extend(set.warnings().clone());
     Ok((
         Loaded {
             model: robot.model,
@@ -403,6 +532,7 @@ fn load_robot(
             bt_notes: robot.bt_notes.iter().map(|d| d.to_string()).collect(),
             // The lowering is AS2FM's translation; its sends mean what AS2FM's JANI means.
             events: opts.events.unwrap_or(EventSemantics::As2fm),
+            warnings,
         },
         external,
     ))

@@ -9,8 +9,7 @@
 //! variables, applies the ports of a sent message, and steps the monitors. When every
 //! verdict is final ([`monitor_core::analysis::settle`]) it stops the run.
 
-use std::collections::BTreeSet;
-
+use codegen::diag::{Diagnostic, Diagnostics};
 use codegen::{Compiled, DeclInput, FormulaInput, Origin, SpecInput};
 use monitor_core::{analysis, valuation, Monitor, Ty, Value, VarKind};
 
@@ -57,6 +56,8 @@ pub struct PropertySet {
     by_event: Vec<Vec<Port>>,
     /// Model string id -> spec string id (`u32::MAX`: equal to no constant).
     strings: Vec<u32>,
+    /// What compiling found questionable ([`PropertySet::warnings`]).
+    warnings: Diagnostics,
 }
 
 /// Maps a SCAN port type to a spec type name.
@@ -66,7 +67,7 @@ fn spec_type(scan: &str) -> Option<&'static str> {
 
 /// The type a state port holds: the declared one (`written` in the file, `declared` as
 /// the spec language names it), except that an integer port reading a floating-point
-/// parameter takes it as a float (with a warning, once per process), as SCAN does:
+/// parameter takes it as a float (with a warning pushed on `warnings`), as SCAN does:
 /// SCAN's port holds the parameter's value whatever type the port declares, and
 /// truncating it would change what the property's comparisons see.
 fn widened(
@@ -75,6 +76,7 @@ fn widened(
     param: &str,
     (written, declared): (&str, &'static str),
     file: &str,
+    warnings: &mut Diagnostics,
 ) -> &'static str {
     let float = model
         .event_id(&port.event)
@@ -82,17 +84,18 @@ fn widened(
         .and_then(|(e, i)| model.event_params(e).get(i))
         .is_some_and(|(_, t)| matches!(t, crate::expr::value::Ty::Float));
     if float && declared.starts_with(['i', 'u']) {
-        // A sweep compiles the file once per property: say it once.
-        static SAID: std::sync::Mutex<BTreeSet<String>> = std::sync::Mutex::new(BTreeSet::new());
-        let warning = format!(
-            "warning: {file}:{}:{}: port `{}` is declared {written} but `{param}` is a \
-             float: it is read as a float (f64), as SCAN reads it",
-            port.at.line, port.at.column, port.id
+        warnings.push(
+            Diagnostic::error(
+                file,
+                (port.at.line, port.at.column),
+                format!(
+                    "port `{}` is declared {written} but `{param}` is a float: it is read as \
+                     a float (f64), as SCAN reads it",
+                    port.id
+                ),
+            )
+            .warning(),
         );
-        let mut said = SAID.lock().unwrap_or_else(|e| e.into_inner());
-        if said.insert(warning.clone()) {
-            eprintln!("{warning}");
-        }
         "f64"
     } else {
         declared
@@ -108,7 +111,7 @@ pub fn spec_input(
     props: &PropertyFile,
     unit_ns: Option<u64>,
     mut state_type: impl FnMut(&crate::props::Port, &str, &str, &'static str) -> &'static str,
-) -> Result<SpecInput, String> {
+) -> Result<SpecInput, Diagnostics> {
     let file = props.path.display().to_string();
     let origin = |line: u32, col: u32| Origin {
         file: file.clone(),
@@ -129,9 +132,10 @@ pub fn spec_input(
             PortKind::Part { ty, .. } => match spec_type(ty) {
                 Some(t) => (VarKind::State, t.to_string(), None),
                 None => {
-                    errors.push(format!(
-                        "{file}:{}:{}: port `{}`: unsupported type `{ty}`",
-                        p.at.line, p.at.column, p.id
+                    errors.push(Diagnostic::error(
+                        file.as_str(),
+                        (p.at.line, p.at.column),
+                        format!("port `{}`: unsupported type `{ty}`", p.id),
                     ));
                     continue;
                 }
@@ -143,9 +147,10 @@ pub fn spec_input(
                     Some(init.as_str().to_string()),
                 ),
                 None => {
-                    errors.push(format!(
-                        "{file}:{}:{}: port `{}`: unsupported type `{ty}`",
-                        p.at.line, p.at.column, p.id
+                    errors.push(Diagnostic::error(
+                        file.as_str(),
+                        (p.at.line, p.at.column),
+                        format!("port `{}`: unsupported type `{ty}`", p.id),
                     ));
                     continue;
                 }
@@ -176,7 +181,7 @@ pub fn spec_input(
     // Assumption names cannot clash with guarantees: property ids are unique.
     formulas.extend(props.assumptions.iter().map(|p| formula(p, p.id.clone())));
     if !errors.is_empty() {
-        return Err(errors.join("\n"));
+        return Err(Diagnostics(errors));
     }
     Ok(SpecInput {
         unit: unit_ns.map(|ns| (codegen::duration::format(ns), origin(1, 1))),
@@ -188,8 +193,8 @@ pub fn spec_input(
 
 impl PropertySet {
     /// Compiles `props` and resolves its ports against `model`. Every error names the
-    /// property file's line and column.
-    pub fn new(props: &PropertyFile, model: &CompiledModel) -> Result<PropertySet, String> {
+    /// property file's line and column; warnings are kept in [`PropertySet::warnings`].
+    pub fn new(props: &PropertyFile, model: &CompiledModel) -> Result<PropertySet, Diagnostics> {
         Self::with_unit(props, model, None)
     }
 
@@ -200,29 +205,34 @@ impl PropertySet {
         props: &PropertyFile,
         model: &CompiledModel,
         unit_ns: Option<u64>,
-    ) -> Result<PropertySet, String> {
+    ) -> Result<PropertySet, Diagnostics> {
         let file = props.path.display().to_string();
         let mut errors = Vec::new();
+        let mut warnings = Diagnostics::new();
         let input = spec_input(props, unit_ns, |p, param, written, declared| {
-            widened(model, p, param, (written, declared), &file)
+            widened(model, p, param, (written, declared), &file, &mut warnings)
         })?;
-        let compiled = codegen::compile_input(&input).map_err(|d| d.to_string())?;
-        if !compiled.warnings().is_empty() {
-            eprint!("{}", compiled.warnings());
-        }
+        let compiled = codegen::compile_input(&input)?;
+        warnings.extend(compiled.warnings().clone());
 
         let mut by_event = vec![Vec::new(); model.event_count()];
         for p in &props.ports {
-            let here = format!("{file}:{}:{}: port `{}`", p.at.line, p.at.column, p.id);
+            let here = |message: String| {
+                Diagnostic::error(
+                    file.as_str(),
+                    (p.at.line, p.at.column),
+                    format!("port `{}`: {message}", p.id),
+                )
+            };
             let Some(event) = model.event_id(&p.event) else {
-                errors.push(format!("{here}: the model sends no event `{}`", p.event));
+                errors.push(here(format!("the model sends no event `{}`", p.event)));
                 continue;
             };
             let origin = match model.machine_id(&p.origin) {
                 Some(m) => Some(m),
                 None if p.origin == ANY => None,
                 None => {
-                    errors.push(format!("{here}: no machine `{}` in the model", p.origin));
+                    errors.push(here(format!("no machine `{}` in the model", p.origin)));
                     continue;
                 }
             };
@@ -231,7 +241,7 @@ impl PropertySet {
                 None if p.target == "NONE" => Some(None),
                 None if p.target == ANY => None,
                 None => {
-                    errors.push(format!("{here}: no machine `{}` in the model", p.target));
+                    errors.push(here(format!("no machine `{}` in the model", p.target)));
                     continue;
                 }
             };
@@ -253,7 +263,7 @@ impl PropertySet {
                         length: *length,
                     },
                     None => {
-                        errors.push(format!("{here}: {}", missing_param(model, event, param)));
+                        errors.push(here(missing_param(model, event, param)));
                         continue;
                     }
                 },
@@ -266,14 +276,14 @@ impl PropertySet {
                         length: false,
                     },
                     None => {
-                        errors.push(format!("{here}: {}", missing_param(model, event, param)));
+                        errors.push(here(missing_param(model, event, param)));
                         continue;
                     }
                 },
             };
             let var = compiled
                 .var_index(&p.id)
-                .ok_or_else(|| format!("{here}: not compiled"))?;
+                .ok_or_else(|| here("not compiled".to_owned()))?;
             by_event[event.0 as usize].push(Port {
                 origin,
                 target,
@@ -282,7 +292,7 @@ impl PropertySet {
             });
         }
         if !errors.is_empty() {
-            return Err(errors.join("\n"));
+            return Err(Diagnostics(errors));
         }
         let table = model.strings();
         let strings = (0..table.len() as u32)
@@ -302,7 +312,15 @@ impl PropertySet {
             compiled,
             by_event,
             strings,
+            warnings,
         })
+    }
+
+    /// What compiling the file found questionable without refusing it (an integer port
+    /// read as a float, operators SCAN groups differently): the caller decides how to
+    /// print them.
+    pub fn warnings(&self) -> &Diagnostics {
+        &self.warnings
     }
 
     /// The guarantees' ids, in file order (one verdict each).
@@ -343,11 +361,22 @@ pub struct Judge<'a> {
     raised: Vec<usize>,
 }
 
+/// The monitor refused the program codegen compiled: a bug, not bad input.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct JudgeError(pub monitor_core::TableError);
+
+impl std::fmt::Display for JudgeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "internal: compiled program rejected: {}", self.0)
+    }
+}
+
+impl std::error::Error for JudgeError {}
+
 impl<'a> Judge<'a> {
     /// A judge for `set`, before the run's initial point.
-    pub fn new(set: &'a PropertySet) -> Result<Judge<'a>, String> {
-        let monitor = Monitor::try_new_planned(set.compiled.program())
-            .map_err(|e| format!("internal: compiled program rejected: {e}"))?;
+    pub fn new(set: &'a PropertySet) -> Result<Judge<'a>, JudgeError> {
+        let monitor = Monitor::try_new_planned(set.compiled.program()).map_err(JudgeError)?;
         let vars = monitor.program().vars;
         let mut vals = vec![Value::Bool(false); vars.len()];
         valuation::init(vars, &mut vals);

@@ -30,8 +30,7 @@ pub(super) fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
     let mut studies = Vec::new();
     let stop = interrupt_flag();
     for bt in args.input.semantics()? {
-        let loaded =
-            crate::verify::load::load(&args.input.options_with(bt)?).map_err(CliError::Input)?;
+        let loaded = crate::cli::load_model(&args.input.options_with(bt)?)?;
         let rule = rule_config(args);
         let run_cfg = run_config(args, &loaded)?;
         let study_cfg = StudyConfig {
