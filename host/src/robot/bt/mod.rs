@@ -35,9 +35,9 @@
 mod blackboard;
 mod btcpp;
 mod btcpp4;
-mod btcpp4_time;
 mod btcpp4_conds;
 mod btcpp4_script;
+mod btcpp4_time;
 mod build;
 mod control;
 mod decorators;
