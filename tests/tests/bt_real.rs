@@ -539,6 +539,55 @@ fn where_as2fm_and_btcpp_differ() {
     }
 }
 
+/// The script language's operators where a reading of the grammar could go either way,
+/// each in a one-`Script` tree: the entry `x` the real library leaves, against the
+/// oracle's (`&&` and `||` on one level, read left to right; `? :` true for any number
+/// but 0; chained comparisons; `!` and unary `-` on booleans).
+#[test]
+fn script_operators_agree_with_the_library() {
+    const SCRIPTS: [&str; 12] = [
+        "x:= true || false && false",
+        "x:= false && true || true",
+        "x:= true && false || true && false",
+        "x:= 1 < 2 || 3 < 2 && false",
+        "x:= 2 ? 5 : 7",
+        "x:= -1 ? 5 : 7",
+        "x:= 0 ? 5 : 7",
+        "x:= 1 < 2 ? 3 : 4",
+        "x:= 1 < 3 < 2",
+        "x:= 3 > 2 == true",
+        "x:= -true + 2 * 3",
+        "x:= !0 && !false",
+    ];
+    let Some(mut real) = harness() else { return };
+    for code in SCRIPTS {
+        let xml = doc(&format!(
+            "<Script code=\"{}\"/>",
+            code.replace('&', "&amp;")
+                .replace('<', "&lt;")
+                .replace('>', "&gt;")
+        ));
+        let s = Scripts::new();
+        let (t, want) =
+            expect(&xml, &s, 1, TickMode::Once).unwrap_or_else(|e| panic!("{code}: {e}"));
+        assert!(want.vars.contains_key("x"), "{code}: the oracle set no x");
+        let a = real
+            .run(&[Request {
+                xml: xml.clone(),
+                scripts: s.clone(),
+                ticks: 1,
+                mode: TickMode::Once,
+                budget: BUDGET,
+                read: vec!["x".to_string()],
+            }])
+            .expect("harness");
+        let got = real::outcome(t.as_ref(), &a[0]).expect("outcome");
+        if let Some(d) = differ(&want, &got) {
+            panic!("{code}: {d}");
+        }
+    }
+}
+
 /// The executor period of [`timed_nodes_agree_with_the_real_library`], in the real
 /// library's wall-clock milliseconds; the oracle runs the same trees at its default
 /// 100 ms with every duration scaled by 100/60.

@@ -11,7 +11,9 @@
 //!   is the last statement's;
 //! - a statement is an assignment `name := e` (creates the entry), `name = e` (the entry
 //!   must exist: "doesn't exist, yet"), `name += e`, `-=`, `*=`, or an expression;
-//! - precedence, loosest first: `? :`, `||`, `&&`, comparisons (`== != < <= > >=`; a
+//! - precedence, loosest first: `? :` (not chained; its condition is true for any number
+//!   but 0), `&&` and `||` (one level, left to right: `true || false && false` is false),
+//!   comparisons (`== != < <= > >=`; a
 //!   chain `a < b < c` means `a < b && b < c`), `+ -`, `*`, unary `- !`;
 //! - `true`/`false` are the numbers 1 and 0 in arithmetic (`-true` is -1, `a:=1; a+=true`
 //!   gives 2); comparisons give a boolean; `!x` is `x == 0` for any number;
@@ -201,22 +203,23 @@ impl P {
         Ok(c)
     }
 
+    /// `&&` and `||`: one level, read left to right (BT.CPP 4's grammar has them in one
+    /// left-associative infix operation, so `true || false && false` is
+    /// `(true || false) && false`, false; checked against 4.8.2 by
+    /// `script_operators_agree_with_the_library` in `tests/tests/bt_real.rs`).
     fn or(&mut self) -> Result<Expr, String> {
-        let mut a = self.and()?;
-        while self.eat("||") {
-            let b = self.and()?;
-            a = Expr::Logic(false, Box::new(a), Box::new(b));
-        }
-        Ok(a)
-    }
-
-    fn and(&mut self) -> Result<Expr, String> {
         let mut a = self.cmp()?;
-        while self.eat("&&") {
+        loop {
+            let and = if self.eat("&&") {
+                true
+            } else if self.eat("||") {
+                false
+            } else {
+                return Ok(a);
+            };
             let b = self.cmp()?;
-            a = Expr::Logic(true, Box::new(a), Box::new(b));
+            a = Expr::Logic(and, Box::new(a), Box::new(b));
         }
-        Ok(a)
     }
 
     fn cmp(&mut self) -> Result<Expr, String> {
@@ -394,8 +397,11 @@ impl Expr {
                     a | b
                 }
             }
+            // The condition of `c ? a : b` is true for any number but 0 (BT.CPP 4's
+            // `ExprIf::evaluate` compares it with 0; unlike a node's condition it is not
+            // cast to bool): `2 ? 5 : 7` and `-1 ? 5 : 7` give 5 in 4.8.2.
             Expr::Ite(c, a, b) => {
-                if truth(c.eval(env)?)? {
+                if c.eval(env)? != 0 {
                     a.eval(env)?
                 } else {
                     b.eval(env)?
@@ -481,6 +487,11 @@ mod tests {
         assert_eq!(run("a:=1; b:=(a<2)+(a>0)").unwrap().0, 2);
         assert_eq!(run("a:=1; a+=2; b:=a; b-=5; c:=b; c*=3").unwrap().0, -6);
         assert_eq!(run("a:= true ? 1 : 2").unwrap().0, 1);
+        assert_eq!(run("a:= true || false && false").unwrap().0, 0);
+        assert_eq!(run("a:= false && true || true").unwrap().0, 1);
+        assert_eq!(run("a:= 2 ? 5 : 7").unwrap().0, 5);
+        assert_eq!(run("a:= -1 ? 5 : 7").unwrap().0, 5);
+        assert_eq!(run("a:= 0 ? 5 : 7").unwrap().0, 7);
         assert!(matches!(run("a:=3 && 1"), Err(Fault::Throws(t)) if t.contains("Logic operators")));
         assert!(matches!(run("a:=x"), Err(Fault::Throws(t)) if t.contains("Variable not found")));
         assert!(matches!(run("b=2"), Err(Fault::Throws(t)) if t.contains("doesn't exist")));
