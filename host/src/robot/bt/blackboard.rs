@@ -692,15 +692,7 @@ fn check(ctx: &Ctx, cond: &str, reads: bool, mismatch: u8) -> Element {
                 .with_child(on_mismatch),
         );
     }
-    m.push(
-        b.state_entry("halting_child", ctx.halt_child_body(0))
-            .with_child(b.tr(
-                Some(&ctx.child_halt_resp(0)),
-                None,
-                Some("wait_for_tick"),
-                vec![ctx.respond_halted()],
-            )),
-    );
+    m.push(ctx.halting_child_state());
     let mut t = b.state_entry("tick_child", vec![ctx.tick_child(0)]);
     for s in [SUCCESS, FAILURE, RUNNING] {
         let mut body = vec![ctx.respond(s)];

@@ -317,15 +317,7 @@ fn decorator_halt(ctx: &Ctx, w: &mut Element, m: &mut Element, also: Vec<Element
         at_once,
     ));
     w.push(b.tr(Some(&ctx.halt_ev()), None, Some("halting_child"), also));
-    m.push(
-        b.state_entry("halting_child", ctx.halt_child_body(0))
-            .with_child(b.tr(
-                Some(&ctx.child_halt_resp(0)),
-                None,
-                Some("wait_for_tick"),
-                vec![ctx.respond_halted()],
-            )),
-    );
+    m.push(ctx.halting_child_state());
 }
 
 /// `tick_child`: the child's answer; a finished one runs `finish` (the node's own

@@ -144,6 +144,19 @@ impl Ctx {
                 .assign(&v, if status == RUNNING { "true" } else { "false" }),
         )
     }
+    /// The `halting_child` state of a one-child node: halts child 0 (only if it runs),
+    /// and when the child has answered, answers the parent's halt and goes back to
+    /// `wait_for_tick`.
+    pub(crate) fn halting_child_state(&self) -> Element {
+        let b = &self.b;
+        b.state_entry("halting_child", self.halt_child_body(0))
+            .with_child(b.tr(
+                Some(&self.child_halt_resp(0)),
+                None,
+                Some("wait_for_tick"),
+                vec![self.respond_halted()],
+            ))
+    }
     /// Halts child `i`, forgetting that it ran.
     pub fn halt_child_body(&self, i: usize) -> Vec<Element> {
         let mut v: Vec<Element> = self
