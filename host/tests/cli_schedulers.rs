@@ -8,6 +8,7 @@ use common::hindsight;
 
 const RACE: &str = "host/tests/data/schedulers/race";
 const ALTERNATE: &str = "host/tests/data/schedulers/alternate";
+const STARVE: &str = "host/tests/data/schedulers/starve";
 
 fn json(args: &[&str]) -> serde_json::Value {
     let mut all = args.to_vec();
@@ -158,20 +159,13 @@ fn bounds_are_the_same_on_one_and_two_threads() {
 }
 
 #[test]
-fn schedulers_refuse_shards_thresholds_and_bad_ids_with_a_reason() {
+fn schedulers_refuse_thresholds_stray_plans_and_bad_ids_with_a_reason() {
     for (args, needle) in [
         (
             vec![
-                "verify",
-                RACE,
-                "--schedulers",
-                "4",
-                "--runs",
-                "10",
-                "--shard",
-                "0/2",
+                "verify", RACE, "--runs", "10", "--shard", "0/2", "--plan", "p.json",
             ],
-            "--schedulers: not with --runs / --shard",
+            "--plan: the plan of a sharded scheduler study needs --schedulers",
         ),
         (
             vec!["verify", RACE, "--schedulers", "4", "--threshold", "0.5"],
@@ -191,4 +185,218 @@ fn schedulers_refuse_shards_thresholds_and_bad_ids_with_a_reason() {
         assert_eq!(code, 2, "{args:?}: {err}");
         assert!(err.contains(needle), "{args:?}: {err}");
     }
+}
+
+/// Runs every stage of `verify RACE --schedulers 8 --selection-runs 4 --runs 200` (with
+/// `extra`) as `k` shards, merging each stage with `merge --next`, and returns the last
+/// merge's JSON and the stages run.
+fn sharded(dir: &std::path::Path, k: u64, extra: &[&str]) -> (serde_json::Value, u32) {
+    sharded_study(dir, RACE, k, extra)
+}
+
+fn sharded_study(
+    dir: &std::path::Path,
+    model: &str,
+    k: u64,
+    extra: &[&str],
+) -> (serde_json::Value, u32) {
+    let plan = dir.join(format!("plan-{k}.json"));
+    let plan = plan.to_str().unwrap().to_string();
+    for stage in 0..20u32 {
+        let mut parts = Vec::new();
+        for i in 0..k {
+            let part = dir.join(format!("k{k}-s{stage}-{i}.json"));
+            let part = part.to_str().unwrap().to_string();
+            let shard = format!("{i}/{k}");
+            let mut args = vec![
+                "verify",
+                model,
+                "--schedulers",
+                "8",
+                "--selection-runs",
+                "4",
+                "--runs",
+                "200",
+                "--shard",
+                &shard,
+                "--partial",
+                &part,
+            ];
+            args.extend_from_slice(extra);
+            if stage > 0 {
+                args.extend(["--plan", plan.as_str()]);
+            }
+            let (code, _, err) = hindsight(&args);
+            assert_eq!(code, 0, "stage {stage} shard {shard}: {err}");
+            parts.push(part);
+        }
+        let mut args: Vec<&str> = vec!["merge"];
+        args.extend(parts.iter().map(String::as_str));
+        args.extend(["--next", plan.as_str(), "--json"]);
+        let (code, out, err) = hindsight(&args);
+        assert_eq!(code, 0, "merge of stage {stage}: {err}");
+        if !out.trim().is_empty() {
+            return (serde_json::from_str(&out).expect("json"), stage + 1);
+        }
+        assert!(err.contains("--plan"), "{err}");
+    }
+    panic!("more than 20 stages");
+}
+
+#[test]
+fn a_sharded_scheduler_study_merges_to_the_unsharded_json() {
+    let dir = std::env::temp_dir().join(format!("hindsight-sched-shards-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let whole = json(&[
+        "verify",
+        RACE,
+        "--schedulers",
+        "8",
+        "--selection-runs",
+        "4",
+        "--runs",
+        "200",
+    ]);
+    let s = &prop(&whole, "a_wins")["schedulers"];
+    assert_eq!(s["min"]["probability"], 0.0, "{whole}");
+    assert_eq!(s["max"]["probability"], 1.0, "{whole}");
+    assert_eq!(s["min"]["runs"], 200);
+    assert_eq!(s["order_sensitive"], true);
+    assert_eq!(prop(&whole, "a_wins")["runs"], 200);
+    let (three, stages) = sharded(&dir, 3, &[]);
+    // At least one selection round (8 schedulers, 2 candidates per side), then the
+    // confirmation.
+    assert!(stages >= 2, "{stages} stages");
+    assert_eq!(three, whole);
+    let (one, _) = sharded(&dir, 1, &["--threads", "1"]);
+    assert_eq!(one, whole);
+    // A part of another stage is refused, naming the shard.
+    let stale = dir.join("k3-s0-1.json");
+    let fresh = dir.join("k3-s1-0.json");
+    let (code, _, err) = hindsight(&["merge", fresh.to_str().unwrap(), stale.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("another stage"), "{err}");
+    // A plan given to another study (another seed) is refused.
+    let plan = dir.join("plan-3.json");
+    let (code, _, err) = hindsight(&[
+        "verify",
+        RACE,
+        "--schedulers",
+        "8",
+        "--selection-runs",
+        "4",
+        "--runs",
+        "200",
+        "--seed",
+        "9",
+        "--shard",
+        "0/2",
+        "--plan",
+        plan.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`seed` differs"), "{err}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+const STARVING: [&str; 8] = [
+    "--schedulers",
+    "16",
+    "--selection-runs",
+    "4",
+    "--max-instant-steps",
+    "1000",
+    "--max-time",
+    "3",
+];
+
+#[test]
+fn unfair_schedulers_are_left_out_and_counted_unless_kept() {
+    let mut args = vec!["verify", STARVE];
+    args.extend(STARVING);
+    let fair = json(&args);
+    let w = prop(&fair, "written");
+    assert_eq!(w["probability"], 1.0, "uniform: {fair}");
+    let s = &w["schedulers"];
+    // Every fair scheduler lets cell take the write.
+    assert_eq!(s["min"]["probability"], 1.0, "{s}");
+    assert_eq!(s["max"]["probability"], 1.0, "{s}");
+    assert_eq!(s["order_sensitive"], false);
+    let left = s["left_out"].as_u64().expect("some left out");
+    assert!(left > 0 && left < 16, "{left} left out");
+    let first = &s["left_out_first"][0];
+    assert!(
+        first["reason"].as_str().unwrap().contains(
+            "machine `spin` in state `busy` keeps the model busy without letting time advance"
+        ),
+        "{first}"
+    );
+    // The run named replays the block: under that scheduler the study fails at it.
+    let (code, _, err) = hindsight(&[
+        "verify",
+        STARVE,
+        "--max-instant-steps",
+        "1000",
+        "--max-time",
+        "3",
+        "--scheduler",
+        first["scheduler"].as_str().unwrap(),
+    ]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("without letting time advance"), "{err}");
+    // Kept, an unfair scheduler's blocked run is judged as it stands: cell never wrote,
+    // a minimum no fair executor gives.
+    args.push("--keep-unfair");
+    let kept = json(&args);
+    let s = &prop(&kept, "written")["schedulers"];
+    assert_eq!(s["min"]["probability"], 0.0, "{s}");
+    assert_eq!(s["max"]["probability"], 1.0, "{s}");
+    assert_eq!(s["order_sensitive"], true);
+    assert!(s.get("left_out").is_none(), "{s}");
+    // The table says how many were left out and why.
+    let mut table = vec!["verify", STARVE];
+    table.extend(STARVING);
+    let (code, out, err) = hindsight(&table);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains(&format!(
+            "left out as unfair: {left} of 16 sampled schedulers"
+        )),
+        "{out}"
+    );
+}
+
+#[test]
+fn a_sharded_study_leaves_the_same_unfair_schedulers_out() {
+    let dir = std::env::temp_dir().join(format!("hindsight-sched-unfair-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut args = vec!["verify", STARVE];
+    args.extend(STARVING);
+    args.extend(["--runs", "200"]);
+    let whole = json(&args);
+    let s = &prop(&whole, "written")["schedulers"];
+    assert_eq!(s["min"]["probability"], 1.0, "{s}");
+    assert!(s["left_out"].as_u64().unwrap() > 0, "{s}");
+    let (two, _) = sharded_study(
+        &dir,
+        STARVE,
+        2,
+        &["--max-instant-steps", "1000", "--max-time", "3"],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    // sharded_study gives --schedulers 8; compare with the same study unsharded.
+    let mut eight = vec!["verify", STARVE];
+    eight.extend([
+        "--schedulers",
+        "8",
+        "--selection-runs",
+        "4",
+        "--max-instant-steps",
+        "1000",
+        "--max-time",
+        "3",
+        "--runs",
+        "200",
+    ]);
+    assert_eq!(two, json(&eight));
 }

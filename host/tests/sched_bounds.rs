@@ -17,7 +17,7 @@ use hindsight::smc::stats::{RuleConfig, RuleKind};
 use hindsight::smc::StudyConfig;
 use hindsight::verify::load::{load, LoadOptions, Loaded};
 use hindsight::verify::schedulers::{bounds, SchedulerBounds, SchedulerOptions};
-use hindsight::verify::study::{study, Runner};
+use hindsight::verify::study::{study, Runner, Unfair};
 
 /// A model's choices as a tree: the explorer's input.
 enum Tree {
@@ -153,6 +153,7 @@ fn sampled(
         count,
         memory,
         selection_runs: 8,
+        unfair: Unfair::LeaveOut,
     };
     let b = bounds(
         &l.model,

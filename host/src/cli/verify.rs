@@ -9,7 +9,7 @@ mod both;
 mod schedulers;
 mod shard;
 
-pub use schedulers::{parse_scheduler, MemoryArg};
+pub use schedulers::{parse_scheduler, BadScheduler, MemoryArg};
 pub use shard::{merge, MergeArgs};
 use shard::{merged_report, run_shard_cli};
 
@@ -182,6 +182,24 @@ pub struct VerifyArgs {
     /// rounds give the survivors more).
     #[arg(long, value_name = "R", default_value_t = 16, value_parser = super::run_count)]
     pub selection_runs: u64,
+    /// With --schedulers: keep a sampled scheduler whose run blocks time (an instant of
+    /// --max-instant-steps steps) and judge that run as it stands, instead of leaving the
+    /// scheduler out as unfair (see docs/SEMANTICS.md, "Fair schedulers").
+    #[arg(long, requires = "schedulers")]
+    pub keep_unfair: bool,
+    /// Steps one instant may take before the run is a loop that never lets time advance:
+    /// a model failure under the uniform scheduler, an unfair run under a sampled one.
+    #[arg(
+        long,
+        value_name = "N",
+        default_value_t = 1_000_000,
+        value_parser = clap::value_parser!(u64).range(1..)
+    )]
+    pub max_instant_steps: u64,
+    /// The plan of a sharded scheduler study's next stage, as `hindsight merge --next`
+    /// wrote it (with --schedulers N --runs R --shard I/K; without it, stage 0).
+    #[arg(long, value_name = "FILE", requires = "shard")]
+    pub plan: Option<PathBuf>,
     /// Run every run under this scheduler: `uniform` (the default) or a witness that
     /// --schedulers printed (`memoryless:ID`, `history:ID`).
     #[arg(long, value_name = "ID", value_parser = parse_scheduler)]
@@ -495,6 +513,7 @@ fn run_config(args: &VerifyArgs, loaded: &Loaded) -> Result<RunConfig, CliError>
             .max_time(args.max_time.as_deref())
             .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
         max_steps: args.max_steps,
+        max_steps_per_instant: args.max_instant_steps,
         events: loaded.events,
         scheduler: args.scheduler.unwrap_or_default(),
         ..RunConfig::default()
@@ -537,6 +556,19 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         )
         .collect::<Vec<_>>()
     };
+    if let (Some(_), Some(runs)) = (args.schedulers, args.runs) {
+        // A fixed-size scheduler study: one shard of one stage, or every stage here.
+        let Some(mut report) = schedulers::run_fixed(args, &loaded, &run_cfg, &study_cfg, runs)?
+        else {
+            return Ok(());
+        };
+        report.model = args.input.model.display().to_string();
+        report.properties_file = props_path.display().to_string();
+        if let Some(path) = &args.report {
+            super::report::from_verify(path, &report, &loaded, settings(), &[])?;
+        }
+        return print_report(&report, args.json);
+    }
     if let Some(runs) = args.runs {
         // A fixed-size study: one shard of it, or all of it (shard 0/1) reported as
         // `merge` reports the shards of one, so both give the same numbers.

@@ -4,5 +4,6 @@ pub mod load;
 pub mod observe;
 pub mod record;
 pub mod result;
+pub mod sched_fixed;
 pub mod schedulers;
 pub mod study;

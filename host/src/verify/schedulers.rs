@@ -52,7 +52,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use serde::{Deserialize, Serialize};
 
 use super::observe::PropertySet;
-use super::study::Runner;
+use super::study::{Runner, Unfair};
 use crate::sim::{
     mix, CompiledModel, EventId, EventSemantics, MachineId, Memory, PutBack, RunConfig, Sampled,
     Scheduler, TransitionChoice,
@@ -65,8 +65,8 @@ pub const CANDIDATES: usize = 2;
 
 /// Salts of the seeds derived from the study seed.
 const IDS: u64 = 0x5c4e_d01e_0000_0001;
-const SELECT: u64 = 0x5c4e_d01e_0000_0002;
-const ESTIMATE: u64 = 0x5c4e_d01e_0000_0003;
+pub(crate) const SELECT: u64 = 0x5c4e_d01e_0000_0002;
+pub(crate) const ESTIMATE: u64 = 0x5c4e_d01e_0000_0003;
 
 /// What `--schedulers` asks for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -77,6 +77,9 @@ pub struct SchedulerOptions {
     pub memory: Memory,
     /// Runs per scheduler in the first selection round (at least 1).
     pub selection_runs: u64,
+    /// What a run that blocks time under a sampled scheduler does: leave the scheduler
+    /// out (the default of `verify`), keep the run, or fail the study.
+    pub unfair: Unfair,
 }
 
 /// Scheduler `i` of a study with `seed`.
@@ -121,6 +124,33 @@ pub struct SchedulerBounds {
     /// one kind of choice, or one machine's or event's position, put back to uniform.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub sources: Vec<Source>,
+    /// Sampled schedulers left out as unfair (a run of theirs blocked time), the same
+    /// for every property: the bounds are over the others.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub left_out: u64,
+    /// The first of them (up to [`LEFT_OUT_SHOWN`]), in the order they were met.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub left_out_first: Vec<LeftOut>,
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
+}
+
+/// Left-out schedulers listed by name in the report.
+pub const LEFT_OUT_SHOWN: usize = 5;
+
+/// A sampled scheduler left out of the bounds as unfair.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LeftOut {
+    /// The scheduler.
+    pub scheduler: String,
+    /// `selection` or `estimate`: where its unfair run was met.
+    pub phase: String,
+    /// The run (index in that phase's streams): `verify --scheduler ID` replays it.
+    pub run: u64,
+    /// Why: the machine and state that kept the instant going.
+    pub reason: String,
 }
 
 /// An estimate of a source and its interval.
@@ -245,79 +275,87 @@ pub enum Stage<'a> {
     },
 }
 
-/// Bounds over `opts.count` sampled schedulers, one per guarantee of `set`, or `None` when
-/// `stop` was set before the end. `study_cfg` gives the seed and threads (its `max_runs`
-/// caps each fresh estimate), `rule` the stopping rule and the confidence split over the
-/// candidates.
-#[allow(clippy::too_many_arguments)]
-pub fn bounds(
-    model: &CompiledModel,
-    set: &PropertySet,
-    run_cfg: &RunConfig,
-    study_cfg: &StudyConfig,
-    rule: &RuleConfig,
-    opts: &SchedulerOptions,
-    stop: &AtomicBool,
-    progress: &mut dyn FnMut(Stage<'_>),
-) -> Result<Option<Vec<SchedulerBounds>>, String> {
-    let props = set.guarantee_names().len();
-    let n = opts.count.max(1) as usize;
-    let seed = study_cfg.seed;
-    let scheds: Vec<Scheduler> = (0..n as u64)
-        .map(|i| Scheduler::Sampled(sampled(seed, i, opts.memory)))
-        .collect();
-    let runner = Runner::new(model, set, run_cfg);
-    let mut quiet = |_: &crate::smc::Progress<'_>| {};
+/// The selection of candidates by successive halving (step 2 of the module doc), as
+/// state advanced one round at a time, so that a round's runs can be run in one process
+/// ([`bounds`]) or as the shards of a stage ([`super::sched_fixed`]).
+///
+/// Rounds run only while some side holds more than [`CANDIDATES`] schedulers: the
+/// counts of a round after which nothing is ranked would choose nothing.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Selection {
+    /// Runs of one round in all, `N * R`.
+    budget: u64,
+    /// Runs each scheduler has after the first round, `R`.
+    first: u64,
+    /// Per scheduler, its counts per property so far.
+    counts: Vec<Vec<PropertyCounts>>,
+    /// Per scheduler, the selection runs it had so far (runs `0..done`).
+    done: Vec<u64>,
+    /// Per property, the min and max sides still in the running.
+    pub sides: Vec<[Vec<usize>; 2]>,
+    /// The schedulers on some side, in index order.
+    pub alive: Vec<usize>,
+    /// Runs each of them has after the current round.
+    pub per: u64,
+}
 
-    // Selection: successive halving per property and side.
-    let select_cfg = StudyConfig {
-        seed: mix(seed, SELECT),
-        keep_failing: 0,
-        max_runs: None,
-        ..study_cfg.clone()
-    };
-    let mut counts = vec![vec![PropertyCounts::default(); props]; n];
-    let mut done = vec![0u64; n];
-    let all: Vec<usize> = (0..n).collect();
-    // Per property: (min side, max side).
-    let mut sides: Vec<[Vec<usize>; 2]> = vec![[all.clone(), all.clone()]; props];
-    let budget = (n as u64).saturating_mul(opts.selection_runs.max(1));
-    let mut alive = all;
-    loop {
-        let per = (budget / alive.len().max(1) as u64).max(opts.selection_runs.max(1));
-        progress(Stage::Round {
-            alive: alive.len(),
-            runs: per,
-        });
-        for &i in &alive {
-            if stop.load(Ordering::Relaxed) {
-                return Ok(None);
-            }
-            if done[i] >= per {
-                continue;
-            }
-            let got = run_range(
-                &select_cfg,
-                done[i]..per,
-                props,
-                |k, rng| runner.run_under(k, rng, scheds[i]),
-                &mut quiet,
-            );
-            for (c, g) in counts[i].iter_mut().zip(&got.properties) {
-                c.add(g);
-            }
-            done[i] = per;
-            if got.runs.failed > 0 {
-                runner.finish()?;
-                return Err("a selection run failed without a message".into());
-            }
+impl Selection {
+    /// The selection of `n` schedulers over `props` properties, `selection_runs` runs
+    /// each in the first round.
+    pub fn new(n: usize, props: usize, selection_runs: u64) -> Selection {
+        let all: Vec<usize> = (0..n).collect();
+        let first = selection_runs.max(1);
+        let budget = (n as u64).saturating_mul(first);
+        Selection {
+            budget,
+            first,
+            counts: vec![vec![PropertyCounts::default(); props]; n],
+            done: vec![0; n],
+            sides: vec![[all.clone(), all.clone()]; props],
+            per: (budget / n.max(1) as u64).max(first),
+            alive: all,
         }
-        let size = sides.first().map_or(0, |s| s[0].len());
-        if size <= CANDIDATES {
-            break;
+    }
+
+    /// Whether every side is down to [`CANDIDATES`] (no round left to run).
+    pub fn finished(&self) -> bool {
+        self.sides
+            .iter()
+            .flatten()
+            .all(|side| side.len() <= CANDIDATES)
+    }
+
+    /// Leaves scheduler `i` out (unfair): off every side, no more runs.
+    pub fn leave_out(&mut self, i: usize) {
+        for side in self.sides.iter_mut().flatten() {
+            side.retain(|&j| j != i);
         }
-        let keep = (size / 2).max(CANDIDATES);
-        for (p, [low, high]) in sides.iter_mut().enumerate() {
+        self.alive.retain(|&j| j != i);
+    }
+
+    /// The runs of the current round: per scheduler that needs more, its selection run
+    /// indices (streams of the selection seed).
+    pub fn round(&self) -> Vec<(usize, std::ops::Range<u64>)> {
+        self.alive
+            .iter()
+            .filter(|&&i| self.done[i] < self.per)
+            .map(|&i| (i, self.done[i]..self.per))
+            .collect()
+    }
+
+    /// Adds the counts of scheduler `i`'s runs of the current round.
+    pub fn absorb(&mut self, i: usize, got: &[PropertyCounts]) {
+        for (c, g) in self.counts[i].iter_mut().zip(got) {
+            c.add(g);
+        }
+        self.done[i] = self.per;
+    }
+
+    /// Ends the round: per property, keeps the lower and the upper half of each side
+    /// (at least [`CANDIDATES`]) by the counts so far, ties by index.
+    pub fn halve(&mut self) {
+        let counts = &self.counts;
+        for (p, [low, high]) in self.sides.iter_mut().enumerate() {
             let rate = |i: &usize| {
                 let c = &counts[*i][p];
                 match c.judged() {
@@ -337,28 +375,197 @@ pub fn bounds(
                 let (x, y) = (rate(a).unwrap_or(-1.0), rate(b).unwrap_or(-1.0));
                 y.total_cmp(&x).then(a.cmp(b))
             });
-            low.truncate(keep);
-            high.truncate(keep);
+            // Sides have one size unless schedulers were left out.
+            low.truncate((low.len() / 2).max(CANDIDATES));
+            high.truncate((high.len() / 2).max(CANDIDATES));
         }
-        let mut next: Vec<usize> = sides
+        let mut next: Vec<usize> = self
+            .sides
             .iter()
             .flat_map(|s| s.iter().flatten().copied())
             .collect();
         next.sort_unstable();
         next.dedup();
-        alive = next;
+        self.alive = next;
+        self.per = (self.budget / self.alive.len().max(1) as u64).max(self.first);
     }
+}
+
+/// Per property, the min and max witnesses among its sides' candidates: the candidate
+/// with the lowest (highest) fresh estimate `value(i, p)`, ties by index, unjudged ones
+/// last.
+pub fn witnesses(
+    sides: &[[Vec<usize>; 2]],
+    value: impl Fn(usize, usize) -> Option<f64>,
+) -> Vec<[usize; 2]> {
+    sides
+        .iter()
+        .enumerate()
+        .map(|(p, [low, high])| {
+            let lo = *low
+                .iter()
+                .min_by(|a, b| {
+                    let (x, y) = (
+                        value(**a, p).unwrap_or(f64::INFINITY),
+                        value(**b, p).unwrap_or(f64::INFINITY),
+                    );
+                    x.total_cmp(&y).then(a.cmp(b))
+                })
+                .expect("at least one candidate");
+            let hi = *high
+                .iter()
+                .min_by(|a, b| {
+                    let (x, y) = (value(**a, p).unwrap_or(-1.0), value(**b, p).unwrap_or(-1.0));
+                    y.total_cmp(&x).then(a.cmp(b))
+                })
+                .expect("at least one candidate");
+            [lo, hi]
+        })
+        .collect()
+}
+
+/// The intervals each property's confidence is split over: the most candidates on a
+/// property's two sides (`2 K`; with schedulers left out a property's sides may hold
+/// fewer, and the most keeps the split valid for each).
+pub fn split_count(sides: &[[Vec<usize>; 2]]) -> usize {
+    sides
+        .iter()
+        .map(|[low, high]| low.len() + high.len())
+        .max()
+        .unwrap_or(2)
+        .max(1)
+}
+
+/// The confidence of each fresh estimate: `1 - (1 - c) / m` over `m` intervals
+/// ([`split_count`]; Bonferroni's inequality).
+pub fn split_rule(rule: &RuleConfig, m: usize) -> RuleConfig {
+    RuleConfig {
+        confidence: 1.0 - (1.0 - rule.confidence) / m.max(1) as f64,
+        ..*rule
+    }
+}
+
+/// Why [`bounds`] failed.
+#[derive(Debug)]
+pub enum BoundsError {
+    /// The model failed during a run (its message).
+    Model(String),
+    /// A run of this phase failed and left no message.
+    Silent(&'static str),
+    /// The stopping rule is invalid.
+    Rule(crate::smc::stats::StatsError),
+    /// A fixed-size study's plan asked for its report before its last stage (the stage).
+    Unfinished(u32),
+    /// Every candidate of some property's side was left out as unfair.
+    AllUnfair {
+        /// Schedulers left out.
+        left_out: u64,
+        /// Sampled.
+        sampled: u64,
+    },
+}
+
+impl std::fmt::Display for BoundsError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BoundsError::Model(m) => write!(f, "{m}"),
+            BoundsError::Silent(what) => write!(f, "{what} failed without a message"),
+            BoundsError::Rule(e) => write!(f, "statistics: {e}"),
+            BoundsError::Unfinished(stage) => write!(
+                f,
+                "the scheduler study's plan is at stage {stage}, not finished: run its shards \
+                 with --plan and merge them"
+            ),
+            BoundsError::AllUnfair { left_out, sampled } => write!(
+                f,
+                "{left_out} of {sampled} sampled schedulers were left out as unfair (a run \
+                 blocked time), leaving no candidate on some side: sample more schedulers, \
+                 or keep them with --keep-unfair"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for BoundsError {}
+
+/// Bounds over `opts.count` sampled schedulers, one per guarantee of `set`, or `None` when
+/// `stop` was set before the end. `study_cfg` gives the seed and threads (its `max_runs`
+/// caps each fresh estimate), `rule` the stopping rule and the confidence split over the
+/// candidates.
+#[allow(clippy::too_many_arguments)]
+pub fn bounds(
+    model: &CompiledModel,
+    set: &PropertySet,
+    run_cfg: &RunConfig,
+    study_cfg: &StudyConfig,
+    rule: &RuleConfig,
+    opts: &SchedulerOptions,
+    stop: &AtomicBool,
+    progress: &mut dyn FnMut(Stage<'_>),
+) -> Result<Option<Vec<SchedulerBounds>>, BoundsError> {
+    let props = set.guarantee_names().len();
+    let n = opts.count.max(1) as usize;
+    let seed = study_cfg.seed;
+    let scheds: Vec<Scheduler> = (0..n as u64)
+        .map(|i| Scheduler::Sampled(sampled(seed, i, opts.memory)))
+        .collect();
+    let runner = Runner::new(model, set, run_cfg).with_unfair(opts.unfair);
+    let mut quiet = |_: &crate::smc::Progress<'_>| {};
+    let mut left_out: Vec<LeftOut> = Vec::new();
+    let mut leave_out = |i: usize, phase: &str, (run, reason): (u64, String)| {
+        left_out.push(LeftOut {
+            scheduler: scheds[i].to_string(),
+            phase: phase.to_string(),
+            run,
+            reason,
+        });
+    };
+
+    // Selection: successive halving per property and side.
+    let select_cfg = StudyConfig {
+        seed: mix(seed, SELECT),
+        keep_failing: 0,
+        max_runs: None,
+        ..study_cfg.clone()
+    };
+    let mut selection = Selection::new(n, props, opts.selection_runs);
+    while !selection.finished() {
+        progress(Stage::Round {
+            alive: selection.alive.len(),
+            runs: selection.per,
+        });
+        for (i, range) in selection.round() {
+            if stop.load(Ordering::Relaxed) {
+                return Ok(None);
+            }
+            let got = run_range(
+                &select_cfg,
+                range,
+                props,
+                |k, rng| runner.run_under(k, rng, scheds[i]),
+                &mut quiet,
+            );
+            if got.runs.failed > 0 {
+                if let Some(why) = runner.unfair_run(&scheds[i]) {
+                    leave_out(i, "selection", why);
+                    selection.leave_out(i);
+                    continue;
+                }
+                runner.finish().map_err(BoundsError::Model)?;
+                return Err(BoundsError::Silent("a selection run"));
+            }
+            selection.absorb(i, &got.properties);
+        }
+        selection.halve();
+    }
+    let (mut sides, alive) = (selection.sides, selection.alive);
 
     // Fresh estimates of the candidates, confidence split over each property's 2K.
-    let per_side = sides.first().map_or(1, |s| s[0].len().max(1));
-    let split = RuleConfig {
-        confidence: 1.0 - (1.0 - rule.confidence) / (2 * per_side) as f64,
-        ..*rule
-    };
+    let split = split_rule(rule, split_count(&sides));
     let rules = (0..props)
         .map(|_| split.build())
         .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| format!("statistics: {e}"))?;
+        .map_err(BoundsError::Rule)?;
     let estimate_cfg = StudyConfig {
         seed: mix(seed, ESTIMATE),
         keep_failing: 0,
@@ -379,8 +586,15 @@ pub fn bounds(
             stop,
         );
         if r.runs.failed > 0 {
-            runner.finish()?;
-            return Err("an estimate run failed without a message".into());
+            if let Some(why) = runner.unfair_run(&scheds[i]) {
+                leave_out(i, "estimate", why);
+                for side in sides.iter_mut().flatten() {
+                    side.retain(|&j| j != i);
+                }
+                continue;
+            }
+            runner.finish().map_err(BoundsError::Model)?;
+            return Err(BoundsError::Silent("an estimate run"));
         }
         if r.interrupted {
             return Ok(None);
@@ -398,27 +612,16 @@ pub fn bounds(
             successes: r.counts.successes,
         }
     };
-    let value = |i: &usize, p: usize| fresh[*i].as_ref().and_then(|r| r[p].estimate.estimate);
+    if sides.iter().flatten().any(|side| side.is_empty()) {
+        return Err(BoundsError::AllUnfair {
+            left_out: left_out.len() as u64,
+            sampled: n as u64,
+        });
+    }
+    let value = |i: usize, p: usize| fresh[i].as_ref().and_then(|r| r[p].estimate.estimate);
+    let witnesses = witnesses(&sides, value);
     let mut out = Vec::with_capacity(props);
-    let mut witnesses = Vec::with_capacity(props);
-    for (p, [low, high]) in sides.iter().enumerate() {
-        let lo = *low
-            .iter()
-            .min_by(|a, b| {
-                let (x, y) = (
-                    value(a, p).unwrap_or(f64::INFINITY),
-                    value(b, p).unwrap_or(f64::INFINITY),
-                );
-                x.total_cmp(&y).then(a.cmp(b))
-            })
-            .expect("at least one candidate");
-        let hi = *high
-            .iter()
-            .min_by(|a, b| {
-                let (x, y) = (value(a, p).unwrap_or(-1.0), value(b, p).unwrap_or(-1.0));
-                y.total_cmp(&x).then(a.cmp(b))
-            })
-            .expect("at least one candidate");
+    for (p, &[lo, hi]) in witnesses.iter().enumerate() {
         let (min, max) = (bound(lo, p), bound(hi, p));
         let order_sensitive = match (min.probability, max.probability) {
             (Some(a), Some(b)) => b - a > 2.0 * rule.precision,
@@ -431,8 +634,9 @@ pub fn bounds(
             max,
             order_sensitive,
             sources: Vec::new(),
+            left_out: left_out.len() as u64,
+            left_out_first: left_out.iter().take(LEFT_OUT_SHOWN).cloned().collect(),
         });
-        witnesses.push([lo, hi]);
     }
 
     // Sources: the witnesses again with one kind of choice put back to uniform, on the
@@ -441,7 +645,7 @@ pub fn bounds(
     let rules = (0..props)
         .map(|_| rule.build())
         .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| format!("statistics: {e}"))?;
+        .map_err(BoundsError::Rule)?;
     let mut cache: std::collections::HashMap<Scheduler, Vec<crate::smc::PropertyResult>> =
         Default::default();
     let names = set.guarantee_names();
@@ -458,7 +662,9 @@ pub fn bounds(
                 continue;
             };
             let base = fresh[i].as_ref().and_then(|r| r[p].estimate.estimate);
-            let mut estimate = |uniform: PutBack| -> Result<Option<Estimated>, ()> {
+            // Err(true): a run of it blocked time (the source is left out); Err(false): the
+            // model failed.
+            let mut estimate = |uniform: PutBack| -> Result<Option<Estimated>, bool> {
                 let sched = Scheduler::Sampled(Sampled { uniform, ..w });
                 if let std::collections::hash_map::Entry::Vacant(slot) = cache.entry(sched) {
                     let r = run_study_until(
@@ -469,7 +675,7 @@ pub fn bounds(
                         stop,
                     );
                     if r.runs.failed > 0 {
-                        return Err(());
+                        return Err(runner.unfair_run(&sched).is_some());
                     }
                     if r.interrupted {
                         return Ok(None);
@@ -511,9 +717,10 @@ pub fn bounds(
                 let (probability, interval) = match estimate(uniform) {
                     Ok(Some(x)) => x,
                     Ok(None) => return Ok(None),
-                    Err(()) => {
-                        runner.finish()?;
-                        return Err("a run of the sources failed without a message".into());
+                    Err(true) => continue,
+                    Err(false) => {
+                        runner.finish().map_err(BoundsError::Model)?;
+                        return Err(BoundsError::Silent("a run of the sources"));
                     }
                 };
                 let source = Source {
@@ -564,9 +771,10 @@ pub fn bounds(
                     let (probability, interval) = match estimate(uniform) {
                         Ok(Some(x)) => x,
                         Ok(None) => return Ok(None),
-                        Err(()) => {
-                            runner.finish()?;
-                            return Err("a run of the sources failed without a message".into());
+                        Err(true) => continue,
+                        Err(false) => {
+                            runner.finish().map_err(BoundsError::Model)?;
+                            return Err(BoundsError::Silent("a run of the sources"));
                         }
                     };
                     sources.push(Source {
@@ -584,6 +792,6 @@ pub fn bounds(
         }
         out[p].sources = sources;
     }
-    runner.finish()?;
+    runner.finish().map_err(BoundsError::Model)?;
     Ok(Some(out))
 }

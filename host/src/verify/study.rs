@@ -10,7 +10,7 @@ use std::sync::Mutex;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::observe::{Judge, PropertySet};
-use crate::sim::{CompiledModel, EndReason, RunConfig, Scheduler, Simulator};
+use crate::sim::{CompiledModel, EndReason, RunConfig, Scheduler, Simulator, SpinKind};
 use crate::smc::progress::TerminalProgress;
 use crate::smc::stats::RuleConfig;
 use crate::smc::{run_study_until, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
@@ -79,6 +79,31 @@ pub struct Runner<'m> {
     run_cfg: &'m RunConfig,
     pool: Mutex<Vec<(Simulator<'m>, Judge<'m>)>>,
     failure: Mutex<Option<String>>,
+    /// What a run that blocks time under a sampled scheduler does (see [`Unfair`]).
+    unfair: Unfair,
+    /// Per sampled scheduler, its first unfair run (lowest index) and why.
+    unfair_runs: Mutex<std::collections::BTreeMap<UnfairKey, (u64, String)>>,
+}
+
+/// A sampled scheduler as a map key (its name: id, memory and put-backs).
+type UnfairKey = String;
+
+/// What a run under a *sampled* scheduler that blocks time does: a run whose instant
+/// reaches `max_steps_per_instant` steps (time never advances again: the scheduler keeps
+/// choosing moves that keep the instant going, which the uniform scheduler does with
+/// probability 0 when its own runs let time pass). See docs/SEMANTICS.md, "Fair
+/// schedulers". Under the uniform scheduler it is a model failure, as always.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Unfair {
+    /// A model failure, as under the uniform scheduler (the study stops).
+    #[default]
+    Fail,
+    /// The run ends as failed without a failure message; [`Runner::unfair_run`] names
+    /// it, so that the study leaves its scheduler out.
+    LeaveOut,
+    /// The run is kept: judged as it stands, as if the time horizon were the instant it
+    /// blocked (`verify --keep-unfair`).
+    Keep,
 }
 
 impl<'m> Runner<'m> {
@@ -90,7 +115,22 @@ impl<'m> Runner<'m> {
             run_cfg,
             pool: Mutex::new(Vec::new()),
             failure: Mutex::new(None),
+            unfair: Unfair::Fail,
+            unfair_runs: Mutex::new(Default::default()),
         }
+    }
+
+    /// This runner with `unfair` for runs that block time under a sampled scheduler.
+    pub fn with_unfair(mut self, unfair: Unfair) -> Self {
+        self.unfair = unfair;
+        self
+    }
+
+    /// The first run (lowest index) of `scheduler` that blocked time and was left out
+    /// ([`Unfair::LeaveOut`]), and why.
+    pub fn unfair_run(&self, scheduler: &Scheduler) -> Option<(u64, String)> {
+        let runs = self.unfair_runs.lock().ok()?;
+        runs.get(&scheduler.to_string()).cloned()
     }
 
     /// Run `k` with its stream.
@@ -139,6 +179,27 @@ impl<'m> Runner<'m> {
                 EndReason::MaxTime => Some(RunEnd::TimeHorizon),
                 EndReason::MaxSteps => Some(RunEnd::StepLimit),
                 EndReason::Stopped => Some(RunEnd::Decided),
+                EndReason::Spin(s)
+                    if s.kind == SpinKind::NoTimeProgress
+                        && scheduler != Scheduler::Uniform
+                        && self.unfair != Unfair::Fail =>
+                {
+                    if self.unfair == Unfair::Keep {
+                        Some(RunEnd::TimeHorizon)
+                    } else {
+                        if let Ok(mut runs) = self.unfair_runs.lock() {
+                            let slot = runs
+                                .entry(scheduler.to_string())
+                                .or_insert((u64::MAX, String::new()));
+                            // The lowest index: the run a study consuming in order meets
+                            // first, whatever ran ahead on other threads.
+                            if k.0 < slot.0 {
+                                *slot = (k.0, s.to_string());
+                            }
+                        }
+                        None
+                    }
+                }
                 EndReason::Spin(s) => {
                     record(&self.failure, format!("run {k}: {s}"));
                     None

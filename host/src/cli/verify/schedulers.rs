@@ -2,12 +2,30 @@
 //! scheduler beside the smallest and largest found among N sampled deterministic
 //! schedulers, and which properties are order-sensitive.
 
+use super::shard::{fixed_study, merged_report};
 use super::{CliError, VerifyArgs};
 use crate::sim::{Memory, Scheduler};
 use crate::smc::stats::RuleKind;
 use crate::verify::load::Loaded;
 use crate::verify::result::Study;
-use crate::verify::schedulers::{bounds, explain, SchedulerOptions, Stage};
+use crate::verify::sched_fixed::{run_all, run_stage, Plan, StageError};
+use crate::verify::schedulers::{bounds, explain, BoundsError, SchedulerOptions, Stage};
+use crate::verify::study::Unfair;
+
+impl From<BoundsError> for CliError {
+    fn from(e: BoundsError) -> Self {
+        match e {
+            BoundsError::Rule(_) => CliError::Input(format!("--schedulers: {e}")),
+            _ => CliError::Input(e.to_string()),
+        }
+    }
+}
+
+impl From<StageError> for CliError {
+    fn from(e: StageError) -> Self {
+        CliError::Input(format!("--schedulers: {e}"))
+    }
+}
 
 /// What a sampled scheduler's choices depend on, as named on the command line.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -28,9 +46,22 @@ impl From<MemoryArg> for Memory {
     }
 }
 
-/// Parses `--scheduler`: `uniform`, `memoryless:ID` or `history:ID`.
-pub fn parse_scheduler(text: &str) -> Result<Scheduler, String> {
-    text.parse()
+/// A `--scheduler` value that names no scheduler: the text and what is wrong with it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BadScheduler(pub String);
+
+impl std::fmt::Display for BadScheduler {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for BadScheduler {}
+
+/// Parses `--scheduler`: `uniform`, `memoryless:ID` or `history:ID` (with `+...`
+/// put-backs, as `--json` names them).
+pub fn parse_scheduler(text: &str) -> Result<Scheduler, BadScheduler> {
+    text.parse().map_err(BadScheduler)
 }
 
 /// Refuses combinations `--schedulers` does not support, with the reason.
@@ -41,27 +72,26 @@ pub(super) fn check(args: &VerifyArgs) -> Result<(), CliError> {
         )))
     };
     if args.schedulers.is_none() {
+        if args.plan.is_some() {
+            return Err(CliError::Input(
+                "--plan: the plan of a sharded scheduler study needs --schedulers N --runs R \
+                 --shard I/K (the same as the plan's first stage)"
+                    .into(),
+            ));
+        }
         return Ok(());
-    }
-    if args.shard.is_some() || args.runs.is_some() {
-        return refuse(
-            "--runs / --shard",
-            "a scheduler study is not one fixed-size study: after each selection round it \
-             ranks all N schedulers on their counts so far (successive halving) and gives \
-             only the survivors more runs, and the fresh estimates run on the candidates \
-             chosen by the last round; a shard would need every other shard's counts \
-             between rounds, and `merge` adds counts of one fixed study. Run --schedulers \
-             on one machine (the result does not depend on --threads), then shard the \
-             witnesses it prints: --scheduler ID --runs N --shard I/K",
-        );
     }
     if args.threshold.is_some() {
         return refuse(
             "--threshold",
-            "the selection ranks schedulers by estimated probability and the bounds are \
-             estimates with intervals, while --threshold runs Wald's sequential test, \
-             which gives a verdict, not an estimate to rank or bound; ask the threshold \
-             question of each witness: --scheduler ID --threshold THETA",
+            "the threshold question over schedulers is already answered by the bounds \
+             without a second test: with confidence c, if the min interval's upper end is \
+             below THETA some scheduler (the min witness) has P < THETA, and if the max \
+             interval's lower end is above THETA some scheduler has P > THETA; Wald's \
+             sequential test (--threshold) would decide the same of one fixed scheduler \
+             only, and of no scheduler outside the sample. Run --schedulers N and compare \
+             THETA with the intervals, or ask it of one witness: --scheduler ID \
+             --threshold THETA",
         );
     }
     if args.scheduler.is_some() {
@@ -93,6 +123,11 @@ pub(super) fn add_bounds(
         count,
         memory: args.scheduler_memory.into(),
         selection_runs: args.selection_runs,
+        unfair: if args.keep_unfair {
+            Unfair::Keep
+        } else {
+            Unfair::LeaveOut
+        },
     };
     let show = !args.json;
     let mut progress = |s: Stage<'_>| {
@@ -123,8 +158,7 @@ pub(super) fn add_bounds(
         &opts,
         stop,
         &mut progress,
-    )
-    .map_err(CliError::Input)?;
+    )?;
     let Some(found) = found else {
         return Ok(false);
     };
@@ -219,6 +253,26 @@ pub(super) fn print_bounds(r: &Study) {
             );
         }
     }
+    if first.left_out > 0 {
+        println!(
+            "left out as unfair: {} of {} sampled schedulers (a run of theirs kept one instant \
+             going without letting time advance; the bounds are over the others; \
+             --keep-unfair keeps them):",
+            first.left_out, first.sampled
+        );
+        for l in &first.left_out_first {
+            println!(
+                "  {} ({} run {}): {}",
+                l.scheduler, l.phase, l.run, l.reason
+            );
+        }
+        if first.left_out as usize > first.left_out_first.len() {
+            println!(
+                "  ... and {} more",
+                first.left_out as usize - first.left_out_first.len()
+            );
+        }
+    }
     let sensitive = rows.iter().filter(|(_, b)| b.order_sensitive).count();
     println!(
         "{sensitive} of {} properties order-sensitive (max - min > 2 x precision {})",
@@ -274,4 +328,95 @@ pub(super) fn witness_runs(
         }
     }
     Ok(out)
+}
+
+/// `verify --schedulers N --runs R [--shard I/K [--plan FILE]]`: the fixed-size scheduler
+/// study ([`crate::verify::sched_fixed`]). With `--shard`, runs that shard of the plan's
+/// current stage (stage 0 without `--plan`) and writes its part (`Ok(None)`); without,
+/// runs every stage here and returns the report `merge` gives for the shards.
+pub(super) fn run_fixed(
+    args: &VerifyArgs,
+    loaded: &Loaded,
+    run_cfg: &crate::sim::RunConfig,
+    study_cfg: &crate::smc::StudyConfig,
+    runs: u64,
+) -> Result<Option<Study>, CliError> {
+    let Some(count) = args.schedulers else {
+        return Ok(None);
+    };
+    let rule = super::rule_config(args);
+    let fixed = fixed_study(
+        args,
+        &loaded.model,
+        &loaded.set,
+        &loaded.props_path,
+        run_cfg,
+        &rule,
+        runs,
+    );
+    let opts = SchedulerOptions {
+        count,
+        memory: args.scheduler_memory.into(),
+        selection_runs: args.selection_runs,
+        unfair: if args.keep_unfair {
+            Unfair::Keep
+        } else {
+            Unfair::LeaveOut
+        },
+    };
+    let plan = match &args.plan {
+        Some(p) => {
+            let text = crate::cli::read_file(p)?;
+            let plan: Plan = serde_json::from_str(&text).map_err(|e| {
+                CliError::Input(format!(
+                    "{}: not a scheduler study's plan: {e}",
+                    p.display()
+                ))
+            })?;
+            plan.check(&fixed, &opts)
+                .map_err(|e| CliError::Input(format!("{}: {e}", p.display())))?;
+            plan
+        }
+        None => Plan::new(fixed, &opts),
+    };
+    if let Some(shard) = args.shard {
+        let part = run_stage(&loaded.model, &loaded.set, run_cfg, study_cfg, &plan, shard)?;
+        let json =
+            serde_json::to_string(&part).map_err(|e| CliError::Failed(format!("json: {e}")))?;
+        match &args.partial {
+            Some(p) => std::fs::write(p, json)
+                .map_err(|e| CliError::Failed(format!("{}: {e}", p.display())))?,
+            None => println!("{json}"),
+        }
+        return Ok(None);
+    }
+    let show = !args.json;
+    let plan = run_all(
+        &loaded.model,
+        &loaded.set,
+        run_cfg,
+        study_cfg,
+        plan,
+        &mut |p: &Plan| {
+            if show {
+                eprintln!(
+                    "schedulers: stage {} ({} run ranges)",
+                    p.stage,
+                    p.jobs.len()
+                );
+            }
+        },
+    )?;
+    fixed_report(&plan).map(Some)
+}
+
+/// The report of a finished fixed-size scheduler study: the uniform study as `merge`
+/// reports a fixed-size one, each property with its bounds.
+pub(super) fn fixed_report(plan: &Plan) -> Result<Study, CliError> {
+    let (merged, bounds) = plan.report()?;
+    let mut report = merged_report(&merged);
+    for (row, b) in report.properties.iter_mut().zip(bounds) {
+        row.schedulers = Some(b);
+    }
+    Ok(report)
 }

@@ -11,7 +11,52 @@ use crate::smc::stats::RuleConfig;
 use crate::smc::StudyConfig;
 use crate::verify::observe::PropertySet;
 use crate::verify::result::{PropertyRow, Study};
+use crate::verify::sched_fixed::{merge_stage, StagePart, PART_FORMAT};
 use crate::verify::study::Runner;
+
+/// `merge` of the parts of one stage of a scheduler study: the next stage's plan to
+/// `--next`, or the report after the last stage.
+fn merge_stage_cli(args: &MergeArgs, texts: &[String], staged: &[bool]) -> Result<(), CliError> {
+    let mut parts = Vec::new();
+    for ((p, text), &is) in args.parts.iter().zip(texts).zip(staged) {
+        if !is {
+            return Err(CliError::Input(format!(
+                "merge: {}: not a part of a scheduler study's stage, while {} is: merge the \
+                 parts of one study",
+                p.display(),
+                args.parts[staged.iter().position(|&s| s).unwrap_or(0)].display()
+            )));
+        }
+        parts.push(
+            serde_json::from_str::<StagePart>(text)
+                .map_err(|e| CliError::Input(format!("{}: {e}", p.display())))?,
+        );
+    }
+    let plan = merge_stage(&parts).map_err(|e| CliError::Input(format!("merge: {e}")))?;
+    if plan.done() {
+        let report = super::schedulers::fixed_report(&plan)?;
+        return print_report(&report, args.json);
+    }
+    let Some(next) = &args.next else {
+        return Err(CliError::Input(format!(
+            "merge: these are the parts of stage {} of a scheduler study, which is not the \
+             last: give --next PLAN.json to write stage {}'s plan",
+            plan.stage - 1,
+            plan.stage
+        )));
+    };
+    let json = serde_json::to_string(&plan).map_err(|e| CliError::Failed(format!("json: {e}")))?;
+    std::fs::write(next, json).map_err(|e| CliError::Failed(format!("{}: {e}", next.display())))?;
+    eprintln!(
+        "merge: stage {} merged; stage {} has {} run ranges: run every shard with --plan {}, \
+         then merge their parts",
+        plan.stage - 1,
+        plan.stage,
+        plan.jobs.len(),
+        next.display()
+    );
+    Ok(())
+}
 
 /// FNV-1a over bytes: a stable fingerprint so `merge` can refuse mixed studies.
 fn fingerprint(parts: &[&[u8]]) -> String {
@@ -25,19 +70,18 @@ fn fingerprint(parts: &[&[u8]]) -> String {
     format!("{h:016x}")
 }
 
-#[allow(clippy::too_many_arguments)]
-pub(super) fn run_shard_cli(
+/// What identifies the fixed-size study of `runs` runs that `args` describe: what `merge`
+/// compares across shards.
+pub(super) fn fixed_study(
     args: &VerifyArgs,
     model: &CompiledModel,
     set: &PropertySet,
     props_path: &Path,
     run_cfg: &RunConfig,
-    study_cfg: &StudyConfig,
     rule: &RuleConfig,
-    shard: crate::smc::shard::Shard,
     runs: u64,
-) -> Result<crate::smc::shard::PartialResult, CliError> {
-    use crate::smc::shard::{run_shard, FixedStudy, PropertySpec};
+) -> crate::smc::shard::FixedStudy {
+    use crate::smc::shard::{FixedStudy, PropertySpec};
     let props_text = std::fs::read(props_path).unwrap_or_default();
     let mut model_desc = format!(
         "{} machines, {} events, max_time {}, max_steps {}",
@@ -51,7 +95,7 @@ pub(super) fn run_shard_cli(
     if run_cfg.scheduler != Scheduler::Uniform {
         model_desc.push_str(&format!(", scheduler {}", run_cfg.scheduler));
     }
-    let fixed = FixedStudy {
+    FixedStudy {
         seed: args.seed,
         study_runs: runs,
         model: format!("{} ({model_desc})", fingerprint(&[model_desc.as_bytes()])),
@@ -68,7 +112,23 @@ pub(super) fn run_shard_cli(
             model: args.input.model.display().to_string(),
             properties: props_path.display().to_string(),
         }),
-    };
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(super) fn run_shard_cli(
+    args: &VerifyArgs,
+    model: &CompiledModel,
+    set: &PropertySet,
+    props_path: &Path,
+    run_cfg: &RunConfig,
+    study_cfg: &StudyConfig,
+    rule: &RuleConfig,
+    shard: crate::smc::shard::Shard,
+    runs: u64,
+) -> Result<crate::smc::shard::PartialResult, CliError> {
+    use crate::smc::shard::run_shard;
+    let fixed = fixed_study(args, model, set, props_path, run_cfg, rule, runs);
     let runner = Runner::new(model, set, run_cfg);
     let mut bar = TerminalProgress::stderr();
     let part = run_shard(
@@ -91,14 +151,33 @@ pub struct MergeArgs {
     /// Print JSON instead of the table.
     #[arg(long)]
     pub json: bool,
+    /// For the parts of a stage of a scheduler study (`verify --schedulers N --runs R
+    /// --shard I/K`) that is not the last: where to write the next stage's plan (give it
+    /// to every shard of that stage with --plan).
+    #[arg(long, value_name = "PLAN")]
+    pub next: Option<PathBuf>,
 }
 
 /// Runs `hindsight merge`: checks the parts cover one study exactly once, then reports it.
 pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
     use crate::smc::shard::{duplicates, merge, PartialResult, Shard, ShardError};
-    let mut parts = Vec::new();
+    let mut texts = Vec::new();
     for p in &args.parts {
-        let text = super::super::read_file(p)?;
+        texts.push(super::super::read_file(p)?);
+    }
+    let format = |t: &str| -> Option<String> {
+        let v: serde_json::Value = serde_json::from_str(t).ok()?;
+        Some(v.get("format")?.as_str()?.to_string())
+    };
+    let staged: Vec<bool> = texts
+        .iter()
+        .map(|t| format(t).as_deref() == Some(PART_FORMAT))
+        .collect();
+    if staged.iter().any(|&s| s) {
+        return merge_stage_cli(args, &texts, &staged);
+    }
+    let mut parts = Vec::new();
+    for (p, text) in args.parts.iter().zip(texts) {
         parts.push(
             PartialResult::from_json(&text)
                 .map_err(|e| CliError::Input(format!("{}: {e}", p.display())))?,
