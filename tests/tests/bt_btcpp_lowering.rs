@@ -522,6 +522,36 @@ fn random_trees_with_scripts_lower_to_what_btcpp_does() {
     });
 }
 
+/// The same with UnsetBlackboard (`gen::Options::unset`) among the scripts: a script
+/// reading an entry after it was unset throws in BT.CPP and stops the lowered tree.
+#[test]
+fn random_trees_with_unset_lower_to_what_btcpp_does() {
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        unset: true,
+        ..Default::default()
+    };
+    random_trees(opts);
+    // The trees held UnsetBlackboard (the same seeds, generated again).
+    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0);
+    let with = (seed0..seed0 + n)
+        .filter(|&seed| {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+            let c = gen::case_with_conds(
+                &mut rng,
+                4 + (seed % 12) as i64,
+                opts,
+                gen::Conditions::WithoutSkip,
+            );
+            c.xml.contains("<UnsetBlackboard ")
+        })
+        .count() as u64;
+    eprintln!("{with} of the {n} trees unset an entry");
+    assert!(with >= n / 10, "only {with} of {n} trees unset an entry");
+}
+
 /// The same with BT.CPP 4's nodes AS2FM has no model of (AsyncSequence, AsyncFallback,
 /// ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2-6) in the
 /// format-4 trees.
