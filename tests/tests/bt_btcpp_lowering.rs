@@ -522,6 +522,36 @@ fn random_trees_with_scripts_lower_to_what_btcpp_does() {
     });
 }
 
+/// The same with UnsetBlackboard (`gen::Options::unset`) among the scripts: a script
+/// reading an entry after it was unset throws in BT.CPP and stops the lowered tree.
+#[test]
+fn random_trees_with_unset_lower_to_what_btcpp_does() {
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        unset: true,
+        ..Default::default()
+    };
+    random_trees(opts);
+    // The trees held UnsetBlackboard (the same seeds, generated again).
+    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0);
+    let with = (seed0..seed0 + n)
+        .filter(|&seed| {
+            let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+            let c = gen::case_with_conds(
+                &mut rng,
+                4 + (seed % 12) as i64,
+                opts,
+                gen::Conditions::WithoutSkip,
+            );
+            c.xml.contains("<UnsetBlackboard ")
+        })
+        .count() as u64;
+    eprintln!("{with} of the {n} trees unset an entry");
+    assert!(with >= n / 10, "only {with} of {n} trees unset an entry");
+}
+
 /// The same with BT.CPP 4's nodes AS2FM has no model of (AsyncSequence, AsyncFallback,
 /// ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2-6) in the
 /// format-4 trees.
@@ -890,18 +920,25 @@ fn harness() -> Option<real::Real> {
 
 #[test]
 fn random_trees_with_btcpp4_nodes_lower_to_what_the_real_library_does() {
-    real_library(false, 2_000, 700_000);
+    real_library(false, false, 2_000, 700_000);
 }
 
 /// The same with scripts (`Script`, `ScriptCondition`, `Precondition`) in the trees.
 #[test]
 fn random_trees_with_scripts_lower_to_what_the_real_library_does() {
-    real_library(true, 1_000, 800_000);
+    real_library(true, false, 1_000, 800_000);
+}
+
+/// The same with UnsetBlackboard (`gen::Options::unset`) among the scripts.
+#[test]
+fn random_trees_with_unset_lower_to_what_the_real_library_does() {
+    real_library(true, true, 500, 900_000);
 }
 
 /// `HINDSIGHT_BT_REAL_LOWERING_TREES` (default `default_n`) random format-4 trees with
-/// BT.CPP 4's own nodes (and scripts when `scripts`) run in the real library and lowered.
-fn real_library(scripts: bool, default_n: u64, offset: u64) {
+/// BT.CPP 4's own nodes (and scripts when `scripts`, UnsetBlackboard when `unset`) run in
+/// the real library and lowered.
+fn real_library(scripts: bool, unset: bool, default_n: u64, offset: u64) {
     let Some(mut lib) = harness() else { return };
     let n = env("HINDSIGHT_BT_REAL_LOWERING_TREES", default_n) as usize;
     let seed0 = env("HINDSIGHT_BT_SEED", 0) + offset;
@@ -921,6 +958,7 @@ fn real_library(scripts: bool, default_n: u64, offset: u64) {
             gen::Options {
                 btcpp4_nodes: true,
                 scripts,
+                unset,
                 ..Default::default()
             },
             gen::Conditions::WithoutSkip,
@@ -947,6 +985,14 @@ fn real_library(scripts: bool, default_n: u64, offset: u64) {
             kinds[k] += usize::from(*s);
         }
         cases.push((seed, c, t));
+    }
+    if unset {
+        let with = cases
+            .iter()
+            .filter(|(_, c, _)| c.xml.contains("<UnsetBlackboard "))
+            .count();
+        eprintln!("{with} of the {} trees unset an entry", cases.len());
+        assert!(with >= n / 10, "only {with} trees unset an entry");
     }
     let modes = [
         (BtTick::Once, TickMode::Once),

@@ -209,6 +209,15 @@ fn check_all(
                 match expect(xml, scripts, *ticks, mode) {
                     Ok(w) => {
                         read = w.1.vars.keys().cloned().collect();
+                        // An entry the oracle says UnsetBlackboard erased must be missing
+                        // in the library too.
+                        if xml.contains("<UnsetBlackboard ") {
+                            for k in ["x", "y", "f"] {
+                                if !read.iter().any(|r| r == k) {
+                                    read.push(k.to_string());
+                                }
+                            }
+                        }
                         wants.push((name, xml, scripts, *ticks, mode, w))
                     }
                     Err(e) => fails.push(format!("{name}: the oracle: {e}")),
@@ -396,7 +405,7 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
     let random = counts.runs;
     let mut files = Vec::new();
     let mut files_v3 = 0;
-    for dir in ["bt/btcpp", "bt/regressions", "bt/real"] {
+    for dir in ["bt/btcpp", "bt/btcpp4", "bt/regressions", "bt/real"] {
         for (file, c) in load(dir) {
             let ticks = c.ticks.unwrap_or(c.statuses.len()).max(1);
             let xml = doc(&c.tree);
@@ -466,6 +475,86 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
             .join("\n")
     );
 }
+
+/// BT.CPP 4's blackboard nodes against the real library: random format-4 trees with
+/// scripts, pre/post conditions and UnsetBlackboard, WasEntryUpdated, WaitValueUpdate,
+/// SkipUnlessUpdated and the Loop nodes (`gen::Options::bb_nodes`), both tick modes;
+/// root statuses, leaf events, how a run ends and the script entries at the end must
+/// agree. `HINDSIGHT_BT_REAL_BB_TREES` sets the count (default 3,000).
+#[test]
+fn blackboard_nodes_agree_with_the_real_library() {
+    let Some(mut real) = harness() else { return };
+    let n = env("HINDSIGHT_BT_REAL_BB_TREES", 3000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0) + 4_000_000;
+    let start = std::time::Instant::now();
+    let mut cases = Vec::new();
+    for seed in seed0.. {
+        if cases.len() as u64 >= n {
+            break;
+        }
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let opts = gen::Options {
+            btcpp4_nodes: seed % 2 == 0,
+            scripts: true,
+            bb_nodes: true,
+            ..Default::default()
+        };
+        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
+        if BB_FEATURES[..8].iter().any(|f| c.xml.contains(f)) {
+            cases.push((format!("bb seed {seed}"), c.xml, c.scripts, c.ticks));
+        }
+    }
+    let mut counts = Counts::default();
+    let fails = check_all(&mut real, &cases, &mut counts);
+    let mut seen = vec![0usize; BB_FEATURES.len()];
+    for (_, xml, _, _) in &cases {
+        for (f, k) in BB_FEATURES.iter().zip(&mut seen) {
+            *k += usize::from(xml.contains(f));
+        }
+    }
+    eprintln!(
+        "BehaviorTree.CPP {}: {} trees with blackboard nodes, each under tickOnce and \
+         tickExactlyOnce: {} runs ({} ran every tick, {} refused at load, {} threw, {} \
+         livelocks, {} hangs) in {:.1} s; {} disagreements",
+        real.version,
+        cases.len(),
+        counts.runs,
+        counts.ran_all,
+        counts.refused,
+        counts.errors,
+        counts.livelocks,
+        counts.hangs,
+        start.elapsed().as_secs_f64(),
+        fails.len()
+    );
+    if n >= 1000 {
+        for (f, k) in BB_FEATURES.iter().zip(&seen) {
+            eprintln!("  {k:>6} trees with `{f}`");
+            assert!(*k as u64 >= n / 100, "only {k} trees have `{f}`");
+        }
+    }
+    assert!(
+        fails.is_empty(),
+        "{} disagreements (first 5):\n{}",
+        fails.len(),
+        fails.iter().take(5).cloned().collect::<Vec<_>>().join("\n")
+    );
+}
+
+/// The blackboard nodes (the first eight) and ports the test must see.
+const BB_FEATURES: &[&str] = &[
+    "<UnsetBlackboard ",
+    "<WasEntryUpdated ",
+    "<WaitValueUpdate ",
+    "<SkipUnlessUpdated ",
+    "<LoopInt ",
+    "<LoopBool ",
+    "<LoopDouble ",
+    "<LoopString ",
+    "if_empty=\"SKIPPED\"",
+    "if_empty=\"RUNNING\"",
+    "value=\"{x}\"",
+];
 
 /// The minimal trees of the README's table: BT.CPP's statuses in the case's mode, in the
 /// real library and the oracle; AS2FM's reading gives the `as2fm` statuses.

@@ -6,7 +6,9 @@
 //! nodes that AS2FM has no model of; with [`Options::scripts`], BT.CPP 4's script
 //! language (`Script`, `ScriptCondition`, `Precondition`) and pre/post conditions on
 //! nodes, over the integer entries `x`, `y` and the boolean `f`; with [`Options::time_nodes`]
-//! and [`Options::try_catch`], Timeout, Delay, Sleep and TryCatch.
+//! and [`Options::try_catch`], Timeout, Delay, Sleep and TryCatch; with
+//! [`Options::bb_nodes`], BT.CPP 4's blackboard nodes (UnsetBlackboard, the entry-updated
+//! nodes, the Loop nodes).
 
 use super::oracle::Scripts;
 use super::tree::Status;
@@ -36,6 +38,8 @@ struct G<'r, R: Rng> {
     opts: Options,
     /// With scripts: which pre/post-condition attributes.
     conds: Conditions,
+    /// Writing a SubTree's body (no UnsetBlackboard there).
+    in_subtree: bool,
 }
 
 /// Which pre/post-condition attributes [`Options::scripts`] writes.
@@ -75,6 +79,17 @@ pub struct Options {
     /// `catch_on_halt` (format-4 trees only). Off, the generator draws what it drew
     /// before.
     pub try_catch: bool,
+    /// BT.CPP 4's blackboard nodes, with [`Options::scripts`] only (over the script
+    /// entries `x`, `y`, `f`): UnsetBlackboard (in the main tree only), WasEntryUpdated,
+    /// WaitValueUpdate, SkipUnlessUpdated (with [`Conditions::All`] only: it answers
+    /// SKIPPED), and LoopInt, LoopBool, LoopDouble, LoopString over queues written in
+    /// the tree (`if_empty="SKIPPED"` with [`Conditions::All`] only). Off, the generator
+    /// draws what it drew before.
+    pub bb_nodes: bool,
+    /// UnsetBlackboard alone (of [`Options::bb_nodes`]), with [`Options::scripts`], in
+    /// the main tree, over the script entries: what the lowering takes of the blackboard
+    /// nodes. Off, the generator draws what it drew before.
+    pub unset: bool,
 }
 
 /// The script entries: `x`, `y` integers, `f` a boolean, all written first by the main
@@ -307,7 +322,13 @@ impl<R: Rng> G<'_, R> {
                 "_onHalted",
             ]
         };
-        let name = self.pick(names);
+        let mut name = self.pick(names);
+        // With UnsetBlackboard, an `_onHalted` script could read an erased entry and
+        // throw inside a halt, which BT.CPP may meet in a destructor (and the oracle
+        // does not model): `_post` instead.
+        if name == "_onHalted" && (self.opts.bb_nodes || self.opts.unset) {
+            name = "_post";
+        }
         let code = if name.starts_with("_on") || name == "_post" {
             self.script()
         } else {
@@ -410,6 +431,58 @@ impl<R: Rng> G<'_, R> {
         }
     }
 
+    /// One of BT.CPP 4's blackboard nodes ([`Options::bb_nodes`]).
+    fn bb_node(&mut self, depth: u32) -> String {
+        let skip = self.conds == Conditions::All;
+        let e = self.pick(&["x", "y", "f", "{x}", "{y}", "{f}"]);
+        match self.below(10) {
+            0 if !self.in_subtree => {
+                format!("<UnsetBlackboard key=\"{}\"/>", self.pick(&["x", "y", "f"]))
+            }
+            0 | 1 => format!("<WasEntryUpdated entry=\"{e}\"/>"),
+            2 => {
+                let child = self.node(depth + 1);
+                format!("<WaitValueUpdate entry=\"{e}\">{child}</WaitValueUpdate>")
+            }
+            3 if skip => {
+                let child = self.node(depth + 1);
+                format!("<SkipUnlessUpdated entry=\"{e}\">{child}</SkipUnlessUpdated>")
+            }
+            _ => {
+                let (tag, items, values): (_, &[&str], &[&str]) = match self.below(6) {
+                    // One item type per entry: BT.CPP refuses a tree whose Loop nodes write one
+                    // entry with two types ("was initially created with type").
+                    0 => ("LoopBool", &["true", "false", "1", "0"], &["{f}"]),
+                    1 => ("LoopDouble", &["1.5", "2.0", "-0.5"], &["{ld}"]),
+                    2 => ("LoopString", &["a", "b"], &["{ls}"]),
+                    _ => ("LoopInt", &["0", "1", "2", "-3"], &["{x}", "{y}"]),
+                };
+                let n = self.below(4);
+                let mut q: Vec<&str> = (0..n).map(|_| self.pick(items)).collect();
+                if n > 0 && self.below(8) == 0 {
+                    q.push("");
+                }
+                let value = if self.below(4) == 0 {
+                    String::new()
+                } else {
+                    format!(" value=\"{}\"", self.pick(values))
+                };
+                let empty = match self.below(8) {
+                    0 => " if_empty=\"FAILURE\"",
+                    1 => " if_empty=\"RUNNING\"",
+                    2 if skip => " if_empty=\"SKIPPED\"",
+                    3 => " if_empty=\"SUCCESS\"",
+                    _ => "",
+                };
+                let child = self.node(depth + 1);
+                format!(
+                    "<{tag} queue=\"{}\"{value}{empty}>{child}</{tag}>",
+                    q.join(";")
+                )
+            }
+        }
+    }
+
     /// `n` children of a parallel (as [`Self::children_skip`]).
     fn kids_skip(&mut self, depth: u32, n: i64) -> String {
         (0..n)
@@ -439,6 +512,22 @@ impl<R: Rng> G<'_, R> {
         if self.opts.btcpp4_nodes && !self.v3 && depth < 5 && self.budget > 0 && self.below(6) == 0
         {
             return self.btcpp4_node(depth);
+        }
+        if self.opts.bb_nodes
+            && self.scripts_on()
+            && depth < 5
+            && self.budget > 0
+            && self.below(6) == 0
+        {
+            return self.bb_node(depth);
+        }
+        if self.opts.unset
+            && self.scripts_on()
+            && !self.in_subtree
+            && depth < 5
+            && self.below(10) == 0
+        {
+            return format!("<UnsetBlackboard key=\"{}\"/>", self.pick(&["x", "y", "f"]));
         }
         if self.scripts_on() && depth < 5 && self.below(6) == 0 {
             return self.script_node(depth);
@@ -590,6 +679,7 @@ pub fn case_with_conds<R: Rng>(rng: &mut R, size: i64, opts: Options, conds: Con
         v3: false,
         opts,
         conds,
+        in_subtree: true,
     };
     g.v3 = g.below(3) == 0;
     let n_sub = g.below(3);
@@ -605,6 +695,7 @@ pub fn case_with_conds<R: Rng>(rng: &mut R, size: i64, opts: Options, conds: Con
         g.subtrees.push(format!("S{i}"));
     }
     g.budget = size;
+    g.in_subtree = false;
     let body = g.node(0);
     let format = if g.v3 { 3 } else { 4 };
     let init = if g.scripts_on() {

@@ -211,13 +211,7 @@ const V4_NAMES: &[&str] = &[
     "Timeout",
     "Delay",
     "Sleep",
-];
-
-/// The other built-in nodes BT.CPP 4.8.2 registers: a scripted leaf cannot take their
-/// names (`registerBuilder`: "ID [..] already registered"). (4.10 adds `TryCatch`.)
-const V4_OTHERS: &[&str] = &[
     "UnsetBlackboard",
-    "SubTree",
     "LoopInt",
     "LoopBool",
     "LoopDouble",
@@ -226,6 +220,10 @@ const V4_OTHERS: &[&str] = &[
     "SkipUnlessUpdated",
     "WaitValueUpdate",
 ];
+
+/// The other built-in nodes BT.CPP 4.8.2 registers: a scripted leaf cannot take their
+/// names (`registerBuilder`: "ID [..] already registered"). (4.10 adds `TryCatch`.)
+const V4_OTHERS: &[&str] = &["SubTree"];
 
 /// What BT.CPP 4's factory refuses at load, if anything: a leaf type that has the
 /// name of a built-in node of 4 (`registerBuilder`: "ID [..] already registered"; the
@@ -251,6 +249,17 @@ pub fn btcpp4_refuses(tree: &Tree, scripts: &Scripts) -> Option<String> {
         .collect();
     if refused.is_empty() && tree.reactive_async {
         return Some("A ReactiveSequence cannot have more than one async child".into());
+    }
+    // An entry the `value` ports of two Loop nodes of different item types name: "The
+    // creation of the tree failed because the port [..] was initially created with type
+    // [..] and, later type [..] was used somewhere else" (4.8.2, found against it).
+    let mut typed = BTreeMap::new();
+    for x in &tree.nodes {
+        if let Kind::Loop(ty, _, Some(v), _) = &x.kind {
+            if *typed.entry(v.as_str()).or_insert(*ty) != *ty && refused.is_empty() {
+                return Some("was initially created with type".into());
+            }
+        }
     }
     (!refused.is_empty()).then(|| refused.join("|"))
 }
@@ -306,6 +315,16 @@ pub struct Oracle<'t> {
     started: Vec<bool>,
     /// TryCatch `in_catch_`.
     in_catch: Vec<bool>,
+    /// Each entry's update counter (BT.CPP 4 `Blackboard::Entry::sequence_id`): 0 when
+    /// the entry is created, one more at every write; an entry unset and created again
+    /// counts from 0 (docs/SEMANTICS.md, "Entries that may be unset").
+    seq: BTreeMap<String, u64>,
+    /// The entry-updated nodes' `sequence_id_` (the counter they saw last).
+    seen: Vec<u64>,
+    /// `EntryUpdatedDecorator::still_executing_child_`; LoopNode `child_running_`.
+    child_running: Vec<bool>,
+    /// LoopNode `current_queue_`: the items left.
+    queue: Vec<std::collections::VecDeque<String>>,
 }
 
 impl From<Fault> for Stop {
@@ -366,6 +385,10 @@ impl<'t> Oracle<'t> {
             flag: vec![false; n],
             started: vec![false; n],
             in_catch: vec![false; n],
+            seq: BTreeMap::new(),
+            seen: vec![0; n],
+            child_running: vec![false; n],
+            queue: vec![Default::default(); n],
         }
     }
 
@@ -531,12 +554,13 @@ impl<'t> Oracle<'t> {
                 let s = self.tick_inner(n)?;
                 let sets_running = !matches!(
                     self.tree.nodes[n].kind,
-                    Kind::Precondition(..) | Kind::Switch(..)
+                    Kind::Precondition(..) | Kind::Switch(..) | Kind::Loop(..) | Kind::Updated(..)
                 );
                 if s == Status::Skipped && sets_running {
                     // The controls and decorators set themselves RUNNING first
                     // (`setStatus(NodeStatus::RUNNING)` in their `tick`; not
-                    // `PreconditionNode` nor `SwitchNode`), and `executeTick` does not
+                    // `PreconditionNode`, `SwitchNode`, `EntryUpdatedDecorator`, nor
+                    // `LoopNode`, which does it only before ticking its child), and `executeTick` does not
                     // store SKIPPED: such a node stays RUNNING (and a reset halts it).
                     self.status[n] = Some(Status::Running);
                 }
@@ -554,7 +578,7 @@ impl<'t> Oracle<'t> {
         if matches!(s, Status::Success | Status::Failure) {
             let which = if s == Status::Success { 2 } else { 1 };
             for p in [&post[which], &post[3]].into_iter().flatten() {
-                p.run(&mut self.vars)?;
+                self.run_program(p)?;
             }
         }
         if s == Status::Skipped && !self.takes_skipped(n) {
@@ -581,7 +605,7 @@ impl<'t> Oracle<'t> {
             let Some(p) = p else { continue };
             match self.status[n] {
                 None => {
-                    let holds = p.holds(&mut self.vars)?;
+                    let holds = self.holds(p)?;
                     match (i, holds) {
                         (0, true) => return Ok(Some(Status::Failure)),
                         (1, true) => return Ok(Some(Status::Success)),
@@ -590,7 +614,7 @@ impl<'t> Oracle<'t> {
                     }
                 }
                 Some(Status::Running) if i == 3 => {
-                    let holds = p.holds(&mut self.vars)?;
+                    let holds = self.holds(p)?;
                     if !holds {
                         self.halt_node(n);
                         return Ok(Some(Status::Skipped));
@@ -613,7 +637,7 @@ impl<'t> Oracle<'t> {
     fn halt_node(&mut self, n: usize) {
         self.halt(n);
         if let Some(p) = &self.tree.nodes[n].conds.post[0] {
-            if let Err(f) = p.run(&mut self.vars) {
+            if let Err(f) = self.run_program(p) {
                 self.fault.get_or_insert(format!("{f:?}"));
             }
         }
@@ -621,7 +645,55 @@ impl<'t> Oracle<'t> {
 
     /// A script node's program run once over the entries.
     fn script(&mut self, p: &Program) -> Result<i64, Stop> {
-        Ok(p.run(&mut self.vars)?)
+        Ok(self.run_program(p)?)
+    }
+
+    /// A script run over the entries; every assignment it makes counts as a write of
+    /// its entry (`Blackboard::Entry::sequence_id`: the real library counts `x := 0`
+    /// twice in `x := 0; x := 0`, and `x += 0` too, but not a read).
+    /// An assignment other than `:=` to an entry that does not exist (UnsetBlackboard
+    /// erased it) throws before its right side is read ("The blackboard entry [..]
+    /// doesn't exist", as 4.8.2 answers).
+    fn run_program(&mut self, p: &Program) -> Result<i64, Fault> {
+        use super::script::Expr;
+        let mut last = 0;
+        for s in &p.0 {
+            if let Expr::Assign(v, op, _) = s {
+                if *op != ":=" && !self.vars.contains_key(v) {
+                    return Err(Fault::Throws(format!(
+                        "The blackboard entry [{v}] doesn't exist"
+                    )));
+                }
+            }
+            let fresh = match s {
+                Expr::Assign(v, _, _) if !self.vars.contains_key(v) => Some(v.clone()),
+                _ => None,
+            };
+            last = match Program(vec![s.clone()]).run(&mut self.vars) {
+                Ok(v) => v,
+                // `v := e` with `v` missing creates `v` without a value before reading
+                // `e`: an `e` that reads `v` throws, with the message of the operator
+                // that met the empty value (4.8.2: "The right operand of the operator
+                // [:=] is not initialized", "ExprUnaryArithmetic: undefined", ...).
+                Err(Fault::Throws(t))
+                    if fresh
+                        .as_ref()
+                        .is_some_and(|v| t == format!("Variable not found: {v}")) =>
+                {
+                    return Err(Fault::Throws("Error in script".into()));
+                }
+                Err(f) => return Err(f),
+            };
+            if let Expr::Assign(v, ..) = s {
+                *self.seq.entry(v.clone()).or_default() += 1;
+            }
+        }
+        Ok(last)
+    }
+
+    /// A script run as a condition.
+    fn holds(&mut self, p: &Program) -> Result<bool, Fault> {
+        super::script::truth(self.run_program(p)?)
     }
 
     /// `ControlNode::haltChild` / `DecoratorNode::resetChild`: BT.CPP halts the child
@@ -675,6 +747,19 @@ impl<'t> Oracle<'t> {
                 self.due[n] = None;
             }
             &Kind::TryCatch(catch_on_halt) => self.halt_try_catch(n, catch_on_halt),
+            Kind::Unset(_) | Kind::EntryUpdated(_) => {}
+            // 4.10 `EntryUpdatedDecorator::halt`: not executing the child, then
+            // `DecoratorNode::halt`, which halts a RUNNING child. The real library
+            // (4.8.2) leaves the child alone, as found against it: it stays RUNNING
+            // without a halt, and the next time the decorator ticks it, it goes on.
+            // `sequence_id_` is kept.
+            Kind::Updated(..) => self.child_running[n] = false,
+            // `LoopNode` has no `halt` of its own (`DecoratorNode::halt`): its queue is
+            // dropped at its next IDLE tick.
+            Kind::Loop(..) => {
+                self.child_running[n] = false;
+                self.reset_children(n);
+            }
             // `ParallelNode::halt` / `ParallelAllNode::halt` clear; AS2FM's counts restart
             // on every tick anyway.
             Kind::Parallel(..) | Kind::ParallelAll(_) => {
@@ -795,6 +880,31 @@ impl<'t> Oracle<'t> {
                 self.precondition(n, p, otherwise)
             }
             Kind::SetBlackboard(key, v) => self.set_blackboard(key, v),
+            // `UnsetBlackboardNode::tick`: `blackboard->unset(key)` erases the entry (a
+            // missing one is no error), SUCCESS.
+            Kind::Unset(key) => {
+                self.vars.remove(key);
+                self.bb.remove(key);
+                self.seq.remove(key);
+                Ok(Success)
+            }
+            Kind::EntryUpdated(e) => {
+                let e = e.clone();
+                Ok(if self.updated(n, &e) {
+                    Success
+                } else {
+                    Failure
+                })
+            }
+            Kind::Updated(e, otherwise) => {
+                let (e, otherwise) = (e.clone(), *otherwise);
+                self.entry_updated_decorator(n, &e, otherwise)
+            }
+            Kind::Loop(ty, items, value, if_empty) => {
+                let (ty, value, if_empty) = (*ty, value.clone(), *if_empty);
+                let items = items.clone();
+                self.loop_node(n, ty, &items, value.as_deref(), if_empty)
+            }
             Kind::Check(ty, a, b, mismatch, numeric) => {
                 let (ty, mut mismatch, numeric) = (*ty, *mismatch, *numeric);
                 let c = self.child(n, 0);
@@ -820,6 +930,132 @@ impl<'t> Oracle<'t> {
         }
     }
 
+    /// Whether entry `e` was written since node `n` last looked (4.10
+    /// `updated_action.cpp`, `EntryUpdatedAction::tick`, and `updated_decorator.cpp`,
+    /// `EntryUpdatedDecorator::tick`): the entry's `sequence_id` against the one the node
+    /// kept (0 at first), which it then keeps; a missing entry is not updated and leaves
+    /// the kept one alone. An entry is missing until a script or an output writes it
+    /// ([`Oracle::seq`]); one a port names in `{}` exists from load with counter 0, which
+    /// answers the same.
+    fn updated(&mut self, n: usize, e: &str) -> bool {
+        let exists = self.vars.contains_key(e) || self.bb.contains_key(e);
+        if !exists {
+            return false;
+        }
+        let now = self.seq.get(e).copied().unwrap_or(0);
+        let before = std::mem::replace(&mut self.seen[n], now);
+        before != now
+    }
+
+    /// `EntryUpdatedDecorator::tick` (4.10 `updated_decorator.cpp`): a child still
+    /// RUNNING is ticked again without looking at the entry; otherwise, not updated
+    /// answers `otherwise` (SKIPPED for `SkipUnlessUpdated`, RUNNING for
+    /// `WaitValueUpdate`) and updated ticks the child.
+    fn entry_updated_decorator(
+        &mut self,
+        n: usize,
+        e: &str,
+        otherwise: Status,
+    ) -> Result<Status, Stop> {
+        let c = self.child(n, 0);
+        if !self.child_running[n] && !self.updated(n, e) {
+            return Ok(otherwise);
+        }
+        let s = self.tick(c)?;
+        self.child_running[n] = s == Status::Running;
+        // `DecoratorNode::executeTick` (4.10 `decorator_node.cpp`): after the tick a
+        // finished child's status is reset (no halt), so a leaf runs again next time.
+        if matches!(s, Status::Success | Status::Failure) {
+            self.status[c] = None;
+        }
+        Ok(s)
+    }
+
+    /// `LoopNode<T>::tick` (4.10 `decorators/loop_node.h`) over a queue written in the
+    /// tree: when IDLE, a fresh copy of the queue and no child running; unless the child
+    /// is RUNNING, the front item is popped and written to `value`; nothing popped and
+    /// no child running answers `if_empty` (without ticking the child or leaving IDLE);
+    /// else the node goes RUNNING and ticks the child, resets a finished child, answers
+    /// FAILURE on its FAILURE and RUNNING otherwise.
+    fn loop_node(
+        &mut self,
+        n: usize,
+        ty: super::tree::LoopType,
+        items: &[String],
+        value: Option<&str>,
+        if_empty: Status,
+    ) -> Result<Status, Stop> {
+        if self.status[n].is_none() {
+            self.child_running[n] = false;
+            self.queue[n] = items.iter().cloned().collect();
+        }
+        let mut popped = false;
+        if !self.child_running[n] {
+            if let Some(item) = self.queue[n].pop_front() {
+                popped = true;
+                if let Some(key) = value {
+                    self.write_output(key, ty, &item)?;
+                }
+            }
+        }
+        if !popped && !self.child_running[n] {
+            return Ok(if_empty);
+        }
+        self.status[n] = Some(Status::Running);
+        let c = self.child(n, 0);
+        let s = self.tick(c)?;
+        self.child_running[n] = s == Status::Running;
+        if matches!(s, Status::Success | Status::Failure) {
+            self.halt_child(c);
+        }
+        Ok(if s == Status::Failure {
+            Status::Failure
+        } else {
+            Status::Running
+        })
+    }
+
+    /// `setOutput("value", item)`: the entry written (one more on its counter). An entry
+    /// scripts use holds a number: an int or bool item is written as one (a bool as 0 or
+    /// 1, as the real library reads it back), a double only if it is whole ("Invalid
+    /// floating point to integer conversion" otherwise), a string throws ("Any::copyInto
+    /// fails"), all as found against the real library (4.8.2). Any other entry keeps the
+    /// text.
+    fn write_output(
+        &mut self,
+        key: &str,
+        ty: super::tree::LoopType,
+        item: &str,
+    ) -> Result<(), Stop> {
+        use super::tree::LoopType;
+        let number = matches!(ty, LoopType::Int | LoopType::Bool);
+        if number || self.vars.contains_key(key) {
+            let v = match ty {
+                LoopType::Int => item
+                    .parse::<i64>()
+                    .map_err(|_| Stop::Model(format!("queue item {item}")))?,
+                LoopType::Bool => i64::from(matches!(item, "true" | "1")),
+                LoopType::Double => {
+                    let d: f64 = item
+                        .parse()
+                        .map_err(|_| Stop::Model(format!("queue item {item}")))?;
+                    if d.fract() != 0.0 {
+                        return Err(Stop::Error(
+                            "Invalid floating point to integer conversion".into(),
+                        ));
+                    }
+                    d as i64
+                }
+                LoopType::String => return Err(Stop::Error("Any::copyInto fails".into())),
+            };
+            self.vars.insert(key.to_string(), v);
+        } else {
+            self.bb.insert(key.to_string(), item.to_string());
+        }
+        *self.seq.entry(key.to_string()).or_default() += 1;
+        Ok(())
+    }
+
     /// `PreconditionNode::tick` (4.10; 4.8.2 alike, as the real-library differential
     /// finds): the `if` script only while the child has not started
     /// (`_children_running`); false answers `else`; true ticks the child, and a finished
@@ -827,7 +1063,7 @@ impl<'t> Oracle<'t> {
     /// not clear `_children_running`: after one, the next tick skips the script.
     fn precondition(&mut self, n: usize, p: &Program, otherwise: Status) -> Result<Status, Stop> {
         if !self.memo[n] {
-            self.memo[n] = p.holds(&mut self.vars)?;
+            self.memo[n] = self.holds(p)?;
         }
         if !self.memo[n] {
             return Ok(otherwise);
@@ -871,6 +1107,7 @@ impl<'t> Oracle<'t> {
         let v = self.value(v)?;
         self.bb.insert(key.to_string(), v);
         *self.writes.entry(key.to_string()).or_default() += 1;
+        *self.seq.entry(key.to_string()).or_default() += 1;
         Ok(Status::Success)
     }
 

@@ -145,6 +145,30 @@ pub enum Kind {
     Sleep(u64),
     /// `TryCatch` with `catch_on_halt` (BT.CPP 4.10 only: 4.8.2 does not know it).
     TryCatch(bool),
+    /// `UnsetBlackboard` with its `key` (a name, BT.CPP 4).
+    Unset(String),
+    /// `WasEntryUpdated` with its `entry` (after remapping, BT.CPP 4).
+    EntryUpdated(String),
+    /// `SkipUnlessUpdated` (SKIPPED) and `WaitValueUpdate` (RUNNING): the `entry` and
+    /// what the node answers when it was not updated (BT.CPP 4).
+    Updated(String, Status),
+    /// `LoopInt`, `LoopDouble`, `LoopString`, `LoopBool` over a queue written in the
+    /// tree (`queue="1;2;3"`): the type, the items as text, the `value` entry, `if_empty`
+    /// (BT.CPP 4).
+    Loop(LoopType, Vec<String>, Option<String>, Status),
+}
+
+/// The item type of a `Loop<T>` node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LoopType {
+    /// `LoopInt`.
+    Int,
+    /// `LoopDouble`.
+    Double,
+    /// `LoopString`.
+    String,
+    /// `LoopBool`.
+    Bool,
 }
 
 impl Kind {
@@ -166,6 +190,10 @@ impl Kind {
                 | Kind::Delay(_)
                 | Kind::Sleep(_)
                 | Kind::TryCatch(_)
+                | Kind::Unset(_)
+                | Kind::EntryUpdated(_)
+                | Kind::Updated(..)
+                | Kind::Loop(..)
         )
     }
 }
@@ -342,6 +370,30 @@ pub const NODES: &[(&[&str], Arity, Make)] = &[
             Some(v) => Err(format!("bad catch_on_halt {v}")),
         }
     }),
+    // `UnsetBlackboardNode::providedPorts`: `key`, a string (the entry's name; `{x}`
+    // would read x's value as the name).
+    (&["UnsetBlackboard"], (0, 0), |a| {
+        let k = a.get("key").ok_or("missing `key`")?;
+        match entry(k) {
+            Some(_) => Err("UnsetBlackboard with `key` in {}: not modelled".into()),
+            None => Ok(Kind::Unset(k.trim().to_string())),
+        }
+    }),
+    // `EntryUpdatedAction` / `EntryUpdatedDecorator`: `entry`, with or without braces
+    // (`isBlackboardPointer` strips them); [`Flat::node`] writes it braced.
+    (&["WasEntryUpdated"], (0, 0), |a| {
+        Ok(Kind::EntryUpdated(updated_entry(a)?))
+    }),
+    (&["SkipUnlessUpdated"], (1, 1), |a| {
+        Ok(Kind::Updated(updated_entry(a)?, Status::Skipped))
+    }),
+    (&["WaitValueUpdate"], (1, 1), |a| {
+        Ok(Kind::Updated(updated_entry(a)?, Status::Running))
+    }),
+    (&["LoopInt"], (1, 1), |a| loop_node(a, LoopType::Int)),
+    (&["LoopDouble"], (1, 1), |a| loop_node(a, LoopType::Double)),
+    (&["LoopString"], (1, 1), |a| loop_node(a, LoopType::String)),
+    (&["LoopBool"], (1, 1), |a| loop_node(a, LoopType::Bool)),
     (&["AlwaysSuccess"], (0, 0), |_| Ok(Kind::AlwaysSuccess)),
     (&["AlwaysFailure"], (0, 0), |_| Ok(Kind::AlwaysFailure)),
     (&["SetBlackboard"], (0, 0), |a| {
@@ -401,6 +453,53 @@ fn operand(a: &Attrs, k: &str) -> Result<Operand, String> {
         Some(e) => Operand::Entry(e.to_string()),
         None => Operand::Lit(v.trim().to_string()),
     })
+}
+
+/// The `entry` port of the entry-updated nodes (braced by [`Flat::node`]).
+fn updated_entry(a: &Attrs) -> Result<String, String> {
+    let v = a.get("entry").ok_or("missing `entry`")?;
+    Ok(entry(v).unwrap_or(v.trim()).to_string())
+}
+
+/// The nodes whose `entry` port names an entry with or without braces.
+const UPDATED: [&str; 3] = ["WasEntryUpdated", "SkipUnlessUpdated", "WaitValueUpdate"];
+
+/// A `Loop<T>` node (4.10 `decorators/loop_node.h`). The queue is a literal: the
+/// constructor converts it (`convertFromString<SharedQueue<T>>`: `splitString` on `;`,
+/// each part converted, a part that does not convert refuses the tree at load; 4.8.2
+/// drops a last empty part, as found against the real library). `if_empty` defaults to
+/// SUCCESS; `value` is an output (unset: nothing written).
+fn loop_node(a: &Attrs, ty: LoopType) -> Result<Kind, String> {
+    let q = a.get("queue").ok_or("missing `queue`")?;
+    if entry(q).is_some() {
+        return Err("a Loop node over a queue entry: not modelled".into());
+    }
+    let mut parts: Vec<&str> = q.split(';').collect();
+    if parts.last() == Some(&"") {
+        parts.pop();
+    }
+    let items = parts
+        .iter()
+        .map(|p| {
+            let ok = match ty {
+                LoopType::Int => p.parse::<i32>().is_ok(),
+                LoopType::Double => p.parse::<f64>().is_ok(),
+                LoopType::String => true,
+                LoopType::Bool => matches!(*p, "true" | "false" | "1" | "0"),
+            };
+            ok.then(|| p.to_string())
+                .ok_or(format!("queue item `{p}` is not a {ty:?}"))
+        })
+        .collect::<Result<_, _>>()?;
+    let value = a.get("value").map(|v| match entry(v) {
+        Some(e) => Ok(e.to_string()),
+        None => Err(format!("`value` {v} is not an entry")),
+    });
+    let if_empty = match a.get("if_empty") {
+        None => Status::Success,
+        Some(s) => Status::parse(s).ok_or(format!("bad if_empty {s}"))?,
+    };
+    Ok(Kind::Loop(ty, items, value.transpose()?, if_empty))
 }
 
 /// A `SwitchN` node: `variable` and `case_1` ... `case_N` (each a literal).
@@ -590,8 +689,14 @@ impl Flat<'_> {
         }
         let depth = self.scopes.len() - 1;
         let mut attrs = el.attrs.clone();
+        if el.name == "UnsetBlackboard" && depth > 0 {
+            // `Blackboard::unset` erases the SubTree's own entry only, which a remapped
+            // key may or may not be: not modelled.
+            return Err("UnsetBlackboard inside a SubTree: not modelled".into());
+        }
         for (k, v) in attrs.iter_mut() {
-            if k == "output_key" && entry(v).is_none() {
+            let updated = k == "entry" && UPDATED.contains(&el.name.as_str());
+            if (k == "output_key" || updated) && entry(v).is_none() {
                 *v = format!("{{{}}}", v.trim());
             }
             if let Some(e) = entry(v) {

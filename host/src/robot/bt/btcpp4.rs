@@ -34,6 +34,7 @@ pub(super) fn node_name(k: Btcpp4) -> String {
         Btcpp4::Delay => "Delay".into(),
         Btcpp4::Sleep => "Sleep".into(),
         Btcpp4::TryCatch => "TryCatch".into(),
+        Btcpp4::Unset => "UnsetBlackboard".into(),
         Btcpp4::Script(s) => match s {
             ScriptNode::Script => "Script".into(),
             ScriptNode::Condition => "ScriptCondition".into(),
@@ -125,6 +126,7 @@ pub(super) fn lower(
         // `mod.rs` lowers them with `btcpp4_time.rs`, which needs the tree's clock.
         Btcpp4::Timeout | Btcpp4::Delay | Btcpp4::Sleep | Btcpp4::TryCatch => None,
         Btcpp4::Script(s) => super::btcpp4_script::lower(sm, s, n, ctx, bb, errs),
+        Btcpp4::Unset => super::btcpp4_blackboard::unset(sm, n, ctx, bb, errs),
         Btcpp4::Switch(cases) => {
             let pick = switch_pick(sm, k, cases as usize, n, bb, errs)?;
             if matches!(pick, SwitchPick::Entry(..)) {

@@ -20,7 +20,7 @@
 //!   BlackboardCheckInt / Double / String / Bool) are generated (`control.rs` and the
 //!   files it dispatches to, `blackboard.rs`; under BT.CPP's rules also BT.CPP 4's own
 //!   nodes, `btcpp4.rs`, and Timeout, Delay, Sleep and TryCatch, `btcpp4_time.rs`, whose
-//!   timers the root machine keeps); leaves are instances of their plugin
+//!   timers the root machine keeps, and UnsetBlackboard, `btcpp4_blackboard.rs`); leaves are instances of their plugin
 //!   (`plugin.rs`) and keep their ROS tags for the ROS lowering.
 //! - `bt_blackboard_fsm` when the tree names `{entries}`.
 //!
@@ -35,6 +35,7 @@
 mod blackboard;
 mod btcpp;
 mod btcpp4;
+mod btcpp4_blackboard;
 mod btcpp4_conds;
 mod btcpp4_script;
 mod btcpp4_time;

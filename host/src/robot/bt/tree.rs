@@ -69,6 +69,9 @@ pub(crate) enum Btcpp4 {
     /// `Script`, `ScriptCondition`, `Precondition`: BT.CPP 4's script language
     /// (`btcpp4_script.rs`).
     Script(ScriptNode),
+    /// `UnsetBlackboard` (`key`): an entry only scripts use loses its value
+    /// (`btcpp4_blackboard.rs`).
+    Unset,
 }
 
 /// The nodes that run a script.
@@ -177,6 +180,7 @@ impl Control {
             "Script" => Control::Btcpp4(Btcpp4::Script(ScriptNode::Script)),
             "ScriptCondition" => Control::Btcpp4(Btcpp4::Script(ScriptNode::Condition)),
             "Precondition" => Control::Btcpp4(Btcpp4::Script(ScriptNode::Precondition)),
+            "UnsetBlackboard" => Control::Btcpp4(Btcpp4::Unset),
             _ => return None,
         })
     }
@@ -200,7 +204,7 @@ impl Control {
                 | self::Btcpp4::RunOnce
                 | self::Btcpp4::Timeout
                 | self::Btcpp4::Delay => (1, 1),
-                self::Btcpp4::Sleep => (0, 0),
+                self::Btcpp4::Sleep | self::Btcpp4::Unset => (0, 0),
                 // The try block and the catch child (`TryCatchNode::tick`: at least 2).
                 self::Btcpp4::TryCatch => (2, usize::MAX),
                 // The cases and the default (BT.CPP 4.10 `switch_node.h`,
@@ -234,6 +238,7 @@ impl Control {
             Btcpp4(self::Btcpp4::TryCatch) => &["catch_on_halt"],
             Btcpp4(self::Btcpp4::Script(ScriptNode::Precondition)) => &["if", "else"],
             Btcpp4(self::Btcpp4::Script(_)) => &["code"],
+            Btcpp4(self::Btcpp4::Unset) => &["key"],
             _ => &[],
         }
     }
@@ -262,7 +267,7 @@ const SUPPORTED: &[&str] = &[
     "BlackboardCheckBool",
     "SubTree",
     "SubTreePlus (format 3)",
-    "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6, Timeout, Delay, Sleep, TryCatch, Script, ScriptCondition, Precondition (with `--bt btcpp`)",
+    "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6, Timeout, Delay, Sleep, TryCatch, Script, ScriptCondition, Precondition, UnsetBlackboard (with `--bt btcpp`)",
 ];
 
 /// BehaviorTree.CPP's other built-in nodes (the ones its `BehaviorTreeFactory`
@@ -273,34 +278,24 @@ pub(crate) const UNSUPPORTED: &[(&str, &str)] = &[
         "ManualSelector",
         "it asks a person at a terminal which child to run",
     ),
-    (
-        "UnsetBlackboard",
-        "entries in hindsight's blackboard always hold a value",
-    ),
-    ("LoopInt", "it pops from a queue held in the blackboard"),
-    ("LoopDouble", "it pops from a queue held in the blackboard"),
-    ("LoopString", "it pops from a queue held in the blackboard"),
-    ("LoopBool", "it pops from a queue held in the blackboard"),
-    (
-        "ConsumeQueue",
-        "it pops from a queue held in the blackboard",
-    ),
-    (
-        "PopFromQueue",
-        "it pops from a queue held in the blackboard",
-    ),
-    ("QueueSize", "it reads a queue held in the blackboard"),
+    ("LoopInt", "the lowering does not model its queue yet (docs/SEMANTICS.md)"),
+    ("LoopDouble", "the lowering does not model its queue yet (docs/SEMANTICS.md)"),
+    ("LoopString", "the lowering does not model its queue yet (docs/SEMANTICS.md)"),
+    ("LoopBool", "the lowering does not model its queue yet (docs/SEMANTICS.md)"),
+    ("ConsumeQueue", "BehaviorTree.CPP 4 does not register it: a C++ program registers it for its own queue type"),
+    ("PopFromQueue", "BehaviorTree.CPP 4 does not register it: a C++ program registers it for its own queue type"),
+    ("QueueSize", "BehaviorTree.CPP 4 does not register it: a C++ program registers it for its own queue type"),
     (
         "WasEntryUpdated",
-        "it needs the blackboard's update counters",
+        "the lowering does not model the blackboard's update counters yet (docs/SEMANTICS.md)",
     ),
     (
         "SkipUnlessUpdated",
-        "it needs the blackboard's update counters",
+        "the lowering does not model the blackboard's update counters yet (docs/SEMANTICS.md)",
     ),
     (
         "WaitValueUpdate",
-        "it needs the blackboard's update counters",
+        "the lowering does not model the blackboard's update counters yet (docs/SEMANTICS.md)",
     ),
 ];
 
@@ -777,6 +772,25 @@ impl Reader<'_> {
                 if !script_names.iter().any(|(n, _)| *n == name) {
                     let v = self.resolve_bb(&name, self.scopes.len());
                     script_names.push((name, v));
+                }
+            }
+        }
+        // UnsetBlackboard's `key` names an entry (`blackboard->unset(key)`), resolved as a
+        // script's names are; inside a SubTree `Blackboard::unset` erases the SubTree's
+        // own entry only, which a remapped key may or may not be: not modelled.
+        if let Kind::Control(Control::Btcpp4(Btcpp4::Unset)) = kind {
+            if let Some(p) = ports.iter().find(|p| p.key == "key") {
+                if let PortValue::Literal(k) = &p.value {
+                    let k = k.trim().to_string();
+                    if self.scopes.is_empty() && is_ident(&k) {
+                        if !script_names.iter().any(|(n, _)| *n == k) {
+                            script_names.push((k.clone(), PortValue::Blackboard(k)));
+                        }
+                    } else if !self.scopes.is_empty() {
+                        self.err(p.span, "UnsetBlackboard inside a SubTree is not modelled (BehaviorTree.CPP erases the SubTree's own entry only, which a remapped key may or may not be)".to_string());
+                    } else {
+                        self.err(p.span, format!("`{k}` is not a blackboard entry name"));
+                    }
                 }
             }
         }

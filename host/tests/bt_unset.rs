@@ -1,0 +1,100 @@
+//! BehaviorTree.CPP 4's UnsetBlackboard in a tree: lowered under `--bt btcpp` over an
+//! entry only scripts use; refused with file:line:col under AS2FM's semantics, inside a
+//! SubTree, with `key` in braces, and over an entry a SetBlackboard writes. The entry-
+//! updated and Loop nodes are refused, saying why. (What the lowered node does is held
+//! to the oracle by `tests/tests/bt_btcpp_lowering.rs`.)
+
+use hindsight::model::source::SourceMap;
+use hindsight::model::Diagnostics;
+use hindsight::robot::bt::{self, BtInput, BtSemantics, BtTick, Halts};
+
+const LEAF: &str = r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="Act">
+<state id="s"><bt_tick target="s"><bt_return_status status="SUCCESS"/></bt_tick></state>
+</ascxml>"#;
+
+const BTCPP: BtSemantics = BtSemantics::Btcpp { tick: BtTick::Once };
+
+/// Lowers a document (`body` inside the main tree, `more` after it); the errors, if any.
+fn lower(body: &str, more: &str, semantics: BtSemantics) -> Result<(), String> {
+    let tree = format!(
+        "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n{body}\n</BehaviorTree>\n{more}</root>\n"
+    );
+    let mut sm = SourceMap::new();
+    let t = sm.add("tree.xml", tree);
+    let plugins = vec![sm.add("act.ascxml", LEAF.to_string())];
+    bt::lower(
+        &sm,
+        &BtInput {
+            tree: t,
+            plugins,
+            tick_rate_hz: 1.0,
+            tick_if_not_running: false,
+            halts: Halts::As2fm,
+            semantics,
+        },
+    )
+    .map(|_| ())
+    .map_err(|ds| Diagnostics(ds).to_string())
+}
+
+#[test]
+fn unset_lowers_under_btcpp_over_a_script_entry() {
+    let body = "<Sequence>\n<Script code=\"x:=1\"/>\n<UnsetBlackboard key=\"x\"/>\n<Script code=\"x:=2\"/>\n</Sequence>";
+    lower(body, "", BTCPP).expect("lowers");
+    let e = lower(body, "", BtSemantics::As2fm).expect_err("AS2FM has no model");
+    assert!(
+        e.contains("tree.xml:5:1: `UnsetBlackboard` is a BehaviorTree.CPP 4 node that AS2FM has no model of"),
+        "{e}"
+    );
+}
+
+#[test]
+fn unset_is_refused_where_it_is_not_modelled() {
+    let e = lower(
+        "<SubTree ID=\"S\" _autoremap=\"true\"/>",
+        "<BehaviorTree ID=\"S\">\n<UnsetBlackboard key=\"x\"/>\n</BehaviorTree>\n",
+        BTCPP,
+    )
+    .expect_err("inside a SubTree");
+    assert!(
+        e.contains("tree.xml:6:23: UnsetBlackboard inside a SubTree is not modelled"),
+        "{e}"
+    );
+    let e = lower("<UnsetBlackboard key=\"{x}\"/>", "", BTCPP).expect_err("braces");
+    assert!(
+        e.contains("tree.xml:3:23: `key` of UnsetBlackboard is the entry's name"),
+        "{e}"
+    );
+    let e = lower(
+        "<Sequence>\n<SetBlackboard output_key=\"k\" value=\"1\"/>\n<UnsetBlackboard key=\"k\"/>\n</Sequence>",
+        "",
+        BTCPP,
+    )
+    .expect_err("a SetBlackboard entry");
+    assert!(
+        e.contains("tree.xml:5:23: UnsetBlackboard erases `k`, which a SetBlackboard writes"),
+        "{e}"
+    );
+}
+
+#[test]
+fn the_other_blackboard_nodes_are_refused_saying_why() {
+    for (node, why) in [
+        (
+            "<LoopInt queue=\"1;2\"><Act/></LoopInt>",
+            "does not model its queue yet",
+        ),
+        ("<WasEntryUpdated entry=\"x\"/>", "update counters"),
+        (
+            "<WaitValueUpdate entry=\"x\"><Act/></WaitValueUpdate>",
+            "update counters",
+        ),
+        ("<PopFromQueue queue=\"{q}\"/>", "does not register it"),
+    ] {
+        let e = lower(node, "", BTCPP).expect_err(node);
+        assert!(
+            e.contains("tree.xml:3:1: ") && e.contains(why),
+            "{node}: {e}"
+        );
+    }
+}
