@@ -384,6 +384,7 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
         let opts = gen::Options {
             btcpp4_nodes: true,
             scripts: true,
+            skipped: true,
             ..Default::default()
         };
         let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
@@ -396,7 +397,7 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
     let random = counts.runs;
     let mut files = Vec::new();
     let mut files_v3 = 0;
-    for dir in ["bt/btcpp", "bt/regressions", "bt/real"] {
+    for dir in ["bt/btcpp", "bt/btcpp4", "bt/regressions", "bt/real"] {
         for (file, c) in load(dir) {
             let ticks = c.ticks.unwrap_or(c.statuses.len()).max(1);
             let xml = doc(&c.tree);
