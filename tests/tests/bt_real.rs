@@ -171,6 +171,8 @@ const FEATURES: &[&str] = &[
     "<Precondition ",
     "_skipIf=",
     "_while=",
+    "<RunOnce>",
+    "else=\"SKIPPED\"",
     "_successIf=",
     "_failureIf=",
     "_onSuccess=",
