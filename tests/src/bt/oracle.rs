@@ -530,11 +530,10 @@ impl<'t> Oracle<'t> {
             None => {
                 let s = self.tick_inner(n)?;
                 // RunOnce answers its `then_skip` SKIPPED before `setStatus`.
-                let sets_running = !matches!(
-                    self.tree.nodes[n].kind,
-                    Kind::Precondition(..) | Kind::Switch(..)
-                ) && !(matches!(self.tree.nodes[n].kind, Kind::RunOnce(true))
-                    && self.once[n].is_some());
+                let kind = &self.tree.nodes[n].kind;
+                let keeps_status = matches!(kind, Kind::Precondition(..) | Kind::Switch(..))
+                    || (matches!(kind, Kind::RunOnce(true)) && self.once[n].is_some());
+                let sets_running = !keeps_status;
                 if s == Status::Skipped && sets_running {
                     // The controls and decorators set themselves RUNNING first
                     // (`setStatus(NodeStatus::RUNNING)` in their `tick`; not
