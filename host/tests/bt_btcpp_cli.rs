@@ -297,9 +297,9 @@ fn btcpp4_nodes_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         (
             "skip",
             "btcpp",
-            "<RunOnce>\n  <FailOnce/>\n</RunOnce>",
+            "<WhileDoElse>\n  <FailOnce/>\n  <RunOnce>\n    <FailOnce/>\n  </RunOnce>\n</WhileDoElse>",
             "<RunOnce>",
-            "answers SKIPPED",
+            "SKIPPED reaching a WhileDoElse is not modelled yet",
         ),
         (
             "case",
@@ -381,9 +381,9 @@ fn scripts_and_conditions_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         (
             "skip",
             "btcpp",
-            "<Sequence>\n  <FailOnce _skipIf=\"true\"/>\n</Sequence>",
-            "_skipIf",
-            "answer SKIPPED, a status hindsight does not model yet",
+            "<WhileDoElse>\n  <FailOnce/>\n  <FailOnce _skipIf=\"true\"/>\n</WhileDoElse>",
+            "<FailOnce _skipIf",
+            "SKIPPED reaching a WhileDoElse is not modelled yet",
         ),
         (
             "string",
@@ -416,9 +416,9 @@ fn scripts_and_conditions_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         (
             "else",
             "btcpp",
-            "<Precondition if=\"true\" else=\"SKIPPED\">\n  <FailOnce/>\n</Precondition>",
-            "SKIPPED\"",
-            "SKIPPED is not modelled yet",
+            "<Precondition if=\"true\" else=\"IDLE\">\n  <FailOnce/>\n</Precondition>",
+            "IDLE\"",
+            "`IDLE` is not SUCCESS, FAILURE, RUNNING or SKIPPED",
         ),
         (
             "stale",

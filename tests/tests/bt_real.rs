@@ -171,6 +171,8 @@ const FEATURES: &[&str] = &[
     "<Precondition ",
     "_skipIf=",
     "_while=",
+    "<RunOnce>",
+    "else=\"SKIPPED\"",
     "_successIf=",
     "_failureIf=",
     "_onSuccess=",
@@ -393,6 +395,7 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
         let opts = gen::Options {
             btcpp4_nodes: true,
             scripts: true,
+            skipped: true,
             ..Default::default()
         };
         let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);

@@ -90,6 +90,11 @@ pub struct Options {
     /// the main tree, over the script entries: what the lowering takes of the blackboard
     /// nodes. Off, the generator draws what it drew before.
     pub unset: bool,
+    /// SKIPPED from the nodes that make it besides `_skipIf` / `_while`
+    /// ([`Conditions::All`]): RunOnce with `then_skip` true (written, or left to its
+    /// default) half the time, and Precondition with `else="SKIPPED"` among its `else`
+    /// statuses. Off, the generator draws what it drew before.
+    pub skipped: bool,
 }
 
 /// The script entries: `x`, `y` integers, `f` a boolean, all written first by the main
@@ -281,7 +286,11 @@ impl<R: Rng> G<'_, R> {
                 esc(&self.bool_expr(1, true))
             ),
             _ => {
-                let e = self.pick(&["SUCCESS", "FAILURE", "RUNNING"]);
+                let e = if self.opts.skipped {
+                    self.pick(&["SUCCESS", "FAILURE", "RUNNING", "SKIPPED"])
+                } else {
+                    self.pick(&["SUCCESS", "FAILURE", "RUNNING"])
+                };
                 let cond = esc(&self.bool_expr(1, true));
                 let child = self.node(depth + 1);
                 format!("<Precondition if=\"{cond}\" else=\"{e}\">{child}</Precondition>")
@@ -384,6 +393,10 @@ impl<R: Rng> G<'_, R> {
                 "<KeepRunningUntilFailure>{}</KeepRunningUntilFailure>",
                 self.node(depth + 1)
             ),
+            5 if self.opts.skipped && self.below(2) == 0 => {
+                let attr = self.pick(&["", " then_skip=\"true\""]);
+                format!("<RunOnce{attr}>{}</RunOnce>", self.node(depth + 1))
+            }
             5 => format!(
                 "<RunOnce then_skip=\"false\">{}</RunOnce>",
                 self.node(depth + 1)

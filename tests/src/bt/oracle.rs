@@ -552,10 +552,13 @@ impl<'t> Oracle<'t> {
             Some(s) => s,
             None => {
                 let s = self.tick_inner(n)?;
-                let sets_running = !matches!(
-                    self.tree.nodes[n].kind,
+                // RunOnce answers its `then_skip` SKIPPED before `setStatus`.
+                let kind = &self.tree.nodes[n].kind;
+                let keeps_status = matches!(
+                    kind,
                     Kind::Precondition(..) | Kind::Switch(..) | Kind::Loop(..) | Kind::Updated(..)
-                );
+                ) || (matches!(kind, Kind::RunOnce(true)) && self.once[n].is_some());
+                let sets_running = !keeps_status;
                 if s == Status::Skipped && sets_running {
                     // The controls and decorators set themselves RUNNING first
                     // (`setStatus(NodeStatus::RUNNING)` in their `tick`; not
@@ -831,7 +834,7 @@ impl<'t> Oracle<'t> {
             &Kind::ParallelAll(f) => self.parallel_all(n, f),
             Kind::WhileDoElse => self.while_do_else(n),
             Kind::KeepRunningUntilFailure => self.keep_running(n),
-            Kind::RunOnce => self.run_once(n),
+            &Kind::RunOnce(skip) => self.run_once(n, skip),
             Kind::Switch(v, cases) => {
                 let (v, cases) = (v.clone(), cases.clone());
                 self.switch(n, &v, &cases)
@@ -1475,12 +1478,12 @@ impl<'t> Oracle<'t> {
         })
     }
 
-    /// `RunOnceNode::tick` (4.10) with `then_skip` false: once the child has finished
-    /// (then reset), the node answers that status for ever without ticking it; a halt
-    /// (`DecoratorNode::halt`) does not forget it.
-    fn run_once(&mut self, n: usize) -> Result<Status, Stop> {
+    /// `RunOnceNode::tick` (4.10): once the child has finished (then reset), the node
+    /// answers, without ticking it, SKIPPED with `then_skip` (`skip`, the default), else
+    /// that status, for ever; a halt (`DecoratorNode::halt`) does not forget it.
+    fn run_once(&mut self, n: usize, skip: bool) -> Result<Status, Stop> {
         if let Some(s) = self.once[n] {
-            return Ok(s);
+            return Ok(if skip { Status::Skipped } else { s });
         }
         let c = self.child(n, 0);
         let s = self.tick(c)?;

@@ -123,9 +123,9 @@ pub enum Kind {
     WhileDoElse,
     /// `KeepRunningUntilFailure` (BT.CPP 4).
     KeepRunningUntilFailure,
-    /// `RunOnce` with `then_skip="false"` (BT.CPP 4; skipping answers SKIPPED, a status
-    /// the oracle does not model).
-    RunOnce,
+    /// `RunOnce` and its `then_skip` (BT.CPP 4; true, the default, answers SKIPPED once
+    /// the child has run).
+    RunOnce(bool),
     /// `Switch2` ... `Switch6`: the `variable` and the `case_1..N` values (BT.CPP 4).
     Switch(Operand, Vec<String>),
     /// `BlackboardCheckInt/Double/String/Bool`: `value_A`, `value_B`,
@@ -181,7 +181,7 @@ impl Kind {
                 | Kind::ParallelAll(_)
                 | Kind::WhileDoElse
                 | Kind::KeepRunningUntilFailure
-                | Kind::RunOnce
+                | Kind::RunOnce(_)
                 | Kind::Switch(..)
                 | Kind::Script(_)
                 | Kind::ScriptCondition(_)
@@ -325,10 +325,12 @@ pub const NODES: &[(&[&str], Arity, Make)] = &[
     (&["KeepRunningUntilFailure"], (1, 1), |_| {
         Ok(Kind::KeepRunningUntilFailure)
     }),
+    // `RunOnceNode::providedPorts`: `then_skip` defaults to true.
     (&["RunOnce"], (1, 1), |a| {
         match a.get("then_skip").map(|s| s.trim()) {
-            Some("false") => Ok(Kind::RunOnce),
-            _ => Err("RunOnce without then_skip=\"false\" answers SKIPPED, which the oracle does not model".into()),
+            Some("false") => Ok(Kind::RunOnce(false)),
+            None | Some("true") => Ok(Kind::RunOnce(true)),
+            Some(o) => Err(format!("bad then_skip {o}")),
         }
     }),
     (&["Switch2"], (3, 3), |a| switch(a, 2)),

@@ -36,6 +36,8 @@ impl Watch<'_> {
             Some(Value::Int(1)) => Status::Success,
             Some(Value::Int(2)) => Status::Failure,
             Some(Value::Int(3)) => Status::Running,
+            // SKIPPED, the node IDLE (4) or RUNNING (5) afterwards (`--bt btcpp`).
+            Some(Value::Int(4 | 5)) => Status::Skipped,
             other => {
                 self.bad = Some(format!("root answered {other:?}"));
                 return Flow::Stop;

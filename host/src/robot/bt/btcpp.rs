@@ -30,7 +30,10 @@
 //! `if_then_else`).
 
 use super::build::B;
-use super::control::{format_rate, init_state, n_children, Ctx, FAILURE, RUNNING, SUCCESS};
+use super::control::{
+    format_rate, init_state, n_children, on_child_skipped, Ctx, FAILURE, IS_SKIPPED, RUNNING,
+    SKIPPED_RUNNING, SKIP_COUNT, SUCCESS,
+};
 use crate::model::xml::Element;
 
 /// The event a node sends the root machine when it emits the wake-up signal.
@@ -102,6 +105,7 @@ pub(super) fn sequence_with_memory(ctx: &Ctx) -> Element {
         (idx, "int8", "0".to_string()),
         (h, "int8", "0".to_string()),
         ("children_count", "int8", n_children(ctx)),
+        (SKIP_COUNT, "int8", "0".to_string()),
     ];
     data.extend(flags.iter().map(|(v, t, e)| (v.as_str(), *t, e.clone())));
     m.push(b.datamodel(&data));
@@ -121,6 +125,15 @@ pub(super) fn sequence_with_memory(ctx: &Ctx) -> Element {
         vec![ctx.dispatch(idx, false)],
     );
     let mut t = b.state_entry("tick_children", vec![guard]);
+    // 4.10 `SequenceWithMemory::tick`, `case NodeStatus::SKIPPED`: on to the next child,
+    // counted in `skipped_count_` (cleared when the node starts IDLE: after it finished,
+    // was halted, or failed and was reset by its parent).
+    on_child_skipped(ctx, &mut t, idx, "tick_children", || {
+        vec![
+            b.assign(idx, &format!("{idx} + 1")),
+            b.assign(SKIP_COUNT, &format!("{SKIP_COUNT} + 1")),
+        ]
+    });
     for i in 0..ctx.children.len() {
         let r = running(ctx, i);
         let resp = ctx.child_resp(i);
@@ -169,23 +182,33 @@ pub(super) fn sequence_with_memory(ctx: &Ctx) -> Element {
         vec![],
     ));
     m.push(t);
+    // Every child skipped: SKIPPED (the node set itself RUNNING first).
+    let all_skipped = b
+        .if_chain(
+            vec![(
+                format!("{SKIP_COUNT} == children_count"),
+                vec![ctx.respond(SKIPPED_RUNNING)],
+            )],
+            vec![ctx.respond(SUCCESS)],
+        )
+        .expect("one branch");
     m.push(halting_state(
         ctx,
         "halting_on_success",
         h,
-        vec![b.assign(idx, "0"), ctx.respond(SUCCESS)],
+        vec![b.assign(idx, "0"), all_skipped, b.assign(SKIP_COUNT, "0")],
     ));
     m.push(halting_state(
         ctx,
         "halting_on_failure",
         h,
-        vec![ctx.respond(FAILURE)],
+        vec![ctx.respond(FAILURE), b.assign(SKIP_COUNT, "0")],
     ));
     m.push(halting_state(
         ctx,
         "halting_on_halt",
         h,
-        vec![ctx.respond_halted()],
+        vec![ctx.respond_halted(), b.assign(SKIP_COUNT, "0")],
     ));
     m.push(b.state("error"));
     m
@@ -298,8 +321,29 @@ pub(super) fn repeat(ctx: &Ctx, n: i64, retry: bool) -> Element {
                 Some(&is(RUNNING)),
                 Some("wait_for_tick"),
                 vec![b.assign(&r, "true"), ctx.respond(RUNNING)],
+            ))
+            // 4.10 `RepeatNode::tick` / `RetryNode::tick`, `case NodeStatus::SKIPPED`:
+            // `resetChild()` (a halt only if it still runs, code 5) and SKIPPED, the
+            // count kept.
+            .with_child(b.tr(
+                Some(&resp),
+                Some(&format!("_event.data.status == {SKIPPED_RUNNING}")),
+                Some("halting_skipped"),
+                ctx.halt_child_body(0),
+            ))
+            .with_child(b.tr(
+                Some(&resp),
+                Some(IS_SKIPPED),
+                Some("wait_for_tick"),
+                vec![b.assign(&r, "false"), ctx.respond(SKIPPED_RUNNING)],
             )),
     );
+    m.push(b.state("halting_skipped").with_child(b.tr(
+        Some(&ctx.child_halt_resp(0)),
+        None,
+        Some("wait_for_tick"),
+        vec![ctx.respond(SKIPPED_RUNNING)],
+    )));
     m.push(b.state("error"));
     m
 }
@@ -312,7 +356,12 @@ pub(super) fn repeat(ctx: &Ctx, n: i64, retry: bool) -> Element {
 /// cases clearing what it remembers and resetting the children (`clear`,
 /// `resetChildren`); RUNNING after the last child. `ParallelNode::halt` clears and
 /// resets the children. The thresholds are already resolved (`-1`: all children).
-pub(super) fn parallel(ctx: &Ctx, success: i64, failure: i64) -> Element {
+///
+/// SKIPPED (4.10 `ParallelNode::tick`): a skipped child is not finished; the children
+/// skipped in this tick count towards a success threshold written negative
+/// (`success_neg`), and every child skipped answers SKIPPED (the node set itself
+/// RUNNING first).
+pub(super) fn parallel(ctx: &Ctx, success: i64, failure: i64, success_neg: bool) -> Element {
     let b = &ctx.b;
     let (idx, h) = ("current_child_idx", "halt_idx");
     let n = ctx.children.len();
@@ -326,6 +375,7 @@ pub(super) fn parallel(ctx: &Ctx, success: i64, failure: i64) -> Element {
         (h.into(), "int8", "0".into()),
         ("success_count".into(), "int8", "0".into()),
         ("failure_count".into(), "int8", "0".into()),
+        (SKIP_COUNT.into(), "int8", "0".into()),
     ];
     data.extend((0..n).map(|i| (done(i), "bool", "false".to_string())));
     data.extend(ctx.running_data());
@@ -341,7 +391,7 @@ pub(super) fn parallel(ctx: &Ctx, success: i64, failure: i64) -> Element {
                 Some(&ctx.tick_ev()),
                 None,
                 Some("tick_current_child"),
-                vec![b.assign(idx, "0")],
+                vec![b.assign(idx, "0"), b.assign(SKIP_COUNT, "0")],
             ))
             .with_child(b.tr(
                 Some(&ctx.halt_ev()),
@@ -367,10 +417,21 @@ pub(super) fn parallel(ctx: &Ctx, success: i64, failure: i64) -> Element {
     let mut t = b.state_entry("tick_current_child", vec![tick]);
     t.push(b.tr(
         None,
+        Some(&format!(
+            "{idx} >= children_count && {SKIP_COUNT} == children_count"
+        )),
+        Some("wait_for_tick"),
+        vec![ctx.respond(SKIPPED_RUNNING)],
+    ));
+    t.push(b.tr(
+        None,
         Some(&format!("{idx} >= children_count")),
         Some("wait_for_tick"),
         vec![ctx.respond(RUNNING)],
     ));
+    on_child_skipped(ctx, &mut t, idx, "eval_after_child", || {
+        vec![b.assign(SKIP_COUNT, &format!("{SKIP_COUNT} + 1"))]
+    });
     for i in 0..n {
         t.push(b.tr(
             None,
@@ -413,7 +474,11 @@ pub(super) fn parallel(ctx: &Ctx, success: i64, failure: i64) -> Element {
         b.state("eval_after_child")
             .with_child(b.tr(
                 None,
-                Some("success_count >= success_threshold"),
+                Some(&if success_neg {
+                    format!("success_count + {SKIP_COUNT} >= success_threshold")
+                } else {
+                    "success_count >= success_threshold".to_string()
+                }),
                 Some("halting_after_success"),
                 vec![b.assign(h, "0")],
             ))

@@ -15,7 +15,10 @@
 
 use super::blackboard::Blackboard;
 use super::btcpp::{halting_state, running, yield_running};
-use super::control::{init_state, n_children, Ctx, FAILURE, RUNNING, SUCCESS};
+use super::control::{
+    init_state, n_children, on_child_skipped, Ctx, FAILURE, IS_SKIPPED, RUNNING, SKIPPED,
+    SKIPPED_RUNNING, SKIP_COUNT, SUCCESS,
+};
 use super::tree::{Btcpp4, PortValue, ScriptNode, TreeNode};
 use crate::model::source::{Diagnostic, SourceMap};
 use crate::model::xml::Element;
@@ -67,10 +70,12 @@ pub(super) fn lower(
         // `KeepRunningUntilFailureNode::tick` (4.10 `decorators/
         // keep_running_until_failure_node.h`): a finished child is reset
         // (`resetChild`), its SUCCESS answered RUNNING (no wake-up), its FAILURE
-        // FAILURE, RUNNING RUNNING: the one-child decorator's machine.
-        Btcpp4::KeepRunningUntilFailure => Some(super::decorators::decorator(
+        // FAILURE, RUNNING RUNNING: the one-child decorator's machine. A SKIPPED child
+        // is not reset and the node answers `status()`, the RUNNING it set itself.
+        Btcpp4::KeepRunningUntilFailure => Some(super::decorators::decorator_skipping(
             ctx,
             [RUNNING, FAILURE, RUNNING],
+            RUNNING,
         )),
         Btcpp4::ParallelAll => {
             // `max_failures` defaults to 1 (`ParallelAllNode::providedPorts`).
@@ -112,16 +117,7 @@ pub(super) fn lower(
                     return None;
                 }
             };
-            match skip {
-                Some((false, _)) => Some(run_once(ctx)),
-                other => {
-                    errs.push(sm.diag(
-                        other.map_or(n.span, |(_, s)| s),
-                        "RunOnce with `then_skip` true (BehaviorTree.CPP's default) answers SKIPPED once its child has run, a status hindsight does not model: write then_skip=\"false\" (it then answers the child's status again)",
-                    ));
-                    None
-                }
-            }
+            Some(run_once(ctx, skip.is_none_or(|(s, _)| s)))
         }
         // `mod.rs` lowers them with `btcpp4_time.rs`, which needs the tree's clock.
         Btcpp4::Timeout | Btcpp4::Delay | Btcpp4::Sleep | Btcpp4::TryCatch => None,
@@ -252,6 +248,7 @@ pub(super) fn async_sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
             (idx, "int8", "0".into()),
             (h, "int8", "0".into()),
             ("children_count", "int8", n_children(ctx)),
+            (SKIP_COUNT, "int8", "0".into()),
         ],
     );
     m.push(init_state(ctx, "children_count < 1"));
@@ -306,6 +303,13 @@ pub(super) fn async_sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
             vec![b.assign(&r, "true"), ctx.respond(RUNNING)],
         ));
     }
+    // `case NodeStatus::SKIPPED`: on to the next child, counted (`skipped_count_`).
+    on_child_skipped(ctx, &mut t, idx, "tick_children", || {
+        vec![
+            b.assign(idx, &format!("{idx} + 1")),
+            b.assign(SKIP_COUNT, &format!("{SKIP_COUNT} + 1")),
+        ]
+    });
     t.push(b.tr(
         None,
         Some(&format!("{idx} == children_count")),
@@ -319,8 +323,18 @@ pub(super) fn async_sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
         vec![],
     ));
     m.push(t);
+    // Every child skipped answers SKIPPED (the node set itself RUNNING first).
+    let on_cont = b
+        .if_chain(
+            vec![(
+                format!("{SKIP_COUNT} == children_count"),
+                vec![ctx.respond(SKIPPED_RUNNING)],
+            )],
+            vec![ctx.respond(cont)],
+        )
+        .expect("one branch");
     for (state, answer) in [
-        ("halting_on_cont", ctx.respond(cont)),
+        ("halting_on_cont", on_cont),
         ("halting_on_stop", ctx.respond(stop)),
         ("halting_on_halt", ctx.respond_halted()),
     ] {
@@ -328,7 +342,7 @@ pub(super) fn async_sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
             ctx,
             state,
             h,
-            vec![b.assign(idx, "0"), answer],
+            vec![b.assign(idx, "0"), answer, b.assign(SKIP_COUNT, "0")],
         ));
     }
     m.push(b.state("error"));
@@ -356,6 +370,7 @@ pub(super) fn parallel_all(ctx: &Ctx, threshold: i64) -> Element {
         (h.into(), "int8", "0".into()),
         ("done_count".into(), "int8", "0".into()),
         ("failure_count".into(), "int8", "0".into()),
+        (SKIP_COUNT.into(), "int8", "0".into()),
     ];
     vars.extend((0..n).map(|i| (done(i), "bool", "false".to_string())));
     let vars: Vec<(&str, &str, String)> = vars
@@ -370,7 +385,7 @@ pub(super) fn parallel_all(ctx: &Ctx, threshold: i64) -> Element {
                 Some(&ctx.tick_ev()),
                 None,
                 Some("tick_current_child"),
-                vec![b.assign(idx, "0")],
+                vec![b.assign(idx, "0"), b.assign(SKIP_COUNT, "0")],
             ))
             .with_child(b.tr(
                 Some(&ctx.halt_ev()),
@@ -393,10 +408,27 @@ pub(super) fn parallel_all(ctx: &Ctx, threshold: i64) -> Element {
         )
         .expect("ParallelAll has children");
     let mut t = b.state_entry("tick_current_child", vec![tick]);
+    // 4.10 `ParallelAllNode::tick`: a skipped child counts as finished for this tick only
+    // (`skipped_count`); every child skipped answers SKIPPED (the node set itself
+    // RUNNING first), nothing cleared.
     t.push(b.tr(
         None,
         Some(&format!(
-            "{idx} >= children_count && done_count >= children_count"
+            "{idx} >= children_count && {SKIP_COUNT} == children_count"
+        )),
+        Some("wait_for_tick"),
+        vec![ctx.respond(SKIPPED_RUNNING)],
+    ));
+    on_child_skipped(ctx, &mut t, idx, "tick_current_child", || {
+        vec![
+            b.assign(SKIP_COUNT, &format!("{SKIP_COUNT} + 1")),
+            b.assign(idx, &format!("{idx} + 1")),
+        ]
+    });
+    t.push(b.tr(
+        None,
+        Some(&format!(
+            "{idx} >= children_count && done_count + {SKIP_COUNT} >= children_count"
         )),
         Some("halting_when_done"),
         vec![b.assign(h, "0")],
@@ -645,13 +677,15 @@ pub(super) fn while_do_else(ctx: &Ctx) -> Element {
     m
 }
 
-/// RunOnce with `then_skip` false as BT.CPP 4.10 runs it
-/// (`decorators/run_once_node.h`, `RunOnceNode::tick`): until the child has finished
-/// once the node ticks it and answers as it does; its first finished status is kept
-/// (`returned_status_`), the child reset, and every later tick answers that status
-/// without ticking the child. A halt (`DecoratorNode::halt`) resets the child (halting it
-/// if RUNNING) and keeps what it remembers.
-pub(super) fn run_once(ctx: &Ctx) -> Element {
+/// RunOnce as BT.CPP 4.10 runs it (`decorators/run_once_node.h`, `RunOnceNode::tick`):
+/// until the child has finished once the node ticks it and answers as it does (a
+/// SKIPPED child is not finished: SKIPPED, the node RUNNING as it set itself); its first
+/// finished status is kept (`returned_status_`), the child reset, and every later tick
+/// answers, without ticking the child, SKIPPED with `then_skip` (`skip`, the default;
+/// the node's own status untouched, so IDLE: code 4), else that status. A halt
+/// (`DecoratorNode::halt`) resets the child (halting it if RUNNING) and keeps what it
+/// remembers.
+pub(super) fn run_once(ctx: &Ctx, skip: bool) -> Element {
     let b = &ctx.b;
     let once = "returned_status";
     let mut m = b.scxml(&ctx.machine, "init");
@@ -670,7 +704,11 @@ pub(super) fn run_once(ctx: &Ctx) -> Element {
             Some(&ctx.tick_ev()),
             Some(&format!("{once} > 0")),
             Some("wait_for_tick"),
-            vec![ctx.respond_expr(once)],
+            vec![if skip {
+                ctx.respond(SKIPPED)
+            } else {
+                ctx.respond_expr(once)
+            }],
         ))
         .with_child(b.tr(Some(&ctx.tick_ev()), None, Some("tick_child"), vec![]));
     for t in ctx.halt_single("halting_child", Vec::new()) {
@@ -692,6 +730,14 @@ pub(super) fn run_once(ctx: &Ctx) -> Element {
             ctx.marked(0, s, body),
         ));
     }
+    let mut body: Vec<Element> = ctx.mark_skipped(0).into_iter().collect();
+    body.push(ctx.respond(SKIPPED_RUNNING));
+    t.push(b.tr(
+        Some(&ctx.child_resp(0)),
+        Some(IS_SKIPPED),
+        Some("wait_for_tick"),
+        body,
+    ));
     m.push(t);
     m.push(b.state("error"));
     m

@@ -1,5 +1,6 @@
-//! BehaviorTree.CPP 4's pre/post conditions (`_failureIf`, `_successIf`, `_onSuccess`,
-//! `_onFailure`, `_post`, `_onHalted`) on any node, under [`super::BtSemantics::Btcpp`].
+//! BehaviorTree.CPP 4's pre/post conditions (`_failureIf`, `_successIf`, `_skipIf`,
+//! `_while`, `_onSuccess`, `_onFailure`, `_post`, `_onHalted`) on any node, under
+//! [`super::BtSemantics::Btcpp`].
 //!
 //! A node with conditions gets a second machine between it and its parent,
 //! `<node machine>_conditions`: the parent ticks and halts it with `bt_<id>_cond_tick` /
@@ -11,7 +12,10 @@
 //!   node's `tick` is not called; `checkPostConditions` for a finished answer (SUCCESS or
 //!   FAILURE, whoever decided it).
 //! - `TreeNode::checkPreConditions`: only while the node is IDLE, `_failureIf` (true:
-//!   FAILURE) then `_successIf` (true: SUCCESS); not while it is RUNNING.
+//!   FAILURE), `_successIf` (true: SUCCESS), `_skipIf` (true: SKIPPED), `_while` (false:
+//!   SKIPPED), the node IDLE still (status 4, `control.rs`); while it is RUNNING only
+//!   `_while`, whose false halts the node (`haltNode`) and answers SKIPPED. A SKIPPED
+//!   the node itself answers is passed on (4 or 5), and 5 leaves the node RUNNING.
 //! - `TreeNode::checkPostConditions`: `_onSuccess` or `_onFailure`, then `_post`.
 //! - `TreeNode::haltNode`: the node's `halt`, then `_onHalted` (a parent halts a child
 //!   only while it is RUNNING, `ControlNode::haltChild`).
@@ -20,13 +24,12 @@
 //! that finished before ticking it again, except the condition of a two-child
 //! IfThenElse or of a WhileDoElse and the child of a BlackboardCheck, which BT.CPP may
 //! tick again in its finished status (skipping its pre-conditions); conditions there are
-//! refused. Also refused (not modelled yet): `_skipIf` and `_while` (the SKIPPED status),
-//! conditions on the tree's root node.
+//! refused. Also refused (not modelled yet): conditions on the tree's root node.
 
 use super::blackboard::{Blackboard, MACHINE};
 use super::btcpp4_script::compile;
 use super::build::B;
-use super::control::{Ctx, FAILURE, RUNNING, SUCCESS};
+use super::control::{Ctx, FAILURE, IS_SKIPPED, RUNNING, SKIPPED, SKIPPED_RUNNING, SUCCESS};
 use super::tree::{Btcpp4, Control, Kind, Tree, TreeNode};
 use crate::model::source::{Diagnostic, SourceMap};
 use crate::model::xml::Element;
@@ -54,8 +57,6 @@ pub(super) fn refusals(sm: &SourceMap, tree: &Tree, i: usize, btcpp: bool) -> Ve
     for c in &n.conds {
         let why = if !btcpp {
             "AS2FM has no model of BehaviorTree.CPP's script language, so the default semantics (`--bt as2fm`) cannot lower it: use `--bt btcpp` (BehaviorTree.CPP 4's rules)"
-        } else if c.attr == "_skipIf" || c.attr == "_while" {
-            "it makes the node answer SKIPPED, a status hindsight does not model yet"
         } else if let Some(p) = n.parent {
             let p = &tree.nodes[p];
             let first = p.children.first() == Some(&i);
@@ -85,6 +86,9 @@ pub(super) fn refusals(sm: &SourceMap, tree: &Tree, i: usize, btcpp: bool) -> Ve
 
 fn pre_event(id: u32) -> String {
     format!("bt_script_{id}_pre")
+}
+fn while_event(id: u32) -> String {
+    format!("bt_script_{id}_while")
 }
 fn post_event(id: u32, s: u8) -> String {
     format!("bt_script_{id}_post_{s}")
@@ -131,11 +135,13 @@ fn chain(
         let label = format!("`{}`", c.attr);
         let next = rest.clone();
         let reply = reply.clone();
+        // `_while` decides the answer (SKIPPED) when it is false.
+        let negate = c.attr == "_while";
         let then = move |v: Option<String>| match (v, stop) {
             (Some(v), Some(s)) => vec![b
                 .if_chain(
                     vec![(
-                        v,
+                        if negate { format!("!({v})") } else { v },
                         vec![b.send_params(&reply, wrapper, &[("status", &s.to_string())])],
                     )],
                     next.clone(),
@@ -186,7 +192,24 @@ pub(super) fn wrapper(
         b,
         &me,
         &pre_event(id),
-        &[("_failureIf", Some(FAILURE)), ("_successIf", Some(SUCCESS))],
+        &[
+            ("_failureIf", Some(FAILURE)),
+            ("_successIf", Some(SUCCESS)),
+            ("_skipIf", Some(SKIPPED)),
+            ("_while", Some(SKIPPED)),
+        ],
+        bb,
+        errs,
+        &mut ok,
+    );
+    // `_while` is checked again while the node is RUNNING.
+    let has_while = chain(
+        sm,
+        n,
+        b,
+        &me,
+        &while_event(id),
+        &[("_while", Some(SKIPPED))],
         bb,
         errs,
         &mut ok,
@@ -243,12 +266,16 @@ pub(super) fn wrapper(
         (run, "bool", "false".into()),
         ("result", "int8", "0".into()),
     ]));
-    let mut w = b.state("wait_for_tick").with_child(b.tr(
-        Some(&tick),
-        Some(run),
-        Some("ticking"),
-        vec![tick_inner()],
-    ));
+    let mut w = b.state("wait_for_tick");
+    if has_while {
+        w.push(b.tr(
+            Some(&tick),
+            Some(run),
+            Some("while_check"),
+            vec![b.send(&while_event(id), MACHINE)],
+        ));
+    }
+    w.push(b.tr(Some(&tick), Some(run), Some("ticking"), vec![tick_inner()]));
     if has_pre {
         w.push(b.tr(
             Some(&tick),
@@ -266,6 +293,51 @@ pub(super) fn wrapper(
     ));
     w.push(b.tr(Some(&halt), None, Some("wait_for_tick"), vec![halted()]));
     m.push(w);
+    if has_while {
+        // `checkPreConditions` on a RUNNING node: `_while` false halts it (`haltNode`:
+        // its `halt`, then `_onHalted`) and answers SKIPPED; the node is IDLE then.
+        let ev = done(&while_event(id));
+        m.push(
+            b.state("while_check")
+                .with_child(b.tr(
+                    Some(&ev),
+                    Some("_event.data.status == 0"),
+                    Some("ticking"),
+                    vec![tick_inner()],
+                ))
+                .with_child(b.tr(
+                    Some(&ev),
+                    None,
+                    Some("while_halting"),
+                    vec![b.send(&format!("bt_{id}_halt"), &n.machine)],
+                )),
+        );
+        let skipped = respond(&SKIPPED.to_string());
+        let mut h = b.state("while_halting");
+        if has_halted {
+            h.push(b.tr(
+                Some(&halt_resp),
+                None,
+                Some("while_on_halted"),
+                vec![b.assign(run, "false"), b.send(&halted_event(id), MACHINE)],
+            ));
+            m.push(h);
+            m.push(b.state("while_on_halted").with_child(b.tr(
+                Some(&done(&halted_event(id))),
+                None,
+                Some("wait_for_tick"),
+                vec![skipped],
+            )));
+        } else {
+            h.push(b.tr(
+                Some(&halt_resp),
+                None,
+                Some("wait_for_tick"),
+                vec![b.assign(run, "false"), skipped],
+            ));
+            m.push(h);
+        }
+    }
     if has_pre {
         let ev = done(&pre_event(id));
         m.push(
@@ -275,6 +347,14 @@ pub(super) fn wrapper(
                     Some("_event.data.status == 0"),
                     Some("ticking"),
                     vec![tick_inner()],
+                ))
+                // `_skipIf` true or `_while` false on an IDLE node: SKIPPED, the node
+                // left IDLE, no post-condition (`isStatusCompleted` is false).
+                .with_child(b.tr(
+                    Some(&ev),
+                    Some(&format!("_event.data.status == {SKIPPED}")),
+                    Some("wait_for_tick"),
+                    vec![respond(&SKIPPED.to_string())],
                 ))
                 .with_child(b.tr(
                     Some(&ev),
@@ -291,6 +371,17 @@ pub(super) fn wrapper(
                 Some(&format!("_event.data.status == {RUNNING}")),
                 Some("wait_for_tick"),
                 vec![b.assign(run, "true"), respond(&RUNNING.to_string())],
+            ))
+            // The node's own SKIPPED: passed on, the node RUNNING still if it set
+            // itself so (code 5); no post-condition.
+            .with_child(b.tr(
+                Some(&resp),
+                Some(IS_SKIPPED),
+                Some("wait_for_tick"),
+                vec![
+                    b.assign(run, &format!("_event.data.status == {SKIPPED_RUNNING}")),
+                    respond("_event.data.status"),
+                ],
             ))
             .with_child(b.tr(
                 Some(&resp),

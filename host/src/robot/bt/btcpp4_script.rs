@@ -444,11 +444,12 @@ pub(super) fn lower(
                 None => FAILURE,
                 Some((PortValue::Literal(v), span)) => match super::control::status_code(v) {
                     Some(s) => s,
+                    // `else` is answered only while the child has not started, so the
+                    // node is not RUNNING then: SKIPPED with the node IDLE (code 4).
+                    None if v.trim() == "SKIPPED" => super::control::SKIPPED,
                     None => {
-                        let why = match v.trim() {
-                            "SKIPPED" => "SKIPPED is not modelled yet".to_string(),
-                            other => format!("`{other}` is not SUCCESS, FAILURE or RUNNING"),
-                        };
+                        let why =
+                            format!("`{}` is not SUCCESS, FAILURE, RUNNING or SKIPPED", v.trim());
                         errs.push(sm.diag(span, format!("`else` of Precondition: {why}")));
                         return None;
                     }

@@ -20,6 +20,17 @@ pub(crate) const SUCCESS: u8 = 1;
 pub(crate) const FAILURE: u8 = 2;
 /// Status code of RUNNING.
 pub(crate) const RUNNING: u8 = 3;
+/// Status code of SKIPPED from a node that is IDLE afterwards (BT.CPP 4 only: a
+/// pre-condition skipped it, or it answers SKIPPED without setting its own status;
+/// `TreeNode::executeTick` does not store SKIPPED, 4.10 `tree_node.cpp`).
+pub(crate) const SKIPPED: u8 = 4;
+/// Status code of SKIPPED from a node that set itself RUNNING before every child was
+/// skipped (`setStatus(NodeStatus::RUNNING)` at the top of most controls' and
+/// decorators' `tick`): its parent sees a RUNNING child, and halts it when it resets it
+/// (`ControlNode::haltChild`). Every parent reads 4 and 5 alike otherwise.
+pub(crate) const SKIPPED_RUNNING: u8 = 5;
+/// The guard of a SKIPPED answer (4 or 5).
+pub(crate) const IS_SKIPPED: &str = "_event.data.status >= 4";
 
 /// The code of a status name (`SUCCESS`, `FAILURE`, `RUNNING`).
 pub(crate) fn status_code(name: &str) -> Option<u8> {
@@ -184,6 +195,14 @@ impl Ctx {
             Some(c) => vec![at_once(Some(&c)), go],
         }
     }
+    /// Records that child `i` answered SKIPPED: RUNNING still when the code is 5.
+    pub fn mark_skipped(&self, i: usize) -> Option<Element> {
+        let v = self.running_var(i)?;
+        Some(
+            self.b
+                .assign(&v, &format!("_event.data.status == {SKIPPED_RUNNING}")),
+        )
+    }
     /// `body` followed by the record that child `i` answered `status`.
     pub(crate) fn marked(&self, i: usize, status: u8, mut body: Vec<Element>) -> Vec<Element> {
         body.extend(self.mark(i, status));
@@ -275,6 +294,30 @@ pub(crate) fn machine(c: Control, ctx: &Ctx, num: &[i64]) -> Element {
     }
 }
 
+/// The count of children skipped since the node last finished (`skipped_count_`).
+pub(super) const SKIP_COUNT: &str = "skipped_count";
+
+/// Under BT.CPP's rules, one transition per child: its SKIPPED answer while `idx` points
+/// at it goes to `target`, recording whether it still runs, doing `body()`.
+pub(super) fn on_child_skipped(
+    ctx: &Ctx,
+    t: &mut Element,
+    idx: &str,
+    target: &str,
+    body: impl Fn() -> Vec<Element>,
+) {
+    for i in 0..ctx.children.len() {
+        let mut v: Vec<Element> = ctx.mark_skipped(i).into_iter().collect();
+        v.extend(body());
+        t.push(ctx.b.tr(
+            Some(&ctx.child_resp(i)),
+            Some(&format!("{IS_SKIPPED} && {idx} == {i}")),
+            Some(target),
+            v,
+        ));
+    }
+}
+
 /// One transition per child, as AS2FM writes them: the child's response with `status`
 /// while `idx` points at it goes to `target` doing `body()`.
 pub(super) fn on_child_status(
@@ -304,6 +347,10 @@ pub(super) fn sequence_head(ctx: &Ctx, idx: &str, flags: &[&str]) -> Element {
     let mut data = vec![(idx, "int8", "0".to_string())];
     data.extend(flags.iter().map(|f| (*f, "bool", "false".to_string())));
     data.push(("children_count", "int8", n_children(ctx)));
+    // BT.CPP 4.10 `SequenceNode` / `FallbackNode`: `skipped_count_`.
+    if ctx.btcpp {
+        data.push((SKIP_COUNT, "int8", "0".to_string()));
+    }
     let flags = ctx.running_data();
     data.extend(flags.iter().map(|(v, t, e)| (v.as_str(), *t, e.clone())));
     m.push(b.datamodel(&data));

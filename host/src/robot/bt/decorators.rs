@@ -1,11 +1,21 @@
 //! The machines of the one-child decorators (Inverter, ForceSuccess, ForceFailure, Repeat,
 //! RetryUntilSuccessful) and of the leaves AlwaysSuccess / AlwaysFailure.
 
-use super::control::{init_state, n_children, Ctx, HaltEffect, FAILURE, RUNNING, SUCCESS};
+use super::control::{
+    init_state, n_children, Ctx, HaltEffect, FAILURE, IS_SKIPPED, RUNNING, SKIPPED_RUNNING, SUCCESS,
+};
 use crate::model::xml::Element;
 
-/// A one-child decorator mapping the child's SUCCESS, FAILURE, RUNNING to `map`.
+/// A one-child decorator mapping the child's SUCCESS, FAILURE, RUNNING to `map`; under
+/// BT.CPP's rules a SKIPPED child answers SKIPPED, the node RUNNING (4.10
+/// `InverterNode::tick`, `ForceSuccessNode::tick`, `ForceFailureNode::tick`: the child's
+/// SKIPPED is returned after `setStatus(RUNNING)`, the child not reset).
 pub(super) fn decorator(ctx: &Ctx, map: [u8; 3]) -> Element {
+    decorator_skipping(ctx, map, SKIPPED_RUNNING)
+}
+
+/// [`decorator`] answering `skipped` when the child is SKIPPED (under BT.CPP's rules).
+pub(super) fn decorator_skipping(ctx: &Ctx, map: [u8; 3], skipped: u8) -> Element {
     let b = &ctx.b;
     let mut m = b.scxml(&ctx.machine, "init");
     let mut data = vec![("children_count".to_string(), "int8", n_children(ctx))];
@@ -34,6 +44,16 @@ pub(super) fn decorator(ctx: &Ctx, map: [u8; 3]) -> Element {
             Some(&format!("_event.data.status == {from}")),
             Some("wait_for_tick"),
             ctx.marked(0, from, vec![ctx.respond(to)]),
+        ));
+    }
+    if ctx.btcpp {
+        let mut body: Vec<Element> = ctx.mark_skipped(0).into_iter().collect();
+        body.push(ctx.respond(skipped));
+        t.push(b.tr(
+            Some(&ctx.child_resp(0)),
+            Some(IS_SKIPPED),
+            Some("wait_for_tick"),
+            body,
         ));
     }
     m.push(t);

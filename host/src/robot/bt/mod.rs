@@ -38,6 +38,7 @@ mod btcpp4;
 mod btcpp4_blackboard;
 mod btcpp4_conds;
 mod btcpp4_script;
+mod btcpp4_skip;
 mod btcpp4_time;
 mod build;
 mod control;
@@ -258,6 +259,9 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
     // Under BT.CPP's rules a node with pre/post conditions talks to its parent through
     // its conditions' machine (`btcpp4_conds.rs`).
     let wrapped = |i: usize| btcpp && btcpp4_conds::wrapped(&tree, i);
+    if btcpp {
+        errs.extend(btcpp4_skip::refusals(sm, &tree));
+    }
     for (idx, n) in tree.nodes.iter().enumerate() {
         let refused = btcpp4_conds::refusals(sm, &tree, idx, btcpp);
         if !refused.is_empty() {
@@ -493,7 +497,7 @@ fn builtin(
     match c {
         Control::Parallel => {
             let ok_before = errs.len();
-            let mut th = |keys: &[&str], default: i64, what: &str| -> i64 {
+            let mut th = |keys: &[&str], default: i64, what: &str| -> (i64, bool) {
                 // BT.CPP 4's name and 3's (AS2FM's) for one threshold: one of them only.
                 if let (Some(_), Some(b)) = (n.port(keys[0]), n.port(keys[1])) {
                     errs.push(sm.diag(
@@ -502,20 +506,21 @@ fn builtin(
                     ));
                 }
                 let (v, span) = int_param(sm, n, keys, errs).unwrap_or((default, n.span));
-                let v = if v < 0 { count + v + 1 } else { v };
+                let neg = v < 0;
+                let v = if neg { count + v + 1 } else { v };
                 if v < 1 || v > count {
                     errs.push(sm.diag(
                         span,
                         format!("the {what} threshold must be between 1 and the number of children ({count})"),
                     ));
                 }
-                v
+                (v, neg)
             };
-            let s = th(&["success_count", "success_threshold"], -1, "success");
-            let f = th(&["failure_count", "failure_threshold"], 1, "failure");
+            let (s, s_neg) = th(&["success_count", "success_threshold"], -1, "success");
+            let (f, _) = th(&["failure_count", "failure_threshold"], 1, "failure");
             (errs.len() == ok_before).then(|| {
                 if ctx.btcpp {
-                    btcpp::parallel(ctx, s, f)
+                    btcpp::parallel(ctx, s, f, s_neg)
                 } else {
                     control::machine(c, ctx, &[s, f])
                 }

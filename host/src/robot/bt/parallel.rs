@@ -2,8 +2,8 @@
 //! (a condition child chooses the branch child).
 
 use super::control::{
-    answer_by_flags, init_state, n_children, on_child_status, reset_children, Ctx, FAILURE,
-    RUNNING, SUCCESS,
+    answer_by_flags, init_state, n_children, on_child_skipped, on_child_status, reset_children,
+    Ctx, FAILURE, IS_SKIPPED, RUNNING, SKIPPED_RUNNING, SUCCESS,
 };
 use crate::model::xml::Element;
 
@@ -172,6 +172,9 @@ pub(super) fn if_then_else(ctx: &Ctx, stale_condition: bool) -> Element {
     if stale_condition {
         data.push(("condition_failed", "bool", "false".into()));
     }
+    if ctx.btcpp {
+        data.push(("ret_skipped", "bool", "false".into()));
+    }
     m.push(b.datamodel(&data));
     m.push(init_state(ctx, "children_count < 2 || children_count > 3"));
     let mut w = b.state("wait_for_tick");
@@ -203,12 +206,35 @@ pub(super) fn if_then_else(ctx: &Ctx, stale_condition: bool) -> Element {
             vec![b.assign(idx, "0")],
         )),
     );
-    let finish = answer_by_flags(ctx, idx, "ret_failure", "ret_success");
+    let mut finish = answer_by_flags(ctx, idx, "ret_failure", "ret_success");
+    if ctx.btcpp {
+        // 4.10 `IfThenElseNode::tick`: a skipped branch is not RUNNING, so the children
+        // are reset and its SKIPPED is the answer (the node set itself RUNNING first).
+        finish = vec![b
+            .if_chain(
+                vec![(
+                    "ret_skipped".into(),
+                    vec![
+                        ctx.respond(SKIPPED_RUNNING),
+                        b.assign("ret_skipped", "false"),
+                        b.assign(idx, "0"),
+                    ],
+                )],
+                answer_by_flags(ctx, idx, "ret_failure", "ret_success"),
+            )
+            .expect("one branch")];
+    }
     m.push(reset_children(ctx, idx, finish));
     let cond_resp = ctx.child_resp(0);
+    let mut cond = b.state_entry("tick_condition_child", vec![ctx.tick_child(0)]);
+    if ctx.btcpp {
+        // 4.10 `IfThenElseNode::tick`: a skipped condition leaves `child_idx_` 0 and
+        // reaches `throw std::logic_error("Something unexpected happened in
+        // IfThenElseNode")`; where BT.CPP throws the tree stops (README).
+        cond.push(b.tr(Some(&cond_resp), Some(IS_SKIPPED), Some("error"), vec![]));
+    }
     m.push(
-        b.state_entry("tick_condition_child", vec![ctx.tick_child(0)])
-            .with_child(b.tr(None, Some(&format!("{idx} != 0")), Some("error"), vec![]))
+        cond.with_child(b.tr(None, Some(&format!("{idx} != 0")), Some("error"), vec![]))
             .with_child(b.tr(
                 Some(&cond_resp),
                 Some(&format!("_event.data.status == {SUCCESS}")),
@@ -265,6 +291,11 @@ pub(super) fn if_then_else(ctx: &Ctx, stale_condition: bool) -> Element {
     on_child_status(ctx, &mut t, idx, RUNNING, "wait_for_tick", || {
         vec![ctx.respond(RUNNING)]
     });
+    if ctx.btcpp {
+        on_child_skipped(ctx, &mut t, idx, "reset_children", || {
+            vec![b.assign(idx, "0"), b.assign("ret_skipped", "true")]
+        });
+    }
     m.push(t);
     m.push(b.state("error"));
     m

@@ -2,8 +2,9 @@
 //! ReactiveFallback: the nodes that tick their children one after another.
 
 use super::control::{
-    answer_by_flags, init_state, n_children, on_child_status, reset_children, sequence_head, Ctx,
-    HaltEffect, FAILURE, RUNNING, SUCCESS,
+    answer_by_flags, init_state, n_children, on_child_skipped, on_child_status, reset_children,
+    sequence_head, Ctx, HaltEffect, FAILURE, IS_SKIPPED, RUNNING, SKIPPED_RUNNING, SKIP_COUNT,
+    SUCCESS,
 };
 use crate::model::xml::Element;
 
@@ -14,13 +15,6 @@ pub(super) fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
     let b = &ctx.b;
     let idx = "current_child_idx";
     let mut m = sequence_head(ctx, idx, &["seq_failure", "seq_success"]);
-    let finish = answer_by_flags(ctx, idx, "seq_failure", "seq_success");
-    m.push(reset_children(ctx, idx, finish));
-    let guard = b.if_then(
-        &format!("{idx} < children_count"),
-        vec![ctx.dispatch(idx, false)],
-    );
-    let mut t = b.state_entry("tick_children", vec![guard]);
     let flag = |s: u8| {
         if s == SUCCESS {
             "seq_success"
@@ -28,6 +22,37 @@ pub(super) fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
             "seq_failure"
         }
     };
+    let finish = if ctx.btcpp {
+        // BT.CPP 4.10 `SequenceNode::tick` / `FallbackNode::tick`: every child skipped
+        // answers SKIPPED (the node set itself RUNNING first); `halt` and a finished
+        // loop clear `skipped_count_`.
+        vec![
+            b.if_chain(
+                vec![
+                    (flag(stop).into(), vec![ctx.respond(stop)]),
+                    (
+                        format!("{} && {SKIP_COUNT} == children_count", flag(cont)),
+                        vec![ctx.respond(SKIPPED_RUNNING)],
+                    ),
+                    (flag(cont).into(), vec![ctx.respond(cont)]),
+                ],
+                vec![ctx.respond_halted()],
+            )
+            .expect("three branches"),
+            b.assign(idx, "0"),
+            b.assign(SKIP_COUNT, "0"),
+            b.assign("seq_failure", "false"),
+            b.assign("seq_success", "false"),
+        ]
+    } else {
+        answer_by_flags(ctx, idx, "seq_failure", "seq_success")
+    };
+    m.push(reset_children(ctx, idx, finish));
+    let guard = b.if_then(
+        &format!("{idx} < children_count"),
+        vec![ctx.dispatch(idx, false)],
+    );
+    let mut t = b.state_entry("tick_children", vec![guard]);
     // The child's answers in each model's order, state `tick_children`: AS2FM's
     // sequence.ascxml SUCCESS, FAILURE, RUNNING; fallback.ascxml RUNNING, SUCCESS,
     // FAILURE (one status each, so the order changes no run, only the text).
@@ -50,6 +75,15 @@ pub(super) fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
                 vec![ctx.respond(RUNNING)]
             });
         }
+    }
+    // `case NodeStatus::SKIPPED`: on to the next child, counted.
+    if ctx.btcpp {
+        on_child_skipped(ctx, &mut t, idx, "tick_children", || {
+            vec![
+                b.assign(idx, &format!("{idx} + 1")),
+                b.assign(SKIP_COUNT, &format!("{SKIP_COUNT} + 1")),
+            ]
+        });
     }
     t.push(b.tr(
         None,
@@ -157,21 +191,25 @@ pub(super) fn reactive(ctx: &Ctx, seq: bool) -> Element {
         (idx, "int8", "0".into()),
         ("children_count", "int8", n_children(ctx)),
     ];
+    // BT.CPP 4.10 `ReactiveSequence::tick` / `ReactiveFallback::tick`: the children
+    // skipped in this tick (`all_skipped`).
+    if ctx.btcpp {
+        data.push((SKIP_COUNT, "int8", "0".into()));
+    }
     data.extend(flags.iter().map(|(v, t, e)| (v.as_str(), *t, e.clone())));
     m.push(b.datamodel(&data));
     m.push(init_state(ctx, "children_count < 1"));
+    let mut start = vec![
+        b.assign(count, "0"),
+        b.assign(idx, "0"),
+        b.assign(stop_child, "-1"),
+    ];
+    if ctx.btcpp {
+        start.push(b.assign(SKIP_COUNT, "0"));
+    }
     m.push(
         b.state("wait_for_tick")
-            .with_child(b.tr(
-                Some(&ctx.tick_ev()),
-                None,
-                Some("tick_children"),
-                vec![
-                    b.assign(count, "0"),
-                    b.assign(idx, "0"),
-                    b.assign(stop_child, "-1"),
-                ],
-            ))
+            .with_child(b.tr(Some(&ctx.tick_ev()), None, Some("tick_children"), start))
             .with_child(b.tr(
                 Some(&ctx.halt_ev()),
                 None,
@@ -186,25 +224,44 @@ pub(super) fn reactive(ctx: &Ctx, seq: bool) -> Element {
                 ],
             )),
     );
-    let finish = vec![
-        b.if_chain(
-            vec![
-                (
-                    format!("{count} == children_count"),
-                    vec![ctx.respond(cont)],
-                ),
-                (format!("{stop_child} >= 0"), vec![ctx.respond(stop)]),
-            ],
-            vec![ctx.respond_halted()],
-        )
-        .expect("two branches"),
+    let mut answers = vec![
+        (
+            format!("{count} == children_count"),
+            vec![ctx.respond(cont)],
+        ),
+        (format!("{stop_child} >= 0"), vec![ctx.respond(stop)]),
+    ];
+    if ctx.btcpp {
+        // Every child skipped: SKIPPED (the node set itself RUNNING first); some
+        // skipped, the others `cont`: `cont`.
+        answers.insert(
+            0,
+            (
+                format!("{SKIP_COUNT} == children_count"),
+                vec![ctx.respond(SKIPPED_RUNNING)],
+            ),
+        );
+        answers[1].0 = format!("{count} + {SKIP_COUNT} == children_count");
+    }
+    let mut finish = vec![
+        b.if_chain(answers, vec![ctx.respond_halted()])
+            .expect("two branches"),
         b.assign(idx, "0"),
         b.assign(count, "0"),
         b.assign("running_child", "-1"),
         b.assign(stop_child, "-1"),
     ];
+    if ctx.btcpp {
+        finish.push(b.assign(SKIP_COUNT, "0"));
+    }
     m.push(reset_children(ctx, idx, finish));
-    let guard_var = if seq { count } else { idx };
+    let guard_var = if ctx.btcpp {
+        idx
+    } else if seq {
+        count
+    } else {
+        idx
+    };
     let guard = b.if_then(
         &format!("{guard_var} < children_count"),
         vec![ctx.dispatch(idx, false)],
@@ -237,9 +294,48 @@ pub(super) fn reactive(ctx: &Ctx, seq: bool) -> Element {
             });
         }
     }
+    if ctx.btcpp {
+        // `case NodeStatus::SKIPPED`: `haltChild(index)` (a halt only if it still runs,
+        // code 5), then on to the next child.
+        let next = || {
+            vec![
+                b.assign(SKIP_COUNT, &format!("{SKIP_COUNT} + 1")),
+                b.assign(idx, &format!("{idx} + 1")),
+            ]
+        };
+        let mut hs = b.state("halting_skipped");
+        for i in 0..n {
+            t.push(b.tr(
+                Some(&ctx.child_resp(i)),
+                Some(&format!(
+                    "_event.data.status == {SKIPPED_RUNNING} && {idx} == {i}"
+                )),
+                Some("halting_skipped"),
+                ctx.halt_child_body(i),
+            ));
+            t.push(b.tr(
+                Some(&ctx.child_resp(i)),
+                Some(&format!("{IS_SKIPPED} && {idx} == {i}")),
+                Some("tick_children"),
+                next(),
+            ));
+            hs.push(b.tr(
+                Some(&ctx.child_halt_resp(i)),
+                Some(&format!("{idx} == {i}")),
+                Some("tick_children"),
+                next(),
+            ));
+        }
+        m.push(hs);
+    }
+    let done = if ctx.btcpp {
+        format!("{count} + {SKIP_COUNT} == children_count")
+    } else {
+        format!("{count} == children_count")
+    };
     t.push(b.tr(
         None,
-        Some(&format!("{count} == children_count")),
+        Some(&done),
         Some("reset_children"),
         vec![b.assign(idx, "0")],
     ));
