@@ -49,11 +49,14 @@ fn full_type(written: &str, service: bool) -> Result<String, String> {
     })
 }
 
+/// A port's declared type, whether it is a service's, and the QoS it names.
+type Declared = (String, bool, Vec<(String, String)>);
+
 /// The type of each port of a property file: the `type` of the `<ros_topic>` or
-/// `<ros_service>` element that declares it. The reader records one type per element,
-/// at its start tag, before the element's variables: a port's type is the last one
-/// written before it.
-fn file_types(file: &PropertyFile) -> Vec<Option<(String, bool, Vec<(String, String)>)>> {
+/// `<ros_service>` element that declares it, with the QoS it names. The reader records
+/// one type per element, at its start tag, before the element's variables: a port's
+/// type is the last one written before it.
+fn file_types(file: &PropertyFile) -> Vec<Option<Declared>> {
     file.ports
         .iter()
         .map(|p| {

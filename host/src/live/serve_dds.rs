@@ -272,8 +272,11 @@ impl DdsServices {
     }
 }
 
+/// A request: its id header and its fields as the model's parameters.
+type Request = ([u8; HEADER], Vec<(usize, Scalar)>);
+
 /// A request's header and its fields as the model's parameters.
-fn decode_request(s: &Served, data: &[u8]) -> Result<([u8; HEADER], Vec<(usize, Scalar)>), String> {
+fn decode_request(s: &Served, data: &[u8]) -> Result<Request, String> {
     let (header, body) = split_header(data).ok_or_else(|| {
         format!(
             "a request of {} byte(s) is shorter than the encapsulation and the 16-byte \
