@@ -82,6 +82,7 @@ fn main() {
         feed: TopicFeed::new("/level", ty, &ports, &defs, spec.strings()).unwrap(),
         vars: vec!["level".into(), "published".into()],
         schema_text: "int32 data\n".into(),
+        qos: Qos::ros_default(),
     };
 
     // The plain subscriber.
@@ -132,6 +133,8 @@ fn main() {
         heartbeat: 1,
         speed: 1.0,
         from_first_message: true,
+        // The latency measured is not judged: no sample is late.
+        max_latency: Duration::ZERO,
     };
     let mon = {
         let progress = progress.clone();

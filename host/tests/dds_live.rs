@@ -14,132 +14,20 @@
 
 mod common;
 
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
-use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::process::{Command, Output};
+use std::time::Duration;
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("host/ has a parent")
-        .to_path_buf()
-}
-
-fn data(name: &str) -> PathBuf {
-    repo().join("host/tests/data/dds").join(name)
-}
-
-/// The Python of the project's environment, if it has what these tests need.
-fn python() -> Option<PathBuf> {
-    common::pyenv::python_with(
-        &["cyclonedds.domain", "mcap", "mcap_ros2"],
-        "cyclonedds, mcap and mcap-ros2-support",
-    )
-}
-
-/// A domain for one test: random, from the process, the test and the clock.
-fn domain(salt: u64) -> u16 {
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .as_nanos() as u64;
-    let mut x = nanos ^ (u64::from(std::process::id()) << 20) ^ salt.wrapping_mul(0x9E37_79B9);
-    x ^= x >> 33;
-    x = x.wrapping_mul(0xff51_afd7_ed55_8ccd);
-    x ^= x >> 33;
-    // ROS 2 allows 0..=232; 0 is everyone's default, so leave it out.
-    1 + (x % 232) as u16
-}
+use common::dds::{data, domain, python, Proc};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hindsight-dds-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::dds::scratch("dds", name)
 }
 
-/// A running `hindsight monitor --ros2`, with its standard error collected.
-struct Monitor {
-    child: Child,
-    stderr: Arc<Mutex<String>>,
-}
-
-impl Monitor {
-    fn start(domain: u16, args: &[&std::ffi::OsStr]) -> Monitor {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_hindsight"))
-            .arg("monitor")
-            .args(args)
-            .env("ROS_DOMAIN_ID", domain.to_string())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let stderr = Arc::new(Mutex::new(String::new()));
-        let pipe = child.stderr.take().unwrap();
-        let sink = stderr.clone();
-        std::thread::spawn(move || {
-            for line in BufReader::new(pipe).lines().map_while(Result::ok) {
-                let mut s = sink.lock().unwrap();
-                s.push_str(&line);
-                s.push('\n');
-            }
-        });
-        let m = Monitor { child, stderr };
-        m.wait_for("monitor: ready:", Duration::from_secs(60));
-        m
-    }
-
-    fn stderr(&self) -> String {
-        self.stderr.lock().unwrap().clone()
-    }
-
-    fn wait_for(&self, text: &str, timeout: Duration) {
-        let start = Instant::now();
-        while !self.stderr().contains(text) {
-            assert!(
-                start.elapsed() < timeout,
-                "no `{text}` from the monitor within {timeout:?}; its standard error:\n{}",
-                self.stderr()
-            );
-            std::thread::sleep(Duration::from_millis(20));
-        }
-    }
-
-    /// SIGINT, then the exit status and the whole standard error.
-    fn interrupt(mut self) -> (std::process::ExitStatus, String) {
-        let pid = self.child.id().to_string();
-        assert!(Command::new("kill")
-            .args(["-INT", &pid])
-            .status()
-            .unwrap()
-            .success());
-        let start = Instant::now();
-        let status = loop {
-            if let Some(s) = self.child.try_wait().unwrap() {
-                break s;
-            }
-            if start.elapsed() > Duration::from_secs(30) {
-                let _ = self.child.kill();
-                panic!(
-                    "the monitor did not stop within 30 s of SIGINT:\n{}",
-                    self.stderr()
-                );
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        };
-        // The reader thread ends with the pipe.
-        std::thread::sleep(Duration::from_millis(100));
-        (status, self.stderr())
-    }
-}
-
-impl Drop for Monitor {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
+/// SIGINT to the monitor, then its exit status and its whole standard error.
+fn stop(mut m: Proc) -> (std::process::ExitStatus, String) {
+    let status = m.interrupt(Duration::from_secs(30));
+    (status, m.err())
 }
 
 /// Runs the Cyclone DDS publisher with `steps` (see cyclone.py) and checks it succeeded.
@@ -196,7 +84,7 @@ fn cyclone_samples_are_judged_and_a_silent_topic_fails_on_time() {
     let dir = scratch("judged");
     let out = dir.join("verdicts.jsonl");
     let props = data("props.xml");
-    let m = Monitor::start(
+    let m = Proc::monitor(
         d,
         &[
             "--ros2".as_ref(),
@@ -228,7 +116,7 @@ fn cyclone_samples_are_judged_and_a_silent_topic_fails_on_time() {
     let said = publish(&py, d, &format!("[{}]", steps.join(",")));
     assert!(said.contains("sent 26"), "{said}");
     m.wait_for("is malformed", Duration::from_secs(30));
-    let (status, stderr) = m.interrupt();
+    let (status, stderr) = stop(m);
     assert!(status.success(), "exit {status:?}\n{stderr}");
     let lines = verdicts(&out);
     assert!(!lines.is_empty(), "no verdict line\n{stderr}");
@@ -335,7 +223,7 @@ fn a_restarted_publisher_is_picked_up() {
     let dir = scratch("restart");
     let out = dir.join("verdicts.jsonl");
     let props = data("props.xml");
-    let m = Monitor::start(
+    let m = Proc::monitor(
         d,
         &[
             "--ros2".as_ref(),
@@ -351,7 +239,7 @@ fn a_restarted_publisher_is_picked_up() {
         r#"[["wait_match", "/battery", 30], ["int32", "/battery", 30], ["int32", "/battery", 5]]"#;
     assert!(publish(&py, d, second).contains("sent 2"));
     m.wait_for("new publisher after a gap", Duration::from_secs(30));
-    let (status, stderr) = m.interrupt();
+    let (status, stderr) = stop(m);
     assert!(status.success(), "exit {status:?}\n{stderr}");
     assert!(
         stderr.contains("monitor: /battery: 4 judged, 0 lost, 0 malformed, 1 restarts"),
@@ -378,7 +266,7 @@ fn the_record_is_read_by_python_mcap_and_by_replay() {
     let dir = scratch("record");
     let rec = dir.join("run.mcap");
     let props = data("props.xml");
-    let m = Monitor::start(
+    let m = Proc::monitor(
         d,
         &[
             "--ros2".as_ref(),
@@ -403,7 +291,7 @@ fn the_record_is_read_by_python_mcap_and_by_replay() {
     // The publisher waited for every sample to be acknowledged, so each is in the
     // monitor's reader; give its loop a moment to take and judge them before SIGINT.
     std::thread::sleep(Duration::from_millis(500));
-    let (status, stderr) = m.interrupt();
+    let (status, stderr) = stop(m);
     assert!(status.success(), "exit {status:?}\n{stderr}");
     assert!(stderr.contains("monitor: /battery: 5 judged"), "{stderr}");
     let read = ok(
@@ -454,6 +342,134 @@ fn the_record_is_read_by_python_mcap_and_by_replay() {
     let first_false = level.iter().position(|v| *v == "false").unwrap();
     assert!(level[..first_false].iter().all(|v| *v == "true"), "{csv}");
     assert!(level[first_false..].iter().all(|v| *v == "false"), "{csv}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// A sample whose source timestamp is older than points the monitor has already judged
+/// (Cyclone DDS writes it with a timestamp 1 s in the past, while heartbeats were judged
+/// every millisecond) makes the properties reading its topic `unknown`, with the event
+/// `late /battery`, and they judge again after it; samples on time do not.
+#[test]
+fn a_late_sample_makes_its_properties_unknown() {
+    let Some(py) = python() else { return };
+    let d = domain(4);
+    let dir = scratch("late");
+    let out = dir.join("verdicts.jsonl");
+    let props = data("props.xml");
+    let m = Proc::monitor(
+        d,
+        &[
+            "--ros2".as_ref(),
+            props.as_os_str(),
+            "--max-latency".as_ref(),
+            "300ms".as_ref(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ],
+    );
+    // The late sample's sending falls after the monitor started and after the writer's
+    // first sample reached it (1.5 s before): the monitor knew of the writer and judged
+    // heartbeats without the sample.
+    let steps = r#"[["wait_match", "/battery", 30], ["sleep", 1.0],
+        ["int32", "/battery", 50], ["sleep", 1.5],
+        ["int32", "/battery", 60, {"age": 1.0}], ["sleep", 0.5],
+        ["int32", "/battery", 70]]"#;
+    assert!(publish(&py, d, steps).contains("sent 3"));
+    m.wait_for("is late", Duration::from_secs(30));
+    std::thread::sleep(Duration::from_millis(500));
+    let (status, stderr) = stop(m);
+    assert!(status.success(), "exit {status:?}\n{stderr}");
+    assert!(
+        stderr.contains("monitor: /battery: 3 judged, 0 lost, 0 malformed, 0 restarts, 1 late"),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("monitor: /battery: sample 2 is late: sent at tick"),
+        "{stderr}"
+    );
+    let lines = verdicts(&out);
+    let unknown: Vec<_> = lines.iter().filter(|(_, _, v, _)| v == "unknown").collect();
+    // Only level_ok reads /battery; it is unknown once, at the late sample.
+    assert_eq!(unknown.len(), 1, "{lines:?}");
+    let (p, t, _, e) = unknown[0];
+    assert_eq!((p.as_str(), e.as_str()), ("level_ok", "late /battery"));
+    assert_eq!(verdict_at(&lines, "level_ok", t - 1), "currently_true");
+    // Judged again from the next point on.
+    assert!(
+        lines
+            .iter()
+            .any(|(q, u, v, _)| q == "level_ok" && u > t && v == "currently_true"),
+        "{lines:?}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// The QoS a `<ros_topic>` port names (`props_qos.xml`): a monitor that joins after a
+/// transient-local Cyclone DDS publisher wrote gets the last sample it kept (depth 1:
+/// the 15, not the 30 before it), and a best-effort publisher is matched (a reliable
+/// reader, ROS 2's default, would not match it) and judged.
+#[test]
+fn ports_name_their_qos_transient_local_and_best_effort() {
+    let Some(py) = python() else { return };
+    let d = domain(5);
+    let dir = scratch("qos");
+    let out = dir.join("verdicts.jsonl");
+    let props = data("props_qos.xml");
+    let steps = r#"[
+        ["qos", "/battery", {"durability": "transient_local", "depth": 1}],
+        ["int32", "/battery", 30], ["int32", "/battery", 15], ["say", "written"],
+        ["qos", "/alive", {"reliability": "best_effort"}],
+        ["wait_match", "/alive", 60, "bool"], ["sleep", 1.0],
+        ["bool", "/alive", true], ["sleep", 0.05], ["bool", "/alive", true], ["sleep", 0.05],
+        ["bool", "/alive", true], ["sleep", 0.05], ["bool", "/alive", true], ["sleep", 0.05],
+        ["bool", "/alive", true], ["say", "alive sent"], ["sleep", 60]]"#;
+    let publisher = common::dds::cyclone(&py, "publish", d, steps);
+    publisher.wait_for("written", Duration::from_secs(60));
+    // The publisher has written both samples before the monitor exists.
+    let m = Proc::monitor(
+        d,
+        &[
+            "--ros2".as_ref(),
+            props.as_os_str(),
+            "-o".as_ref(),
+            out.as_os_str(),
+        ],
+    );
+    publisher.wait_for("alive sent", Duration::from_secs(60));
+    std::thread::sleep(Duration::from_millis(500));
+    let (status, stderr) = stop(m);
+    drop(publisher);
+    assert!(status.success(), "exit {status:?}\n{stderr}");
+    assert!(
+        stderr.contains("monitor: /battery: 1 judged, 0 lost, 0 malformed, 0 restarts, 0 late"),
+        "{stderr}"
+    );
+    let alive: u64 = stderr
+        .lines()
+        .find_map(|l| {
+            l.strip_prefix("monitor: /alive: ")?
+                .split(' ')
+                .next()?
+                .parse()
+                .ok()
+        })
+        .unwrap_or_else(|| panic!("{stderr}"));
+    // Best effort on loopback: all five, or nearly.
+    assert!((3..=5).contains(&alive), "{stderr}");
+    let lines = verdicts(&out);
+    // The kept sample is the 15: level_ok false, at a /battery sample.
+    assert!(
+        lines
+            .iter()
+            .any(|(p, _, v, e)| p == "level_ok" && v == "false" && e == "/battery"),
+        "{lines:?}"
+    );
+    assert!(
+        lines
+            .iter()
+            .any(|(p, _, v, e)| p == "alive_seen" && v == "true" && e == "/alive"),
+        "{lines:?}"
+    );
     let _ = std::fs::remove_dir_all(dir);
 }
 
@@ -516,5 +532,50 @@ fn bad_arguments_exit_2() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // A QoS attribute with a value ROS 2 has no name for: the file, line and column.
+    let bad_qos = dir.join("bad_qos.xml");
+    std::fs::write(
+        &bad_qos,
+        std::fs::read_to_string(data("props_qos.xml"))
+            .unwrap()
+            .replace("reliability=\"best_effort\"", "reliability=\"sometimes\""),
+    )
+    .unwrap();
+    let out = run(&["--ros2".as_ref(), bad_qos.as_os_str()], None);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("bad_qos.xml:") && err.contains("sometimes") && err.contains("best_effort"),
+        "{err}"
+    );
+    for (flag, says) in [
+        ("/battery=depth=0", "QoS depth=`0`"),
+        ("/nope=depth=1", "no port reads `/nope`"),
+        ("/battery", "expected /topic="),
+    ] {
+        let out = run(
+            &[
+                "--ros2".as_ref(),
+                props.as_os_str(),
+                "--qos".as_ref(),
+                flag.as_ref(),
+            ],
+            None,
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flag}: {err}");
+        assert!(err.contains(says), "{flag}: {err}");
+    }
+    let out = run(
+        &[
+            "--ros2".as_ref(),
+            props.as_os_str(),
+            "--max-latency".as_ref(),
+            "soon".as_ref(),
+        ],
+        None,
+    );
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--max-latency soon"));
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -165,12 +165,26 @@ fn filter_refuses_a_falsifying_request_and_leaves_no_trace() {
 fn replay_errors_name_the_line() {
     let spec = codegen::compile_spec(SPEC, "t.hspec").unwrap();
     let log = "{\"kind\":\"tick\",\"time\":0}\n{\"kind\":\"sample\",\"time\":1,\"source\":\"s\",\"sets\":{\"nope\":true}}\n";
-    let e = replay(&spec, log, "in.jsonl", false).unwrap_err();
+    let err = replay(&spec, log, "in.jsonl", false).unwrap_err();
+    assert!(
+        matches!(
+            &err,
+            hindsight::live::record::LogError::Record {
+                line: 2,
+                error: hindsight::live::record::RecordError::UnknownVariable(v),
+                ..
+            } if v == "nope"
+        ),
+        "{err:?}"
+    );
+    let e = err.to_string();
     assert!(
         e.starts_with("in.jsonl:2:1: `nope` is not a variable"),
         "{e}"
     );
-    let e = replay(&spec, "{\"kind\":\"tick\"}\n", "in.jsonl", false).unwrap_err();
+    let e = replay(&spec, "{\"kind\":\"tick\"}\n", "in.jsonl", false)
+        .unwrap_err()
+        .to_string();
     assert!(e.starts_with("in.jsonl:1:"), "{e}");
     let e = replay(
         &spec,
@@ -178,6 +192,7 @@ fn replay_errors_name_the_line() {
         "in.jsonl",
         false,
     )
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     assert!(e.starts_with("in.jsonl:2:1:"), "{e}");
 }

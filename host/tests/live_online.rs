@@ -579,7 +579,7 @@ fn a_recorded_log_starts_with_its_unit_and_replays_only_with_that_unit() {
     let ms =
         codegen::compile_spec("unit 1ms;\nevent e;\nproperty p = H({e});\n", "t.hspec").unwrap();
     assert_eq!(
-        hindsight::live::record::replay(&ms, &text, "in.jsonl", false),
+        hindsight::live::record::replay(&ms, &text, "in.jsonl", false).map_err(|e| e.to_string()),
         Err(
             "in.jsonl:1:1: the log's ticks are 100ms long, the spec's are 1ms: record and \
              replay with the same unit"

@@ -125,6 +125,16 @@ fn bad_ros_ports_and_patterns_name_their_position() {
             "3:8",
             "topic",
         ),
+        (
+            r#"<ports><ros_topic topic="/t" type="t/T" durability="durable"><event_var id="a"/></ros_topic></ports>"#,
+            "3:41",
+            "\"volatile\", \"transient_local\", \"system_default\"",
+        ),
+        (
+            r#"<ports><ros_topic topic="/t" type="t/T" depth="0"><event_var id="a"/></ros_topic></ports>"#,
+            "3:41",
+            "a count of samples from 1 to 1048576",
+        ),
     ];
     for (i, (body, at, expected)) in cases.iter().enumerate() {
         let path = write_props(&format!("bad{i}.xml"), &format!("\n{body}"));
@@ -132,6 +142,37 @@ fn bad_ros_ports_and_patterns_name_their_position() {
         assert!(err.contains(&format!("bad{i}.xml:{at}")), "case {i}: {err}");
         assert!(err.contains(expected), "case {i}: {err}");
     }
+}
+
+/// A `<ros_topic>` names its QoS with ROS 2's names; the reader keeps them, in the order
+/// of `QOS_SETTINGS`, for `monitor --ros2`; a port without them has none.
+#[test]
+fn ros_topics_name_their_qos() {
+    let path = write_props(
+        "qos.xml",
+        r#"<ports>
+  <ros_topic topic="/map" type="nav_msgs/OccupancyGrid" depth="1" durability="transient_local" reliability="best_effort" history="keep_last"><event_var id="m"/></ros_topic>
+  <ros_topic topic="/t" type="std_msgs/Int32"><event_var id="t"/></ros_topic>
+</ports>"#,
+    );
+    let file = parse_file(&path).unwrap();
+    let pairs = |i: usize| -> Vec<(&str, &str)> {
+        file.ros_types[i]
+            .qos
+            .iter()
+            .map(|(k, v)| (k.as_str(), v.as_str()))
+            .collect()
+    };
+    assert_eq!(
+        pairs(0),
+        [
+            ("reliability", "best_effort"),
+            ("durability", "transient_local"),
+            ("history", "keep_last"),
+            ("depth", "1"),
+        ]
+    );
+    assert!(pairs(1).is_empty());
 }
 
 #[test]

@@ -7,6 +7,36 @@ use std::collections::BTreeMap;
 use std::io::BufWriter;
 use std::path::Path;
 
+/// Why an MCAP file could not be written: the file and what failed.
+#[derive(Debug)]
+pub enum WriteError {
+    /// The file could not be created.
+    Create {
+        /// The file.
+        path: String,
+        /// Why.
+        error: std::io::Error,
+    },
+    /// The MCAP writer failed (a write, the summary).
+    Mcap {
+        /// The file.
+        path: String,
+        /// Why.
+        error: mcap::McapError,
+    },
+}
+
+impl std::fmt::Display for WriteError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            WriteError::Create { path, error } => write!(f, "{path}: cannot write: {error}"),
+            WriteError::Mcap { path, error } => write!(f, "{path}: {error}"),
+        }
+    }
+}
+
+impl std::error::Error for WriteError {}
+
 /// An MCAP file being written.
 pub struct McapWriter {
     writer: mcap::Writer<BufWriter<std::fs::File>>,
@@ -15,22 +45,31 @@ pub struct McapWriter {
 
 impl McapWriter {
     /// Creates (or truncates) `path`.
-    pub fn create(path: &Path) -> Result<McapWriter, String> {
+    pub fn create(path: &Path) -> Result<McapWriter, WriteError> {
         let shown = path.display().to_string();
-        let f = std::fs::File::create(path).map_err(|e| format!("{shown}: cannot write: {e}"))?;
+        let f = std::fs::File::create(path).map_err(|error| WriteError::Create {
+            path: shown.clone(),
+            error,
+        })?;
         let writer = mcap::WriteOptions::new()
             .profile("ros2")
             .library("hindsight")
             .create(BufWriter::new(f))
-            .map_err(|e| format!("{shown}: {e}"))?;
+            .map_err(|error| WriteError::Mcap {
+                path: shown.clone(),
+                error,
+            })?;
         Ok(McapWriter {
             writer,
             path: shown,
         })
     }
 
-    fn err(&self, e: mcap::McapError) -> String {
-        format!("{}: {e}", self.path)
+    fn err(&self, error: mcap::McapError) -> WriteError {
+        WriteError::Mcap {
+            path: self.path.clone(),
+            error,
+        }
     }
 
     /// Adds topic `topic` of ROS type `type_name` (`std_msgs/msg/Int32`) defined by
@@ -40,7 +79,7 @@ impl McapWriter {
         topic: &str,
         type_name: &str,
         ros2msg: &str,
-    ) -> Result<u16, String> {
+    ) -> Result<u16, WriteError> {
         let schema = self
             .writer
             .add_schema(type_name, "ros2msg", ros2msg.as_bytes())
@@ -58,7 +97,7 @@ impl McapWriter {
         sequence: u32,
         log_time: u64,
         data: &[u8],
-    ) -> Result<(), String> {
+    ) -> Result<(), WriteError> {
         let header = mcap::records::MessageHeader {
             channel_id: channel,
             sequence,
@@ -71,7 +110,7 @@ impl McapWriter {
     }
 
     /// Writes the summary and flushes: the file is complete.
-    pub fn finish(mut self) -> Result<(), String> {
+    pub fn finish(mut self) -> Result<(), WriteError> {
         self.writer.finish().map_err(|e| self.err(e))?;
         Ok(())
     }

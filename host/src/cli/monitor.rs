@@ -57,6 +57,22 @@ pub struct MonitorArgs {
     /// for a service, its `.srv` type); repeat for more.
     #[arg(long = "topic-type", value_name = "TOPIC=TYPE", requires = "ros2")]
     pub topic_type: Vec<String>,
+    /// With --ros2: the QoS of a topic's reader, in ROS 2's names, over what its port
+    /// names (`/battery=reliability=best_effort,durability=transient_local,depth=1`;
+    /// settings `reliability`, `durability`, `history`, `depth`). Default: ROS 2's
+    /// (reliable, volatile, keep last 10) or the `<ros_topic>` port's attributes.
+    #[arg(long = "qos", value_name = "TOPIC=SETTINGS", requires = "ros2")]
+    pub qos: Vec<String>,
+    /// With --ros2: a sample whose source timestamp (the writer's clock) is more than
+    /// this before a point already judged arrived late: the properties reading its
+    /// topic are `unknown` from it, as after a lost sample (`0s`: never late).
+    #[arg(
+        long,
+        value_name = "DURATION",
+        default_value = "100ms",
+        requires = "ros2"
+    )]
+    pub max_latency: String,
     /// Off-line: replay an input log written by `--record` and print its verdicts.
     #[arg(long, value_name = "LOG", conflicts_with_all = ["config", "record", "bench"])]
     pub replay: Option<PathBuf>,
@@ -334,8 +350,8 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         if let Some(warning) = cut {
             eprintln!("{warning}");
         }
-        let lines =
-            live::record::replay(&spec, text, &name, args.every_point).map_err(CliError::Input)?;
+        let lines = live::record::replay(&spec, text, &name, args.every_point)
+            .map_err(|e| CliError::Input(e.to_string()))?;
         let io = |e: std::io::Error| CliError::Failed(format!("output: {e}"));
         for l in lines {
             writeln!(out, "{l}").map_err(io)?;

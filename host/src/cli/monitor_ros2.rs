@@ -49,11 +49,14 @@ fn full_type(written: &str, service: bool) -> Result<String, String> {
     })
 }
 
+/// A port's declared type, whether it is a service's, and the QoS it names.
+type Declared = (String, bool, Vec<(String, String)>);
+
 /// The type of each port of a property file: the `type` of the `<ros_topic>` or
-/// `<ros_service>` element that declares it. The reader records one type per element,
-/// at its start tag, before the element's variables: a port's type is the last one
-/// written before it.
-fn file_types(file: &PropertyFile) -> Vec<Option<(String, bool)>> {
+/// `<ros_service>` element that declares it, with the QoS it names. The reader records
+/// one type per element, at its start tag, before the element's variables: a port's
+/// type is the last one written before it.
+fn file_types(file: &PropertyFile) -> Vec<Option<Declared>> {
     file.ports
         .iter()
         .map(|p| {
@@ -62,7 +65,7 @@ fn file_types(file: &PropertyFile) -> Vec<Option<(String, bool)>> {
                 .iter()
                 .rev()
                 .find(|t| (t.at.line, t.at.column) < at)
-                .map(|t| (t.type_name.clone(), t.service))
+                .map(|t| (t.type_name.clone(), t.service, t.qos.clone()))
         })
         .collect()
 }
@@ -86,15 +89,21 @@ pub fn run(
         !args.bind.is_empty(),
     )?;
     let spec = &props.compiled;
-    // Each port and its topic's type.
+    // Each port, its topic's type and the QoS its port names.
+    let mut port_qos: Vec<Vec<(String, String)>> = Vec::new();
     let (ports, types): (Vec<BagPort>, Vec<Option<String>>) = match &props.file {
         Some(file) => {
             let ports = file_ports(file, spec)?;
-            let types = file_types(file)
+            let declared = file_types(file);
+            port_qos = declared
+                .iter()
+                .map(|t| t.as_ref().map(|t| t.2.clone()).unwrap_or_default())
+                .collect();
+            let types = declared
                 .into_iter()
                 .zip(&ports)
                 .map(|(t, p)| {
-                    t.map(|(name, service)| full_type(&name, service || p.service.is_some()))
+                    t.map(|(name, service, _)| full_type(&name, service || p.service.is_some()))
                         .transpose()
                 })
                 .collect::<Result<Vec<_>, _>>()
@@ -137,21 +146,58 @@ pub fn run(
             props_path.display()
         )));
     }
-    // One reader per topic as recorded, with one type.
-    let mut topics: Vec<(String, String)> = Vec::new();
-    for (p, t) in ports.iter().zip(&types) {
+    // `--qos /topic=settings`, over what the ports name.
+    let mut qos_flags: BTreeMap<String, String> = BTreeMap::new();
+    for q in &args.qos {
+        let Some((topic, settings)) = q.split_once('=') else {
+            return Err(input(format!(
+                "--qos {q}: expected /topic=reliability=best_effort,durability=transient_local,..."
+            )));
+        };
+        let topic = topic.trim().to_string();
+        ros2::dds::Qos::ros_default()
+            .with_list(settings)
+            .map_err(|e| input(format!("--qos {q}: {e}")))?;
+        if !ports.iter().any(|p| p.recorded_topic() == topic) {
+            return Err(input(format!("--qos {q}: no port reads `{topic}`")));
+        }
+        let all = qos_flags.entry(topic).or_default();
+        all.push(',');
+        all.push_str(settings);
+    }
+    // One reader per topic as recorded, with one type and one QoS.
+    let mut topics: Vec<(String, String, ros2::dds::Qos)> = Vec::new();
+    for (i, (p, t)) in ports.iter().zip(&types).enumerate() {
         let topic = p.recorded_topic();
         let Some(t) = t else {
             return Err(input(format!("port `{}`: its type is not written", p.name)));
         };
-        match topics.iter().find(|(name, _)| *name == topic) {
-            Some((_, other)) if other != t => {
+        let mut qos = ros2::dds::Qos::ros_default();
+        for (k, v) in port_qos.get(i).map(Vec::as_slice).unwrap_or_default() {
+            qos.set(k, v)
+                .map_err(|e| input(format!("port `{}`: {e}", p.name)))?;
+        }
+        match topics.iter().find(|(name, _, _)| *name == topic) {
+            Some((_, other, _)) if other != t => {
                 return Err(input(format!(
                     "topic `{topic}` is read as `{other}` and as `{t}`: one topic has one type"
                 )))
             }
+            Some((_, _, other)) if *other != qos => {
+                return Err(input(format!(
+                    "topic `{topic}` is read with QoS {} and with {}: one topic has one reader \
+                     (name the same QoS on every port of it)",
+                    other.describe(),
+                    qos.describe()
+                )))
+            }
             Some(_) => {}
-            None => topics.push((topic, t.clone())),
+            None => topics.push((topic, t.clone(), qos)),
+        }
+    }
+    for (topic, _, qos) in &mut topics {
+        if let Some(list) = qos_flags.get(topic.as_str()) {
+            *qos = qos.with_list(list).map_err(|e| input(e.to_string()))?;
         }
     }
     let mut sm = codegen::diag::SourceMap::new();
@@ -169,7 +215,7 @@ pub fn run(
     })?;
     let defs = Packages(packages);
     let mut sources = Vec::new();
-    for (topic, type_name) in topics {
+    for (topic, type_name, qos) in topics {
         let feed = TopicFeed::new(&topic, &type_name, &ports, &defs, spec.strings())
             .map_err(|e| input(format!("topic `{topic}`: {e}")))?;
         let schema = ros2::schema::Schema::resolve(&type_name, &defs).map_err(|e| {
@@ -188,9 +234,14 @@ pub fn run(
             feed,
             vars,
             schema_text: schema.ros2msg_text(),
+            qos,
         });
     }
-    let domain = ros2::dds::domain_id().map_err(input)?;
+    let domain = ros2::dds::domain_id().map_err(|e| input(e.to_string()))?;
+    let max_latency = match codegen::duration::parse(&args.max_latency) {
+        Ok(ns) => Duration::from_nanos(ns),
+        Err(m) => return Err(input(format!("--max-latency {}: {m}", args.max_latency))),
+    };
     let speed = match args.speed {
         Some(s) => live::check_speed(s).map_err(|m| input(format!("--speed: {m}")))?,
         None => 1.0,
@@ -203,13 +254,14 @@ pub fn run(
         heartbeat,
         speed,
         from_first_message: args.from_first_message,
+        max_latency,
     };
     let mcap = args
         .record
         .as_deref()
         .map(ros2::write::McapWriter::create)
         .transpose()
-        .map_err(CliError::Failed)?;
+        .map_err(|e| CliError::Failed(e.to_string()))?;
     let mut out: Box<dyn Write + Send> = match &args.output {
         Some(p) => super::monitor::create(p)?,
         None => Box::new(std::io::stdout()),

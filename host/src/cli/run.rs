@@ -1,5 +1,6 @@
 //! `hindsight run`: one seeded simulation of a model, paced in wall-clock time, its ROS topics published over iceoryx2 (or, with `--ros2`, on DDS as a ROS 2 robot publishes them: [`crate::live::publish_dds`]).
 
+use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Once;
@@ -68,6 +69,12 @@ pub struct RunArgs {
     /// first message (repeat for several).
     #[arg(long, value_name = "TOPIC", requires = "ros2")]
     pub wait_match: Vec<String>,
+    /// With --ros2: the QoS of a topic's writer, in ROS 2's names
+    /// (`/battery=reliability=best_effort,durability=transient_local,depth=1`; settings
+    /// `reliability`, `durability`, `history`, `depth`); default ROS 2's (reliable,
+    /// volatile, keep last 10). Repeat for several topics.
+    #[arg(long = "qos", value_name = "TOPIC=SETTINGS", requires = "ros2")]
+    pub qos: Vec<String>,
 }
 
 const AFTER_HELP: &str = "\
@@ -121,14 +128,19 @@ On ROS 2 over DDS (--ros2), no ROS install needed:
   and publishes what a ROS 2 robot running the model would: topic /a/b on DDS topic
   rt/a/b, type pkg/msg/T as pkg::msg::dds_::T_, the message CDR-encoded from its
   .msg definition (the model's fields set, every other field zero), with ROS 2's
-  default QoS (reliable, volatile, keep last 10). Each service the model serves is
+  default QoS (reliable, volatile, keep last 10) or what --qos names for a topic
+  (--qos /a/b=durability=transient_local,depth=1). Each service the model serves is
   published as ROS 2's service introspection publishes it: on /<service>/_service_event
   (type pkg/srv/Name_Event), a REQUEST_RECEIVED event with the request, then a
   RESPONSE_SENT event with the response, one sequence_number for both. A ROS 2 node
   (`ros2 topic echo`, `ros2 bag record`) or `hindsight monitor --ros2` listens to it.
-  Not supported over DDS (refused or warned, never silent): answering service calls
-  from ROS 2 clients, actions (their goals, feedback and results are not published),
-  --external (a ROS 2 node standing in for a component) and --layout (iceoryx2 only).
+  With --external NAME, a ROS 2 client may stand in for the node NAME where it calls
+  the model's services: its requests on rq/<service>Request (the request id header
+  rmw_cyclonedds writes, then the request) go to the model's server, and the answer
+  goes back on rr/<service>Reply with the same header. Not supported over DDS (warned,
+  never silent): the rest of an --external node (its topics, the services it serves,
+  actions), Fast DDS clients (they carry the request id differently), actions (their
+  goals, feedback and results are not published) and --layout (iceoryx2 only).
   --wait-match TOPIC holds the first step until a subscriber to TOPIC is matched,
   then 5 s more for the subscriber's side of DDS discovery, so a monitor started
   first sees the run from its first message.
@@ -493,14 +505,6 @@ const SETTLE: std::time::Duration = std::time::Duration::from_secs(5);
 fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
     let input = CliError::Input;
     check_speed(args.speed).map_err(|m| input(format!("--speed: {m}")))?;
-    if !args.external.is_empty() {
-        return Err(input(
-            "--external with --ros2 is not supported: a ROS 2 node cannot yet stand in for a \
-             component over DDS (publish into the run, serve or call its services); \
-             --external works over iceoryx2 (leave out --ros2)"
-                .into(),
-        ));
-    }
     if args.layout {
         return Err(input(
             "--layout prints the iceoryx2 payload layout; with --ros2 the payload is the \
@@ -508,7 +512,7 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
                 .into(),
         ));
     }
-    let domain = ros2::dds::domain_id().map_err(input)?;
+    let domain = ros2::dds::domain_id().map_err(|e| input(e.to_string()))?;
     let Some(main_path) = crate::robot::load::main_file_of(&args.input.model) else {
         return Err(input(format!(
             "{}: --ros2 needs a robot model (a main file whose node models declare their \
@@ -516,8 +520,50 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
             args.input.model.display()
         )));
     };
-    let (loaded, _) = load_without(&args.input, &[])?;
+    let (loaded, external) = load_without(&args.input, &args.external)?;
     let model = &loaded.model;
+    // Over DDS a node played by a ROS 2 process may call the model's services; what else
+    // it does is not bridged (said, not silent).
+    let mut service_routes = Vec::new();
+    for c in &external {
+        for (what, list) in [
+            ("publishes", &c.publishes),
+            ("subscribes to", &c.subscribes),
+            ("serves", &c.serves),
+            ("serves action", &c.serves_actions),
+            ("calls action", &c.calls_actions),
+        ] {
+            for (name, _) in list.iter() {
+                eprintln!(
+                    "warning: --external {}: it {what} {name}, which is not bridged over DDS \
+                     (only the services it calls are served to ROS 2 clients)",
+                    c.name
+                );
+            }
+        }
+        for (service, ty) in &c.calls {
+            let event = |response| {
+                model.event_id(&crate::props::ros::service_client_event(
+                    service, &c.name, response,
+                ))
+            };
+            match (event(false), event(true)) {
+                (Some(request), Some(response)) => {
+                    service_routes.push(crate::live::serve_dds::ServiceRoute {
+                        service: service.clone(),
+                        type_name: ty.clone(),
+                        request,
+                        response,
+                    })
+                }
+                _ => eprintln!(
+                    "warning: --external {}: nothing in the model serves {service}; it is not \
+                     served on DDS",
+                    c.name
+                ),
+            }
+        }
+    }
     let diags = |errs: Vec<crate::model::Diagnostic>| {
         CliError::Input(
             errs.iter()
@@ -533,9 +579,33 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
     let packages =
         crate::robot::interfaces::Interfaces::discover_with(&mut sm, &main_path, &search)
             .map_err(diags)?;
-    let (routes, warnings) = plan(model, &types, &super::replay::Packages(packages));
+    let defs = super::replay::Packages(packages);
+    let (routes, mut warnings) = plan(model, &types, &defs);
+    let services = if service_routes.is_empty() {
+        None
+    } else {
+        Some(
+            crate::live::serve_dds::DdsServices::new(
+                domain,
+                model,
+                service_routes,
+                &defs,
+                &mut warnings,
+            )
+            .map_err(CliError::Failed)?,
+        )
+    };
     for w in &warnings {
         eprintln!("warning: {w}");
+    }
+    if let Some(s) = &services {
+        for st in s.stats() {
+            let (rq, rr) = ros2::dds::service_topics(&st.service);
+            eprintln!(
+                "run: serving {} to ROS 2 clients on {rq} and {rr}",
+                st.service
+            );
+        }
     }
     let Some(unit_ns) = loaded.unit_ns else {
         return Err(input(format!(
@@ -546,8 +616,28 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
     let max_time = loaded
         .max_time(args.duration.as_deref())
         .map_err(|m| input(format!("--duration: {m}")))?;
-    let publisher = DdsPublisher::new(domain, model, routes, ros2::dds::Qos::ros_default())
-        .map_err(CliError::Failed)?;
+    let mut qos: BTreeMap<String, ros2::dds::Qos> = BTreeMap::new();
+    for q in &args.qos {
+        let Some((topic, settings)) = q.split_once('=') else {
+            return Err(input(format!(
+                "--qos {q}: expected /topic=reliability=best_effort,durability=transient_local,..."
+            )));
+        };
+        let topic = topic.trim();
+        if !routes.iter().any(|r| r.topic == topic) {
+            return Err(input(format!(
+                "--qos {q}: the run does not publish `{topic}`"
+            )));
+        }
+        let entry = qos
+            .entry(topic.to_string())
+            .or_insert_with(ros2::dds::Qos::ros_default);
+        *entry = entry
+            .with_list(settings)
+            .map_err(|e| input(format!("--qos {q}: {e}")))?;
+    }
+    let publisher = DdsPublisher::new(domain, model, routes, &qos)
+        .map_err(|e| CliError::Failed(e.to_string()))?;
     let topics: Vec<&str> = publisher.topics().collect();
     for t in &args.wait_match {
         if !topics.contains(&t.as_str()) {
@@ -605,6 +695,7 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
     let mut live = DdsPaced {
         model,
         publisher,
+        services,
         clock: Clock::with_speed(unit_ns, args.speed),
         unit_ns,
         stop,
@@ -620,6 +711,21 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
     }
     // Reliable delivery of the last messages before the participant goes.
     live.publisher.flush(std::time::Duration::from_secs(2));
+    if let Some(s) = &live.services {
+        s.flush(std::time::Duration::from_secs(2));
+        for st in s.stats() {
+            eprintln!(
+                "run: serving {} on DDS: {} requests from ROS 2 clients, {} answered, {} malformed{}",
+                st.service,
+                st.requests,
+                st.answered,
+                st.malformed,
+                st.last_error
+                    .as_deref()
+                    .map_or(String::new(), |e| format!(" (last error: {e})"))
+            );
+        }
+    }
     let (failed, why) = live.publisher.failed();
     if failed > 0 {
         eprintln!(

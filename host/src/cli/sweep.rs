@@ -320,7 +320,7 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
             let mut counts = vec![PropertyCounts::default(); values.len()];
             for (name, records) in &logs {
                 let finals = live::record::final_verdicts(set.compiled(), records, name)
-                    .map_err(CliError::Input)?;
+                    .map_err(|e| CliError::Input(e.to_string()))?;
                 for (c, v) in counts.iter_mut().zip(&finals) {
                     match v {
                         Some(Verdict::True | Verdict::CurrentlyTrue) => c.successes += 1,
@@ -453,7 +453,8 @@ fn read_logs(paths: &[PathBuf]) -> Result<Vec<Log>, CliError> {
         .map(|p| {
             let name = p.display().to_string();
             let text = super::read_file(p)?;
-            let records = live::record::parse_log(&text, &name).map_err(CliError::Input)?;
+            let records = live::record::parse_log(&text, &name)
+                .map_err(|e| CliError::Input(e.to_string()))?;
             Ok((name, live::record::run_span(&records)))
         })
         .collect()

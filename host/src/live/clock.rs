@@ -97,6 +97,12 @@ impl Clock {
             .unwrap_or(self.start + Duration::from_secs(1 << 40))
     }
 
+    /// The tick the clock read `age` of wall-clock time ago, or `None` when that was
+    /// before the clock started (see [`Clock::now`]).
+    pub fn ticks_ago(&self, age: Duration) -> Option<u64> {
+        self.start.elapsed().checked_sub(age).map(|e| self.ticks(e))
+    }
+
     /// Whole ticks of model time in `elapsed` wall-clock time:
     /// `floor(elapsed * speed / tick)`, saturating.
     pub fn ticks(&self, elapsed: Duration) -> u64 {

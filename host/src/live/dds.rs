@@ -12,6 +12,18 @@
 //!   one); a sample that does not decode is one loss, with the topic and index;
 //! - **restart**: a sample from a writer (GUID) not seen before, after another, is a
 //!   restart with the gap since the last sample;
+//! - **lateness**: a sample's source timestamp (the writer's clock, RTPS `INFO_TS`),
+//!   placed on the monitor's clock, is its sending tick; when a point later than that
+//!   by more than `max_latency` has already been judged (a heartbeat or another
+//!   topic's sample), the verdicts since were reached without it: the properties
+//!   reading its topic are `unknown` from it, by the loss rule (event `late /topic`),
+//!   and the sample is then judged at its arrival. A sample sent before the monitor's
+//!   clock started (or, with `--from-first-message`, before the first message), or
+//!   before the first sample of its writer reached the monitor (DDS discovery still
+//!   under way, a transient-local writer's history), is not late: the monitor could not
+//!   have known of it. A sample that does not decode is a loss as such, not also late.
+//!   Writer and monitor on two machines need their clocks synchronised to well within
+//!   `max_latency`;
 //! - **heartbeats** every `heartbeat` ticks keep a silent topic's bounded properties
 //!   failing on time;
 //! - **never blocked**: samples are taken without waiting; a slow or dead publisher
@@ -49,6 +61,8 @@ pub struct TopicSource {
     pub vars: Vec<String>,
     /// The type in `ros2msg` form, for `--record`.
     pub schema_text: String,
+    /// The reader's QoS.
+    pub qos: Qos,
 }
 
 /// How the monitor runs.
@@ -61,13 +75,17 @@ pub struct Settings {
     pub speed: f64,
     /// No heartbeat before the first sample.
     pub from_first_message: bool,
+    /// A sample sent more than this (wall-clock time) before a point already judged is
+    /// late (zero: no sample is late).
+    pub max_latency: Duration,
 }
 
 struct Tap {
     source: TopicSource,
     reader: Reader,
-    /// Writers seen, with the last sequence number of each.
-    writers: Vec<([u8; 16], i64)>,
+    /// Writers seen, with the last sequence number of each and the tick their first
+    /// sample arrived at.
+    writers: Vec<([u8; 16], i64, u64)>,
     last_sample: Option<u64>,
     /// Samples received on the topic (the index errors name, from 1).
     received: u64,
@@ -90,13 +108,13 @@ pub fn run(
     let mut taps = Vec::new();
     for source in sources {
         let reader = participant
-            .reader(&source.topic, &source.type_name, Qos::ros_default())
+            .reader(&source.topic, &source.type_name, source.qos)
             .map_err(dds)?;
         let channel = match &mut mcap {
             None => None,
             Some(m) => Some(
                 m.add_topic(&source.topic, &source.type_name, &source.schema_text)
-                    .map_err(LiveError::Io)?,
+                    .map_err(|e| LiveError::Io(e.to_string()))?,
             ),
         };
         taps.push(Tap {
@@ -157,6 +175,7 @@ pub fn run(
                     &mut run,
                     tap,
                     &r,
+                    settings.max_latency,
                     mcap.as_mut().map(|m| (m, &mut record_base)),
                 )?;
             }
@@ -192,14 +211,14 @@ pub fn run(
         flush(r)?;
     }
     if let Some(m) = mcap {
-        m.finish().map_err(LiveError::Io)?;
+        m.finish().map_err(|e| LiveError::Io(e.to_string()))?;
     }
     let sources: Vec<SourceStats> = taps.iter().map(|t| t.stats.clone()).collect();
     for s in &sources {
         let _ = writeln!(
             run.opts.log,
-            "monitor: {}: {} judged, {} lost, {} malformed, {} restarts",
-            s.service, s.samples, s.lost, s.malformed, s.restarts
+            "monitor: {}: {} judged, {} lost, {} malformed, {} restarts, {} late",
+            s.service, s.samples, s.lost, s.malformed, s.restarts, s.late
         );
     }
     let _ = run.opts.log.flush();
@@ -211,17 +230,43 @@ pub fn run(
     })
 }
 
-/// Judges one sample of `tap`: restart and loss first, then its variables.
+/// The tick `r` was sent at on the monitor's clock, and the last point judged, when a
+/// point more than `max_latency` after its sending was judged before it came (see the
+/// module's docs); `None` when it is on time, has no source timestamp or was sent
+/// before the clock started.
+fn late(run: &Run<'_, '_>, r: &Received, max_latency: Duration) -> Option<(u64, u64)> {
+    if max_latency.is_zero() {
+        return None;
+    }
+    let sent_ns = r.source_ns?;
+    let now_ns = SystemTime::now()
+        .duration_since(SystemTime::UNIX_EPOCH)
+        .ok()?
+        .as_nanos();
+    // A source time ahead of ours (clock skew) is taken as sent now.
+    let age = Duration::from_nanos(
+        u64::try_from(now_ns.saturating_sub(u128::from(sent_ns))).unwrap_or(u64::MAX),
+    );
+    let sent = run.clock.ticks_ago(age)?;
+    let last = run.engine.last_time()?;
+    let allowed = run.clock.ticks(max_latency);
+    (sent.saturating_add(allowed) < last).then_some((sent, last))
+}
+
+/// Judges one sample of `tap`: restart, loss and lateness first, then its variables.
 fn sample(
     run: &mut Run<'_, '_>,
     tap: &mut Tap,
     r: &Received,
+    max_latency: Duration,
     mcap: Option<(&mut McapWriter, &mut Option<u64>)>,
 ) -> Result<(), LiveError> {
     let time = run.now();
+    // Before this sample's own point: the last point judged without it.
+    let late = late(run, r, max_latency);
     tap.received += 1;
     let topic = tap.source.topic.clone();
-    let idx = match tap.writers.iter().position(|(w, _)| *w == r.writer) {
+    let idx = match tap.writers.iter().position(|(w, _, _)| *w == r.writer) {
         Some(i) => i,
         None => {
             if !tap.writers.is_empty() {
@@ -240,7 +285,7 @@ fn sample(
             }
             // The first sample of a writer: nothing before it is counted as lost (a
             // volatile reader joining late never had the earlier ones).
-            tap.writers.push((r.writer, r.seq - 1));
+            tap.writers.push((r.writer, r.seq - 1, time));
             tap.writers.len() - 1
         }
     };
@@ -262,6 +307,29 @@ fn sample(
     }
     tap.writers[idx].1 = tap.writers[idx].1.max(r.seq);
     tap.last_sample = Some(time);
+    // Sent before its writer's first sample reached the monitor (discovery still under
+    // way, or a transient-local writer's history): the monitor could not have known of
+    // it, so it is not late.
+    let first_arrival = tap.writers[idx].2;
+    let late = late.filter(|(sent, _)| *sent >= first_arrival);
+    // A sample that does not decode is a loss by itself (below), late or not.
+    let decoded = tap.source.feed.read(&r.data);
+    if let (Some((sent, last)), Ok(_)) = (late, &decoded) {
+        tap.stats.late += 1;
+        run.loss(
+            time,
+            &topic,
+            &tap.source.vars,
+            1,
+            super::record::LATE,
+            format!(
+                "sample {} is late: sent at tick {sent}, after points up to tick {last} were \
+                 judged (--max-latency {} ms)",
+                tap.received,
+                max_latency.as_millis()
+            ),
+        )?;
+    }
     if let (Some((m, base)), Some(channel)) = (mcap, tap.channel) {
         // A sample's log time is the time it is judged at, on the system's clock: the
         // wall-clock time of the first sample recorded, plus the judged time since it (at
@@ -280,9 +348,9 @@ fn sample(
             base.saturating_add(at),
             &r.data,
         )
-        .map_err(LiveError::Io)?;
+        .map_err(|e| LiveError::Io(e.to_string()))?;
     }
-    match tap.source.feed.read(&r.data) {
+    match decoded {
         Ok(sets) => {
             tap.stats.samples += 1;
             run.judge(time, &topic, sets, None)?;

@@ -15,7 +15,8 @@
 //! - [`record`]: the verdict line and input log formats; replay.
 //! - [`mod@bench`]: throughput and added latency against a plain subscriber.
 //! - [`dds`]: the same judging over a live ROS 2 graph (DDS), `monitor --ros2`.
-//! - [`pace`]: `hindsight run`'s observer, pacing a simulation on the same [`Clock`].
+//! - [`pace`]: `hindsight run`'s observer, pacing a simulation on the same [`Clock`];
+//!   [`publish_dds`] and [`serve_dds`]: `run --ros2`'s topics and services on DDS.
 //! - [`serve`]: the live page (`--serve`): verdict lines streamed to a browser;
 //!   [`http`]: its HTTP plumbing and limits.
 //!
@@ -36,6 +37,7 @@ pub mod publish;
 pub mod publish_dds;
 pub mod record;
 pub mod serve;
+pub mod serve_dds;
 
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -74,6 +76,9 @@ pub struct SourceStats {
     pub malformed: u64,
     /// New publishers seen after a first one (restarts).
     pub restarts: u64,
+    /// Samples that arrived after points later than their sending were judged (DDS:
+    /// from their source timestamps).
+    pub late: u64,
     /// Requests refused by `filter` (or undeliverable).
     pub blocked: u64,
     /// Requests forwarded to the real service.
@@ -129,7 +134,7 @@ pub enum LiveError {
     /// Writing an output failed.
     Io(String),
     /// The DDS participant, a reader or a writer could not be created.
-    Dds(String),
+    Dds(ros2::dds::DdsError),
     /// The engine rejected a point (a bug: the config checks types).
     Engine(String),
 }
@@ -139,7 +144,7 @@ impl std::fmt::Display for LiveError {
         match self {
             LiveError::Ipc(m) => write!(f, "iceoryx2: {m}"),
             LiveError::Io(m) => write!(f, "output: {m}"),
-            LiveError::Dds(m) => f.write_str(m),
+            LiveError::Dds(e) => write!(f, "{e}"),
             LiveError::Engine(m) => write!(f, "monitor: {m}"),
         }
     }
@@ -228,7 +233,7 @@ impl Run<'_, '_> {
         self.write_record(&input)?;
         self.changes.clear();
         record::apply(self.spec, &mut self.engine, &input, &mut self.changes)
-            .map_err(LiveError::Engine)?;
+            .map_err(|e| LiveError::Engine(e.to_string()))?;
         let point = matches!(input, Input::Tick { .. });
         let judged = matches!(input, Input::Loss { .. });
         self.emit(point, judged)

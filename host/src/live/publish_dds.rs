@@ -17,6 +17,9 @@
 //! and its answer, `stamp` the wall-clock time of the send. That is what `ros2 bag record
 //! --all-services` keeps and what a property file's `<ros_service>` ports read.
 //!
+//! With `--external NODE`, the services NODE called are served to ROS 2 clients on their
+//! request and reply topics ([`super::serve_dds`]).
+//!
 //! A message is the type's zeros ([`ros2::cdr_write::Val::zero`]) with every field the
 //! model's event carries (AS2FM's `ros_fields__a__b` parameters: `a.b`) set from the
 //! sent values: booleans, integers, floats, strings and arrays of them. A field of
@@ -24,8 +27,10 @@
 //! not published on DDS (one warning each): their DDS form (`rt/<a>/_action/...` with
 //! goal ids and the action services) is not built.
 //!
-//! Writers use ROS 2's default QoS (reliable, volatile, keep last 10): a slow or absent
-//! reader loses the oldest samples, it never slows the run.
+//! Writers use ROS 2's default QoS (reliable, volatile, keep last 10), or what `--qos
+//! /topic=...` names for a topic: a slow or absent reader loses the oldest samples, it
+//! never slows the run; a transient-local writer keeps its last `depth` samples for
+//! readers that join later.
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -33,7 +38,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant, SystemTime};
 
 use ros2::cdr_write::{encode, Val};
-use ros2::dds::{Participant, Qos, Writer};
+use ros2::dds::{DdsError, Participant, Qos, Writer};
 use ros2::schema::{Definitions, Schema};
 
 use super::publish::{wire_name, WireKind};
@@ -271,13 +276,14 @@ pub struct DdsPublisher {
 
 impl DdsPublisher {
     /// Joins `domain` and creates one writer per topic (a service's requests and
-    /// responses share its `_service_event` writer), with `qos`.
+    /// responses share its `_service_event` writer), with the QoS `qos` names for its ROS
+    /// topic, ROS 2's default for the others.
     pub fn new(
         domain: u16,
         model: &CompiledModel,
         routes: Vec<Route>,
-        qos: Qos,
-    ) -> Result<DdsPublisher, String> {
+        qos: &BTreeMap<String, Qos>,
+    ) -> Result<DdsPublisher, DdsError> {
         let participant = Participant::new(domain)?;
         let mut writers: Vec<(String, Writer)> = Vec::new();
         let mut by_event = vec![None; model.event_count()];
@@ -288,7 +294,11 @@ impl DdsPublisher {
                 None => {
                     writers.push((
                         r.topic.clone(),
-                        participant.writer(&r.topic, &r.type_name, qos)?,
+                        participant.writer(
+                            &r.topic,
+                            &r.type_name,
+                            qos.get(&r.topic).copied().unwrap_or_else(Qos::ros_default),
+                        )?,
                     ));
                     writers.len() - 1
                 }
@@ -385,7 +395,7 @@ impl DdsPublisher {
         }
         let result = result
             .and_then(|()| encode(&route.schema, &v))
-            .and_then(|bytes| self.writers[*w].1.write(&bytes));
+            .and_then(|bytes| self.writers[*w].1.write(&bytes).map_err(|e| e.to_string()));
         match result {
             Ok(()) => self.published += 1,
             Err(e) => {
@@ -403,6 +413,8 @@ pub struct DdsPaced<'m> {
     pub model: &'m CompiledModel,
     /// The DDS writers.
     pub publisher: DdsPublisher,
+    /// The services external nodes called, served to ROS 2 clients (`--external`).
+    pub services: Option<super::serve_dds::DdsServices>,
     /// Model time on the wall clock.
     pub clock: Clock,
     /// Nanoseconds per model time unit (for the progress line).
@@ -442,6 +454,9 @@ impl DdsPaced<'_> {
 impl Observer for DdsPaced<'_> {
     fn on_send(&mut self, _time: u64, msg: &SentMessage<'_>) -> Flow {
         self.publisher.publish(self.model, msg);
+        if let Some(s) = &mut self.services {
+            s.answer(self.model, msg);
+        }
         Flow::Continue
     }
 
@@ -462,7 +477,11 @@ impl Observer for DdsPaced<'_> {
         Flow::Continue
     }
 
-    fn inputs(&mut self, _time: u64, _inbox: &mut Inbox) {}
+    fn inputs(&mut self, _time: u64, inbox: &mut Inbox) {
+        if let Some(s) = &mut self.services {
+            s.poll(inbox);
+        }
+    }
 }
 
 #[cfg(test)]

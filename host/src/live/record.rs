@@ -9,7 +9,9 @@
 //! - `{"kind":"sample","time":T,"source":S,"sets":{VAR:VALUE,..}}`: a tapped sample;
 //! - `{"kind":"request","time":T,"source":S,"sets":{..},"filter":[PROP,..]|null}`: a proxied request;
 //! - `{"kind":"tick","time":T}`: a heartbeat point with no sample;
-//! - `{"kind":"loss","time":T,"source":S,"vars":[VAR,..],"count":N,"reason":R}`: lost or malformed samples;
+//! - `{"kind":"loss","time":T,"source":S,"vars":[VAR,..],"count":N,"reason":R}`: lost or
+//!   malformed samples, or (reason `late`) a sample that arrived after later points were
+//!   judged; its `unknown` verdicts name the event `lost S` (`late S`);
 //! - `{"kind":"restart","time":T,"source":S,"gap":TICKS}`: a new publisher (informational).
 //!
 //! Values are JSON booleans, integers and floats, typed by the spec's variables.
@@ -21,6 +23,101 @@ use monitor_core::{Ty, Value};
 use serde::{Deserialize, Serialize};
 
 use super::engine::{Change, Engine, Verdict};
+
+/// What makes one record unjudgeable by a spec ([`apply`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum RecordError {
+    /// A variable the spec does not have.
+    UnknownVariable(String),
+    /// A `filter` property the spec does not have.
+    UnknownProperty(String),
+    /// A value that is not of its variable's type.
+    BadValue {
+        /// The value as JSON.
+        value: String,
+        /// The variable.
+        var: String,
+        /// Its type in the spec.
+        ty: String,
+    },
+    /// The log was recorded with another tick than the spec's.
+    Unit {
+        /// The log's tick, in nanoseconds.
+        log_ns: u64,
+        /// The spec's.
+        spec_ns: u64,
+    },
+    /// The monitors refused the point (time going backwards), as the spec describes it.
+    Step(String),
+    /// The spec's monitors could not be built.
+    Engine(String),
+}
+
+impl std::fmt::Display for RecordError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RecordError::UnknownVariable(n) => write!(f, "`{n}` is not a variable of the spec"),
+            RecordError::UnknownProperty(n) => write!(f, "`{n}` is not a property of the spec"),
+            RecordError::BadValue { value, var, ty } => {
+                write!(f, "`{value}` is not a value of type `{ty}` for `{var}`")
+            }
+            RecordError::Unit { log_ns, spec_ns } => write!(
+                f,
+                "the log's ticks are {} long, the spec's are {}: record and replay with the \
+                 same unit",
+                codegen::duration::format(*log_ns),
+                codegen::duration::format(*spec_ns)
+            ),
+            RecordError::Step(m) | RecordError::Engine(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for RecordError {}
+
+/// Why an input log does not replay: where (`file:line:col`) and what.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum LogError {
+    /// A line that is not a record.
+    Syntax {
+        /// The log's name.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What the JSON reader says.
+        message: String,
+    },
+    /// A record the spec cannot judge.
+    Record {
+        /// The log's name.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// What is wrong with it.
+        error: RecordError,
+    },
+    /// The spec's monitors could not be built (before any record).
+    Engine(String),
+}
+
+impl std::fmt::Display for LogError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LogError::Syntax {
+                file,
+                line,
+                column,
+                message,
+            } => write!(f, "{file}:{line}:{column}: {message}"),
+            LogError::Record { file, line, error } => write!(f, "{file}:{line}:1: {error}"),
+            LogError::Engine(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for LogError {}
 
 /// One record of the input log.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -109,12 +206,12 @@ pub fn sets_json(spec: &Compiled, sets: &[(usize, Value)]) -> BTreeMap<String, s
 fn sets_back(
     spec: &Compiled,
     sets: &BTreeMap<String, serde_json::Value>,
-) -> Result<Vec<(usize, Value)>, String> {
+) -> Result<Vec<(usize, Value)>, RecordError> {
     let mut out = Vec::with_capacity(sets.len());
     for (name, j) in sets {
         let var = spec
             .var_index(name)
-            .ok_or_else(|| format!("`{name}` is not a variable of the spec"))?;
+            .ok_or_else(|| RecordError::UnknownVariable(name.clone()))?;
         let v = match (spec.vars()[var].ty, j) {
             (Ty::Bool, serde_json::Value::Bool(b)) => Value::Bool(*b),
             (Ty::Int, serde_json::Value::Number(n)) if n.is_i64() => {
@@ -122,10 +219,11 @@ fn sets_back(
             }
             (Ty::Float, serde_json::Value::Number(n)) => Value::Float(n.as_f64().unwrap_or(0.0)),
             _ => {
-                return Err(format!(
-                    "`{j}` is not a value of type `{}` for `{name}`",
-                    spec.vars()[var].type_name
-                ))
+                return Err(RecordError::BadValue {
+                    value: j.to_string(),
+                    var: name.clone(),
+                    ty: spec.vars()[var].type_name.clone(),
+                })
             }
         };
         out.push((var, v));
@@ -133,12 +231,12 @@ fn sets_back(
     Ok(out)
 }
 
-fn vars_back(spec: &Compiled, names: &[String]) -> Result<Vec<usize>, String> {
+fn vars_back(spec: &Compiled, names: &[String]) -> Result<Vec<usize>, RecordError> {
     names
         .iter()
         .map(|n| {
             spec.var_index(n)
-                .ok_or_else(|| format!("`{n}` is not a variable of the spec"))
+                .ok_or_else(|| RecordError::UnknownVariable(n.clone()))
         })
         .collect()
 }
@@ -180,8 +278,8 @@ pub fn apply(
     engine: &mut Engine<'_>,
     input: &Input,
     out: &mut Vec<Change>,
-) -> Result<Option<bool>, String> {
-    let step = |e: monitor_core::StepError| spec.describe(&e);
+) -> Result<Option<bool>, RecordError> {
+    let step = |e: monitor_core::StepError| RecordError::Step(spec.describe(&e));
     match input {
         Input::Sample { time, source, sets } => {
             let sets = sets_back(spec, sets)?;
@@ -202,7 +300,7 @@ pub fn apply(
                         .map(|n| {
                             spec.property_names()
                                 .position(|p| p == n)
-                                .ok_or_else(|| format!("`{n}` is not a property of the spec"))
+                                .ok_or_else(|| RecordError::UnknownProperty(n.clone()))
                         })
                         .collect::<Result<Vec<_>, _>>()?,
                 ),
@@ -214,38 +312,57 @@ pub fn apply(
         }
         Input::Tick { time } => engine.point(*time, &[], "tick", out).map_err(step)?,
         Input::Loss {
-            time, source, vars, ..
+            time,
+            source,
+            vars,
+            reason,
+            ..
         } => {
             let vars = vars_back(spec, vars)?;
             engine
-                .loss(*time, &vars, &format!("lost {source}"), out)
+                .loss(*time, &vars, &loss_event(reason, source), out)
                 .map_err(step)?;
         }
         Input::Restart { .. } => {}
         Input::Start { unit_ns, .. } => {
             if *unit_ns != spec.tick_ns() {
-                return Err(format!(
-                    "the log's ticks are {} long, the spec's are {}: record and replay with \
-                     the same unit",
-                    codegen::duration::format(*unit_ns),
-                    codegen::duration::format(spec.tick_ns())
-                ));
+                return Err(RecordError::Unit {
+                    log_ns: *unit_ns,
+                    spec_ns: spec.tick_ns(),
+                });
             }
         }
     }
     Ok(None)
 }
 
+/// The event a loss's `unknown` verdicts name: `late SOURCE` for a sample that came
+/// after later points were judged ([`LATE`]), `lost SOURCE` otherwise.
+fn loss_event(reason: &str, source: &str) -> String {
+    if reason == LATE {
+        format!("late {source}")
+    } else {
+        format!("lost {source}")
+    }
+}
+
+/// The reason of a [`Input::Loss`] for a late sample.
+pub const LATE: &str = "late";
+
 /// Parses an input log: every record with its line number (1-based); blank lines are
 /// skipped. Errors name `file:line:col`.
-pub fn parse_log(text: &str, file: &str) -> Result<Vec<(usize, Input)>, String> {
+pub fn parse_log(text: &str, file: &str) -> Result<Vec<(usize, Input)>, LogError> {
     let mut out = Vec::new();
     for (i, l) in text.lines().enumerate() {
         if l.trim().is_empty() {
             continue;
         }
-        let input: Input =
-            serde_json::from_str(l).map_err(|e| format!("{file}:{}:{}: {e}", i + 1, e.column()))?;
+        let input: Input = serde_json::from_str(l).map_err(|e| LogError::Syntax {
+            file: file.to_string(),
+            line: i + 1,
+            column: e.column(),
+            message: e.to_string(),
+        })?;
         out.push((i + 1, input));
     }
     Ok(out)
@@ -277,13 +394,17 @@ pub fn replay(
     text: &str,
     file: &str,
     every_point: bool,
-) -> Result<Vec<String>, String> {
-    let mut engine = Engine::new(spec, every_point)?;
+) -> Result<Vec<String>, LogError> {
+    let mut engine = Engine::new(spec, every_point).map_err(LogError::Engine)?;
     let mut lines = Vec::new();
     let mut out = Vec::new();
     for (line, input) in parse_log(text, file)? {
         out.clear();
-        apply(spec, &mut engine, &input, &mut out).map_err(|e| format!("{file}:{line}:1: {e}"))?;
+        apply(spec, &mut engine, &input, &mut out).map_err(|error| LogError::Record {
+            file: file.to_string(),
+            line,
+            error,
+        })?;
         lines.extend(out.iter().map(|c| verdict_line(spec, c)));
     }
     Ok(lines)
@@ -327,8 +448,8 @@ pub fn final_verdicts(
     spec: &Compiled,
     records: &[(usize, Input)],
     file: &str,
-) -> Result<Vec<Option<Verdict>>, String> {
-    let mut engine = Engine::new(spec, false)?;
+) -> Result<Vec<Option<Verdict>>, LogError> {
+    let mut engine = Engine::new(spec, false).map_err(LogError::Engine)?;
     let mut out = Vec::new();
     for (line, input) in records {
         out.clear();
@@ -346,7 +467,11 @@ pub fn final_verdicts(
             }
             other => other,
         };
-        apply(spec, &mut engine, input, &mut out).map_err(|e| format!("{file}:{line}:1: {e}"))?;
+        apply(spec, &mut engine, input, &mut out).map_err(|error| LogError::Record {
+            file: file.to_string(),
+            line: *line,
+            error,
+        })?;
     }
     Ok(engine.verdicts().to_vec())
 }

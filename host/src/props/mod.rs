@@ -95,6 +95,9 @@ pub struct RosTypeUse {
     pub service: bool,
     /// The `type` attribute.
     pub at: Location,
+    /// The QoS a `<ros_topic>` names (`("durability", "transient_local")`, checked
+    /// against [`ros::QOS_SETTINGS`]), in that list's order; empty: ROS 2's default.
+    pub qos: Vec<(String, String)>,
 }
 
 /// One variable of a property file, observed on one message.

@@ -65,10 +65,42 @@ fn ros_name(name: &str) -> String {
     name.trim_start_matches('/').replace('/', "__")
 }
 
+/// The QoS attributes of a `<ros_topic>` port and their values: ROS 2's own names, those
+/// of rclcpp's QoS overrides (`qos_overrides./topic.subscription.reliability`; ROS 2
+/// design article "ROS 2 QoS configurability") and of `ros2 bag record
+/// --qos-profile-overrides-path`. `depth` takes a count (no list). AS2FM's ports name no
+/// QoS; a port without them reads with ROS 2's default (reliable, volatile, keep last 10).
+pub const QOS_SETTINGS: [(&str, &[&str]); 4] = [
+    (
+        "reliability",
+        &["reliable", "best_effort", "system_default"],
+    ),
+    (
+        "durability",
+        &["volatile", "transient_local", "system_default"],
+    ),
+    ("history", &["keep_last", "keep_all", "system_default"]),
+    ("depth", &[]),
+];
+
 impl<'a> FileReader<'_, 'a> {
-    /// `<ros_topic topic|topic_name type [event="publish"]>` with its variables.
+    /// `<ros_topic topic|topic_name type [event="publish"] [reliability durability history
+    /// depth]>` with its variables; the QoS attributes are ROS 2's names for them (see
+    /// [`QOS_SETTINGS`]).
     pub(super) fn ros_topic(&mut self, element: &Element, ports: &mut Vec<Port>) {
-        self.check_attrs(element, &["topic", "topic_name", "type", "event"]);
+        self.check_attrs(
+            element,
+            &[
+                "topic",
+                "topic_name",
+                "type",
+                "event",
+                "reliability",
+                "durability",
+                "history",
+                "depth",
+            ],
+        );
         let name = match (
             Self::attr(element, "topic").is_some(),
             Self::attr(element, "topic_name").is_some(),
@@ -87,7 +119,8 @@ impl<'a> FileReader<'_, 'a> {
                 None
             }
         };
-        self.ros_type(element, false);
+        let qos = self.ros_qos(element);
+        self.ros_type(element, false, qos);
         if let Some((event, at)) = self.optional(element, "event") {
             if event.as_str() != "publish" {
                 self.bad_value(at, "event", event.as_str(), "\"publish\"");
@@ -102,7 +135,7 @@ impl<'a> FileReader<'_, 'a> {
     pub(super) fn ros_service(&mut self, element: &Element, ports: &mut Vec<Port>) {
         self.check_attrs(element, &["service_name", "type", "event"]);
         let name = self.required_name(element, "service_name");
-        self.ros_type(element, true);
+        self.ros_type(element, true, Vec::new());
         let response = match self.required(element, "event") {
             Some((event, _)) if event.as_str() == "request" => Some(false),
             Some((event, _)) if event.as_str() == "response" => Some(true),
@@ -117,17 +150,50 @@ impl<'a> FileReader<'_, 'a> {
         }
     }
 
-    /// The port's `type`, kept to be checked against the model's interfaces.
-    fn ros_type(&mut self, element: &Element, service: bool) {
+    /// The port's `type`, kept to be checked against the model's interfaces, with the
+    /// QoS it names.
+    fn ros_type(&mut self, element: &Element, service: bool, qos: Vec<(String, String)>) {
         if let Some(type_name) = self.required_name(element, "type") {
             if let Some((_, at)) = self.optional(element, "type") {
                 self.ros_types.push(super::RosTypeUse {
                     type_name,
                     service,
                     at,
+                    qos,
                 });
             }
         }
+    }
+
+    /// The QoS attributes of a `<ros_topic>`, checked, in [`QOS_SETTINGS`] order.
+    fn ros_qos(&mut self, element: &Element) -> Vec<(String, String)> {
+        let mut out = Vec::new();
+        for (key, values) in QOS_SETTINGS {
+            let Some((value, at)) = self.optional(element, key) else {
+                continue;
+            };
+            let v = value.as_str();
+            let ok = if values.is_empty() {
+                v.parse::<u32>().is_ok_and(|d| (1..=1 << 20).contains(&d))
+            } else {
+                values.contains(&v)
+            };
+            if ok {
+                out.push((key.to_string(), v.to_string()));
+            } else {
+                let expected = if values.is_empty() {
+                    "a count of samples from 1 to 1048576".to_string()
+                } else {
+                    values
+                        .iter()
+                        .map(|x| format!("\"{x}\""))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
+                self.bad_value(at, key, v, &expected);
+            }
+        }
+        out
     }
 
     /// The `<state_var id type field expr>` and `<event_var id>` children of a ROS port.

@@ -1,6 +1,7 @@
 //! What the integration tests share: running the `hindsight` binary, where the external
 //! corpus is (and skipping a test without it: `corpus.rs`), the project's Python
-//! environment for the interoperability tests (`pyenv.rs`), the museum model the
+//! environment for the interoperability tests (`pyenv.rs`), the DDS tests' processes and
+//! domains (`dds.rs`), the museum model the
 //! simulator tests run, and a counting allocator.
 //!
 //! Each test file that needs it says `mod common;`; not every file uses every helper.
@@ -9,6 +10,7 @@
 pub mod alloc;
 pub mod canon;
 pub mod corpus;
+pub mod dds;
 pub mod pyenv;
 
 use std::path::{Path, PathBuf};

@@ -7,12 +7,22 @@
 # Usage:
 #   cyclone.py publish DOMAIN STEPS_JSON   STEPS: [["wait_match", "/topic", seconds],
 #       ["int32", "/topic", value], ["bool", "/topic", value], ["bad", "/topic"] (a
-#       malformed std_msgs/Int32MultiArray),
-#       ["sleep", seconds]]; prints "matched /topic" and "sent N" lines.
-#   cyclone.py subscribe DOMAIN SPEC_JSON  SPEC: {"topics": [["/topic", "TYPE"], ...],
+#       malformed std_msgs/Int32MultiArray), ["int32", "/topic", value, {"age": s}] (written
+#       with a source timestamp s seconds in the past),
+#       ["qos", "/topic", {"reliability": "best_effort", "durability": "transient_local",
+#       "depth": N}] (the QoS of the topic's writer, created after it; ROS 2's names),
+#       ["say", "text"] (prints the text), ["sleep", seconds]]; prints "matched /topic" and
+#       "sent N" lines.
+#   cyclone.py subscribe DOMAIN SPEC_JSON  SPEC: {"topics": [["/topic", "TYPE"] or
+#       ["/topic", "TYPE", QOS] (QOS as for publish's "qos" step), ...],
 #       "count": N, "seconds": S}: reads the topics (TYPE: a key of ros_types()) with ROS
 #       2's default QoS, prints "ready" once its readers exist, then one JSON line per
 #       sample {"topic", "data": the sample's fields} until N samples or S seconds.
+#   cyclone.py call DOMAIN SPEC_JSON       SPEC: {"service": "/s", "calls": [[a, b], ...],
+#       "seconds": S}: a ROS 2 client of example_interfaces/srv/AddTwoInts as
+#       rmw_cyclonedds makes one: requests on rq/<s>Request, replies on rr/<s>Reply, each
+#       sample headed by the request id (uint64 client guid, int64 sequence number);
+#       prints "matched", then one JSON line per reply {"seq", "sum"} of its own guid.
 #   cyclone.py read_mcap FILE              prints one JSON line per message:
 #       {"topic", "schema", "encoding", "message_encoding", "log_time", and "data"
 #       decoded with mcap-ros2-support, or "error" when it does not decode}.
@@ -55,13 +65,15 @@ def publish(domain, steps):
     )
     dp = DomainParticipant(domain)
     writers = {}
+    topic_qos = {}
 
     def writer(kind, topic):
         key = (kind, topic)
         if key not in writers:
             ty = {"int32": Int32_, "bool": Bool_, "bad": Short_}[kind]
-            t = Topic(dp, "rt" + topic, ty, qos=qos)
-            writers[key] = (DataWriter(dp, t, qos=qos), ty)
+            q = topic_qos.get(topic, qos)
+            t = Topic(dp, "rt" + topic, ty, qos=q)
+            writers[key] = (DataWriter(dp, t, qos=q), ty)
         return writers[key]
 
     sent = 0
@@ -78,9 +90,19 @@ def publish(domain, steps):
                     sys.exit(3)
                 time.sleep(0.02)
             print(f"matched {step[1]}", flush=True)
+        elif op == "qos":
+            topic_qos[step[1]] = ros_qos(step[2])
+        elif op == "say":
+            print(step[1], flush=True)
         elif op in ("int32", "bool"):
             w, ty = writer(op, step[1])
-            w.write(ty(data=step[2]))
+            opts = step[3] if len(step) > 3 else {}
+            if "age" in opts:
+                # The sample's source timestamp, `age` seconds before now (ns since the
+                # UNIX epoch, the time DDS writes in the sample's INFO_TS).
+                w.write(ty(data=step[2]), timestamp=time.time_ns() - int(opts["age"] * 1e9))
+            else:
+                w.write(ty(data=step[2]))
             sent += 1
         elif op == "bad":
             w, ty = writer("bad", step[1])
@@ -92,6 +114,28 @@ def publish(domain, steps):
     for w, _ in writers.values():
         w.wait_for_acks(duration(seconds=2))
     print(f"sent {sent}", flush=True)
+
+
+def ros_qos(settings):
+    """A Cyclone DDS QoS from ROS 2's names for the policies (rmw_qos_profile_t's
+    reliability, durability, history and depth), over ROS 2's default profile."""
+    from cyclonedds.core import Policy, Qos
+    from cyclonedds.util import duration
+
+    depth = settings.get("depth", 10)
+    reliability = {
+        "reliable": Policy.Reliability.Reliable(duration(milliseconds=100)),
+        "best_effort": Policy.Reliability.BestEffort,
+    }[settings.get("reliability", "reliable")]
+    durability = {
+        "volatile": Policy.Durability.Volatile,
+        "transient_local": Policy.Durability.TransientLocal,
+    }[settings.get("durability", "volatile")]
+    history = {
+        "keep_last": Policy.History.KeepLast(depth),
+        "keep_all": Policy.History.KeepAll,
+    }[settings.get("history", "keep_last")]
+    return Qos(reliability, durability, history)
 
 
 def ros_types():
@@ -188,9 +232,11 @@ def subscribe(domain, spec):
     )
     dp = DomainParticipant(domain)
     readers = []
-    for topic, kind in spec["topics"]:
-        t = Topic(dp, "rt" + topic, types[kind], qos=qos)
-        readers.append((topic, DataReader(dp, t, qos=qos)))
+    for entry in spec["topics"]:
+        topic, kind = entry[0], entry[1]
+        q = ros_qos(entry[2]) if len(entry) > 2 else qos
+        t = Topic(dp, "rt" + topic, types[kind], qos=q)
+        readers.append((topic, DataReader(dp, t, qos=q)))
     print("ready", flush=True)
     end = time.time() + spec["seconds"]
     got = 0
@@ -208,6 +254,66 @@ def subscribe(domain, spec):
                 print(json.dumps(line, default=list), flush=True)
         if idle:
             time.sleep(0.005)
+
+
+def call(domain, spec):
+    from cyclonedds.core import Policy, Qos
+    from cyclonedds.domain import DomainParticipant
+    from cyclonedds.idl import IdlStruct
+    from cyclonedds.idl.types import int64, uint64
+    from cyclonedds.pub import DataWriter
+    from cyclonedds.sub import DataReader
+    from cyclonedds.topic import Topic
+    from cyclonedds.util import duration
+
+    # rmw_cyclonedds's service samples: the request id header (cdds_request_header_t:
+    # guid, seq) written before the request's or the response's own fields.
+    @dataclass
+    class Request_(IdlStruct, typename="example_interfaces::srv::dds_::AddTwoInts_Request_"):
+        guid: uint64
+        seq: int64
+        a: int64
+        b: int64
+
+    @dataclass
+    class Response_(IdlStruct, typename="example_interfaces::srv::dds_::AddTwoInts_Response_"):
+        guid: uint64
+        seq: int64
+        sum: int64
+
+    # rmw_qos_profile_services_default: reliable, volatile, keep last 10.
+    qos = Qos(
+        Policy.Reliability.Reliable(duration(milliseconds=100)),
+        Policy.Durability.Volatile,
+        Policy.History.KeepLast(10),
+    )
+    dp = DomainParticipant(domain)
+    name = spec["service"].lstrip("/")
+    w = DataWriter(dp, Topic(dp, f"rq/{name}Request", Request_, qos=qos), qos=qos)
+    r = DataReader(dp, Topic(dp, f"rr/{name}Reply", Response_, qos=qos), qos=qos)
+    end = time.time() + spec["seconds"]
+    while not (w.get_matched_subscriptions() and r.get_matched_publications()):
+        if time.time() > end:
+            print("the server was never matched", file=sys.stderr)
+            sys.exit(3)
+        time.sleep(0.02)
+    # The server's side of discovery: its reply writer must know our reader too.
+    time.sleep(3.0)
+    print("matched", flush=True)
+    guid = 0x0102030405060708
+    for seq, (a, b) in enumerate(spec["calls"], start=1):
+        w.write(Request_(guid=guid, seq=seq, a=a, b=b))
+        got = None
+        while got is None and time.time() < end:
+            for sample in r.take(N=16):
+                if not sample.sample_info.valid_data or sample.guid != guid:
+                    continue
+                got = sample
+            time.sleep(0.005)
+        if got is None:
+            print(f"no reply to request {seq}", file=sys.stderr)
+            sys.exit(4)
+        print(json.dumps({"seq": got.seq, "sum": got.sum}), flush=True)
 
 
 def read_mcap(path):
@@ -242,6 +348,8 @@ if __name__ == "__main__":
         publish(int(sys.argv[2]), json.loads(sys.argv[3]))
     elif sys.argv[1] == "subscribe":
         subscribe(int(sys.argv[2]), json.loads(sys.argv[3]))
+    elif sys.argv[1] == "call":
+        call(int(sys.argv[2]), json.loads(sys.argv[3]))
     elif sys.argv[1] == "read_mcap":
         read_mcap(sys.argv[2])
     else:
