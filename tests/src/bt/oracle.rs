@@ -553,8 +553,9 @@ impl<'t> Oracle<'t> {
         let post = &self.tree.nodes[n].conds.post;
         if matches!(s, Status::Success | Status::Failure) {
             let which = if s == Status::Success { 2 } else { 1 };
+            let texts = self.texts();
             for p in [&post[which], &post[3]].into_iter().flatten() {
-                p.run(&mut self.vars)?;
+                p.run(&mut self.vars, &texts)?;
             }
         }
         if s == Status::Skipped && !self.takes_skipped(n) {
@@ -581,7 +582,8 @@ impl<'t> Oracle<'t> {
             let Some(p) = p else { continue };
             match self.status[n] {
                 None => {
-                    let holds = p.holds(&mut self.vars)?;
+                    let texts = self.texts();
+                    let holds = p.holds(&mut self.vars, &texts)?;
                     match (i, holds) {
                         (0, true) => return Ok(Some(Status::Failure)),
                         (1, true) => return Ok(Some(Status::Success)),
@@ -590,7 +592,8 @@ impl<'t> Oracle<'t> {
                     }
                 }
                 Some(Status::Running) if i == 3 => {
-                    let holds = p.holds(&mut self.vars)?;
+                    let texts = self.texts();
+                    let holds = p.holds(&mut self.vars, &texts)?;
                     if !holds {
                         self.halt_node(n);
                         return Ok(Some(Status::Skipped));
@@ -613,15 +616,33 @@ impl<'t> Oracle<'t> {
     fn halt_node(&mut self, n: usize) {
         self.halt(n);
         if let Some(p) = &self.tree.nodes[n].conds.post[0] {
-            if let Err(f) = p.run(&mut self.vars) {
+            let texts = self.texts();
+            if let Err(f) = p.run(&mut self.vars, &texts) {
                 self.fault.get_or_insert(format!("{f:?}"));
             }
         }
     }
 
     /// A script node's program run once over the entries.
-    fn script(&mut self, p: &Program) -> Result<i64, Stop> {
-        Ok(p.run(&mut self.vars)?)
+    fn script(&mut self, p: &Program) -> Result<super::script::V, Stop> {
+        let texts = self.texts();
+        Ok(p.run(&mut self.vars, &texts)?)
+    }
+
+    /// What scripts read of the entries SetBlackboard wrote: the text, or `None` for an
+    /// entry BT.CPP 4.8.2 holds without a value (one a copy names or made, see
+    /// [`Self::set_blackboard`]).
+    fn texts(&self) -> super::script::Texts {
+        let odd = |k: &String| self.any_typed.contains(k) || self.at_load.contains(k);
+        let mut t: super::script::Texts = self
+            .bb
+            .iter()
+            .map(|(k, v)| (k.clone(), (!odd(k)).then(|| v.clone())))
+            .collect();
+        for k in self.any_typed.iter().chain(&self.at_load) {
+            t.insert(k.clone(), None);
+        }
+        t
     }
 
     /// `ControlNode::haltChild` / `DecoratorNode::resetChild`: BT.CPP halts the child
@@ -784,7 +805,7 @@ impl<'t> Oracle<'t> {
             // `ScriptCondition::tick`: `cast<bool>` of the code's value.
             Kind::ScriptCondition(p) => {
                 let v = self.script(p)?;
-                Ok(if super::script::truth(v)? {
+                Ok(if super::script::truth(&v)? {
                     Success
                 } else {
                     Failure
@@ -827,7 +848,8 @@ impl<'t> Oracle<'t> {
     /// not clear `_children_running`: after one, the next tick skips the script.
     fn precondition(&mut self, n: usize, p: &Program, otherwise: Status) -> Result<Status, Stop> {
         if !self.memo[n] {
-            self.memo[n] = p.holds(&mut self.vars)?;
+            let texts = self.texts();
+            self.memo[n] = p.holds(&mut self.vars, &texts)?;
         }
         if !self.memo[n] {
             return Ok(otherwise);
