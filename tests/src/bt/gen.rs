@@ -245,6 +245,18 @@ impl<R: Rng> G<'_, R> {
             2 => format!("{} && {} || f", c(self), c(self)),
             3 => format!("!({})", self.bool_expr(d - 1, risky)),
             4 => format!("({}) == f", c(self)),
+            // A chain `a - b + c` in a condition, where BT.CPP's grouping (to the right)
+            // shows in the node's answer.
+            6 => {
+                let op = self.pick(&["==", "!=", "<", "<=", ">", ">="]);
+                format!(
+                    "{} - {} + {} {op} {}",
+                    self.int_expr(0),
+                    self.int_expr(0),
+                    self.int_expr(0),
+                    self.int_expr(0)
+                )
+            }
             // Arithmetic over a SetBlackboard's text throws ("Operation not permitted");
             // as the condition of `?:` it reads as a number.
             5 if risky && self.below(4) == 0 => match self.below(4) {

@@ -463,7 +463,12 @@ impl Expr {
                 let c = match c.eval(env, texts)? {
                     V::Num(c) => c,
                     V::Text(t) => text_number(&t)?,
-                    V::Empty => return Err(empty()),
+                    // 4.8.2's message here.
+                    V::Empty => {
+                        return Err(Fault::Throws(
+                            "Any::cast failed because it is empty".into(),
+                        ))
+                    }
                 };
                 return if c != 0 {
                     a.eval(env, texts)
@@ -665,6 +670,7 @@ mod tests {
         throws("y := s == 3", "string to number");
         throws("y := e == 1", "not initialized");
         throws("y := e + 1", "not initialized");
+        throws("y := e ? 1 : 2", "Any::cast failed because it is empty");
         let mut env = BTreeMap::new();
         assert!(matches!(
             parse("k").unwrap().holds(&mut env, &texts),
