@@ -409,9 +409,9 @@ fn scripts_and_conditions_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         (
             "text",
             "btcpp",
-            "<Sequence>\n  <SetBlackboard output_key=\"n\" value=\"1\"/>\n  <ScriptCondition code=\"n == 1\"/>\n</Sequence>",
-            "n == 1",
-            "which a SetBlackboard writes",
+            "<Sequence>\n  <SetBlackboard output_key=\"n\" value=\"1\"/>\n  <Script code=\"n += 1\"/>\n</Sequence>",
+            "n += 1",
+            "a script writing `n`, which a SetBlackboard writes",
         ),
         (
             "else",

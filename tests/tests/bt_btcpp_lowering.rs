@@ -427,6 +427,30 @@ fn scripts_assign_and_conditions_read_the_entries() {
 }
 
 #[test]
+fn scripts_read_the_text_setblackboard_wrote() {
+    // Checked against the real library (BT.CPP 4.8.2): SetBlackboard stores `3` as text;
+    // compared with a number it reads as 3 (`k == 3` holds, `k < 2` does not, so `y` is
+    // 2), and `k + 1` throws ("Operation not permitted"): the tree stops after A.
+    let t = v4(
+        "<Sequence><SetBlackboard output_key=\"k\" value=\"3\"/>\
+         <ScriptCondition code=\"k == 3\"/><Script code=\"y := k &lt; 2 ? 1 : 2\"/>\
+         <ScriptCondition code=\"y == 2\"/><A/><ScriptCondition code=\"k + 1 &gt; 0\"/></Sequence>",
+    );
+    let sc = scripts(&[("A", &[S])]);
+    assert_eq!(
+        lowered(&t, &sc, 2, BtTick::Once).unwrap(),
+        ran(&[], &[T(1005)])
+    );
+    // The text `0` as the condition of `?:` is false.
+    let t = v4("<Sequence><SetBlackboard output_key=\"k\" value=\"0\"/>\
+         <Script code=\"y := k ? 1 : 2\"/><ScriptCondition code=\"y == 2\"/><A/></Sequence>");
+    assert_eq!(
+        lowered(&t, &sc, 2, BtTick::Once).unwrap(),
+        ran(&[S, S], &[T(1004), T(1004)])
+    );
+}
+
+#[test]
 fn pre_and_post_conditions_run_around_the_node() {
     // A fails on its first tick: `_onFailure` counts it, and B's `_successIf` answers
     // SUCCESS without ticking B. On the second tick A succeeds.
@@ -648,6 +672,29 @@ fn conds_refused(t: &tree::Tree) -> bool {
     stale || t.nodes[0].conds.any()
 }
 
+/// The scripts of a generated document (the values of its `code`, `if` and `_...`
+/// attributes, unescaped enough to read): whether one reads a SetBlackboard's text
+/// (`k0`, `k1`, `p0`), and whether one chains `+`/`-` (`a - b + c`, which BT.CPP groups
+/// to the right).
+fn script_features(xml: &str) -> (bool, bool) {
+    let parts: Vec<&str> = xml.split('"').collect();
+    let (mut texts, mut chains) = (false, false);
+    for w in parts.windows(2) {
+        let (before, value) = (w[0], w[1]);
+        let name = before.rsplit([' ', '<']).next().unwrap_or("");
+        if !(name == "code=" || name == "if=" || name.starts_with('_')) {
+            continue;
+        }
+        texts |= value
+            .split(|c: char| !c.is_ascii_alphanumeric())
+            .any(|t| matches!(t, "k0" | "k1" | "p0"));
+        chains |= value
+            .split(';')
+            .any(|st| st.matches(" + ").count() + st.matches(" - ").count() >= 2);
+    }
+    (texts, chains)
+}
+
 /// `HINDSIGHT_BT_TREES` random trees from `HINDSIGHT_BT_SEED`, each lowered under both
 /// tick modes and compared with the oracle's BT.CPP 4 reading.
 fn random_trees(opts: gen::Options) {
@@ -673,6 +720,9 @@ fn random_trees(opts: gen::Options) {
     // Trees compared that hold each of BT.CPP 4's own node kinds.
     let kinds: [AtomicUsize; 14] = Default::default();
     let kinds = &kinds;
+    // Trees compared whose scripts read a SetBlackboard's text; chain `+`/`-`.
+    let feats: [AtomicUsize; 2] = Default::default();
+    let feats = &feats;
     let fails: Vec<String> = std::thread::scope(|s| {
         let hs: Vec<_> = (0..threads)
             .map(|t| {
@@ -724,6 +774,9 @@ fn random_trees(opts: gen::Options) {
                                 .iter()
                                 .any(|x| matches!(x.kind, Kind::Precondition(_, Status::Skipped))),
                         ];
+                        let (texts, chains) = script_features(&c.xml);
+                        feats[0].fetch_add(usize::from(texts), Relaxed);
+                        feats[1].fetch_add(usize::from(chains), Relaxed);
                         let mut seen = [false; 14];
                         for x in &t.nodes {
                             if let Some(k) = btcpp4_kind(&x.kind) {
@@ -829,13 +882,15 @@ fn random_trees(opts: gen::Options) {
         );
     }
     let kinds = kinds.each_ref().map(|c| c.load(Relaxed));
+    let [texts, chains] = feats.each_ref().map(|c| c.load(Relaxed));
     eprintln!(
         "{n} random trees{} in {:.1} s on {threads} threads: {copies} with a SetBlackboard copy \
          and {not_modelled} with pre/post conditions not modelled yet left out, \
          {with_conds} compared with pre/post conditions; {runs} runs of the others (tickOnce and tickExactlyOnce): {refused} of \
          them on trees BT.CPP 4 refuses at load (3.x names; compared with the oracle's BT.CPP 4 \
          rules), {livelocks} with an executor tick that never returns, {errors} where BT.CPP \
-         throws; {modes_differ} trees whose two tick modes differ; trees with BT.CPP 4's own \
+         throws; {modes_differ} trees whose two tick modes differ; trees with scripts reading \
+         a SetBlackboard's text {texts}, chaining `+`/`-` {chains}; trees with BT.CPP 4's own \
          nodes: {}",
         match (opts.btcpp4_nodes, opts.scripts) {
             (true, true) => " (BT.CPP 4's own nodes and scripts included)",
@@ -866,6 +921,10 @@ fn random_trees(opts: gen::Options) {
             assert!(
                 with_conds as u64 >= n / 10,
                 "only {with_conds} compared trees with pre/post conditions"
+            );
+            assert!(
+                texts as u64 >= n / 100 && chains as u64 >= n / 100,
+                "only {texts} compared trees reading a SetBlackboard's text, {chains} chaining `+`/`-`"
             );
         }
         // With BT.CPP 4's own nodes on, each kind is in at least one tree in 100.

@@ -169,6 +169,9 @@ const FEATURES: &[&str] = &[
     "<Script ",
     "<ScriptCondition ",
     "<Precondition ",
+    // A script reading a SetBlackboard's text (`k0` only appears followed by a space in
+    // a script).
+    "k0 ",
     "_skipIf=",
     "_while=",
     "<RunOnce>",
@@ -637,8 +640,14 @@ fn where_as2fm_and_btcpp_differ() {
 /// but 0; chained comparisons; `!` and unary `-` on booleans).
 #[test]
 fn script_operators_agree_with_the_library() {
-    const SCRIPTS: [&str; 12] = [
+    const SCRIPTS: [&str; 17] = [
         "x:= true || false && false",
+        // `+ -` and `*` group to the right in 4.8.2.
+        "x:= 10 - 4 - 2",
+        "x:= 1 - 1 + 1",
+        "x:= 3 - 2 * 2 - 1",
+        "x:= 2 * 3 - 4 * 5 - 6",
+        "x:= 100 - 10 - 1 == 91",
         "x:= false && true || true",
         "x:= true && false || true && false",
         "x:= 1 < 2 || 3 < 2 && false",

@@ -264,3 +264,71 @@ fn try_catch_with_catch_on_halt_runs_the_catch_when_halted() {
         &[T(1001), T(1003), T(1004), T(1001), H(1004)],
     );
 }
+
+// BT.CPP 4.10 `tests/gtest_decorator.cpp`, the timed tests, as tick facts. The gtests
+// tick on wall-clock time (sleeps between ticks); here the executor ticks every 100 ms,
+// so each duration is chosen to keep the gtest's order of ticks, timers and the
+// action's end.
+
+#[test]
+fn gtest_decorator_deadline_triggered() {
+    // `DeadlineTest.DeadlineTriggeredTest`: a Timeout of 100 ms over an action of 150 ms,
+    // ticked at 0 and 170 ms: RUNNING, then FAILURE with the action halted (IDLE). The
+    // deadline falls between the two ticks and before the action ends: 50 ms here, the
+    // action answering RUNNING then (were it ticked) SUCCESS. The gtest builds the nodes
+    // by hand (no wake-up signal, as `tickExactlyOnce` of a tree of these two nodes).
+    check(
+        "<Timeout msec=\"50\"><A/></Timeout>",
+        &[("A", &[R, S])],
+        TickMode::ExactlyOnce,
+        &[R, F],
+        &[T(1001), H(1001)],
+    );
+}
+
+#[test]
+fn gtest_decorator_deadline_not_triggered() {
+    // `DeadlineTest.DeadlineNotTriggeredTest`: the action (30 ms) ends before the
+    // second tick (50 ms), the deadline (100 ms) after it: RUNNING, then SUCCESS with
+    // the action IDLE (not halted). Here the deadline is 150 ms, the second tick at 100.
+    check(
+        "<Timeout msec=\"150\"><A/></Timeout>",
+        &[("A", &[R, S])],
+        TickMode::ExactlyOnce,
+        &[R, S],
+        &[T(1001), T(1001)],
+    );
+}
+
+#[test]
+fn gtest_decorator_delay_with_xml() {
+    // `Decorator.DelayWithXML`: a tree from XML, `tickOnce`: a Delay of 100 ms over
+    // AlwaysSuccess answers RUNNING at 0 and 50 ms and SUCCESS at the first tick after
+    // its timer. Here 150 ms: RUNNING at 0 and 100, SUCCESS at 200.
+    check(
+        "<Delay delay_msec=\"150\"><AlwaysSuccess/></Delay>",
+        &[],
+        TickMode::Once,
+        &[R, R, S],
+        &[],
+    );
+}
+
+#[test]
+fn gtest_decorator_issue57() {
+    // `TimeoutAndRetry.Issue57`: a Timeout of 9 ms over RetryUntilSuccessful (1000
+    // attempts) over an action that always fails, ticked for 2 s: the Timeout never
+    // answers IDLE (BT.CPP issue 57: a Timeout whose timer halted its child). The gtest
+    // builds the nodes by hand; as a tree from XML (what hindsight lowers), under
+    // `tickExactlyOnce`, the Retry yields RUNNING after each failed attempt (its wake-up
+    // signal), the timer halts it at 9 ms (resetting its count; the action is not
+    // RUNNING, so it gets no halt), and the next tick answers FAILURE; then again. (100
+    // attempts instead of 1000: the lowering counts to 127; one attempt a tick is made.)
+    check(
+        "<Timeout msec=\"9\"><RetryUntilSuccessful num_attempts=\"100\"><A/></RetryUntilSuccessful></Timeout>",
+        &[("A", &[F])],
+        TickMode::ExactlyOnce,
+        &[R, F, R, F],
+        &[T(1002), T(1002)],
+    );
+}

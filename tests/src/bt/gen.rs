@@ -5,7 +5,8 @@
 //! without `<bt_halt>`; counts of -1. With [`Options::btcpp4_nodes`], also BT.CPP 4's
 //! nodes that AS2FM has no model of; with [`Options::scripts`], BT.CPP 4's script
 //! language (`Script`, `ScriptCondition`, `Precondition`) and pre/post conditions on
-//! nodes, over the integer entries `x`, `y` and the boolean `f`; with [`Options::time_nodes`]
+//! nodes, over the integer entries `x`, `y` and the boolean `f` (conditions also read the
+//! texts SetBlackboard wrote to `k0`, `k1`, `p0`); with [`Options::time_nodes`]
 //! and [`Options::try_catch`], Timeout, Delay, Sleep and TryCatch; with
 //! [`Options::bb_nodes`], BT.CPP 4's blackboard nodes (UnsetBlackboard, the entry-updated
 //! nodes, the Loop nodes).
@@ -227,9 +228,18 @@ impl<R: Rng> G<'_, R> {
     /// throw (the real-library harness relies on it: `Tree::haltTree` runs every
     /// `_onHalted` script, and a throw from the tree's destructor aborts).
     fn bool_expr(&mut self, d: u32, risky: bool) -> String {
+        // Now and then, in a condition (`risky`), an entry a SetBlackboard wrote (`k0`,
+        // `k1`, `p0`): BT.CPP 4 holds its text, which a comparison reads as a number.
+        // Not in statements: a SubTree's own `p0` does not exist until the SubTree runs,
+        // and `Tree::haltTree` runs every `_onHalted`, ticked or not.
         let c = |g: &mut Self| {
             let op = g.pick(&["==", "!=", "<", "<=", ">", ">="]);
-            format!("{} {op} {}", g.int_expr(0), g.int_expr(0))
+            let a = if risky && g.below(4) == 0 {
+                g.int_entry().to_string()
+            } else {
+                g.int_expr(0)
+            };
+            format!("{a} {op} {}", g.int_expr(0))
         };
         if d == 0 {
             return match self.below(6) {
@@ -255,7 +265,25 @@ impl<R: Rng> G<'_, R> {
             2 => format!("{} && {} || f", c(self), c(self)),
             3 => format!("!({})", self.bool_expr(d - 1, risky)),
             4 => format!("({}) == f", c(self)),
-            5 if risky && self.below(4) == 0 => "x".into(),
+            // A chain `a - b + c` in a condition, where BT.CPP's grouping (to the right)
+            // shows in the node's answer.
+            6 => {
+                let op = self.pick(&["==", "!=", "<", "<=", ">", ">="]);
+                format!(
+                    "{} - {} + {} {op} {}",
+                    self.int_expr(0),
+                    self.int_expr(0),
+                    self.int_expr(0),
+                    self.int_expr(0)
+                )
+            }
+            // Arithmetic over a SetBlackboard's text throws ("Operation not permitted");
+            // as the condition of `?:` it reads as a number.
+            5 if risky && self.below(4) == 0 => match self.below(4) {
+                0 => format!("{} + 1 > 0", self.int_entry()),
+                1 => format!("({} ? 1 : 0) == 1", self.int_entry()),
+                _ => "x".into(),
+            },
             _ => self.bool_expr(0, risky),
         }
     }
@@ -265,7 +293,8 @@ impl<R: Rng> G<'_, R> {
         let n = 1 + self.below(3);
         let stmts: Vec<String> = (0..n)
             .map(|_| match self.below(7) {
-                0 => format!("x := {}", self.int_expr(1)),
+                // Depth 2: chains such as `x - 1 + y - 2`, which BT.CPP groups to the right.
+                0 => format!("x := {}", self.int_expr(2)),
                 1 => format!("y = {}", self.int_expr(1)),
                 2 => format!("x += {}", self.below(3)),
                 3 => format!("y -= {}", self.below(3)),

@@ -580,6 +580,7 @@ impl<'t> Oracle<'t> {
         let post = &self.tree.nodes[n].conds.post;
         if matches!(s, Status::Success | Status::Failure) {
             let which = if s == Status::Success { 2 } else { 1 };
+            let texts = self.texts();
             for p in [&post[which], &post[3]].into_iter().flatten() {
                 self.run_program(p)?;
             }
@@ -646,20 +647,16 @@ impl<'t> Oracle<'t> {
         }
     }
 
-    /// A script node's program run once over the entries.
-    fn script(&mut self, p: &Program) -> Result<i64, Stop> {
-        Ok(self.run_program(p)?)
-    }
-
     /// A script run over the entries; every assignment it makes counts as a write of
     /// its entry (`Blackboard::Entry::sequence_id`: the real library counts `x := 0`
     /// twice in `x := 0; x := 0`, and `x += 0` too, but not a read).
     /// An assignment other than `:=` to an entry that does not exist (UnsetBlackboard
     /// erased it) throws before its right side is read ("The blackboard entry [..]
     /// doesn't exist", as 4.8.2 answers).
-    fn run_program(&mut self, p: &Program) -> Result<i64, Fault> {
+    fn run_program(&mut self, p: &Program) -> Result<super::script::V, Fault> {
         use super::script::Expr;
-        let mut last = 0;
+        let texts = self.texts();
+        let mut last = super::script::V::Num(0);
         for s in &p.0 {
             if let Expr::Assign(v, op, _) = s {
                 if *op != ":=" && !self.vars.contains_key(v) {
@@ -672,7 +669,7 @@ impl<'t> Oracle<'t> {
                 Expr::Assign(v, _, _) if !self.vars.contains_key(v) => Some(v.clone()),
                 _ => None,
             };
-            last = match Program(vec![s.clone()]).run(&mut self.vars) {
+            last = match Program(vec![s.clone()]).run(&mut self.vars, &texts) {
                 Ok(v) => v,
                 // `v := e` with `v` missing creates `v` without a value before reading
                 // `e`: an `e` that reads `v` throws, with the message of the operator
@@ -696,7 +693,28 @@ impl<'t> Oracle<'t> {
 
     /// A script run as a condition.
     fn holds(&mut self, p: &Program) -> Result<bool, Fault> {
-        super::script::truth(self.run_program(p)?)
+        super::script::truth(&self.run_program(p)?)
+    }
+
+    /// A script node's program run once over the entries.
+    fn script(&mut self, p: &Program) -> Result<super::script::V, Stop> {
+        Ok(self.run_program(p)?)
+    }
+
+    /// What scripts read of the entries SetBlackboard wrote: the text, or `None` for an
+    /// entry BT.CPP 4.8.2 holds without a value (one a copy names or made, see
+    /// [`Self::set_blackboard`]).
+    fn texts(&self) -> super::script::Texts {
+        let odd = |k: &String| self.any_typed.contains(k) || self.at_load.contains(k);
+        let mut t: super::script::Texts = self
+            .bb
+            .iter()
+            .map(|(k, v)| (k.clone(), (!odd(k)).then(|| v.clone())))
+            .collect();
+        for k in self.any_typed.iter().chain(&self.at_load) {
+            t.insert(k.clone(), None);
+        }
+        t
     }
 
     /// `ControlNode::haltChild` / `DecoratorNode::resetChild`: BT.CPP halts the child
@@ -872,7 +890,7 @@ impl<'t> Oracle<'t> {
             // `ScriptCondition::tick`: `cast<bool>` of the code's value.
             Kind::ScriptCondition(p) => {
                 let v = self.script(p)?;
-                Ok(if super::script::truth(v)? {
+                Ok(if super::script::truth(&v)? {
                     Success
                 } else {
                     Failure

@@ -14,7 +14,8 @@
 //! - precedence, loosest first: `? :` (not chained; its condition is true for any number
 //!   but 0), `&&` and `||` (one level, left to right: `true || false && false` is false),
 //!   comparisons (`== != < <= > >=`; a
-//!   chain `a < b < c` means `a < b && b < c`), `+ -`, `*`, unary `- !`;
+//!   chain `a < b < c` means `a < b && b < c`), `+ -`, `*`, unary `- !`; `+ -` and `*`
+//!   group to the right (4.8.2: `10 - 4 - 2` is 8, `1 - 1 + 1` is -1);
 //! - `true`/`false` are the numbers 1 and 0 in arithmetic (`-true` is -1, `a:=1; a+=true`
 //!   gives 2); comparisons give a boolean; `!x` is `x == 0` for any number;
 //! - `&&`/`||` refuse an operand other than 0 or 1 ("Logic operators are not allowed if one
@@ -30,8 +31,14 @@
 //!   and the `a` of `c ? a : b` start a new expression; `b` continues `c`'s (`!f ? -1 : 2`
 //!   is a script, `!f ? 1 : -x` is not).
 //!
-//! Division (`/` gives a double in BT.CPP), `%` (not in the language), strings, reals and
-//! the bit operators are outside the subset: the parser refuses them.
+//! An entry a SetBlackboard wrote holds a string (BT.CPP 4 stores SetBlackboard's value as
+//! text), which scripts read ([`Texts`]): compared with a number it is read as one (the
+//! text `3` equals 3; `abc` throws "Any failed string to number conversion"), two strings
+//! compare as strings, `c ? a : b` reads it as a number, and the arithmetic and logic
+//! operators, `-`, `!` and a condition's cast to bool throw (4.8.2's answers).
+//!
+//! Division (`/` gives a double in BT.CPP), `%` (not in the language), string literals,
+//! reals and the bit operators are outside the subset: the parser refuses them.
 
 use std::collections::BTreeMap;
 
@@ -238,30 +245,32 @@ impl P {
         })
     }
 
+    /// `+` and `-`, grouped to the right: BT.CPP 4.8.2 computes `10 - 4 - 2` as
+    /// `10 - (4 - 2)`, 8, and `1 - 1 + 1` as -1 (checked by
+    /// `script_operators_agree_with_the_library` in `tests/tests/bt_real.rs`).
     fn add(&mut self) -> Result<Expr, String> {
-        let mut a = self.mul()?;
-        loop {
-            let op = if self.eat("+") {
-                '+'
-            } else if self.eat("-") {
-                '-'
-            } else {
-                return Ok(a);
-            };
-            self.group(false)?;
-            let b = self.mul()?;
-            a = Expr::Arith(op, Box::new(a), Box::new(b));
-        }
+        let a = self.mul()?;
+        let op = if self.eat("+") {
+            '+'
+        } else if self.eat("-") {
+            '-'
+        } else {
+            return Ok(a);
+        };
+        self.group(false)?;
+        let b = self.add()?;
+        Ok(Expr::Arith(op, Box::new(a), Box::new(b)))
     }
 
+    /// `*`, grouped to the right as `+` and `-` are.
     fn mul(&mut self) -> Result<Expr, String> {
-        let mut a = self.unary()?;
-        while self.eat("*") {
-            self.group(false)?;
-            let b = self.unary()?;
-            a = Expr::Arith('*', Box::new(a), Box::new(b));
+        let a = self.unary()?;
+        if !self.eat("*") {
+            return Ok(a);
         }
-        Ok(a)
+        self.group(false)?;
+        let b = self.mul()?;
+        Ok(Expr::Arith('*', Box::new(a), Box::new(b)))
     }
 
     fn unary(&mut self) -> Result<Expr, String> {
@@ -347,17 +356,52 @@ impl Expr {
         }
     }
 
-    fn eval(&self, env: &mut BTreeMap<String, i64>) -> Result<i64, Fault> {
+    fn eval(&self, env: &mut BTreeMap<String, i64>, texts: &Texts) -> Result<V, Fault> {
         let over = || Fault::Model("integer overflow in a script".into());
-        Ok(match self {
+        let num = |v: V| -> Result<i64, Fault> {
+            match v {
+                V::Num(n) => Ok(n),
+                V::Empty => Err(empty()),
+                // An arithmetic or logic operator over a string: BT.CPP 4.8.2 throws
+                // "Operation not permitted" (`+` of two strings concatenates: not in
+                // the oracle's subset).
+                V::Text(_) => Err(Fault::Throws("Operation not permitted".into())),
+            }
+        };
+        Ok(V::Num(match self {
             Expr::Num(v) => *v,
-            Expr::Var(v) => *env
-                .get(v)
-                .ok_or_else(|| Fault::Throws(format!("Variable not found: {v}")))?,
-            Expr::Neg(a) => a.eval(env)?.checked_neg().ok_or_else(over)?,
-            Expr::Not(a) => i64::from(a.eval(env)? == 0),
+            Expr::Var(v) => match (env.get(v), texts.get(v)) {
+                (Some(x), None) => *x,
+                (None, Some(Some(t))) => return Ok(V::Text(t.clone())),
+                (None, Some(None)) => return Ok(V::Empty),
+                (None, None) => return Err(Fault::Throws(format!("Variable not found: {v}"))),
+                _ => {
+                    return Err(Fault::Model(format!(
+                        "a script reads `{v}`, which both a script and a SetBlackboard wrote: not modelled"
+                    )))
+                }
+            },
+            Expr::Neg(a) | Expr::Not(a) => {
+                let x = match a.eval(env, texts)? {
+                    V::Num(x) => x,
+                    // 4.8.2: "Invalid operator for std::string".
+                    V::Text(_) => {
+                        return Err(Fault::Throws("Invalid operator for std::string".into()))
+                    }
+                    V::Empty => return Err(empty()),
+                };
+                if matches!(self, Expr::Neg(_)) {
+                    x.checked_neg().ok_or_else(over)?
+                } else {
+                    i64::from(x == 0)
+                }
+            }
             Expr::Arith(op, a, b) => {
-                let (a, b) = (a.eval(env)?, b.eval(env)?);
+                let (a, b) = (a.eval(env, texts)?, b.eval(env, texts)?);
+                if matches!((&a, &b), (V::Text(_), V::Text(_))) {
+                    return Err(Fault::Model("an operator over two strings".into()));
+                }
+                let (a, b) = (num(a)?, num(b)?);
                 match op {
                     '+' => a.checked_add(b),
                     '-' => a.checked_sub(b),
@@ -369,23 +413,37 @@ impl Expr {
                 // Each operand once, left to right; the chain holds where every pair does.
                 let vals = xs
                     .iter()
-                    .map(|x| x.eval(env))
+                    .map(|x| x.eval(env, texts))
                     .collect::<Result<Vec<_>, _>>()?;
-                let all = ops.iter().enumerate().all(|(i, op)| {
-                    let (a, b) = (vals[i], vals[i + 1]);
-                    match *op {
-                        "==" => a == b,
-                        "!=" => a != b,
-                        "<" => a < b,
-                        "<=" => a <= b,
-                        ">" => a > b,
-                        _ => a >= b,
-                    }
-                });
+                if vals.contains(&V::Empty) {
+                    return Err(empty());
+                }
+                let mut all = true;
+                for (i, op) in ops.iter().enumerate() {
+                    let ord = match (&vals[i], &vals[i + 1]) {
+                        (V::Num(a), V::Num(b)) => a.cmp(b),
+                        // Two strings compare as strings (4.8.2: `'abc' < 'abd'`; a
+                        // SetBlackboard's `3` and `03` differ).
+                        (V::Text(a), V::Text(b)) => a.cmp(b),
+                        // A string and a number: the string read as a number (4.8.2:
+                        // the text `3` equals 3, ` 3` and `03` too; `abc` throws).
+                        (V::Text(t), V::Num(b)) => text_number(t)?.cmp(b),
+                        (V::Num(a), V::Text(t)) => a.cmp(&text_number(t)?),
+                        (V::Empty, _) | (_, V::Empty) => unreachable!("refused above"),
+                    };
+                    all &= match *op {
+                        "==" => ord.is_eq(),
+                        "!=" => ord.is_ne(),
+                        "<" => ord.is_lt(),
+                        "<=" => ord.is_le(),
+                        ">" => ord.is_gt(),
+                        _ => ord.is_ge(),
+                    };
+                }
                 i64::from(all)
             }
             Expr::Logic(and, a, b) => {
-                let (a, b) = (a.eval(env)?, b.eval(env)?);
+                let (a, b) = (num(a.eval(env, texts)?)?, num(b.eval(env, texts)?)?);
                 if !(0..=1).contains(&a) || !(0..=1).contains(&b) {
                     return Err(Fault::Throws(
                         "Logic operators are not allowed if one of the operands is not castable to bool".into(),
@@ -399,16 +457,39 @@ impl Expr {
             }
             // The condition of `c ? a : b` is true for any number but 0 (BT.CPP 4's
             // `ExprIf::evaluate` compares it with 0; unlike a node's condition it is not
-            // cast to bool): `2 ? 5 : 7` and `-1 ? 5 : 7` give 5 in 4.8.2.
+            // cast to bool): `2 ? 5 : 7` and `-1 ? 5 : 7` give 5 in 4.8.2; a string is
+            // read as a number (the text `0` is false).
             Expr::Ite(c, a, b) => {
-                if c.eval(env)? != 0 {
-                    a.eval(env)?
+                let c = match c.eval(env, texts)? {
+                    V::Num(c) => c,
+                    V::Text(t) => text_number(&t)?,
+                    // 4.8.2's message here.
+                    V::Empty => {
+                        return Err(Fault::Throws(
+                            "Any::cast failed because it is empty".into(),
+                        ))
+                    }
+                };
+                return if c != 0 {
+                    a.eval(env, texts)
                 } else {
-                    b.eval(env)?
-                }
+                    b.eval(env, texts)
+                };
             }
             Expr::Assign(v, op, e) => {
-                let x = e.eval(env)?;
+                if texts.contains_key(v) {
+                    return Err(Fault::Model(format!(
+                        "a script writes `{v}`, which a SetBlackboard writes: not modelled"
+                    )));
+                }
+                let x = match e.eval(env, texts)? {
+                    V::Num(x) => x,
+                    V::Text(_) | V::Empty => {
+                        return Err(Fault::Model(format!(
+                            "a script copies a string into `{v}`: not modelled"
+                        )))
+                    }
+                };
                 let old = env.get(v).copied();
                 let new = match (*op, old) {
                     (":=", _) => x,
@@ -425,22 +506,69 @@ impl Expr {
                 env.insert(v.clone(), new);
                 new
             }
-        })
+        }))
     }
 }
 
-/// `Any::cast<bool>` of a script's value: 0 and 1 only.
-pub fn truth(v: i64) -> Result<bool, Fault> {
+/// The entries a SetBlackboard wrote, as text, for scripts to read (`None`: an entry that
+/// exists without a value, see [`V::Empty`]).
+pub type Texts = BTreeMap<String, Option<String>>;
+
+/// 4.8.2's exception for an operator over an entry that exists without a value.
+fn empty() -> Fault {
+    Fault::Throws("is not initialized".into())
+}
+
+/// A script value: a number (booleans as 0 and 1), or the text of an entry a
+/// SetBlackboard wrote (BT.CPP 4 stores SetBlackboard's value as a string).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum V {
+    /// A number.
+    Num(i64),
+    /// A string.
+    Text(String),
+    /// An entry that exists but holds no value: one a SetBlackboard `value` port names
+    /// (`{k}`; BT.CPP 4.8.2 creates it at load, and literal writes leave it empty) or one
+    /// a failed SetBlackboard copy created. An operator over it throws (4.8.2: "The left
+    /// operand of the operator [==] is not initialized", "Any::cast failed because it
+    /// is empty"); other uses are outside the oracle's subset.
+    Empty,
+}
+
+/// A string read as a number where a script compares it with one (BT.CPP 4.8.2 reads
+/// the SetBlackboard texts `3`, ` 3` and `03` as 3, and throws "Any failed string to
+/// number conversion" for `abc`); texts that are not whole numbers are outside the
+/// oracle's subset.
+fn text_number(t: &str) -> Result<i64, Fault> {
+    let t = t.trim();
+    if let Ok(n) = t.parse::<i64>() {
+        return Ok(n);
+    }
+    if t.parse::<f64>().is_ok() || t == "true" || t == "false" {
+        return Err(Fault::Model(format!("the text `{t}` read as a number")));
+    }
+    Err(Fault::Throws(
+        "Any failed string to number conversion".into(),
+    ))
+}
+
+/// `Any::cast<bool>` of a script's value: 0 and 1 only; a string throws (4.8.2: "no
+/// known safe conversion between [std::string] and [bool]").
+pub fn truth(v: &V) -> Result<bool, Fault> {
     match v {
-        0 => Ok(false),
-        1 => Ok(true),
+        V::Num(0) => Ok(false),
+        V::Num(1) => Ok(true),
         // 4.8.2's message for a negative number (`Any::convert` through an unsigned).
-        ..0 => Err(Fault::Throws(
+        V::Num(..0) => Err(Fault::Throws(
             "Value is negative and can't be converted to unsigned".into(),
         )),
-        _ => Err(Fault::Throws(
+        V::Num(_) => Err(Fault::Throws(
             "Implicit casting to bool is not allowed".into(),
         )),
+        V::Text(_) => Err(Fault::Throws(
+            "no known safe conversion between [std::string] and [bool]".into(),
+        )),
+        V::Empty => Err(Fault::Model("an empty entry as a condition".into())),
     }
 }
 
@@ -450,18 +578,19 @@ impl Program {
         self.0.iter_mut().for_each(|e| e.rename(f));
     }
 
-    /// Runs the statements in order over the entries; the last one's value.
-    pub fn run(&self, env: &mut BTreeMap<String, i64>) -> Result<i64, Fault> {
-        let mut last = 0;
+    /// Runs the statements in order over the entries scripts write (`env`) and the
+    /// texts SetBlackboard wrote; the last one's value.
+    pub fn run(&self, env: &mut BTreeMap<String, i64>, texts: &Texts) -> Result<V, Fault> {
+        let mut last = V::Num(0);
         for s in &self.0 {
-            last = s.eval(env)?;
+            last = s.eval(env, texts)?;
         }
         Ok(last)
     }
 
     /// Runs it as a condition (`cast<bool>` of its value).
-    pub fn holds(&self, env: &mut BTreeMap<String, i64>) -> Result<bool, Fault> {
-        truth(self.run(env)?)
+    pub fn holds(&self, env: &mut BTreeMap<String, i64>, texts: &Texts) -> Result<bool, Fault> {
+        truth(&self.run(env, texts)?)
     }
 }
 
@@ -471,8 +600,10 @@ mod tests {
 
     fn run(src: &str) -> Result<(i64, BTreeMap<String, i64>), Fault> {
         let mut env = BTreeMap::new();
-        let v = parse(src).expect("parses").run(&mut env)?;
-        Ok((v, env))
+        match parse(src).expect("parses").run(&mut env, &Texts::new())? {
+            V::Num(v) => Ok((v, env)),
+            v => panic!("not a number: {v:?}"),
+        }
     }
 
     #[test]
@@ -492,12 +623,59 @@ mod tests {
         assert_eq!(run("a:= 2 ? 5 : 7").unwrap().0, 5);
         assert_eq!(run("a:= -1 ? 5 : 7").unwrap().0, 5);
         assert_eq!(run("a:= 0 ? 5 : 7").unwrap().0, 7);
+        // `+ -` and `*` group to the right.
+        assert_eq!(run("a:= 10 - 4 - 2").unwrap().0, 8);
+        assert_eq!(run("a:= 16 - 8 - 4 - 2").unwrap().0, 10);
+        assert_eq!(run("a:= 1 - 1 + 1").unwrap().0, -1);
+        assert_eq!(run("a:= 3 - 2 * 2 - 1").unwrap().0, 0);
+        assert_eq!(run("a:= 100; b:= a - 10 - 1 == 91").unwrap().0, 1);
         assert!(matches!(run("a:=3 && 1"), Err(Fault::Throws(t)) if t.contains("Logic operators")));
         assert!(matches!(run("a:=x"), Err(Fault::Throws(t)) if t.contains("Variable not found")));
         assert!(matches!(run("b=2"), Err(Fault::Throws(t)) if t.contains("doesn't exist")));
         let mut env = BTreeMap::new();
-        assert!(parse("3").unwrap().holds(&mut env).is_err());
-        assert!(parse("5-5").unwrap().holds(&mut env) == Ok(false));
+        let none = Texts::new();
+        assert!(parse("3").unwrap().holds(&mut env, &none).is_err());
+        assert!(parse("5-5").unwrap().holds(&mut env, &none) == Ok(false));
+    }
+
+    #[test]
+    fn scripts_read_what_setblackboard_wrote_as_text() {
+        // Each answer below is what BT.CPP 4.8.2 gave after `SetBlackboard` wrote `k`.
+        let mut texts: Texts = [("k", "3"), ("z", "03"), ("s", "abc")]
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), Some(v.to_string())))
+            .collect();
+        // An entry a SetBlackboard `value="{e}"` names: created empty at load.
+        texts.insert("e".into(), None);
+        let go = |src: &str| {
+            let mut env = BTreeMap::new();
+            parse(src).expect("parses").run(&mut env, &texts)
+        };
+        let throws = |src: &str, what: &str| {
+            assert!(
+                matches!(go(src), Err(Fault::Throws(t)) if t.contains(what)),
+                "{src}: {:?}",
+                go(src)
+            )
+        };
+        assert_eq!(go("y := k == 3"), Ok(V::Num(1)));
+        assert_eq!(go("y := 1 < k < 5"), Ok(V::Num(1)));
+        assert_eq!(go("y := k == 1 + 2"), Ok(V::Num(1)));
+        assert_eq!(go("y := k == true"), Ok(V::Num(0)));
+        assert_eq!(go("y := k ? 1 : 2"), Ok(V::Num(1)));
+        assert_eq!(go("y := z == 3"), Ok(V::Num(1)));
+        assert_eq!(go("y := k == z"), Ok(V::Num(0)));
+        throws("y := k + 1", "Operation not permitted");
+        throws("y := -k", "Invalid operator");
+        throws("y := s == 3", "string to number");
+        throws("y := e == 1", "not initialized");
+        throws("y := e + 1", "not initialized");
+        throws("y := e ? 1 : 2", "Any::cast failed because it is empty");
+        let mut env = BTreeMap::new();
+        assert!(matches!(
+            parse("k").unwrap().holds(&mut env, &texts),
+            Err(Fault::Throws(t)) if t.contains("safe conversion")
+        ));
     }
 
     #[test]

@@ -62,6 +62,8 @@ pub(crate) struct Blackboard {
     pub conflicted: Vec<String>,
     /// Entries a SetBlackboard writes (BT.CPP 4 stores its value as text).
     pub texts: Vec<String>,
+    /// Entries a SetBlackboard copies to or from (`value="{entry}"`).
+    pub copies: Vec<String>,
     /// Entries scripts read or write: the machine keeps whether each holds a value
     /// (`btcpp4_script.rs`).
     pub script_entries: Vec<String>,
@@ -326,6 +328,13 @@ pub(crate) fn type_entries(
             .then(|| set_ports(n))
             .flatten()
         {
+            if let Some(PortValue::Blackboard(from)) = n.port("value").map(|p| &p.value) {
+                for e in [&entry, from] {
+                    if !bb.copies.contains(e) {
+                        bb.copies.push(e.clone());
+                    }
+                }
+            }
             if !bb.texts.contains(&entry) {
                 bb.texts.push(entry);
             }

@@ -23,14 +23,22 @@
 //!   last statement's value: 0 or 1, anything else throws.
 //! - Reading an entry that holds no value throws ("Variable not found"); so does `=`,
 //!   `+=`, `-=`, `*=` on one (`:=` creates it).
+//! - `+ -` and `*` group to the right (`10 - 4 - 2` is 8, `1 - 1 + 1` is -1).
+//! - An entry SetBlackboard wrote holds a string (BT.CPP 4 stores SetBlackboard's value
+//!   as text). Where every write is an integer constant, a script may read it: compared
+//!   with a number it reads as that number (the text `3` equals 3), as the condition of
+//!   `c ? a : b` it is true unless 0; an arithmetic or logic operator, `-`, `!` over it,
+//!   or a condition whose value it is, throws ("Operation not permitted", "Invalid
+//!   operator for std::string", "no known safe conversion"). Refused: comparing two such
+//!   entries (a string comparison), copying one (`y := k`), writing one from a script.
 //!
 //! Where BT.CPP throws, the exception ends the tree's execution: the blackboard machine
 //! goes to its `error` state (`bt_script_fault` set), the node never answers, and the
 //! tree stops. Refused when the tree is read, each at the script's attribute with the
 //! column in the script: strings and real numbers (not modelled yet), division (`/`,
 //! `/=`: BT.CPP divides in floating point and may store a real number), the bit
-//! operators, an entry SetBlackboard writes (BT.CPP 4 stores its text), an entry of a
-//! type other than integer or boolean, an entry a SubTree maps to a constant.
+//! operators, an entry SetBlackboard writes other than as above, an entry of a type
+//! other than integer or boolean, an entry a SubTree maps to a constant.
 
 use super::blackboard::{Blackboard, MACHINE};
 use super::control::{init_state, n_children, Ctx, FAILURE, RUNNING, SUCCESS};
@@ -62,7 +70,13 @@ fn done_event(id: u32) -> String {
 enum Ty {
     Int,
     Bool,
+    /// An entry SetBlackboard wrote an integer constant to: BT.CPP 4 holds its text
+    /// (the model variable holds the number the text reads as).
+    Text,
 }
+
+/// Why an operator over an entry SetBlackboard wrote cannot be modelled.
+const TWO_TEXTS: &str = "two entries SetBlackboard wrote: BT.CPP 4 holds their texts and compares or joins them as strings, which is not modelled";
 
 /// A refusal: the byte offset in the script and why.
 type Refuse = (usize, String);
@@ -77,7 +91,7 @@ struct Tr<'a> {
 
 fn int(x: &str, t: Ty) -> String {
     match t {
-        Ty::Int => x.to_string(),
+        Ty::Int | Ty::Text => x.to_string(),
         Ty::Bool => format!("({x} ? 1 : 0)"),
     }
 }
@@ -92,6 +106,11 @@ impl Tr<'_> {
         (g.clone(), *t)
     }
 
+    /// `e` is an entry SetBlackboard wrote, read as it is (a string in BT.CPP 4).
+    fn is_text(&self, e: &Ex) -> bool {
+        matches!(&e.k, K::Name(n) if self.entry(n).1 == Ty::Text)
+    }
+
     fn check(&mut self, guard: &str, cond: String) {
         self.checks.push(if guard.is_empty() {
             cond
@@ -100,12 +119,24 @@ impl Tr<'_> {
         });
     }
 
+    /// An operand of an arithmetic or logic operator, `-` or `!`: a string (an entry
+    /// SetBlackboard wrote) throws there (BT.CPP 4.8.2: "Operation not permitted",
+    /// "Invalid operator for std::string"), so its value no longer matters.
+    fn number(&mut self, e: &Ex, guard: &str) -> Result<(String, Ty), Refuse> {
+        let (x, t) = self.ex(e, guard)?;
+        if t == Ty::Text {
+            self.check(guard, "true".into());
+            return Ok(("0".into(), Ty::Int));
+        }
+        Ok((x, t))
+    }
+
     /// Operand of `&&` / `||`: a boolean, or an integer that must be 0 or 1.
     fn logic_operand(&mut self, e: &Ex, guard: &str) -> Result<String, Refuse> {
-        let (x, t) = self.ex(e, guard)?;
+        let (x, t) = self.number(e, guard)?;
         Ok(match t {
             Ty::Bool => x,
-            Ty::Int => {
+            Ty::Int | Ty::Text => {
                 self.check(guard, format!("{x} != 0 && {x} != 1"));
                 format!("({x} == 1)")
             }
@@ -131,20 +162,23 @@ impl Tr<'_> {
                 (g, t)
             }
             K::Un("-", a) => {
-                let (x, t) = self.ex(a, guard)?;
+                let (x, t) = self.number(a, guard)?;
                 (format!("(-{})", int(&x, t)), Ty::Int)
             }
             K::Un("!", a) => {
-                let (x, t) = self.ex(a, guard)?;
+                let (x, t) = self.number(a, guard)?;
                 match t {
                     Ty::Bool => (format!("(!{x})"), Ty::Bool),
-                    Ty::Int => (format!("({x} == 0)"), Ty::Bool),
+                    Ty::Int | Ty::Text => (format!("({x} == 0)"), Ty::Bool),
                 }
             }
             K::Un(..) => return refuse("the bit operators (`~`, `|`, `&`, `^`) are not modelled"),
             K::Bin(op @ ("+" | "-" | "*"), a, b) => {
-                let (x, tx) = self.ex(a, guard)?;
-                let (y, ty) = self.ex(b, guard)?;
+                if self.is_text(a) && self.is_text(b) {
+                    return Err((e.at, format!("`{op}` over {TWO_TEXTS}")));
+                }
+                let (x, tx) = self.number(a, guard)?;
+                let (y, ty) = self.number(b, guard)?;
                 (format!("({} {op} {})", int(&x, tx), int(&y, ty)), Ty::Int)
             }
             K::Bin("/", ..) => return refuse(
@@ -157,6 +191,12 @@ impl Tr<'_> {
             }
             K::Bin(..) => return refuse("the bit operators (`~`, `|`, `&`, `^`) are not modelled"),
             K::Cmp(xs, ops) => {
+                // A string compared with a number is read as one (BT.CPP 4.8.2: the text
+                // `3` equals 3): the model variable's number. Two strings compare as
+                // strings.
+                if let Some(w) = xs.windows(2).find(|w| self.is_text(&w[0]) && self.is_text(&w[1])) {
+                    return Err((w[0].at, format!("comparing {TWO_TEXTS}")));
+                }
                 let mut vs = Vec::with_capacity(xs.len());
                 for x in xs {
                     let (v, t) = self.ex(x, guard)?;
@@ -170,10 +210,11 @@ impl Tr<'_> {
                 (format!("({})", parts.join(" && ")), Ty::Bool)
             }
             K::Ite(c, a, b) => {
+                // A string condition is read as a number (4.8.2: the text `0` is false).
                 let (cx, ct) = self.ex(c, guard)?;
                 let cond = match ct {
                     Ty::Bool => cx,
-                    Ty::Int => format!("({cx} != 0)"),
+                    Ty::Int | Ty::Text => format!("({cx} != 0)"),
                 };
                 let join = |g: &str, c: &str| {
                     if g.is_empty() {
@@ -183,6 +224,9 @@ impl Tr<'_> {
                     }
                 };
                 // Only the branch taken is evaluated: its checks only count then.
+                if let Some(x) = [a, b].into_iter().find(|x| self.is_text(x)) {
+                    return Err((x.at, "a SetBlackboard's text as the value of `?:`: BT.CPP 4 gives the string, and strings in scripts are not modelled yet".into()));
+                }
                 let (x, tx) = self.ex(a, &join(guard, &cond))?;
                 let (y, ty) = self.ex(b, &join(guard, &format!("!{cond}")))?;
                 if tx == Ty::Bool && ty == Ty::Bool {
@@ -219,6 +263,12 @@ fn statement(names: &[(String, String, Ty)], s: &Stmt) -> Result<Lowered, Refuse
         });
     };
     let (g, et) = tr.entry(target);
+    if et == Ty::Text {
+        return Err((*at, format!("a script writing `{g}`, which a SetBlackboard writes: BT.CPP 4 holds a string there (4.8.2 refuses to assign it a number), which is not modelled")));
+    }
+    if t == Ty::Text {
+        return Err((s.e.at, format!("assigning a SetBlackboard's text to `{g}`: BT.CPP 4 copies the string, and strings in scripts are not modelled yet")));
+    }
     if *op != ":=" {
         // "The blackboard entry [..] doesn't exist".
         tr.checks.push(format!("!{}", has(&g)));
@@ -239,6 +289,7 @@ fn statement(names: &[(String, String, Ty)], s: &Stmt) -> Result<Lowered, Refuse
             return Err((*at, format!("`{op}` on the boolean entry `{g}` (typed by a port) is not modelled")))
         }
         (_, Ty::Int, _) => format!("({g} {} {})", &op[..1], int(&x, t)),
+        (_, Ty::Text, _) => unreachable!("refused above"),
     };
     Ok(Lowered {
         checks: tr.checks,
@@ -268,7 +319,26 @@ fn resolve(
             }
         };
         if bb.texts.contains(&g) {
-            errs.push(sm.diag(span, format!("the script uses the entry `{g}`, which a SetBlackboard writes: BT.CPP 4 stores SetBlackboard's value as text, and scripts over it are not modelled")));
+            // BT.CPP 4 holds SetBlackboard's text; a script reads a string there. Modelled
+            // where every write is an integer constant (typed `int32`/`int64` by
+            // `blackboard::type_entries`, the model variable holding the number the text
+            // reads as; a BlackboardCheck may read it too), no plugin port types it
+            // (a plugin's output would store a number), and no SetBlackboard copies to or
+            // from it (4.8.2's copies leave entries a script cannot read,
+            // `tests/bt/real/set_blackboard.toml`).
+            let e = bb.entry(&g);
+            let ints = e.is_some_and(|e| {
+                !e.why.contains("of plugin")
+                    && Scalar::from_name(e.ty.trim()).is_some_and(|s| s.int_range().is_some())
+            });
+            if !ints || bb.copies.contains(&g) || bb.conflicted.contains(&g) {
+                errs.push(sm.diag(span, format!("the script uses the entry `{g}`, which a SetBlackboard writes: BT.CPP 4 stores SetBlackboard's value as text; scripts read it only where every write is an integer constant and no SetBlackboard copies to or from it (strings and reals in scripts are not modelled yet)")));
+                continue;
+            }
+            if !bb.script_entries.contains(&g) {
+                bb.script_entries.push(g.clone());
+            }
+            out.push((name.clone(), g, Ty::Text));
             continue;
         }
         let t = match bb.entry(&g) {
@@ -341,6 +411,9 @@ pub(super) fn compile(
             Ty::Bool => (v, None),
             // `Any::cast<bool>`: 0 or 1, else it throws.
             Ty::Int => (format!("{v} == 1"), Some(format!("{v} != 0 && {v} != 1"))),
+            // A string: 4.8.2 throws ("no known safe conversion between [std::string]
+            // and [bool]").
+            Ty::Text => ("false".into(), Some("true".into())),
         };
         let rest = then(Some(value));
         match check {

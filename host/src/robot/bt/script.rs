@@ -13,7 +13,8 @@
 //! parentheses and the middle part of `c ? a : b` start a new one.
 //!
 //! [`parse`] gives the statements as a tree ([`Stmt`], [`Ex`]); `&&` and `||` are one
-//! level, read left to right (BT.CPP 4.8.2: `true || false && false` is false), and
+//! level, read left to right (BT.CPP 4.8.2: `true || false && false` is false), `+ -`
+//! and `* /` group to the right (4.8.2: `10 - 4 - 2` is 8, `1 - 1 + 1` is -1), and
 //! `c ? a : b ? ...` is refused ("operator cannot be chained"), as the real library
 //! does. AS2FM has no model of the language; the BT.CPP semantics (`--bt btcpp`) lowers
 //! its integer and boolean part (`btcpp4_script.rs`).
@@ -256,6 +257,16 @@ impl<'s> Parser<'s> {
                 self.note(1)?;
             }
             self.pos += 1;
+            if level >= 3 {
+                // `+ -` and `* /` group to the right: BT.CPP 4.8.2 computes
+                // `10 - 4 - 2` as `10 - (4 - 2)`, 8, and `12 / 2 / 3` as 18 (the oracle's
+                // `script_operators_agree_with_the_library` holds it to the library).
+                let rhs = self.binary(level)?;
+                return Ok(Ex {
+                    at,
+                    k: K::Bin(op, Box::new(acc), Box::new(rhs)),
+                });
+            }
             let rhs = self.binary(level + 1)?;
             if level == 1 {
                 // Comparisons chain.
@@ -476,5 +487,12 @@ mod tests {
         assert!(matches!(&s[0].e.k, K::Cmp(xs, ops) if xs.len() == 3 && ops == &["<", "<="]));
         assert_eq!(at("x := 2 ? 3 : 4 ? 5 : 6"), 15);
         assert_eq!(names("y := x + 1; f = !g"), ["y", "x", "f", "g"]);
+        // `-` groups to the right: `a - b - c` is `a - (b - c)`.
+        let s = parse("10 - 4 - 2").unwrap();
+        let K::Bin("-", l, r) = &s[0].e.k else {
+            panic!("{:?}", s[0].e)
+        };
+        assert_eq!(l.k, K::Int(10));
+        assert!(matches!(&r.k, K::Bin("-", a, b) if a.k == K::Int(4) && b.k == K::Int(2)));
     }
 }
