@@ -124,7 +124,16 @@ impl StateDef {
     /// Transitions on `event`, in document order.
     #[inline]
     pub fn transitions<'a>(&self, event: u32, dispatch: &'a [u32]) -> &'a [u32] {
-        match self.on_event.binary_search_by_key(&event, |&(e, _, _)| e) {
+        // A state handles few events: a scan of a short list costs less than a search.
+        let found = if self.on_event.len() <= 8 {
+            self.on_event
+                .iter()
+                .position(|&(e, _, _)| e == event)
+                .ok_or(0)
+        } else {
+            self.on_event.binary_search_by_key(&event, |&(e, _, _)| e)
+        };
+        match found {
             Ok(i) => {
                 let (_, s, e) = self.on_event[i];
                 dispatch.get(s as usize..e as usize).unwrap_or(&[])

@@ -441,16 +441,26 @@ impl<'a> Judge<'a> {
         self.set
     }
 
+    /// Judges the point at `time`, unless it repeats the last one stepped (see
+    /// [`Judge::step_now`]). Always inlined into the observer's calls: most points of a
+    /// run repeat the last one, and for them the call cost more than the test.
+    #[inline(always)]
     fn step(&mut self, time: u64) -> Flow {
+        if self.repeat_is_noop && self.last_time == Some(time) && !self.changed {
+            return Flow::Continue;
+        }
+        self.step_now(time)
+    }
+
+    /// Steps the monitors at `time` and settles what became final.
+    #[inline(never)]
+    fn step_now(&mut self, time: u64) -> Flow {
         // Skipping a repeated point is exact, not an approximation: without `Y` / `Z`
         // every node's update is idempotent at one time with the same inputs (atoms are
         // pure, `S` keeps or resets the same witness, windows expire nothing more and
         // extend the newest run to the same time), so the state after the step would be
         // bit for bit the one before it, and so the verdicts and their finality. Most
         // points of a run (messages that set no port) repeat the last one.
-        if self.repeat_is_noop && self.last_time == Some(time) && !self.changed {
-            return Flow::Continue;
-        }
         self.last_time = Some(time);
         self.changed = false;
         if let Err(e) = self
@@ -480,7 +490,11 @@ impl<'a> Judge<'a> {
 
     /// Starts a point: every event variable becomes `false`
     /// ([`valuation::begin_point`]'s rule), touching only the ones that were raised.
+    #[inline(always)]
     fn begin(&mut self) {
+        if self.raised.is_empty() {
+            return;
+        }
         for v in self.raised.drain(..) {
             if !is_false(self.vals[v]) {
                 self.vals[v] = Value::Bool(false);
