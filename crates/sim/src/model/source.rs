@@ -54,7 +54,7 @@ pub fn unescaped_offset(sm: &SourceMap, span: Span, k: u32) -> Span {
 /// XML tree (`model::xml`, attribute values of every XML file read), by the property
 /// reader's position-keeping unescaping (formulas, element text) and by
 /// [`unescaped_offset`]; names are decoded by [`resolve_entity`].
-pub(crate) fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
+pub fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
     let after = rest.strip_prefix('&')?;
     // A name longer than any entity or reasonable character reference is taken as a
     // stray `&`, so the message does not quote half a line.
@@ -97,11 +97,11 @@ const ATTR_WHITESPACE: [char; 3] = ['\t', '\n', '\r'];
 
 /// The characters an attribute value's decoding stops at: a reference, or whitespace
 /// to normalise.
-pub(crate) const ATTR_SPECIAL: [char; 4] = ['&', '\t', '\n', '\r'];
+pub const ATTR_SPECIAL: [char; 4] = ['&', '\t', '\n', '\r'];
 
 /// The bytes of raw attribute text at the start of `rest` that normalise to one space
 /// (`\r\n` is 2), or `None` when `rest` does not start with a line break or tab.
-pub(crate) fn normalised_space(rest: &str) -> Option<usize> {
+pub fn normalised_space(rest: &str) -> Option<usize> {
     if rest.starts_with("\r\n") {
         Some(2)
     } else if rest.starts_with(ATTR_WHITESPACE) {
