@@ -73,7 +73,7 @@ pub fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
 /// The character an XML entity name (without `&` and `;`) stands for: the five
 /// predefined entities and character references (`&#65;`, `&#x41;`). `&#0;` is `None`:
 /// U+0000 is not an XML character (XML 1.0, production `Char`). The one entity decoder.
-pub(crate) fn resolve_entity(name: &str) -> Option<char> {
+pub fn resolve_entity(name: &str) -> Option<char> {
     match name {
         "lt" => Some('<'),
         "gt" => Some('>'),
@@ -117,7 +117,7 @@ pub fn normalised_space(rest: &str) -> Option<usize> {
 /// XML 1.0's attribute-value normalisation for CDATA attributes (sections 2.11 and
 /// 3.3.3), which AS2FM gets from lxml: an `expr` written over two lines reads the same
 /// in both tools. `Err` gives the byte offset of a bad reference and what is wrong.
-pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, String)> {
+pub fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, String)> {
     if !raw.contains(ATTR_SPECIAL) {
         return Ok(std::borrow::Cow::Borrowed(raw));
     }
