@@ -17,7 +17,7 @@
 //! parses, type-checks and compiles them. All errors are [`Diagnostics`].
 
 pub mod ast;
-pub(crate) mod json;
+pub mod json;
 mod scxml;
 pub mod source;
 pub mod types;
@@ -73,7 +73,7 @@ impl ModelSource {
     }
 
     /// Errors for machine names used twice.
-    pub(crate) fn check_names(&self, errs: &mut Diagnostics) {
+    pub fn check_names(&self, errs: &mut Diagnostics) {
         for (i, m) in self.machines.iter().enumerate() {
             if let Some(first) = self.machines[..i]
                 .iter()
@@ -290,7 +290,7 @@ pub fn load_spec(path: &Path) -> Result<ModelSource, Diagnostics> {
 /// `base` joined with a path `rel` that a model file names, without `rel`'s `.`
 /// components: `./policy.xml` is read, and named in messages, as `policy.xml` of the
 /// model's folder (a main file's inputs, a SCAN `model.xml`'s processes and files).
-pub(crate) fn join_clean(base: &Path, rel: &str) -> PathBuf {
+pub fn join_clean(base: &Path, rel: &str) -> PathBuf {
     let mut path = base.to_path_buf();
     for c in Path::new(rel).components() {
         if c != Component::CurDir {

@@ -54,7 +54,7 @@ pub fn unescaped_offset(sm: &SourceMap, span: Span, k: u32) -> Span {
 /// XML tree (`model::xml`, attribute values of every XML file read), by the property
 /// reader's position-keeping unescaping (formulas, element text) and by
 /// [`unescaped_offset`]; names are decoded by [`resolve_entity`].
-pub(crate) fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
+pub fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
     let after = rest.strip_prefix('&')?;
     // A name longer than any entity or reasonable character reference is taken as a
     // stray `&`, so the message does not quote half a line.
@@ -73,7 +73,7 @@ pub(crate) fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
 /// The character an XML entity name (without `&` and `;`) stands for: the five
 /// predefined entities and character references (`&#65;`, `&#x41;`). `&#0;` is `None`:
 /// U+0000 is not an XML character (XML 1.0, production `Char`). The one entity decoder.
-pub(crate) fn resolve_entity(name: &str) -> Option<char> {
+pub fn resolve_entity(name: &str) -> Option<char> {
     match name {
         "lt" => Some('<'),
         "gt" => Some('>'),
@@ -97,11 +97,11 @@ const ATTR_WHITESPACE: [char; 3] = ['\t', '\n', '\r'];
 
 /// The characters an attribute value's decoding stops at: a reference, or whitespace
 /// to normalise.
-pub(crate) const ATTR_SPECIAL: [char; 4] = ['&', '\t', '\n', '\r'];
+pub const ATTR_SPECIAL: [char; 4] = ['&', '\t', '\n', '\r'];
 
 /// The bytes of raw attribute text at the start of `rest` that normalise to one space
 /// (`\r\n` is 2), or `None` when `rest` does not start with a line break or tab.
-pub(crate) fn normalised_space(rest: &str) -> Option<usize> {
+pub fn normalised_space(rest: &str) -> Option<usize> {
     if rest.starts_with("\r\n") {
         Some(2)
     } else if rest.starts_with(ATTR_WHITESPACE) {
@@ -117,7 +117,7 @@ pub(crate) fn normalised_space(rest: &str) -> Option<usize> {
 /// XML 1.0's attribute-value normalisation for CDATA attributes (sections 2.11 and
 /// 3.3.3), which AS2FM gets from lxml: an `expr` written over two lines reads the same
 /// in both tools. `Err` gives the byte offset of a bad reference and what is wrong.
-pub(crate) fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, String)> {
+pub fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, String)> {
     if !raw.contains(ATTR_SPECIAL) {
         return Ok(std::borrow::Cow::Borrowed(raw));
     }

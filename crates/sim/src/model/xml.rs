@@ -214,7 +214,7 @@ pub fn parse(sm: &SourceMap, file: FileId) -> Result<Element, Diagnostic> {
 
 /// Why a text is not one well-formed element tree, and the byte offset where.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub(crate) struct XmlError {
+pub struct XmlError {
     /// Byte offset in the text.
     pub offset: u32,
     /// What is wrong (without the `malformed XML: ` that [`fmt::Display`] puts first).
@@ -231,7 +231,7 @@ impl fmt::Display for XmlError {
 /// of models, robot models and property files. Attribute values are unescaped by the
 /// one entity decoder ([`unescape`]); a bad reference, like any malformed XML, stops
 /// the reading.
-pub(crate) fn parse_text(src: &str, file: FileId) -> Result<Element, XmlError> {
+pub fn parse_text(src: &str, file: FileId) -> Result<Element, XmlError> {
     let fail = |offset: u64, message: String| XmlError {
         offset: offset.min(u32::MAX as u64) as u32,
         message,

@@ -6,7 +6,7 @@
 
 /// A JSON value and the byte offset where it starts.
 #[derive(Clone, Debug, PartialEq)]
-pub(crate) struct Node {
+pub struct Node {
     /// Byte offset of the value's first character.
     pub offset: usize,
     /// The value.
@@ -15,12 +15,16 @@ pub(crate) struct Node {
 
 /// A JSON value.
 #[derive(Clone, Debug, PartialEq)]
-pub(crate) enum Json {
+pub enum Json {
+    /// `null`.
     Null,
+    /// `true` or `false`.
     Bool(bool),
     /// A number, as written (so `10` and `10.0` stay apart).
     Number(String),
+    /// A string, unescaped.
     Str(String),
+    /// An array's elements.
     Array(Vec<Node>),
     /// Members in file order: key, key offset, value.
     Object(Vec<(String, usize, Node)>),
@@ -61,7 +65,7 @@ struct Parser<'a> {
 }
 
 /// Parses a whole document; an error is `(byte offset, message)`.
-pub(crate) fn parse(text: &str) -> Result<Node, (usize, String)> {
+pub fn parse(text: &str) -> Result<Node, (usize, String)> {
     let mut p = Parser { text, pos: 0 };
     p.ws();
     let node = p.value(0)?;

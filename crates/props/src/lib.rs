@@ -58,6 +58,43 @@
 //! first error. Otherwise every problem is collected ([`Diagnostics`]): unknown elements
 //! and attributes, missing attributes and elements, bad values and types, duplicate ids,
 //! unknown references, predicate cycles, each with file, line and column.
+//!
+//! # Crate
+//!
+//! `hindsight-props` depends on `codegen` (source map, diagnostics), `hindsight-expr` (the
+//! port types) and `hindsight-sim` (the XML tree, and a compiled model's events that
+//! [`jani`] resolves names against), on no other crate of the project; `hindsight`'s
+//! `verify` compiles its formulas with codegen and binds its ports to a model.
+//!
+//! ```
+//! use hindsight_props::{parse_str, PortKind};
+//! use std::path::Path;
+//!
+//! let text = r#"<properties>
+//!   <ports>
+//!     <scxml_event_send event="E" origin="M" target="T">
+//!       <state_var id="x" param="p" type="int32" expr="0"/>
+//!     </scxml_event_send>
+//!   </ports>
+//!   <guarantees><property id="P1" logic="pmtl" expr="historically({ x &lt; 3 })"/></guarantees>
+//! </properties>"#;
+//! let file = parse_str(text, Path::new("props.xml")).unwrap();
+//! assert_eq!(file.ports[0].id, "x");
+//! assert!(matches!(file.ports[0].kind, PortKind::State { .. }));
+//! let p1 = &file.guarantees[0];
+//! assert_eq!(p1.formula.as_str(), "historically({ x < 3 })"); // `&lt;` unescaped
+//! assert_eq!((p1.at.line, p1.at.column), (7, 15));
+//!
+//! // Every problem is collected, with its file, line and column.
+//! let bad = text.replace("state_var id=\"x\"", "state_var");
+//! let errors = parse_str(&bad, Path::new("props.xml")).unwrap_err();
+//! assert!(errors.to_string().contains("props.xml:4:"), "{errors}");
+//! ```
+
+// Inside this crate the model layer is `crate::model` / `crate::sim` and the expression
+// language `crate::expr`, as they were inside `hindsight`.
+use hindsight_expr as expr;
+use hindsight_sim::{model, sim};
 
 mod error;
 pub mod jani;
