@@ -557,7 +557,8 @@ impl<'t> Oracle<'t> {
                 let keeps_status = matches!(
                     kind,
                     Kind::Precondition(..) | Kind::Switch(..) | Kind::Loop(..) | Kind::Updated(..)
-                ) || (matches!(kind, Kind::RunOnce(true)) && self.once[n].is_some());
+                ) || (matches!(kind, Kind::RunOnce(true))
+                    && self.once[n].is_some());
                 let sets_running = !keeps_status;
                 if s == Status::Skipped && sets_running {
                     // The controls and decorators set themselves RUNNING first
@@ -580,7 +581,6 @@ impl<'t> Oracle<'t> {
         let post = &self.tree.nodes[n].conds.post;
         if matches!(s, Status::Success | Status::Failure) {
             let which = if s == Status::Success { 2 } else { 1 };
-            let texts = self.texts();
             for p in [&post[which], &post[3]].into_iter().flatten() {
                 self.run_program(p)?;
             }

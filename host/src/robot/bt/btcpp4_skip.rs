@@ -75,7 +75,9 @@ pub(super) fn may_skip(tree: &Tree) -> Vec<bool> {
                 | Control::AlwaysFailure
                 | Control::SetBlackboard
                 | Control::Btcpp4(
-                    Btcpp4::Sleep | Btcpp4::Script(ScriptNode::Script | ScriptNode::Condition),
+                    Btcpp4::Sleep
+                    | Btcpp4::Unset
+                    | Btcpp4::Script(ScriptNode::Script | ScriptNode::Condition),
                 ) => false,
             },
         };
