@@ -69,6 +69,12 @@ pub(crate) struct Blackboard {
     pub script_entries: Vec<String>,
     /// The transitions that run the tree's scripts (`btcpp4_script.rs`).
     pub scripts: Vec<Element>,
+    /// Entries whose update counter the machine keeps (`bt_seq__<entry>`, one more at
+    /// every write): the ones an entry-updated node looks at (`btcpp4_blackboard.rs`).
+    pub watched: Vec<String>,
+    /// The entry-updated nodes: id, entry, machine; each gets a transition that compares
+    /// the entry's counter with the one it saw last (`btcpp4_blackboard.rs`).
+    pub updated: Vec<(u32, String, String)>,
 }
 
 impl Blackboard {
@@ -86,7 +92,7 @@ impl Blackboard {
 
     /// The blackboard machine, or `None` when the tree uses no entry.
     pub fn machine(&self, b: B) -> Option<Element> {
-        if self.entries.is_empty() && self.scripts.is_empty() {
+        if self.entries.is_empty() && self.scripts.is_empty() && self.updated.is_empty() {
             return None;
         }
         let mut m = b.scxml(MACHINE, "idle");
@@ -108,6 +114,12 @@ impl Blackboard {
         if !self.scripts.is_empty() {
             vars.push((super::btcpp4_script::FAULT, "bool", "false".to_string()));
         }
+        let counters = super::btcpp4_blackboard::counter_data(self);
+        vars.extend(
+            counters
+                .iter()
+                .map(|(v, t)| (v.as_str(), *t, "0".to_string())),
+        );
         m.push(b.datamodel(&vars));
         let mut idle = b.state("idle");
         for e in &self.entries {
@@ -115,7 +127,11 @@ impl Blackboard {
             if self.script_entries.contains(&e.name) {
                 body.push(b.assign(&super::btcpp4_script::has(&e.name), "true"));
             }
+            body.extend(super::btcpp4_blackboard::count_write(self, b, &e.name));
             idle.push(b.tr(Some(&set_event(&e.name)), None, Some("idle"), body));
+        }
+        for t in super::btcpp4_blackboard::updated_transitions(self, b) {
+            idle.push(t);
         }
         // A script that threw stops the tree (`btcpp4_script.rs`).
         if !self.scripts.is_empty() {

@@ -425,6 +425,12 @@ pub(super) fn compile(
     };
     for l in lowered.into_iter().rev() {
         let mut body: Vec<Element> = l.assigns.iter().map(|(g, e)| b.assign(g, e)).collect();
+        // Every assignment is a write (`Entry::sequence_id`, `btcpp4_blackboard.rs`).
+        body.extend(
+            l.assigns
+                .iter()
+                .filter_map(|(g, _)| super::btcpp4_blackboard::count_write(bb, *b, g)),
+        );
         body.extend(inner);
         inner = if l.checks.is_empty() {
             body

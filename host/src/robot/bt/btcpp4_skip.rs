@@ -8,10 +8,12 @@
 //! the lowering handles: Sequence, Fallback, SequenceWithMemory, AsyncSequence,
 //! AsyncFallback, ReactiveSequence, ReactiveFallback, Parallel, ParallelAll,
 //! IfThenElse, Inverter, ForceSuccess, ForceFailure, Repeat, RetryUntilSuccessful,
-//! KeepRunningUntilFailure, RunOnce and the root. The parents it does not handle yet
-//! refuse a child that may answer SKIPPED, at the child.
+//! KeepRunningUntilFailure, RunOnce, SkipUnlessUpdated, WaitValueUpdate, the Loop nodes
+//! and the root (SkipUnlessUpdated and a Loop with `if_empty="SKIPPED"` make it too,
+//! `btcpp4_blackboard.rs`, `btcpp4_loop.rs`). The parents it does not handle yet refuse
+//! a child that may answer SKIPPED, at the child.
 
-use super::tree::{Btcpp4, Control, Kind, PortValue, ScriptNode, Tree};
+use super::tree::{Btcpp4, Control, Kind, PortValue, ScriptNode, Tree, UpdatedNode};
 use crate::model::source::{Diagnostic, SourceMap};
 
 /// Whether node `i` may answer SKIPPED, for every node (children after their parent in
@@ -71,12 +73,20 @@ pub(super) fn may_skip(tree: &Tree) -> Vec<bool> {
                 }
                 // A skipped child answers RUNNING.
                 Control::Btcpp4(Btcpp4::KeepRunningUntilFailure) => false,
+                // Not updated: SKIPPED; WaitValueUpdate passes a skipped child on.
+                Control::Btcpp4(Btcpp4::Updated(UpdatedNode::Skip)) => true,
+                Control::Btcpp4(Btcpp4::Updated(UpdatedNode::Wait)) => any,
+                // `if_empty="SKIPPED"` (a skipped child answers RUNNING).
+                Control::Btcpp4(Btcpp4::Loop(_)) => n.port("if_empty").is_some_and(
+                    |p| matches!(&p.value, PortValue::Literal(v) if v.trim() == "SKIPPED"),
+                ),
                 Control::AlwaysSuccess
                 | Control::AlwaysFailure
                 | Control::SetBlackboard
                 | Control::Btcpp4(
                     Btcpp4::Sleep
                     | Btcpp4::Unset
+                    | Btcpp4::Updated(UpdatedNode::Was)
                     | Btcpp4::Script(ScriptNode::Script | ScriptNode::Condition),
                 ) => false,
             },

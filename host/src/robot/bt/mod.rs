@@ -20,7 +20,8 @@
 //!   BlackboardCheckInt / Double / String / Bool) are generated (`control.rs` and the
 //!   files it dispatches to, `blackboard.rs`; under BT.CPP's rules also BT.CPP 4's own
 //!   nodes, `btcpp4.rs`, and Timeout, Delay, Sleep and TryCatch, `btcpp4_time.rs`, whose
-//!   timers the root machine keeps, and UnsetBlackboard, `btcpp4_blackboard.rs`); leaves are instances of their plugin
+//!   timers the root machine keeps, UnsetBlackboard and the entry-updated nodes,
+//!   `btcpp4_blackboard.rs`, and the Loop nodes, `btcpp4_loop.rs`); leaves are instances of their plugin
 //!   (`plugin.rs`) and keep their ROS tags for the ROS lowering.
 //! - `bt_blackboard_fsm` when the tree names `{entries}`.
 //!
@@ -37,6 +38,7 @@ mod btcpp;
 mod btcpp4;
 mod btcpp4_blackboard;
 mod btcpp4_conds;
+mod btcpp4_loop;
 mod btcpp4_script;
 mod btcpp4_skip;
 mod btcpp4_time;
@@ -220,6 +222,10 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
     // Entry types first (plugins' ports, BlackboardCheck's values, SetBlackboard's
     // constants), so every node knows the type of what it reads and writes.
     blackboard::type_entries(sm, &tree, &plugins, &mut bb, &mut errs);
+    // Then the entries the entry-updated nodes watch and the Loop nodes write.
+    if input.semantics != BtSemantics::As2fm {
+        btcpp4_blackboard::prepare(sm, &tree, &mut bb, &mut errs);
+    }
     let effects = halt_effects(&tree, &plugins);
     // The clock of the timed nodes (Timeout, Delay, Sleep), kept by the root machine.
     let clock = match input.semantics {

@@ -72,6 +72,32 @@ pub(crate) enum Btcpp4 {
     /// `UnsetBlackboard` (`key`): an entry only scripts use loses its value
     /// (`btcpp4_blackboard.rs`).
     Unset,
+    /// `WasEntryUpdated`, `SkipUnlessUpdated`, `WaitValueUpdate` (`entry`): the entry's
+    /// update counter (`btcpp4_loop.rs`).
+    Updated(UpdatedNode),
+    /// `LoopInt`, `LoopBool`, `LoopDouble`, `LoopString` over a queue written in the tree
+    /// (`btcpp4_loop.rs`).
+    Loop(LoopType),
+}
+
+/// The nodes that look at an entry's update counter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum UpdatedNode {
+    /// `WasEntryUpdated`: SUCCESS if updated, else FAILURE.
+    Was,
+    /// `SkipUnlessUpdated`: ticks its child if updated, else SKIPPED.
+    Skip,
+    /// `WaitValueUpdate`: ticks its child if updated, else RUNNING.
+    Wait,
+}
+
+/// The item type of a `Loop<T>` node.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum LoopType {
+    Int,
+    Bool,
+    Double,
+    String,
 }
 
 /// The nodes that run a script.
@@ -181,6 +207,13 @@ impl Control {
             "ScriptCondition" => Control::Btcpp4(Btcpp4::Script(ScriptNode::Condition)),
             "Precondition" => Control::Btcpp4(Btcpp4::Script(ScriptNode::Precondition)),
             "UnsetBlackboard" => Control::Btcpp4(Btcpp4::Unset),
+            "WasEntryUpdated" => Control::Btcpp4(Btcpp4::Updated(UpdatedNode::Was)),
+            "SkipUnlessUpdated" => Control::Btcpp4(Btcpp4::Updated(UpdatedNode::Skip)),
+            "WaitValueUpdate" => Control::Btcpp4(Btcpp4::Updated(UpdatedNode::Wait)),
+            "LoopInt" => Control::Btcpp4(Btcpp4::Loop(LoopType::Int)),
+            "LoopBool" => Control::Btcpp4(Btcpp4::Loop(LoopType::Bool)),
+            "LoopDouble" => Control::Btcpp4(Btcpp4::Loop(LoopType::Double)),
+            "LoopString" => Control::Btcpp4(Btcpp4::Loop(LoopType::String)),
             _ => return None,
         })
     }
@@ -203,8 +236,12 @@ impl Control {
                 self::Btcpp4::KeepRunningUntilFailure
                 | self::Btcpp4::RunOnce
                 | self::Btcpp4::Timeout
-                | self::Btcpp4::Delay => (1, 1),
-                self::Btcpp4::Sleep | self::Btcpp4::Unset => (0, 0),
+                | self::Btcpp4::Delay
+                | self::Btcpp4::Loop(_)
+                | self::Btcpp4::Updated(UpdatedNode::Skip | UpdatedNode::Wait) => (1, 1),
+                self::Btcpp4::Sleep
+                | self::Btcpp4::Unset
+                | self::Btcpp4::Updated(UpdatedNode::Was) => (0, 0),
                 // The try block and the catch child (`TryCatchNode::tick`: at least 2).
                 self::Btcpp4::TryCatch => (2, usize::MAX),
                 // The cases and the default (BT.CPP 4.10 `switch_node.h`,
@@ -239,6 +276,8 @@ impl Control {
             Btcpp4(self::Btcpp4::Script(ScriptNode::Precondition)) => &["if", "else"],
             Btcpp4(self::Btcpp4::Script(_)) => &["code"],
             Btcpp4(self::Btcpp4::Unset) => &["key"],
+            Btcpp4(self::Btcpp4::Updated(_)) => &["entry"],
+            Btcpp4(self::Btcpp4::Loop(_)) => &["queue", "value", "if_empty"],
             _ => &[],
         }
     }
@@ -267,7 +306,7 @@ const SUPPORTED: &[&str] = &[
     "BlackboardCheckBool",
     "SubTree",
     "SubTreePlus (format 3)",
-    "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6, Timeout, Delay, Sleep, TryCatch, Script, ScriptCondition, Precondition, UnsetBlackboard (with `--bt btcpp`)",
+    "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6, Timeout, Delay, Sleep, TryCatch, Script, ScriptCondition, Precondition, UnsetBlackboard, WasEntryUpdated, SkipUnlessUpdated, WaitValueUpdate, LoopInt, LoopBool, LoopDouble, LoopString (with `--bt btcpp`)",
 ];
 
 /// BehaviorTree.CPP's other built-in nodes (the ones its `BehaviorTreeFactory`
@@ -278,25 +317,9 @@ pub(crate) const UNSUPPORTED: &[(&str, &str)] = &[
         "ManualSelector",
         "it asks a person at a terminal which child to run",
     ),
-    ("LoopInt", "the lowering does not model its queue yet (docs/SEMANTICS.md)"),
-    ("LoopDouble", "the lowering does not model its queue yet (docs/SEMANTICS.md)"),
-    ("LoopString", "the lowering does not model its queue yet (docs/SEMANTICS.md)"),
-    ("LoopBool", "the lowering does not model its queue yet (docs/SEMANTICS.md)"),
     ("ConsumeQueue", "BehaviorTree.CPP 4 does not register it: a C++ program registers it for its own queue type"),
     ("PopFromQueue", "BehaviorTree.CPP 4 does not register it: a C++ program registers it for its own queue type"),
     ("QueueSize", "BehaviorTree.CPP 4 does not register it: a C++ program registers it for its own queue type"),
-    (
-        "WasEntryUpdated",
-        "the lowering does not model the blackboard's update counters yet (docs/SEMANTICS.md)",
-    ),
-    (
-        "SkipUnlessUpdated",
-        "the lowering does not model the blackboard's update counters yet (docs/SEMANTICS.md)",
-    ),
-    (
-        "WaitValueUpdate",
-        "the lowering does not model the blackboard's update counters yet (docs/SEMANTICS.md)",
-    ),
 ];
 
 /// Why `name` cannot be used in a tree of format `format` although hindsight knows it:
@@ -790,6 +813,19 @@ impl Reader<'_> {
                         self.err(p.span, "UnsetBlackboard inside a SubTree is not modelled (BehaviorTree.CPP erases the SubTree's own entry only, which a remapped key may or may not be)".to_string());
                     } else {
                         self.err(p.span, format!("`{k}` is not a blackboard entry name"));
+                    }
+                }
+            }
+        }
+        // The entry-updated nodes' `entry` names an entry with or without braces (4.10
+        // `EntryUpdatedAction` / `EntryUpdatedDecorator` constructors strip them), which
+        // `Blackboard::getEntry` looks up through a SubTree's remapping.
+        if let Kind::Control(Control::Btcpp4(Btcpp4::Updated(_))) = kind {
+            if let Some(p) = ports.iter_mut().find(|p| p.key == "entry") {
+                if let PortValue::Literal(k) = &p.value {
+                    let k = k.trim().to_string();
+                    if is_ident(&k) {
+                        p.value = self.resolve_bb(&k, self.scopes.len());
                     }
                 }
             }

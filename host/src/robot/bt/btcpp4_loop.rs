@@ -1,0 +1,420 @@
+//! BehaviorTree.CPP 4's Loop nodes (LoopInt, LoopBool, LoopDouble, LoopString) over a
+//! queue written in the tree, lowered under [`super::BtSemantics::Btcpp`]
+//! (docs/SEMANTICS.md, "Entries that may be unset, update counters, and queues").
+//!
+//! The rules, BT.CPP 4.10 `include/behaviortree_cpp/decorators/loop_node.h`:
+//! - `LoopNode` constructor: a `queue` that is not `{entry}` is converted when the tree
+//!   is loaded (`convertFromString<SharedQueue<T>>`: split on `;`, each part converted;
+//!   a part that does not convert refuses the tree). BT.CPP 4.8.2, the library the tests
+//!   run, drops a last empty part (`"1;2;"` is two items).
+//! - `LoopNode<T>::tick`: ticked IDLE, the node starts from a fresh copy of the queue
+//!   with no child running; unless the child is RUNNING it pops the front item and
+//!   writes it to `value` (`setOutput`); nothing popped and no child running answers
+//!   `if_empty` (default SUCCESS) without ticking the child or setting its own status;
+//!   otherwise the node sets itself RUNNING and ticks the child, resets a finished one
+//!   (`resetChild`), and answers FAILURE on its FAILURE and RUNNING otherwise (a
+//!   skipped child too). A halt (`DecoratorNode::halt`) halts a RUNNING child and leaves
+//!   the node IDLE.
+//!
+//! The queue is the literal: the machine keeps the index of the next item
+//! (`queue_pos`, at most the literal's length, nothing to overflow) and sends each item
+//! to the blackboard machine as a write of `value` (`bt_blackboard_set_<entry>`, which
+//! counts as an update, `btcpp4_blackboard.rs`). "IDLE" is "did not answer RUNNING
+//! last" (`loop_active`), which holds wherever the parent resets a finished child before
+//! ticking it again; a Loop node BT.CPP may tick again without resetting it (the
+//! condition of a two-child IfThenElse or of a WhileDoElse, the child of a
+//! BlackboardCheck) is refused. Refused too: a queue held in an entry (`queue="{q}"`),
+//! an item that BT.CPP would not convert, and a `value` entry whose type is not the
+//! node's item type (the node's port types an entry no one else types).
+
+use super::blackboard::{register, set_event, Blackboard, Entry, MACHINE};
+use super::control::{Ctx, FAILURE, IS_SKIPPED, RUNNING, SKIPPED, SKIPPED_RUNNING, SUCCESS};
+use super::tree::{Btcpp4, Control, Kind, LoopType, PortValue, Tree, TreeNode};
+use crate::model::source::{Diagnostic, SourceMap};
+use crate::model::types::Scalar;
+use crate::model::xml::Element;
+
+/// The node's name in a tree.
+pub(super) fn loop_name(t: LoopType) -> &'static str {
+    match t {
+        LoopType::Int => "LoopInt",
+        LoopType::Bool => "LoopBool",
+        LoopType::Double => "LoopDouble",
+        LoopType::String => "LoopString",
+    }
+}
+
+/// The type `OutputPort<T>("value")` gives an entry no one else types.
+fn port_type(t: LoopType) -> &'static str {
+    match t {
+        LoopType::Int => "int32",
+        LoopType::Bool => "bool",
+        LoopType::Double => "float64",
+        LoopType::String => "string",
+    }
+}
+
+/// What a Loop node's `value` port says when it types an entry (for errors).
+fn why(t: LoopType) -> String {
+    format!("port `value` of {}", loop_name(t))
+}
+
+/// What a script gives an entry only scripts type (`btcpp4_script.rs`, `resolve`).
+const SCRIPT: &str = "a script";
+
+/// Before the nodes are lowered: types the entry Loop node `i` writes (after the ports
+/// of plugins and BlackboardChecks and SetBlackboard's constants, before scripts), and
+/// refuses a Loop node BT.CPP may tick again without resetting it. An entry a script
+/// (or UnsetBlackboard) names is a script's, `int64`, as `btcpp4_script.rs` types it:
+/// the Loop writes numbers there (found against 4.8.2, docs/SEMANTICS.md); any other
+/// takes the port's type.
+pub(super) fn prepare(
+    sm: &SourceMap,
+    tree: &Tree,
+    i: usize,
+    t: LoopType,
+    bb: &mut Blackboard,
+    errs: &mut Vec<Diagnostic>,
+) {
+    let n = &tree.nodes[i];
+    if let Some(p) = n.parent.map(|p| &tree.nodes[p]) {
+        let first = p.children.first() == Some(&i);
+        let stale = match p.kind {
+            Kind::Control(Control::IfThenElse) => first && p.children.len() == 2,
+            Kind::Control(Control::Btcpp4(Btcpp4::WhileDoElse)) => first,
+            Kind::Control(Control::BlackboardCheck(_)) => true,
+            _ => false,
+        };
+        if stale {
+            errs.push(sm.diag(
+                n.span,
+                format!("{}: BehaviorTree.CPP may tick this node again without resetting it (the condition of a two-child IfThenElse or of a WhileDoElse, the child of a BlackboardCheck), and then goes on with the rest of its queue: not modelled yet", loop_name(t)),
+            ));
+        }
+    }
+    if let Some(p) = n.port("value") {
+        if let PortValue::Blackboard(g) = &p.value {
+            let scripted = tree.nodes.iter().any(|m| {
+                m.script_names
+                    .iter()
+                    .any(|(_, v)| matches!(v, PortValue::Blackboard(x) if x == g))
+            });
+            if bb.entry(g).is_some() {
+            } else if scripted {
+                bb.entries.push(Entry {
+                    name: g.clone(),
+                    ty: "int64".into(),
+                    span: p.span,
+                    why: SCRIPT.into(),
+                });
+                if !bb.script_entries.contains(g) {
+                    bb.script_entries.push(g.clone());
+                }
+            } else {
+                register(sm, bb, g, port_type(t), p.span, &why(t), errs);
+            }
+        }
+    }
+}
+
+/// Item `s` of a queue as `convertFromString<T>` reads it (a whole number, `true` or
+/// `false`, a decimal number with a point, a string's model expression); `Err` says why
+/// BT.CPP refuses it.
+fn item(t: LoopType, s: &str) -> Result<String, String> {
+    match t {
+        // `convertFromString<int>`: a whole number in range, nothing around it.
+        LoopType::Int => {
+            let digits = s.strip_prefix('-').unwrap_or(s);
+            if !digits.is_empty()
+                && digits.chars().all(|c| c.is_ascii_digit())
+                && s.parse::<i32>().is_ok()
+            {
+                Ok(s.to_string())
+            } else {
+                Err(format!("`{s}` is not a whole number of 32 bits"))
+            }
+        }
+        // `convertFromString<bool>`.
+        LoopType::Bool => match s {
+            "1" | "true" | "True" | "TRUE" => Ok("true".into()),
+            "0" | "false" | "False" | "FALSE" => Ok("false".into()),
+            _ => Err(format!("`{s}` is not a boolean (true, false, 1, 0)")),
+        },
+        LoopType::Double => {
+            let numeric = !s.is_empty()
+                && s.chars()
+                    .all(|c| c.is_ascii_digit() || matches!(c, '.' | 'e' | 'E' | '-' | '+'));
+            match s.parse::<f64>() {
+                Ok(x) if numeric && x.is_finite() => {
+                    let d = format!("{x}");
+                    Ok(if d.contains('.') { d } else { format!("{d}.0") })
+                }
+                _ => Err(format!("`{s}` is not a finite decimal number")),
+            }
+        }
+        LoopType::String => Ok(super::plugin::literal_expr(s, "string")),
+    }
+}
+
+/// Item `x` (as [`item`] reads it) written into entry `e`: its model expression, or why
+/// that is not modelled.
+fn written(t: LoopType, x: &str, e: &Entry) -> Result<String, String> {
+    let s = Scalar::from_name(e.ty.trim());
+    if e.why == SCRIPT {
+        // A script's entry holds a number: an int or a bool item is written as one
+        // (true is 1), a double only when whole (BT.CPP throws "Invalid floating point
+        // to integer conversion" otherwise), a string throws ("Any::copyInto fails").
+        return match t {
+            LoopType::Int => Ok(x.to_string()),
+            LoopType::Bool => Ok(if x == "true" { "1" } else { "0" }.into()),
+            LoopType::Double => match x.parse::<f64>() {
+                Ok(d) if d.fract() == 0.0 && d.abs() < 9.0e15 => Ok(format!("{}", d as i64)),
+                _ => Err(format!("the item {x} is not whole, and BehaviorTree.CPP throws writing it into an entry a script holds a number in (\"Invalid floating point to integer conversion\"): not modelled")),
+            },
+            LoopType::String => Err("BehaviorTree.CPP throws writing a string into an entry a script holds a number in (\"Any::copyInto fails\"): not modelled".into()),
+        };
+    }
+    let fits = match t {
+        LoopType::Int => s.is_some_and(|s| s.int_range().is_some()),
+        LoopType::Bool => s == Some(Scalar::Bool),
+        LoopType::Double => matches!(s, Some(Scalar::F32 | Scalar::F64)),
+        LoopType::String => s == Some(Scalar::Str),
+    };
+    if fits {
+        Ok(x.to_string())
+    } else {
+        Err(format!(
+            "a {} item in that entry is not modelled",
+            port_type(t)
+        ))
+    }
+}
+
+/// Checks Loop node `n` and builds its machine.
+pub(super) fn lower(
+    sm: &SourceMap,
+    t: LoopType,
+    n: &TreeNode,
+    ctx: &Ctx,
+    bb: &mut Blackboard,
+    errs: &mut Vec<Diagnostic>,
+) -> Option<Element> {
+    let name = loop_name(t);
+    let before = errs.len();
+    let items: Vec<String> = match n.port("queue").map(|p| (&p.value, p.span)) {
+        None => {
+            errs.push(sm.diag(n.span, format!("{name} needs `queue`")));
+            return None;
+        }
+        Some((PortValue::Blackboard(q), span)) => {
+            errs.push(sm.diag(
+                span,
+                format!("`queue` of {name} is the entry `{{{q}}}`: a queue held in the blackboard (written by C++ code, or a string converted at the node's first pop) is not modelled; write the items in the tree (`queue=\"1;2;3\"`)"),
+            ));
+            return None;
+        }
+        Some((PortValue::Literal(q), span)) => {
+            let mut parts: Vec<&str> = q.split(';').collect();
+            // 4.8.2 drops a last empty part.
+            if parts.last() == Some(&"") {
+                parts.pop();
+            }
+            let mut out = Vec::new();
+            for (k, p) in parts.iter().enumerate() {
+                match item(t, p) {
+                    Ok(x) => out.push(x),
+                    Err(why) => errs.push(sm.diag(
+                        span,
+                        format!("item {} of the `queue` of {name}: {why}, so BehaviorTree.CPP refuses the tree when it loads it (`convertFromString`)", k + 1),
+                    )),
+                }
+            }
+            out
+        }
+    };
+    // `InputPort<NodeStatus>("if_empty", NodeStatus::SUCCESS, ..)`, read with
+    // `convertFromString<NodeStatus>`.
+    let if_empty = match n.port("if_empty").map(|p| (&p.value, p.span)) {
+        None => SUCCESS,
+        Some((PortValue::Literal(v), span)) => match v.trim() {
+            "SKIPPED" => SKIPPED,
+            s => match super::control::status_code(s) {
+                Some(c) => c,
+                None => {
+                    errs.push(sm.diag(
+                        span,
+                        format!("`if_empty` of {name}: `{s}` is not SUCCESS, FAILURE, RUNNING or SKIPPED"),
+                    ));
+                    SUCCESS
+                }
+            },
+        },
+        Some((PortValue::Blackboard(e), span)) => {
+            errs.push(sm.diag(
+                span,
+                format!("`if_empty` of {name} must be a constant status; a blackboard entry (`{{{e}}}`) is not supported here"),
+            ));
+            SUCCESS
+        }
+    };
+    let value = match n.port("value").map(|p| (&p.value, p.span)) {
+        None => None,
+        Some((PortValue::Literal(v), span)) => {
+            errs.push(sm.diag(
+                span,
+                format!(
+                    "`value` of {name} is an output: write the entry it goes to, `{{{}}}`",
+                    v.trim()
+                ),
+            ));
+            None
+        }
+        Some((PortValue::Blackboard(g), span)) => match bb.entry(g).cloned() {
+            // `prepare` typed it or reported why not.
+            None => None,
+            Some(_) if bb.texts.contains(g) => {
+                errs.push(sm.diag(
+                    span,
+                    format!("`value` of {name} writes `{g}`, which a SetBlackboard writes too: BehaviorTree.CPP 4 holds SetBlackboard's text there, which is not modelled"),
+                ));
+                None
+            }
+            Some(e) => {
+                let mut exprs = Vec::with_capacity(items.len());
+                for x in &items {
+                    match written(t, x, &e) {
+                        Ok(v) => exprs.push(v),
+                        Err(why) => {
+                            let at = sm.diag(e.span, "");
+                            errs.push(sm.diag(
+                                span,
+                                format!("`value` of {name} writes its items to `{g}`, which is {} at {}:{}:{} ({}): {why}", e.ty, at.file, at.line, at.col, e.why),
+                            ));
+                            break;
+                        }
+                    }
+                }
+                Some((g.clone(), exprs))
+            }
+        },
+    };
+    (errs.len() == before).then(|| {
+        let writes = value.map_or_else(
+            || vec![None; items.len()],
+            |(g, xs)| xs.into_iter().map(|x| Some((g.clone(), x))).collect(),
+        );
+        machine(ctx, &writes, if_empty)
+    })
+}
+
+/// The Loop node's machine over the queue's items: each item's write (the entry and the
+/// model expression), if `value` is given.
+fn machine(ctx: &Ctx, items: &[Option<(String, String)>], if_empty: u8) -> Element {
+    let b = &ctx.b;
+    let (pos, cr, active) = ("queue_pos", "loop_child_running", "loop_active");
+    let len = items.len();
+    let mut m = b.scxml(&ctx.machine, "wait_for_tick");
+    let mut data = vec![
+        (pos, "int32", "0".to_string()),
+        (cr, "bool", "false".to_string()),
+        (active, "bool", "false".to_string()),
+    ];
+    let flags = ctx.running_data();
+    data.extend(flags.iter().map(|(v, t, e)| (v.as_str(), *t, e.clone())));
+    m.push(b.datamodel(&data));
+    // Ticked IDLE: a fresh copy of the queue, no child running.
+    let mut w = b.state("wait_for_tick").with_child(b.tr(
+        Some(&ctx.tick_ev()),
+        Some(&format!("!{active}")),
+        Some("popping"),
+        vec![b.assign(pos, "0"), b.assign(cr, "false")],
+    ));
+    w.push(b.tr(Some(&ctx.tick_ev()), None, Some("popping"), vec![]));
+    // `DecoratorNode::halt`: the child halted if RUNNING, the node IDLE.
+    let r = ctx.running_var(0);
+    if let Some(r) = &r {
+        w.push(b.tr(
+            Some(&ctx.halt_ev()),
+            Some(&format!("!{r}")),
+            Some("wait_for_tick"),
+            vec![b.assign(active, "false"), ctx.respond_halted()],
+        ));
+    }
+    w.push(b.tr(
+        Some(&ctx.halt_ev()),
+        None,
+        Some("halting_child"),
+        vec![b.assign(active, "false")],
+    ));
+    m.push(w);
+    let mut p = b.state("popping");
+    // Pop the front item into `value`.
+    let mut pop = Vec::new();
+    let writes = items
+        .iter()
+        .enumerate()
+        .filter_map(|(i, w)| {
+            let (g, x) = w.as_ref()?;
+            Some((
+                format!("{pos} == {i}"),
+                vec![b.send_params(&set_event(g), MACHINE, &[("value", x)])],
+            ))
+        })
+        .collect();
+    pop.extend(b.if_chain(writes, Vec::new()));
+    pop.push(b.assign(pos, &format!("{pos} + 1")));
+    pop.push(b.assign(active, "true"));
+    p.push(b.tr(
+        None,
+        Some(&format!("!{cr} && {pos} < {len}")),
+        Some("tick_child"),
+        pop,
+    ));
+    p.push(b.tr(
+        None,
+        Some(cr),
+        Some("tick_child"),
+        vec![b.assign(active, "true")],
+    ));
+    // Nothing popped, no child running: `if_empty`, the node's status left as it was
+    // (a SKIPPED is not stored, `TreeNode::executeTick`).
+    let empty = match if_empty {
+        SKIPPED => vec![b
+            .if_chain(
+                vec![(active.to_string(), vec![ctx.respond(SKIPPED_RUNNING)])],
+                vec![ctx.respond(SKIPPED)],
+            )
+            .expect("one branch")],
+        RUNNING => vec![b.assign(active, "true"), ctx.respond(RUNNING)],
+        s => vec![b.assign(active, "false"), ctx.respond(s)],
+    };
+    p.push(b.tr(None, None, Some("wait_for_tick"), empty));
+    m.push(p);
+    let mut t = b.state_entry("tick_child", vec![ctx.tick_child(0)]);
+    for (s, answer) in [(SUCCESS, RUNNING), (FAILURE, FAILURE), (RUNNING, RUNNING)] {
+        let mut body = vec![b.assign(cr, if s == RUNNING { "true" } else { "false" })];
+        if s == FAILURE {
+            body.push(b.assign(active, "false"));
+        }
+        body.push(ctx.respond(answer));
+        t.push(b.tr(
+            Some(&ctx.child_resp(0)),
+            Some(&format!("_event.data.status == {s}")),
+            Some("wait_for_tick"),
+            ctx.marked(0, s, body),
+        ));
+    }
+    // A skipped child: not RUNNING to the node, RUNNING (code 5) to its halts.
+    let mut body: Vec<Element> = ctx.mark_skipped(0).into_iter().collect();
+    body.push(b.assign(cr, "false"));
+    body.push(ctx.respond(RUNNING));
+    t.push(b.tr(
+        Some(&ctx.child_resp(0)),
+        Some(IS_SKIPPED),
+        Some("wait_for_tick"),
+        body,
+    ));
+    m.push(t);
+    m.push(ctx.halting_child_state());
+    m
+}

@@ -1,0 +1,152 @@
+//! BehaviorTree.CPP 4's entry-updated nodes (WasEntryUpdated, SkipUnlessUpdated,
+//! WaitValueUpdate) and Loop nodes (LoopInt, LoopBool, LoopDouble, LoopString) in a tree:
+//! lowered under `--bt btcpp` (the counters and the queue's index in the model), refused
+//! with file:line:col under AS2FM's semantics and where BT.CPP's behaviour is not modelled,
+//! each saying why. (What the lowered nodes do is held to the oracle and the real library
+//! by `tests/tests/bt_btcpp_lowering.rs`.)
+
+use hindsight::model::source::SourceMap;
+use hindsight::model::xml::Element;
+use hindsight::model::Diagnostics;
+use hindsight::robot::bt::{self, BtInput, BtSemantics, BtTick, Halts};
+
+const LEAF: &str = r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="Act">
+<state id="s"><bt_tick target="s"><bt_return_status status="SUCCESS"/></bt_tick></state>
+</ascxml>"#;
+
+const BTCPP: BtSemantics = BtSemantics::Btcpp { tick: BtTick::Once };
+
+/// Lowers a document (`body` inside the main tree, `more` after it): the machines, or
+/// the errors.
+fn lower(body: &str, more: &str, semantics: BtSemantics) -> Result<Vec<Element>, String> {
+    let tree = format!(
+        "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n{body}\n</BehaviorTree>\n{more}</root>\n"
+    );
+    let mut sm = SourceMap::new();
+    let t = sm.add("tree.xml", tree);
+    let plugins = vec![sm.add("act.ascxml", LEAF.to_string())];
+    bt::lower(
+        &sm,
+        &BtInput {
+            tree: t,
+            plugins,
+            tick_rate_hz: 1.0,
+            tick_if_not_running: false,
+            halts: Halts::As2fm,
+            semantics,
+        },
+    )
+    .map_err(|ds| Diagnostics(ds).to_string())
+}
+
+/// The `<data>` ids of machine `name`.
+fn data(ms: &[Element], name: &str) -> Vec<String> {
+    let m = ms
+        .iter()
+        .find(|m| m.attr_value("name") == Some(name))
+        .unwrap_or_else(|| panic!("no machine {name}"));
+    m.elements()
+        .filter(|e| e.name == "datamodel")
+        .flat_map(|d| d.elements())
+        .filter_map(|d| d.attr_value("id").map(str::to_string))
+        .collect()
+}
+
+#[test]
+fn the_nodes_lower_under_btcpp_and_not_under_as2fm() {
+    let body = "<Sequence>\n<Script code=\"x:=1\"/>\n<LoopInt queue=\"1;2;3\" value=\"{x}\">\n\
+                <WaitValueUpdate entry=\"x\"><Act/></WaitValueUpdate>\n</LoopInt>\n\
+                <SkipUnlessUpdated entry=\"{y}\"><WasEntryUpdated entry=\"x\"/></SkipUnlessUpdated>\n\
+                <LoopString queue=\"a;b\" value=\"{s}\"><LoopBool queue=\"true;0\" value=\"{b}\">\
+                <LoopDouble queue=\"1.5;2\" value=\"{d}\"><Act/></LoopDouble></LoopBool></LoopString>\n</Sequence>";
+    let ms = lower(body, "", BTCPP).expect("lowers");
+    // The counters of the watched entries and each node's last seen one, in the
+    // blackboard machine.
+    let bb = data(&ms, "bt_blackboard_fsm");
+    for v in [
+        "bt_seq__x",
+        "bt_seq__y",
+        "bt_seen__1003",
+        "bt_seen__1005",
+        "bt_seen__1006",
+    ] {
+        assert!(bb.iter().any(|d| d == v), "{v} in {bb:?}");
+    }
+    let e = lower(body, "", BtSemantics::As2fm).expect_err("AS2FM has no model");
+    for (at, node) in [
+        ("5:1", "LoopInt"),
+        ("6:1", "WaitValueUpdate"),
+        ("8:1", "SkipUnlessUpdated"),
+    ] {
+        assert!(
+            e.contains(&format!(
+                "tree.xml:{at}: `{node}` is a BehaviorTree.CPP 4 node that AS2FM has no model of"
+            )),
+            "{node}: {e}"
+        );
+    }
+}
+
+#[test]
+fn what_is_not_modelled_is_refused_at_its_place() {
+    for (body, want) in [
+        (
+            "<LoopInt queue=\"{q}\"><Act/></LoopInt>",
+            "tree.xml:3:17: `queue` of LoopInt is the entry `{q}`",
+        ),
+        (
+            "<LoopInt queue=\"1; 2\"><Act/></LoopInt>",
+            "tree.xml:3:17: item 2 of the `queue` of LoopInt: ` 2` is not a whole number",
+        ),
+        (
+            "<LoopBool queue=\"yes\"><Act/></LoopBool>",
+            "tree.xml:3:18: item 1 of the `queue` of LoopBool: `yes` is not a boolean",
+        ),
+        (
+            "<LoopInt queue=\"1\" if_empty=\"IDLE\"><Act/></LoopInt>",
+            "tree.xml:3:30: `if_empty` of LoopInt: `IDLE` is not SUCCESS",
+        ),
+        (
+            "<LoopInt queue=\"1\" value=\"x\"><Act/></LoopInt>",
+            "tree.xml:3:27: `value` of LoopInt is an output",
+        ),
+        (
+            "<Sequence><Script code=\"x:=0\"/><LoopString queue=\"7\" value=\"{x}\"><Act/></LoopString></Sequence>",
+            "tree.xml:3:61: `value` of LoopString writes its items to `x`, which is int64",
+        ),
+        (
+            "<Sequence><Script code=\"x:=0\"/><LoopDouble queue=\"1.5\" value=\"{x}\"><Act/></LoopDouble></Sequence>",
+            "Invalid floating point to integer conversion",
+        ),
+        (
+            "<Sequence><SetBlackboard output_key=\"k\" value=\"1\"/><LoopInt queue=\"1\" value=\"{k}\"><Act/></LoopInt></Sequence>",
+            "which a SetBlackboard writes too",
+        ),
+        (
+            "<IfThenElse><LoopInt queue=\"1\"><Act/></LoopInt><Act/></IfThenElse>",
+            "tree.xml:3:13: LoopInt: BehaviorTree.CPP may tick this node again without resetting it",
+        ),
+        (
+            "<WasEntryUpdated/>",
+            "tree.xml:3:1: WasEntryUpdated needs `entry`",
+        ),
+        (
+            "<SkipUnlessUpdated entry=\"a b\"><Act/></SkipUnlessUpdated>",
+            "tree.xml:3:27: `entry` of SkipUnlessUpdated must name a blackboard entry",
+        ),
+    ] {
+        let e = lower(body, "", BTCPP).expect_err(body);
+        assert!(e.contains(want), "{body}:\n{e}");
+    }
+    // A SubTree's constant has no counter in the model.
+    let e = lower(
+        "<SubTree ID=\"S\" x=\"5\"/>",
+        "<BehaviorTree ID=\"S\">\n<WasEntryUpdated entry=\"x\"/>\n</BehaviorTree>\n",
+        BTCPP,
+    )
+    .expect_err("a constant");
+    assert!(
+        e.contains("tree.xml:6:25: `entry` of WasEntryUpdated must name a blackboard entry"),
+        "{e}"
+    );
+}
