@@ -99,8 +99,7 @@ pub(super) fn prepare(
                     .iter()
                     .any(|(_, v)| matches!(v, PortValue::Blackboard(x) if x == g))
             });
-            if bb.entry(g).is_some() {
-            } else if scripted {
+            if bb.entry(g).is_none() && scripted {
                 bb.entries.push(Entry {
                     name: g.clone(),
                     ty: "int64".into(),
@@ -110,7 +109,7 @@ pub(super) fn prepare(
                 if !bb.script_entries.contains(g) {
                     bb.script_entries.push(g.clone());
                 }
-            } else {
+            } else if bb.entry(g).is_none() {
                 register(sm, bb, g, port_type(t), p.span, &why(t), errs);
             }
         }
