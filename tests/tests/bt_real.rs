@@ -210,10 +210,9 @@ fn check_all(
         let mut wants = Vec::new();
         for (name, xml, scripts, ticks) in chunk {
             for mode in MODES {
-                let mut read = Vec::new();
-                match expect(xml, scripts, *ticks, mode) {
+                let read = match expect(xml, scripts, *ticks, mode) {
                     Ok(w) => {
-                        read = w.1.vars.keys().cloned().collect();
+                        let mut read: Vec<String> = w.1.vars.keys().cloned().collect();
                         // An entry the oracle says UnsetBlackboard erased must be missing
                         // in the library too.
                         if xml.contains("<UnsetBlackboard ") {
@@ -223,7 +222,8 @@ fn check_all(
                                 }
                             }
                         }
-                        wants.push((name, xml, scripts, *ticks, mode, w))
+                        wants.push((name, xml, scripts, *ticks, mode, w));
+                        read
                     }
                     // Accounted for here, per case: the library is not asked about this
                     // one, and the rest of the batch still runs.
@@ -231,7 +231,7 @@ fn check_all(
                         fails.push(format!("{name}: the oracle: {e}"));
                         continue;
                     }
-                }
+                };
                 reqs.push(Request {
                     xml: xml.clone(),
                     scripts: scripts.clone(),
