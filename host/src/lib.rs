@@ -3,7 +3,6 @@
 pub mod cli;
 pub mod live;
 pub mod report;
-pub mod robot;
 pub mod tracefile;
 pub mod verify;
 
@@ -13,5 +12,6 @@ pub mod verify;
 // `crate::props::…` and `crate::smc::…` name the same items as before the split.
 pub use hindsight_expr as expr;
 pub use hindsight_props as props;
+pub use hindsight_robot as robot;
 pub use hindsight_sim::{model, sim};
 pub use hindsight_smc as smc;
