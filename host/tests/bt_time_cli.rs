@@ -1,6 +1,6 @@
 //! BT.CPP 4's timed nodes on the command line: `verify --bt btcpp` on small robot models
 //! whose verdicts depend on a Delay's or a Timeout's duration (the timers fire in model
-//! time, kept by the root machine: `host/src/robot/bt/btcpp4_time.rs`), and their
+//! time, kept by the root machine: `crates/robot/src/bt/btcpp4_time.rs`), and their
 //! refusals under the default semantics and for durations the clock cannot time.
 
 use std::path::{Path, PathBuf};

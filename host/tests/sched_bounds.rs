@@ -173,7 +173,7 @@ fn sampled(
         &run_cfg(max_time),
         &study_cfg,
         &rule(),
-        false,
+        &mut |_| {},
     )
     .expect("uniform study");
     let u = u

@@ -321,8 +321,19 @@ pub fn study(
     rule: &RuleConfig,
     show_progress: bool,
 ) -> Result<StudyResult, CliError> {
-    crate::verify::study::study(model, set, run_cfg, study_cfg, rule, show_progress)
+    let mut bar = progress_bar(show_progress);
+    crate::verify::study::study(model, set, run_cfg, study_cfg, rule, &mut |p| bar.update(p))
         .map_err(CliError::Input)
+}
+
+/// The progress bar of a study on standard error, or none (`--json`): the library reports
+/// progress to a callback and prints nothing.
+fn progress_bar(show: bool) -> crate::smc::progress::TerminalProgress {
+    if show {
+        crate::smc::progress::TerminalProgress::stderr()
+    } else {
+        crate::smc::progress::TerminalProgress::hidden()
+    }
 }
 
 /// Set by the first Ctrl-C (SIGINT) or SIGTERM once [`interrupt_flag`] installed the
@@ -598,13 +609,14 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         }
         return print_report(&report, args.json);
     }
+    let mut bar = progress_bar(!args.json);
     let result = study_until(
         model,
         set,
         &run_cfg,
         &study_cfg,
         &rule,
-        !args.json,
+        &mut |p| bar.update(p),
         interrupt_flag(),
     )
     .map_err(CliError::Input)?;

@@ -259,7 +259,7 @@ pub const CLOCKED_RATE_HZ: f64 = 10.0;
 
 /// Lowers `xml` under `semantics` (BT.CPP's) and runs `ticks` executor ticks with the
 /// lowered root machine itself, the keeper of the timers of Timeout, Delay and Sleep
-/// (`host/src/robot/bt/btcpp4_time.rs`), ticking at [`CLOCKED_RATE_HZ`] in model time.
+/// (`crates/robot/src/bt/btcpp4_time.rs`), ticking at [`CLOCKED_RATE_HZ`] in model time.
 ///
 /// The ROS lowering is not run here, so its timer tags become plain SCXML: each
 /// `<ros_rate_callback name="x">` a transition on `ros_time_rate.x`, and a ticker machine

@@ -44,13 +44,14 @@ pub(super) fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
             eprintln!("--bt {}:", bt.label());
         }
         // Once interrupted, the next semantics' study starts no run (0 runs, no estimate).
+        let mut bar = super::progress_bar(!args.json);
         let result = study_until(
             &loaded.model,
             &loaded.set,
             &run_cfg,
             &study_cfg,
             &rule,
-            !args.json,
+            &mut |p| bar.update(p),
             stop,
         )
         .map_err(CliError::Input)?;

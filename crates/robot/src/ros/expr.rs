@@ -3,7 +3,7 @@
 
 use crate::expr::ast::{Expr, ExprKind};
 use crate::expr::parse_expr;
-use crate::robot::types::FlatField;
+use crate::types::FlatField;
 
 /// What the pseudo-variables of one callback refer to.
 #[derive(Clone, Debug, Default)]

@@ -343,7 +343,7 @@ fn inert_stub(root: &Element, interfaces: &Interfaces) -> Element {
                 .attr_value("type")
                 .and_then(|t| interfaces.action(t.trim()).ok())
                 .unwrap_or_default();
-            let with_fields = |tag: &str, list: &[crate::robot::types::FlatField]| {
+            let with_fields = |tag: &str, list: &[crate::types::FlatField]| {
                 let mut e = Element::new(tag, c.span)
                     .with_attr("name", alias)
                     .with_attr("goal_id", "0");

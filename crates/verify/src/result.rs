@@ -89,7 +89,7 @@ pub struct PropertyRow {
     /// With `verify --schedulers N`: the smallest and largest probability among the
     /// sampled schedulers, their witnesses, and whether the property is order-sensitive.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub schedulers: Option<crate::verify::schedulers::SchedulerBounds>,
+    pub schedulers: Option<crate::schedulers::SchedulerBounds>,
 }
 
 impl PropertyRow {

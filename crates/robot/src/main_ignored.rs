@@ -31,7 +31,7 @@ pub(super) fn close_to<'k>(name: &str, known: &[&'k str]) -> Option<&'k str> {
     let lower = name.to_ascii_lowercase();
     known
         .iter()
-        .map(|k| (crate::robot::interfaces::edit_distance(&lower, k), *k))
+        .map(|k| (crate::interfaces::edit_distance(&lower, k), *k))
         .filter(|(d, k)| name != *k && *d <= (k.len() / 3 + 1).min(3))
         .min()
         .map(|(_, k)| k)

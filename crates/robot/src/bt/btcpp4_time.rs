@@ -113,7 +113,7 @@ fn gcd(a: u64, b: u64) -> u64 {
 }
 
 /// The rate in hertz whose period is exactly `ns` nanoseconds, written as a decimal
-/// (`crate::robot::rate::period` reads it back exactly), if there is one.
+/// (`crate::rate::period` reads it back exactly), if there is one.
 fn exact_rate(ns: u64) -> Option<String> {
     (0..=18u32).find_map(|k| {
         let num = 1_000_000_000u128 * 10u128.pow(k);
@@ -129,7 +129,7 @@ fn exact_rate(ns: u64) -> Option<String> {
         } else {
             format!("0.{}{m}", "0".repeat(k - m.len()))
         };
-        let p = crate::robot::rate::period(&text).ok()?;
+        let p = crate::rate::period(&text).ok()?;
         (p.exact && p.period_ns == ns).then_some(text)
     })
 }
@@ -163,7 +163,7 @@ pub(super) fn clock(
         timed.push((n, ms * 1_000_000));
     }
     let first = timed.first()?.0;
-    let period = crate::robot::rate::period(rate_text).ok()?.period_ns;
+    let period = crate::rate::period(rate_text).ok()?.period_ns;
     let q = timed
         .iter()
         .fold(period, |g, (_, d)| if *d == 0 { g } else { gcd(g, *d) });

@@ -11,18 +11,20 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::observe::{Judge, PropertySet};
 use crate::sim::{CompiledModel, EndReason, RunConfig, Scheduler, Simulator, SpinKind};
-use crate::smc::progress::TerminalProgress;
 use crate::smc::stats::RuleConfig;
-use crate::smc::{run_study_until, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
+use crate::smc::{
+    run_study_until, Progress, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict,
+};
 
-/// Runs a study of `set` on `model`: the function `verify` and `sweep` share.
+/// Runs a study of `set` on `model`: the function `verify` and `sweep` share. `progress`
+/// is told of every run consumed (the binary draws a bar; the library prints nothing).
 pub fn study(
     model: &CompiledModel,
     set: &PropertySet,
     run_cfg: &RunConfig,
     study_cfg: &StudyConfig,
     rule: &RuleConfig,
-    show_progress: bool,
+    progress: &mut dyn FnMut(&Progress<'_>),
 ) -> Result<StudyResult, String> {
     study_until(
         model,
@@ -30,7 +32,7 @@ pub fn study(
         run_cfg,
         study_cfg,
         rule,
-        show_progress,
+        progress,
         &AtomicBool::new(false),
     )
 }
@@ -43,7 +45,7 @@ pub fn study_until(
     run_cfg: &RunConfig,
     study_cfg: &StudyConfig,
     rule: &RuleConfig,
-    show_progress: bool,
+    progress: &mut dyn FnMut(&Progress<'_>),
     stop: &AtomicBool,
 ) -> Result<StudyResult, String> {
     let rules = set
@@ -53,16 +55,11 @@ pub fn study_until(
         .collect::<Result<Vec<_>, _>>()
         .map_err(|e| format!("statistics: {e}"))?;
     let runner = Runner::new(model, set, run_cfg);
-    let mut bar = if show_progress {
-        TerminalProgress::stderr()
-    } else {
-        TerminalProgress::hidden()
-    };
     let result = run_study_until(
         study_cfg,
         &rules,
         |k, rng| runner.run(k, rng),
-        &mut |p| bar.update(p),
+        progress,
         stop,
     );
     runner.finish()?;

@@ -46,7 +46,7 @@ use std::path::{Path, PathBuf};
 
 use crate::model::source::{Diagnostic, FileId, SourceMap, Span};
 use crate::model::xml::{self, Element, Node};
-use crate::robot::rate::{self, RateError, RatePeriod};
+use crate::rate::{self, RateError, RatePeriod};
 use codegen::duration;
 
 use super::main_ignored::{close_to, Notes, PARAMETERS, SECTIONS};

@@ -518,7 +518,7 @@ mod tests {
     /// Every built-in type resolves and flattens into the leaf fields the lowering sends.
     #[test]
     fn every_builtin_flattens() {
-        use crate::robot::types::InterfaceLookup;
+        use crate::types::InterfaceLookup;
         use codegen::diag::SourceMap;
         let ifs = Interfaces::with_builtins();
         assert_eq!(ifs.iter().count(), builtin::definitions().len());

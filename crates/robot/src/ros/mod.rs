@@ -56,7 +56,7 @@ mod lower;
 
 use crate::model::source::{Diagnostic, SourceMap, Span};
 use crate::model::xml::{Element, Node};
-use crate::robot::types::{ActionFields, FlatField, InterfaceLookup, ServiceFields};
+use crate::types::{ActionFields, FlatField, InterfaceLookup, ServiceFields};
 
 /// What the ROS lowering needs: the node models and how to find message layouts.
 pub struct RosInput<'a> {
@@ -412,7 +412,7 @@ impl Cx<'_> {
                         }
                         // The one rate rule (`robot::rate`): exact when the period is whole;
                         // otherwise rounded to the nanosecond, as before.
-                        match crate::robot::rate::period(rate.trim()) {
+                        match crate::rate::period(rate.trim()) {
                             Ok(p) => {
                                 self.timers.push(Timer {
                                     name: tname.clone(),
@@ -421,7 +421,7 @@ impl Cx<'_> {
                                 });
                                 d.timers.push((tname, self.timers.len() - 1));
                             }
-                            Err(crate::robot::rate::RateError::TooSlow) => self.err(
+                            Err(crate::rate::RateError::TooSlow) => self.err(
                                 rspan,
                                 format!(
                                     "`rate_hz` `{rate}` is slower than the slowest rate hindsight can time (one tick per 2^64 ns, about 584 years)"

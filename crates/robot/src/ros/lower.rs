@@ -4,7 +4,7 @@ use super::expr::{rewrite, Scope};
 use super::{find, Cx, DECLARATIONS};
 use crate::model::source::{unescaped_offset, Span};
 use crate::model::xml::{Element, Node};
-use crate::robot::types::FlatField;
+use crate::types::FlatField;
 
 /// Every ROS tag the lowering knows: declarations and the tags inside states.
 const KNOWN_TAGS: &[&str] = &[

@@ -7,7 +7,7 @@
 use super::{gcd, Cx, AUTO_TARGET};
 use crate::model::source::Span;
 use crate::model::xml::Element;
-use crate::robot::types::FlatField;
+use crate::types::FlatField;
 
 fn data(span: Span, id: &str, ty: &str, expr: &str) -> Element {
     Element::new("data", span)

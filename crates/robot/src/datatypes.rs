@@ -392,8 +392,7 @@ mod tests {
             " ",
         ];
         let (mut oks, mut errs) = (0, 0);
-        for text in crate::robot::random_text::texts(&tokens, 0x2545_f491_4f6c_dd1du64, 12, 20_000)
-        {
+        for text in crate::random_text::texts(&tokens, 0x2545_f491_4f6c_dd1du64, 12, 20_000) {
             match parse(&text) {
                 Ok(v) => {
                     oks += 1;

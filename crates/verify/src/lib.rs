@@ -1,0 +1,49 @@
+//! Statistical model checking glue: properties observed on simulated runs, judged by monitors.
+//!
+//! The off-line pipeline as a library: [`load`] reads a model (plain SCXML or a robot
+//! model) and its property file, [`observe`] judges a simulated run with the compiled
+//! monitors, [`study`] runs studies under stopping rules, [`schedulers`] and
+//! [`sched_fixed`] bound the probabilities over schedulers, [`record`] writes a run as CSV
+//! and [`result`] is a study's result as `verify --json` prints it. Nothing here prints:
+//! errors are values ([`load::LoadError`] carries the files' diagnostics), warnings come
+//! back with what was loaded ([`load::Loaded::warnings`]) and progress goes to a callback.
+//!
+//! # Crate
+//!
+//! `hindsight-verify` depends on `monitor-core`, `codegen` and the crates below it in the
+//! pipeline, re-exported here under the paths its modules name them by: [`expr`],
+//! [`model`], [`sim`], [`props`], [`robot`] and [`smc`]; on no other crate of the project.
+//! `hindsight`'s command line drives it.
+//!
+//! One run of the museum example, judged by its five requirements:
+//!
+//! ```
+//! use hindsight_verify::load::{load, LoadOptions};
+//! use hindsight_verify::sim::RunConfig;
+//! use hindsight_verify::smc::{stream, RunEnd};
+//! use hindsight_verify::study::Runner;
+//!
+//! let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/museum-scxml");
+//! let loaded = load(&LoadOptions { model: dir.into(), ..LoadOptions::default() }).unwrap();
+//! let run_cfg = RunConfig { max_time: 1000, events: loaded.events, ..RunConfig::default() };
+//! let runner = Runner::new(&loaded.model, &loaded.set, &run_cfg);
+//! let run = runner.run(0, &mut stream(1, 0));
+//! assert_eq!(run.verdicts.len(), loaded.set.guarantee_names().len());
+//! assert!(!matches!(run.end, RunEnd::Failed));
+//! runner.finish().unwrap();
+//! ```
+
+pub mod load;
+pub mod observe;
+pub mod record;
+pub mod result;
+pub mod sched_fixed;
+pub mod schedulers;
+pub mod study;
+
+// The crates below this one, under the paths its modules name them by.
+pub use hindsight_expr as expr;
+pub use hindsight_props as props;
+pub use hindsight_robot as robot;
+pub use hindsight_sim::{model, sim};
+pub use hindsight_smc as smc;

@@ -1,9 +1,0 @@
-//! Statistical model checking glue: properties observed on simulated runs, judged by monitors.
-
-pub mod load;
-pub mod observe;
-pub mod record;
-pub mod result;
-pub mod sched_fixed;
-pub mod schedulers;
-pub mod study;
