@@ -100,3 +100,59 @@ fn a_well_formed_condition_is_refused_saying_why() {
         "{e}"
     );
 }
+
+#[test]
+fn scripts_the_btcpp_lowering_cannot_model_are_refused_saying_why() {
+    // At the attribute (line 3, the value of `code` at column 15), with the column in the
+    // script and the reason.
+    let btcpp = BtSemantics::Btcpp { tick: BtTick::Once };
+    for (code, col, why) in [
+        ("x := 5 / 2", 1, "need not be whole"),
+        ("x := 1; x /= 2", 9, "need not be whole"),
+        ("x := 2.5 &gt; 1 ? 0.5 : 1", 1, "need not be whole"),
+        ("x := 1 &amp; 3", 6, "no bitwise operations"),
+        ("x := ~1", 6, "no bitwise operations"),
+        ("x := 'abc'", 6, "no string operations"),
+        ("x := 1. &lt; 2", 6, "not one BT.CPP 4 reads"),
+        ("x := 1e400 &gt; 0", 6, "out of a double's range"),
+        ("x := 1 / y &gt; 0", 10, "sign of a zero"),
+        ("x := 1 / 0 &gt; 0", 10, "sign of a zero"),
+    ] {
+        let e = errors(&format!("<Script code=\"{code}\"/>"), btcpp);
+        assert!(
+            e.contains("tree.xml:3:15: `code` of Script: ")
+                && e.contains(why)
+                && e.contains(&format!("(at column {col} of the script)")),
+            "{code}: {e}"
+        );
+    }
+    // What is lowered: doubles compared, tested and cast, hexadecimal and exponents.
+    for code in [
+        "x := 5 / 2 &gt; 2",
+        "x := (1e308 * 10 - 1e308 * 10) &lt; 1 ? 1 : 2",
+        "x := 1; x += x / -2.5 &lt; 0",
+        "x := 2.5e-1 == 0.25 &amp;&amp; 0x10 == 16",
+        "x := 0; x += 1 / 2 &gt; 0.4",
+    ] {
+        let tree = format!(
+            "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n<Script code=\"{code}\"/>\n</BehaviorTree>\n</root>\n"
+        );
+        let mut sm = SourceMap::new();
+        let t = sm.add("tree.xml", tree);
+        let plugins = vec![sm.add("act.ascxml", LEAF.to_string())];
+        let r = bt::lower(
+            &sm,
+            &BtInput {
+                tree: t,
+                plugins,
+                tick_rate_hz: 1.0,
+                tick_if_not_running: false,
+                halts: Halts::As2fm,
+                semantics: btcpp,
+            },
+        );
+        if let Err(ds) = r {
+            panic!("{code}: {}", Diagnostics(ds));
+        }
+    }
+}

@@ -427,6 +427,47 @@ fn scripts_assign_and_conditions_read_the_entries() {
 }
 
 #[test]
+fn scripts_cast_doubles_and_integers_as_btcpp_does() {
+    // Each run checked against the real library (BT.CPP 4.8.2): every operator gives a
+    // double, cast to bool as true unless 0 (negative throws); an integer (a literal, an
+    // entry created from one) must be 0 or 1. A throw stops the tree before A.
+    let sc = scripts(&[("A", &[S])]);
+    let a_runs = ran(&[S], &[T(1002)]);
+    let stops = ran(&[], &[]);
+    for (cond, want) in [
+        ("1+1", &a_runs),
+        ("1/2", &a_runs),
+        ("1e308 * 10 - 1e308 * 10", &a_runs),
+        (
+            "(1e308 * 10 - 1e308 * 10) &lt; 1 &amp;&amp; (1e308 * 10 - 1e308 * 10) &gt;= 1",
+            &a_runs,
+        ),
+        ("1/3 == 0.3333333 &amp;&amp; 1/3 != 0.333333", &a_runs),
+        ("(1/2) &amp;&amp; true", &a_runs),
+        ("3", &stops),
+        ("0-1/2", &stops),
+        ("(0-1) || true", &stops),
+    ] {
+        let t = v4(&format!(
+            "<Sequence><ScriptCondition code=\"{cond}\"/><A/></Sequence>"
+        ));
+        assert_eq!(&lowered(&t, &sc, 1, BtTick::Once).unwrap(), want, "{cond}");
+    }
+    // An entry keeps the type it was created with.
+    for (init, want) in [
+        ("x := 1+1", ran(&[S], &[T(1003)])),
+        ("x := 2", ran(&[], &[])),
+        ("x := 2; x := 1+1", ran(&[], &[])),
+        ("x := 0+0; x := 2", ran(&[S], &[T(1003)])),
+    ] {
+        let t = v4(&format!(
+            "<Sequence><Script code=\"{init}\"/><ScriptCondition code=\"x\"/><A/></Sequence>"
+        ));
+        assert_eq!(lowered(&t, &sc, 1, BtTick::Once).unwrap(), want, "{init}");
+    }
+}
+
+#[test]
 fn scripts_read_the_text_setblackboard_wrote() {
     // Checked against the real library (BT.CPP 4.8.2): SetBlackboard stores `3` as text;
     // compared with a number it reads as 3 (`k == 3` holds, `k < 2` does not, so `y` is
@@ -607,6 +648,49 @@ fn random_trees_with_bb_nodes_lower_to_what_btcpp_does() {
             assert!(c >= n / 50, "only {c} of {n} trees with {k}");
         }
     }
+/// The same with doubles in the scripts (`gen::Options::reals`): `x` or `f` created
+/// from a double (BT.CPP keeps an entry's first type: a double is cast to bool as true
+/// unless 0, an integer must be 0 or 1), `/` (inf and NaN included), real literals,
+/// comparisons of doubles (within float epsilon; NaN on both sides of every ordering),
+/// arithmetic values cast to bool.
+#[test]
+fn random_trees_with_reals_lower_to_what_btcpp_does() {
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        reals: true,
+        ..Default::default()
+    };
+    random_trees(opts);
+    // The trees held the new constructs (the same seeds, generated again).
+    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0);
+    let (mut division, mut real_lit, mut double_init) = (0u64, 0u64, 0u64);
+    for seed in seed0..seed0 + n {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let c = gen::case_with_conds(
+            &mut rng,
+            4 + (seed % 12) as i64,
+            opts,
+            gen::Conditions::WithoutSkip,
+        );
+        division += u64::from(c.xml.contains(" / "));
+        real_lit += u64::from(
+            ["0.5", "2.5e-1", "1e1", "0.0", "1e308"]
+                .iter()
+                .any(|l| c.xml.contains(l)),
+        );
+        double_init += u64::from(
+            ["x:=0+0", "f:=1&gt;0", "x:=0*1", "f:=!false"]
+                .iter()
+                .any(|l| c.xml.contains(l)),
+        );
+    }
+    eprintln!(
+        "of the {n} trees: {division} divide, {real_lit} hold a real literal, {double_init} \
+         create `x` or `f` from a double"
+    );
+    assert!(division >= n / 10 && real_lit >= n / 10 && double_init >= n / 10);
 }
 
 /// The same with the SKIPPED status: `_skipIf` and `_while` on any node, RunOnce with
@@ -1163,6 +1247,13 @@ fn random_trees_with_scripts_lower_to_what_the_real_library_does() {
     real_library(true, false, false, false, 1_000, 800_000);
 }
 
+/// The same with doubles in the scripts (`gen::Options::reals`): entries created from a
+/// double, `/`, real literals, arithmetic values cast to bool.
+#[test]
+fn random_trees_with_reals_lower_to_what_the_real_library_does() {
+    real_library_with(true, false, false, false, true, 1_000, 1_100_000);
+}
+
 /// The same with UnsetBlackboard (`gen::Options::unset`) among the scripts.
 #[test]
 fn random_trees_with_unset_lower_to_what_the_real_library_does() {
@@ -1188,6 +1279,19 @@ fn random_trees_with_bb_nodes_lower_to_what_the_real_library_does() {
 /// SKIPPED-making constructs when `skipped`, the blackboard nodes when `bb`) run in the
 /// real library and lowered.
 fn real_library(scripts: bool, unset: bool, skipped: bool, bb: bool, default_n: u64, offset: u64) {
+    real_library_with(scripts, unset, skipped, bb, false, default_n, offset);
+}
+
+/// [`real_library`], with doubles in the scripts when `reals` (`gen::Options::reals`).
+fn real_library_with(
+    scripts: bool,
+    unset: bool,
+    skipped: bool,
+    bb: bool,
+    reals: bool,
+    default_n: u64,
+    offset: u64,
+) {
     let Some(mut lib) = harness() else { return };
     let n = env("HINDSIGHT_BT_REAL_LOWERING_TREES", default_n) as usize;
     let seed0 = env("HINDSIGHT_BT_SEED", 0) + offset;
@@ -1210,6 +1314,7 @@ fn real_library(scripts: bool, unset: bool, skipped: bool, bb: bool, default_n: 
                 unset,
                 skipped,
                 bb_nodes: bb,
+                reals,
                 ..Default::default()
             },
             if skipped {

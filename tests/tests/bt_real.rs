@@ -696,6 +696,96 @@ fn script_operators_agree_with_the_library() {
     }
 }
 
+/// Doubles in scripts against the real library: `ScriptCondition`s whose values are
+/// doubles or integers cast to bool, `/` with inf and NaN, real literals and float
+/// comparisons (each of them measured in 4.8.2 while writing the oracle's rules), then
+/// the format-4 random trees with `gen::Options::reals` of `HINDSIGHT_BT_REAL_REAL_TREES`
+/// seeds (default 10,000; a third are format 3 and left out), both tick modes: root statuses, leaf events, how a run ends
+/// (a throw included) and the script entries at the end must agree.
+#[test]
+fn doubles_in_scripts_agree_with_the_real_library() {
+    const CONDITIONS: [&str; 24] = [
+        "1+1",
+        "3",
+        "0-1",
+        "x:=2; x",
+        "x:=1+1; x",
+        "x:=2; x+0",
+        "1 ? 2 : 3",
+        "1 ? 2+0 : 3",
+        "5/5",
+        "1/2",
+        "0/2",
+        "0/0",
+        "-(0/0)",
+        "-(1/0)",
+        "-1/2",
+        "2.5",
+        "0.0",
+        "(1/2) && true",
+        "(0-1) && true",
+        "x:=2; x && true",
+        "(0/0) < 1 && (0/0) >= 1",
+        "1/3 == 0.3333333",
+        "x:=6; x/=2; x == 3",
+        "x:=5; x/=2; x == 2",
+    ];
+    let Some(mut real) = harness() else { return };
+    let mut cases: Vec<(String, String, Scripts, usize)> = CONDITIONS
+        .iter()
+        .map(|code| {
+            let xml = doc(&format!(
+                "<ScriptCondition code=\"{}\"/>",
+                code.replace('&', "&amp;")
+                    .replace('<', "&lt;")
+                    .replace('>', "&gt;")
+            ));
+            (format!("`{code}`"), xml, Scripts::new(), 1)
+        })
+        .collect();
+    let n = env("HINDSIGHT_BT_REAL_REAL_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0) + 5_000_000;
+    let start = std::time::Instant::now();
+    for seed in seed0..seed0 + n {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let opts = gen::Options {
+            btcpp4_nodes: true,
+            scripts: true,
+            reals: true,
+            ..Default::default()
+        };
+        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
+        if !c.xml.contains("BTCPP_format=\"3\"") {
+            cases.push((format!("reals seed {seed}"), c.xml, c.scripts, c.ticks));
+        }
+    }
+    let mut counts = Counts::default();
+    let fails = check_all(&mut real, &cases, &mut counts);
+    let with = |pat: &str| cases.iter().filter(|c| c.1.contains(pat)).count();
+    eprintln!(
+        "BehaviorTree.CPP {}: {} conditions and {} random trees with doubles in scripts \
+         ({} divide, {} create `x` from a double), each under tickOnce and tickExactlyOnce: \
+         {} runs ({} ran every tick, {} threw) in {:.1} s; {} disagreements",
+        real.version,
+        CONDITIONS.len(),
+        cases.len() - CONDITIONS.len(),
+        with(" / "),
+        with("x:=0+0") + with("x:=0*1"),
+        counts.runs,
+        counts.ran_all,
+        counts.errors,
+        start.elapsed().as_secs_f64(),
+        fails.len()
+    );
+    assert!(
+        fails.is_empty(),
+        "{} disagreements (first 5):\n{}",
+        fails.len(),
+        fails.iter().take(5).cloned().collect::<Vec<_>>().join("\n")
+    );
+    assert!(counts.errors > 0 && counts.ran_all > 0);
+}
+
 /// The executor period of [`timed_nodes_agree_with_the_real_library`], in the real
 /// library's wall-clock milliseconds; the oracle runs the same trees at its default
 /// 100 ms with every duration scaled by 100/60.

@@ -96,6 +96,13 @@ pub struct Options {
     /// default) half the time, and Precondition with `else="SKIPPED"` among its `else`
     /// statuses. Off, the generator draws what it drew before.
     pub skipped: bool,
+    /// Doubles in the scripts, with [`Options::scripts`]: the main tree creates `x` or
+    /// `f` from a double now and then (`x:=0+0`, `f:=1>0`: BT.CPP keeps the type an entry
+    /// was created with), and conditions use `/`, real literals, and arithmetic values
+    /// cast to bool (a double is true unless 0 and throws when negative; an integer
+    /// must be 0 or 1). Nothing stores a number that is not whole. Off, the generator
+    /// draws what it drew before.
+    pub reals: bool,
 }
 
 /// The script entries: `x`, `y` integers, `f` a boolean, all written first by the main
@@ -228,6 +235,9 @@ impl<R: Rng> G<'_, R> {
     /// throw (the real-library harness relies on it: `Tree::haltTree` runs every
     /// `_onHalted` script, and a throw from the tree's destructor aborts).
     fn bool_expr(&mut self, d: u32, risky: bool) -> String {
+        if self.opts.reals && self.below(4) == 0 {
+            return self.real_cond(risky);
+        }
         // Now and then, in a condition (`risky`), an entry a SetBlackboard wrote (`k0`,
         // `k1`, `p0`): BT.CPP 4 holds its text, which a comparison reads as a number.
         // Not in statements: a SubTree's own `p0` does not exist until the SubTree runs,
@@ -285,6 +295,52 @@ impl<R: Rng> G<'_, R> {
                 _ => "x".into(),
             },
             _ => self.bool_expr(0, risky),
+        }
+    }
+
+    /// A condition over doubles ([`Options::reals`]); `risky`: with one that throws
+    /// (a negative double or an integer other than 0 and 1 cast to bool).
+    fn real_cond(&mut self, risky: bool) -> String {
+        let lit = |g: &mut Self| g.pick(&["0.5", "1.5", "2.5e-1", "1e1", "0.0"]).to_string();
+        // Divisors are literals other than 0 (the lowering refuses others: the sign of a
+        // zero divisor shows in BT.CPP's doubles).
+        let div = |g: &mut Self| g.pick(&["2", "3", "-2", "0.5", "4"]).to_string();
+        let op = self.pick(&["==", "!=", "<", "<=", ">", ">="]);
+        match self.below(if risky { 8 } else { 5 }) {
+            0 => format!("{} / {} {op} {}", self.int_expr(0), div(self), lit(self)),
+            1 => format!(
+                "{} * {} {op} {}",
+                self.int_expr(0),
+                lit(self),
+                self.int_expr(0)
+            ),
+            2 => format!(
+                "({} / {}) {op} ({} / {})",
+                self.int_expr(1),
+                div(self),
+                self.int_expr(0),
+                div(self)
+            ),
+            3 => format!("({} / {} ? 1 : 0) == 1", self.int_expr(0), div(self)),
+            // inf, and NaN (`inf - inf`), on both sides of every ordering in BT.CPP.
+            4 => format!(
+                "{} * 1e308 * 10 {} 1e308 * 10 {op} {}",
+                self.pick(&["x", "y", "1"]),
+                self.pick(&["-", "+"]),
+                self.int_expr(0)
+            ),
+            // An arithmetic value, or an entry, cast to bool.
+            5 => format!(
+                "{} {} {}",
+                self.pick(&["x", "y"]),
+                self.pick(&["+", "-"]),
+                self.int_expr(0)
+            ),
+            6 => format!("{} / {}", self.pick(&["x", "y"]), div(self)),
+            _ => match self.below(3) {
+                0 => format!("({} - {}) && f", self.pick(&["x", "y"]), self.int_expr(0)),
+                _ => self.pick(&["x", "f", "y - 1"]).to_string(),
+            },
         }
     }
 
@@ -740,7 +796,15 @@ pub fn case_with_conds<R: Rng>(rng: &mut R, size: i64, opts: Options, conds: Con
     g.in_subtree = false;
     let body = g.node(0);
     let format = if g.v3 { 3 } else { 4 };
-    let init = if g.scripts_on() {
+    let init = if g.scripts_on() && g.opts.reals {
+        let init = g.pick(&[
+            SCRIPT_INIT,
+            "x:=0+0; y:=1; f:=true",
+            "x:=0; y:=1; f:=1>0",
+            "x:=0*1; y:=1; f:=!false",
+        ]);
+        format!("<Script code=\"{init}\"/>")
+    } else if g.scripts_on() {
         format!("<Script code=\"{SCRIPT_INIT}\"/>")
     } else {
         String::new()

@@ -297,6 +297,8 @@ pub struct Oracle<'t> {
     pub log: Vec<LeafEvent>,
     /// The entries scripts read and write (booleans as 0 and 1).
     pub vars: BTreeMap<String, i64>,
+    /// Those of them that hold a `double` (`script::Env`).
+    dbl: std::collections::BTreeSet<String>,
     /// Sequences and fallbacks: children skipped so far (`skipped_count_`).
     skipped: Vec<usize>,
     /// A script a halt ran threw: surfaced when the tick returns.
@@ -376,6 +378,7 @@ impl<'t> Oracle<'t> {
             node_ticks: 0,
             log: Vec::new(),
             vars: BTreeMap::new(),
+            dbl: Default::default(),
             skipped: vec![0; n],
             fault: None,
             memo: vec![false; n],
@@ -669,7 +672,11 @@ impl<'t> Oracle<'t> {
                 Expr::Assign(v, _, _) if !self.vars.contains_key(v) => Some(v.clone()),
                 _ => None,
             };
-            last = match Program(vec![s.clone()]).run(&mut self.vars, &texts) {
+            let mut env = super::script::Env {
+                vals: &mut self.vars,
+                dbl: &mut self.dbl,
+            };
+            last = match Program(vec![s.clone()]).run(&mut env, &texts) {
                 Ok(v) => v,
                 // `v := e` with `v` missing creates `v` without a value before reading
                 // `e`: an `e` that reads `v` throws, with the message of the operator

@@ -37,23 +37,33 @@
 //! compare as strings, `c ? a : b` reads it as a number, and the arithmetic and logic
 //! operators, `-`, `!` and a condition's cast to bool throw (4.8.2's answers).
 //!
-//! Division (`/` gives a double in BT.CPP), `%` (not in the language), string literals,
-//! reals and the bit operators are outside the subset: the parser refuses them.
+//! Values are `int64_t` or `double` as in BT.CPP ([`V::Num`], [`V::Dbl`]): every operator
+//! computes in doubles and gives one (4.10 `scripting/operators.hpp`), `/` included
+//! (`1/0` is inf, `0/0` NaN), with `==` within `f32::EPSILON` and each ordering the
+//! negation of its opposite ([`compare`]); an entry keeps the type of its first value
+//! ([`Env`]); a cast to bool ([`truth`]) takes an integer 0 or 1 and a double that is not
+//! negative. A double that is not whole stored in an entry is outside the oracle's
+//! subset (into an integer entry it throws, as BT.CPP does). `%` (not in the language),
+//! string literals and the bit operators are outside the subset: the parser refuses
+//! them.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// An expression of the subset.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Expr {
-    /// An integer literal, or `true` (1) / `false` (0).
+    /// An integer literal, or `true` (1) / `false` (0): an `int64_t` in BT.CPP.
     Num(i64),
+    /// A real literal (`2.5`, `1e3`): a `double` in BT.CPP; the bits of the `f64` (so
+    /// that expressions compare with `Eq`).
+    Real(u64),
     /// A blackboard entry.
     Var(String),
     /// `-e`.
     Neg(Box<Expr>),
     /// `!e`.
     Not(Box<Expr>),
-    /// `a + b`, `a - b`, `a * b`.
+    /// `a + b`, `a - b`, `a * b`, `a / b`.
     Arith(char, Box<Expr>, Box<Expr>),
     /// A comparison chain: operands and the operators between them.
     Cmp(Vec<Expr>, Vec<&'static str>),
@@ -61,7 +71,7 @@ pub enum Expr {
     Logic(bool, Box<Expr>, Box<Expr>),
     /// `c ? a : b`.
     Ite(Box<Expr>, Box<Expr>, Box<Expr>),
-    /// `name op e` with op one of `:=`, `=`, `+=`, `-=`, `*=`.
+    /// `name op e` with op one of `:=`, `=`, `+=`, `-=`, `*=`, `/=`.
     Assign(String, &'static str, Box<Expr>),
 }
 
@@ -79,17 +89,70 @@ pub enum Fault {
     Model(String),
 }
 
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq)]
 enum Tok {
     Num(i64),
+    Real(f64),
     Id(String),
     Op(&'static str),
 }
 
-const OPS: [&str; 21] = [
-    ":=", "+=", "-=", "*=", "==", "!=", "<=", ">=", "&&", "||", "=", "<", ">", "+", "-", "*", "!",
-    "(", ")", "?", ":",
+const OPS: [&str; 23] = [
+    ":=", "+=", "-=", "*=", "/=", "==", "!=", "<=", ">=", "&&", "||", "=", "<", ">", "+", "-", "*",
+    "/", "!", "(", ")", "?", ":",
 ];
+
+/// A number literal at `s` (BT.CPP 4's `Grammar::Real` and `Grammar::Integer` in
+/// `scripting/any_types.hpp`: digits, then `.digits` with an optional exponent, or an
+/// exponent, make a `double` read by `std::stod`; digits alone an `int64_t`; a `.` or a
+/// letter right after either is an error, so `1.` and `1.5e` are refused, as 4.8.2
+/// refuses them). Hexadecimal integers are outside the oracle's subset.
+fn number(src: &str, s: usize) -> Result<(Tok, usize), String> {
+    let b = src.as_bytes();
+    let digits = |mut i: usize| {
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        i
+    };
+    let mut i = digits(s);
+    let int_end = i;
+    if i + 1 < b.len() && b[i] == b'.' && b[i + 1].is_ascii_digit() {
+        i = digits(i + 1);
+    }
+    if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
+        let mut j = i + 1;
+        if j < b.len() && (b[j] == b'+' || b[j] == b'-') {
+            j += 1;
+        }
+        if j < b.len() && b[j].is_ascii_digit() {
+            i = digits(j);
+        }
+    }
+    if i < b.len() && (b[i] == b'.' || b[i].is_ascii_alphabetic() || b[i] == b'_') {
+        return Err(format!(
+            "column {}: invalid suffix on a number literal",
+            s + 1
+        ));
+    }
+    if i == int_end {
+        let v = src[s..i]
+            .parse()
+            .map_err(|_| format!("column {}: number too large", s + 1))?;
+        return Ok((Tok::Num(v), i));
+    }
+    // `std::stod` throws `out_of_range` where the value overflows or underflows (4.8.2:
+    // `1e400` and `1e-400` fail at load).
+    let v: f64 = src[s..i].parse().expect("a real literal");
+    let zero = src[s..i]
+        .split(['e', 'E'])
+        .next()
+        .is_some_and(|m| m.bytes().all(|c| c == b'0' || c == b'.'));
+    if !v.is_finite() || (!v.is_normal() && !zero) {
+        return Err(format!("column {}: number out of range", s + 1));
+    }
+    Ok((Tok::Real(v), i))
+}
 
 fn lex(src: &str) -> Result<Vec<(Tok, usize)>, String> {
     let b = src.as_bytes();
@@ -104,16 +167,9 @@ fn lex(src: &str) -> Result<Vec<(Tok, usize)>, String> {
             i += 1;
         } else if c.is_ascii_digit() {
             let s = i;
-            while i < b.len() && b[i].is_ascii_digit() {
-                i += 1;
-            }
-            if i < b.len() && (b[i] == b'.' || b[i].is_ascii_alphabetic()) {
-                return Err(format!("column {}: only integer literals", s + 1));
-            }
-            let v = src[s..i]
-                .parse()
-                .map_err(|_| format!("column {}: number too large", s + 1))?;
-            out.push((Tok::Num(v), s));
+            let (t, end) = number(src, s)?;
+            i = end;
+            out.push((t, s));
         } else if c.is_ascii_alphabetic() || c == b'_' {
             let s = i;
             while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
@@ -179,7 +235,7 @@ impl P {
         if let (Some(Tok::Id(name)), Some((Tok::Op(op), _))) =
             (self.peek().cloned(), self.toks.get(self.at + 1))
         {
-            if matches!(*op, ":=" | "=" | "+=" | "-=" | "*=") {
+            if matches!(*op, ":=" | "=" | "+=" | "-=" | "*=" | "/=") {
                 let op = *op;
                 self.at += 2;
                 let e = self.expr()?;
@@ -262,15 +318,20 @@ impl P {
         Ok(Expr::Arith(op, Box::new(a), Box::new(b)))
     }
 
-    /// `*`, grouped to the right as `+` and `-` are.
+    /// `*` and `/`, grouped to the right as `+` and `-` are (4.8.2: `12 / 2 / 3` is 18,
+    /// `7 / 2 * 2` is 1.75).
     fn mul(&mut self) -> Result<Expr, String> {
         let a = self.unary()?;
-        if !self.eat("*") {
+        let op = if self.eat("*") {
+            '*'
+        } else if self.eat("/") {
+            '/'
+        } else {
             return Ok(a);
-        }
+        };
         self.group(false)?;
         let b = self.mul()?;
-        Ok(Expr::Arith('*', Box::new(a), Box::new(b)))
+        Ok(Expr::Arith(op, Box::new(a), Box::new(b)))
     }
 
     fn unary(&mut self) -> Result<Expr, String> {
@@ -286,6 +347,10 @@ impl P {
             Some(Tok::Num(v)) => {
                 self.at += 1;
                 Ok(Expr::Num(v))
+            }
+            Some(Tok::Real(v)) => {
+                self.at += 1;
+                Ok(Expr::Real(v.to_bits()))
             }
             Some(Tok::Id(id)) => {
                 self.at += 1;
@@ -336,7 +401,7 @@ impl Expr {
     /// Renames every entry (a SubTree's remapping).
     pub fn rename(&mut self, f: &dyn Fn(&str) -> String) {
         match self {
-            Expr::Num(_) => {}
+            Expr::Num(_) | Expr::Real(_) => {}
             Expr::Var(v) => *v = f(v),
             Expr::Neg(a) | Expr::Not(a) => a.rename(f),
             Expr::Arith(_, a, b) | Expr::Logic(_, a, b) => {
@@ -356,11 +421,11 @@ impl Expr {
         }
     }
 
-    fn eval(&self, env: &mut BTreeMap<String, i64>, texts: &Texts) -> Result<V, Fault> {
-        let over = || Fault::Model("integer overflow in a script".into());
-        let num = |v: V| -> Result<i64, Fault> {
+    fn eval(&self, env: &mut Env<'_>, texts: &Texts) -> Result<V, Fault> {
+        let num = |v: V| -> Result<f64, Fault> {
             match v {
-                V::Num(n) => Ok(n),
+                V::Num(n) => exact(n),
+                V::Dbl(x) => Ok(x),
                 V::Empty => Err(empty()),
                 // An arithmetic or logic operator over a string: BT.CPP 4.8.2 throws
                 // "Operation not permitted" (`+` of two strings concatenates: not in
@@ -368,10 +433,16 @@ impl Expr {
                 V::Text(_) => Err(Fault::Throws("Operation not permitted".into())),
             }
         };
-        Ok(V::Num(match self {
-            Expr::Num(v) => *v,
-            Expr::Var(v) => match (env.get(v), texts.get(v)) {
-                (Some(x), None) => *x,
+        // Every operator computes in `double` and gives a `double` (BT.CPP 4.10
+        // `scripting/operators.hpp`: `ExprUnaryArithmetic::evaluate`,
+        // `ExprBinaryArithmetic::evaluate` and `ExprComparison::evaluate` return
+        // `Any(double)`); a literal integer and an `int64_t` entry stay integers.
+        Ok(V::Dbl(match self {
+            Expr::Num(v) => return Ok(V::Num(*v)),
+            Expr::Real(bits) => f64::from_bits(*bits),
+            Expr::Var(v) => match (env.vals.get(v), texts.get(v)) {
+                (Some(x), None) if env.dbl.contains(v) => *x as f64,
+                (Some(x), None) => return Ok(V::Num(*x)),
                 (None, Some(Some(t))) => return Ok(V::Text(t.clone())),
                 (None, Some(None)) => return Ok(V::Empty),
                 (None, None) => return Err(Fault::Throws(format!("Variable not found: {v}"))),
@@ -383,7 +454,8 @@ impl Expr {
             },
             Expr::Neg(a) | Expr::Not(a) => {
                 let x = match a.eval(env, texts)? {
-                    V::Num(x) => x,
+                    V::Num(x) => exact(x)?,
+                    V::Dbl(x) => x,
                     // 4.8.2: "Invalid operator for std::string".
                     V::Text(_) => {
                         return Err(Fault::Throws("Invalid operator for std::string".into()))
@@ -391,9 +463,10 @@ impl Expr {
                     V::Empty => return Err(empty()),
                 };
                 if matches!(self, Expr::Neg(_)) {
-                    x.checked_neg().ok_or_else(over)?
+                    -x
                 } else {
-                    i64::from(x == 0)
+                    // `!static_cast<bool>(x)`: NaN is true, so `!(0/0)` is 0.
+                    f64::from(x == 0.0)
                 }
             }
             Expr::Arith(op, a, b) => {
@@ -402,12 +475,19 @@ impl Expr {
                     return Err(Fault::Model("an operator over two strings".into()));
                 }
                 let (a, b) = (num(a)?, num(b)?);
-                match op {
-                    '+' => a.checked_add(b),
-                    '-' => a.checked_sub(b),
-                    _ => a.checked_mul(b),
+                let r = match op {
+                    '+' => a + b,
+                    '-' => a - b,
+                    '*' => a * b,
+                    // IEEE division: `1/0` is inf, `0/0` NaN, no exception (4.8.2).
+                    _ => a / b,
+                };
+                // Whole operands with a result past 2^53: the lowering's integers would
+                // differ from doubles (not in the subset).
+                if a.abs() <= LIMIT && b.abs() <= LIMIT && r.is_finite() && r.fract() == 0.0 && r.abs() > LIMIT {
+                    return Err(Fault::Model("a whole number beyond 2^53 in a script".into()));
                 }
-                .ok_or_else(over)?
+                r
             }
             Expr::Cmp(xs, ops) => {
                 // Each operand once, left to right; the chain holds where every pair does.
@@ -420,49 +500,68 @@ impl Expr {
                 }
                 let mut all = true;
                 for (i, op) in ops.iter().enumerate() {
-                    let ord = match (&vals[i], &vals[i + 1]) {
-                        (V::Num(a), V::Num(b)) => a.cmp(b),
+                    let as_num = |v: &V| -> Result<Option<f64>, Fault> {
+                        Ok(match v {
+                            V::Num(n) => Some(exact(*n)?),
+                            V::Dbl(x) => Some(*x),
+                            V::Text(_) | V::Empty => None,
+                        })
+                    };
+                    all &= match (&vals[i], &vals[i + 1]) {
                         // Two strings compare as strings (4.8.2: `'abc' < 'abd'`; a
                         // SetBlackboard's `3` and `03` differ).
-                        (V::Text(a), V::Text(b)) => a.cmp(b),
+                        (V::Text(a), V::Text(b)) => {
+                            let ord = a.cmp(b);
+                            match *op {
+                                "==" => ord.is_eq(),
+                                "!=" => ord.is_ne(),
+                                "<" => ord.is_lt(),
+                                "<=" => ord.is_le(),
+                                ">" => ord.is_gt(),
+                                _ => ord.is_ge(),
+                            }
+                        }
                         // A string and a number: the string read as a number (4.8.2:
                         // the text `3` equals 3, ` 3` and `03` too; `abc` throws).
-                        (V::Text(t), V::Num(b)) => text_number(t)?.cmp(b),
-                        (V::Num(a), V::Text(t)) => a.cmp(&text_number(t)?),
-                        (V::Empty, _) | (_, V::Empty) => unreachable!("refused above"),
-                    };
-                    all &= match *op {
-                        "==" => ord.is_eq(),
-                        "!=" => ord.is_ne(),
-                        "<" => ord.is_lt(),
-                        "<=" => ord.is_le(),
-                        ">" => ord.is_gt(),
-                        _ => ord.is_ge(),
+                        (l, r) => {
+                            let l = match as_num(l)? {
+                                Some(x) => x,
+                                None => text_number(text_of(l))? as f64,
+                            };
+                            let r = match as_num(r)? {
+                                Some(x) => x,
+                                None => text_number(text_of(r))? as f64,
+                            };
+                            compare(op, l, r)
+                        }
                     };
                 }
-                i64::from(all)
+                f64::from(all)
             }
             Expr::Logic(and, a, b) => {
-                let (a, b) = (num(a.eval(env, texts)?)?, num(b.eval(env, texts)?)?);
-                if !(0..=1).contains(&a) || !(0..=1).contains(&b) {
-                    return Err(Fault::Throws(
-                        "Logic operators are not allowed if one of the operands is not castable to bool".into(),
-                    ));
-                }
-                if *and {
-                    a & b
-                } else {
-                    a | b
-                }
+                let (a, b) = (a.eval(env, texts)?, b.eval(env, texts)?);
+                let cast = |v: V| -> Result<bool, Fault> {
+                    match v {
+                        V::Text(_) | V::Empty => num(v).map(|_| false),
+                        v => truth(&v).map_err(|_| {
+                            Fault::Throws(
+                                "Logic operators are not allowed if one of the operands is not castable to bool".into(),
+                            )
+                        }),
+                    }
+                };
+                let (a, b) = (cast(a)?, cast(b)?);
+                f64::from(if *and { a && b } else { a || b })
             }
             // The condition of `c ? a : b` is true for any number but 0 (BT.CPP 4's
             // `ExprIf::evaluate` compares it with 0; unlike a node's condition it is not
-            // cast to bool): `2 ? 5 : 7` and `-1 ? 5 : 7` give 5 in 4.8.2; a string is
-            // read as a number (the text `0` is false).
+            // cast to bool): `2 ? 5 : 7` and `-1 ? 5 : 7` give 5 in 4.8.2, and so does
+            // `(0/0) ? 5 : 7`; a string is read as a number (the text `0` is false).
             Expr::Ite(c, a, b) => {
                 let c = match c.eval(env, texts)? {
-                    V::Num(c) => c,
-                    V::Text(t) => text_number(&t)?,
+                    V::Num(c) => c != 0,
+                    V::Dbl(c) => c != 0.0,
+                    V::Text(t) => text_number(&t)? != 0,
                     // 4.8.2's message here.
                     V::Empty => {
                         return Err(Fault::Throws(
@@ -470,43 +569,145 @@ impl Expr {
                         ))
                     }
                 };
-                return if c != 0 {
+                return if c {
                     a.eval(env, texts)
                 } else {
                     b.eval(env, texts)
                 };
             }
-            Expr::Assign(v, op, e) => {
-                if texts.contains_key(v) {
-                    return Err(Fault::Model(format!(
-                        "a script writes `{v}`, which a SetBlackboard writes: not modelled"
-                    )));
-                }
-                let x = match e.eval(env, texts)? {
-                    V::Num(x) => x,
-                    V::Text(_) | V::Empty => {
-                        return Err(Fault::Model(format!(
-                            "a script copies a string into `{v}`: not modelled"
-                        )))
-                    }
-                };
-                let old = env.get(v).copied();
-                let new = match (*op, old) {
-                    (":=", _) => x,
-                    (_, None) => {
-                        return Err(Fault::Throws(format!(
-                            "The blackboard entry [{v}] doesn't exist"
-                        )))
-                    }
-                    ("=", Some(_)) => x,
-                    ("+=", Some(o)) => o.checked_add(x).ok_or_else(over)?,
-                    ("-=", Some(o)) => o.checked_sub(x).ok_or_else(over)?,
-                    (_, Some(o)) => o.checked_mul(x).ok_or_else(over)?,
-                };
-                env.insert(v.clone(), new);
-                new
-            }
+            Expr::Assign(v, op, e) => return assign(v, op, e, env, texts),
         }))
+    }
+}
+
+/// 2^53: up to it every whole number is exact in a `double`.
+const LIMIT: f64 = 9_007_199_254_740_992.0;
+
+/// An integer read as a `double` (`Any::cast<double>`, which 4.8.2 refuses past 2^53:
+/// "Loss of precision"; outside the oracle's subset).
+fn exact(n: i64) -> Result<f64, Fault> {
+    if n.unsigned_abs() > 1 << 53 {
+        return Err(Fault::Model("an integer beyond 2^53 in arithmetic".into()));
+    }
+    Ok(n as f64)
+}
+
+fn text_of(v: &V) -> &str {
+    match v {
+        V::Text(t) => t,
+        _ => "",
+    }
+}
+
+/// A comparison of two numbers as BT.CPP 4.10 makes it (`scripting/operators.hpp`,
+/// `ExprComparison::evaluate` and `IsSame`): `==` within single precision's epsilon, and
+/// each ordering as the negation of its opposite, so that NaN is `<`, `>`, `<=` and `>=`
+/// anything (4.8.2: `(0/0) < 1` and `(0/0) >= 1` are both true).
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // the negations are BT.CPP's rule for NaN
+pub fn compare(op: &str, l: f64, r: f64) -> bool {
+    let same = (l - r).abs() <= f64::from(f32::EPSILON);
+    match op {
+        "==" => same,
+        "!=" => !same,
+        "<" => !(l >= r),
+        "<=" => !(l > r),
+        ">" => !(l <= r),
+        _ => !(l < r),
+    }
+}
+
+/// The entries scripts write: the values (booleans as 0 and 1) and which of them hold a
+/// `double` (an entry a script created from a `double`, `x := 1 + 1`, keeps that type:
+/// BT.CPP 4.10 `ExprAssignment::evaluate` stores the first value as it is and converts
+/// the later ones to its type with `Any::copyInto`).
+pub struct Env<'a> {
+    /// The values.
+    pub vals: &'a mut BTreeMap<String, i64>,
+    /// The entries holding a `double`.
+    pub dbl: &'a mut BTreeSet<String>,
+}
+
+/// `v op e`, as BT.CPP 4.10 `ExprAssignment::evaluate` makes it.
+fn assign(v: &str, op: &str, e: &Expr, env: &mut Env<'_>, texts: &Texts) -> Result<V, Fault> {
+    if texts.contains_key(v) {
+        return Err(Fault::Model(format!(
+            "a script writes `{v}`, which a SetBlackboard writes: not modelled"
+        )));
+    }
+    let x = match e.eval(env, texts)? {
+        V::Text(_) | V::Empty => {
+            return Err(Fault::Model(format!(
+                "a script copies a string into `{v}`: not modelled"
+            )))
+        }
+        x => x,
+    };
+    let old = env.vals.get(v).copied();
+    // The value to store, and whether it is a `double`.
+    let (new, dbl) = match (op, old) {
+        // The first value goes in as it is.
+        (":=", None) => match x {
+            V::Num(n) => (V::Num(n), false),
+            x => (x, true),
+        },
+        (_, None) => {
+            return Err(Fault::Throws(format!(
+                "The blackboard entry [{v}] doesn't exist"
+            )))
+        }
+        (":=" | "=", Some(_)) => (x, env.dbl.contains(v)),
+        (_, Some(o)) => {
+            let o = if env.dbl.contains(v) {
+                o as f64
+            } else {
+                exact(o)?
+            };
+            let r = match x {
+                V::Num(n) => exact(n)?,
+                V::Dbl(r) => r,
+                _ => unreachable!("refused above"),
+            };
+            let t = match op {
+                "+=" => o + r,
+                "-=" => o - r,
+                "*=" => o * r,
+                _ => o / r,
+            };
+            (V::Dbl(t), env.dbl.contains(v))
+        }
+    };
+    // `Any::copyInto` an `int64_t` entry: a `double` with a fraction, NaN or infinite
+    // throws (4.8.2: "Invalid floating point to integer conversion" for `x:=5; x/=2`).
+    let stored = match new {
+        V::Num(n) => n,
+        V::Dbl(r) if r.is_finite() && r.fract() == 0.0 && r.abs() <= LIMIT => r as i64,
+        V::Dbl(_) if dbl => {
+            return Err(Fault::Model(format!(
+                "a script stores a number other than a whole one in `{v}`: not modelled"
+            )))
+        }
+        V::Dbl(r) if r.is_finite() && r.fract() == 0.0 => {
+            return Err(Fault::Model(format!(
+                "a whole number beyond 2^53 stored in `{v}`"
+            )))
+        }
+        V::Dbl(_) => {
+            return Err(Fault::Throws(
+                "Invalid floating point to integer conversion".into(),
+            ))
+        }
+        _ => unreachable!("refused above"),
+    };
+    // A negative zero in a `double` entry reads back as 0: its sign shows only when
+    // dividing by it, and the lowering divides by number literals only (the generator
+    // writes no other divisor).
+    env.vals.insert(v.to_string(), stored);
+    if dbl {
+        env.dbl.insert(v.to_string());
+        Ok(V::Dbl(stored as f64))
+    } else {
+        env.dbl.remove(v);
+        Ok(V::Num(stored))
     }
 }
 
@@ -519,12 +720,14 @@ fn empty() -> Fault {
     Fault::Throws("is not initialized".into())
 }
 
-/// A script value: a number (booleans as 0 and 1), or the text of an entry a
-/// SetBlackboard wrote (BT.CPP 4 stores SetBlackboard's value as a string).
-#[derive(Clone, Debug, PartialEq, Eq)]
+/// A script value: an integer (booleans as 0 and 1), a `double`, or the text of an
+/// entry a SetBlackboard wrote (BT.CPP 4 stores SetBlackboard's value as a string).
+#[derive(Clone, Debug, PartialEq)]
 pub enum V {
-    /// A number.
+    /// An `int64_t`: a literal, or an entry that holds one.
     Num(i64),
+    /// A `double`: what every operator gives, a real literal, an entry that holds one.
+    Dbl(f64),
     /// A string.
     Text(String),
     /// An entry that exists but holds no value: one a SetBlackboard `value` port names
@@ -552,10 +755,18 @@ fn text_number(t: &str) -> Result<i64, Fault> {
     ))
 }
 
-/// `Any::cast<bool>` of a script's value: 0 and 1 only; a string throws (4.8.2: "no
-/// known safe conversion between [std::string] and [bool]").
+/// `Any::cast<bool>` of a script's value: an integer 0 or 1 only; a `double` is true
+/// unless 0, and throws when negative (4.8.2: `ScriptCondition code="1+1"` and `"1/2"`
+/// succeed, `"2"` throws "Implicit casting to bool is not allowed", `"0-1"` and
+/// `"-1/2"` "Value is negative and can't be converted to unsigned", `"0/0"` succeeds);
+/// a string throws (4.8.2: "no known safe conversion between [std::string] and
+/// [bool]").
 pub fn truth(v: &V) -> Result<bool, Fault> {
     match v {
+        V::Dbl(x) if *x < 0.0 => Err(Fault::Throws(
+            "Value is negative and can't be converted to unsigned".into(),
+        )),
+        V::Dbl(x) => Ok(*x != 0.0),
         V::Num(0) => Ok(false),
         V::Num(1) => Ok(true),
         // 4.8.2's message for a negative number (`Any::convert` through an unsigned).
@@ -580,7 +791,7 @@ impl Program {
 
     /// Runs the statements in order over the entries scripts write (`env`) and the
     /// texts SetBlackboard wrote; the last one's value.
-    pub fn run(&self, env: &mut BTreeMap<String, i64>, texts: &Texts) -> Result<V, Fault> {
+    pub fn run(&self, env: &mut Env<'_>, texts: &Texts) -> Result<V, Fault> {
         let mut last = V::Num(0);
         for s in &self.0 {
             last = s.eval(env, texts)?;
@@ -589,7 +800,7 @@ impl Program {
     }
 
     /// Runs it as a condition (`cast<bool>` of its value).
-    pub fn holds(&self, env: &mut BTreeMap<String, i64>, texts: &Texts) -> Result<bool, Fault> {
+    pub fn holds(&self, env: &mut Env<'_>, texts: &Texts) -> Result<bool, Fault> {
         truth(&self.run(env, texts)?)
     }
 }
@@ -599,10 +810,149 @@ mod tests {
     use super::*;
 
     fn run(src: &str) -> Result<(i64, BTreeMap<String, i64>), Fault> {
-        let mut env = BTreeMap::new();
+        let (mut vals, mut dbl) = (BTreeMap::new(), BTreeSet::new());
+        let mut env = Env {
+            vals: &mut vals,
+            dbl: &mut dbl,
+        };
         match parse(src).expect("parses").run(&mut env, &Texts::new())? {
-            V::Num(v) => Ok((v, env)),
-            v => panic!("not a number: {v:?}"),
+            V::Num(v) => Ok((v, vals)),
+            V::Dbl(v) if v.fract() == 0.0 => Ok((v as i64, vals)),
+            v => panic!("not a whole number: {v:?}"),
+        }
+    }
+
+    /// A script's value and `Any::cast<bool>` of it, as a `ScriptCondition` reads it.
+    fn cond(src: &str) -> Result<bool, Fault> {
+        let (mut vals, mut dbl) = (BTreeMap::new(), BTreeSet::new());
+        let mut env = Env {
+            vals: &mut vals,
+            dbl: &mut dbl,
+        };
+        parse(src).expect("parses").holds(&mut env, &Texts::new())
+    }
+
+    fn value(src: &str) -> Result<V, Fault> {
+        let (mut vals, mut dbl) = (BTreeMap::new(), BTreeSet::new());
+        let mut env = Env {
+            vals: &mut vals,
+            dbl: &mut dbl,
+        };
+        parse(src).expect("parses").run(&mut env, &Texts::new())
+    }
+
+    #[test]
+    fn doubles_and_integers_as_the_real_library_casts_them() {
+        // Each answer below is what BT.CPP 4.8.2 gave for the same `ScriptCondition`
+        // or `Script` (measured through `behaviortreepy`).
+        let throws = |r: Result<bool, Fault>, what: &str| {
+            assert!(
+                matches!(&r, Err(Fault::Throws(t)) if t.contains(what)),
+                "{r:?}"
+            )
+        };
+        // An integer literal or an entry holding one: 0 or 1 only.
+        throws(cond("3"), "Implicit casting");
+        throws(cond("x:=2; x"), "Implicit casting");
+        throws(cond("1 ? 2 : 3"), "Implicit casting");
+        // Every operator gives a double: true unless 0, negative throws.
+        assert_eq!(cond("1+1"), Ok(true));
+        assert_eq!(cond("3*1"), Ok(true));
+        assert_eq!(cond("x:=1+1; x"), Ok(true));
+        assert_eq!(cond("x:=2; x+0"), Ok(true));
+        assert_eq!(cond("1 ? 2+0 : 3"), Ok(true));
+        assert_eq!(cond("(1 < 2) + 1"), Ok(true));
+        throws(cond("0-1"), "negative");
+        throws(cond("-3+1"), "negative");
+        assert_eq!(cond("5/5"), Ok(true));
+        assert_eq!(cond("1/2"), Ok(true));
+        assert_eq!(cond("0/2"), Ok(false));
+        assert_eq!(cond("0/0"), Ok(true));
+        assert_eq!(cond("1/0"), Ok(true));
+        assert_eq!(cond("2.5"), Ok(true));
+        assert_eq!(cond("0.0"), Ok(false));
+        throws(cond("-1/2"), "negative");
+        throws(cond("-(1/0)"), "negative");
+        assert_eq!(cond("-(0/0)"), Ok(true));
+        // `&&` / `||` cast the same way.
+        assert_eq!(run("a := (1+1) && true").unwrap().0, 1);
+        assert_eq!(run("x := 1+1; a := x && true").unwrap().0, 1);
+        assert_eq!(run("a := (1/2) && true").unwrap().0, 1);
+        assert_eq!(run("a := (0/0) || false").unwrap().0, 1);
+        assert_eq!(run("a := 0.0 || 0.0").unwrap().0, 0);
+        for s in [
+            "a := 2 && true",
+            "x := 2; a := x && true",
+            "a := (0-1) && true",
+        ] {
+            assert!(
+                matches!(run(s), Err(Fault::Throws(t)) if t.contains("Logic operators")),
+                "{s}"
+            );
+        }
+        // Comparisons of doubles: `==` within float epsilon, NaN on either side of
+        // every ordering.
+        for (s, v) in [
+            ("a := (0/0) < 1", 1),
+            ("a := (0/0) > 1", 1),
+            ("a := (0/0) <= 1", 1),
+            ("a := (0/0) >= 1", 1),
+            ("a := (0/0) == 1", 0),
+            ("a := (0/0) != 1", 1),
+            ("a := (0/0) == (0/0)", 0),
+            ("a := (1/0) == (1/0)", 0),
+            ("a := (1/0) > 1e308", 1),
+            ("a := 1/3 == 0.3333333", 1),
+            ("a := 1/3 == 0.333333", 0),
+            ("a := 2.5e-1 == 0.25", 1),
+            ("a := 1E3 == 1000", 1),
+            ("a := 1e+2 == 100", 1),
+            ("a := 00.5 == 0.5", 1),
+            ("a := 3 > 2.5 > 2", 1),
+            ("a := !2.5", 0),
+            ("a := !(0/0)", 0),
+            ("a := -(1/2) < 0", 1),
+            ("a := (0/0) ? 5 : 7", 5),
+            ("a := (1/2) ? 5 : 7", 5),
+            ("a := 12 / 2 / 3", 18),
+            ("x := 1; a := x / 0 < 0", 0),
+        ] {
+            assert_eq!(run(s).map(|r| r.0), Ok(v), "{s}");
+        }
+        assert_eq!(
+            value("a := 7 / 2 * 2"),
+            Err(Fault::Model(
+                "a script stores a number other than a whole one in `a`: not modelled".into()
+            ))
+        );
+        assert_eq!(value("7 / 2 * 2"), Ok(V::Dbl(1.75)));
+        assert_eq!(value("1 - 1 / 2"), Ok(V::Dbl(0.5)));
+        // Stored into an integer entry, a double must be whole.
+        assert_eq!(run("x := 6; x /= 2").unwrap().1["x"], 3);
+        assert_eq!(run("x := 6; x := 6 / 2").unwrap().0, 3);
+        for s in [
+            "x := 5; x /= 2",
+            "x := 1; x += 0.5",
+            "x := 1; x := 1.5",
+            "x := 1; x := 0/0",
+        ] {
+            assert!(
+                matches!(run(s), Err(Fault::Throws(t)) if t.contains("Invalid floating point")),
+                "{s}"
+            );
+        }
+        // ... and it stays an integer entry; one a double created stays a double one.
+        throws(cond("x := 2; x := 2 / 1; x"), "Implicit casting");
+        assert_eq!(cond("x := 1 + 1; x := 2; x"), Ok(true));
+        // Literals BT.CPP refuses at load.
+        for s in [
+            "a := 1.",
+            "a := 1.5e",
+            "a := 1.5.2",
+            "a := 1e400",
+            "a := 1e-400",
+        ] {
+            assert!(parse(s).is_err(), "{s}");
         }
     }
 
@@ -632,8 +982,12 @@ mod tests {
         assert!(matches!(run("a:=3 && 1"), Err(Fault::Throws(t)) if t.contains("Logic operators")));
         assert!(matches!(run("a:=x"), Err(Fault::Throws(t)) if t.contains("Variable not found")));
         assert!(matches!(run("b=2"), Err(Fault::Throws(t)) if t.contains("doesn't exist")));
-        let mut env = BTreeMap::new();
         let none = Texts::new();
+        let (mut vals, mut dbl) = (BTreeMap::new(), BTreeSet::new());
+        let mut env = Env {
+            vals: &mut vals,
+            dbl: &mut dbl,
+        };
         assert!(parse("3").unwrap().holds(&mut env, &none).is_err());
         assert!(parse("5-5").unwrap().holds(&mut env, &none) == Ok(false));
     }
@@ -648,7 +1002,11 @@ mod tests {
         // An entry a SetBlackboard `value="{e}"` names: created empty at load.
         texts.insert("e".into(), None);
         let go = |src: &str| {
-            let mut env = BTreeMap::new();
+            let (mut vals, mut dbl) = (BTreeMap::new(), BTreeSet::new());
+            let mut env = Env {
+                vals: &mut vals,
+                dbl: &mut dbl,
+            };
             parse(src).expect("parses").run(&mut env, &texts)
         };
         let throws = |src: &str, what: &str| {
@@ -658,20 +1016,24 @@ mod tests {
                 go(src)
             )
         };
-        assert_eq!(go("y := k == 3"), Ok(V::Num(1)));
-        assert_eq!(go("y := 1 < k < 5"), Ok(V::Num(1)));
-        assert_eq!(go("y := k == 1 + 2"), Ok(V::Num(1)));
-        assert_eq!(go("y := k == true"), Ok(V::Num(0)));
+        assert_eq!(go("y := k == 3"), Ok(V::Dbl(1.0)));
+        assert_eq!(go("y := 1 < k < 5"), Ok(V::Dbl(1.0)));
+        assert_eq!(go("y := k == 1 + 2"), Ok(V::Dbl(1.0)));
+        assert_eq!(go("y := k == true"), Ok(V::Dbl(0.0)));
         assert_eq!(go("y := k ? 1 : 2"), Ok(V::Num(1)));
-        assert_eq!(go("y := z == 3"), Ok(V::Num(1)));
-        assert_eq!(go("y := k == z"), Ok(V::Num(0)));
+        assert_eq!(go("y := z == 3"), Ok(V::Dbl(1.0)));
+        assert_eq!(go("y := k == z"), Ok(V::Dbl(0.0)));
         throws("y := k + 1", "Operation not permitted");
         throws("y := -k", "Invalid operator");
         throws("y := s == 3", "string to number");
         throws("y := e == 1", "not initialized");
         throws("y := e + 1", "not initialized");
         throws("y := e ? 1 : 2", "Any::cast failed because it is empty");
-        let mut env = BTreeMap::new();
+        let (mut vals, mut dbl) = (BTreeMap::new(), BTreeSet::new());
+        let mut env = Env {
+            vals: &mut vals,
+            dbl: &mut dbl,
+        };
         assert!(matches!(
             parse("k").unwrap().holds(&mut env, &texts),
             Err(Fault::Throws(t)) if t.contains("safe conversion")
@@ -686,7 +1048,7 @@ mod tests {
         );
         assert_eq!(parse("a:=1 a:=2").unwrap_err(), "column 6: expected ';'");
         assert_eq!(parse("1 + ").unwrap_err(), "column 5: expected operand");
-        assert!(parse("a:=5/2").unwrap_err().starts_with("column 5"));
+        assert!(parse("a:=5%2").unwrap_err().starts_with("column 5"));
         // Where BT.CPP 4.8.2 put its caret.
         let mixed = "operator cannot be mixed with previous operators";
         assert_eq!(

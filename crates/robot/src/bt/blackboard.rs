@@ -99,7 +99,7 @@ impl Blackboard {
         let flags: Vec<String> = self
             .script_entries
             .iter()
-            .map(|e| super::btcpp4_script::has(e))
+            .flat_map(|e| [super::btcpp4_script::has(e), super::btcpp4_script::dbl(e)])
             .collect();
         let mut vars: Vec<(&str, &str, String)> = self
             .entries

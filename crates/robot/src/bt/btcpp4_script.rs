@@ -1,6 +1,6 @@
 //! BehaviorTree.CPP 4's script language lowered under [`super::BtSemantics::Btcpp`]:
 //! the `Script`, `ScriptCondition` and `Precondition` nodes over integer and boolean
-//! blackboard entries.
+//! blackboard entries, with doubles (`/`, real literals) where they are not stored.
 //!
 //! # Where a script runs
 //! In the blackboard machine (`blackboard.rs`), which holds every entry: the node sends
@@ -14,13 +14,26 @@
 //!   2; `x:=true; x=3` gives 3), so an entry only scripts write is an `int64` holding
 //!   booleans as 0 and 1. An entry a plugin port types keeps that type (any integer
 //!   type, or `bool`: only a boolean value is assigned to it).
-//! - `!e` is `e == 0`; `-`, `+`, `*` are integer arithmetic (BT.CPP computes in doubles:
-//!   the same values up to 2^53); comparisons chain (`a < b < c` is `a < b && b < c`).
-//! - `&&` / `||` take operands 0 or 1 only, else BT.CPP throws ("Logic operators are not
-//!   allowed if one of the operands is not castable to bool"); `c ? a : b` takes any
-//!   number, non-zero being true.
-//! - A condition (`ScriptCondition`, Precondition's `if`) is `Any::cast<bool>` of the
-//!   last statement's value: 0 or 1, anything else throws.
+//! - `!e` is `e == 0`; `-`, `+`, `*` over whole numbers are integer arithmetic (BT.CPP
+//!   computes in doubles: the same values up to 2^53); comparisons chain (`a < b < c` is
+//!   `a < b && b < c`).
+//! - Every operator gives a `double`; a literal integer, `true`, `false` and an entry
+//!   holding an integer are `int64_t` (4.10 `scripting/operators.hpp`, the `evaluate`
+//!   functions; `scripting/any_types.hpp`, `BooleanLiteral`). An entry a script creates
+//!   keeps the type of its first value (`ExprAssignment::evaluate`: the first `:=` stores
+//!   the value as it is, later ones go through `Any::copyInto`): the blackboard machine's
+//!   [`dbl`] flag.
+//! - A value cast to bool (`Any::cast<bool>`: a condition, `ScriptCondition`,
+//!   Precondition's `if`, an operand of `&&` / `||`, which then throw "Logic operators
+//!   are not allowed ...") is, as an integer, 0 or 1, anything else throws; as a double,
+//!   true unless 0, throwing when negative (4.8.2: `1+1` and `1/2` are true, `0-1`
+//!   throws). `c ? a : b` takes any number, non-zero (NaN too) being true.
+//! - `/` and real literals are the model's floats ([`Ty::Real`]) where the value is
+//!   compared, tested or cast: `==` within `f32::EPSILON` and each ordering as the
+//!   negation of its opposite (`ExprComparison::evaluate`, `IsSame`), so NaN satisfies
+//!   `<`, `>`, `<=`, `>=`; never stored; divisors are number literals other than 0
+//!   (the model's integers have no negative zero, whose sign BT.CPP's doubles show in
+//!   `1/-0.0`).
 //! - Reading an entry that holds no value throws ("Variable not found"); so does `=`,
 //!   `+=`, `-=`, `*=` on one (`:=` creates it).
 //! - `+ -` and `*` group to the right (`10 - 4 - 2` is 8, `1 - 1 + 1` is -1).
@@ -35,10 +48,13 @@
 //! Where BT.CPP throws, the exception ends the tree's execution: the blackboard machine
 //! goes to its `error` state (`bt_script_fault` set), the node never answers, and the
 //! tree stops. Refused when the tree is read, each at the script's attribute with the
-//! column in the script: strings and real numbers (not modelled yet), division (`/`,
-//! `/=`: BT.CPP divides in floating point and may store a real number), the bit
-//! operators, an entry SetBlackboard writes other than as above, an entry of a type
-//! other than integer or boolean, an entry a SubTree maps to a constant.
+//! column in the script and why: strings (the model's expressions have no string
+//! operations), the bit operators (nor bitwise ones), storing a number that need not be
+//! whole (`x := 5/2`, `x /= 2`: the model's script entries are integers), a divisor
+//! other than a number literal other than 0, a number
+//! literal BT.CPP refuses at load, an entry SetBlackboard writes other than as above,
+//! an entry of a type other than integer or boolean, an entry a SubTree maps to a
+//! constant.
 
 use super::blackboard::{Blackboard, MACHINE};
 use super::control::{init_state, n_children, Ctx, FAILURE, RUNNING, SUCCESS};
@@ -73,37 +89,188 @@ enum Ty {
     /// An entry SetBlackboard wrote an integer constant to: BT.CPP 4 holds its text
     /// (the model variable holds the number the text reads as).
     Text,
+    /// A `double` that need not be whole (the value of `/`, a real literal, or an
+    /// operator over one): a `float64` expression in the model, never stored.
+    Real,
+}
+
+/// The blackboard machine's flag: entry `e`, created by a script, holds a `double`.
+pub(crate) fn dbl(e: &str) -> String {
+    format!("bt_dbl__{e}")
 }
 
 /// Why an operator over an entry SetBlackboard wrote cannot be modelled.
 const TWO_TEXTS: &str = "two entries SetBlackboard wrote: BT.CPP 4 holds their texts and compares or joins them as strings, which is not modelled";
 
+/// Why the bit operators are refused.
+const BITS: &str = "the bit operators (`~`, `&`, `|`, `^`) are not modelled: the model's expression language has no bitwise operations";
+
+/// Why a value that need not be whole cannot be stored.
+const STORE_REAL: &str = "the model's script entries are integers, and BT.CPP would store a double here (or throw converting it to an integer entry); `/` and real numbers are modelled only where the value is compared, tested or cast to a condition, not stored";
+
+/// Why a divisor other than a literal is refused.
+const DIVISOR: &str = "a divisor other than a number literal other than 0 is not modelled: BT.CPP divides in doubles, where the sign of a zero shows (`1/-0.0` is -inf), and the model holds whole numbers as integers, which have no negative zero";
+
+/// A number literal other than 0, possibly negated: a divisor the model's floats divide
+/// by as BT.CPP's doubles do (no zero, so no sign of zero to lose).
+fn nonzero_literal(e: &Ex) -> bool {
+    match &e.k {
+        K::Int(n) => *n != 0,
+        K::Number(t) => literal(t).is_ok_and(|(x, _)| x.parse::<f64>().is_ok_and(|v| v != 0.0)),
+        K::Un("-", a) => nonzero_literal(a),
+        _ => false,
+    }
+}
+
+/// `f32::EPSILON`, within which BT.CPP 4.10 counts two doubles equal
+/// (`scripting/operators.hpp`, `IsSame`).
+const EPS: &str = "1.1920928955078125e-7";
+
 /// A refusal: the byte offset in the script and why.
 type Refuse = (usize, String);
 
+/// A translated expression: the model expression, its type, and a model boolean
+/// expression saying whether BT.CPP holds it as a `double` (every operator gives one:
+/// BT.CPP 4.10 `scripting/operators.hpp`, the `evaluate` functions return
+/// `Any(double)`; a literal integer, `true`, `false` and an entry holding an integer are
+/// `int64_t`). `Any::cast<bool>` treats the two differently (see [`cast_bool`]).
+struct Val {
+    x: String,
+    t: Ty,
+    d: String,
+}
+
+fn val(x: String, t: Ty, d: &str) -> Val {
+    Val {
+        x,
+        t,
+        d: d.to_string(),
+    }
+}
+
+/// A script entry: its name in the script, in the tree's terms, its type, and whether
+/// a script creates it (BT.CPP then gives it the type of its first value: an
+/// `int64_t` or a `double`, kept in [`dbl`]).
+type Name = (String, String, Ty, bool);
+
 /// Translates one script of one node to the blackboard machine's expressions.
 struct Tr<'a> {
-    /// The script's entry names: the entry in the tree's terms and its type.
-    names: &'a [(String, String, Ty)],
+    /// The script's entry names.
+    names: &'a [Name],
     /// Conditions under which the statement being translated throws.
     checks: Vec<String>,
 }
 
+/// A number as the model's arithmetic takes it (a boolean as 0 or 1).
 fn int(x: &str, t: Ty) -> String {
     match t {
-        Ty::Int | Ty::Text => x.to_string(),
+        Ty::Int | Ty::Text | Ty::Real => x.to_string(),
         Ty::Bool => format!("({x} ? 1 : 0)"),
     }
 }
 
+/// `Any::cast<bool>` of a number (BT.CPP 4.8.2, measured: an `int64_t` is 0 or 1, else
+/// it throws, "Implicit casting to bool is not allowed" or, negative, "Value is
+/// negative and can't be converted to unsigned"; a `double` is true unless 0 and
+/// throws when negative, so `1+1` and `1/2` are true and NaN too): the condition under
+/// which it throws and the boolean.
+fn cast_bool(v: &Val) -> (Option<String>, String) {
+    let x = &v.x;
+    match (v.t, v.d.as_str()) {
+        (Ty::Bool, _) => (None, x.clone()),
+        (Ty::Real, _) | (_, "true") => (Some(format!("{x} < 0")), format!("({x} != 0)")),
+        (_, "false") => (Some(format!("{x} != 0 && {x} != 1")), format!("({x} != 0)")),
+        (_, d) => (
+            Some(format!(
+                "(({d}) && {x} < 0) || (!({d}) && {x} != 0 && {x} != 1)"
+            )),
+            format!("({x} != 0)"),
+        ),
+    }
+}
+
+/// A real literal as BT.CPP 4 reads it (`scripting/any_types.hpp`, `Grammar::Real`:
+/// digits, then `.digits` and an optional exponent, or an exponent; `std::stod`, which
+/// refuses a value out of range) or a hexadecimal integer (`Grammar::Integer`).
+fn literal(t: &str) -> Result<(String, Ty), String> {
+    if let Some(h) = t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
+        return i64::from_str_radix(h, 16)
+            .map(|v| (v.to_string(), Ty::Int))
+            .map_err(|_| format!("the number `{t}` is not one BT.CPP 4 reads"));
+    }
+    let b = t.as_bytes();
+    let digits = |mut i: usize| {
+        let s = i;
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        (i, i > s)
+    };
+    let (mut i, _) = digits(0);
+    let mut real = false;
+    if i < b.len() && b[i] == b'.' {
+        let (j, some) = digits(i + 1);
+        if !some {
+            return Err(format!(
+                "the number `{t}` is not one BT.CPP 4 reads (4.8.2 refuses it at load)"
+            ));
+        }
+        (i, real) = (j, true);
+    }
+    if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
+        let j = i + 1 + usize::from(b.get(i + 1).is_some_and(|c| *c == b'+' || *c == b'-'));
+        let (k, some) = digits(j);
+        if !some {
+            return Err(format!(
+                "the number `{t}` is not one BT.CPP 4 reads (4.8.2 refuses it at load)"
+            ));
+        }
+        (i, real) = (k, true);
+    }
+    if i != b.len() || !real {
+        return Err(format!(
+            "the number `{t}` is not one BT.CPP 4 reads (4.8.2 refuses it at load)"
+        ));
+    }
+    let v: f64 = t
+        .parse()
+        .map_err(|_| format!("the number `{t}` is not one BT.CPP 4 reads"))?;
+    let zero = t
+        .split(['e', 'E'])
+        .next()
+        .is_some_and(|m| m.bytes().all(|c| c == b'0' || c == b'.'));
+    if !v.is_finite() || (!v.is_normal() && !zero) {
+        return Err(format!(
+            "the number `{t}` is out of a double's range (BT.CPP's `std::stod` throws at load)"
+        ));
+    }
+    Ok((format!("{v:?}"), Ty::Real))
+}
+
+/// A comparison of two numbers, one of them possibly not whole, as BT.CPP 4.10 makes it
+/// (`scripting/operators.hpp`, `ExprComparison::evaluate`, `IsSame`): `==` within
+/// [`EPS`], each ordering the negation of its opposite (NaN is `<`, `>`, `<=` and `>=`
+/// anything: 4.8.2 agrees).
+fn compare_real(op: &str, l: &str, r: &str) -> String {
+    let same = format!("(Math.abs({l} - {r}) <= {EPS})");
+    match op {
+        "==" => same,
+        "!=" => format!("!{same}"),
+        "<" => format!("!({l} >= {r})"),
+        "<=" => format!("!({l} > {r})"),
+        ">" => format!("!({l} <= {r})"),
+        _ => format!("!({l} < {r})"),
+    }
+}
+
 impl Tr<'_> {
-    fn entry(&self, name: &str) -> (String, Ty) {
-        let (_, g, t) = self
+    fn entry(&self, name: &str) -> (String, Ty, bool) {
+        let (_, g, t, dynamic) = self
             .names
             .iter()
-            .find(|(n, _, _)| n == name)
+            .find(|(n, _, _, _)| n == name)
             .expect("every name was resolved");
-        (g.clone(), *t)
+        (g.clone(), *t, *dynamic)
     }
 
     /// `e` is an entry SetBlackboard wrote, read as it is (a string in BT.CPP 4).
@@ -122,74 +289,92 @@ impl Tr<'_> {
     /// An operand of an arithmetic or logic operator, `-` or `!`: a string (an entry
     /// SetBlackboard wrote) throws there (BT.CPP 4.8.2: "Operation not permitted",
     /// "Invalid operator for std::string"), so its value no longer matters.
-    fn number(&mut self, e: &Ex, guard: &str) -> Result<(String, Ty), Refuse> {
-        let (x, t) = self.ex(e, guard)?;
-        if t == Ty::Text {
+    fn number(&mut self, e: &Ex, guard: &str) -> Result<Val, Refuse> {
+        let v = self.ex(e, guard)?;
+        if v.t == Ty::Text {
             self.check(guard, "true".into());
-            return Ok(("0".into(), Ty::Int));
+            return Ok(val("0".into(), Ty::Int, "false"));
         }
-        Ok((x, t))
+        Ok(v)
     }
 
-    /// Operand of `&&` / `||`: a boolean, or an integer that must be 0 or 1.
+    /// Operand of `&&` / `||`: cast to bool as a condition is (BT.CPP 4.10
+    /// `ExprBinaryArithmetic::evaluate` casts both with `Any::cast<bool>` and throws
+    /// "Logic operators are not allowed ..." where that throws).
     fn logic_operand(&mut self, e: &Ex, guard: &str) -> Result<String, Refuse> {
-        let (x, t) = self.number(e, guard)?;
-        Ok(match t {
-            Ty::Bool => x,
-            Ty::Int | Ty::Text => {
-                self.check(guard, format!("{x} != 0 && {x} != 1"));
-                format!("({x} == 1)")
-            }
-        })
+        let v = self.number(e, guard)?;
+        let (throws, b) = cast_bool(&v);
+        if let Some(c) = throws {
+            self.check(guard, c);
+        }
+        Ok(b)
     }
 
-    fn ex(&mut self, e: &Ex, guard: &str) -> Result<(String, Ty), Refuse> {
+    fn ex(&mut self, e: &Ex, guard: &str) -> Result<Val, Refuse> {
         let refuse = |what: &str| Err((e.at, what.to_string()));
         Ok(match &e.k {
-            K::Int(n) => (n.to_string(), Ty::Int),
-            K::Bool(b) => (b.to_string(), Ty::Bool),
+            K::Int(n) => val(n.to_string(), Ty::Int, "false"),
+            K::Bool(b) => val(b.to_string(), Ty::Bool, "false"),
             K::Number(t) => {
-                return Err((
-                    e.at,
-                    format!("the number `{t}`: only whole decimal numbers are modelled (real numbers in scripts are not modelled yet)"),
-                ))
+                let (x, ty) = literal(t).map_err(|w| (e.at, w))?;
+                let d = if ty == Ty::Real { "true" } else { "false" };
+                val(x, ty, d)
             }
-            K::Str => return refuse("strings in scripts are not modelled yet"),
+            K::Str => {
+                return refuse(
+                    "strings in scripts are not modelled: the model's expressions have no string operations (BT.CPP joins them with `+`/`..` and orders them)",
+                )
+            }
             K::Name(n) => {
-                let (g, t) = self.entry(n);
+                let (g, t, dynamic) = self.entry(n);
                 // "Variable not found".
                 self.check(guard, format!("!{}", has(&g)));
-                (g, t)
+                let d = if dynamic { dbl(&g) } else { "false".into() };
+                Val { x: g, t, d }
             }
             K::Un("-", a) => {
-                let (x, t) = self.number(a, guard)?;
-                (format!("(-{})", int(&x, t)), Ty::Int)
+                let v = self.number(a, guard)?;
+                let t = if v.t == Ty::Real { Ty::Real } else { Ty::Int };
+                val(format!("(-{})", int(&v.x, v.t)), t, "true")
             }
             K::Un("!", a) => {
-                let (x, t) = self.number(a, guard)?;
-                match t {
-                    Ty::Bool => (format!("(!{x})"), Ty::Bool),
-                    Ty::Int | Ty::Text => (format!("({x} == 0)"), Ty::Bool),
+                // `!static_cast<bool>(x)`: exact, so NaN gives 0.
+                let v = self.number(a, guard)?;
+                match v.t {
+                    Ty::Bool => val(format!("(!{})", v.x), Ty::Bool, "true"),
+                    _ => val(format!("({} == 0)", v.x), Ty::Bool, "true"),
                 }
             }
-            K::Un(..) => return refuse("the bit operators (`~`, `|`, `&`, `^`) are not modelled"),
-            K::Bin(op @ ("+" | "-" | "*"), a, b) => {
+            K::Un(..) => return refuse(BITS),
+            K::Bin(op @ ("+" | "-" | "*" | "/"), a, b) => {
                 if self.is_text(a) && self.is_text(b) {
                     return Err((e.at, format!("`{op}` over {TWO_TEXTS}")));
                 }
-                let (x, tx) = self.number(a, guard)?;
-                let (y, ty) = self.number(b, guard)?;
-                (format!("({} {op} {})", int(&x, tx), int(&y, ty)), Ty::Int)
+                if *op == "/" && !nonzero_literal(b) {
+                    return Err((b.at, DIVISOR.to_string()));
+                }
+                let x = self.number(a, guard)?;
+                let y = self.number(b, guard)?;
+                // BT.CPP computes in doubles (`ExprBinaryArithmetic::evaluate`); over
+                // whole numbers the model's integers give the same values (up to
+                // 2^53), `/` and real operands take the model's floats.
+                let t = if *op == "/" || x.t == Ty::Real || y.t == Ty::Real {
+                    Ty::Real
+                } else {
+                    Ty::Int
+                };
+                val(
+                    format!("({} {op} {})", int(&x.x, x.t), int(&y.x, y.t)),
+                    t,
+                    "true",
+                )
             }
-            K::Bin("/", ..) => return refuse(
-                "division: BT.CPP divides in floating point and may store a real number, which is not modelled yet",
-            ),
             K::Bin(op @ ("&&" | "||"), a, b) => {
                 let x = self.logic_operand(a, guard)?;
                 let y = self.logic_operand(b, guard)?;
-                (format!("({x} {op} {y})"), Ty::Bool)
+                val(format!("({x} {op} {y})"), Ty::Bool, "true")
             }
-            K::Bin(..) => return refuse("the bit operators (`~`, `|`, `&`, `^`) are not modelled"),
+            K::Bin(..) => return refuse(BITS),
             K::Cmp(xs, ops) => {
                 // A string compared with a number is read as one (BT.CPP 4.8.2: the text
                 // `3` equals 3): the model variable's number. Two strings compare as
@@ -199,22 +384,31 @@ impl Tr<'_> {
                 }
                 let mut vs = Vec::with_capacity(xs.len());
                 for x in xs {
-                    let (v, t) = self.ex(x, guard)?;
-                    vs.push(int(&v, t));
+                    let v = self.ex(x, guard)?;
+                    vs.push((int(&v.x, v.t), v.t == Ty::Real));
                 }
                 let parts: Vec<String> = ops
                     .iter()
                     .enumerate()
-                    .map(|(i, op)| format!("{} {op} {}", vs[i], vs[i + 1]))
+                    .map(|(i, op)| {
+                        let ((l, lr), (r, rr)) = (&vs[i], &vs[i + 1]);
+                        if *lr || *rr {
+                            compare_real(op, l, r)
+                        } else {
+                            format!("{l} {op} {r}")
+                        }
+                    })
                     .collect();
-                (format!("({})", parts.join(" && ")), Ty::Bool)
+                val(format!("({})", parts.join(" && ")), Ty::Bool, "true")
             }
             K::Ite(c, a, b) => {
-                // A string condition is read as a number (4.8.2: the text `0` is false).
-                let (cx, ct) = self.ex(c, guard)?;
-                let cond = match ct {
-                    Ty::Bool => cx,
-                    Ty::Int | Ty::Text => format!("({cx} != 0)"),
+                // `ExprIf::evaluate`: `cast<double>() != 0`, so any number but 0 (NaN
+                // too) is true; a string is read as a number (4.8.2: the text `0` is
+                // false).
+                let cv = self.ex(c, guard)?;
+                let cond = match cv.t {
+                    Ty::Bool => cv.x,
+                    Ty::Int | Ty::Text | Ty::Real => format!("({} != 0)", cv.x),
                 };
                 let join = |g: &str, c: &str| {
                     if g.is_empty() {
@@ -227,16 +421,26 @@ impl Tr<'_> {
                 if let Some(x) = [a, b].into_iter().find(|x| self.is_text(x)) {
                     return Err((x.at, "a SetBlackboard's text as the value of `?:`: BT.CPP 4 gives the string, and strings in scripts are not modelled yet".into()));
                 }
-                let (x, tx) = self.ex(a, &join(guard, &cond))?;
-                let (y, ty) = self.ex(b, &join(guard, &format!("!{cond}")))?;
-                if tx == Ty::Bool && ty == Ty::Bool {
-                    (format!("({cond} ? {x} : {y})"), Ty::Bool)
+                let x = self.ex(a, &join(guard, &cond))?;
+                let y = self.ex(b, &join(guard, &format!("!{cond}")))?;
+                let d = match (x.d.as_str(), y.d.as_str()) {
+                    (l, r) if l == r => l.to_string(),
+                    (l, r) => format!("({cond} ? {l} : {r})"),
+                };
+                let (xx, t) = if x.t == Ty::Bool && y.t == Ty::Bool {
+                    (format!("({cond} ? {} : {})", x.x, y.x), Ty::Bool)
                 } else {
+                    let t = if x.t == Ty::Real || y.t == Ty::Real {
+                        Ty::Real
+                    } else {
+                        Ty::Int
+                    };
                     (
-                        format!("({cond} ? {} : {})", int(&x, tx), int(&y, ty)),
-                        Ty::Int,
+                        format!("({cond} ? {} : {})", int(&x.x, x.t), int(&y.x, y.t)),
+                        t,
                     )
-                }
+                };
+                Val { x: xx, t, d }
             }
         })
     }
@@ -246,55 +450,67 @@ impl Tr<'_> {
 struct Lowered {
     checks: Vec<String>,
     assigns: Vec<(String, String)>,
-    value: (String, Ty),
+    value: Val,
 }
 
-fn statement(names: &[(String, String, Ty)], s: &Stmt) -> Result<Lowered, Refuse> {
+fn statement(names: &[Name], s: &Stmt) -> Result<Lowered, Refuse> {
     let mut tr = Tr {
         names,
         checks: Vec::new(),
     };
-    let (x, t) = tr.ex(&s.e, "")?;
+    let v = tr.ex(&s.e, "")?;
     let Some((target, op, at)) = &s.assign else {
         return Ok(Lowered {
             checks: tr.checks,
             assigns: Vec::new(),
-            value: (x, t),
+            value: v,
         });
     };
-    let (g, et) = tr.entry(target);
+    let (g, et, dynamic) = tr.entry(target);
+    let (x, t) = (v.x.as_str(), v.t);
     if et == Ty::Text {
         return Err((*at, format!("a script writing `{g}`, which a SetBlackboard writes: BT.CPP 4 holds a string there (4.8.2 refuses to assign it a number), which is not modelled")));
     }
     if t == Ty::Text {
         return Err((s.e.at, format!("assigning a SetBlackboard's text to `{g}`: BT.CPP 4 copies the string, and strings in scripts are not modelled yet")));
     }
+    if t == Ty::Real || *op == "/=" {
+        return Err((
+            *at,
+            format!("`{op}` storing a number that need not be whole in `{g}`: {STORE_REAL}"),
+        ));
+    }
     if *op != ":=" {
         // "The blackboard entry [..] doesn't exist".
         tr.checks.push(format!("!{}", has(&g)));
     }
     let new = match (*op, et, t) {
-        ("/=", ..) => {
-            return Err((
-                *at,
-                "`/=`: BT.CPP divides in floating point and may store a real number, which is not modelled yet".into(),
-            ))
-        }
-        (":=" | "=", Ty::Int, _) => int(&x, t),
-        (":=" | "=", Ty::Bool, Ty::Bool) => x,
-        (":=" | "=", Ty::Bool, Ty::Int) => {
+        (":=" | "=", Ty::Int, _) => int(x, t),
+        (":=" | "=", Ty::Bool, Ty::Bool) => x.to_string(),
+        (":=" | "=", Ty::Bool, _) => {
             return Err((*at, format!("assigning an integer to the boolean entry `{g}` (typed by a port) is not modelled: assign a boolean")))
         }
         (_, Ty::Bool, _) => {
             return Err((*at, format!("`{op}` on the boolean entry `{g}` (typed by a port) is not modelled")))
         }
-        (_, Ty::Int, _) => format!("({g} {} {})", &op[..1], int(&x, t)),
-        (_, Ty::Text, _) => unreachable!("refused above"),
+        (_, Ty::Int, _) => format!("({g} {} {})", &op[..1], int(x, t)),
+        (_, Ty::Text | Ty::Real, _) => unreachable!("refused above"),
     };
+    let mut assigns = Vec::new();
+    if dynamic {
+        // BT.CPP 4.10 `ExprAssignment::evaluate`: the first value of an entry a script
+        // creates goes in as it is (an `int64_t` or a `double`); later ones are
+        // converted to that type (`Any::copyInto`).
+        let d = dbl(&g);
+        assigns.push((d.clone(), format!("({} ? {d} : {})", has(&g), v.d)));
+    }
+    assigns.push((g.clone(), new));
+    assigns.push((has(&g), "true".into()));
+    let d = if dynamic { dbl(&g) } else { "false".into() };
     Ok(Lowered {
         checks: tr.checks,
-        assigns: vec![(g.clone(), new), (has(&g), "true".into())],
-        value: (g, et),
+        assigns,
+        value: Val { x: g, t: et, d },
     })
 }
 
@@ -307,7 +523,7 @@ fn resolve(
     span: Span,
     bb: &mut Blackboard,
     errs: &mut Vec<Diagnostic>,
-) -> Option<Vec<(String, String, Ty)>> {
+) -> Option<Vec<Name>> {
     let mut out = Vec::new();
     let before = errs.len();
     for (name, v) in &n.script_names {
@@ -338,9 +554,11 @@ fn resolve(
             if !bb.script_entries.contains(&g) {
                 bb.script_entries.push(g.clone());
             }
-            out.push((name.clone(), g, Ty::Text));
+            out.push((name.clone(), g, Ty::Text, false));
             continue;
         }
+        // An entry no port types: BT.CPP's script creates it (`PortInfo()`, any type).
+        let dynamic = bb.entry(&g).is_none_or(|e| e.why == "a script");
         let t = match bb.entry(&g) {
             None => {
                 bb.entries.push(super::blackboard::Entry {
@@ -364,7 +582,7 @@ fn resolve(
         if !bb.script_entries.contains(&g) {
             bb.script_entries.push(g.clone());
         }
-        out.push((name.clone(), g, t));
+        out.push((name.clone(), g, t, dynamic));
     }
     (errs.len() == before).then_some(out)
 }
@@ -405,15 +623,13 @@ pub(super) fn compile(
     }
     let fault = || vec![b.assign(FAULT, "true")];
     // Innermost: what follows, after every statement.
-    let (v, t) = lowered.last().expect("a statement").value.clone();
+    let last = &lowered.last().expect("a statement").value;
     let mut inner = if condition {
-        let (value, check) = match t {
-            Ty::Bool => (v, None),
-            // `Any::cast<bool>`: 0 or 1, else it throws.
-            Ty::Int => (format!("{v} == 1"), Some(format!("{v} != 0 && {v} != 1"))),
+        let (check, value) = match last.t {
             // A string: 4.8.2 throws ("no known safe conversion between [std::string]
             // and [bool]").
-            Ty::Text => ("false".into(), Some("true".into())),
+            Ty::Text => (Some("true".into()), "false".into()),
+            _ => cast_bool(last),
         };
         let rest = then(Some(value));
         match check {

@@ -17,7 +17,7 @@
 //! and `* /` group to the right (4.8.2: `10 - 4 - 2` is 8, `1 - 1 + 1` is -1), and
 //! `c ? a : b ? ...` is refused ("operator cannot be chained"), as the real library
 //! does. AS2FM has no model of the language; the BT.CPP semantics (`--bt btcpp`) lowers
-//! its integer and boolean part (`btcpp4_script.rs`).
+//! its integer, boolean and (where not stored) double part (`btcpp4_script.rs`).
 
 /// A syntax error: the byte offset in the script (from 0) and what is wrong.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -112,8 +112,20 @@ fn tokens(s: &str) -> Result<Vec<(T<'_>, usize)>, SyntaxError> {
             out.push((T::Sym(";"), i));
             i += 1;
         } else if c.is_ascii_digit() {
+            // A number runs on through letters and `.`, and a sign right after the `e`
+            // of a decimal exponent (`2.5e-1`; BT.CPP 4 `scripting/any_types.hpp`,
+            // `Grammar::Real`): the lowering reads what it holds.
+            let hex = s[i..].starts_with("0x") || s[i..].starts_with("0X");
             while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'.') {
+                let exp = !hex && (b[i] == b'e' || b[i] == b'E');
                 i += 1;
+                if exp
+                    && i + 1 < b.len()
+                    && (b[i] == b'+' || b[i] == b'-')
+                    && b[i + 1].is_ascii_digit()
+                {
+                    i += 1;
+                }
             }
             out.push((T::Num, start));
         } else if c == b'\'' {
@@ -446,7 +458,8 @@ mod tests {
             "x:=0; y:=1; f:=true",
             "a := 3; b := a*2+1; c := a<b",
             "msg := 'hello world'",
-            "A := 42; B := 3.14",
+            "A := 42; B := 3.14; C := 2.5e-1 < 1E+3",
+            "x := 0xe-1",
             "a := !true || 1 > 2",
             "a := !true || (-1 < 0)",
             "a := !true ? -1 : 2",
