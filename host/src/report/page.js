@@ -456,7 +456,7 @@
   // The behavior tree of a robot model, read from the run's own messages: the lowering
   // names each node's machine BT_plugin_<id>_<type>, a parent sends bt_<id>_tick and
   // bt_<id>_halt, the node answers bt_<id>_response with status 1 SUCCESS, 2 FAILURE,
-  // 3 RUNNING (host/src/robot/bt/control.rs). A node's status at a point is its last
+  // 3 RUNNING (crates/robot/src/bt/control.rs). A node's status at a point is its last
   // such message: ticked (waiting for its answer), its answer, or idle after a halt.
   var BT_STATUS = { 1: "success", 2: "failure", 3: "running" };
   var BT_FILL = { idle: "#eeeeee", ticked: "#fff3b0", success: "#8fd694", failure: "#f08a8a", running: "#f6c26b" };
