@@ -24,8 +24,9 @@ use crate::schema::{Elem, Schema};
 /// root type's name for the whole message).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum EncodeError {
-    /// [`Val::set`] named a field the type does not have as asked.
-    Field(FieldError),
+    /// [`Val::set`] named a field the type does not have as asked (boxed: it is the
+    /// largest variant, and results are passed around on every message).
+    Field(Box<FieldError>),
     /// A message was expected (of type `ty`).
     NotAMessage {
         /// The field path.
@@ -134,7 +135,7 @@ impl std::error::Error for EncodeError {}
 
 impl From<FieldError> for EncodeError {
     fn from(e: FieldError) -> Self {
-        EncodeError::Field(e)
+        EncodeError::Field(Box::new(e))
     }
 }
 
