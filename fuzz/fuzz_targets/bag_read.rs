@@ -41,6 +41,6 @@ fuzz_target!(|data: &[u8]| {
         &BuiltinDefs::new(),
         TimeSource::Log,
         &[],
-        &mut |_| Ok(()),
+        &mut |_| Ok::<(), std::convert::Infallible>(()),
     );
 });

@@ -149,7 +149,7 @@ fn main() {
                 compiled.strings(),
                 &mut |p| {
                     step(p.time_ns / tick, p.sets);
-                    Ok(())
+                    Ok::<(), std::convert::Infallible>(())
                 },
             )
             .unwrap();

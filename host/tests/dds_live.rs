@@ -579,3 +579,63 @@ fn bad_arguments_exit_2() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--max-latency soon"));
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// A plain GET of the monitor's own server, status line and all.
+fn get(addr: &str, path: &str) -> String {
+    use std::io::{Read, Write};
+    let mut s = std::net::TcpStream::connect(addr).unwrap();
+    write!(s, "GET {path} HTTP/1.1\r\nHost: {addr}\r\n\r\n").unwrap();
+    let mut text = String::new();
+    s.read_to_string(&mut text).unwrap();
+    text
+}
+
+/// `--serve` beside `--ros2`: the live page is served, and so are the verdict lines, here
+/// those the heartbeats give while nothing publishes (`/alive` silent past 0.3 s turns its
+/// recurrence false). No publisher is needed, so this runs without the Python side.
+#[test]
+fn serve_gives_the_live_page_and_the_verdicts() {
+    let d = domain(7);
+    let props = data("props.xml");
+    let m = Proc::monitor(
+        d,
+        &[
+            "--ros2".as_ref(),
+            props.as_os_str(),
+            "--serve".as_ref(),
+            ":0".as_ref(),
+        ],
+    );
+    m.wait_for("live page at http://", Duration::from_secs(30));
+    let err = m.err();
+    let addr = err
+        .split("live page at http://")
+        .nth(1)
+        .and_then(|r| r.split('/').next())
+        .unwrap()
+        .to_string();
+    let page = get(&addr, "/");
+    assert!(page.starts_with("HTTP/1.1 200"), "{page}");
+    let deadline = std::time::Instant::now() + Duration::from_secs(30);
+    loop {
+        let body = get(&addr, "/verdicts.jsonl");
+        let body = &body[body.find("\r\n\r\n").unwrap() + 4..];
+        let turned_false = body.lines().any(|l| {
+            serde_json::from_str::<serde_json::Value>(l).is_ok_and(|v| {
+                v["property"] == "alive_recurrence"
+                    && (v["verdict"] == "false" || v["verdict"] == "currently_false")
+            })
+        });
+        if turned_false {
+            break;
+        }
+        assert!(
+            std::time::Instant::now() < deadline,
+            "no false alive_recurrence served:\n{body}\n{}",
+            m.err()
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let (status, stderr) = stop(m);
+    assert!(status.success(), "exit {status:?}\n{stderr}");
+}

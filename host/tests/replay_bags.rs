@@ -222,9 +222,15 @@ fn a_spec_with_bindings() {
 /// An MCAP file of `std_msgs/Int32` messages on `/battery_level`, written with the `mcap`
 /// crate (no Python needed).
 fn int32_mcap(messages: &[Vec<u8>]) -> Vec<u8> {
+    mcap_of("ros2msg", "int32 data\n", messages)
+}
+
+/// An MCAP file of messages on `/battery_level` of type `std_msgs/msg/Int32` as the schema
+/// (`encoding`, `text`) says it is.
+fn mcap_of(encoding: &str, text: &str, messages: &[Vec<u8>]) -> Vec<u8> {
     let mut w = mcap::Writer::new(std::io::Cursor::new(Vec::new())).unwrap();
     let s = w
-        .add_schema("std_msgs/msg/Int32", "ros2msg", b"int32 data\n")
+        .add_schema("std_msgs/msg/Int32", encoding, text.as_bytes())
         .unwrap();
     let c = w
         .add_channel(s, "/battery_level", "cdr", &Default::default())
@@ -242,8 +248,10 @@ fn int32_mcap(messages: &[Vec<u8>]) -> Vec<u8> {
     w.into_inner().into_inner()
 }
 
-/// A bad sample, a truncated file and a field the type lacks exit 2, naming the topic and
-/// the message's index (or the field and the type).
+/// A bad sample, a 4 GB length prefix, a truncated file, a chunk claiming 4 GB, a schema
+/// we do not read or that does not parse, a `.db3` that is not SQLite and a field the type
+/// lacks exit 2, naming the file and the topic and the message's index (or the field and
+/// the type).
 #[test]
 fn bad_bags_exit_2_naming_topic_and_index() {
     let dir = std::env::temp_dir().join(format!("hindsight-bad-bags-{}", std::process::id()));
@@ -286,6 +294,60 @@ fn bad_bags_exit_2_naming_topic_and_index() {
         &ok_file[..ok_file.len() * 2 / 3],
         &props,
         &["cut.mcap"],
+    );
+    // A length prefix of 4 G in a 16-byte message: an error at once, nothing allocated.
+    let mut huge_string = vec![0, 1, 0, 0];
+    huge_string.extend(u32::MAX.to_le_bytes());
+    huge_string.extend(7i32.to_le_bytes());
+    check(
+        "prefix.mcap",
+        &mcap_of("ros2msg", "string name\nint32 data\n", &[huge_string]),
+        &props,
+        &[
+            "topic `/battery_level` message 1",
+            "claims 4294967295 element(s)",
+        ],
+    );
+    // A chunk whose header claims 4 GB uncompressed: refused before the `mcap` crate
+    // reserves that much.
+    let mut chunked = ok_file.clone();
+    let mut at = 8;
+    let mut patched = false;
+    while at + 9 <= chunked.len() {
+        let len = u64::from_le_bytes(chunked[at + 1..at + 9].try_into().unwrap()) as usize;
+        if chunked[at] == 0x06 {
+            chunked[at + 9 + 16..at + 9 + 24].copy_from_slice(&(1u64 << 32).to_le_bytes());
+            patched = true;
+            break;
+        }
+        at += 9 + len;
+    }
+    assert!(patched, "the mcap writer writes chunks");
+    check(
+        "chunk.mcap",
+        &chunked,
+        &props,
+        &["chunk.mcap", "claims 4294967296 uncompressed bytes"],
+    );
+    // Wrong schemas: one in a form we do not read, one whose text does not parse.
+    check(
+        "idl.mcap",
+        &mcap_of("ros2idl", "module std_msgs { };", &[good(1)]),
+        &props,
+        &["message 1", "/battery_level", "schema encoding `ros2idl`"],
+    );
+    check(
+        "schema.mcap",
+        &mcap_of("ros2msg", "int32 data\n=====\nint8 x\n", &[good(1)]),
+        &props,
+        &["topic `/battery_level`", "no `MSG: package/Type` line"],
+    );
+    // A `.db3` that is not SQLite, and a .db3 without rosbag2's tables.
+    check(
+        "junk.db3",
+        b"not a database at all, not even close to one",
+        &props,
+        &["junk.db3", "not a rosbag2 SQLite file"],
     );
     let wrong = dir.join("wrong.xml");
     std::fs::write(

@@ -29,19 +29,256 @@ use crate::interface::{ArraySize, Primitive};
 use crate::schema::{Elem, SType, Schema};
 
 /// A problem decoding one message (the caller adds the topic and the message index).
+/// Byte offsets count from the start of the message, its 4-byte header included.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub struct CdrError(pub String);
+pub enum CdrError {
+    /// Shorter than the encapsulation header (`len` bytes).
+    NoHeader {
+        /// The message's length.
+        len: usize,
+    },
+    /// An encapsulation kind other than plain CDR.
+    Encapsulation {
+        /// The header's first two bytes.
+        kind: [u8; 2],
+    },
+    /// The message ends (at byte `end`) before `need` bytes at byte `at`.
+    Truncated {
+        /// Its length.
+        end: usize,
+        /// Bytes needed.
+        need: usize,
+        /// Where.
+        at: usize,
+    },
+    /// A sequence or string claims more elements than the bytes left could hold.
+    Count {
+        /// The claimed count.
+        count: usize,
+        /// Bytes left.
+        left: usize,
+    },
+    /// A `bool` byte other than 0 or 1.
+    Bool(u8),
+    /// A string without its terminating NUL.
+    NoNul,
+    /// Bytes after the end of the message's type (another type's message).
+    Trailing {
+        /// Bytes left over.
+        left: usize,
+        /// The type decoded.
+        ty: String,
+    },
+    /// A bounded sequence with more elements than its bound.
+    PastBound {
+        /// The field.
+        field: String,
+        /// Its message type.
+        ty: String,
+        /// Elements in the message.
+        count: usize,
+        /// The bound.
+        bound: u32,
+    },
+    /// An unsigned value past the largest integer a property holds (`i64`).
+    TooLarge {
+        /// The field path.
+        path: String,
+        /// The value.
+        value: u64,
+    },
+    /// A value of another kind than the slot's type.
+    Mismatch {
+        /// The field path.
+        path: String,
+    },
+}
 
 impl std::fmt::Display for CdrError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
+        match self {
+            CdrError::NoHeader { len } => write!(
+                f,
+                "{len} bytes: too short for the 4-byte CDR encapsulation header"
+            ),
+            CdrError::Encapsulation { kind: [a, b] } => write!(
+                f,
+                "encapsulation kind 0x{a:02x}{b:02x} is not plain CDR (0x0000 big endian or 0x0001 little endian)"
+            ),
+            CdrError::Truncated { end, need, at } => write!(
+                f,
+                "the message ends at byte {end} but {need} more byte(s) are needed at byte {at}"
+            ),
+            CdrError::Count { count, left } => write!(
+                f,
+                "a sequence claims {count} element(s) but only {left} byte(s) are left"
+            ),
+            CdrError::Bool(v) => write!(f, "a bool is {v}, not 0 or 1"),
+            CdrError::NoNul => f.write_str("a string does not end with a NUL byte"),
+            CdrError::Trailing { left, ty } => write!(
+                f,
+                "{left} byte(s) follow the end of a `{ty}` (is this the message's type?)"
+            ),
+            CdrError::PastBound {
+                field,
+                ty,
+                count,
+                bound,
+            } => write!(
+                f,
+                "field `{field}` of `{ty}` has {count} elements, more than its bound {bound}"
+            ),
+            CdrError::TooLarge { path, value } => write!(
+                f,
+                "`{path}` is {value}, past the largest integer a property holds"
+            ),
+            CdrError::Mismatch { path } => write!(f, "`{path}`: type mismatch"),
+        }
     }
 }
 
 impl std::error::Error for CdrError {}
 
-fn err<T>(msg: impl Into<String>) -> Result<T, CdrError> {
-    Err(CdrError(msg.into()))
+/// A field path a property (or a writer) names that the message type does not have as
+/// asked: every variant names the path and the types involved.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum FieldError {
+    /// Not a field path (`a.b[2].c`): the path and why.
+    Syntax {
+        /// The text given.
+        path: String,
+        /// What is wrong with it.
+        why: &'static str,
+    },
+    /// A step names a field the message does not have.
+    NoField {
+        /// The message type that lacks it.
+        ty: String,
+        /// The field named.
+        field: String,
+        /// The whole path.
+        path: String,
+        /// The root type of the path.
+        root: String,
+        /// The fields `ty` has.
+        known: Vec<String>,
+    },
+    /// `here` indexes field `field` of `ty`, which is not an array.
+    NotAnArray {
+        /// The path up to this step.
+        here: String,
+        /// The field.
+        field: String,
+        /// Its message type.
+        ty: String,
+    },
+    /// `here` indexes past the `bound` elements field `field` of `ty` can have.
+    PastBound {
+        /// The path up to this step.
+        here: String,
+        /// The field.
+        field: String,
+        /// Its message type.
+        ty: String,
+        /// Its fixed size or bound.
+        bound: usize,
+    },
+    /// `here` is an array: one element must be named.
+    IsAnArray {
+        /// The path up to this step.
+        here: String,
+        /// The field.
+        field: String,
+        /// Its message type.
+        ty: String,
+    },
+    /// `here` is a primitive (`prim`, a `.msg` type name) of `ty`, yet the path goes on.
+    NoFields {
+        /// The path up to this step.
+        here: String,
+        /// The primitive's `.msg` name.
+        prim: &'static str,
+        /// Its message type.
+        ty: String,
+    },
+    /// `here` is a message (of type `ty`): the path must name one of its fields.
+    IsAMessage {
+        /// The whole path.
+        here: String,
+        /// The nested message's type.
+        ty: String,
+    },
+    /// The field is a `prim`, which is not read as the property's type (`want`).
+    Convert {
+        /// The whole path.
+        path: String,
+        /// The root type.
+        root: String,
+        /// The field's `.msg` type.
+        prim: &'static str,
+        /// What the property reads (`bool`, `an integer`, `a number`, `string`).
+        want: &'static str,
+    },
+}
+
+impl std::fmt::Display for FieldError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FieldError::Syntax { path, why } => {
+                write!(f, "`{path}` is not a field path ({why})")
+            }
+            FieldError::NoField {
+                ty,
+                field,
+                path,
+                root,
+                known,
+            } => write!(
+                f,
+                "message `{ty}` has no field `{field}` (field path `{path}` of `{root}`; its fields: {})",
+                known.join(", ")
+            ),
+            FieldError::NotAnArray { here, field, ty } => write!(
+                f,
+                "`{here}` indexes field `{field}` of `{ty}`, which is not an array"
+            ),
+            FieldError::PastBound {
+                here,
+                field,
+                ty,
+                bound,
+            } => write!(
+                f,
+                "`{here}`: field `{field}` of `{ty}` has at most {bound} element(s)"
+            ),
+            FieldError::IsAnArray { here, field, ty } => write!(
+                f,
+                "`{here}` is an array (field `{field}` of `{ty}`): name one element, `{here}[0]`"
+            ),
+            FieldError::NoFields { here, prim, ty } => {
+                write!(f, "`{here}` is a {prim} of `{ty}`, it has no fields")
+            }
+            FieldError::IsAMessage { here, ty } => write!(
+                f,
+                "`{here}` is a message (`{ty}`): name one of its fields"
+            ),
+            FieldError::Convert {
+                path,
+                root,
+                prim,
+                want,
+            } => write!(
+                f,
+                "field `{path}` of `{root}` is a {prim}, which is not read as {want}"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for FieldError {}
+
+fn err<T>(e: CdrError) -> Result<T, CdrError> {
+    Err(e)
 }
 
 /// A position in a message's body (after the encapsulation header).
@@ -55,19 +292,12 @@ impl<'a> Cursor<'a> {
     /// The body of a message whose first 4 bytes are the encapsulation header.
     fn open(bytes: &'a [u8]) -> Result<Cursor<'a>, CdrError> {
         if bytes.len() < 4 {
-            return err(format!(
-                "{} bytes: too short for the 4-byte CDR encapsulation header",
-                bytes.len()
-            ));
+            return err(CdrError::NoHeader { len: bytes.len() });
         }
         let be = match (bytes[0], bytes[1]) {
             (0, 0) => true,
             (0, 1) => false,
-            (a, b) => {
-                return err(format!(
-                    "encapsulation kind 0x{a:02x}{b:02x} is not plain CDR (0x0000 big endian or 0x0001 little endian)"
-                ))
-            }
+            (a, b) => return err(CdrError::Encapsulation { kind: [a, b] }),
         };
         Ok(Cursor {
             data: &bytes[4..],
@@ -88,11 +318,11 @@ impl<'a> Cursor<'a> {
                 self.pos = end;
                 Ok(&self.data[start..end])
             }
-            _ => err(format!(
-                "the message ends at byte {} but {n} more byte(s) are needed at byte {}",
-                self.data.len() + 4,
-                start.min(self.data.len()) + 4
-            )),
+            _ => err(CdrError::Truncated {
+                end: self.data.len() + 4,
+                need: n,
+                at: start.min(self.data.len()) + 4,
+            }),
         }
     }
 
@@ -111,10 +341,10 @@ impl<'a> Cursor<'a> {
     fn count(&mut self, min_size: usize) -> Result<usize, CdrError> {
         let n = self.u32()? as usize;
         if n.saturating_mul(min_size.max(1)) > self.left() {
-            return err(format!(
-                "a sequence claims {n} element(s) but only {} byte(s) are left",
-                self.left()
-            ));
+            return err(CdrError::Count {
+                count: n,
+                left: self.left(),
+            });
         }
         Ok(n)
     }
@@ -148,7 +378,7 @@ impl<'a> Cursor<'a> {
             Primitive::Bool => match b[0] {
                 0 => Leaf::Bool(false),
                 1 => Leaf::Bool(true),
-                v => return err(format!("a bool is {v}, not 0 or 1")),
+                v => return err(CdrError::Bool(v)),
             },
             Primitive::Byte | Primitive::Char | Primitive::UInt8 => Leaf::UInt(b[0] as u64),
             Primitive::Int8 => Leaf::Int(b[0] as i8 as i64),
@@ -170,7 +400,7 @@ impl<'a> Cursor<'a> {
         // The length counts the terminating NUL (a length of 0 is read as "").
         Ok(match b.split_last() {
             Some((0, s)) => s,
-            Some(_) => return err("a string does not end with a NUL byte"),
+            Some(_) => return err(CdrError::NoNul),
             None => b,
         })
     }
@@ -193,7 +423,7 @@ impl<'a> Cursor<'a> {
                 if p == Primitive::Bool {
                     for b in self.take(n, 1)? {
                         if *b > 1 {
-                            return err(format!("a bool is {b}, not 0 or 1"));
+                            return err(CdrError::Bool(*b));
                         }
                     }
                 } else {
@@ -242,8 +472,11 @@ pub struct PathStep {
 }
 
 /// Parses a field path: `data`, `header.stamp.sec`, `cell_voltage[0]`, `a[2].b`.
-pub fn parse_path(path: &str) -> Result<Vec<PathStep>, String> {
-    let bad = |why: &str| format!("`{path}` is not a field path ({why})");
+pub fn parse_path(path: &str) -> Result<Vec<PathStep>, FieldError> {
+    let bad = |why: &'static str| FieldError::Syntax {
+        path: path.to_string(),
+        why,
+    };
     let mut out = Vec::new();
     for part in path.split('.') {
         let (field, index) = match part.split_once('[') {
@@ -336,7 +569,7 @@ impl Decoder {
     /// the path and the message type when the message has no such field, the field is
     /// not a primitive, or its type does not convert to `ty` (integers to `int` or
     /// `float`, floats to `float`, `bool` to `bool`, strings to `string`).
-    pub fn add(&mut self, path: &str, ty: Ty) -> Result<usize, String> {
+    pub fn add(&mut self, path: &str, ty: Ty) -> Result<usize, FieldError> {
         // A failed path leaves the selection as it was.
         let mut sel = std::mem::take(&mut self.sel);
         let before = sel.clone();
@@ -345,7 +578,7 @@ impl Decoder {
         r
     }
 
-    fn add_into(&mut self, top: &mut MsgSel, path: &str, ty: Ty) -> Result<usize, String> {
+    fn add_into(&mut self, top: &mut MsgSel, path: &str, ty: Ty) -> Result<usize, FieldError> {
         let steps = parse_path(path)?;
         let slot = self.slot_ty.len();
         let mut ty_index = 0usize;
@@ -355,13 +588,13 @@ impl Decoder {
             let last = k + 1 == steps.len();
             let st: &SType = &self.schema.types[ty_index];
             let Some(fi) = st.fields.iter().position(|f| f.name == step.field) else {
-                let known: Vec<&str> = st.fields.iter().map(|f| f.name.as_str()).collect();
-                return Err(format!(
-                    "message `{}` has no field `{}` (field path `{path}` of `{root}`; its fields: {})",
-                    st.name,
-                    step.field,
-                    known.join(", ")
-                ));
+                return Err(FieldError::NoField {
+                    ty: st.name.clone(),
+                    field: step.field.clone(),
+                    path: path.to_string(),
+                    root,
+                    known: st.fields.iter().map(|f| f.name.clone()).collect(),
+                });
             };
             let f = st.fields[fi].clone();
             let pos = match sel.fields.binary_search_by_key(&fi, |(i, _)| *i) {
@@ -387,24 +620,28 @@ impl Decoder {
             if let Some(i) = step.index {
                 match f.array {
                     ArraySize::Scalar => {
-                        return Err(format!(
-                            "`{here}` indexes field `{}` of `{}`, which is not an array",
-                            step.field, st.name
-                        ))
+                        return Err(FieldError::NotAnArray {
+                            here: here.clone(),
+                            field: step.field.clone(),
+                            ty: st.name.clone(),
+                        })
                     }
                     ArraySize::Fixed(n) | ArraySize::Bounded(n) if i >= n => {
-                        return Err(format!(
-                            "`{here}`: field `{}` of `{}` has at most {n} element(s)",
-                            step.field, st.name
-                        ))
+                        return Err(FieldError::PastBound {
+                            here: here.clone(),
+                            field: step.field.clone(),
+                            ty: st.name.clone(),
+                            bound: n as usize,
+                        })
                     }
                     _ => {}
                 }
             } else if f.array != ArraySize::Scalar {
-                return Err(format!(
-                    "`{here}` is an array (field `{}` of `{}`): name one element, `{here}[0]`",
-                    step.field, st.name
-                ));
+                return Err(FieldError::IsAnArray {
+                    here: here.clone(),
+                    field: step.field.clone(),
+                    ty: st.name.clone(),
+                });
             }
             let leaf_or_sub = match &mut sel.fields[pos].1 {
                 FieldSel::Leaf(s) => Err(s),
@@ -431,11 +668,11 @@ impl Decoder {
             match (leaf_or_sub, f.elem) {
                 (Err(s), Elem::Prim(p)) => {
                     if !last {
-                        return Err(format!(
-                            "`{here}` is a {} of `{}`, it has no fields",
-                            p.msg_name(),
-                            st.name
-                        ));
+                        return Err(FieldError::NoFields {
+                            here: here.clone(),
+                            prim: p.msg_name(),
+                            ty: st.name.clone(),
+                        });
                     }
                     check_convert(p, ty, path, &root)?;
                     if *s != usize::MAX {
@@ -448,10 +685,10 @@ impl Decoder {
                 }
                 (Ok(sub), Elem::Msg(t)) => {
                     if last {
-                        return Err(format!(
-                            "`{here}` is a message (`{}`): name one of its fields",
-                            self.schema.types[t].name
-                        ));
+                        return Err(FieldError::IsAMessage {
+                            here: here.clone(),
+                            ty: self.schema.types[t].name.clone(),
+                        });
                     }
                     ty_index = t;
                     sel = sub;
@@ -459,7 +696,11 @@ impl Decoder {
                 _ => unreachable!("a selection follows its field's element type"),
             }
         }
-        Err(format!("`{path}`: empty field path"))
+        // `parse_path` gives at least one step (an empty path is a step with no name).
+        Err(FieldError::Syntax {
+            path: path.to_string(),
+            why: "it is empty",
+        })
     }
 
     /// Decodes one serialised message (encapsulation header included), writing every
@@ -478,11 +719,10 @@ impl Decoder {
         self.walk(&mut c, 0, Some(&self.sel), out, present)?;
         // Writers pad a message to a multiple of 4 bytes (or 8): more is not this type.
         if c.left() >= 8 {
-            return err(format!(
-                "{} byte(s) follow the end of a `{}` (is this the message's type?)",
-                c.left(),
-                self.schema.root().name
-            ));
+            return err(CdrError::Trailing {
+                left: c.left(),
+                ty: self.schema.root().name.clone(),
+            });
         }
         Ok(())
     }
@@ -525,10 +765,12 @@ impl Decoder {
                 ArraySize::Bounded(b) => {
                     let n = c.count(1)?;
                     if n > b as usize {
-                        return err(format!(
-                            "field `{}` of `{}` has {n} elements, more than its bound {b}",
-                            f.name, st.name
-                        ));
+                        return err(CdrError::PastBound {
+                            field: f.name.clone(),
+                            ty: st.name.clone(),
+                            count: n,
+                            bound: b,
+                        });
                     }
                     n
                 }
@@ -594,10 +836,10 @@ impl Decoder {
             (Ty::Int, Leaf::UInt(u)) => match i64::try_from(u) {
                 Ok(i) => Value::Int(i),
                 Err(_) => {
-                    return err(format!(
-                        "`{}` is {u}, past the largest integer a property holds",
-                        self.slot_path[slot]
-                    ))
+                    return err(CdrError::TooLarge {
+                        path: self.slot_path[slot].clone(),
+                        value: u,
+                    })
                 }
             },
             (Ty::Float, Leaf::Float(f)) => Value::Float(f),
@@ -617,7 +859,11 @@ impl Decoder {
                         .unwrap_or(u32::MAX),
                 )
             }
-            _ => return err(format!("`{}`: type mismatch", self.slot_path[slot])),
+            _ => {
+                return err(CdrError::Mismatch {
+                    path: self.slot_path[slot].clone(),
+                })
+            }
         };
         Ok(())
     }
@@ -642,7 +888,7 @@ fn mark_absent(sel: &MsgSel, present: &mut [bool]) {
 }
 
 /// Whether a field of primitive `p` converts to a value of type `ty`.
-fn check_convert(p: Primitive, ty: Ty, path: &str, root: &str) -> Result<(), String> {
+fn check_convert(p: Primitive, ty: Ty, path: &str, root: &str) -> Result<(), FieldError> {
     let ok = match ty {
         Ty::Bool => p == Primitive::Bool,
         Ty::Int => p.int_range().is_some(),
@@ -660,10 +906,12 @@ fn check_convert(p: Primitive, ty: Ty, path: &str, root: &str) -> Result<(), Str
             Ty::Float => "a number",
             Ty::Str => "string",
         };
-        Err(format!(
-            "field `{path}` of `{root}` is a {}, which is not read as {want}",
-            p.msg_name()
-        ))
+        Err(FieldError::Convert {
+            path: path.to_string(),
+            root: root.to_string(),
+            prim: p.msg_name(),
+            want,
+        })
     }
 }
 
@@ -692,11 +940,11 @@ mod tests {
             .unwrap();
         assert_eq!(out[0], Value::Int(256));
         assert!(d.decode(&[0, 1, 0, 0, 1, 2], &mut out, &mut p).is_err());
-        assert!(d
+        let e = d
             .decode(&[0, 2, 0, 0, 1, 2, 3, 4], &mut out, &mut p)
-            .unwrap_err()
-            .0
-            .contains("encapsulation"));
+            .unwrap_err();
+        assert_eq!(e, CdrError::Encapsulation { kind: [0, 2] });
+        assert!(e.to_string().contains("encapsulation"));
     }
 
     #[test]
@@ -706,15 +954,25 @@ mod tests {
         let sec = d.add("header.stamp.sec", Ty::Int).unwrap();
         let frame = d.add("header.frame_id", Ty::Str).unwrap();
         let cell = d.add("cell_voltage[1]", Ty::Float).unwrap();
-        assert!(d
-            .add("cell_voltag[0]", Ty::Float)
-            .unwrap_err()
-            .contains("no field `cell_voltag`"));
-        assert!(d
-            .add("cell_voltage", Ty::Float)
-            .unwrap_err()
-            .contains("array"));
-        assert!(d.add("voltage", Ty::Bool).unwrap_err().contains("float32"));
+        let e = d.add("cell_voltag[0]", Ty::Float).unwrap_err();
+        assert!(
+            matches!(&e, FieldError::NoField { field, root, .. }
+                if field == "cell_voltag" && root == "sensor_msgs/BatteryState"),
+            "{e:?}"
+        );
+        assert!(e.to_string().contains("no field `cell_voltag`"));
+        assert!(matches!(
+            d.add("cell_voltage", Ty::Float).unwrap_err(),
+            FieldError::IsAnArray { .. }
+        ));
+        assert!(matches!(
+            d.add("voltage", Ty::Bool).unwrap_err(),
+            FieldError::Convert {
+                prim: "float32",
+                want: "bool",
+                ..
+            }
+        ));
         let mut m = vec![0, 1, 0, 0];
         m.extend(7i32.to_le_bytes()); // sec
         m.extend(0u32.to_le_bytes()); // nanosec
@@ -750,8 +1008,18 @@ mod tests {
         assert!(!p[cell] && p[sec]);
         // A sequence that claims 4 G elements fails at once, without allocating.
         m[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
-        let e = d.decode(&m, &mut out, &mut p).unwrap_err().0;
-        assert!(e.contains("4294967295"), "{e}");
+        let e = d.decode(&m, &mut out, &mut p).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                CdrError::Count {
+                    count: 4294967295,
+                    ..
+                }
+            ),
+            "{e}"
+        );
+        assert!(e.to_string().contains("4294967295"), "{e}");
         // Truncated anywhere: an error, never a panic.
         m[at..at + 4].copy_from_slice(&2u32.to_le_bytes());
         for n in 0..m.len() - 3 {

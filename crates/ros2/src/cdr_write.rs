@@ -16,9 +16,128 @@
 //! length or a value of another kind is an error naming the field, never a wrapped or
 //! truncated number.
 
-use crate::cdr::parse_path;
+use crate::cdr::{parse_path, FieldError};
 use crate::interface::{ArraySize, Primitive};
 use crate::schema::{Elem, Schema};
+
+/// A value that does not fit its type: every variant names the field path (`at`, the
+/// root type's name for the whole message).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum EncodeError {
+    /// [`Val::set`] named a field the type does not have as asked (boxed: it is the
+    /// largest variant, and results are passed around on every message).
+    Field(Box<FieldError>),
+    /// A message was expected (of type `ty`).
+    NotAMessage {
+        /// The field path.
+        at: String,
+        /// The message type.
+        ty: String,
+    },
+    /// A message value with another number of fields than its type.
+    FieldCount {
+        /// The field path.
+        at: String,
+        /// The message type.
+        ty: String,
+        /// Fields of the type.
+        want: usize,
+        /// Fields of the value.
+        got: usize,
+    },
+    /// An array or sequence was expected.
+    NotAnArray {
+        /// The field path.
+        at: String,
+    },
+    /// A fixed array of `n` elements given `got`.
+    FixedLength {
+        /// The field path.
+        at: String,
+        /// Its size.
+        n: u32,
+        /// The value's.
+        got: usize,
+    },
+    /// A bounded sequence or string past its bound (`len` elements, bytes or UTF-16
+    /// units).
+    PastBound {
+        /// The field path.
+        at: String,
+        /// The value's length.
+        len: usize,
+        /// The bound.
+        bound: u32,
+        /// `elements`, `bytes` or `UTF-16 units`.
+        unit: &'static str,
+    },
+    /// A sequence or string longer than CDR's `uint32` length holds.
+    TooLong {
+        /// The field path.
+        at: String,
+    },
+    /// A value of another kind than the primitive field (`what` says which).
+    Kind {
+        /// The field path.
+        at: String,
+        /// The field's `.msg` type.
+        prim: &'static str,
+        /// What the value is not (`is not a bool`, ...).
+        what: &'static str,
+    },
+    /// A string with a NUL byte (CDR ends strings with one).
+    Nul {
+        /// The field path.
+        at: String,
+    },
+    /// An integer out of its field's range.
+    Range {
+        /// The field path.
+        at: String,
+        /// The field's `.msg` type.
+        prim: &'static str,
+        /// The value.
+        value: i128,
+    },
+}
+
+impl std::fmt::Display for EncodeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            EncodeError::Field(e) => write!(f, "{e}"),
+            EncodeError::NotAMessage { at, ty } => write!(f, "`{at}`: expected a `{ty}` message"),
+            EncodeError::FieldCount { at, ty, want, got } => {
+                write!(f, "`{at}`: a `{ty}` has {want} field(s), the value {got}")
+            }
+            EncodeError::NotAnArray { at } => write!(f, "`{at}`: expected an array"),
+            EncodeError::FixedLength { at, n, got } => {
+                write!(f, "`{at}`: a fixed array of {n}, the value has {got}")
+            }
+            EncodeError::PastBound {
+                at,
+                len,
+                bound,
+                unit,
+            } => write!(f, "`{at}`: {len} {unit}, past the bound {bound}"),
+            EncodeError::TooLong { at } => write!(f, "`{at}`: too long for CDR"),
+            EncodeError::Kind { at, prim, what } => {
+                write!(f, "`{at}` is a {prim}, the value {what}")
+            }
+            EncodeError::Nul { at } => write!(f, "`{at}`: a string holds no NUL byte"),
+            EncodeError::Range { at, prim, value } => {
+                write!(f, "`{at}` is a {prim}, which does not hold {value}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for EncodeError {}
+
+impl From<FieldError> for EncodeError {
+    fn from(e: FieldError) -> Self {
+        EncodeError::Field(Box::new(e))
+    }
+}
 
 /// A message value, shaped like its type.
 #[derive(Clone, Debug, PartialEq)]
@@ -66,31 +185,50 @@ impl Val {
     /// A sequence too short for an index grows with zeros (up to its bound). An error
     /// names the path when the type has no such field or `v` is not of its kind (checked
     /// in full by [`encode`]).
-    pub fn set(&mut self, schema: &Schema, path: &str, v: Val) -> Result<(), String> {
+    pub fn set(&mut self, schema: &Schema, path: &str, v: Val) -> Result<(), EncodeError> {
         let steps = parse_path(path)?;
         let mut t = 0usize;
         let mut here: &mut Val = self;
         for (k, step) in steps.iter().enumerate() {
             let last = k + 1 == steps.len();
             let st = &schema.types[t];
+            let upto = || {
+                steps[..=k]
+                    .iter()
+                    .map(|s| match s.index {
+                        Some(i) => format!("{}[{i}]", s.field),
+                        None => s.field.clone(),
+                    })
+                    .collect::<Vec<_>>()
+                    .join(".")
+            };
             let Some(fi) = st.fields.iter().position(|f| f.name == step.field) else {
-                return Err(format!(
-                    "message `{}` has no field `{}` (field path `{path}`)",
-                    st.name, step.field
-                ));
+                return Err(FieldError::NoField {
+                    ty: st.name.clone(),
+                    field: step.field.clone(),
+                    path: path.to_string(),
+                    root: schema.root().name.clone(),
+                    known: st.fields.iter().map(|f| f.name.clone()).collect(),
+                }
+                .into());
             };
             let f = &st.fields[fi];
             let Val::Msg(fields) = here else {
-                return Err(format!("`{path}`: `{}` is not a message value", st.name));
+                return Err(EncodeError::NotAMessage {
+                    at: path.to_string(),
+                    ty: st.name.clone(),
+                });
             };
             let mut slot = &mut fields[fi];
             if let Some(i) = step.index {
                 let i = i as usize;
                 let Val::Seq(items) = slot else {
-                    return Err(format!(
-                        "`{path}` indexes field `{}` of `{}`, which is not an array",
-                        f.name, st.name
-                    ));
+                    return Err(FieldError::NotAnArray {
+                        here: upto(),
+                        field: f.name.clone(),
+                        ty: st.name.clone(),
+                    }
+                    .into());
                 };
                 let max = match f.array {
                     ArraySize::Scalar => 0,
@@ -98,10 +236,13 @@ impl Val {
                     ArraySize::Unbounded => usize::MAX,
                 };
                 if i >= max {
-                    return Err(format!(
-                        "`{path}`: field `{}` of `{}` has at most {max} element(s)",
-                        f.name, st.name
-                    ));
+                    return Err(FieldError::PastBound {
+                        here: upto(),
+                        field: f.name.clone(),
+                        ty: st.name.clone(),
+                        bound: max,
+                    }
+                    .into());
                 }
                 while items.len() <= i {
                     items.push(match f.elem {
@@ -111,10 +252,12 @@ impl Val {
                 }
                 slot = &mut items[i];
             } else if f.array != ArraySize::Scalar && !last {
-                return Err(format!(
-                    "`{path}`: field `{}` of `{}` is an array: name one element",
-                    f.name, st.name
-                ));
+                return Err(FieldError::IsAnArray {
+                    here: upto(),
+                    field: f.name.clone(),
+                    ty: st.name.clone(),
+                }
+                .into());
             }
             match f.elem {
                 Elem::Msg(m) if !last => {
@@ -122,12 +265,12 @@ impl Val {
                     here = slot;
                 }
                 Elem::Prim(p) if !last => {
-                    return Err(format!(
-                        "`{path}`: field `{}` of `{}` is a {}, it has no fields",
-                        f.name,
-                        st.name,
-                        p.msg_name()
-                    ))
+                    return Err(FieldError::NoFields {
+                        here: upto(),
+                        prim: p.msg_name(),
+                        ty: st.name.clone(),
+                    }
+                    .into())
                 }
                 _ => {
                     *slot = v;
@@ -135,7 +278,12 @@ impl Val {
                 }
             }
         }
-        Err(format!("`{path}`: empty field path"))
+        // `parse_path` gives at least one step (an empty path is a step with no name).
+        Err(FieldError::Syntax {
+            path: path.to_string(),
+            why: "it is empty",
+        }
+        .into())
     }
 }
 
@@ -150,7 +298,7 @@ fn prim_zero(p: Primitive) -> Val {
 
 /// Serialises `v`, a value of the root type of `schema`: the 4-byte little-endian header,
 /// then the body.
-pub fn encode(schema: &Schema, v: &Val) -> Result<Vec<u8>, String> {
+pub fn encode(schema: &Schema, v: &Val) -> Result<Vec<u8>, EncodeError> {
     let mut w = Writer {
         out: vec![0, 1, 0, 0],
     };
@@ -175,18 +323,21 @@ impl Writer {
         self.out.extend_from_slice(&n.to_le_bytes());
     }
 
-    fn msg(&mut self, schema: &Schema, t: usize, v: &Val, at: &str) -> Result<(), String> {
+    fn msg(&mut self, schema: &Schema, t: usize, v: &Val, at: &str) -> Result<(), EncodeError> {
         let st = &schema.types[t];
         let Val::Msg(fields) = v else {
-            return Err(format!("`{at}`: expected a `{}` message", st.name));
+            return Err(EncodeError::NotAMessage {
+                at: at.to_string(),
+                ty: st.name.clone(),
+            });
         };
         if fields.len() != st.fields.len() {
-            return Err(format!(
-                "`{at}`: a `{}` has {} field(s), the value {}",
-                st.name,
-                st.fields.len(),
-                fields.len()
-            ));
+            return Err(EncodeError::FieldCount {
+                at: at.to_string(),
+                ty: st.name.clone(),
+                want: st.fields.len(),
+                got: fields.len(),
+            });
         }
         for (f, fv) in st.fields.iter().zip(fields) {
             let path = if at == st.name || at.is_empty() {
@@ -203,25 +354,28 @@ impl Writer {
                 continue;
             }
             let Val::Seq(items) = fv else {
-                return Err(format!("`{path}`: expected an array"));
+                return Err(EncodeError::NotAnArray { at: path });
             };
             match f.array {
                 ArraySize::Fixed(n) if items.len() != n as usize => {
-                    return Err(format!(
-                        "`{path}`: a fixed array of {n}, the value has {}",
-                        items.len()
-                    ))
+                    return Err(EncodeError::FixedLength {
+                        at: path,
+                        n,
+                        got: items.len(),
+                    })
                 }
                 ArraySize::Fixed(_) => {}
                 ArraySize::Bounded(b) if items.len() > b as usize => {
-                    return Err(format!(
-                        "`{path}`: {} elements, past the bound {b}",
-                        items.len()
-                    ))
+                    return Err(EncodeError::PastBound {
+                        at: path,
+                        len: items.len(),
+                        bound: b,
+                        unit: "elements",
+                    })
                 }
                 _ => {
                     let n = u32::try_from(items.len())
-                        .map_err(|_| format!("`{path}`: too many elements"))?;
+                        .map_err(|_| EncodeError::TooLong { at: path.clone() })?;
                     self.u32(n);
                 }
             }
@@ -238,8 +392,14 @@ impl Writer {
         bound: Option<u32>,
         v: &Val,
         path: &str,
-    ) -> Result<(), String> {
-        let kind = |what: &str| Err(format!("`{path}` is a {}, the value {what}", p.msg_name()));
+    ) -> Result<(), EncodeError> {
+        let kind = |what: &'static str| {
+            Err(EncodeError::Kind {
+                at: path.to_string(),
+                prim: p.msg_name(),
+                what,
+            })
+        };
         match p {
             Primitive::Bool => match v {
                 Val::Bool(b) => self.out.push(u8::from(*b)),
@@ -266,27 +426,37 @@ impl Writer {
                 };
                 if p == Primitive::String {
                     if s.as_bytes().contains(&0) {
-                        return Err(format!("`{path}`: a string holds no NUL byte"));
+                        return Err(EncodeError::Nul {
+                            at: path.to_string(),
+                        });
                     }
-                    if bound.is_some_and(|b| s.len() > b as usize) {
-                        return Err(format!(
-                            "`{path}`: {} bytes, past the bound {}",
-                            s.len(),
-                            bound.unwrap_or(0)
-                        ));
+                    if let Some(b) = bound.filter(|b| s.len() > *b as usize) {
+                        return Err(EncodeError::PastBound {
+                            at: path.to_string(),
+                            len: s.len(),
+                            bound: b,
+                            unit: "bytes",
+                        });
                     }
-                    let n = u32::try_from(s.len() + 1)
-                        .map_err(|_| format!("`{path}`: string too long"))?;
+                    let n = u32::try_from(s.len() + 1).map_err(|_| EncodeError::TooLong {
+                        at: path.to_string(),
+                    })?;
                     self.u32(n);
                     self.out.extend_from_slice(s.as_bytes());
                     self.out.push(0);
                 } else {
                     let units: Vec<u16> = s.encode_utf16().collect();
-                    if bound.is_some_and(|b| units.len() > b as usize) {
-                        return Err(format!("`{path}`: past the bound"));
+                    if let Some(b) = bound.filter(|b| units.len() > *b as usize) {
+                        return Err(EncodeError::PastBound {
+                            at: path.to_string(),
+                            len: units.len(),
+                            bound: b,
+                            unit: "UTF-16 units",
+                        });
                     }
-                    let n = u32::try_from(units.len())
-                        .map_err(|_| format!("`{path}`: string too long"))?;
+                    let n = u32::try_from(units.len()).map_err(|_| EncodeError::TooLong {
+                        at: path.to_string(),
+                    })?;
                     self.u32(n);
                     for u in units {
                         self.out.extend_from_slice(&u.to_le_bytes());
@@ -301,10 +471,11 @@ impl Writer {
                 };
                 let (lo, hi) = p.int_range().unwrap_or((0, 0));
                 if n < lo || n > hi {
-                    return Err(format!(
-                        "`{path}` is a {}, which does not hold {n}",
-                        p.msg_name()
-                    ));
+                    return Err(EncodeError::Range {
+                        at: path.to_string(),
+                        prim: p.msg_name(),
+                        value: n,
+                    });
                 }
                 let size = match p {
                     Primitive::Int16 | Primitive::UInt16 => 2,
@@ -348,10 +519,26 @@ mod tests {
         // Out of range, of another kind, no such field: errors naming the field.
         let mut v = Val::zero(&s, 0);
         v.set(&s, "data", Val::Int(1 << 40)).unwrap();
-        assert!(encode(&s, &v).unwrap_err().contains("`data` is a int32"));
+        let e = encode(&s, &v).unwrap_err();
+        assert!(e.to_string().contains("`data` is a int32"), "{e}");
+        assert_eq!(
+            e,
+            EncodeError::Range {
+                at: "data".into(),
+                prim: "int32",
+                value: 1 << 40
+            }
+        );
         v.set(&s, "data", Val::Bool(true)).unwrap();
-        assert!(encode(&s, &v).unwrap_err().contains("not an integer"));
-        assert!(v.set(&s, "dat", Val::Int(1)).unwrap_err().contains("`dat`"));
+        assert!(encode(&s, &v)
+            .unwrap_err()
+            .to_string()
+            .contains("not an integer"));
+        assert!(v
+            .set(&s, "dat", Val::Int(1))
+            .unwrap_err()
+            .to_string()
+            .contains("`dat`"));
     }
 
     /// Every field the writer writes, the reader reads back: nested, strings, sequences,
@@ -415,12 +602,19 @@ mod tests {
         assert!(v
             .set(&s, "request[1].a", Val::Int(5))
             .unwrap_err()
+            .to_string()
             .contains("at most 1"));
         v.set(&s, "info.client_gid", Val::Seq(vec![Val::Int(1)]))
             .unwrap();
-        assert!(encode(&s, &v).unwrap_err().contains("fixed array of 16"));
+        assert!(matches!(
+            encode(&s, &v).unwrap_err(),
+            EncodeError::FixedLength { n: 16, got: 1, .. }
+        ));
         v.set(&s, "info.client_gid", Val::zero(&s, 0)).unwrap();
-        assert!(encode(&s, &v).unwrap_err().contains("expected an array"));
+        assert!(encode(&s, &v)
+            .unwrap_err()
+            .to_string()
+            .contains("expected an array"));
         let mut v = Val::zero(&s, 0);
         v.set(&s, "request[0].b", Val::Int(-9)).unwrap();
         v.set(&s, "info.event_type", Val::Int(1)).unwrap();

@@ -28,9 +28,217 @@ use std::path::Path;
 
 use monitor_core::{Ty, Value};
 
-use crate::bag::{Connection, Recording, Visit};
-use crate::cdr::Decoder;
-use crate::schema::{Definitions, Ros2MsgDefs, Schema};
+use crate::bag::{BagError, Connection, Recording, Visit};
+use crate::cdr::{CdrError, Decoder, FieldError};
+use crate::schema::{Definitions, Ros2MsgDefs, Schema, SchemaError};
+
+/// Why the ports of a topic cannot read its type (the caller names the topic).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PlanError {
+    /// The definition the recording embeds does not resolve.
+    Embedded(SchemaError),
+    /// The type is not embedded and the interface packages do not define it.
+    NotEmbedded {
+        /// The ROS type.
+        type_name: String,
+        /// Why it does not resolve.
+        error: SchemaError,
+    },
+    /// `--time header` on a type without `header.stamp`.
+    NoHeader(Box<FieldError>),
+    /// A service port on a topic whose type is not a service event.
+    NotServiceEvent(Box<FieldError>),
+    /// A port reads a field the type lacks (or of another kind).
+    Port {
+        /// The port's variable.
+        name: String,
+        /// Why.
+        error: Box<FieldError>,
+    },
+}
+
+impl std::fmt::Display for PlanError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PlanError::Embedded(e) => write!(f, "{e}"),
+            PlanError::NotEmbedded { type_name, error } => write!(
+                f,
+                "{error}: the recording does not embed the definition of `{type_name}`; name its package's folder with --interfaces (or source its ROS workspace)"
+            ),
+            PlanError::NoHeader(e) => write!(f, "--time header needs a `header` field: {e}"),
+            PlanError::NotServiceEvent(e) => write!(f, "not a service event: {e}"),
+            PlanError::Port { name, error } => write!(f, "port `{name}`: {error}"),
+        }
+    }
+}
+
+impl std::error::Error for PlanError {}
+
+/// What is wrong with one message (the caller names the topic and the index).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum MessageError {
+    /// It does not decode as its type.
+    Cdr(CdrError),
+    /// Its `header.stamp` is before 1970.
+    BeforeEpoch {
+        /// `header.stamp.sec`.
+        sec: i64,
+        /// `header.stamp.nanosec`.
+        nanosec: i64,
+    },
+    /// A field a port reads is past the end of an array in this message.
+    Absent {
+        /// The field path.
+        path: String,
+    },
+    /// Its time is before the previous message's.
+    Backwards {
+        /// Which time.
+        time: TimeSource,
+        /// Its time, ns since the epoch.
+        at: u64,
+        /// The previous message's.
+        previous: u64,
+    },
+}
+
+impl std::fmt::Display for MessageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MessageError::Cdr(e) => write!(f, "{e}"),
+            MessageError::BeforeEpoch { sec, nanosec } => {
+                write!(f, "header.stamp {sec}s {nanosec}ns is before 1970")
+            }
+            MessageError::Absent { path } => write!(
+                f,
+                "`{path}` is not in this message (an array on its path is shorter)"
+            ),
+            MessageError::Backwards { time, at, previous } => {
+                let what = match time {
+                    TimeSource::Header => "header stamp",
+                    TimeSource::Log => "log time",
+                };
+                write!(
+                    f,
+                    "its {what} {at} ns is before the previous message's ({previous} ns)"
+                )
+            }
+        }
+    }
+}
+
+impl std::error::Error for MessageError {}
+
+/// Why a replay stopped: the recording, a topic's ports, a message, or the caller's
+/// `on_point` (error `E`). Every variant names the file, and the topic and the message's
+/// index on it (from 1) where one is at fault.
+#[derive(Debug)]
+pub enum ReplayError<E> {
+    /// The recording does not read.
+    Bag(BagError),
+    /// The ports of `topic` cannot read its type.
+    Topic {
+        /// The recording.
+        file: String,
+        /// The topic.
+        topic: String,
+        /// Why (boxed: errors are rare, results are passed around on every message).
+        error: Box<PlanError>,
+    },
+    /// Message `index` of `topic` is bad.
+    Message {
+        /// The recording.
+        file: String,
+        /// The topic.
+        topic: String,
+        /// The message's index on the topic, from 1.
+        index: u64,
+        /// The topic's type.
+        type_name: String,
+        /// Why (boxed, as above).
+        error: Box<MessageError>,
+    },
+    /// `on_point` refused the point of message `index` of `topic`.
+    Point {
+        /// The recording.
+        file: String,
+        /// The topic.
+        topic: String,
+        /// The message's index on the topic, from 1.
+        index: u64,
+        /// The caller's error.
+        error: E,
+    },
+}
+
+impl<E> ReplayError<E> {
+    /// The same error with `on_point`'s error mapped by `f` (to describe it).
+    pub fn map_point<F>(self, f: impl FnOnce(E) -> F) -> ReplayError<F> {
+        match self {
+            ReplayError::Bag(e) => ReplayError::Bag(e),
+            ReplayError::Topic { file, topic, error } => ReplayError::Topic { file, topic, error },
+            ReplayError::Message {
+                file,
+                topic,
+                index,
+                type_name,
+                error,
+            } => ReplayError::Message {
+                file,
+                topic,
+                index,
+                type_name,
+                error,
+            },
+            ReplayError::Point {
+                file,
+                topic,
+                index,
+                error,
+            } => ReplayError::Point {
+                file,
+                topic,
+                index,
+                error: f(error),
+            },
+        }
+    }
+}
+
+impl<E> From<BagError> for ReplayError<E> {
+    fn from(e: BagError) -> Self {
+        ReplayError::Bag(e)
+    }
+}
+
+impl<E: std::fmt::Display> std::fmt::Display for ReplayError<E> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ReplayError::Bag(e) => write!(f, "{e}"),
+            ReplayError::Topic { file, topic, error } => {
+                write!(f, "{file}: topic `{topic}`: {error}")
+            }
+            ReplayError::Message {
+                file,
+                topic,
+                index,
+                type_name,
+                error,
+            } => write!(
+                f,
+                "{file}: topic `{topic}` message {index} (type `{type_name}`): {error}"
+            ),
+            ReplayError::Point {
+                file,
+                topic,
+                index,
+                error,
+            } => write!(f, "{file}: topic `{topic}` message {index}: {error}"),
+        }
+    }
+}
+
+impl<E: std::fmt::Debug + std::fmt::Display> std::error::Error for ReplayError<E> {}
 
 /// Where a point's time comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -137,7 +345,7 @@ impl Plan {
         slots: &mut Vec<Value>,
         present: &mut Vec<bool>,
         sets: &mut Vec<(usize, Value)>,
-    ) -> Result<Option<u64>, String> {
+    ) -> Result<Option<u64>, MessageError> {
         sets.clear();
         let Some(d) = &self.decoder else {
             for &(var, _, _) in &self.sets {
@@ -149,19 +357,19 @@ impl Plan {
             slots.resize(d.slots(), Value::Bool(false));
             present.resize(d.slots(), false);
         }
-        d.decode(data, slots, present).map_err(|e| e.to_string())?;
+        d.decode(data, slots, present).map_err(MessageError::Cdr)?;
         let mut stamp = None;
         if let Some((s, n)) = self.stamp {
+            // A decoder built by `plan` reads both as integers.
             let (Value::Int(sec), Value::Int(nsec)) = (slots[s], slots[n]) else {
-                // Unreachable for a decoder built by `plan`: both are integers.
-                return Err("header.stamp is not two integers".into());
+                unreachable!("header.stamp is read as two integers")
             };
             let ns = sec
                 .checked_mul(1_000_000_000)
                 .and_then(|x| x.checked_add(nsec))
                 .and_then(|x| u64::try_from(x).ok());
             let Some(ns) = ns else {
-                return Err(format!("header.stamp {sec}s {nsec}ns is before 1970"));
+                return Err(MessageError::BeforeEpoch { sec, nanosec: nsec });
             };
             stamp = Some(ns);
         }
@@ -175,10 +383,9 @@ impl Plan {
                 None => sets.push((var, Value::Bool(true))),
                 Some(s) if present[s] => sets.push((var, slots[s])),
                 Some(s) => {
-                    return Err(format!(
-                        "`{}` is not in this message (an array on its path is shorter)",
-                        d.slot_path(s)
-                    ))
+                    return Err(MessageError::Absent {
+                        path: d.slot_path(s).to_string(),
+                    })
                 }
             }
         }
@@ -205,7 +412,7 @@ impl TopicFeed {
         ports: &[Port],
         defs: &dyn Definitions,
         strings: &[String],
-    ) -> Result<TopicFeed, String> {
+    ) -> Result<TopicFeed, PlanError> {
         let conn = Connection {
             topic: topic.to_string(),
             type_name: type_name.to_string(),
@@ -221,7 +428,7 @@ impl TopicFeed {
 
     /// The variables one message sets (its CDR bytes with their 4-byte header). An
     /// error says what is wrong with the message; the caller names topic and index.
-    pub fn read(&mut self, data: &[u8]) -> Result<&[(usize, Value)], String> {
+    pub fn read(&mut self, data: &[u8]) -> Result<&[(usize, Value)], MessageError> {
         self.plan
             .read(data, &mut self.slots, &mut self.present, &mut self.sets)?;
         Ok(&self.sets)
@@ -232,14 +439,14 @@ impl TopicFeed {
 ///
 /// `defs` gives the definitions of types the recording does not embed (a `.db3` file);
 /// `strings` are the spec's string constants (see [`Decoder::new`]).
-pub fn replay(
+pub fn replay<E>(
     input: &Path,
     ports: &[Port],
     defs: &dyn Definitions,
     time: TimeSource,
     strings: &[String],
-    on_point: &mut dyn FnMut(Point<'_>) -> Result<(), String>,
-) -> Result<Summary, String> {
+    on_point: &mut dyn FnMut(Point<'_>) -> Result<(), E>,
+) -> Result<Summary, ReplayError<E>> {
     let rec = Recording::open(input)?;
     let shown = input.display().to_string();
     run(
@@ -254,14 +461,14 @@ pub fn replay(
 }
 
 /// [`replay`] of an MCAP file held in memory (the fuzz target's and the bench's entry).
-pub fn replay_mcap_bytes(
+pub fn replay_mcap_bytes<E>(
     bytes: &[u8],
     ports: &[Port],
     defs: &dyn Definitions,
     time: TimeSource,
     strings: &[String],
-    on_point: &mut dyn FnMut(Point<'_>) -> Result<(), String>,
-) -> Result<Summary, String> {
+    on_point: &mut dyn FnMut(Point<'_>) -> Result<(), E>,
+) -> Result<Summary, ReplayError<E>> {
     run(
         &mut |visit| crate::bag::mcap_bytes(bytes, "<mcap>", &mut Vec::new(), visit),
         "<mcap>",
@@ -273,15 +480,18 @@ pub fn replay_mcap_bytes(
     )
 }
 
-fn run(
-    source: &mut dyn FnMut(&mut Visit<'_>) -> Result<(), String>,
+/// What reads the messages: a recording's [`Recording::for_each`] or [`crate::bag::mcap_bytes`].
+type Source<'s, E> = dyn FnMut(&mut Visit<'_, ReplayError<E>>) -> Result<(), ReplayError<E>> + 's;
+
+fn run<E>(
+    source: &mut Source<'_, E>,
     shown: &str,
     ports: &[Port],
     defs: &dyn Definitions,
     time: TimeSource,
     strings: &[String],
-    on_point: &mut dyn FnMut(Point<'_>) -> Result<(), String>,
-) -> Result<Summary, String> {
+    on_point: &mut dyn FnMut(Point<'_>) -> Result<(), E>,
+) -> Result<Summary, ReplayError<E>> {
     let mut plans: Vec<Option<Plan>> = Vec::new();
     let mut slots: Vec<Value> = Vec::new();
     let mut present: Vec<bool> = Vec::new();
@@ -296,34 +506,36 @@ fn run(
         let plan = match &mut plans[msg.conn] {
             Some(p) => p,
             slot => {
-                let p = plan(&conns[msg.conn], ports, defs, time, strings)
-                    .map_err(|e| format!("{shown}: topic `{}`: {e}", conns[msg.conn].topic))?;
+                let p = plan(&conns[msg.conn], ports, defs, time, strings).map_err(|error| {
+                    ReplayError::Topic {
+                        file: shown.to_string(),
+                        topic: conns[msg.conn].topic.clone(),
+                        error: Box::new(error),
+                    }
+                })?;
                 slot.insert(p)
             }
         };
         plan.count += 1;
         messages += 1;
-        let at = |e: &dyn std::fmt::Display| {
-            format!(
-                "{shown}: topic `{}` message {} (type `{}`): {e}",
-                plan.topic, plan.count, conns[msg.conn].type_name
-            )
+        let at = |error| ReplayError::Message {
+            file: shown.to_string(),
+            topic: plan.topic.clone(),
+            index: plan.count,
+            type_name: conns[msg.conn].type_name.clone(),
+            error: Box::new(error),
         };
         let stamp = plan
             .read(msg.data, &mut slots, &mut present, &mut sets)
-            .map_err(|e| at(&e))?;
+            .map_err(at)?;
         let abs = stamp.unwrap_or(msg.log_time);
         let origin = *first.get_or_insert(abs);
         let Some(t) = abs.checked_sub(origin).filter(|t| *t >= last) else {
-            let what = if time == TimeSource::Header {
-                "header stamp"
-            } else {
-                "log time"
-            };
-            return Err(at(&format!(
-                "its {what} {abs} ns is before the previous message's ({} ns)",
-                origin + last
-            )));
+            return Err(at(MessageError::Backwards {
+                time,
+                at: abs,
+                previous: origin + last,
+            }));
         };
         last = t;
         on_point(Point {
@@ -331,6 +543,12 @@ fn run(
             sets: &sets,
             topic: &plan.topic,
             index: plan.count,
+        })
+        .map_err(|error| ReplayError::Point {
+            file: shown.to_string(),
+            topic: plan.topic.clone(),
+            index: plan.count,
+            error,
         })
     })?;
     let mut topics: Vec<(String, u64)> = Vec::new();
@@ -351,7 +569,7 @@ fn plan(
     defs: &dyn Definitions,
     time: TimeSource,
     strings: &[String],
-) -> Result<Plan, String> {
+) -> Result<Plan, PlanError> {
     let mine: Vec<&Port> = ports
         .iter()
         .filter(|p| p.recorded_topic() == conn.topic)
@@ -373,14 +591,12 @@ fn plan(
     }
     let schema = match &conn.definition {
         Some(text) => {
-            let local = Ros2MsgDefs::parse(&conn.type_name, text)?;
-            Schema::resolve(&conn.type_name, &local)?
+            let local = Ros2MsgDefs::parse(&conn.type_name, text).map_err(PlanError::Embedded)?;
+            Schema::resolve(&conn.type_name, &local).map_err(PlanError::Embedded)?
         }
-        None => Schema::resolve(&conn.type_name, defs).map_err(|e| {
-            format!(
-                "{e}: the recording does not embed the definition of `{}`; name its package's folder with --interfaces (or source its ROS workspace)",
-                conn.type_name
-            )
+        None => Schema::resolve(&conn.type_name, defs).map_err(|error| PlanError::NotEmbedded {
+            type_name: conn.type_name.clone(),
+            error,
         })?,
     };
     let mut d = Decoder::new(schema, strings);
@@ -389,9 +605,7 @@ fn plan(
         let nsec = d.add("header.stamp.nanosec", Ty::Int);
         match (sec, nsec) {
             (Ok(s), Ok(n)) => out.stamp = Some((s, n)),
-            (Err(e), _) | (_, Err(e)) => {
-                return Err(format!("--time header needs a `header` field: {e}"))
-            }
+            (Err(e), _) | (_, Err(e)) => return Err(PlanError::NoHeader(Box::new(e))),
         }
     }
     for p in mine {
@@ -400,7 +614,7 @@ fn plan(
             Some(side) => {
                 let s = d
                     .add("info.event_type", Ty::Int)
-                    .map_err(|e| format!("not a service event: {e}"))?;
+                    .map_err(|e| PlanError::NotServiceEvent(Box::new(e)))?;
                 Some((
                     s,
                     match side {
@@ -418,10 +632,10 @@ fn plan(
                     Some(ServiceSide::Request) => format!("request[0].{f}"),
                     Some(ServiceSide::Response) => format!("response[0].{f}"),
                 };
-                Some(
-                    d.add(&path, p.ty)
-                        .map_err(|e| format!("port `{}`: {e}", p.name))?,
-                )
+                Some(d.add(&path, p.ty).map_err(|error| PlanError::Port {
+                    name: p.name.clone(),
+                    error: Box::new(error),
+                })?)
             }
         };
         out.sets.push((p.var, slot, when));

@@ -20,7 +20,7 @@
 
 use std::collections::BTreeMap;
 
-use codegen::diag::SourceMap;
+use codegen::diag::{Diagnostics, SourceMap};
 
 use crate::interface::{
     parse_interface, ArraySize, BaseType, Field, FieldType, InterfaceKind, MessageDef, Primitive,
@@ -31,6 +31,62 @@ pub const MAX_DEPTH: usize = 32;
 
 /// Most distinct types one message may use.
 const MAX_TYPES: usize = 4096;
+
+/// A message type that cannot be resolved: its name, a definition missing or malformed,
+/// or a layout past the limits.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SchemaError {
+    /// Not `package/Type` or `package/msg/Type`.
+    TypeName(String),
+    /// A type that contains itself (`package/Type`).
+    ContainsItself(String),
+    /// Nesting deeper than [`MAX_DEPTH`], at this type.
+    TooDeep(String),
+    /// More than 4096 distinct types.
+    TooManyTypes,
+    /// No definition of this type.
+    NoDefinition(String),
+    /// A `ros2msg` section after a `===` line without `MSG: package/Type`, in the schema
+    /// of this root type.
+    UnnamedSection(String),
+    /// A `ros2msg` section that does not parse: the root type and the reader's
+    /// diagnostics (each naming the section and line).
+    Definition {
+        /// The root type whose schema text it is.
+        root: String,
+        /// What is wrong, where.
+        diagnostics: Diagnostics,
+    },
+}
+
+impl std::fmt::Display for SchemaError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SchemaError::TypeName(t) => write!(
+                f,
+                "`{t}` is not a ROS type name (expected `package/msg/Type`)"
+            ),
+            SchemaError::ContainsItself(t) => write!(
+                f,
+                "message `{t}` contains itself, so it has no finite layout"
+            ),
+            SchemaError::TooDeep(t) => {
+                write!(f, "messages nest deeper than {MAX_DEPTH} levels at `{t}`")
+            }
+            SchemaError::TooManyTypes => {
+                write!(f, "the message uses more than {MAX_TYPES} types")
+            }
+            SchemaError::NoDefinition(t) => write!(f, "no definition of message type `{t}`"),
+            SchemaError::UnnamedSection(root) => write!(
+                f,
+                "schema of `{root}`: a section after a `===` line has no `MSG: package/Type` line"
+            ),
+            SchemaError::Definition { diagnostics, .. } => write!(f, "{diagnostics}"),
+        }
+    }
+}
+
+impl std::error::Error for SchemaError {}
 
 /// Where message definitions come from.
 pub trait Definitions {
@@ -89,7 +145,7 @@ impl Schema {
 
     /// Resolves `type_name` (`pkg/Type`, `pkg/msg/Type`, `pkg/srv/Name_Event` ...) and every
     /// type it uses from `defs`.
-    pub fn resolve(type_name: &str, defs: &dyn Definitions) -> Result<Schema, String> {
+    pub fn resolve(type_name: &str, defs: &dyn Definitions) -> Result<Schema, SchemaError> {
         let (pkg, name) = split_type_name(type_name)?;
         let mut b = Builder {
             defs,
@@ -141,15 +197,13 @@ impl Schema {
 }
 
 /// `pkg/Type` or `pkg/msg/Type` (also `srv`, `action`) -> `(pkg, Type)`.
-pub fn split_type_name(type_name: &str) -> Result<(String, String), String> {
+pub fn split_type_name(type_name: &str) -> Result<(String, String), SchemaError> {
     let parts: Vec<&str> = type_name.trim().split('/').collect();
     match parts.as_slice() {
         [p, n] | [p, "msg" | "srv" | "action", n] if !p.is_empty() && !n.is_empty() => {
             Ok((p.to_string(), n.to_string()))
         }
-        _ => Err(format!(
-            "`{type_name}` is not a ROS type name (expected `package/msg/Type`)"
-        )),
+        _ => Err(SchemaError::TypeName(type_name.to_string())),
     }
 }
 
@@ -161,24 +215,18 @@ struct Builder<'a> {
 }
 
 impl Builder<'_> {
-    fn add(&mut self, pkg: &str, name: &str, depth: usize) -> Result<usize, String> {
+    fn add(&mut self, pkg: &str, name: &str, depth: usize) -> Result<usize, SchemaError> {
         let key = (pkg.to_string(), name.to_string());
         match self.index.get(&key) {
-            Some(&usize::MAX) => {
-                return Err(format!(
-                    "message `{pkg}/{name}` contains itself, so it has no finite layout"
-                ))
-            }
+            Some(&usize::MAX) => return Err(SchemaError::ContainsItself(format!("{pkg}/{name}"))),
             Some(&i) => return Ok(i),
             None => {}
         }
         if depth > MAX_DEPTH {
-            return Err(format!(
-                "messages nest deeper than {MAX_DEPTH} levels at `{pkg}/{name}`"
-            ));
+            return Err(SchemaError::TooDeep(format!("{pkg}/{name}")));
         }
         if self.types.len() >= MAX_TYPES {
-            return Err(format!("the message uses more than {MAX_TYPES} types"));
+            return Err(SchemaError::TooManyTypes);
         }
         let def = self.lookup(pkg, name)?;
         let at = self.types.len();
@@ -217,7 +265,7 @@ impl Builder<'_> {
         Ok(at)
     }
 
-    fn lookup(&self, pkg: &str, name: &str) -> Result<MessageDef, String> {
+    fn lookup(&self, pkg: &str, name: &str) -> Result<MessageDef, SchemaError> {
         if let Some(d) = self.defs.message(pkg, name) {
             return Ok(d);
         }
@@ -235,7 +283,7 @@ impl Builder<'_> {
                 });
             }
         }
-        Err(format!("no definition of message type `{pkg}/{name}`"))
+        Err(SchemaError::NoDefinition(format!("{pkg}/{name}")))
     }
 }
 
@@ -287,7 +335,7 @@ pub struct Ros2MsgDefs {
 impl Ros2MsgDefs {
     /// Reads the `ros2msg` text of root type `type_name`. Errors name the section
     /// (`MSG: pkg/Type`) and line of the text.
-    pub fn parse(type_name: &str, text: &str) -> Result<Ros2MsgDefs, String> {
+    pub fn parse(type_name: &str, text: &str) -> Result<Ros2MsgDefs, SchemaError> {
         let (root_pkg, root_name) = split_type_name(type_name)?;
         let mut sections: Vec<(String, String, String)> =
             vec![(root_pkg, root_name, String::new())];
@@ -316,17 +364,13 @@ impl Ros2MsgDefs {
                 if body.trim().is_empty() {
                     continue;
                 }
-                return Err(format!(
-                    "schema of `{type_name}`: a section after a `===` line has no `MSG: package/Type` line"
-                ));
+                return Err(SchemaError::UnnamedSection(type_name.to_string()));
             }
             let file = sm.add(format!("<schema of {type_name}: {pkg}/{name}>"), body);
             let def = parse_interface(&sm, file, &pkg, &name, InterfaceKind::Message).map_err(
-                |errs| {
-                    errs.iter()
-                        .map(|d| d.to_string())
-                        .collect::<Vec<_>>()
-                        .join("\n")
+                |errs| SchemaError::Definition {
+                    root: type_name.to_string(),
+                    diagnostics: Diagnostics(errs),
                 },
             )?;
             let part = def.parts.into_iter().next().unwrap_or_default();
@@ -420,11 +464,17 @@ mod tests {
     #[test]
     fn a_missing_dependency_and_a_cycle_are_errors() {
         let defs = Ros2MsgDefs::parse("p/A", "q/B b\n").unwrap();
-        assert!(Schema::resolve("p/A", &defs).unwrap_err().contains("`q/B`"));
+        assert!(matches!(
+            Schema::resolve("p/A", &defs).unwrap_err(),
+            SchemaError::NoDefinition(t) if t == "q/B"
+        ));
         let defs = Ros2MsgDefs::parse("p/A", "B b\n===\nMSG: p/B\nA a\n").unwrap();
-        assert!(Schema::resolve("p/A", &defs)
-            .unwrap_err()
-            .contains("contains itself"));
+        let e = Schema::resolve("p/A", &defs).unwrap_err();
+        assert!(
+            matches!(&e, SchemaError::ContainsItself(t) if t == "p/A"),
+            "{e}"
+        );
+        assert!(e.to_string().contains("contains itself"));
     }
 
     #[test]

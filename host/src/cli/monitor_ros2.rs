@@ -40,7 +40,7 @@ fn stop_flag() -> &'static AtomicBool {
 
 /// A ROS type as DDS and the recordings name it: `pkg/msg/Type`, or for a service port
 /// the service's event type `pkg/srv/Name_Event`.
-fn full_type(written: &str, service: bool) -> Result<String, String> {
+fn full_type(written: &str, service: bool) -> Result<String, ros2::schema::SchemaError> {
     let (pkg, name) = ros2::schema::split_type_name(written)?;
     Ok(if service {
         format!("{pkg}/srv/{name}_Event")
@@ -107,7 +107,7 @@ pub fn run(
                         .transpose()
                 })
                 .collect::<Result<Vec<_>, _>>()
-                .map_err(input)?;
+                .map_err(|e| input(e.to_string()))?;
             (ports, types)
         }
         None => {

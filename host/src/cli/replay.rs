@@ -328,7 +328,9 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
     let mut points = 0usize;
     let start;
     {
-        let mut step = |time: u64, sets: &[(usize, Value)]| {
+        let mut step = |time: u64,
+                        sets: &[(usize, Value)]|
+         -> Result<(), monitor_core::StepError> {
             valuation::begin_point(program.vars, &mut vals);
             for &(var, v) in sets {
                 vals[var] = v;
@@ -375,19 +377,12 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
                 &Packages(packages),
                 time,
                 compiled.strings(),
-                &mut |p| {
-                    step(p.time_ns / tick, p.sets).map_err(|e: monitor_core::StepError| {
-                        format!(
-                            "{}: topic `{}` message {}: {}",
-                            args.trace.display(),
-                            p.topic,
-                            p.index,
-                            compiled.describe(&e)
-                        )
-                    })
-                },
+                &mut |p| step(p.time_ns / tick, p.sets),
             )
-            .map_err(CliError::Input)?;
+            .map_err(|e| {
+                // Exit 2 naming the file, the topic and the message's index on it.
+                CliError::Input(e.map_point(|s| compiled.describe(&s)).to_string())
+            })?;
             for p in &ports {
                 let topic = p.recorded_topic();
                 if !summary.topics.iter().any(|(t, _)| *t == topic) {

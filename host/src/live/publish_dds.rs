@@ -395,6 +395,7 @@ impl DdsPublisher {
         }
         let result = result
             .and_then(|()| encode(&route.schema, &v))
+            .map_err(|e| e.to_string())
             .and_then(|bytes| self.writers[*w].1.write(&bytes).map_err(|e| e.to_string()));
         match result {
             Ok(()) => self.published += 1,

@@ -106,7 +106,7 @@ fn scalar_ty(ty: &Ty) -> Option<monitor_core::Ty> {
 }
 
 /// The `pkg/srv/Name_<part>` of a declared service type `pkg/Name` or `pkg/srv/Name`.
-fn part_type(declared: &str, part: &str) -> Result<String, String> {
+fn part_type(declared: &str, part: &str) -> Result<String, ros2::schema::SchemaError> {
     let (pkg, name) = ros2::schema::split_type_name(declared)?;
     Ok(format!("{pkg}/srv/{name}_{part}"))
 }
@@ -125,8 +125,10 @@ impl DdsServices {
         let mut served = Vec::new();
         for route in routes {
             let s = &route.service;
-            let req_type = part_type(&route.type_name, "Request")?;
-            let resp_type = part_type(&route.type_name, "Response")?;
+            let req_type =
+                part_type(&route.type_name, "Request").map_err(|e| format!("service {s}: {e}"))?;
+            let resp_type =
+                part_type(&route.type_name, "Response").map_err(|e| format!("service {s}: {e}"))?;
             let req_schema =
                 Schema::resolve(&req_type, defs).map_err(|e| format!("service {s}: {e}"))?;
             let reply_schema =
@@ -246,6 +248,7 @@ impl DdsServices {
         }
         let sent = result
             .and_then(|()| encode(&s.reply_schema, &v))
+            .map_err(|e| e.to_string())
             .and_then(|cdr| {
                 s.writer
                     .write(&with_header(&cdr, &header))
