@@ -589,6 +589,61 @@ fn random_trees_with_skipped_lower_to_what_btcpp_does() {
     });
 }
 
+/// The same with the timed nodes and TryCatch too (`gen::Options::time_nodes`,
+/// `try_catch`), so that SKIPPED reaches every parent that takes it: WhileDoElse,
+/// Switch, TryCatch, Timeout, Delay and Precondition among them (`SKIP_PARENTS`), run
+/// by the lowered root machine in model time.
+#[test]
+fn random_trees_with_skipped_and_time_nodes_lower_to_what_btcpp_does() {
+    random_trees(gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        skipped: true,
+        time_nodes: true,
+        try_catch: true,
+        ..Default::default()
+    });
+}
+
+/// The parents whose SKIPPED child the coverage check counts (`skip_parents`).
+const SKIP_PARENTS: [&str; 6] = [
+    "WhileDoElse",
+    "Switch",
+    "TryCatch",
+    "Timeout",
+    "Delay",
+    "Precondition",
+];
+
+/// For each of [`SKIP_PARENTS`], whether the tree has one with a child that makes
+/// SKIPPED itself (`_skipIf`, `_while`, RunOnce with `then_skip`, Precondition with
+/// `else="SKIPPED"`).
+fn skip_parents(t: &tree::Tree) -> [bool; 6] {
+    let makes = |c: usize| {
+        let x = &t.nodes[c];
+        x.conds.pre[2].is_some()
+            || x.conds.pre[3].is_some()
+            || matches!(
+                x.kind,
+                Kind::RunOnce(true) | Kind::Precondition(_, Status::Skipped)
+            )
+    };
+    let mut out = [false; 6];
+    for p in &t.nodes {
+        let k = match p.kind {
+            Kind::WhileDoElse => 0,
+            Kind::Switch(..) => 1,
+            Kind::TryCatch(_) => 2,
+            Kind::Timeout(_) => 3,
+            Kind::Delay(_) => 4,
+            Kind::Precondition(..) => 5,
+            _ => continue,
+        };
+        out[k] |= p.children.iter().any(|&c| makes(c));
+    }
+    out
+}
+
 /// The same with BT.CPP 4's nodes AS2FM has no model of (AsyncSequence, AsyncFallback,
 /// ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2-6) in the
 /// format-4 trees.
@@ -657,7 +712,7 @@ fn btcpp4_kind(k: &Kind) -> Option<usize> {
 }
 
 /// Whether the lowering refuses the tree's pre/post conditions as not modelled yet
-/// (`btcpp4_conds.rs`): conditions on the root, or on a node BT.CPP may tick again without resetting it (the condition of a two-child
+/// (`btcpp4_conds.rs`): conditions on a node BT.CPP may tick again without resetting it (the condition of a two-child
 /// IfThenElse or of a WhileDoElse, the child of a BlackboardCheck).
 fn conds_refused(t: &tree::Tree) -> bool {
     let stale = t.nodes.iter().any(|p| {
@@ -669,7 +724,7 @@ fn conds_refused(t: &tree::Tree) -> bool {
         };
         kids.iter().any(|&c| t.nodes[c].conds.any())
     });
-    stale || t.nodes[0].conds.any()
+    stale
 }
 
 /// The scripts of a generated document (the values of its `code`, `if` and `_...`
@@ -716,6 +771,9 @@ fn random_trees(opts: gen::Options) {
     // `else="SKIPPED"`; runs where some root tick answered SKIPPED.
     let skip_kinds: [AtomicUsize; 5] = Default::default();
     let skip_kinds = &skip_kinds;
+    // Trees compared with a SKIPPED-making child under each of `SKIP_PARENTS`.
+    let skip_under: [AtomicUsize; 6] = Default::default();
+    let skip_under = &skip_under;
     let counts = &counts;
     // Trees compared that hold each of BT.CPP 4's own node kinds.
     let kinds: [AtomicUsize; 14] = Default::default();
@@ -856,6 +914,11 @@ fn random_trees(opts: gen::Options) {
                             }
                         }
                         skip_kinds[4].fetch_add(root_skipped, Relaxed);
+                        for (k, s) in skip_parents(&t).iter().enumerate() {
+                            if *s {
+                                skip_under[k].fetch_add(1, Relaxed);
+                            }
+                        }
                         if by_mode.len() == 2 && by_mode[0] != by_mode[1] {
                             counts[5].fetch_add(1, Relaxed);
                         }
@@ -878,7 +941,14 @@ fn random_trees(opts: gen::Options) {
             "SKIPPED: {skip_refused} trees left out where SKIPPED reaches a parent not modelled yet \
              (btcpp4_skip.rs); {with_skip} trees compared with a construct that makes SKIPPED: \
              _skipIf {skip_if}, _while {while_}, RunOnce skipping {run_once_skip}, Precondition \
-             else=SKIPPED {else_skipped}; {root_skipped} runs where the root answered SKIPPED"
+             else=SKIPPED {else_skipped}; {root_skipped} runs where the root answered SKIPPED; \
+             trees with such a child under {}",
+            SKIP_PARENTS
+                .iter()
+                .zip(skip_under.each_ref().map(|c| c.load(Relaxed)))
+                .map(|(k, c)| format!("{k} {c}"))
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     let kinds = kinds.each_ref().map(|c| c.load(Relaxed));
@@ -926,6 +996,28 @@ fn random_trees(opts: gen::Options) {
                 texts as u64 >= n / 100 && chains as u64 >= n / 100,
                 "only {texts} compared trees reading a SetBlackboard's text, {chains} chaining `+`/`-`"
             );
+        }
+        // With SKIPPED on, it reaches each parent of `SKIP_PARENTS` that is generated in
+        // at least one compared tree in 200.
+        if opts.skipped {
+            for (i, (k, c)) in SKIP_PARENTS
+                .iter()
+                .zip(skip_under.each_ref().map(|c| c.load(Relaxed)))
+                .enumerate()
+            {
+                let on = match i {
+                    0 | 1 => opts.btcpp4_nodes,
+                    2 => opts.try_catch,
+                    3 | 4 => opts.time_nodes,
+                    _ => opts.scripts,
+                };
+                if on {
+                    assert!(
+                        c as u64 >= n / 200,
+                        "only {c} compared trees where SKIPPED reaches a {k}"
+                    );
+                }
+            }
         }
         // With BT.CPP 4's own nodes on, each kind is in at least one tree in 100.
         for (i, (k, c)) in BTCPP4_KINDS.iter().zip(kinds).enumerate() {
