@@ -374,6 +374,35 @@ fn keep_running_run_once_and_parallel_all() {
 }
 
 #[test]
+fn a_skipped_while_do_else_condition_resets_the_children_and_stops_the_tree() {
+    // Derived from BT.CPP 4.10 `WhileDoElseNode::tick`. Tick 1: A (x is 0) fails, the
+    // Inverter succeeds, the do branch sets x and leaves B RUNNING. Tick 2: the
+    // Inverter, not reset, ticks A again (reset by `InverterNode::tick`), whose `_skipIf`
+    // now holds: the Inverter answers SKIPPED, staying RUNNING; the condition is neither
+    // SUCCESS nor FAILURE, so `resetChildren()` halts the Inverter and the do branch (B
+    // halted) and `return IDLE` throws in `executeTick` (`setStatus(IDLE)`). The
+    // differential test only compares the ticks before a throw (the oracle counts ticks
+    // from 0), so this one checks the
+    // halts made on the way and that no answer follows.
+    let t = v4(
+        "<Sequence><Script code=\"x := 0\"/><WhileDoElse><Inverter><A _skipIf=\"x == 1\"/></Inverter>\
+         <Sequence><Script code=\"x := 1\"/><B/></Sequence><C/></WhileDoElse></Sequence>",
+    );
+    let sc = scripts(&[("A", &[F]), ("B", &[R]), ("C", &[S])]);
+    let tree = tree::read(&t).unwrap();
+    let want = oracle::run_with(&tree, &sc, Options::xml4(TickMode::Once), 3).unwrap();
+    assert!(
+        matches!(want.end, Some(End::Error { tick: 1, .. })),
+        "{:?}",
+        want.end
+    );
+    assert_eq!(want.statuses, [R]);
+    let log = [T(1004), T(1007), H(1007)];
+    assert_eq!(want.log, log);
+    assert_eq!(lowered(&t, &sc, 3, BtTick::Once).unwrap(), ran(&[R], &log));
+}
+
+#[test]
 fn switch_halts_the_child_it_no_longer_picks() {
     // The IfThenElse writes `s` = a, then b: the Switch halts A, running, before ticking
     // B (`haltChild(running_child_)`). Checked against the real library.
