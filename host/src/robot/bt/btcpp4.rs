@@ -912,7 +912,7 @@ pub(super) fn switch(ctx: &Ctx, pick: &SwitchPick) -> Element {
         // only if it answered RUNNING last (`executeTick` does not store SKIPPED).
         let mut skipped: Vec<Element> = ctx.mark_skipped(i).into_iter().collect();
         skipped.push(b.assign("running_child", "-1"));
-        skipped.push(ctx.respond_expr(&format!("{SELF_RUNNING} ? {SKIPPED_RUNNING} : {SKIPPED}")));
+        skipped.push(super::btcpp4_skip::skipped_keeping_status(ctx));
         t.push(b.tr(
             Some(&ctx.child_resp(i)),
             Some(&format!("{IS_SKIPPED} && match_index == {i}")),

@@ -25,7 +25,7 @@ use crate::model::xml::Element;
 pub(super) const SELF_RUNNING: &str = "self_running";
 
 /// SKIPPED answered by a node that keeps its own status (see [`SELF_RUNNING`]).
-fn skipped_keeping_status(ctx: &Ctx) -> Element {
+pub(super) fn skipped_keeping_status(ctx: &Ctx) -> Element {
     ctx.respond_expr(&format!("{SELF_RUNNING} ? {SKIPPED_RUNNING} : {SKIPPED}"))
 }
 
