@@ -297,9 +297,9 @@ fn btcpp4_nodes_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         (
             "skip",
             "btcpp",
-            "<WhileDoElse>\n  <FailOnce/>\n  <RunOnce>\n    <FailOnce/>\n  </RunOnce>\n</WhileDoElse>",
+            "<IfThenElse>\n  <Sequence>\n    <RunOnce>\n      <FailOnce/>\n    </RunOnce>\n  </Sequence>\n  <AlwaysSuccess/>\n</IfThenElse>",
             "<RunOnce>",
-            "SKIPPED reaching a WhileDoElse is not modelled yet",
+            "SKIPPED reaching a sequence that BehaviorTree.CPP may tick again without resetting it",
         ),
         (
             "case",
@@ -381,9 +381,9 @@ fn scripts_and_conditions_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         (
             "skip",
             "btcpp",
-            "<WhileDoElse>\n  <FailOnce/>\n  <FailOnce _skipIf=\"true\"/>\n</WhileDoElse>",
+            "<IfThenElse>\n  <Sequence>\n    <FailOnce _skipIf=\"true\"/>\n  </Sequence>\n  <AlwaysSuccess/>\n</IfThenElse>",
             "<FailOnce _skipIf",
-            "SKIPPED reaching a WhileDoElse is not modelled yet",
+            "SKIPPED reaching a sequence that BehaviorTree.CPP may tick again without resetting it",
         ),
         (
             "string",

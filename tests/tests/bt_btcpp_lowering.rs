@@ -374,6 +374,35 @@ fn keep_running_run_once_and_parallel_all() {
 }
 
 #[test]
+fn a_skipped_while_do_else_condition_resets_the_children_and_stops_the_tree() {
+    // Derived from BT.CPP 4.10 `WhileDoElseNode::tick`. Tick 1: A (x is 0) fails, the
+    // Inverter succeeds, the do branch sets x and leaves B RUNNING. Tick 2: the
+    // Inverter, not reset, ticks A again (reset by `InverterNode::tick`), whose `_skipIf`
+    // now holds: the Inverter answers SKIPPED, staying RUNNING; the condition is neither
+    // SUCCESS nor FAILURE, so `resetChildren()` halts the Inverter and the do branch (B
+    // halted) and `return IDLE` throws in `executeTick` (`setStatus(IDLE)`). The
+    // differential test only compares the ticks before a throw (the oracle counts ticks
+    // from 0), so this one checks the
+    // halts made on the way and that no answer follows.
+    let t = v4(
+        "<Sequence><Script code=\"x := 0\"/><WhileDoElse><Inverter><A _skipIf=\"x == 1\"/></Inverter>\
+         <Sequence><Script code=\"x := 1\"/><B/></Sequence><C/></WhileDoElse></Sequence>",
+    );
+    let sc = scripts(&[("A", &[F]), ("B", &[R]), ("C", &[S])]);
+    let tree = tree::read(&t).unwrap();
+    let want = oracle::run_with(&tree, &sc, Options::xml4(TickMode::Once), 3).unwrap();
+    assert!(
+        matches!(want.end, Some(End::Error { tick: 1, .. })),
+        "{:?}",
+        want.end
+    );
+    assert_eq!(want.statuses, [R]);
+    let log = [T(1004), T(1007), H(1007)];
+    assert_eq!(want.log, log);
+    assert_eq!(lowered(&t, &sc, 3, BtTick::Once).unwrap(), ran(&[R], &log));
+}
+
+#[test]
 fn switch_halts_the_child_it_no_longer_picks() {
     // The IfThenElse writes `s` = a, then b: the Switch halts A, running, before ticking
     // B (`haltChild(running_child_)`). Checked against the real library.
@@ -706,6 +735,61 @@ fn random_trees_with_skipped_lower_to_what_btcpp_does() {
     });
 }
 
+/// The same with the timed nodes and TryCatch too (`gen::Options::time_nodes`,
+/// `try_catch`), so that SKIPPED reaches every parent that takes it: WhileDoElse,
+/// Switch, TryCatch, Timeout, Delay and Precondition among them (`SKIP_PARENTS`), run
+/// by the lowered root machine in model time.
+#[test]
+fn random_trees_with_skipped_and_time_nodes_lower_to_what_btcpp_does() {
+    random_trees(gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        skipped: true,
+        time_nodes: true,
+        try_catch: true,
+        ..Default::default()
+    });
+}
+
+/// The parents whose SKIPPED child the coverage check counts (`skip_parents`).
+const SKIP_PARENTS: [&str; 6] = [
+    "WhileDoElse",
+    "Switch",
+    "TryCatch",
+    "Timeout",
+    "Delay",
+    "Precondition",
+];
+
+/// For each of [`SKIP_PARENTS`], whether the tree has one with a child that makes
+/// SKIPPED itself (`_skipIf`, `_while`, RunOnce with `then_skip`, Precondition with
+/// `else="SKIPPED"`).
+fn skip_parents(t: &tree::Tree) -> [bool; 6] {
+    let makes = |c: usize| {
+        let x = &t.nodes[c];
+        x.conds.pre[2].is_some()
+            || x.conds.pre[3].is_some()
+            || matches!(
+                x.kind,
+                Kind::RunOnce(true) | Kind::Precondition(_, Status::Skipped)
+            )
+    };
+    let mut out = [false; 6];
+    for p in &t.nodes {
+        let k = match p.kind {
+            Kind::WhileDoElse => 0,
+            Kind::Switch(..) => 1,
+            Kind::TryCatch(_) => 2,
+            Kind::Timeout(_) => 3,
+            Kind::Delay(_) => 4,
+            Kind::Precondition(..) => 5,
+            _ => continue,
+        };
+        out[k] |= p.children.iter().any(|&c| makes(c));
+    }
+    out
+}
+
 /// The same with BT.CPP 4's nodes AS2FM has no model of (AsyncSequence, AsyncFallback,
 /// ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2-6) in the
 /// format-4 trees.
@@ -774,7 +858,7 @@ fn btcpp4_kind(k: &Kind) -> Option<usize> {
 }
 
 /// Whether the lowering refuses the tree's pre/post conditions as not modelled yet
-/// (`btcpp4_conds.rs`): conditions on the root, or on a node BT.CPP may tick again without resetting it (the condition of a two-child
+/// (`btcpp4_conds.rs`): conditions on a node BT.CPP may tick again without resetting it (the condition of a two-child
 /// IfThenElse or of a WhileDoElse, the child of a BlackboardCheck).
 fn conds_refused(t: &tree::Tree) -> bool {
     let stale = t.nodes.iter().any(|p| {
@@ -786,7 +870,7 @@ fn conds_refused(t: &tree::Tree) -> bool {
         };
         kids.iter().any(|&c| t.nodes[c].conds.any())
     });
-    stale || t.nodes[0].conds.any()
+    stale
 }
 
 /// Whether the lowering refuses a Loop node as not modelled yet (`btcpp4_loop.rs`): one
@@ -909,6 +993,9 @@ fn random_trees(opts: gen::Options) {
     // `else="SKIPPED"`; runs where some root tick answered SKIPPED.
     let skip_kinds: [AtomicUsize; 5] = Default::default();
     let skip_kinds = &skip_kinds;
+    // Trees compared with a SKIPPED-making child under each of `SKIP_PARENTS`.
+    let skip_under: [AtomicUsize; 6] = Default::default();
+    let skip_under = &skip_under;
     let counts = &counts;
     // Trees compared that hold each of BT.CPP 4's own node kinds.
     let kinds: [AtomicUsize; 14] = Default::default();
@@ -1049,6 +1136,11 @@ fn random_trees(opts: gen::Options) {
                             }
                         }
                         skip_kinds[4].fetch_add(root_skipped, Relaxed);
+                        for (k, s) in skip_parents(&t).iter().enumerate() {
+                            if *s {
+                                skip_under[k].fetch_add(1, Relaxed);
+                            }
+                        }
                         if by_mode.len() == 2 && by_mode[0] != by_mode[1] {
                             counts[5].fetch_add(1, Relaxed);
                         }
@@ -1071,7 +1163,14 @@ fn random_trees(opts: gen::Options) {
             "SKIPPED: {skip_refused} trees left out where SKIPPED reaches a parent not modelled yet \
              (btcpp4_skip.rs); {with_skip} trees compared with a construct that makes SKIPPED: \
              _skipIf {skip_if}, _while {while_}, RunOnce skipping {run_once_skip}, Precondition \
-             else=SKIPPED {else_skipped}; {root_skipped} runs where the root answered SKIPPED"
+             else=SKIPPED {else_skipped}; {root_skipped} runs where the root answered SKIPPED; \
+             trees with such a child under {}",
+            SKIP_PARENTS
+                .iter()
+                .zip(skip_under.each_ref().map(|c| c.load(Relaxed)))
+                .map(|(k, c)| format!("{k} {c}"))
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     }
     let kinds = kinds.each_ref().map(|c| c.load(Relaxed));
@@ -1119,6 +1218,28 @@ fn random_trees(opts: gen::Options) {
                 texts as u64 >= n / 100 && chains as u64 >= n / 100,
                 "only {texts} compared trees reading a SetBlackboard's text, {chains} chaining `+`/`-`"
             );
+        }
+        // With SKIPPED on, it reaches each parent of `SKIP_PARENTS` that is generated in
+        // at least one compared tree in 200.
+        if opts.skipped {
+            for (i, (k, c)) in SKIP_PARENTS
+                .iter()
+                .zip(skip_under.each_ref().map(|c| c.load(Relaxed)))
+                .enumerate()
+            {
+                let on = match i {
+                    0 | 1 => opts.btcpp4_nodes,
+                    2 => opts.try_catch,
+                    3 | 4 => opts.time_nodes,
+                    _ => opts.scripts,
+                };
+                if on {
+                    assert!(
+                        c as u64 >= n / 200,
+                        "only {c} compared trees where SKIPPED reaches a {k}"
+                    );
+                }
+            }
         }
         // With BT.CPP 4's own nodes on, each kind is in at least one tree in 100.
         for (i, (k, c)) in BTCPP4_KINDS.iter().zip(kinds).enumerate() {

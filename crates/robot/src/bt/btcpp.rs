@@ -531,7 +531,7 @@ pub(super) fn root_machine(
     name: &str,
     timer: &str,
     rate_hz: f64,
-    root: (u32, &str),
+    root: (&str, &str),
     tick_if_not_running: bool,
 ) -> Element {
     let (id, machine) = root;

@@ -15,6 +15,7 @@
 
 use super::blackboard::Blackboard;
 use super::btcpp::{halting_state, running, yield_running};
+use super::btcpp4_skip::SELF_RUNNING;
 use super::control::{
     init_state, n_children, on_child_skipped, Ctx, FAILURE, IS_SKIPPED, RUNNING, SKIPPED,
     SKIPPED_RUNNING, SKIP_COUNT, SUCCESS,
@@ -573,7 +574,27 @@ pub(super) fn while_do_else(ctx: &Ctx) -> Element {
         Some("wait_for_tick"),
         vec![b.assign(&r0, "true"), ctx.respond(RUNNING)],
     ));
+    // 4.10 `WhileDoElseNode::tick`: a skipped condition is neither SUCCESS nor FAILURE,
+    // so no branch runs and `status` stays IDLE: `resetChildren()` (halting the RUNNING
+    // children, the condition too if it answered 5), then `return status`, whose
+    // `setStatus(NodeStatus::IDLE)` in `TreeNode::executeTick` throws. Where BT.CPP
+    // throws the tree stops (`error`).
+    let mut skipped: Vec<Element> = ctx.mark_skipped(0).into_iter().collect();
+    skipped.push(b.assign(h, "0"));
+    c.push(b.tr(
+        Some(&ctx.child_resp(0)),
+        Some(IS_SKIPPED),
+        Some("halting_to_error"),
+        skipped,
+    ));
     m.push(c);
+    m.push(super::btcpp4_time::halting(
+        ctx,
+        "halting_to_error",
+        "children_count",
+        "error",
+        Vec::new(),
+    ));
     // The branch to tick and the one to halt first (only while it runs).
     let three = ctx.children.len() == 3;
     let mut choose = b.state("choose_branch");
@@ -661,6 +682,17 @@ pub(super) fn while_do_else(ctx: &Ctx) -> Element {
             Some(&format!("_event.data.status == {RUNNING} && branch == {i}")),
             Some("wait_for_tick"),
             vec![b.assign(&r, "true"), ctx.respond(RUNNING)],
+        ));
+        // A skipped branch is not RUNNING: `resetChildren()` (a branch that answered 5
+        // is halted) and its SKIPPED is the answer, the node RUNNING as it set itself.
+        let mut skipped: Vec<Element> = ctx.mark_skipped(i).into_iter().collect();
+        skipped.push(b.assign("result", &SKIPPED_RUNNING.to_string()));
+        skipped.push(b.assign(h, "0"));
+        t.push(b.tr(
+            Some(&ctx.child_resp(i)),
+            Some(&format!("{IS_SKIPPED} && branch == {i}")),
+            Some("halting_when_done"),
+            skipped,
         ));
     }
     m.push(t);
@@ -775,6 +807,7 @@ pub(super) fn switch(ctx: &Ctx, pick: &SwitchPick) -> Element {
             ("running_child", "int8", "-1".into()),
             ("match_index", "int8", "0".into()),
             ("result", "int8", "0".into()),
+            (SELF_RUNNING, "bool", "false".into()),
         ],
     );
     m.push(init_state(ctx, "children_count < 1"));
@@ -873,8 +906,22 @@ pub(super) fn switch(ctx: &Ctx, pick: &SwitchPick) -> Element {
             vec![
                 b.assign(&r, "true"),
                 b.assign("running_child", "match_index"),
+                b.assign(SELF_RUNNING, "true"),
                 ctx.respond(RUNNING),
             ],
+        ));
+        // 4.10 `SwitchNode::tick`: a skipped child makes `running_child_ = -1` and is the
+        // answer, nothing reset (a child that answered 5 stays RUNNING until a
+        // `resetChildren`). The node never sets its own status, so it is RUNNING (5)
+        // only if it answered RUNNING last (`executeTick` does not store SKIPPED).
+        let mut skipped: Vec<Element> = ctx.mark_skipped(i).into_iter().collect();
+        skipped.push(b.assign("running_child", "-1"));
+        skipped.push(super::btcpp4_skip::skipped_keeping_status(ctx));
+        t.push(b.tr(
+            Some(&ctx.child_resp(i)),
+            Some(&format!("{IS_SKIPPED} && match_index == {i}")),
+            Some("wait_for_tick"),
+            skipped,
         ));
     }
     m.push(t);
@@ -882,13 +929,21 @@ pub(super) fn switch(ctx: &Ctx, pick: &SwitchPick) -> Element {
         ctx,
         "halting_when_done",
         h,
-        vec![b.assign("running_child", "-1"), ctx.respond_expr("result")],
+        vec![
+            b.assign("running_child", "-1"),
+            b.assign(SELF_RUNNING, "false"),
+            ctx.respond_expr("result"),
+        ],
     ));
     m.push(halting_state(
         ctx,
         "halting_on_halt",
         h,
-        vec![b.assign("running_child", "-1"), ctx.respond_halted()],
+        vec![
+            b.assign("running_child", "-1"),
+            b.assign(SELF_RUNNING, "false"),
+            ctx.respond_halted(),
+        ],
     ));
     m.push(b.state("error"));
     m

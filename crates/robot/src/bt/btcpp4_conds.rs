@@ -24,7 +24,7 @@
 //! that finished before ticking it again, except the condition of a two-child
 //! IfThenElse or of a WhileDoElse and the child of a BlackboardCheck, which BT.CPP may
 //! tick again in its finished status (skipping its pre-conditions); conditions there are
-//! refused. Also refused (not modelled yet): conditions on the tree's root node.
+//! refused. The root's wrapper talks to the root machine as to a parent.
 
 use super::blackboard::{Blackboard, MACHINE};
 use super::btcpp4_script::compile;
@@ -57,7 +57,13 @@ pub(super) fn refusals(sm: &SourceMap, tree: &Tree, i: usize, btcpp: bool) -> Ve
     for c in &n.conds {
         let why = if !btcpp {
             "AS2FM has no model of BehaviorTree.CPP's script language, so the default semantics (`--bt as2fm`) cannot lower it: use `--bt btcpp` (BehaviorTree.CPP 4's rules)"
-        } else if let Some(p) = n.parent {
+        } else {
+            let Some(p) = n.parent else {
+                // The root: the root machine ticks it as a parent would. `Tree::tickRoot`
+                // resets a finished root (`resetStatus`), so it is IDLE at every tick
+                // unless it answered RUNNING (or SKIPPED with its status RUNNING).
+                continue;
+            };
             let p = &tree.nodes[p];
             let first = p.children.first() == Some(&i);
             let stale = match p.kind {
@@ -70,8 +76,6 @@ pub(super) fn refusals(sm: &SourceMap, tree: &Tree, i: usize, btcpp: bool) -> Ve
                 continue;
             }
             "BehaviorTree.CPP may tick this node again without resetting it (the condition of a two-child IfThenElse or of a WhileDoElse, the child of a BlackboardCheck), skipping its pre-conditions: not modelled yet"
-        } else {
-            "conditions on the tree's root node are not modelled yet"
         };
         out.push(sm.diag(
             c.name_span,

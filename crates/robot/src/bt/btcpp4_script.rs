@@ -57,6 +57,7 @@
 //! constant.
 
 use super::blackboard::{Blackboard, MACHINE};
+use super::btcpp4_skip::SELF_RUNNING;
 use super::control::{init_state, n_children, Ctx, FAILURE, RUNNING, SUCCESS};
 use super::script::{self, Ex, Stmt, K};
 use super::tree::{PortValue, ScriptNode, TreeNode};
@@ -824,6 +825,7 @@ fn precondition(ctx: &Ctx, otherwise: u8) -> Element {
         ("children_count", "int8", n_children(ctx)),
         (memo, "bool", "false".into()),
         (r.as_str(), "bool", "false".into()),
+        (SELF_RUNNING, "bool", "false".into()),
     ]));
     m.push(init_state(ctx, "children_count != 1"));
     let mut w = b
@@ -835,7 +837,8 @@ fn precondition(ctx: &Ctx, otherwise: u8) -> Element {
             Some("running_script"),
             vec![b.send(&run_event(ctx.id), MACHINE)],
         ));
-    for t in ctx.halt_single("halting_child", Vec::new()) {
+    // A halt resets the node's status (`haltNode`); `_children_running` stays.
+    for t in ctx.halt_single("halting_child", vec![b.assign(SELF_RUNNING, "false")]) {
         w.push(t);
     }
     m.push(w);
@@ -852,16 +855,17 @@ fn precondition(ctx: &Ctx, otherwise: u8) -> Element {
                 Some(&done),
                 None,
                 Some("wait_for_tick"),
-                vec![ctx.respond(otherwise)],
+                super::btcpp4_skip::else_answer(ctx, otherwise),
             )),
     );
-    m.push(ctx.halting_child_state());
+    m.push(super::btcpp4_skip::precondition_halting(ctx));
     let mut t = b.state_entry("tick_child", vec![ctx.tick_child(0)]);
     for s in [SUCCESS, FAILURE, RUNNING] {
         let mut body = Vec::new();
         if s != RUNNING {
             body.push(b.assign(memo, "false"));
         }
+        body.push(b.assign(SELF_RUNNING, if s == RUNNING { "true" } else { "false" }));
         body.push(ctx.respond(s));
         t.push(b.tr(
             Some(&ctx.child_resp(0)),
@@ -870,6 +874,7 @@ fn precondition(ctx: &Ctx, otherwise: u8) -> Element {
             ctx.marked(0, s, body),
         ));
     }
+    t.push(super::btcpp4_skip::precondition_child_skipped(ctx));
     m.push(t);
     m.push(b.state("error"));
     m

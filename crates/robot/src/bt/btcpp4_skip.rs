@@ -1,5 +1,6 @@
-//! Where BehaviorTree.CPP 4's SKIPPED status can arise in a tree, and where the lowering
-//! (`--bt btcpp`) does not model it yet.
+//! Where BehaviorTree.CPP 4's SKIPPED status can arise in a tree, where the lowering
+//! (`--bt btcpp`) does not model it yet, and the parts of the machines of the nodes that
+//! keep their own status when they pass a SKIPPED on (Switch, Precondition).
 //!
 //! SKIPPED travels as status 4 (the node IDLE afterwards) or 5 (the node RUNNING: it set
 //! itself RUNNING before every child was skipped), `control.rs`. It is made by
@@ -7,14 +8,72 @@
 //! RunOnce with `then_skip` (`btcpp4.rs`), and passed on or summed up by every parent
 //! the lowering handles: Sequence, Fallback, SequenceWithMemory, AsyncSequence,
 //! AsyncFallback, ReactiveSequence, ReactiveFallback, Parallel, ParallelAll,
-//! IfThenElse, Inverter, ForceSuccess, ForceFailure, Repeat, RetryUntilSuccessful,
-//! KeepRunningUntilFailure, RunOnce, SkipUnlessUpdated, WaitValueUpdate, the Loop nodes
-//! and the root (SkipUnlessUpdated and a Loop with `if_empty="SKIPPED"` make it too,
-//! `btcpp4_blackboard.rs`, `btcpp4_loop.rs`). The parents it does not handle yet refuse
-//! a child that may answer SKIPPED, at the child.
+//! IfThenElse, WhileDoElse, Switch2-6, TryCatch, Inverter, ForceSuccess, ForceFailure,
+//! Repeat, RetryUntilSuccessful, KeepRunningUntilFailure, RunOnce, Timeout, Delay,
+//! Precondition, SkipUnlessUpdated, WaitValueUpdate, the Loop nodes and the root
+//! (SkipUnlessUpdated and a Loop with `if_empty="SKIPPED"` make it too,
+//! `btcpp4_blackboard.rs`, `btcpp4_loop.rs`). The parents it does not handle refuse a
+//! child that may answer SKIPPED, at the child: a BlackboardCheck (BT.CPP 3's), and a
+//! sequence (or TryCatch) BT.CPP may tick again without resetting it.
 
+use super::control::{Ctx, IS_SKIPPED, RUNNING, SKIPPED, SKIPPED_RUNNING};
 use super::tree::{Btcpp4, Control, Kind, PortValue, ScriptNode, Tree, UpdatedNode};
 use crate::model::source::{Diagnostic, SourceMap};
+use crate::model::xml::Element;
+
+/// Whether a node that does not set its own status before ticking its child (Switch,
+/// Precondition) answered RUNNING last (its status as BT.CPP keeps it): then a SKIPPED
+/// it passes on leaves it RUNNING (5), else IDLE (4).
+pub(super) const SELF_RUNNING: &str = "self_running";
+
+/// SKIPPED answered by a node that keeps its own status (see [`SELF_RUNNING`]).
+pub(super) fn skipped_keeping_status(ctx: &Ctx) -> Element {
+    ctx.respond_expr(&format!("{SELF_RUNNING} ? {SKIPPED_RUNNING} : {SKIPPED}"))
+}
+
+/// Precondition's `else` answer (`PreconditionNode::tick`, 4.10
+/// `decorators/script_precondition.h`, `return else_return`): stored as the node's
+/// status by `executeTick` unless it is SKIPPED, which leaves the status as it was.
+pub(super) fn else_answer(ctx: &Ctx, otherwise: u8) -> Vec<Element> {
+    if otherwise == SKIPPED {
+        return vec![skipped_keeping_status(ctx)];
+    }
+    let running = if otherwise == RUNNING {
+        "true"
+    } else {
+        "false"
+    };
+    vec![ctx.b.assign(SELF_RUNNING, running), ctx.respond(otherwise)]
+}
+
+/// Precondition's child answering SKIPPED (`PreconditionNode::tick`): not a finished
+/// status (`isStatusCompleted`), so the child is not reset and `_children_running`
+/// stays set (the next tick ticks the child without the `if` script); the SKIPPED is
+/// the answer, the node's own status kept (it never sets it itself).
+pub(super) fn precondition_child_skipped(ctx: &Ctx) -> Element {
+    let mut body: Vec<Element> = ctx.mark_skipped(0).into_iter().collect();
+    body.push(skipped_keeping_status(ctx));
+    ctx.b.tr(
+        Some(&ctx.child_resp(0)),
+        Some(IS_SKIPPED),
+        Some("wait_for_tick"),
+        body,
+    )
+}
+
+/// Precondition's `halting_child` state: the child halted (only while RUNNING), the
+/// node's own status reset (`haltNode`), `_children_running` kept (the node has no
+/// `halt` of its own: `DecoratorNode::halt`).
+pub(super) fn precondition_halting(ctx: &Ctx) -> Element {
+    let b = &ctx.b;
+    b.state_entry("halting_child", ctx.halt_child_body(0))
+        .with_child(b.tr(
+            Some(&ctx.child_halt_resp(0)),
+            None,
+            Some("wait_for_tick"),
+            vec![b.assign(SELF_RUNNING, "false"), ctx.respond_halted()],
+        ))
+}
 
 /// Whether node `i` may answer SKIPPED, for every node (children after their parent in
 /// pre-order, so one pass from the end sees every child first).
@@ -108,22 +167,18 @@ pub(super) fn refusals(sm: &SourceMap, tree: &Tree) -> Vec<Diagnostic> {
         }
         let parent = &tree.nodes[p];
         let why = match parent.kind {
-            Kind::Control(Control::Btcpp4(
-                k @ (Btcpp4::WhileDoElse
-                | Btcpp4::Switch(_)
-                | Btcpp4::TryCatch
-                | Btcpp4::Timeout
-                | Btcpp4::Delay
-                | Btcpp4::Script(ScriptNode::Precondition)),
-            )) => format!("SKIPPED reaching a {} is not modelled yet", super::btcpp4::node_name(k)),
+            // BlackboardCheckInt/Double/String are BT.CPP 3's nodes (4 has no such node,
+            // and no rule for a skipped child of one).
             Kind::Control(Control::BlackboardCheck(_)) => {
-                "SKIPPED reaching a BlackboardCheck is not modelled yet".to_string()
+                "a BlackboardCheck is a BehaviorTree.CPP 3 node, which has no SKIPPED status to pass on".to_string()
             }
             Kind::Control(
                 Control::Sequence
                 | Control::Fallback
                 | Control::SequenceWithMemory
-                | Control::Btcpp4(Btcpp4::AsyncSequence | Btcpp4::AsyncFallback),
+                | Control::Btcpp4(
+                    Btcpp4::AsyncSequence | Btcpp4::AsyncFallback | Btcpp4::TryCatch,
+                ),
             ) if stale(tree, p) => {
                 "SKIPPED reaching a sequence that BehaviorTree.CPP may tick again without resetting it (the condition of a two-child IfThenElse or of a WhileDoElse, the child of a BlackboardCheck), whose count of skipped children then carries over, is not modelled yet".to_string()
             }

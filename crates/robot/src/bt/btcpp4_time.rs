@@ -33,7 +33,9 @@
 
 use super::btcpp::WAKE_UP;
 use super::build::B;
-use super::control::{init_state, n_children, Ctx, FAILURE, RUNNING, SUCCESS};
+use super::control::{
+    init_state, n_children, Ctx, FAILURE, IS_SKIPPED, RUNNING, SKIPPED_RUNNING, SKIP_COUNT, SUCCESS,
+};
 use super::tree::{Btcpp4, Kind, PortValue, Tree, TreeNode};
 use crate::model::source::{Diagnostic, SourceMap};
 use crate::model::xml::{Element, Node};
@@ -343,6 +345,18 @@ fn tick_child_state(ctx: &Ctx, finish: Vec<Element>) -> Element {
         Some("wait_for_tick"),
         vec![b.assign(&r, "true"), ctx.respond(RUNNING)],
     ));
+    // A skipped child is not a finished one (`isStatusCompleted`): its SKIPPED is the
+    // answer, nothing reset, the timer left running; the node set itself RUNNING when it
+    // started (`TimeoutNode::tick`, `DelayNode::tick`), so 5. Timeout's timer then
+    // halts the child only if it stays RUNNING (code 5).
+    let mut skipped: Vec<Element> = ctx.mark_skipped(0).into_iter().collect();
+    skipped.push(ctx.respond(SKIPPED_RUNNING));
+    t.push(b.tr(
+        Some(&ctx.child_resp(0)),
+        Some(IS_SKIPPED),
+        Some("wait_for_tick"),
+        skipped,
+    ));
     t
 }
 
@@ -551,7 +565,13 @@ fn sleep(t: &Timer, timed: bool) -> Element {
 /// every child that last answered RUNNING and resets the others' flags
 /// (`ControlNode::haltChild` for each), then goes to `target` doing `finish`. Whoever
 /// enters it sets `var` first.
-fn halting(ctx: &Ctx, name: &str, bound: &str, target: &str, finish: Vec<Element>) -> Element {
+pub(super) fn halting(
+    ctx: &Ctx,
+    name: &str,
+    bound: &str,
+    target: &str,
+    finish: Vec<Element>,
+) -> Element {
     let b = &ctx.b;
     let var = "halt_idx";
     let mut entry = ctx.skip_idle(var, None);
@@ -600,6 +620,7 @@ fn try_catch(ctx: &Ctx, catch_on_halt: bool) -> Element {
             (idx, "0"),
             ("halt_idx", "0"),
             ("in_catch", "false"),
+            (SKIP_COUNT, "0"),
         ],
     ));
     m.push(init_state(ctx, "children_count < 2"));
@@ -656,6 +677,17 @@ fn try_catch(ctx: &Ctx, catch_on_halt: bool) -> Element {
             Some("wait_for_tick"),
             vec![b.assign(&r, "true"), ctx.respond(RUNNING)],
         ));
+        // `case NodeStatus::SKIPPED`: on to the next try child, counted
+        // (`skipped_count_`); the child RUNNING still if it answered 5.
+        let mut skipped: Vec<Element> = ctx.mark_skipped(i).into_iter().collect();
+        skipped.push(b.assign(idx, &format!("{idx} + 1")));
+        skipped.push(b.assign(SKIP_COUNT, &format!("{SKIP_COUNT} + 1")));
+        t.push(b.tr(
+            Some(&ctx.child_resp(i)),
+            Some(&format!("{IS_SKIPPED} && {idx} == {i}")),
+            Some("tick_try"),
+            skipped,
+        ));
     }
     t.push(b.tr(
         None,
@@ -664,19 +696,38 @@ fn try_catch(ctx: &Ctx, catch_on_halt: bool) -> Element {
         vec![b.assign("halt_idx", "0")],
     ));
     m.push(t);
+    // The whole try block skipped answers SKIPPED (`all_skipped`), the node RUNNING as
+    // it set itself (5); the count restarts either way (`skipped_count_ = 0`).
+    let answer = b
+        .if_chain(
+            vec![(
+                format!("{SKIP_COUNT} == children_count - 1"),
+                vec![ctx.respond(SKIPPED_RUNNING)],
+            )],
+            vec![ctx.respond(SUCCESS)],
+        )
+        .expect("one branch");
     m.push(halting(
         ctx,
         "halting_on_success",
         "children_count",
         "wait_for_tick",
-        vec![b.assign(idx, "0"), ctx.respond(SUCCESS)],
+        vec![b.assign(idx, "0"), answer, b.assign(SKIP_COUNT, "0")],
     ));
+    // A FAILURE leaves `skipped_count_` as it is, but the node then finishes FAILURE and
+    // its parent resets it before the next tick (`!isStatusActive(status())` restarts
+    // the count); a TryCatch BT.CPP ticks again without a reset is refused
+    // (`btcpp4_skip.rs`), so the count restarts here.
     m.push(halting(
         ctx,
         "halting_to_catch",
         "children_count",
         "tick_catch",
-        vec![b.assign(idx, "0"), b.assign("in_catch", "true")],
+        vec![
+            b.assign(idx, "0"),
+            b.assign("in_catch", "true"),
+            b.assign(SKIP_COUNT, "0"),
+        ],
     ));
     // The catch.
     let mut c = b.state_entry("tick_catch", vec![ctx.tick_child(last)]);
@@ -686,11 +737,16 @@ fn try_catch(ctx: &Ctx, catch_on_halt: bool) -> Element {
         Some("wait_for_tick"),
         vec![b.assign(&r_last, "true"), ctx.respond(RUNNING)],
     ));
+    // Any other answer, SKIPPED too, ends the catch (`catch_status != RUNNING`); a
+    // catch child that answered 5 is RUNNING still, so `resetChildren` halts it.
     c.push(b.tr(
         Some(&ctx.child_resp(last)),
         None,
         Some("halting_after_catch"),
-        vec![b.assign(&r_last, "false"), b.assign("halt_idx", "0")],
+        vec![
+            b.assign(&r_last, &format!("_event.data.status == {SKIPPED_RUNNING}")),
+            b.assign("halt_idx", "0"),
+        ],
     ));
     m.push(c);
     m.push(halting(
@@ -712,6 +768,7 @@ fn try_catch(ctx: &Ctx, catch_on_halt: bool) -> Element {
         vec![
             b.assign(idx, "0"),
             b.assign("in_catch", "false"),
+            b.assign(SKIP_COUNT, "0"),
             ctx.respond_halted(),
         ],
     ));
@@ -730,11 +787,16 @@ fn try_catch(ctx: &Ctx, catch_on_halt: bool) -> Element {
             Some("halting_catch"),
             vec![b.assign(&r_last, "true")],
         ));
+        // Not RUNNING (SKIPPED included): not halted here, but a 5 is RUNNING still,
+        // and `ControlNode::halt`'s `resetChildren` halts it.
         c.push(b.tr(
             Some(&ctx.child_resp(last)),
             None,
             Some("halting_on_halt"),
-            vec![b.assign(&r_last, "false"), b.assign("halt_idx", "0")],
+            vec![
+                b.assign(&r_last, &format!("_event.data.status == {SKIPPED_RUNNING}")),
+                b.assign("halt_idx", "0"),
+            ],
         ));
         m.push(c);
         m.push(

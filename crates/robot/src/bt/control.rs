@@ -427,15 +427,16 @@ pub(super) fn init_state(ctx: &Ctx, bad: &str) -> Element {
         .with_child(b.tr(None, None, Some("wait_for_tick"), vec![]))
 }
 
-/// The machine that ticks the root node `root` (`machine`) at every `<stem>_tick` timer
-/// event. With `tick_if_not_running` false it stops after the first answer that is not
+/// The machine that ticks the root node `root` (the stem of its events, `bt_<stem>_tick`,
+/// and its machine: `<id>_cond` and its conditions' machine for a root with pre/post
+/// conditions, `btcpp4_conds.rs`) at every `<stem>_tick` timer event. With `tick_if_not_running` false it stops after the first answer that is not
 /// RUNNING, as AS2FM's does.
 pub(crate) fn root_machine(
     b: B,
     name: &str,
     timer: &str,
     rate_hz: f64,
-    root: (u32, &str),
+    root: (&str, &str),
     tick_if_not_running: bool,
 ) -> Element {
     let (id, machine) = root;

@@ -242,7 +242,19 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
         at: tree.nodes[0].span,
     };
     let timer = format!("{}_tick", stem(sm, input.tree));
-    let root_node = (tree.nodes[0].id, tree.nodes[0].machine.as_str());
+    let btcpp = input.semantics != BtSemantics::As2fm;
+    // Under BT.CPP's rules a node with pre/post conditions talks to its parent through
+    // its conditions' machine (`btcpp4_conds.rs`); the root to the root machine too.
+    let wrapped = |i: usize| btcpp && btcpp4_conds::wrapped(&tree, i);
+    let root_node = if wrapped(0) {
+        (
+            btcpp4_conds::stem(&tree.nodes[0]),
+            btcpp4_conds::machine_name(&tree.nodes[0]),
+        )
+    } else {
+        (tree.nodes[0].id.to_string(), tree.nodes[0].machine.clone())
+    };
+    let root_node = (root_node.0.as_str(), root_node.1.as_str());
     out.push(match input.semantics {
         BtSemantics::Btcpp { tick: BtTick::Once } => btcpp::root_machine(
             root_b,
@@ -261,10 +273,6 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
             input.tick_if_not_running,
         ),
     });
-    let btcpp = input.semantics != BtSemantics::As2fm;
-    // Under BT.CPP's rules a node with pre/post conditions talks to its parent through
-    // its conditions' machine (`btcpp4_conds.rs`).
-    let wrapped = |i: usize| btcpp && btcpp4_conds::wrapped(&tree, i);
     if btcpp {
         errs.extend(btcpp4_skip::refusals(sm, &tree));
     }
@@ -330,15 +338,16 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
             errs.push(sm.diag(n.span, btcpp4::as2fm_refusal(k)));
             continue;
         }
-        if let Kind::Control(Control::Btcpp4(k)) = n.kind {
-            if btcpp4_time::handles(k) {
-                let m = btcpp4_time::lower(sm, k, n, &ctx, &root_name, clock.as_ref(), &mut errs);
-                out.extend(m);
-                continue;
+        let timed = match n.kind {
+            Kind::Control(Control::Btcpp4(k)) if btcpp4_time::handles(k) => Some(k),
+            _ => None,
+        };
+        let m = match (n.kind, timed) {
+            // The timed nodes need the tree's clock (their conditions' machine below).
+            (_, Some(k)) => {
+                btcpp4_time::lower(sm, k, n, &ctx, &root_name, clock.as_ref(), &mut errs)
             }
-        }
-        let m = match n.kind {
-            Kind::Plugin(i) => Some(plugin::instance(
+            (Kind::Plugin(i), None) => Some(plugin::instance(
                 sm,
                 &plugins[i],
                 n,
@@ -346,7 +355,7 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
                 &mut bb,
                 &mut errs,
             )),
-            Kind::Control(c) => {
+            (Kind::Control(c), None) => {
                 // A leaf plugin is a stateful action under BT.CPP's rules (see
                 // `btcpp.rs`); only IfThenElse can tick one that was not reset.
                 let stale_condition = c == Control::IfThenElse
