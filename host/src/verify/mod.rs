@@ -6,4 +6,5 @@ pub mod record;
 pub mod result;
 pub mod sched_fixed;
 pub mod schedulers;
+mod split;
 pub mod study;
