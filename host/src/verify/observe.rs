@@ -60,7 +60,7 @@ pub struct PropertySet {
     strings: Vec<u32>,
     /// What compiling found questionable ([`PropertySet::warnings`]).
     warnings: Diagnostics,
-    /// The program cut into one program per property ([`Split`]).
+    /// The program cut into one program per property (`Split`).
     split: Split,
 }
 
@@ -341,15 +341,15 @@ impl PropertySet {
 
 /// Judges one run: an [`Observer`] stepping the monitors at every point.
 ///
-/// Each property is its own monitor ([`Split`]), stepped only at the points where the
+/// Each property is its own monitor (`verify::split`), stepped only at the points where the
 /// step can change its state: where a variable its atoms read changed, at every new
 /// time if it has a bounded `S`, and at every point if it has a `Y` / `Z`. At any
 /// other point its state, and so its verdict and finality, is exactly what a step
-/// would leave (see [`Judge::step`]), so the verdicts are those of stepping every
+/// would leave (see `Judge::step`), so the verdicts are those of stepping every
 /// property at every point.
 pub struct Judge<'a> {
     set: &'a PropertySet,
-    /// One per part of [`PropertySet::split`], planned for up to 256 nodes and atoms
+    /// One per part of `PropertySet::split`, planned for up to 256 nodes and atoms
     /// (what does not depend on the point is decided once per run; a larger property is
     /// stepped unplanned, with the same results).
     monitors: Vec<Monitor<'a, 256>>,
