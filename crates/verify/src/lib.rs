@@ -39,6 +39,7 @@ pub mod record;
 pub mod result;
 pub mod sched_fixed;
 pub mod schedulers;
+mod split;
 pub mod study;
 
 // The crates below this one, under the paths its modules name them by.

@@ -18,6 +18,8 @@ use crate::props::{PortKind, PropertyFile, ANY};
 use crate::sim::{CompiledModel, EventId, Flow, MachineId, Observer, SentMessage};
 use crate::smc::{RunEnd, RunOutcome, Verdict};
 
+use super::split::Split;
+
 /// One port resolved to model ids.
 #[derive(Clone, Debug)]
 struct Port {
@@ -58,6 +60,8 @@ pub struct PropertySet {
     strings: Vec<u32>,
     /// What compiling found questionable ([`PropertySet::warnings`]).
     warnings: Diagnostics,
+    /// The program cut into one program per property (`Split`).
+    split: Split,
 }
 
 /// Maps a SCAN port type to a spec type name.
@@ -307,6 +311,7 @@ impl PropertySet {
             })
             .collect();
         Ok(PropertySet {
+            split: Split::new(&compiled.program()),
             guarantees: props.guarantees.iter().map(|p| p.id.clone()).collect(),
             assumptions: props.assumptions.len(),
             compiled,
@@ -335,12 +340,22 @@ impl PropertySet {
 }
 
 /// Judges one run: an [`Observer`] stepping the monitors at every point.
+///
+/// Each property is its own monitor (`verify::split`), stepped only at the points where the
+/// step can change its state: where a variable its atoms read changed, at every new
+/// time if it has a bounded `S`, and at every point if it has a `Y` / `Z`. At any
+/// other point its state, and so its verdict and finality, is exactly what a step
+/// would leave (see `Judge::step`), so the verdicts are those of stepping every
+/// property at every point.
 pub struct Judge<'a> {
     set: &'a PropertySet,
-    /// Planned for up to 256 nodes and atoms (what does not depend on the point is
-    /// decided once per run; a larger spec is stepped unplanned, with the same results).
-    monitor: Monitor<'a, 256>,
+    /// One per part of `PropertySet::split`, planned for up to 256 nodes and atoms
+    /// (what does not depend on the point is decided once per run; a larger property is
+    /// stepped unplanned, with the same results).
+    monitors: Vec<Monitor<'a, 256>>,
+    /// The parts' states, one after the other from `offsets[p]`.
     state: Vec<u64>,
+    offsets: Vec<usize>,
     vals: Vec<Value>,
     verdicts: Vec<bool>,
     /// Per node, its final value as of the last point ([`analysis::settle`]).
@@ -348,15 +363,12 @@ pub struct Judge<'a> {
     /// The first error (a payload of the wrong type, a timestamp going back).
     pub error: Option<String>,
     decided: bool,
-    /// The program has no `Y` / `Z` node: a point equal to the last one stepped (same
-    /// time, same values) leaves the monitor state and verdicts exactly as they are.
-    repeat_is_noop: bool,
-    /// The time of the last point stepped (`None` before the first).
-    last_time: Option<u64>,
-    /// Some value may differ from the last point stepped: set by every write that
-    /// changes a value, cleared by a step. Tracked per write, so that telling a
-    /// repeated point costs nothing per variable.
-    changed: bool,
+    /// The time of the last point.
+    last_time: u64,
+    /// The parts some of whose variables may differ from their last step (bit `p % 64`
+    /// for part `p`): set by every write that changes a value, cleared by a step. Tracked
+    /// per write, so that telling a point that changes nothing costs nothing per variable.
+    dirty: u64,
     /// The event variables that may hold `true`: the ones the next point clears.
     raised: Vec<usize>,
 }
@@ -376,22 +388,30 @@ impl std::error::Error for JudgeError {}
 impl<'a> Judge<'a> {
     /// A judge for `set`, before the run's initial point.
     pub fn new(set: &'a PropertySet) -> Result<Judge<'a>, JudgeError> {
-        let monitor = Monitor::try_new_planned(set.compiled.program()).map_err(JudgeError)?;
-        let vars = monitor.program().vars;
+        let whole = set.compiled.program();
+        // The whole program passes first: its errors are the ones to report.
+        Monitor::<0>::try_new(whole).map_err(JudgeError)?;
+        let mut monitors = Vec::with_capacity(set.split.parts.len());
+        let mut offsets = vec![0];
+        for part in &set.split.parts {
+            let m = Monitor::try_new_planned(part.program(&whole)).map_err(JudgeError)?;
+            offsets.push(offsets.last().copied().unwrap_or(0) + m.state_words());
+            monitors.push(m);
+        }
+        let vars = whole.vars;
         let mut vals = vec![Value::Bool(false); vars.len()];
         valuation::init(vars, &mut vals);
-        let repeat_is_noop = analysis::repeat_is_noop(monitor.program());
         Ok(Judge {
             set,
-            finals: vec![None; monitor.program().nodes.len()],
-            state: vec![0; monitor.state_words()],
-            verdicts: vec![false; monitor.properties()],
-            monitor,
+            finals: vec![None; whole.nodes.len()],
+            state: vec![0; offsets.last().copied().unwrap_or(0)],
+            offsets,
+            verdicts: vec![false; whole.props.len()],
+            monitors,
             error: None,
             decided: false,
-            repeat_is_noop,
-            last_time: None,
-            changed: true,
+            last_time: 0,
+            dirty: set.split.all(),
             raised: Vec::new(),
             vals,
         })
@@ -399,17 +419,18 @@ impl<'a> Judge<'a> {
 
     /// Puts the judge back before a run's initial point and judges that point (time 0).
     pub fn start(&mut self) -> Flow {
-        let vars = self.monitor.program().vars;
+        let vars = self.set.compiled.program().vars;
         valuation::init(vars, &mut self.vals);
         self.raised.clear();
         self.raised.extend(
             (0..vars.len()).filter(|&v| vars[v].kind == VarKind::Event && !is_false(self.vals[v])),
         );
-        self.changed = true;
+        // Every part steps at the initial point.
+        self.dirty = self.set.split.all();
         self.state.fill(0);
         self.error = None;
         self.decided = false;
-        self.last_time = None;
+        self.last_time = 0;
         self.step(0)
     }
 
@@ -423,13 +444,20 @@ impl<'a> Judge<'a> {
         &self.verdicts
     }
 
+    /// The value of node `node` of the whole program at the last point.
+    fn node_value(&self, node: u16) -> Option<bool> {
+        let (p, local) = self.set.split.locate(node)?;
+        let st = self.state.get(self.offsets[p]..self.offsets[p + 1])?;
+        self.monitors[p].node_value(st, local)
+    }
+
     /// For property `prop`, the subformula that explains its verdict at the last point
     /// ([`analysis::culprit`]) in surface syntax (bounds in ticks), with its value then.
     pub fn culprit(&self, prop: usize) -> Option<(String, bool)> {
-        let program = self.monitor.program();
+        let program = self.set.compiled.program();
         let root = program.props.get(prop)?.root;
-        let value = |n| self.monitor.node_value(&self.state, n);
-        let n = analysis::culprit(program, root, value);
+        let value = |n| self.node_value(n);
+        let n = analysis::culprit(&program, root, value);
         Some((
             codegen::print::node_formula(&self.set.compiled, n),
             value(n)?,
@@ -441,47 +469,96 @@ impl<'a> Judge<'a> {
         self.set
     }
 
-    /// Judges the point at `time`, unless it repeats the last one stepped (see
-    /// [`Judge::step_now`]). Always inlined into the observer's calls: most points of a
-    /// run repeat the last one, and for them the call cost more than the test.
+    /// Judges the point at `time`: steps the parts that are due. Always inlined into the
+    /// observer's calls: at most points of a run no part is due, and for them the call
+    /// cost more than the test.
+    ///
+    /// Skipping a part that is not due is exact, not an approximation:
+    /// - its variables hold the values of its last step (a write that changes one marks
+    ///   its readers `dirty`), so its atoms have the same values;
+    /// - without `Y` / `Z` every node's update is idempotent at one time with the same
+    ///   inputs (atoms are pure, `S` keeps or resets the same witness, windows expire
+    ///   nothing more and extend the newest run to the same time:
+    ///   [`analysis::repeat_is_noop`]), so the state after the step would be bit for bit
+    ///   the one before it, and so the verdicts and their finality;
+    /// - without a bounded `S` no node reads the time (an unbounded `S` is one bit, the
+    ///   connectives are pure), so that holds at a later time too; a part with one steps
+    ///   at every new time, one with a `Y` / `Z` at every point.
     #[inline(always)]
     fn step(&mut self, time: u64) -> Flow {
-        if self.repeat_is_noop && self.last_time == Some(time) && !self.changed {
+        let split = &self.set.split;
+        let mut due = self.dirty | split.always;
+        if time != self.last_time {
+            if time < self.last_time || time == u64::MAX {
+                return self.time_error(time);
+            }
+            self.last_time = time;
+            due |= split.timed;
+        }
+        if due == 0 {
             return Flow::Continue;
         }
-        self.step_now(time)
+        self.step_now(time, due)
     }
 
-    /// Steps the monitors at `time` and settles what became final.
+    /// A point whose time went back: the error stepping it would give.
+    #[cold]
     #[inline(never)]
-    fn step_now(&mut self, time: u64) -> Flow {
-        // Skipping a repeated point is exact, not an approximation: without `Y` / `Z`
-        // every node's update is idempotent at one time with the same inputs (atoms are
-        // pure, `S` keeps or resets the same witness, windows expire nothing more and
-        // extend the newest run to the same time), so the state after the step would be
-        // bit for bit the one before it, and so the verdicts and their finality. Most
-        // points of a run (messages that set no port) repeat the last one.
-        self.last_time = Some(time);
-        self.changed = false;
-        if let Err(e) = self
-            .monitor
-            .try_step(&mut self.state, time, &self.vals, &mut self.verdicts)
-        {
-            self.error = Some(format!(
-                "monitor step at time {time}: {}",
-                self.set.compiled.describe(&e)
-            ));
-            return Flow::Stop;
+    fn time_error(&mut self, time: u64) -> Flow {
+        let e = if time == u64::MAX {
+            monitor_core::StepError::TimeOutOfRange
+        } else {
+            monitor_core::StepError::TimeWentBackwards {
+                last: self.last_time,
+                now: time,
+            }
+        };
+        self.fail(time, e)
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn fail(&mut self, time: u64, e: monitor_core::StepError) -> Flow {
+        self.error = Some(format!(
+            "monitor step at time {time}: {}",
+            self.set.compiled.describe(&e)
+        ));
+        Flow::Stop
+    }
+
+    /// Steps the parts in `due` (bit `p % 64` for part `p`) at `time` and settles what
+    /// became final.
+    #[inline(never)]
+    fn step_now(&mut self, time: u64, due: u64) -> Flow {
+        self.dirty = 0;
+        let split = &self.set.split;
+        let whole = self.set.compiled.program();
+        let mut newly_final = false;
+        for (p, part) in split.parts.iter().enumerate() {
+            if due >> (p % 64) & 1 == 0 {
+                continue;
+            }
+            let m = &self.monitors[p];
+            let st = &mut self.state[self.offsets[p]..self.offsets[p + 1]];
+            let props = part.first_prop..part.first_prop + m.properties();
+            if let Err(e) = m.try_step(st, time, &self.vals, &mut self.verdicts[props.clone()]) {
+                return self.fail(time, part.global_error(e));
+            }
+            let finals = &mut self.finals[part.first_node..part.first_node + part.node_count()];
+            let st = &*st;
+            analysis::settle(
+                m.program(),
+                |n| m.node_value(st, n).unwrap_or(false),
+                finals,
+            );
+            newly_final |= props
+                .clone()
+                .any(|k| analysis::settled(&whole, &self.finals, k).is_some());
         }
-        let (m, st) = (&self.monitor, &self.state);
-        analysis::settle(
-            m.program(),
-            |n| m.node_value(st, n).unwrap_or(false),
-            &mut self.finals,
-        );
-        let all = (0..self.verdicts.len())
-            .all(|p| analysis::settled(m.program(), &self.finals, p).is_some());
-        if all {
+        if newly_final
+            && (0..self.verdicts.len())
+                .all(|k| analysis::settled(&whole, &self.finals, k).is_some())
+        {
             self.decided = true;
             return Flow::Stop;
         }
@@ -498,7 +575,7 @@ impl<'a> Judge<'a> {
         for v in self.raised.drain(..) {
             if !is_false(self.vals[v]) {
                 self.vals[v] = Value::Bool(false);
-                self.changed = true;
+                self.dirty |= self.set.split.readers[v];
             }
         }
     }
@@ -509,12 +586,11 @@ impl<'a> Judge<'a> {
             return;
         }
         self.vals[var] = value;
-        self.changed = true;
-        if self.monitor.program().vars[var].kind == VarKind::Event {
+        self.dirty |= self.set.split.readers[var];
+        if self.set.compiled.program().vars[var].kind == VarKind::Event {
             self.raised.push(var);
         }
     }
-
     fn convert(&self, v: SimValue<'_>, ty: Ty) -> Option<Value> {
         Some(match (v, ty) {
             (SimValue::Bool(b), Ty::Bool) => Value::Bool(b),
@@ -575,7 +651,7 @@ impl<'a> Judge<'a> {
     pub fn outcome(&self, end: RunEnd, steps: u64, time: u64) -> RunOutcome {
         let g = self.set.guarantees.len();
         let judged = |p: usize| -> Verdict {
-            match analysis::settled(self.monitor.program(), &self.finals, p) {
+            match analysis::settled(&self.set.compiled.program(), &self.finals, p) {
                 Some(v) => v.into(),
                 // A run cut short is judged only where the verdict was already final.
                 None if end == RunEnd::StepLimit => Verdict::Unknown,
@@ -630,7 +706,7 @@ impl Observer for Judge<'_> {
             {
                 continue;
             }
-            let decl = &self.monitor.program().vars[port.var];
+            let decl = &self.set.compiled.program().vars[port.var];
             let value = match &port.value {
                 PortValue::True => Some(Value::Bool(true)),
                 PortValue::Param(i) => msg.param(*i).and_then(|v| self.convert(v, decl.ty)),
@@ -708,168 +784,5 @@ fn missing_param(model: &CompiledModel, event: EventId, param: &str) -> String {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::{same_value, Judge, PropertySet};
-    use monitor_core::{analysis, valuation, Monitor, Value};
-
-    /// The fact [`super::Judge`] relies on to skip repeated points: without `Y` / `Z`, a
-    /// step at the same time with the same values leaves the state bit for bit unchanged.
-    #[test]
-    fn repeated_point_leaves_the_state_unchanged() {
-        let formulas = [
-            "H({p} -> P {q})",
-            "{p} S {q}",
-            "{p} S[3:] {q}",
-            "{p} S[:4] {q}",
-            "{p} S[2:5] {q}",
-            "!{p} S[1:1] ({q} && {n > 2})",
-            "H(P[10:] true -> P[:10] {q})",
-            "H(({p} -> P {n <= 3}) && !((!{p}) S[6:] {n <= 3}))",
-            "P[0:3] ({p} || H[0:2] !{q})",
-        ];
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
-        let mut repeats = 0;
-        for f in formulas {
-            let src = format!("event p;\nevent q;\nstate n: i64 = 0;\nproperty f = {f};\n");
-            let c = codegen::compile_spec(&src, "t.hspec").unwrap();
-            let m = Monitor::try_new(c.program()).unwrap();
-            assert!(analysis::repeat_is_noop(m.program()));
-            for _ in 0..40 {
-                let mut st = vec![0; m.state_words()];
-                let mut vals = vec![Value::Bool(false); c.program().vars.len()];
-                valuation::init(c.program().vars, &mut vals);
-                let mut out = [false];
-                let mut t = 0;
-                for _ in 0..80 {
-                    t += next() % 3;
-                    valuation::begin_point(c.program().vars, &mut vals);
-                    let r = next();
-                    vals[0] = Value::Bool(r % 4 == 0);
-                    vals[1] = Value::Bool(r % 5 == 0);
-                    if r % 7 == 0 {
-                        vals[2] = Value::Int((r % 6) as i64);
-                    }
-                    m.try_step(&mut st, t, &vals, &mut out).unwrap();
-                    let (before, verdict) = (st.clone(), out[0]);
-                    // The same point again, once or twice.
-                    for _ in 0..1 + next() % 2 {
-                        m.try_step(&mut st, t, &vals, &mut out).unwrap();
-                        assert_eq!(st, before, "{f} at {t}");
-                        assert_eq!(out[0], verdict, "{f} at {t}");
-                        repeats += 1;
-                    }
-                }
-            }
-        }
-        assert!(repeats > 1000);
-    }
-
-    /// The judge tells a repeated point by tracking writes, not by comparing every
-    /// variable. Oracle: a monitor of the same program stepped at every point, its
-    /// variables kept by [`valuation::begin_point`]; after every point the judge's
-    /// verdicts, values and state must equal the oracle's. Random points at repeated and
-    /// advancing times write random values (often the value already held, often none).
-    #[test]
-    fn tracked_writes_skip_exactly_the_repeated_points() {
-        use crate::sim::{CompiledModel, Flow};
-        let machine = "<scxml name=\"a\" initial=\"s0\" version=\"1.0\" \
-            xmlns=\"http://www.w3.org/2005/07/scxml\"><datamodel>\
-            <data id=\"x\" type=\"int32\" expr=\"0\"/></datamodel>\
-            <state id=\"s0\"><onentry><send event=\"e\" target=\"b\">\
-            <param name=\"v\" expr=\"x\"/></send></onentry></state></scxml>";
-        let sink = "<scxml name=\"b\" initial=\"s0\" version=\"1.0\" \
-            xmlns=\"http://www.w3.org/2005/07/scxml\"><state id=\"s0\"/></scxml>";
-        let model = CompiledModel::compile(
-            crate::model::ModelSource::from_texts([("a.scxml", machine), ("b.scxml", sink)])
-                .unwrap(),
-        )
-        .unwrap();
-        let props = "<properties><ports>\
-            <scxml_event_send event=\"e\" origin=\"a\" target=\"b\">\
-            <event_var id=\"p\"/><event_var id=\"q\"/>\
-            <state_var id=\"n\" param=\"v\" type=\"int32\" expr=\"0\"/>\
-            </scxml_event_send></ports><guarantees>\
-            <property id=\"g1\" logic=\"pmtl\" expr=\"historically({p} -> once {n &gt; 2})\"/>\
-            <property id=\"g2\" logic=\"pmtl\" expr=\"{q} since[1:3] {n == 1}\"/>\
-            <property id=\"g3\" logic=\"pmtl\" expr=\"once[0:2] ({p} &amp;&amp; !{q})\"/>\
-            <property id=\"g4\" logic=\"pmtl\" expr=\"!{p} since[2:] {n &lt; 2}\"/>\
-            </guarantees></properties>";
-        let file = crate::props::parse_str(props, std::path::Path::new("p.xml")).unwrap();
-        let set = PropertySet::new(&file, &model).unwrap();
-        let mut judge = Judge::new(&set).unwrap();
-        let program = set.compiled().program();
-        let oracle = Monitor::try_new(program).unwrap();
-        let var = |name: &str| set.compiled().var_index(name).unwrap();
-        let (p, q, n) = (var("p"), var("q"), var("n"));
-        let mut x = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
-        let (mut repeats, mut steps) = (0, 0);
-        for _ in 0..30 {
-            let mut st = vec![0; oracle.state_words()];
-            let mut vals = vec![Value::Bool(false); program.vars.len()];
-            valuation::init(program.vars, &mut vals);
-            let mut out = vec![false; oracle.properties()];
-            assert_eq!(judge.start(), Flow::Continue);
-            oracle.try_step(&mut st, 0, &vals, &mut out).unwrap();
-            let mut t = 0;
-            let mut last = (0, vals.clone());
-            for _ in 0..120 {
-                let r = next();
-                t += [0, 0, 0, 1, 2][(r % 5) as usize];
-                judge.begin();
-                valuation::begin_point(program.vars, &mut vals);
-                let mut writes = Vec::new();
-                if r >> 8 & 3 == 0 {
-                    writes.push((p, Value::Bool(true)));
-                }
-                if r >> 10 & 3 == 0 {
-                    writes.push((q, Value::Bool(true)));
-                }
-                if r >> 12 & 3 == 0 {
-                    writes.push((n, Value::Int((r >> 14) as i64 % 4)));
-                }
-                for (v, value) in writes {
-                    judge.write(v, value);
-                    vals[v] = value;
-                }
-                let repeat = t == last.0 && vals == last.1;
-                last = (t, vals.clone());
-                let flow = judge.step(t);
-                oracle.try_step(&mut st, t, &vals, &mut out).unwrap();
-                assert_eq!(judge.values(), &vals[..]);
-                assert_eq!(judge.state, st, "at time {t}");
-                assert_eq!(judge.verdicts(), &out[..], "at time {t}");
-                if repeat {
-                    repeats += 1;
-                } else {
-                    steps += 1;
-                }
-                if flow == Flow::Stop {
-                    break;
-                }
-            }
-        }
-        // Both kinds of point came many times.
-        assert!(repeats > 200 && steps > 200, "{repeats} {steps}");
-    }
-
-    #[test]
-    fn floats_compare_bit_for_bit() {
-        assert!(same_value(Value::Float(0.0), Value::Float(0.0)));
-        assert!(!same_value(Value::Float(0.0), Value::Float(-0.0)));
-        assert!(same_value(Value::Float(f64::NAN), Value::Float(f64::NAN)));
-        assert!(!same_value(Value::Int(1), Value::Float(1.0)));
-        assert!(!same_value(Value::Bool(false), Value::Int(0)));
-    }
-}
+#[path = "observe_tests.rs"]
+mod tests;
