@@ -8,6 +8,7 @@
 use super::ast::{BinOp, Expr, ExprKind, ObjField, UnOp};
 use super::value::{Cell, StrId, Strings, Ty, TypeTable};
 
+mod leaf;
 mod ops;
 mod place;
 #[cfg(test)]
@@ -332,6 +333,37 @@ pub fn coerce(t: Typed, target: &Ty, types: &TypeTable) -> Result<Typed, Ty> {
     }
     let _ = types;
     Err(t.ty)
+}
+
+/// [`compile_as`], then the code that writes the value into a cell
+/// ([`Typed::into_cell_fn`]); a literal, a whole variable or a whole event parameter
+/// (int, bool or string) is written by one closure instead of two.
+pub fn compile_cell(
+    expr: &Expr,
+    scope: &Scope<'_>,
+    strings: &mut Strings,
+    target: &Ty,
+    what: &str,
+) -> Result<CellFn, CompileError> {
+    let t = compile_as(expr, scope, strings, target, what)?;
+    let mut c = Compiler { scope, strings };
+    let store = match target {
+        Ty::Int => Some((leaf::Store::Int, Ty::Int)),
+        Ty::Bool => Some((leaf::Store::Bool, Ty::Bool)),
+        Ty::Str => Some((leaf::Store::Str, Ty::Str)),
+        Ty::Float => Some((leaf::Store::Float, Ty::Int)),
+        _ => None,
+    };
+    if let Some((store, ty)) = store {
+        // The static type before conversion: a float target takes an int leaf only.
+        let source = compile(expr, scope, c.strings, Some(target)).map(|s| s.ty);
+        if source.as_ref() == Ok(&ty) {
+            if let Some(l) = c.leaf(expr, &ty) {
+                return Ok(leaf::write(l, store));
+            }
+        }
+    }
+    Ok(t.into_cell_fn())
 }
 
 /// True when a value of type `from` may be stored where `to` is expected.

@@ -481,6 +481,18 @@ impl Compiler<'_, '_> {
             }
             BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => {
                 let ordered = !matches!(op, BinOp::Eq | BinOp::Ne);
+                // Two leaves (a literal, a whole variable or parameter) of one type: one
+                // closure reads both (see `leaf.rs`).
+                if ta.ty == tb.ty && (ta.ty == Ty::Int || !ordered) {
+                    if let (Some(la), Some(lb)) = (self.leaf(a, &ta.ty), self.leaf(b, &tb.ty)) {
+                        if let Some(code) = leaf::compare(op, la, lb) {
+                            return Ok(Typed {
+                                ty: Ty::Bool,
+                                code: Code::Bool(code),
+                            });
+                        }
+                    }
+                }
                 let (tya, tyb) = (ta.ty.clone(), tb.ty.clone());
                 let code: BoolFn = match (ta.code, tb.code) {
                     (Code::Int(x), Code::Int(y)) => match op {

@@ -464,3 +464,94 @@ fn struct_places() {
         .unwrap_err()
         .contains("has no field `y`"));
 }
+
+/// `compile_cell` of `text` into `target`, evaluated in the scope of [`eval`].
+fn eval_cell(text: &str, target: &Ty) -> Result<Cell, String> {
+    let mut strings = Strings::default();
+    let vs = vars();
+    let types = TypeTable::default();
+    let params = [("p".to_string(), Some(Ty::Int))];
+    let scope = Scope {
+        vars: &vs,
+        event: EventScope::Event {
+            name: "ev",
+            params: &params,
+        },
+        types: &types,
+        abs: &|k| k,
+    };
+    let e = parse_expr(text).map_err(|e| e.to_string())?;
+    let f = compile_cell(&e, &scope, &mut strings, target, "x")
+        .map_err(|e| format!("{}@{}", e.msg, e.at))?;
+    let vals = cells(&mut strings);
+    let ps = [Cell::Int(40)];
+    let mut rng = Fixed(1 << 63);
+    let mut env = Env {
+        vars: &vals,
+        params: &ps,
+        event: StrId(0),
+        origin: StrId(0),
+        rng: &mut rng,
+        strings: &strings,
+    };
+    let mut out = Cell::list(vec![Cell::Int(9)]);
+    f(&mut env, &mut out).map_err(|e| e.message())?;
+    Ok(out)
+}
+
+#[test]
+fn fused_leaf_comparisons_agree_with_the_operators() {
+    // i = 7, p (`_event.data.p`) = 40, b = true, s = "hi": every leaf shape, every operator.
+    let t = Ok(Cell::Bool(true));
+    let f = Ok(Cell::Bool(false));
+    for (text, want) in [
+        ("i == 7", &t),
+        ("i != 7", &f),
+        ("i < 8", &t),
+        ("i <= 6", &f),
+        ("i > -1", &t),
+        ("i >= 8", &f),
+        ("7 == i", &t),
+        ("_event.data.p == 40", &t),
+        ("_event.data.p < 40", &f),
+        ("i == _event.data.p", &f),
+        ("_event.data.p > i", &t),
+        ("i == i", &t),
+        ("i < i", &f),
+        ("3 < 4", &t),
+        ("b == true", &t),
+        ("b != b", &f),
+        ("s == 'hi'", &t),
+        ("s != 'hi'", &f),
+        ("'ho' == s", &f),
+        ("(_event.data.p == 40) && (i == 0)", &f),
+        ("(_event.data.p == 40) && (i == 7)", &t),
+    ] {
+        assert_eq!(&eval(text), want, "{text}");
+    }
+    // Strings and booleans stay unordered.
+    assert!(eval("s < 'hi'").is_err());
+    assert!(eval("b < true").is_err());
+}
+
+#[test]
+fn cells_written_from_leaves_and_other_code() {
+    assert_eq!(eval_cell("3", &Ty::Int), Ok(Cell::Int(3)));
+    assert_eq!(eval_cell("-3", &Ty::Float), Ok(Cell::Float(-3.0)));
+    assert_eq!(eval_cell("i", &Ty::Float), Ok(Cell::Float(7.0)));
+    assert_eq!(eval_cell("_event.data.p", &Ty::Int), Ok(Cell::Int(40)));
+    assert_eq!(eval_cell("b", &Ty::Bool), Ok(Cell::Bool(true)));
+    assert_eq!(eval_cell("false", &Ty::Bool), Ok(Cell::Bool(false)));
+    let mut strings = Strings::default();
+    let _ = cells(&mut strings);
+    let hi = strings.lookup("hi").unwrap_or_default();
+    assert_eq!(eval_cell("s", &Ty::Str), Ok(Cell::Str(hi)));
+    // Not leaves: the general code.
+    assert_eq!(eval_cell("i + 1", &Ty::Int), Ok(Cell::Int(8)));
+    assert_eq!(eval_cell("f", &Ty::Float), Ok(Cell::Float(2.5)));
+    assert_eq!(
+        eval_cell("a", &Ty::Array(Box::new(Ty::Int), None)),
+        Ok(Cell::list(vec![Cell::Int(1), Cell::Int(2), Cell::Int(3)]))
+    );
+    assert!(eval_cell("f", &Ty::Int).is_err());
+}

@@ -11,8 +11,8 @@
 
 use super::ids::{EventId, MachineId, StateId};
 use crate::expr::compile::{
-    compile, compile_as, compile_place, unknown_param_type, BoolFn, CellFn, Code, CompileError,
-    EventScope, IntFn, Place, Scope, StrFn, Typed,
+    compile, compile_as, compile_cell, compile_place, unknown_param_type, BoolFn, CellFn, Code,
+    CompileError, EventScope, IntFn, Place, Scope, StrFn, Typed,
 };
 use crate::expr::parse_expr;
 use crate::expr::value::{Cell, StrId, Strings, StructDef, Ty, TypeTable};

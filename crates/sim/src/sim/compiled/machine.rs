@@ -311,8 +311,11 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                     let Some(Some(pty)) = pdefs.get(pi).map(|(_, t)| t.clone()) else {
                         continue; // reported by inference
                     };
-                    if let Some(t) = self.typed(&p.expr, event, Some(&pty)) {
-                        params.push((pi as u32, t.into_cell_fn()));
+                    let f = self.scoped(&p.expr, event, |ast, scope, strings| {
+                        compile_cell(ast, scope, strings, &pty, "the expression")
+                    });
+                    if let Some(f) = f {
+                        params.push((pi as u32, f));
                         given[pi] = true;
                     }
                 }

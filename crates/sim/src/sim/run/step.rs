@@ -34,25 +34,53 @@ impl Simulator<'_> {
             return Ok(None);
         }
         self.enabled.clear();
-        for &t in list {
+        let doc_order = cfg.transitions == TransitionChoice::DocumentOrder;
+        // Unguarded transitions first, without an environment; from the first guard on,
+        // one environment serves every guard left (building it per guard cost as much
+        // as a simple guard, building it for a list without guards was wasted).
+        let mut rest = list;
+        while let Some((&t, tail)) = rest.split_first() {
             let Some(td) = def.trans.get(t as usize) else {
+                rest = tail;
                 continue;
             };
-            let ok = match &td.cond {
-                None => true,
-                Some(c) => {
-                    let mut env = env(&self.ms, &self.pool, m, &mut *rng, &self.model.strings);
-                    match c(&mut env) {
-                        Ok(b) => b,
-                        Err(e) => return Err(self.diag_error(m, Some(td.pc as usize), e)),
+            if td.cond.is_some() {
+                break;
+            }
+            if doc_order {
+                return Ok(Some(t));
+            }
+            self.enabled.push(t);
+            rest = tail;
+        }
+        if !rest.is_empty() {
+            let mut failed = None;
+            {
+                let mut env = env(&self.ms, &self.pool, m, &mut *rng, &self.model.strings);
+                for &t in rest {
+                    let Some(td) = def.trans.get(t as usize) else {
+                        continue;
+                    };
+                    let ok = match &td.cond {
+                        None => true,
+                        Some(c) => match c(&mut env) {
+                            Ok(b) => b,
+                            Err(e) => {
+                                failed = Some((td.pc, e));
+                                break;
+                            }
+                        },
+                    };
+                    if ok {
+                        if doc_order {
+                            return Ok(Some(t));
+                        }
+                        self.enabled.push(t);
                     }
                 }
-            };
-            if ok {
-                if cfg.transitions == TransitionChoice::DocumentOrder {
-                    return Ok(Some(t));
-                }
-                self.enabled.push(t);
+            }
+            if let Some((pc, e)) = failed {
+                return Err(self.diag_error(m, Some(pc as usize), e));
             }
         }
         match self.enabled.len() {
