@@ -677,6 +677,8 @@ fn random_trees_with_bb_nodes_lower_to_what_btcpp_does() {
             assert!(c >= n / 50, "only {c} of {n} trees with {k}");
         }
     }
+}
+
 /// The same with doubles in the scripts (`gen::Options::reals`): `x` or `f` created
 /// from a double (BT.CPP keeps an entry's first type: a double is cast to bool as true
 /// unless 0, an integer must be 0 or 1), `/` (inf and NaN included), real literals,
