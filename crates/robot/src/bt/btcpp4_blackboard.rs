@@ -28,6 +28,7 @@
 //! one per model step: no run the simulator can make overflows it.
 
 use super::blackboard::{Blackboard, Entry, MACHINE};
+use super::btcpp4_script::asking_machine;
 use super::control::{Ctx, FAILURE, IS_SKIPPED, RUNNING, SKIPPED, SKIPPED_RUNNING, SUCCESS};
 use super::tree::{Btcpp4, Control, Kind, PortValue, Tree, TreeNode, UpdatedNode};
 use crate::model::source::{Diagnostic, SourceMap};
@@ -176,22 +177,7 @@ pub(super) fn updated(
 /// RUNNING, so a halt answers at once.
 fn was_updated(ctx: &Ctx) -> Element {
     let b = &ctx.b;
-    let mut m = b.scxml(&ctx.machine, "wait_for_tick");
-    m.push(
-        b.state("wait_for_tick")
-            .with_child(b.tr(
-                Some(&ctx.tick_ev()),
-                None,
-                Some("asking"),
-                vec![b.send(&updated_run(ctx.id), MACHINE)],
-            ))
-            .with_child(b.tr(
-                Some(&ctx.halt_ev()),
-                None,
-                Some("wait_for_tick"),
-                vec![ctx.respond_halted()],
-            )),
-    );
+    let mut m = asking_machine(ctx, "asking", &updated_run(ctx.id));
     let done = updated_done(ctx.id);
     m.push(
         b.state("asking")
@@ -394,22 +380,7 @@ pub(super) fn unset(
 /// SUCCESS once it has; never RUNNING, so a halt answers at once.
 fn machine(ctx: &Ctx) -> Element {
     let b = &ctx.b;
-    let mut m = b.scxml(&ctx.machine, "wait_for_tick");
-    m.push(
-        b.state("wait_for_tick")
-            .with_child(b.tr(
-                Some(&ctx.tick_ev()),
-                None,
-                Some("unsetting"),
-                vec![b.send(&run_event(ctx.id), MACHINE)],
-            ))
-            .with_child(b.tr(
-                Some(&ctx.halt_ev()),
-                None,
-                Some("wait_for_tick"),
-                vec![ctx.respond_halted()],
-            )),
-    );
+    let mut m = asking_machine(ctx, "unsetting", &run_event(ctx.id));
     m.push(b.state("unsetting").with_child(b.tr(
         Some(&done_event(ctx.id)),
         None,

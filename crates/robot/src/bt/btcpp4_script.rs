@@ -760,12 +760,10 @@ pub(super) fn lower(
     }
 }
 
-/// Script (`condition` false) or ScriptCondition: a tick runs the script in the
-/// blackboard machine; Script answers SUCCESS (BT.CPP 4.10 `actions/script_node.h`,
-/// `ScriptNode::tick`), ScriptCondition SUCCESS if the value is true, else FAILURE
-/// (`actions/script_condition.h`, `ScriptCondition::tick`). Neither is ever RUNNING, so
-/// a halt answers at once.
-fn script_node(ctx: &Ctx, condition: bool) -> Element {
+/// The machine of a node that is never RUNNING and works in the blackboard machine:
+/// idle in `wait_for_tick`, a tick sends `request` to the blackboard machine and goes to
+/// `next` (where the node waits for the answer), a halt answers at once.
+pub(super) fn asking_machine(ctx: &Ctx, next: &str, request: &str) -> Element {
     let b = &ctx.b;
     let mut m = b.scxml(&ctx.machine, "wait_for_tick");
     m.push(
@@ -773,8 +771,8 @@ fn script_node(ctx: &Ctx, condition: bool) -> Element {
             .with_child(b.tr(
                 Some(&ctx.tick_ev()),
                 None,
-                Some("running_script"),
-                vec![b.send(&run_event(ctx.id), MACHINE)],
+                Some(next),
+                vec![b.send(request, MACHINE)],
             ))
             .with_child(b.tr(
                 Some(&ctx.halt_ev()),
@@ -783,6 +781,17 @@ fn script_node(ctx: &Ctx, condition: bool) -> Element {
                 vec![ctx.respond_halted()],
             )),
     );
+    m
+}
+
+/// Script (`condition` false) or ScriptCondition: a tick runs the script in the
+/// blackboard machine; Script answers SUCCESS (BT.CPP 4.10 `actions/script_node.h`,
+/// `ScriptNode::tick`), ScriptCondition SUCCESS if the value is true, else FAILURE
+/// (`actions/script_condition.h`, `ScriptCondition::tick`). Neither is ever RUNNING, so
+/// a halt answers at once.
+fn script_node(ctx: &Ctx, condition: bool) -> Element {
+    let b = &ctx.b;
+    let mut m = asking_machine(ctx, "running_script", &run_event(ctx.id));
     let done = done_event(ctx.id);
     let mut r = b.state("running_script");
     if condition {
