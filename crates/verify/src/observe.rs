@@ -11,7 +11,7 @@
 
 use codegen::diag::{Diagnostic, Diagnostics};
 use codegen::{Compiled, DeclInput, FormulaInput, Origin, SpecInput};
-use monitor_core::{analysis, valuation, Monitor, Ty, Value, VarKind};
+use monitor_core::{analysis, layout, valuation, Monitor, Ty, Value, VarKind};
 
 use crate::expr::Value as SimValue;
 use crate::props::{PortKind, PropertyFile, ANY};
@@ -371,6 +371,16 @@ pub struct Judge<'a> {
     dirty: u64,
     /// The event variables that may hold `true`: the ones the next point clears.
     raised: Vec<usize>,
+    /// Per part, where its node value words lie in `state` (`layout`: after the header
+    /// and the atom bits).
+    value_words: Vec<std::ops::Range<usize>>,
+    /// Per part, its node value words as of its last [`analysis::settle`], one part
+    /// after the other as in `value_words` (shifted to start at 0).
+    settled_values: Vec<u64>,
+    /// The parts whose `finals` must be computed at their next step whatever their
+    /// values (bit `p % 64`): every part at a run's initial point, since `finals` still
+    /// holds the last run's.
+    stale: u64,
 }
 
 /// The monitor refused the program codegen compiled: a bug, not bad input.
@@ -401,6 +411,16 @@ impl<'a> Judge<'a> {
         let vars = whole.vars;
         let mut vals = vec![Value::Bool(false); vars.len()];
         valuation::init(vars, &mut vals);
+        let value_words: Vec<_> = monitors
+            .iter()
+            .zip(&offsets)
+            .map(|(m, &at)| {
+                let (atoms, nodes) = (m.program().atoms.len(), m.program().nodes.len());
+                at + layout::HEADER_WORDS + layout::bit_words(atoms)
+                    ..at + layout::first_node_word(atoms, nodes)
+            })
+            .collect();
+        let words = value_words.iter().map(|r| r.len()).sum();
         Ok(Judge {
             set,
             finals: vec![None; whole.nodes.len()],
@@ -414,6 +434,9 @@ impl<'a> Judge<'a> {
             dirty: set.split.all(),
             raised: Vec::new(),
             vals,
+            value_words,
+            settled_values: vec![0; words],
+            stale: set.split.all(),
         })
     }
 
@@ -425,8 +448,9 @@ impl<'a> Judge<'a> {
         self.raised.extend(
             (0..vars.len()).filter(|&v| vars[v].kind == VarKind::Event && !is_false(self.vals[v])),
         );
-        // Every part steps at the initial point.
+        // Every part steps at the initial point, and settles.
         self.dirty = self.set.split.all();
+        self.stale = self.set.split.all();
         self.state.fill(0);
         self.error = None;
         self.decided = false;
@@ -528,14 +552,28 @@ impl<'a> Judge<'a> {
 
     /// Steps the parts in `due` (bit `p % 64` for part `p`) at `time` and settles what
     /// became final.
+    ///
+    /// A part whose node values are those of its last settle is not settled again: a
+    /// node's finality ([`analysis::node_final`]) is a function of its value and of its
+    /// children's finality, so a part's `finals` are a function of its node values
+    /// alone, and settling the same values gives the same `finals`. Most timed steps
+    /// (a bounded `S` stepped at a new time) change no value. Whether every verdict is
+    /// final is asked after a step that settled a part with a final verdict: verdicts
+    /// can only have all become final at a step that changed some part's `finals`, so
+    /// the run stops at the same point as when every stepped part was settled.
     #[inline(never)]
     fn step_now(&mut self, time: u64, due: u64) -> Flow {
         self.dirty = 0;
         let split = &self.set.split;
         let whole = self.set.compiled.program();
         let mut newly_final = false;
+        let mut kept = 0;
         for (p, part) in split.parts.iter().enumerate() {
-            if due >> (p % 64) & 1 == 0 {
+            let words = self.value_words[p].clone();
+            let saved = kept..kept + words.len();
+            kept = saved.end;
+            let bit = 1u64 << (p % 64);
+            if due & bit == 0 {
                 continue;
             }
             let m = &self.monitors[p];
@@ -544,8 +582,15 @@ impl<'a> Judge<'a> {
             if let Err(e) = m.try_step(st, time, &self.vals, &mut self.verdicts[props.clone()]) {
                 return self.fail(time, part.global_error(e));
             }
+            let now = &self.state[words];
+            let before = &mut self.settled_values[saved];
+            if self.stale & bit == 0 && now == &*before {
+                continue;
+            }
+            self.stale &= !bit;
+            before.copy_from_slice(now);
             let finals = &mut self.finals[part.first_node..part.first_node + part.node_count()];
-            let st = &*st;
+            let st = &self.state[self.offsets[p]..self.offsets[p + 1]];
             analysis::settle(
                 m.program(),
                 |n| m.node_value(st, n).unwrap_or(false),
