@@ -741,11 +741,14 @@ fn is_false(v: Value) -> bool {
     same_value(v, Value::Bool(false))
 }
 
-impl Observer for Judge<'_> {
-    fn on_send(&mut self, time: u64, msg: &SentMessage<'_>) -> Flow {
-        self.begin();
-        let ports = self.set.by_event.get(msg.event().0 as usize);
-        for port in ports.into_iter().flatten() {
+impl Judge<'_> {
+    /// Applies the ports of `msg` (there is at least one for its event) to this point's
+    /// variables; `Flow::Stop` with [`Judge::error`] set when a parameter has not the
+    /// port's type. Out of line: most messages have no port, and for them `on_send` is
+    /// the test of an empty list and a step.
+    #[inline(never)]
+    fn apply_ports(&mut self, time: u64, msg: &SentMessage<'_>, ports: &[Port]) -> Flow {
+        for port in ports {
             if port.origin.is_some_and(|o| o != msg.origin())
                 || port.target.is_some_and(|t| t != msg.target())
             {
@@ -777,6 +780,21 @@ impl Observer for Judge<'_> {
                     return Flow::Stop;
                 }
             }
+        }
+        Flow::Continue
+    }
+}
+
+impl Observer for Judge<'_> {
+    fn on_send(&mut self, time: u64, msg: &SentMessage<'_>) -> Flow {
+        self.begin();
+        let set = self.set;
+        let ports = set
+            .by_event
+            .get(msg.event().0 as usize)
+            .map_or(&[][..], Vec::as_slice);
+        if !ports.is_empty() && self.apply_ports(time, msg, ports) == Flow::Stop {
+            return Flow::Stop;
         }
         self.step(time)
     }
