@@ -24,28 +24,6 @@ pub(super) enum Leaf {
     Param(u32, u32),
 }
 
-/// The key of a scalar cell that is not a float.
-#[inline(always)]
-fn key(c: Option<&Cell>) -> Option<i64> {
-    match c {
-        Some(Cell::Int(v)) => Some(*v),
-        Some(Cell::Bool(b)) => Some(*b as i64),
-        Some(Cell::Str(s)) => Some(s.0 as i64),
-        _ => None,
-    }
-}
-
-/// The key of `leaf` in `env` (an ill-typed cell is an internal error at the leaf).
-#[inline(always)]
-fn read(env: &Env<'_>, leaf: Leaf) -> Res<i64> {
-    let (c, at) = match leaf {
-        Leaf::Const(v) => return Ok(v),
-        Leaf::Var(i, at) => (env.vars.get(i as usize), at),
-        Leaf::Param(i, at) => (env.params.get(i as usize), at),
-    };
-    key(c).ok_or(internal(at))
-}
-
 /// What a key becomes when it is stored: the static type of the leaf, or a float for an
 /// integer converted to one.
 #[derive(Clone, Copy)]
@@ -105,64 +83,254 @@ fn member_chain(e: &Expr) -> bool {
     }
 }
 
-/// `a op b` for two leaves of the same static type (`op` ordered only for integers).
-pub(super) fn compare(op: BinOp, a: Leaf, b: Leaf) -> Option<BoolFn> {
-    macro_rules! fused {
-        ($cmp:tt) => {
-            Some(match (a, b) {
-                (Leaf::Var(i, at), Leaf::Const(k)) => Box::new(move |env: &mut Env<'_>| {
-                    match key(env.vars.get(i as usize)) {
-                        Some(v) => Ok(v $cmp k),
-                        None => Err(internal(at)),
-                    }
-                }),
-                (Leaf::Param(i, at), Leaf::Const(k)) => Box::new(move |env: &mut Env<'_>| {
-                    match key(env.params.get(i as usize)) {
-                        Some(v) => Ok(v $cmp k),
-                        None => Err(internal(at)),
-                    }
-                }),
-                (Leaf::Var(i, ai), Leaf::Var(j, aj)) => Box::new(move |env: &mut Env<'_>| {
-                    match (key(env.vars.get(i as usize)), key(env.vars.get(j as usize))) {
-                        (Some(v), Some(w)) => Ok(v $cmp w),
-                        (None, _) => Err(internal(ai)),
-                        (_, None) => Err(internal(aj)),
-                    }
-                }),
-                (a, b) => Box::new(move |env: &mut Env<'_>| Ok(read(env, a)? $cmp read(env, b)?)),
-            })
-        };
+/// How a leaf of one static type is read as a key: only the cell variant of that type is
+/// accepted (any other is an internal error at the leaf, as the leaf's own closure
+/// reports it), so a read is one tag test and one load instead of a match over the
+/// variants (the shared `key` match was the largest single cost of the fused code in
+/// the profile of issue 26 part 5).
+trait Kind: 'static {
+    fn key(c: Option<&Cell>) -> Option<i64>;
+}
+
+struct IntK;
+struct BoolK;
+struct StrK;
+
+impl Kind for IntK {
+    #[inline(always)]
+    fn key(c: Option<&Cell>) -> Option<i64> {
+        match c {
+            Some(Cell::Int(v)) => Some(*v),
+            _ => None,
+        }
     }
-    match op {
-        BinOp::Eq => fused!(==),
-        BinOp::Ne => fused!(!=),
-        BinOp::Lt => fused!(<),
-        BinOp::Le => fused!(<=),
-        BinOp::Gt => fused!(>),
-        BinOp::Ge => fused!(>=),
+}
+
+impl Kind for BoolK {
+    #[inline(always)]
+    fn key(c: Option<&Cell>) -> Option<i64> {
+        match c {
+            Some(Cell::Bool(b)) => Some(*b as i64),
+            _ => None,
+        }
+    }
+}
+
+impl Kind for StrK {
+    #[inline(always)]
+    fn key(c: Option<&Cell>) -> Option<i64> {
+        match c {
+            Some(Cell::Str(s)) => Some(s.0 as i64),
+            _ => None,
+        }
+    }
+}
+
+/// The key of `leaf` in `env`, read as kind `K`.
+#[inline(always)]
+fn read_k<K: Kind>(env: &Env<'_>, leaf: Leaf) -> Res<i64> {
+    let (c, at) = match leaf {
+        Leaf::Const(v) => return Ok(v),
+        Leaf::Var(i, at) => (env.vars.get(i as usize), at),
+        Leaf::Param(i, at) => (env.params.get(i as usize), at),
+    };
+    K::key(c).ok_or(internal(at))
+}
+
+/// A relation between two keys.
+trait Rel: 'static {
+    fn rel(a: i64, b: i64) -> bool;
+}
+
+macro_rules! rels {
+    ($($name:ident $op:tt),*) => {$(
+        struct $name;
+        impl Rel for $name {
+            #[inline(always)]
+            fn rel(a: i64, b: i64) -> bool {
+                a $op b
+            }
+        }
+    )*};
+}
+rels!(EqR ==, NeR !=, LtR <, LeR <=, GtR >, GeR >=);
+
+/// `a R b` for leaves of kind `K`, one closure per operand shape.
+fn fused<K: Kind, R: Rel>(a: Leaf, b: Leaf) -> BoolFn {
+    match (a, b) {
+        (Leaf::Var(i, at), Leaf::Const(k)) => {
+            Box::new(
+                move |env: &mut Env<'_>| match K::key(env.vars.get(i as usize)) {
+                    Some(v) => Ok(R::rel(v, k)),
+                    None => Err(internal(at)),
+                },
+            )
+        }
+        (Leaf::Param(i, at), Leaf::Const(k)) => {
+            Box::new(
+                move |env: &mut Env<'_>| match K::key(env.params.get(i as usize)) {
+                    Some(v) => Ok(R::rel(v, k)),
+                    None => Err(internal(at)),
+                },
+            )
+        }
+        (Leaf::Var(i, ai), Leaf::Var(j, aj)) => Box::new(move |env: &mut Env<'_>| {
+            match (
+                K::key(env.vars.get(i as usize)),
+                K::key(env.vars.get(j as usize)),
+            ) {
+                (Some(v), Some(w)) => Ok(R::rel(v, w)),
+                (None, _) => Err(internal(ai)),
+                (_, None) => Err(internal(aj)),
+            }
+        }),
+        (a, b) => Box::new(move |env: &mut Env<'_>| {
+            Ok(R::rel(read_k::<K>(env, a)?, read_k::<K>(env, b)?))
+        }),
+    }
+}
+
+fn by_rel<K: Kind>(op: BinOp, a: Leaf, b: Leaf) -> Option<BoolFn> {
+    Some(match op {
+        BinOp::Eq => fused::<K, EqR>(a, b),
+        BinOp::Ne => fused::<K, NeR>(a, b),
+        BinOp::Lt => fused::<K, LtR>(a, b),
+        BinOp::Le => fused::<K, LeR>(a, b),
+        BinOp::Gt => fused::<K, GtR>(a, b),
+        BinOp::Ge => fused::<K, GeR>(a, b),
+        _ => return None,
+    })
+}
+
+/// `a op b` for two leaves of the same static type `ty` (`op` ordered only for integers).
+pub(super) fn compare(op: BinOp, ty: &Ty, a: Leaf, b: Leaf) -> Option<BoolFn> {
+    match ty {
+        Ty::Int => by_rel::<IntK>(op, a, b),
+        Ty::Bool => by_rel::<BoolK>(op, a, b),
+        Ty::Str => by_rel::<StrK>(op, a, b),
         _ => None,
     }
 }
 
-/// Code that writes `leaf`'s value into a cell as `store` says.
-pub(super) fn write(leaf: Leaf, store: Store) -> CellFn {
-    let make = move |v: i64| match store {
-        Store::Int => Cell::Int(v),
-        Store::Bool => Cell::Bool(v != 0),
-        Store::Str => Cell::Str(StrId(v as u32)),
-        Store::Float => Cell::Float(v as f64),
-    };
-    match leaf {
-        Leaf::Const(v) => {
-            let c = make(v);
-            Box::new(move |_, d| {
-                d.clone_from(&c);
-                Ok(())
+/// Integer arithmetic on two keys; `at` is where a remainder by zero is reported.
+trait Arith: 'static {
+    fn apply(a: i64, b: i64, at: u32) -> Res<i64>;
+}
+
+struct AddA;
+struct SubA;
+struct MulA;
+struct RemA;
+
+impl Arith for AddA {
+    #[inline(always)]
+    fn apply(a: i64, b: i64, _: u32) -> Res<i64> {
+        Ok(a.wrapping_add(b))
+    }
+}
+
+impl Arith for SubA {
+    #[inline(always)]
+    fn apply(a: i64, b: i64, _: u32) -> Res<i64> {
+        Ok(a.wrapping_sub(b))
+    }
+}
+
+impl Arith for MulA {
+    #[inline(always)]
+    fn apply(a: i64, b: i64, _: u32) -> Res<i64> {
+        Ok(a.wrapping_mul(b))
+    }
+}
+
+impl Arith for RemA {
+    #[inline(always)]
+    fn apply(a: i64, b: i64, at: u32) -> Res<i64> {
+        if b == 0 {
+            Err(EvalError {
+                at,
+                kind: EvalErrorKind::DivByZero,
             })
+        } else {
+            Ok(a.wrapping_rem(b))
         }
-        leaf => Box::new(move |env, d| {
-            *d = make(read(env, leaf)?);
-            Ok(())
+    }
+}
+
+fn arith_k<A: Arith>(a: Leaf, b: Leaf, at: u32) -> IntFn {
+    match (a, b) {
+        (Leaf::Var(i, ai), Leaf::Const(k)) => {
+            Box::new(
+                move |env: &mut Env<'_>| match IntK::key(env.vars.get(i as usize)) {
+                    Some(v) => A::apply(v, k, at),
+                    None => Err(internal(ai)),
+                },
+            )
+        }
+        (a, b) => Box::new(move |env: &mut Env<'_>| {
+            let x = read_k::<IntK>(env, a)?;
+            A::apply(x, read_k::<IntK>(env, b)?, at)
         }),
+    }
+}
+
+/// `a op b` for two integer leaves and `op` one of `+ - * %` (`at`: where `%` by zero is
+/// reported): one closure for `i + 1`, where the tree of closures made three. Both leaves
+/// are read, in order, before the operation, as the tree reads them.
+pub(super) fn arith(op: BinOp, a: Leaf, b: Leaf, at: u32) -> Option<IntFn> {
+    Some(match op {
+        BinOp::Add => arith_k::<AddA>(a, b, at),
+        BinOp::Sub => arith_k::<SubA>(a, b, at),
+        BinOp::Mul => arith_k::<MulA>(a, b, at),
+        BinOp::Rem => arith_k::<RemA>(a, b, at),
+        _ => return None,
+    })
+}
+
+/// Code that writes `leaf`'s value into a cell as `store` says: a literal is stored
+/// directly (a scalar cell is overwritten whatever it held, as `clone_from` of a scalar
+/// does), a variable or parameter is read as its static type.
+pub(super) fn write(leaf: Leaf, store: Store) -> CellFn {
+    fn of<K: Kind, M: Fn(i64) -> Cell + Copy + Send + Sync + 'static>(
+        leaf: Leaf,
+        make: M,
+    ) -> CellFn {
+        match leaf {
+            Leaf::Const(v) => {
+                let c = make(v);
+                match c {
+                    Cell::Int(v) => Box::new(move |_, d| {
+                        *d = Cell::Int(v);
+                        Ok(())
+                    }),
+                    Cell::Bool(b) => Box::new(move |_, d| {
+                        *d = Cell::Bool(b);
+                        Ok(())
+                    }),
+                    Cell::Str(s) => Box::new(move |_, d| {
+                        *d = Cell::Str(s);
+                        Ok(())
+                    }),
+                    Cell::Float(f) => Box::new(move |_, d| {
+                        *d = Cell::Float(f);
+                        Ok(())
+                    }),
+                    Cell::List(_) => Box::new(move |_, d| {
+                        d.clone_from(&c);
+                        Ok(())
+                    }),
+                }
+            }
+            leaf => Box::new(move |env, d| {
+                *d = make(read_k::<K>(env, leaf)?);
+                Ok(())
+            }),
+        }
+    }
+    match store {
+        Store::Int => of::<IntK, _>(leaf, Cell::Int),
+        Store::Bool => of::<BoolK, _>(leaf, |v| Cell::Bool(v != 0)),
+        Store::Str => of::<StrK, _>(leaf, |v| Cell::Str(StrId(v as u32))),
+        Store::Float => of::<IntK, _>(leaf, |v| Cell::Float(v as f64)),
     }
 }

@@ -369,6 +369,18 @@ impl Compiler<'_, '_> {
 
     pub(super) fn unary(&mut self, at: u32, op: UnOp, x: &Expr) -> Result<Typed, CompileError> {
         let t = self.expr(x, None)?;
+        // `!b` of a boolean leaf is `b == false`: one closure (see `leaf.rs`).
+        if op == UnOp::Not && t.ty == Ty::Bool {
+            if let Some(code) = self
+                .leaf(x, &Ty::Bool)
+                .and_then(|l| leaf::compare(BinOp::Eq, &Ty::Bool, l, leaf::Leaf::Const(0)))
+            {
+                return Ok(Typed {
+                    ty: Ty::Bool,
+                    code: Code::Bool(code),
+                });
+            }
+        }
         match (op, t.code) {
             (UnOp::Not, Code::Bool(f)) => Ok(Typed {
                 ty: Ty::Bool,
@@ -442,6 +454,15 @@ impl Compiler<'_, '_> {
                         return Err(cerr(at, "internal error"));
                     };
                     let bat = self.abs(b.start);
+                    // Two leaves: one closure reads both (see `leaf.rs`).
+                    if let (Some(la), Some(lb)) = (self.leaf(a, &Ty::Int), self.leaf(b, &Ty::Int)) {
+                        if let Some(f) = leaf::arith(op, la, lb, bat) {
+                            return Ok(Typed {
+                                ty: Ty::Int,
+                                code: Code::Int(f),
+                            });
+                        }
+                    }
                     let f: IntFn = match op {
                         BinOp::Add => Box::new(move |e| Ok(x(e)?.wrapping_add(y(e)?))),
                         BinOp::Sub => Box::new(move |e| Ok(x(e)?.wrapping_sub(y(e)?))),
@@ -485,7 +506,7 @@ impl Compiler<'_, '_> {
                 // closure reads both (see `leaf.rs`).
                 if ta.ty == tb.ty && (ta.ty == Ty::Int || !ordered) {
                     if let (Some(la), Some(lb)) = (self.leaf(a, &ta.ty), self.leaf(b, &tb.ty)) {
-                        if let Some(code) = leaf::compare(op, la, lb) {
+                        if let Some(code) = leaf::compare(op, &ta.ty, la, lb) {
                             return Ok(Typed {
                                 ty: Ty::Bool,
                                 code: Code::Bool(code),

@@ -555,3 +555,79 @@ fn cells_written_from_leaves_and_other_code() {
     );
     assert!(eval_cell("f", &Ty::Int).is_err());
 }
+
+#[test]
+fn fused_leaf_arithmetic_and_negation_agree_with_the_operators() {
+    // i = 7, p (`_event.data.p`) = 40, b = true.
+    for (text, want) in [
+        ("i + 1", 8),
+        ("1 + i", 8),
+        ("i - 10", -3),
+        ("i * _event.data.p", 280),
+        ("_event.data.p % i", 5),
+        ("i % -4", 3),
+        ("-7 % i", 0),
+        ("i + i", 14),
+        ("(i + 1) * 2", 16),
+        ("9223372036854775807 + i", i64::MIN + 6),
+    ] {
+        assert_eq!(eval(text), Ok(Cell::Int(want)), "{text}");
+    }
+    // A remainder by zero is reported at the divisor, as the unfused code reports it.
+    let zero = "i % 0";
+    let e = parse_expr(zero).unwrap();
+    let vs = vars();
+    let types = TypeTable::default();
+    let scope = Scope {
+        vars: &vs,
+        event: EventScope::None,
+        types: &types,
+        abs: &|k| k + 100,
+    };
+    let mut strings = Strings::default();
+    let Code::Int(f) = compile(&e, &scope, &mut strings, None).unwrap().code else {
+        panic!("an int")
+    };
+    let vals = cells(&mut strings);
+    let mut rng = Fixed(0);
+    let mut env = Env {
+        vars: &vals,
+        params: &[],
+        event: StrId(0),
+        origin: StrId(0),
+        rng: &mut rng,
+        strings: &strings,
+    };
+    assert_eq!(
+        f(&mut env),
+        Err(EvalError {
+            at: 104,
+            kind: EvalErrorKind::DivByZero
+        })
+    );
+    // A cell that does not hold its static type is an internal error at the leaf (a
+    // fused read takes only the variant of the leaf's type, as the leaf's closure did).
+    let wrong = [Cell::Bool(true)];
+    let mut env = Env {
+        vars: &wrong,
+        params: &[],
+        event: StrId(0),
+        origin: StrId(0),
+        rng: &mut rng,
+        strings: &strings,
+    };
+    assert_eq!(
+        f(&mut env),
+        Err(EvalError {
+            at: 100,
+            kind: EvalErrorKind::Internal
+        })
+    );
+    assert_eq!(eval("!b"), Ok(Cell::Bool(false)));
+    assert_eq!(eval("!(b)"), Ok(Cell::Bool(false)));
+    assert_eq!(eval("!!b"), Ok(Cell::Bool(true)));
+    assert_eq!(eval("!(i == 7)"), Ok(Cell::Bool(false)));
+    assert_eq!(eval("!false"), Ok(Cell::Bool(true)));
+    assert_eq!(eval_cell("true", &Ty::Bool), Ok(Cell::Bool(true)));
+    assert_eq!(eval_cell("7", &Ty::Float), Ok(Cell::Float(7.0)));
+}
