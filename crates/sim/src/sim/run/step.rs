@@ -248,7 +248,14 @@ impl Simulator<'_> {
                     };
                 }
                 Instr::CheckEventless => {
-                    match self.select(m, def, self.candidates(m, def, None), rng, cfg)? {
+                    let list = self.candidates(m, def, None);
+                    // No eventless transition (most states' entry code ends so): idle
+                    // without the call.
+                    if list.is_empty() {
+                        self.ms[m].pc = IDLE;
+                        continue;
+                    }
+                    match self.select(m, def, list, rng, cfg)? {
                         Some(t) => {
                             internal += 1;
                             if internal > cfg.max_eventless {
