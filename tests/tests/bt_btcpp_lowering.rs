@@ -733,6 +733,7 @@ fn random_trees_with_skipped_lower_to_what_btcpp_does() {
         btcpp4_nodes: true,
         scripts: true,
         skipped: true,
+        root_skip: true,
         ..Default::default()
     });
 }
@@ -747,6 +748,7 @@ fn random_trees_with_skipped_and_time_nodes_lower_to_what_btcpp_does() {
         btcpp4_nodes: true,
         scripts: true,
         skipped: true,
+        root_skip: true,
         time_nodes: true,
         try_catch: true,
         ..Default::default()
@@ -859,36 +861,63 @@ fn btcpp4_kind(k: &Kind) -> Option<usize> {
     })
 }
 
-/// Whether the lowering refuses the tree's pre/post conditions as not modelled yet
-/// (`btcpp4_conds.rs`): conditions on a node BT.CPP may tick again without resetting it (the condition of a two-child
-/// IfThenElse or of a WhileDoElse, the child of a BlackboardCheck).
+/// Whether the lowering refuses the tree's pre/post conditions (`btcpp4_conds.rs`):
+/// conditions on the child of a BlackboardCheck, a BT.CPP 3 node (BT.CPP 4 refuses it
+/// at load, and BT.CPP 3 has no conditions). Conditions on a node BT.CPP may tick again
+/// without resetting it (the condition of a two-child IfThenElse or of a WhileDoElse)
+/// are compared.
 fn conds_refused(t: &tree::Tree) -> bool {
-    let stale = t.nodes.iter().any(|p| {
-        let kids: &[usize] = match p.kind {
-            Kind::IfThenElse if p.children.len() == 2 => &p.children[..1],
-            Kind::WhileDoElse => &p.children[..1],
-            Kind::Check(..) => &p.children[..],
-            _ => &[],
-        };
-        kids.iter().any(|&c| t.nodes[c].conds.any())
-    });
-    stale
+    t.nodes.iter().any(|p| {
+        matches!(p.kind, Kind::Check(..)) && p.children.iter().any(|&c| t.nodes[c].conds.any())
+    })
 }
 
-/// Whether the lowering refuses a Loop node as not modelled yet (`btcpp4_loop.rs`): one
-/// BT.CPP may tick again without resetting it (the condition of a two-child IfThenElse or
-/// of a WhileDoElse, the child of a BlackboardCheck), which then goes on with its queue.
+/// Whether the lowering refuses a Loop node (`btcpp4_loop.rs`): under a BlackboardCheck
+/// (BT.CPP 3's node). A Loop BT.CPP may tick again without resetting it is compared.
 fn loop_refused(t: &tree::Tree) -> bool {
     t.nodes.iter().any(|p| {
-        let kids: &[usize] = match p.kind {
-            Kind::IfThenElse if p.children.len() == 2 => &p.children[..1],
-            Kind::WhileDoElse => &p.children[..1],
-            Kind::Check(..) => &p.children[..],
-            _ => &[],
-        };
-        kids.iter()
-            .any(|&c| matches!(t.nodes[c].kind, Kind::Loop(..)))
+        matches!(p.kind, Kind::Check(..))
+            && p.children
+                .iter()
+                .any(|&c| matches!(t.nodes[c].kind, Kind::Loop(..)))
     })
+}
+
+/// Where BT.CPP may tick a node again without resetting it (the condition of a
+/// two-child IfThenElse or of a WhileDoElse): whether the tree has such a node with
+/// pre/post conditions, a Loop there, and a sequence there with a child that makes
+/// SKIPPED itself.
+fn stale_kinds(t: &tree::Tree) -> [bool; 3] {
+    let makes = |c: usize| {
+        let x = &t.nodes[c];
+        x.conds.pre[2].is_some()
+            || x.conds.pre[3].is_some()
+            || matches!(
+                x.kind,
+                Kind::RunOnce(true) | Kind::Precondition(_, Status::Skipped)
+            )
+    };
+    let mut out = [false; 3];
+    for p in &t.nodes {
+        let c = match p.kind {
+            Kind::IfThenElse if p.children.len() == 2 => p.children[0],
+            Kind::WhileDoElse => p.children[0],
+            _ => continue,
+        };
+        let x = &t.nodes[c];
+        out[0] |= x.conds.any();
+        out[1] |= matches!(x.kind, Kind::Loop(..));
+        out[2] |= matches!(
+            x.kind,
+            Kind::Sequence
+                | Kind::Fallback
+                | Kind::SequenceWithMemory
+                | Kind::AsyncSequence
+                | Kind::AsyncFallback
+                | Kind::TryCatch(_)
+        ) && x.children.iter().any(|&g| makes(g));
+    }
+    out
 }
 
 /// The kinds of BT.CPP 4's blackboard nodes the lowering takes (`gen::Options::bb_nodes`),
@@ -1002,6 +1031,10 @@ fn random_trees(opts: gen::Options) {
     // Trees compared that hold each of BT.CPP 4's own node kinds.
     let kinds: [AtomicUsize; 14] = Default::default();
     let kinds = &kinds;
+    // Trees compared with, where BT.CPP may tick a node again without resetting it,
+    // pre/post conditions, a Loop, a sequence with a child that makes SKIPPED.
+    let stale: [AtomicUsize; 3] = Default::default();
+    let stale = &stale;
     // Trees compared whose scripts read a SetBlackboard's text; chain `+`/`-`.
     let feats: [AtomicUsize; 2] = Default::default();
     let feats = &feats;
@@ -1138,6 +1171,11 @@ fn random_trees(opts: gen::Options) {
                             }
                         }
                         skip_kinds[4].fetch_add(root_skipped, Relaxed);
+                        for (k, x) in stale_kinds(&t).iter().enumerate() {
+                            if *x {
+                                stale[k].fetch_add(1, Relaxed);
+                            }
+                        }
                         for (k, s) in skip_parents(&t).iter().enumerate() {
                             if *s {
                                 skip_under[k].fetch_add(1, Relaxed);
@@ -1177,6 +1215,13 @@ fn random_trees(opts: gen::Options) {
     }
     let kinds = kinds.each_ref().map(|c| c.load(Relaxed));
     let [texts, chains] = feats.each_ref().map(|c| c.load(Relaxed));
+    let [stale_conds, stale_loops, stale_seqs] = stale.each_ref().map(|c| c.load(Relaxed));
+    eprintln!(
+        "where BT.CPP ticks a node again without resetting it (the condition of a two-child \
+         IfThenElse or of a WhileDoElse), trees compared with pre/post conditions there \
+         {stale_conds}, a Loop there {stale_loops}, a sequence with a child that makes \
+         SKIPPED there {stale_seqs}"
+    );
     eprintln!(
         "{n} random trees{} in {:.1} s on {threads} threads: {copies} with a SetBlackboard copy \
          and {not_modelled} with pre/post conditions not modelled yet left out, \
@@ -1423,6 +1468,11 @@ fn real_library_with(
     // (a copy fails or throws in 4.8.2; the lowering copies, see above).
     let mut cases = Vec::new();
     let mut kinds = [0usize; 14];
+    // Trees with, where BT.CPP ticks a node again without resetting it, pre/post
+    // conditions, a Loop, a sequence with a child that makes SKIPPED (`stale_kinds`);
+    // trees whose root may answer SKIPPED (`gen::Options::root_skip`).
+    let mut stale = [0usize; 3];
+    let mut root_skips = 0;
     for seed in seed0.. {
         if cases.len() >= n {
             break;
@@ -1436,6 +1486,7 @@ fn real_library_with(
                 scripts,
                 unset,
                 skipped,
+                root_skip: skipped,
                 bb_nodes: bb,
                 reals,
                 ..Default::default()
@@ -1468,7 +1519,45 @@ fn real_library_with(
         for (k, s) in seen.iter().enumerate() {
             kinds[k] += usize::from(*s);
         }
+        for (k, x) in stale_kinds(&t).iter().enumerate() {
+            stale[k] += usize::from(*x);
+        }
+        root_skips += usize::from(c.xml.contains("<RunOnce><Sequence><SetBlackboard"));
         cases.push((seed, c, t));
+    }
+    eprintln!(
+        "of the {} trees: pre/post conditions on a node BT.CPP ticks again without resetting \
+         it {}, a Loop there {}, a sequence with a child that makes SKIPPED there {}; a root \
+         that may answer SKIPPED {root_skips}",
+        cases.len(),
+        stale[0],
+        stale[1],
+        stale[2]
+    );
+    if scripts && n >= 200 {
+        assert!(
+            stale[0] >= n / 50,
+            "only {} trees with conditions there",
+            stale[0]
+        );
+    }
+    if skipped && n >= 200 {
+        assert!(
+            stale[2] >= n / 200,
+            "only {} trees with a skipping sequence there",
+            stale[2]
+        );
+        assert!(
+            root_skips >= n / 10,
+            "only {root_skips} trees whose root may answer SKIPPED"
+        );
+    }
+    if bb && n >= 200 {
+        assert!(
+            stale[1] >= n / 200,
+            "only {} trees with a Loop there",
+            stale[1]
+        );
     }
     if unset {
         let with = cases
