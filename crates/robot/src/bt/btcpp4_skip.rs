@@ -167,7 +167,21 @@ pub(super) fn refusals(sm: &SourceMap, tree: &Tree) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     for (i, n) in tree.nodes.iter().enumerate() {
         let Some(p) = n.parent else { continue };
-        if skips[i]
+        // A sequence there with a child that may answer SKIPPED may answer it too: BT.CPP
+        // 3's BlackboardCheck does not reset its child, so its count of skipped
+        // children carries over a finished tick.
+        let sequence = matches!(
+            n.kind,
+            Kind::Control(
+                Control::Sequence
+                    | Control::Fallback
+                    | Control::SequenceWithMemory
+                    | Control::Btcpp4(
+                        Btcpp4::AsyncSequence | Btcpp4::AsyncFallback | Btcpp4::TryCatch
+                    ),
+            )
+        ) && n.children.iter().any(|&c| skips[c]);
+        if (skips[i] || sequence)
             && matches!(
                 tree.nodes[p].kind,
                 Kind::Control(Control::BlackboardCheck(_))
