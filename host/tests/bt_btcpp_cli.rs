@@ -297,9 +297,9 @@ fn btcpp4_nodes_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         (
             "skip",
             "btcpp",
-            "<IfThenElse>\n  <Sequence>\n    <RunOnce>\n      <FailOnce/>\n    </RunOnce>\n  </Sequence>\n  <AlwaysSuccess/>\n</IfThenElse>",
+            "<BlackboardCheckInt value_A=\"{k}\" value_B=\"1\">\n  <RunOnce>\n    <FailOnce/>\n  </RunOnce>\n</BlackboardCheckInt>",
             "<RunOnce>",
-            "SKIPPED reaching a sequence that BehaviorTree.CPP may tick again without resetting it",
+            "its parent, a BlackboardCheck, is a BehaviorTree.CPP 3 node",
         ),
         (
             "case",
@@ -381,9 +381,9 @@ fn scripts_and_conditions_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         (
             "skip",
             "btcpp",
-            "<IfThenElse>\n  <Sequence>\n    <FailOnce _skipIf=\"true\"/>\n  </Sequence>\n  <AlwaysSuccess/>\n</IfThenElse>",
+            "<BlackboardCheckInt value_A=\"{k}\" value_B=\"1\">\n  <FailOnce _skipIf=\"true\"/>\n</BlackboardCheckInt>",
             "<FailOnce _skipIf",
-            "SKIPPED reaching a sequence that BehaviorTree.CPP may tick again without resetting it",
+            "its parent, a BlackboardCheck, is a BehaviorTree.CPP 3 node",
         ),
         (
             "string",
@@ -423,9 +423,9 @@ fn scripts_and_conditions_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         (
             "stale",
             "btcpp",
-            "<IfThenElse>\n  <FailOnce _onFailure=\"x := 1\"/>\n  <AlwaysSuccess/>\n</IfThenElse>",
+            "<BlackboardCheckInt value_A=\"{k}\" value_B=\"1\">\n  <FailOnce _onFailure=\"x := 1\"/>\n</BlackboardCheckInt>",
             "_onFailure",
-            "without resetting it",
+            "no BehaviorTree.CPP runs this tree",
         ),
     ] {
         let tree = v4(tree);

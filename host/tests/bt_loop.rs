@@ -123,8 +123,8 @@ fn what_is_not_modelled_is_refused_at_its_place() {
             "which a SetBlackboard writes too",
         ),
         (
-            "<IfThenElse><LoopInt queue=\"1\"><Act/></LoopInt><Act/></IfThenElse>",
-            "tree.xml:3:13: LoopInt: BehaviorTree.CPP may tick this node again without resetting it",
+            "<BlackboardCheckInt value_A=\"{k}\" value_B=\"1\"><LoopInt queue=\"1\"><Act/></LoopInt></BlackboardCheckInt>",
+            "tree.xml:3:47: LoopInt: its parent, a BlackboardCheck, is a BehaviorTree.CPP 3 node",
         ),
         (
             "<WasEntryUpdated/>",

@@ -92,11 +92,11 @@ fn a_well_formed_condition_is_refused_saying_why() {
     // Under BT.CPP's rules: what is not modelled yet, at the attribute.
     let btcpp = BtSemantics::Btcpp { tick: BtTick::Once };
     let e = errors(
-        "<IfThenElse>\n<Sequence>\n<Act _skipIf=\"true\"/>\n</Sequence>\n<Act/>\n</IfThenElse>",
+        "<BlackboardCheckInt value_A=\"{k}\" value_B=\"1\">\n<Sequence>\n<Act _skipIf=\"true\"/>\n</Sequence>\n</BlackboardCheckInt>",
         btcpp,
     );
     assert!(
-        e.contains("tree.xml:5:1: this node may answer SKIPPED (BehaviorTree.CPP 4): SKIPPED reaching a sequence that BehaviorTree.CPP may tick again without resetting it"),
+        e.contains("tree.xml:4:1: this node may answer SKIPPED (BehaviorTree.CPP 4): its parent, a BlackboardCheck, is a BehaviorTree.CPP 3 node"),
         "{e}"
     );
 }

@@ -592,6 +592,16 @@ fn compare(want: &oracle::Outcome, got: &Outcome) -> Option<String> {
     }
 }
 
+/// The least count a coverage check accepts of a construct the generator draws in at
+/// least one tree in `per`, among `n` trees: the expected count less four of its
+/// standard deviations (a count of rare draws is close to Poisson), so that the check
+/// holds at any tree count the run is given, not only at the default, and still fails
+/// when the construct is no longer drawn.
+fn floor(n: u64, per: u64) -> u64 {
+    let e = n as f64 / per as f64;
+    (e - 4.0 * e.sqrt()).max(0.0).floor() as u64
+}
+
 fn env(name: &str, default: u64) -> u64 {
     std::env::var(name)
         .ok()
@@ -674,7 +684,7 @@ fn random_trees_with_bb_nodes_lower_to_what_btcpp_does() {
     );
     if n >= 1000 {
         for (k, c) in BB_KINDS.iter().zip(cov) {
-            assert!(c >= n / 50, "only {c} of {n} trees with {k}");
+            assert!(c >= floor(n, 50), "only {c} of {n} trees with {k}");
         }
     }
 }
@@ -733,6 +743,7 @@ fn random_trees_with_skipped_lower_to_what_btcpp_does() {
         btcpp4_nodes: true,
         scripts: true,
         skipped: true,
+        root_skip: true,
         ..Default::default()
     });
 }
@@ -747,6 +758,7 @@ fn random_trees_with_skipped_and_time_nodes_lower_to_what_btcpp_does() {
         btcpp4_nodes: true,
         scripts: true,
         skipped: true,
+        root_skip: true,
         time_nodes: true,
         try_catch: true,
         ..Default::default()
@@ -859,36 +871,63 @@ fn btcpp4_kind(k: &Kind) -> Option<usize> {
     })
 }
 
-/// Whether the lowering refuses the tree's pre/post conditions as not modelled yet
-/// (`btcpp4_conds.rs`): conditions on a node BT.CPP may tick again without resetting it (the condition of a two-child
-/// IfThenElse or of a WhileDoElse, the child of a BlackboardCheck).
+/// Whether the lowering refuses the tree's pre/post conditions (`btcpp4_conds.rs`):
+/// conditions on the child of a BlackboardCheck, a BT.CPP 3 node (BT.CPP 4 refuses it
+/// at load, and BT.CPP 3 has no conditions). Conditions on a node BT.CPP may tick again
+/// without resetting it (the condition of a two-child IfThenElse or of a WhileDoElse)
+/// are compared.
 fn conds_refused(t: &tree::Tree) -> bool {
-    let stale = t.nodes.iter().any(|p| {
-        let kids: &[usize] = match p.kind {
-            Kind::IfThenElse if p.children.len() == 2 => &p.children[..1],
-            Kind::WhileDoElse => &p.children[..1],
-            Kind::Check(..) => &p.children[..],
-            _ => &[],
-        };
-        kids.iter().any(|&c| t.nodes[c].conds.any())
-    });
-    stale
+    t.nodes.iter().any(|p| {
+        matches!(p.kind, Kind::Check(..)) && p.children.iter().any(|&c| t.nodes[c].conds.any())
+    })
 }
 
-/// Whether the lowering refuses a Loop node as not modelled yet (`btcpp4_loop.rs`): one
-/// BT.CPP may tick again without resetting it (the condition of a two-child IfThenElse or
-/// of a WhileDoElse, the child of a BlackboardCheck), which then goes on with its queue.
+/// Whether the lowering refuses a Loop node (`btcpp4_loop.rs`): under a BlackboardCheck
+/// (BT.CPP 3's node). A Loop BT.CPP may tick again without resetting it is compared.
 fn loop_refused(t: &tree::Tree) -> bool {
     t.nodes.iter().any(|p| {
-        let kids: &[usize] = match p.kind {
-            Kind::IfThenElse if p.children.len() == 2 => &p.children[..1],
-            Kind::WhileDoElse => &p.children[..1],
-            Kind::Check(..) => &p.children[..],
-            _ => &[],
-        };
-        kids.iter()
-            .any(|&c| matches!(t.nodes[c].kind, Kind::Loop(..)))
+        matches!(p.kind, Kind::Check(..))
+            && p.children
+                .iter()
+                .any(|&c| matches!(t.nodes[c].kind, Kind::Loop(..)))
     })
+}
+
+/// Where BT.CPP may tick a node again without resetting it (the condition of a
+/// two-child IfThenElse or of a WhileDoElse): whether the tree has such a node with
+/// pre/post conditions, a Loop there, and a sequence there with a child that makes
+/// SKIPPED itself.
+fn stale_kinds(t: &tree::Tree) -> [bool; 3] {
+    let makes = |c: usize| {
+        let x = &t.nodes[c];
+        x.conds.pre[2].is_some()
+            || x.conds.pre[3].is_some()
+            || matches!(
+                x.kind,
+                Kind::RunOnce(true) | Kind::Precondition(_, Status::Skipped)
+            )
+    };
+    let mut out = [false; 3];
+    for p in &t.nodes {
+        let c = match p.kind {
+            Kind::IfThenElse if p.children.len() == 2 => p.children[0],
+            Kind::WhileDoElse => p.children[0],
+            _ => continue,
+        };
+        let x = &t.nodes[c];
+        out[0] |= x.conds.any();
+        out[1] |= matches!(x.kind, Kind::Loop(..));
+        out[2] |= matches!(
+            x.kind,
+            Kind::Sequence
+                | Kind::Fallback
+                | Kind::SequenceWithMemory
+                | Kind::AsyncSequence
+                | Kind::AsyncFallback
+                | Kind::TryCatch(_)
+        ) && x.children.iter().any(|&g| makes(g));
+    }
+    out
 }
 
 /// The kinds of BT.CPP 4's blackboard nodes the lowering takes (`gen::Options::bb_nodes`),
@@ -1002,6 +1041,10 @@ fn random_trees(opts: gen::Options) {
     // Trees compared that hold each of BT.CPP 4's own node kinds.
     let kinds: [AtomicUsize; 14] = Default::default();
     let kinds = &kinds;
+    // Trees compared with, where BT.CPP may tick a node again without resetting it,
+    // pre/post conditions, a Loop, a sequence with a child that makes SKIPPED.
+    let stale: [AtomicUsize; 3] = Default::default();
+    let stale = &stale;
     // Trees compared whose scripts read a SetBlackboard's text; chain `+`/`-`.
     let feats: [AtomicUsize; 2] = Default::default();
     let feats = &feats;
@@ -1138,6 +1181,11 @@ fn random_trees(opts: gen::Options) {
                             }
                         }
                         skip_kinds[4].fetch_add(root_skipped, Relaxed);
+                        for (k, x) in stale_kinds(&t).iter().enumerate() {
+                            if *x {
+                                stale[k].fetch_add(1, Relaxed);
+                            }
+                        }
                         for (k, s) in skip_parents(&t).iter().enumerate() {
                             if *s {
                                 skip_under[k].fetch_add(1, Relaxed);
@@ -1177,6 +1225,13 @@ fn random_trees(opts: gen::Options) {
     }
     let kinds = kinds.each_ref().map(|c| c.load(Relaxed));
     let [texts, chains] = feats.each_ref().map(|c| c.load(Relaxed));
+    let [stale_conds, stale_loops, stale_seqs] = stale.each_ref().map(|c| c.load(Relaxed));
+    eprintln!(
+        "where BT.CPP ticks a node again without resetting it (the condition of a two-child \
+         IfThenElse or of a WhileDoElse), trees compared with pre/post conditions there \
+         {stale_conds}, a Loop there {stale_loops}, a sequence with a child that makes \
+         SKIPPED there {stale_seqs}"
+    );
     eprintln!(
         "{n} random trees{} in {:.1} s on {threads} threads: {copies} with a SetBlackboard copy \
          and {not_modelled} with pre/post conditions not modelled yet left out, \
@@ -1237,11 +1292,39 @@ fn random_trees(opts: gen::Options) {
                 };
                 if on {
                     assert!(
-                        c as u64 >= n / 200,
+                        c as u64 >= floor(n, 200),
                         "only {c} compared trees where SKIPPED reaches a {k}"
                     );
                 }
             }
+        }
+        // Where BT.CPP ticks a node again without resetting it: conditions (one tree
+        // in 45 at 10,000 trees), a Loop (one in 140), a sequence with a child that
+        // makes SKIPPED (one in 240), each held to a rate below that; a root answering
+        // SKIPPED in one run in 40.
+        if opts.scripts && opts.btcpp4_nodes {
+            assert!(
+                stale_conds as u64 >= floor(n, 60),
+                "only {stale_conds} compared trees with conditions on a node ticked again without a reset"
+            );
+        }
+        if opts.bb_nodes {
+            assert!(
+                stale_loops as u64 >= floor(n, 200),
+                "only {stale_loops} compared trees with a Loop ticked again without a reset"
+            );
+        }
+        if opts.skipped && opts.btcpp4_nodes {
+            assert!(
+                stale_seqs as u64 >= floor(n, 400),
+                "only {stale_seqs} compared trees with a skipping sequence ticked again without a reset"
+            );
+        }
+        if opts.root_skip {
+            assert!(
+                root_skipped as u64 >= floor(n, 40),
+                "only {root_skipped} runs where the root answered SKIPPED"
+            );
         }
         // With BT.CPP 4's own nodes on, each kind is in at least one tree in 100.
         for (i, (k, c)) in BTCPP4_KINDS.iter().zip(kinds).enumerate() {
@@ -1252,7 +1335,10 @@ fn random_trees(opts: gen::Options) {
                 _ => opts.scripts,
             };
             if on {
-                assert!(c as u64 >= n / 100, "only {c} compared trees with {k}");
+                assert!(
+                    c as u64 >= floor(n, 100),
+                    "only {c} compared trees with {k}"
+                );
             } else {
                 assert_eq!(c, 0, "{k} generated while off");
             }
@@ -1423,6 +1509,11 @@ fn real_library_with(
     // (a copy fails or throws in 4.8.2; the lowering copies, see above).
     let mut cases = Vec::new();
     let mut kinds = [0usize; 14];
+    // Trees with, where BT.CPP ticks a node again without resetting it, pre/post
+    // conditions, a Loop, a sequence with a child that makes SKIPPED (`stale_kinds`);
+    // trees whose root may answer SKIPPED (`gen::Options::root_skip`).
+    let mut stale = [0usize; 3];
+    let mut root_skips = 0;
     for seed in seed0.. {
         if cases.len() >= n {
             break;
@@ -1436,6 +1527,7 @@ fn real_library_with(
                 scripts,
                 unset,
                 skipped,
+                root_skip: skipped,
                 bb_nodes: bb,
                 reals,
                 ..Default::default()
@@ -1468,7 +1560,46 @@ fn real_library_with(
         for (k, s) in seen.iter().enumerate() {
             kinds[k] += usize::from(*s);
         }
+        for (k, x) in stale_kinds(&t).iter().enumerate() {
+            stale[k] += usize::from(*x);
+        }
+        root_skips += usize::from(c.xml.contains("<RunOnce><Sequence><SetBlackboard"));
         cases.push((seed, c, t));
+    }
+    eprintln!(
+        "of the {} trees: pre/post conditions on a node BT.CPP ticks again without resetting \
+         it {}, a Loop there {}, a sequence with a child that makes SKIPPED there {}; a root \
+         that may answer SKIPPED {root_skips}",
+        cases.len(),
+        stale[0],
+        stale[1],
+        stale[2]
+    );
+    let n64 = n as u64;
+    if scripts {
+        assert!(
+            stale[0] as u64 >= floor(n64, 50),
+            "only {} trees with conditions there",
+            stale[0]
+        );
+    }
+    if skipped {
+        assert!(
+            stale[2] as u64 >= floor(n64, 200),
+            "only {} trees with a skipping sequence there",
+            stale[2]
+        );
+        assert!(
+            root_skips as u64 >= floor(n64, 10),
+            "only {root_skips} trees whose root may answer SKIPPED"
+        );
+    }
+    if bb {
+        assert!(
+            stale[1] as u64 >= floor(n64, 200),
+            "only {} trees with a Loop there",
+            stale[1]
+        );
     }
     if unset {
         let with = cases
@@ -1502,7 +1633,10 @@ fn real_library_with(
         );
         if n >= 200 {
             for (k, c) in BB_KINDS.iter().zip(cov) {
-                assert!(c >= n / 50, "only {c} of {n} trees with {k}");
+                assert!(
+                    c as u64 >= floor(n as u64, 50),
+                    "only {c} of {n} trees with {k}"
+                );
             }
         }
     }
@@ -1598,7 +1732,7 @@ fn real_library_with(
     if n >= 500 {
         for (i, (k, c)) in BTCPP4_KINDS.iter().zip(kinds).enumerate() {
             if i < 7 || (i >= SCRIPT_KINDS && scripts) {
-                assert!(c >= n / 100, "only {c} trees with {k}");
+                assert!(c as u64 >= floor(n as u64, 100), "only {c} trees with {k}");
             }
         }
     }

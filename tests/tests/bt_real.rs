@@ -406,6 +406,7 @@ fn random_trees_and_every_case_run_in_real_btcpp_as_the_oracle_says() {
             btcpp4_nodes: true,
             scripts: true,
             skipped: true,
+            root_skip: true,
             ..Default::default()
         };
         let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);

@@ -103,6 +103,13 @@ pub struct Options {
     /// must be 0 or 1). Nothing stores a number that is not whole. Off, the generator
     /// draws what it drew before.
     pub reals: bool,
+    /// A root that answers SKIPPED (format-4 trees, with [`Options::skipped`]): one tree
+    /// in three has a RunOnce (its `then_skip` left to its default, true) over the main
+    /// tree's Sequence, which answers SKIPPED at every tick after the Sequence first
+    /// finished (4.10 `RunOnceNode::tick`), so the executor neither ticks again nor
+    /// resets it (`Tree::tickRoot`). Drawn after everything else: the trees are those
+    /// of the same seed without it, the root aside.
+    pub root_skip: bool,
 }
 
 /// The script entries: `x`, `y` integers, `f` a boolean, all written first by the main
@@ -818,6 +825,20 @@ pub fn case_with_conds<R: Rng>(rng: &mut R, size: i64, opts: Options, conds: Con
 {init}{body}</Sequence></BehaviorTree>{defs}</root>"
     );
     let ticks = 4 + g.below(7) as usize;
+    let xml = if g.opts.root_skip && g.opts.skipped && !g.v3 && g.below(3) == 0 {
+        xml.replacen(
+            "<BehaviorTree ID=\"Main\"><Sequence>",
+            "<BehaviorTree ID=\"Main\"><RunOnce><Sequence>",
+            1,
+        )
+        .replacen(
+            "</Sequence></BehaviorTree>",
+            "</Sequence></RunOnce></BehaviorTree>",
+            1,
+        )
+    } else {
+        xml
+    };
     Case {
         xml,
         scripts: g.scripts,

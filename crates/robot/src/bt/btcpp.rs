@@ -198,12 +198,14 @@ pub(super) fn sequence_with_memory(ctx: &Ctx) -> Element {
         h,
         vec![b.assign(idx, "0"), all_skipped, b.assign(SKIP_COUNT, "0")],
     ));
-    m.push(halting_state(
-        ctx,
-        "halting_on_failure",
-        h,
-        vec![ctx.respond(FAILURE), b.assign(SKIP_COUNT, "0")],
-    ));
+    // The count is left as it is (a parent resets the node before ticking it again,
+    // which restarts it), except where BT.CPP may tick it again without a reset
+    // (`Ctx::stale`): there it carries over (`!isStatusActive(status())` is false).
+    let mut on_failure = vec![ctx.respond(FAILURE)];
+    if !ctx.stale {
+        on_failure.push(b.assign(SKIP_COUNT, "0"));
+    }
+    m.push(halting_state(ctx, "halting_on_failure", h, on_failure));
     m.push(halting_state(
         ctx,
         "halting_on_halt",

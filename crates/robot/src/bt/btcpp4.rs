@@ -343,12 +343,13 @@ pub(super) fn async_sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
         ("halting_on_stop", ctx.respond(stop)),
         ("halting_on_halt", ctx.respond_halted()),
     ] {
-        m.push(halting_state(
-            ctx,
-            state,
-            h,
-            vec![b.assign(idx, "0"), answer, b.assign(SKIP_COUNT, "0")],
-        ));
+        let mut finish = vec![b.assign(idx, "0"), answer];
+        // `stop` leaves `skipped_count_`: it carries over where BT.CPP may tick the
+        // node again without a reset (`Ctx::stale`).
+        if !(ctx.stale && state == "halting_on_stop") {
+            finish.push(b.assign(SKIP_COUNT, "0"));
+        }
+        m.push(halting_state(ctx, state, h, finish));
     }
     m.push(b.state("error"));
     m

@@ -22,15 +22,19 @@
 //!
 //! A node is IDLE at a tick unless it answered RUNNING last: every parent resets a child
 //! that finished before ticking it again, except the condition of a two-child
-//! IfThenElse or of a WhileDoElse and the child of a BlackboardCheck, which BT.CPP may
-//! tick again in its finished status (skipping its pre-conditions); conditions there are
-//! refused. The root's wrapper talks to the root machine as to a parent.
+//! IfThenElse or of a WhileDoElse (`btcpp4_skip.rs`, `stale`), which BT.CPP may tick
+//! again in its finished status: there the wrapper keeps that status (`node_done`),
+//! the parent halts it at every reset (`control.rs`, `Ctx::resets`), and a tick in it
+//! checks no pre-condition and, for a stateful leaf, answers the status again without
+//! ticking the leaf, the post-conditions run as for any finished answer. Conditions on
+//! the child of a BlackboardCheck (BT.CPP 3's node, refused by BT.CPP 4) are refused.
+//! The root's wrapper talks to the root machine as to a parent.
 
 use super::blackboard::{Blackboard, MACHINE};
 use super::btcpp4_script::compile;
 use super::build::B;
 use super::control::{Ctx, FAILURE, IS_SKIPPED, RUNNING, SKIPPED, SKIPPED_RUNNING, SUCCESS};
-use super::tree::{Btcpp4, Control, Kind, Tree, TreeNode};
+use super::tree::{Tree, TreeNode};
 use crate::model::source::{Diagnostic, SourceMap};
 use crate::model::xml::Element;
 
@@ -58,24 +62,13 @@ pub(super) fn refusals(sm: &SourceMap, tree: &Tree, i: usize, btcpp: bool) -> Ve
         let why = if !btcpp {
             "AS2FM has no model of BehaviorTree.CPP's script language, so the default semantics (`--bt as2fm`) cannot lower it: use `--bt btcpp` (BehaviorTree.CPP 4's rules)"
         } else {
-            let Some(p) = n.parent else {
-                // The root: the root machine ticks it as a parent would. `Tree::tickRoot`
-                // resets a finished root (`resetStatus`), so it is IDLE at every tick
-                // unless it answered RUNNING (or SKIPPED with its status RUNNING).
-                continue;
-            };
-            let p = &tree.nodes[p];
-            let first = p.children.first() == Some(&i);
-            let stale = match p.kind {
-                Kind::Control(Control::IfThenElse) => first && p.children.len() == 2,
-                Kind::Control(Control::Btcpp4(Btcpp4::WhileDoElse)) => first,
-                Kind::Control(Control::BlackboardCheck(_)) => true,
-                _ => false,
-            };
-            if !stale {
+            // The root is ticked by the root machine as by a parent (`Tree::tickRoot`
+            // resets a finished root); a node BT.CPP may tick again without a reset
+            // keeps its status in the wrapper. Only a BlackboardCheck's child is left.
+            if !super::btcpp4_skip::under_check(tree, i) {
                 continue;
             }
-            "BehaviorTree.CPP may tick this node again without resetting it (the condition of a two-child IfThenElse or of a WhileDoElse, the child of a BlackboardCheck), skipping its pre-conditions: not modelled yet"
+            super::btcpp4_skip::BB_CHECK
         };
         out.push(sm.diag(
             c.name_span,
@@ -176,13 +169,27 @@ fn chain(
     true
 }
 
+/// How a wrapped node that BT.CPP may tick again without resetting it
+/// ([`Ctx::stale`] of the wrapper's `outer` context) answers then.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Inner {
+    /// The node is a stateful leaf (`btcpp.rs`, "Leaves"): ticked in a finished status
+    /// it answers that status again without running.
+    pub stateful: bool,
+    /// The node's own machine keeps what a reset clears ([`Ctx::stale`]): the wrapper
+    /// passes the parent's reset on.
+    pub forward: bool,
+}
+
 /// The wrapper machine of node `n` (see the module comment); `outer` is the context the
-/// parent sees (its `parent` and `halt_target`). Its scripts go to the blackboard
-/// machine. `None` after an error.
+/// parent sees (its `parent` and `halt_target`, and whether the parent may tick the
+/// node again without resetting it, `stale`, with how the node answers then, `inner`).
+/// Its scripts go to the blackboard machine. `None` after an error.
 pub(super) fn wrapper(
     sm: &SourceMap,
     n: &TreeNode,
     outer: &Ctx,
+    inner: Inner,
     bb: &mut Blackboard,
     errs: &mut Vec<Diagnostic>,
 ) -> Option<Element> {
@@ -265,12 +272,63 @@ pub(super) fn wrapper(
         format!("bt_{id}_halt_response"),
     );
     let run = "node_running";
+    // The node finished and its parent has not reset it since (its status SUCCESS or
+    // FAILURE), kept only where the parent may tick it again so.
+    let node_done = "node_done";
+    let stale = outer.stale;
     let mut m = b.scxml(&me, "wait_for_tick");
-    m.push(b.datamodel(&[
-        (run, "bool", "false".into()),
+    let mut data = vec![
+        (run, "bool", "false".to_string()),
         ("result", "int8", "0".into()),
-    ]));
+    ];
+    if stale {
+        data.push((node_done, "bool", "false".into()));
+    }
+    m.push(b.datamodel(&data));
     let mut w = b.state("wait_for_tick");
+    if stale {
+        // Ticked in its finished status (4.10 `TreeNode::executeTick`): no
+        // pre-condition (`checkPreConditions` looks only while the node is IDLE or
+        // RUNNING); a stateful leaf answers its status again without running
+        // (`StatefulActionNode::tick`), any other node is ticked; the post-conditions
+        // run for the finished answer.
+        if inner.stateful {
+            w.push(b.tr(Some(&tick), Some(node_done), Some("finished"), vec![]));
+        } else {
+            w.push(b.tr(
+                Some(&tick),
+                Some(node_done),
+                Some("ticking"),
+                vec![tick_inner()],
+            ));
+        }
+        // The parent's reset of a finished node (`ControlNode::resetChildren`:
+        // `resetStatus`, no `haltNode`, so no `_onHalted`): IDLE again.
+        if inner.forward {
+            w.push(b.tr(
+                Some(&halt),
+                Some(node_done),
+                Some("resetting"),
+                vec![
+                    b.assign(node_done, "false"),
+                    b.send(&format!("bt_{id}_halt"), &n.machine),
+                ],
+            ));
+            m.push(b.state("resetting").with_child(b.tr(
+                Some(&halt_resp),
+                None,
+                Some("wait_for_tick"),
+                vec![halted()],
+            )));
+        } else {
+            w.push(b.tr(
+                Some(&halt),
+                Some(node_done),
+                Some("wait_for_tick"),
+                vec![b.assign(node_done, "false"), halted()],
+            ));
+        }
+    }
     if has_while {
         w.push(b.tr(
             Some(&tick),
@@ -368,13 +426,26 @@ pub(super) fn wrapper(
                 )),
         );
     }
+    let mut on_running = vec![b.assign(run, "true")];
+    let mut on_skipped = vec![b.assign(run, &format!("_event.data.status == {SKIPPED_RUNNING}"))];
+    if stale {
+        // RUNNING now; a SKIPPED leaves a finished status as it was unless the node
+        // set itself RUNNING (code 5).
+        on_running.push(b.assign(node_done, "false"));
+        on_skipped.push(b.assign(
+            node_done,
+            &format!("{node_done} && _event.data.status == {SKIPPED}"),
+        ));
+    }
+    on_running.push(respond(&RUNNING.to_string()));
+    on_skipped.push(respond("_event.data.status"));
     m.push(
         b.state("ticking")
             .with_child(b.tr(
                 Some(&resp),
                 Some(&format!("_event.data.status == {RUNNING}")),
                 Some("wait_for_tick"),
-                vec![b.assign(run, "true"), respond(&RUNNING.to_string())],
+                on_running,
             ))
             // The node's own SKIPPED: passed on, the node RUNNING still if it set
             // itself so (code 5); no post-condition.
@@ -382,10 +453,7 @@ pub(super) fn wrapper(
                 Some(&resp),
                 Some(IS_SKIPPED),
                 Some("wait_for_tick"),
-                vec![
-                    b.assign(run, &format!("_event.data.status == {SKIPPED_RUNNING}")),
-                    respond("_event.data.status"),
-                ],
+                on_skipped,
             ))
             .with_child(b.tr(
                 Some(&resp),
@@ -397,7 +465,11 @@ pub(super) fn wrapper(
                 ],
             )),
     );
-    let mut f = b.state("finished");
+    let mut f = if stale {
+        b.state_entry("finished", vec![b.assign(node_done, "true")])
+    } else {
+        b.state("finished")
+    };
     for (k, s) in [SUCCESS, FAILURE].into_iter().enumerate() {
         if has_post[k] {
             f.push(b.tr(

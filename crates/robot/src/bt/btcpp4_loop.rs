@@ -21,15 +21,18 @@
 //! to the blackboard machine as a write of `value` (`bt_blackboard_set_<entry>`, which
 //! counts as an update, `btcpp4_blackboard.rs`). "IDLE" is "did not answer RUNNING
 //! last" (`loop_active`), which holds wherever the parent resets a finished child before
-//! ticking it again; a Loop node BT.CPP may tick again without resetting it (the
-//! condition of a two-child IfThenElse or of a WhileDoElse, the child of a
-//! BlackboardCheck) is refused. Refused too: a queue held in an entry (`queue="{q}"`),
+//! ticking it again. Where BT.CPP may tick the node again without resetting it (the
+//! condition of a two-child IfThenElse or of a WhileDoElse, `btcpp4_skip.rs`, `stale`)
+//! a finished answer leaves it active too (`loop_finished`), so the next tick goes on
+//! with the rest of its queue, and the parent halts it at every reset, which makes it
+//! IDLE. Refused: a Loop under a BlackboardCheck (BT.CPP 3's node), a queue held in an
+//! entry (`queue="{q}"`),
 //! an item that BT.CPP would not convert, and a `value` entry whose type is not the
 //! node's item type (the node's port types an entry no one else types).
 
 use super::blackboard::{register, set_event, Blackboard, Entry, MACHINE};
 use super::control::{Ctx, FAILURE, IS_SKIPPED, RUNNING, SKIPPED, SKIPPED_RUNNING, SUCCESS};
-use super::tree::{Btcpp4, Control, Kind, LoopType, PortValue, Tree, TreeNode};
+use super::tree::{LoopType, PortValue, Tree, TreeNode};
 use crate::model::source::{Diagnostic, SourceMap};
 use crate::model::types::Scalar;
 use crate::model::xml::Element;
@@ -64,7 +67,7 @@ const SCRIPT: &str = "a script";
 
 /// Before the nodes are lowered: types the entry Loop node `i` writes (after the ports
 /// of plugins and BlackboardChecks and SetBlackboard's constants, before scripts), and
-/// refuses a Loop node BT.CPP may tick again without resetting it. An entry a script
+/// refuses a Loop node under a BlackboardCheck (BT.CPP 3's node). An entry a script
 /// (or UnsetBlackboard) names is a script's, `int64`, as `btcpp4_script.rs` types it:
 /// the Loop writes numbers there (found against 4.8.2, docs/SEMANTICS.md); any other
 /// takes the port's type.
@@ -77,20 +80,11 @@ pub(super) fn prepare(
     errs: &mut Vec<Diagnostic>,
 ) {
     let n = &tree.nodes[i];
-    if let Some(p) = n.parent.map(|p| &tree.nodes[p]) {
-        let first = p.children.first() == Some(&i);
-        let stale = match p.kind {
-            Kind::Control(Control::IfThenElse) => first && p.children.len() == 2,
-            Kind::Control(Control::Btcpp4(Btcpp4::WhileDoElse)) => first,
-            Kind::Control(Control::BlackboardCheck(_)) => true,
-            _ => false,
-        };
-        if stale {
-            errs.push(sm.diag(
-                n.span,
-                format!("{}: BehaviorTree.CPP may tick this node again without resetting it (the condition of a two-child IfThenElse or of a WhileDoElse, the child of a BlackboardCheck), and then goes on with the rest of its queue: not modelled yet", loop_name(t)),
-            ));
-        }
+    if super::btcpp4_skip::under_check(tree, i) {
+        errs.push(sm.diag(
+            n.span,
+            format!("{}: {}", loop_name(t), super::btcpp4_skip::BB_CHECK),
+        ));
     }
     if let Some(p) = n.port("value") {
         if let PortValue::Blackboard(g) = &p.value {
@@ -310,7 +304,12 @@ pub(super) fn lower(
 /// model expression), if `value` is given.
 fn machine(ctx: &Ctx, items: &[Option<(String, String)>], if_empty: u8) -> Element {
     let b = &ctx.b;
-    let (pos, cr, active) = ("queue_pos", "loop_child_running", "loop_active");
+    let (pos, cr, active, fin) = (
+        "queue_pos",
+        "loop_child_running",
+        "loop_active",
+        "loop_finished",
+    );
     let len = items.len();
     let mut m = b.scxml(&ctx.machine, "wait_for_tick");
     let mut data = vec![
@@ -318,6 +317,24 @@ fn machine(ctx: &Ctx, items: &[Option<(String, String)>], if_empty: u8) -> Eleme
         (cr, "bool", "false".to_string()),
         (active, "bool", "false".to_string()),
     ];
+    if ctx.stale {
+        data.push((fin, "bool", "false".to_string()));
+    }
+    // A finished answer (`done`) or not: IDLE afterwards, except where BT.CPP may tick
+    // the node again without a reset (`Ctx::stale`), where it keeps its finished
+    // status until the parent's reset (a halt).
+    let finished = |done: bool| {
+        if ctx.stale {
+            vec![
+                b.assign(active, "true"),
+                b.assign(fin, if done { "true" } else { "false" }),
+            ]
+        } else if done {
+            vec![b.assign(active, "false")]
+        } else {
+            Vec::new()
+        }
+    };
     let flags = ctx.running_data();
     data.extend(flags.iter().map(|(v, t, e)| (v.as_str(), *t, e.clone())));
     m.push(b.datamodel(&data));
@@ -330,20 +347,32 @@ fn machine(ctx: &Ctx, items: &[Option<(String, String)>], if_empty: u8) -> Eleme
     ));
     w.push(b.tr(Some(&ctx.tick_ev()), None, Some("popping"), vec![]));
     // `DecoratorNode::halt`: the child halted if RUNNING, the node IDLE.
+    let finished_clear = if ctx.stale {
+        vec![b.assign(fin, "false")]
+    } else {
+        Vec::new()
+    };
     let r = ctx.running_var(0);
     if let Some(r) = &r {
-        w.push(b.tr(
-            Some(&ctx.halt_ev()),
-            Some(&format!("!{r}")),
-            Some("wait_for_tick"),
-            vec![b.assign(active, "false"), ctx.respond_halted()],
-        ));
+        w.push(
+            b.tr(
+                Some(&ctx.halt_ev()),
+                Some(&format!("!{r}")),
+                Some("wait_for_tick"),
+                [
+                    vec![b.assign(active, "false")],
+                    finished_clear.clone(),
+                    vec![ctx.respond_halted()],
+                ]
+                .concat(),
+            ),
+        );
     }
     w.push(b.tr(
         Some(&ctx.halt_ev()),
         None,
         Some("halting_child"),
-        vec![b.assign(active, "false")],
+        [vec![b.assign(active, "false")], finished_clear.clone()].concat(),
     ));
     m.push(w);
     let mut p = b.state("popping");
@@ -363,6 +392,7 @@ fn machine(ctx: &Ctx, items: &[Option<(String, String)>], if_empty: u8) -> Eleme
     pop.extend(b.if_chain(writes, Vec::new()));
     pop.push(b.assign(pos, &format!("{pos} + 1")));
     pop.push(b.assign(active, "true"));
+    pop.extend(finished_clear.clone());
     p.push(b.tr(
         None,
         Some(&format!("!{cr} && {pos} < {len}")),
@@ -373,28 +403,38 @@ fn machine(ctx: &Ctx, items: &[Option<(String, String)>], if_empty: u8) -> Eleme
         None,
         Some(cr),
         Some("tick_child"),
-        vec![b.assign(active, "true")],
+        [vec![b.assign(active, "true")], finished_clear.clone()].concat(),
     ));
     // Nothing popped, no child running: `if_empty`, the node's status left as it was
     // (a SKIPPED is not stored, `TreeNode::executeTick`).
+    // Where BT.CPP may tick the node again without a reset (`Ctx::stale`), a finished
+    // answer leaves it non-IDLE (`loop_finished`): only the parent's reset (a halt)
+    // makes it IDLE again, and a SKIPPED then is 4 (its status is not RUNNING).
+    let running_now = if ctx.stale {
+        format!("{active} && !{fin}")
+    } else {
+        active.to_string()
+    };
     let empty = match if_empty {
         SKIPPED => vec![b
             .if_chain(
-                vec![(active.to_string(), vec![ctx.respond(SKIPPED_RUNNING)])],
+                vec![(running_now, vec![ctx.respond(SKIPPED_RUNNING)])],
                 vec![ctx.respond(SKIPPED)],
             )
             .expect("one branch")],
-        RUNNING => vec![b.assign(active, "true"), ctx.respond(RUNNING)],
-        s => vec![b.assign(active, "false"), ctx.respond(s)],
+        RUNNING => [
+            finished(false),
+            vec![b.assign(active, "true"), ctx.respond(RUNNING)],
+        ]
+        .concat(),
+        s => [finished(true), vec![ctx.respond(s)]].concat(),
     };
     p.push(b.tr(None, None, Some("wait_for_tick"), empty));
     m.push(p);
     let mut t = b.state_entry("tick_child", vec![ctx.tick_child(0)]);
     for (s, answer) in [(SUCCESS, RUNNING), (FAILURE, FAILURE), (RUNNING, RUNNING)] {
         let mut body = vec![b.assign(cr, if s == RUNNING { "true" } else { "false" })];
-        if s == FAILURE {
-            body.push(b.assign(active, "false"));
-        }
+        body.extend(finished(s == FAILURE));
         body.push(ctx.respond(answer));
         t.push(b.tr(
             Some(&ctx.child_resp(0)),

@@ -12,9 +12,11 @@
 //! Repeat, RetryUntilSuccessful, KeepRunningUntilFailure, RunOnce, Timeout, Delay,
 //! Precondition, SkipUnlessUpdated, WaitValueUpdate, the Loop nodes and the root
 //! (SkipUnlessUpdated and a Loop with `if_empty="SKIPPED"` make it too,
-//! `btcpp4_blackboard.rs`, `btcpp4_loop.rs`). The parents it does not handle refuse a
-//! child that may answer SKIPPED, at the child: a BlackboardCheck (BT.CPP 3's), and a
-//! sequence (or TryCatch) BT.CPP may tick again without resetting it.
+//! `btcpp4_blackboard.rs`, `btcpp4_loop.rs`). A sequence (or TryCatch) BT.CPP may tick
+//! again without resetting it keeps its count of skipped children ([`stale`]): its
+//! parent halts it at every reset (`control.rs`, `Ctx::resets`). The one parent that
+//! refuses a child that may answer SKIPPED, at the child, is a BlackboardCheck
+//! (BT.CPP 3's, [`BB_CHECK`]).
 
 use super::control::{Ctx, IS_SKIPPED, RUNNING, SKIPPED, SKIPPED_RUNNING};
 use super::tree::{Btcpp4, Control, Kind, PortValue, ScriptNode, Tree, UpdatedNode};
@@ -155,48 +157,70 @@ pub(super) fn may_skip(tree: &Tree) -> Vec<bool> {
     out
 }
 
-/// The errors for SKIPPED reaching a parent the lowering does not model it for (under
-/// BT.CPP's rules), each at the child that may answer SKIPPED.
+/// The errors for SKIPPED reaching a parent the lowering does not model it for, each at
+/// the child that may answer SKIPPED: a BlackboardCheck. BlackboardCheckInt/Double/String
+/// are BT.CPP 3's nodes: BT.CPP 4's factory does not register them (4.8.2 refuses the
+/// tree at load, "Node not recognized"), and BT.CPP 3 has no SKIPPED status, so no
+/// BehaviorTree.CPP runs such a tree.
 pub(super) fn refusals(sm: &SourceMap, tree: &Tree) -> Vec<Diagnostic> {
     let skips = may_skip(tree);
     let mut out = Vec::new();
     for (i, n) in tree.nodes.iter().enumerate() {
         let Some(p) = n.parent else { continue };
-        if !skips[i] {
-            continue;
-        }
-        let parent = &tree.nodes[p];
-        let why = match parent.kind {
-            // BlackboardCheckInt/Double/String are BT.CPP 3's nodes (4 has no such node,
-            // and no rule for a skipped child of one).
-            Kind::Control(Control::BlackboardCheck(_)) => {
-                "a BlackboardCheck is a BehaviorTree.CPP 3 node, which has no SKIPPED status to pass on".to_string()
-            }
+        // A sequence there with a child that may answer SKIPPED may answer it too: BT.CPP
+        // 3's BlackboardCheck does not reset its child, so its count of skipped
+        // children carries over a finished tick.
+        let sequence = matches!(
+            n.kind,
             Kind::Control(
                 Control::Sequence
-                | Control::Fallback
-                | Control::SequenceWithMemory
-                | Control::Btcpp4(
-                    Btcpp4::AsyncSequence | Btcpp4::AsyncFallback | Btcpp4::TryCatch,
-                ),
-            ) if stale(tree, p) => {
-                "SKIPPED reaching a sequence that BehaviorTree.CPP may tick again without resetting it (the condition of a two-child IfThenElse or of a WhileDoElse, the child of a BlackboardCheck), whose count of skipped children then carries over, is not modelled yet".to_string()
-            }
-            _ => continue,
-        };
-        out.push(sm.diag(
-            n.span,
-            format!("this node may answer SKIPPED (BehaviorTree.CPP 4): {why}"),
-        ));
+                    | Control::Fallback
+                    | Control::SequenceWithMemory
+                    | Control::Btcpp4(
+                        Btcpp4::AsyncSequence | Btcpp4::AsyncFallback | Btcpp4::TryCatch
+                    ),
+            )
+        ) && n.children.iter().any(|&c| skips[c]);
+        if (skips[i] || sequence)
+            && matches!(
+                tree.nodes[p].kind,
+                Kind::Control(Control::BlackboardCheck(_))
+            )
+        {
+            out.push(sm.diag(
+                n.span,
+                format!("this node may answer SKIPPED (BehaviorTree.CPP 4): {BB_CHECK}"),
+            ));
+        }
     }
     out
 }
 
-/// Whether BT.CPP may tick node `i` again in a finished status, without its parent
-/// resetting it: the condition of a two-child IfThenElse (`IfThenElseNode::tick` returns
-/// the condition's FAILURE without `resetChildren`) or of a WhileDoElse (reset only when
-/// a branch finishes), the child of a BlackboardCheck.
-fn stale(tree: &Tree, i: usize) -> bool {
+/// Why a BT.CPP 4 construction under a BlackboardCheck is refused.
+pub(super) const BB_CHECK: &str = "its parent, a BlackboardCheck, is a BehaviorTree.CPP 3 node (BehaviorTree.CPP 4 does not register it and refuses the tree when it loads it, \"Node not recognized\"), and BehaviorTree.CPP 3 has neither SKIPPED, pre/post conditions nor Loop nodes: no BehaviorTree.CPP runs this tree";
+
+/// Whether node `i` is the child of a BlackboardCheck.
+pub(super) fn under_check(tree: &Tree, i: usize) -> bool {
+    tree.nodes[i].parent.is_some_and(|p| {
+        matches!(
+            tree.nodes[p].kind,
+            Kind::Control(Control::BlackboardCheck(_))
+        )
+    })
+}
+
+/// Whether BT.CPP 4 may tick node `i` again in a finished status, without its parent
+/// resetting it: the condition of a two-child IfThenElse (4.10 `IfThenElseNode::tick`
+/// returns the condition's FAILURE without `resetChildren`) or of a WhileDoElse
+/// (`WhileDoElseNode::tick` ticks it at every tick and resets the children only when a
+/// branch finishes). Such a node keeps its finished status: `TreeNode::checkPreConditions`
+/// then checks none of `_failureIf`, `_successIf`, `_skipIf`, `_while` (only while IDLE,
+/// `_while` also while RUNNING); `SequenceNode::tick`, `FallbackNode::tick`,
+/// `SequenceWithMemory::tick`, `TryCatchNode::tick` keep `skipped_count_` (reset only
+/// when `!isStatusActive(status())`); `LoopNode<T>::tick` goes on with its queue (a copy
+/// is taken only when IDLE); a stateful leaf answers its status again without running
+/// (`StatefulActionNode::tick`).
+pub(super) fn stale(tree: &Tree, i: usize) -> bool {
     let Some(p) = tree.nodes[i].parent else {
         return false;
     };
@@ -205,7 +229,27 @@ fn stale(tree: &Tree, i: usize) -> bool {
     match p.kind {
         Kind::Control(Control::IfThenElse) => first && p.children.len() == 2,
         Kind::Control(Control::Btcpp4(Btcpp4::WhileDoElse)) => first,
-        Kind::Control(Control::BlackboardCheck(_)) => true,
+        _ => false,
+    }
+}
+
+/// Whether node `i`'s own machine needs to know when its parent resets it, in a place
+/// where BT.CPP may tick it again without a reset ([`stale`]): a sequence (Sequence,
+/// Fallback, SequenceWithMemory, AsyncSequence, AsyncFallback, TryCatch) with a child
+/// that may answer SKIPPED (its `skipped_count_`), or a Loop node (its queue).
+pub(super) fn resets_matter(tree: &Tree, skips: &[bool], i: usize) -> bool {
+    if !stale(tree, i) {
+        return false;
+    }
+    let n = &tree.nodes[i];
+    match n.kind {
+        Kind::Control(
+            Control::Sequence
+            | Control::Fallback
+            | Control::SequenceWithMemory
+            | Control::Btcpp4(Btcpp4::AsyncSequence | Btcpp4::AsyncFallback | Btcpp4::TryCatch),
+        ) => n.children.iter().any(|&c| skips[c]),
+        Kind::Control(Control::Btcpp4(Btcpp4::Loop(_))) => true,
         _ => false,
     }
 }

@@ -613,30 +613,47 @@ fn try_catch(ctx: &Ctx, catch_on_halt: bool) -> Element {
     let last = ctx.children.len() - 1;
     let r_last = super::btcpp::running(ctx, last);
     let mut m = b.scxml(&ctx.machine, "init");
-    m.push(datamodel(
-        ctx,
-        &[
-            ("children_count", n_children(ctx).as_str()),
-            (idx, "0"),
-            ("halt_idx", "0"),
-            ("in_catch", "false"),
-            (SKIP_COUNT, "0"),
-        ],
-    ));
+    // Where BT.CPP may tick the node again without a reset (`Ctx::stale`) its parent
+    // halts it at every reset, running or not; `TryCatchNode::halt` runs only for a
+    // RUNNING node (`ControlNode::haltChild`), so the catch on halt needs `active`.
+    let n = n_children(ctx);
+    let mut vars = vec![
+        ("children_count", n.as_str()),
+        (idx, "0"),
+        ("halt_idx", "0"),
+        ("in_catch", "false"),
+        (SKIP_COUNT, "0"),
+    ];
+    let active = "active";
+    if ctx.stale {
+        vars.push((active, "false"));
+    }
+    m.push(datamodel(ctx, &vars));
     m.push(init_state(ctx, "children_count < 2"));
+    let set_active = || {
+        if ctx.stale {
+            vec![b.assign(active, "true")]
+        } else {
+            Vec::new()
+        }
+    };
     let mut w = b
         .state("wait_for_tick")
         .with_child(b.tr(
             Some(&ctx.tick_ev()),
             Some("in_catch"),
             Some("tick_catch"),
-            vec![],
+            set_active(),
         ))
-        .with_child(b.tr(Some(&ctx.tick_ev()), None, Some("tick_try"), vec![]));
+        .with_child(b.tr(Some(&ctx.tick_ev()), None, Some("tick_try"), set_active()));
     if catch_on_halt {
         w.push(b.tr(
             Some(&ctx.halt_ev()),
-            Some("!in_catch"),
+            Some(if ctx.stale {
+                "!in_catch && active"
+            } else {
+                "!in_catch"
+            }),
             Some("halting_try"),
             vec![b.assign("halt_idx", "0")],
         ));
@@ -707,27 +724,32 @@ fn try_catch(ctx: &Ctx, catch_on_halt: bool) -> Element {
             vec![ctx.respond(SUCCESS)],
         )
         .expect("one branch");
+    let mut on_success = vec![b.assign(idx, "0")];
+    if ctx.stale {
+        on_success.push(b.assign(active, &format!("{SKIP_COUNT} == children_count - 1")));
+    }
+    on_success.extend([answer, b.assign(SKIP_COUNT, "0")]);
     m.push(halting(
         ctx,
         "halting_on_success",
         "children_count",
         "wait_for_tick",
-        vec![b.assign(idx, "0"), answer, b.assign(SKIP_COUNT, "0")],
+        on_success,
     ));
     // A FAILURE leaves `skipped_count_` as it is, but the node then finishes FAILURE and
     // its parent resets it before the next tick (`!isStatusActive(status())` restarts
-    // the count); a TryCatch BT.CPP ticks again without a reset is refused
-    // (`btcpp4_skip.rs`), so the count restarts here.
+    // the count), so the count restarts here; where BT.CPP may tick it again without a
+    // reset (`Ctx::stale`) it carries over, and the parent's reset (a halt) clears it.
+    let mut to_catch = vec![b.assign(idx, "0"), b.assign("in_catch", "true")];
+    if !ctx.stale {
+        to_catch.push(b.assign(SKIP_COUNT, "0"));
+    }
     m.push(halting(
         ctx,
         "halting_to_catch",
         "children_count",
         "tick_catch",
-        vec![
-            b.assign(idx, "0"),
-            b.assign("in_catch", "true"),
-            b.assign(SKIP_COUNT, "0"),
-        ],
+        to_catch,
     ));
     // The catch.
     let mut c = b.state_entry("tick_catch", vec![ctx.tick_child(last)]);
@@ -754,23 +776,36 @@ fn try_catch(ctx: &Ctx, catch_on_halt: bool) -> Element {
         "halting_after_catch",
         "children_count",
         "wait_for_tick",
-        vec![
-            b.assign(idx, "0"),
-            b.assign("in_catch", "false"),
-            ctx.respond(FAILURE),
-        ],
+        [
+            vec![b.assign(idx, "0"), b.assign("in_catch", "false")],
+            if ctx.stale {
+                vec![b.assign(active, "false")]
+            } else {
+                Vec::new()
+            },
+            vec![ctx.respond(FAILURE)],
+        ]
+        .concat(),
     ));
     m.push(halting(
         ctx,
         "halting_on_halt",
         "children_count",
         "wait_for_tick",
-        vec![
-            b.assign(idx, "0"),
-            b.assign("in_catch", "false"),
-            b.assign(SKIP_COUNT, "0"),
-            ctx.respond_halted(),
-        ],
+        [
+            vec![
+                b.assign(idx, "0"),
+                b.assign("in_catch", "false"),
+                b.assign(SKIP_COUNT, "0"),
+            ],
+            if ctx.stale {
+                vec![b.assign(active, "false")]
+            } else {
+                Vec::new()
+            },
+            vec![ctx.respond_halted()],
+        ]
+        .concat(),
     ));
     if catch_on_halt {
         m.push(halting(

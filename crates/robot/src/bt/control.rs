@@ -89,6 +89,16 @@ pub(crate) struct Ctx {
     /// Under BT.CPP's rules, whether each child is a leaf plugin, a stateful action
     /// (`btcpp.rs`, "Leaves"); empty under AS2FM's.
     pub stateful: Vec<bool>,
+    /// Under BT.CPP's rules, whether the parent may tick this node again in a finished
+    /// status without resetting it (the condition of a two-child IfThenElse or of a
+    /// WhileDoElse, `btcpp4_skip.rs`, `stale`) and this node's rules depend on that
+    /// status (a sequence's `skipped_count_`, a Loop's queue): then the parent halts
+    /// it at every reset, and a halt while it is not running is BT.CPP's
+    /// `resetStatus` (the node IDLE again, nothing else).
+    pub stale: bool,
+    /// Per child: the child is [`Ctx::stale`] (or its conditions' machine is), so it is
+    /// halted at every reset, running or not; empty under AS2FM's rules.
+    pub resets: Vec<bool>,
 }
 
 impl Ctx {
@@ -210,6 +220,9 @@ impl Ctx {
     }
     /// The condition under which halting child `i` is skipped: `None` never skips it.
     pub(crate) fn skip_cond(&self, i: usize) -> Option<String> {
+        if self.resets.get(i) == Some(&true) {
+            return None;
+        }
         match self.effect(i) {
             HaltEffect::Never => Some("true".into()),
             HaltEffect::WhenRunning => self.running_var(i).map(|v| format!("!{v}")),

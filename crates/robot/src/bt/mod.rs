@@ -276,6 +276,21 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
     if btcpp {
         errs.extend(btcpp4_skip::refusals(sm, &tree));
     }
+    // A stateful leaf (`btcpp.rs`, "Leaves"): a leaf plugin, or Sleep.
+    let stateful = |c: usize| match tree.nodes[c].kind {
+        Kind::Plugin(p) => !plugins[p].ticks_children,
+        Kind::Control(c) => c == Control::Btcpp4(tree::Btcpp4::Sleep),
+    };
+    // Where BT.CPP may tick a node again without resetting it (`btcpp4_skip.rs`,
+    // `stale`): whether its own machine keeps what a reset clears, and whether its
+    // parent halts it (or its conditions' machine) at every reset.
+    let skips = if btcpp {
+        btcpp4_skip::may_skip(&tree)
+    } else {
+        Vec::new()
+    };
+    let inner_told = |i: usize| btcpp && btcpp4_skip::resets_matter(&tree, &skips, i);
+    let told = |i: usize| btcpp && btcpp4_skip::stale(&tree, i) && (wrapped(i) || inner_told(i));
     for (idx, n) in tree.nodes.iter().enumerate() {
         let refused = btcpp4_conds::refusals(sm, &tree, idx, btcpp);
         if !refused.is_empty() {
@@ -324,15 +339,15 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
             stateful: if input.semantics == BtSemantics::As2fm {
                 Vec::new()
             } else {
+                // A stateful leaf with pre/post conditions: its conditions' machine
+                // answers for it where it is ticked again without a reset.
                 n.children
                     .iter()
-                    .map(|&c| match tree.nodes[c].kind {
-                        Kind::Plugin(p) => !plugins[p].ticks_children,
-                        // `SleepNode` is a `StatefulActionNode` too.
-                        Kind::Control(c) => c == Control::Btcpp4(tree::Btcpp4::Sleep),
-                    })
+                    .map(|&c| stateful(c) && !wrapped(c))
                     .collect()
             },
+            stale: inner_told(idx),
+            resets: n.children.iter().map(|&c| told(c)).collect(),
         };
         if let (Kind::Control(Control::Btcpp4(k)), BtSemantics::As2fm) = (n.kind, input.semantics) {
             errs.push(sm.diag(n.span, btcpp4::as2fm_refusal(k)));
@@ -375,9 +390,14 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
             let outer = Ctx {
                 parent: outer.0,
                 halt_target: outer.1,
+                stale: told(idx),
                 ..ctx.clone()
             };
-            if let Some(w) = btcpp4_conds::wrapper(sm, n, &outer, &mut bb, &mut errs) {
+            let inner = btcpp4_conds::Inner {
+                stateful: stateful(idx),
+                forward: inner_told(idx),
+            };
+            if let Some(w) = btcpp4_conds::wrapper(sm, n, &outer, inner, &mut bb, &mut errs) {
                 out.push(w);
             }
         }

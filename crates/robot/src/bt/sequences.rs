@@ -25,7 +25,15 @@ pub(super) fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
     let finish = if ctx.btcpp {
         // BT.CPP 4.10 `SequenceNode::tick` / `FallbackNode::tick`: every child skipped
         // answers SKIPPED (the node set itself RUNNING first); `halt` and a finished
-        // loop clear `skipped_count_`.
+        // loop clear `skipped_count_`. `stop` leaves it: the count restarts at the next
+        // tick only if the node was reset in between (`!isStatusActive(status())`),
+        // which every parent does, except where BT.CPP may tick the node again without
+        // a reset (`Ctx::stale`: the parent halts it at every reset instead).
+        let reset_count = if ctx.stale {
+            b.if_then(&format!("!{}", flag(stop)), vec![b.assign(SKIP_COUNT, "0")])
+        } else {
+            b.assign(SKIP_COUNT, "0")
+        };
         vec![
             b.if_chain(
                 vec![
@@ -40,7 +48,7 @@ pub(super) fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
             )
             .expect("three branches"),
             b.assign(idx, "0"),
-            b.assign(SKIP_COUNT, "0"),
+            reset_count,
             b.assign("seq_failure", "false"),
             b.assign("seq_success", "false"),
         ]
