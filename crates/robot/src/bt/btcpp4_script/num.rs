@@ -53,8 +53,11 @@ pub(crate) fn entry_type(bb: &Blackboard, g: &str) -> &'static str {
     }
 }
 
+/// A node's map from script names to entries (`TreeNode::script_names`).
+type Names<'t> = &'t [(String, PortValue)];
+
 /// The scripts of the tree, each with its node's name-to-entry map.
-fn scripts(tree: &Tree) -> Vec<(Vec<script::Stmt>, &[(String, PortValue)])> {
+fn scripts(tree: &Tree) -> Vec<(Vec<script::Stmt>, Names<'_>)> {
     let mut out = Vec::new();
     for n in &tree.nodes {
         let mut codes: Vec<&str> = n.conds.iter().map(|c| c.code.as_str()).collect();
