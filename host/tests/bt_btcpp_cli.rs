@@ -393,20 +393,6 @@ fn scripts_and_conditions_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
             "strings in scripts are not modelled: the model's expressions have no string operations",
         ),
         (
-            "real",
-            "btcpp",
-            "<Sequence>\n  <Script code=\"r := 1.5\"/>\n</Sequence>",
-            "r := 1.5",
-            "storing a number that need not be whole",
-        ),
-        (
-            "division",
-            "btcpp",
-            "<Sequence>\n  <Script code=\"x := 4; x /= 2\"/>\n</Sequence>",
-            "x := 4; x /= 2",
-            "storing a number that need not be whole",
-        ),
-        (
             "text",
             "btcpp",
             "<Sequence>\n  <SetBlackboard output_key=\"n\" value=\"1\"/>\n  <Script code=\"n += 1\"/>\n</Sequence>",

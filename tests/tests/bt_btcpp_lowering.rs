@@ -734,6 +734,64 @@ fn random_trees_with_reals_lower_to_what_btcpp_does() {
     assert!(division >= n / 10 && real_lit >= n / 10 && double_init >= n / 10);
 }
 
+/// The same with the bit operators `~ & | ^` (typed and computed as BT.CPP does: both
+/// operands converted to 64-bit integers, a double that is not whole throwing), numbers
+/// that are not whole stored in the double entry `r` (`r := x / 2`, `r /= y`, `r := -r`:
+/// the lowering keeps it as a `float64` variable), divisors that are entries or
+/// expressions (zero with either sign now and then: `1 / -x` with `x` 0 is -inf), and
+/// Script nodes storing a double into an integer entry, which throw unless it is whole
+/// (`gen::Options::bits`).
+#[test]
+fn random_trees_with_bits_and_stored_reals_lower_to_what_btcpp_does() {
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        bits: true,
+        ..Default::default()
+    };
+    random_trees(opts);
+    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0);
+    let (mut bits, mut stored, mut var_div, mut int_store) = (0u64, 0u64, 0u64, 0u64);
+    for seed in seed0..seed0 + n {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let c = gen::case_with_conds(
+            &mut rng,
+            4 + (seed % 12) as i64,
+            opts,
+            gen::Conditions::WithoutSkip,
+        );
+        bits += u64::from(
+            ["&amp; ", " | ", " ^ ", "~"]
+                .iter()
+                .any(|o| c.xml.contains(o)),
+        );
+        stored += u64::from(
+            ["r := ", "r /= ", "r *= "]
+                .iter()
+                .any(|o| c.xml.contains(o)),
+        );
+        var_div += u64::from(
+            [
+                "/ x", "/ -x", "/ y", "/ (", "/ r", "/ -r", "/= x", "/= y", "/= r", "/= -", "/= (",
+            ]
+            .iter()
+            .any(|o| c.xml.contains(o)),
+        );
+        int_store += u64::from(
+            ["y /= ", "y := r", "x := y /", "y *= "]
+                .iter()
+                .any(|o| c.xml.contains(o)),
+        );
+    }
+    eprintln!(
+        "of the {n} trees: {bits} use a bit operator, {stored} store a number in `r`, \
+         {var_div} divide by an entry or an expression, {int_store} store a double in an \
+         integer entry"
+    );
+    assert!(bits >= n / 10 && stored >= n / 10 && var_div >= n / 10 && int_store >= n / 20);
+}
+
 /// The same with the SKIPPED status: `_skipIf` and `_while` on any node, RunOnce with
 /// `then_skip` true, Precondition with `else="SKIPPED"` (`gen::Options::skipped`,
 /// `gen::Conditions::All`), reaching every kind of parent.
@@ -1460,7 +1518,7 @@ fn random_trees_with_scripts_lower_to_what_the_real_library_does() {
 /// double, `/`, real literals, arithmetic values cast to bool.
 #[test]
 fn random_trees_with_reals_lower_to_what_the_real_library_does() {
-    real_library_with(true, false, false, false, true, 1_000, 1_100_000);
+    real_library_with(true, false, false, false, (true, false), 1_000, 1_100_000);
 }
 
 /// The same with UnsetBlackboard (`gen::Options::unset`) among the scripts.
@@ -1488,16 +1546,33 @@ fn random_trees_with_bb_nodes_lower_to_what_the_real_library_does() {
 /// SKIPPED-making constructs when `skipped`, the blackboard nodes when `bb`) run in the
 /// real library and lowered.
 fn real_library(scripts: bool, unset: bool, skipped: bool, bb: bool, default_n: u64, offset: u64) {
-    real_library_with(scripts, unset, skipped, bb, false, default_n, offset);
+    real_library_with(
+        scripts,
+        unset,
+        skipped,
+        bb,
+        (false, false),
+        default_n,
+        offset,
+    );
 }
 
-/// [`real_library`], with doubles in the scripts when `reals` (`gen::Options::reals`).
+/// The bit operators, numbers that are not whole stored in entries, and divisors that
+/// are entries or expressions (`gen::Options::bits`), `HINDSIGHT_BT_REAL_LOWERING_TREES`
+/// (default 500) format-4 trees through BT.CPP 4.8.2 and the lowering, both tick modes.
+#[test]
+fn random_trees_with_bits_and_stored_reals_lower_to_what_the_real_library_does() {
+    real_library_with(true, false, false, false, (false, true), 500, 1_300_000);
+}
+
+/// [`real_library`], with doubles in the scripts when `reals` (`gen::Options::reals`),
+/// the bit operators and stored reals when `bits` (`gen::Options::bits`).
 fn real_library_with(
     scripts: bool,
     unset: bool,
     skipped: bool,
     bb: bool,
-    reals: bool,
+    (reals, bits): (bool, bool),
     default_n: u64,
     offset: u64,
 ) {
@@ -1530,6 +1605,7 @@ fn real_library_with(
                 root_skip: skipped,
                 bb_nodes: bb,
                 reals,
+                bits,
                 ..Default::default()
             },
             if skipped {

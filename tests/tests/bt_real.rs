@@ -787,6 +787,106 @@ fn doubles_in_scripts_agree_with_the_real_library() {
     assert!(counts.errors > 0 && counts.ran_all > 0);
 }
 
+/// The bit operators (`~ & | ^`), numbers that are not whole stored in entries, and
+/// divisors that are entries or expressions, as 4.8.2 runs them: `Script` nodes measured
+/// while writing the oracle's rules (`script::bits`, `script::assign`), each followed by a
+/// condition that shows the value, then the format-4 random trees with
+/// `gen::Options::bits` of `HINDSIGHT_BT_REAL_BITS_TREES` seeds (default 10,000; a third
+/// are format 3 and left out), both tick modes: root statuses, leaf events, how a run ends
+/// (the exception's text included) and the integer entries at the end must agree.
+#[test]
+fn bits_and_stored_reals_agree_with_the_real_library() {
+    const SCRIPTS: [(&str, &str); 22] = [
+        ("a := 6 & 3", "a == 2"),
+        ("a := 1 | 1 ^ 1", "a == 0"),
+        ("a := 1 | 2 & 4", "a == 1"),
+        ("a := ~2.5", "a == -3"),
+        ("a := ~(0/0)", "a > 9e18"),
+        ("a := 2.5 & 1", "true"),
+        ("a := (4/2) & 1", "a == 0"),
+        ("a := ~(1/0)", "true"),
+        ("a := 1e19 & 1", "true"),
+        ("a := 5/2", "a == 2.5"),
+        ("a := 1; a := 5/2", "true"),
+        ("a := 1; a /= 2", "true"),
+        ("a := 1.5; a /= 2", "a == 0.75"),
+        ("a := 1.5; a := 3", "a == 3"),
+        ("a := 0; b := 1 / -a", "b < 0"),
+        ("a := 0; b := 1 / (0 - a)", "b > 0"),
+        ("a := 0+0; a := -a", "1 / a < 0"),
+        ("a := 0; a := -a", "1 / a > 0"),
+        ("a := 0+0; a /= 0", "a != a"),
+        ("a := 2.5; a := true", "a == 1"),
+        ("a := true; a := 2.5", "true"),
+        ("a := 0; a := 1 / a", "true"),
+    ];
+    let Some(mut real) = harness() else { return };
+    let esc = |c: &str| {
+        c.replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;")
+    };
+    let mut cases: Vec<(String, String, Scripts, usize)> = SCRIPTS
+        .iter()
+        .map(|(code, cond)| {
+            let xml = doc(&format!(
+                "<Sequence><Script code=\"{}\"/><ScriptCondition code=\"{}\"/></Sequence>",
+                esc(code),
+                esc(cond)
+            ));
+            (format!("`{code}` then `{cond}`"), xml, Scripts::new(), 1)
+        })
+        .collect();
+    let n = env("HINDSIGHT_BT_REAL_BITS_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0) + 6_000_000;
+    let start = std::time::Instant::now();
+    for seed in seed0..seed0 + n {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let opts = gen::Options {
+            btcpp4_nodes: true,
+            scripts: true,
+            bits: true,
+            ..Default::default()
+        };
+        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
+        if !c.xml.contains("BTCPP_format=\"3\"") {
+            cases.push((format!("bits seed {seed}"), c.xml, c.scripts, c.ticks));
+        }
+    }
+    let mut counts = Counts::default();
+    let fails = check_all(&mut real, &cases, &mut counts);
+    let with = |pats: &[&str]| {
+        cases
+            .iter()
+            .filter(|c| pats.iter().any(|p| c.1.contains(p)))
+            .count()
+    };
+    eprintln!(
+        "BehaviorTree.CPP {}: {} scripts and {} random trees with bit operators ({}), \
+         numbers stored in `r` ({}) and divisors that are entries ({}), each under tickOnce \
+         and tickExactlyOnce: {} runs ({} ran every tick, {} threw) in {:.1} s; {} \
+         disagreements",
+        real.version,
+        SCRIPTS.len(),
+        cases.len() - SCRIPTS.len(),
+        with(&["&amp; ", " | ", " ^ ", "~"]),
+        with(&["r := ", "r /= ", "r *= "]),
+        with(&["/ x", "/ -x", "/ y", "/ r", "/= x", "/= y", "/= r"]),
+        counts.runs,
+        counts.ran_all,
+        counts.errors,
+        start.elapsed().as_secs_f64(),
+        fails.len()
+    );
+    assert!(
+        fails.is_empty(),
+        "{} disagreements (first 5):\n{}",
+        fails.len(),
+        fails.iter().take(5).cloned().collect::<Vec<_>>().join("\n")
+    );
+    assert!(counts.errors > 0 && counts.ran_all > 0);
+}
+
 /// The executor period of [`timed_nodes_agree_with_the_real_library`], in the real
 /// library's wall-clock milliseconds; the oracle runs the same trees at its default
 /// 100 ms with every duration scaled by 100/60.

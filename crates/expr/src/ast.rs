@@ -9,6 +9,8 @@ pub enum UnOp {
     Plus,
     /// `!x`
     Not,
+    /// `~x` (bitwise complement of an integer)
+    BitNot,
 }
 
 /// Binary operators.
@@ -40,6 +42,12 @@ pub enum BinOp {
     And,
     /// `||`
     Or,
+    /// `&` (bitwise, on integers)
+    BitAnd,
+    /// `|` (bitwise, on integers)
+    BitOr,
+    /// `^` (bitwise exclusive or, on integers)
+    BitXor,
 }
 
 impl BinOp {
@@ -59,6 +67,9 @@ impl BinOp {
             BinOp::Ge => ">=",
             BinOp::And => "&&",
             BinOp::Or => "||",
+            BinOp::BitAnd => "&",
+            BinOp::BitOr => "|",
+            BinOp::BitXor => "^",
         }
     }
 }

@@ -65,7 +65,8 @@
 //! datamodel variables, enumeration labels (`types.xml`), `_event.name`,
 //! `_event.origin`, `_event.data.<param>`. Postfix: `a[i]`, `s.field`,
 //! `a.length`. Operators: `+ - * / %`, `== != === !== < <= > >=`,
-//! `&& || !`, unary `-`/`+`, `c ? a : b`. Calls: `Math.random()`,
+//! `&& || !`, the bitwise `& | ^ ~` (ECMAScript's precedence: `|` loosest, then `^`,
+//! then `&`, all looser than `==`), unary `-`/`+`, `c ? a : b`. Calls: `Math.random()`,
 //! `Math.floor/ceil/round/trunc` (to int), `Math.abs/sign/min/max` (int when
 //! all arguments are), `Math.sqrt/sin/cos/tan/asin/acos/atan/exp/log/log2/
 //! log10/cbrt/atan2/pow/hypot`, constants `Math.PI`, `Math.E`.
@@ -74,7 +75,9 @@
 //! (arithmetic wraps), `float32`/`float64` are `f64`; int mixes with float by
 //! widening; `/` always gives a float (as in ECMAScript); `%` of two ints is an
 //! int (by zero: a run-time error). A float is never silently narrowed to an
-//! int (use `Math.floor`). Strings compare with `==`/`!=` only; there is no
+//! int (use `Math.floor`). The bitwise operators take integers only and compute on
+//! the 64-bit two's complement (for values within 32 bits, ECMAScript's `ToInt32`
+//! result; a float operand is a type error where ECMAScript would truncate it). Strings compare with `==`/`!=` only; there is no
 //! string concatenation, so every string is a model literal (interned).
 //! Writing `a[i]` with `i == a.length` appends; past the end fills with
 //! default values; reading past the end is a run-time error.

@@ -2,9 +2,11 @@
 //!
 //! Grammar, loosest binding first:
 //! `cond := or ('?' cond ':' cond)?`, `or := and ('||' and)*`,
-//! `and := eq ('&&' eq)*`, `eq := rel (('=='|'!='|'==='|'!==') rel)*`,
+//! `and := bor ('&&' bor)*`, `bor := bxor ('|' bxor)*`, `bxor := band ('^' band)*`,
+//! `band := eq ('&' eq)*` (ECMAScript's precedence of the bitwise operators),
+//! `eq := rel (('=='|'!='|'==='|'!==') rel)*`,
 //! `rel := add (('<'|'<='|'>'|'>=') add)*`, `add := mul (('+'|'-') mul)*`,
-//! `mul := unary (('*'|'/'|'%') unary)*`, `unary := ('!'|'-'|'+') unary | postfix`,
+//! `mul := unary (('*'|'/'|'%') unary)*`, `unary := ('!'|'-'|'+'|'~') unary | postfix`,
 //! `postfix := primary ('.' name | '[' cond ']' | '(' args ')')*`,
 //! `primary := number | string | true | false | name | '(' cond ')' | '[' items ']'
 //!   | '{' (key ':' cond),* '}'` where `key := name | string`. Array and object literals
@@ -218,15 +220,51 @@ impl P {
     }
 
     fn and<'a>(&mut self, i: &'a str) -> R<'a, Expr> {
-        let r = self.level(i, &[("&&", BinOp::And)], P::eq)?;
-        let rest = self.ws(r.0);
-        if rest.starts_with('&') && !rest.starts_with("&&") {
-            return Err(self.err(rest, "bitwise `&` is not supported (use `&&`)"));
+        self.level(i, &[("&&", BinOp::And)], P::bit_or)
+    }
+
+    /// One left-associative level of a bitwise operator, `sym` not followed by `not`
+    /// (`|` is not `||`, `&` not `&&`), as in ECMAScript.
+    fn bit_level<'a>(
+        &mut self,
+        i: &'a str,
+        sym: char,
+        not: char,
+        op: BinOp,
+        next: fn(&mut P, &'a str) -> R<'a, Expr>,
+    ) -> R<'a, Expr> {
+        let start = self.off(i);
+        let (mut rest, mut lhs) = next(self, i)?;
+        let depth = self.depth;
+        loop {
+            let r = self.ws(rest);
+            let Some(after) = r.strip_prefix(sym).filter(|a| !a.starts_with(not)) else {
+                self.depth = depth;
+                return Ok((rest, lhs));
+            };
+            let after = self.ws(after);
+            self.enter(after)?;
+            let (r2, rhs) = next(self, after)?;
+            lhs = self.node(
+                ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+                start,
+                r2,
+            );
+            rest = r2;
         }
-        if rest.starts_with('|') && !rest.starts_with("||") {
-            return Err(self.err(rest, "bitwise `|` is not supported (use `||`)"));
-        }
-        Ok(r)
+    }
+
+    fn bit_or<'a>(&mut self, i: &'a str) -> R<'a, Expr> {
+        self.bit_level(i, '|', '|', BinOp::BitOr, P::bit_xor)
+    }
+
+    fn bit_xor<'a>(&mut self, i: &'a str) -> R<'a, Expr> {
+        // `^=` is an assignment, which no expression holds: `^` never meets `=` here.
+        self.bit_level(i, '^', '=', BinOp::BitXor, P::bit_and)
+    }
+
+    fn bit_and<'a>(&mut self, i: &'a str) -> R<'a, Expr> {
+        self.bit_level(i, '&', '&', BinOp::BitAnd, P::eq)
     }
 
     fn eq<'a>(&mut self, i: &'a str) -> R<'a, Expr> {
@@ -273,6 +311,7 @@ impl P {
             Some('!') if !i.starts_with("!=") => Some(UnOp::Not),
             Some('-') if !i.starts_with("--") => Some(UnOp::Neg),
             Some('+') if !i.starts_with("++") => Some(UnOp::Plus),
+            Some('~') => Some(UnOp::BitNot),
             _ => None,
         };
         if i.starts_with("++") || i.starts_with("--") {
@@ -587,6 +626,18 @@ mod tests {
     }
 
     #[test]
+    fn bitwise_operators_bind_as_in_ecmascript() {
+        // Loosest first: `||`, `&&`, `|`, `^`, `&`, then equality; each to the left.
+        assert_eq!(p("a | b ^ c & d"), "(a | (b ^ (c & d)))");
+        assert_eq!(p("a & b | c"), "((a & b) | c)");
+        assert_eq!(p("a ^ b ^ c"), "((a ^ b) ^ c)");
+        assert_eq!(p("a & b == c"), "(a & (b == c))");
+        assert_eq!(p("a || b | c && d & e"), "(a || ((b | c) && (d & e)))");
+        assert_eq!(p("~a & ~-1"), "((BitNot a) & (BitNot (Neg 1)))");
+        assert_eq!(p("a|b&&c"), "((a | b) && c)");
+    }
+
+    #[test]
     fn postfix_literals_and_calls() {
         assert_eq!(p("_event.data.x"), "_event.data.x");
         assert_eq!(p("a[1][i + 1].length"), "a[1][(i + 1)].length");
@@ -666,7 +717,8 @@ mod tests {
             ("f(1,", 4),
             ("'abc", 0),
             ("1 2", 2),
-            ("a & b", 2),
+            ("a &", 3),
+            ("a | | b", 4),
             ("99999999999999999999", 0),
             ("x.", 2),
             ("null", 0),

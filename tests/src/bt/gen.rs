@@ -110,6 +110,13 @@ pub struct Options {
     /// resets it (`Tree::tickRoot`). Drawn after everything else: the trees are those
     /// of the same seed without it, the root aside.
     pub root_skip: bool,
+    /// With [`Options::scripts`]: the bit operators (`~ & | ^`), a double entry `r`
+    /// (created by the main tree as `0.5`, `0+0` or `2.5`, remapped into every SubTree)
+    /// that statements store numbers that are not whole in (`r := x / 2`, `r /= y`,
+    /// `r := -r`), divisors that are entries or expressions (zero now and then, with
+    /// either sign), and Script nodes that store a double into an integer entry (which
+    /// throws unless it is whole). Off, the generator draws what it drew before.
+    pub bits: bool,
 }
 
 /// The script entries: `x`, `y` integers, `f` a boolean, all written first by the main
@@ -242,6 +249,9 @@ impl<R: Rng> G<'_, R> {
     /// throw (the real-library harness relies on it: `Tree::haltTree` runs every
     /// `_onHalted` script, and a throw from the tree's destructor aborts).
     fn bool_expr(&mut self, d: u32, risky: bool) -> String {
+        if self.opts.bits && self.below(4) == 0 {
+            return self.bits_cond(risky);
+        }
         if self.opts.reals && self.below(4) == 0 {
             return self.real_cond(risky);
         }
@@ -355,7 +365,8 @@ impl<R: Rng> G<'_, R> {
     fn script(&mut self) -> String {
         let n = 1 + self.below(3);
         let stmts: Vec<String> = (0..n)
-            .map(|_| match self.below(7) {
+            .map(|_| match self.below(if self.opts.bits { 10 } else { 7 }) {
+                7..=9 => self.bits_statement(),
                 // Depth 2: chains such as `x - 1 + y - 2`, which BT.CPP groups to the right.
                 0 => format!("x := {}", self.int_expr(2)),
                 1 => format!("y = {}", self.int_expr(1)),
@@ -369,8 +380,116 @@ impl<R: Rng> G<'_, R> {
         stmts.join("; ")
     }
 
+    /// A statement of [`Options::bits`] that never throws: bit operators over the
+    /// integer entries, numbers that are not whole stored in the double entry `r`.
+    fn bits_statement(&mut self) -> String {
+        match self.below(8) {
+            0 => format!("y := {}", self.bits_int()),
+            1 => format!("r := {}", self.real_value()),
+            2 => format!("r /= {}", self.divisor()),
+            3 => format!(
+                "r {} {}",
+                self.pick(&["+=", "-=", "*="]),
+                self.pick(&["0.25", "x", "-1", "1.5", "r"])
+            ),
+            4 => "r := -r".into(),
+            5 => format!("r := {} / {}", self.int_expr(0), self.divisor()),
+            6 => format!("f := {}", self.bits_cond(false)),
+            _ => format!("y := ~{}", self.pick(&["y", "x", "0", "f"])),
+        }
+    }
+
+    /// An integer value of the bit operators over `x`, `y`, `f` and small literals (no
+    /// arithmetic operator: BT.CPP does not mix the two groups).
+    fn bits_int(&mut self) -> String {
+        let leaf = |g: &mut Self| {
+            g.pick(&[
+                "x", "y", "f", "1", "2", "3", "6", "~y", "(0 - 2)", "(y - 1)",
+            ])
+            .to_string()
+        };
+        match self.below(4) {
+            0 => format!("{} & {}", leaf(self), leaf(self)),
+            1 => format!("{} | {} ^ {}", leaf(self), leaf(self), leaf(self)),
+            2 => format!("{} ^ {} & {}", leaf(self), leaf(self), leaf(self)),
+            _ => format!("~{}", leaf(self)),
+        }
+    }
+
+    /// A divisor: a literal, or an entry or expression that is zero now and then, of
+    /// either sign (`-x` with `x` 0 is -0.0 in BT.CPP).
+    fn divisor(&mut self) -> String {
+        self.pick(&[
+            "2", "-4", "0.5", "x", "-x", "y", "(y - 1)", "(x * -1)", "r", "-r", "(0 - x)", "0",
+            "(x - x)",
+        ])
+        .to_string()
+    }
+
+    /// A value stored in `r`: not whole, infinite, NaN, or a negative zero now and then.
+    fn real_value(&mut self) -> String {
+        match self.below(6) {
+            0 => format!(
+                "{} / {}",
+                self.pick(&["x", "y", "1", "-1", "r", "0"]),
+                self.divisor()
+            ),
+            1 => format!("r * {}", self.pick(&["1.5", "-1", "0", "0.5"])),
+            2 => self.pick(&["2.5", "0.0", "-0.5", "1e308 * 10"]).to_string(),
+            // The condition in parentheses: `!` and `-` do not mix in one expression.
+            3 => format!("({}) ? (r / 2) : (-r)", self.bool_expr(0, false)),
+            4 => format!("(r {} {}) / 2", self.pick(&["+", "-"]), self.int_expr(0)),
+            _ => self.int_expr(1),
+        }
+    }
+
+    /// A condition of [`Options::bits`]; `risky`: with ones that throw (a bit operator
+    /// over a double that is not whole, NaN or infinite; `r` cast to bool when negative).
+    fn bits_cond(&mut self, risky: bool) -> String {
+        let op = self.pick(&["==", "!=", "<", "<=", ">", ">="]);
+        match self.below(if risky { 10 } else { 7 }) {
+            0 => format!(
+                "{} {op} {}",
+                self.bits_int(),
+                self.pick(&["0", "1", "2", "y", "(0 - 1)"])
+            ),
+            1 => format!("1 / {} {op} 0", self.divisor()),
+            2 => format!(
+                "{} / {} {op} {}",
+                self.int_expr(0),
+                self.divisor(),
+                self.pick(&["0", "1", "r", "0.5"])
+            ),
+            3 => format!("r {op} {}", self.pick(&["0", "2.5", "x", "-0.5", "1"])),
+            4 => format!(
+                "(r {} {}) {op} 1",
+                self.pick(&["+", "*"]),
+                self.pick(&["1", "x", "0.5"])
+            ),
+            5 => format!("!y & 1 {op} 0"),
+            6 => format!("(y & 1 ? r : x) {op} 0"),
+            7 => format!(
+                "({} & 1) {op} 0",
+                self.pick(&["r", "x", "(r * 2)", "(1 / x)"])
+            ),
+            8 => format!("~r {op} {}", self.pick(&["0", "y"])),
+            _ => self.pick(&["r", "y & 1", "~y & 1", "r / 2"]).to_string(),
+        }
+    }
+
     /// A script leaf, or a Precondition over a node.
     fn script_node(&mut self, depth: u32) -> String {
+        if self.opts.bits && self.below(6) == 0 {
+            // A Script storing a double into an integer entry: BT.CPP throws unless it
+            // is whole ("Invalid floating point to integer conversion").
+            let s = match self.below(4) {
+                0 => format!("y /= {}", self.pick(&["2", "x", "-1", "0.5"])),
+                1 => "y := r".to_string(),
+                2 => format!("x := {} / {}", self.pick(&["y", "4", "x"]), self.divisor()),
+                _ => format!("y *= {}", self.pick(&["0.5", "r", "2"])),
+            };
+            return format!("<Script code=\"{}\"/>", esc(&s));
+        }
         match self.below(3) {
             0 => format!("<Script code=\"{}\"/>", esc(&self.script())),
             1 => format!(
@@ -735,7 +854,9 @@ impl<R: Rng> G<'_, R> {
                 e.to_string()
             }
         };
-        let more = if self.scripts_on() {
+        let more = if self.scripts_on() && self.opts.bits {
+            " x=\"{x}\" y=\"{y}\" f=\"{f}\" r=\"{r}\""
+        } else if self.scripts_on() {
             " x=\"{x}\" y=\"{y}\" f=\"{f}\""
         } else {
             ""
@@ -811,6 +932,9 @@ pub fn case_with_conds<R: Rng>(rng: &mut R, size: i64, opts: Options, conds: Con
             "x:=0*1; y:=1; f:=!false",
         ]);
         format!("<Script code=\"{init}\"/>")
+    } else if g.scripts_on() && g.opts.bits {
+        let r = g.pick(&["0.5", "0+0", "2.5"]);
+        format!("<Script code=\"{SCRIPT_INIT}; r:={r}\"/>")
     } else if g.scripts_on() {
         format!("<Script code=\"{SCRIPT_INIT}\"/>")
     } else {

@@ -299,6 +299,8 @@ pub struct Oracle<'t> {
     pub vars: BTreeMap<String, i64>,
     /// Those of them that hold a `double` (`script::Env`).
     dbl: std::collections::BTreeSet<String>,
+    /// Their exact values (`script::Env::reals`).
+    reals: BTreeMap<String, f64>,
     /// Sequences and fallbacks: children skipped so far (`skipped_count_`).
     skipped: Vec<usize>,
     /// A script a halt ran threw: surfaced when the tick returns.
@@ -379,6 +381,7 @@ impl<'t> Oracle<'t> {
             log: Vec::new(),
             vars: BTreeMap::new(),
             dbl: Default::default(),
+            reals: BTreeMap::new(),
             skipped: vec![0; n],
             fault: None,
             memo: vec![false; n],
@@ -675,6 +678,7 @@ impl<'t> Oracle<'t> {
             let mut env = super::script::Env {
                 vals: &mut self.vars,
                 dbl: &mut self.dbl,
+                reals: &mut self.reals,
             };
             last = match Program(vec![s.clone()]).run(&mut env, &texts) {
                 Ok(v) => v,
@@ -912,6 +916,7 @@ impl<'t> Oracle<'t> {
             // missing one is no error), SUCCESS.
             Kind::Unset(key) => {
                 self.vars.remove(key);
+                self.reals.remove(key);
                 self.bb.remove(key);
                 self.seq.remove(key);
                 Ok(Success)
@@ -1077,6 +1082,7 @@ impl<'t> Oracle<'t> {
                 LoopType::String => return Err(Stop::Error("Any::copyInto fails".into())),
             };
             self.vars.insert(key.to_string(), v);
+            self.reals.remove(key);
         } else {
             self.bb.insert(key.to_string(), item.to_string());
         }
@@ -1864,10 +1870,18 @@ pub fn run_with(
             }
         }
     }
+    // An entry holding a double that is not whole is left out: the real-library harness
+    // reads entries as integers (`get_int` fails there).
+    let reals = o.reals;
     let vars = o
         .vars
         .into_iter()
         .filter(|(k, _)| !k.starts_with("__st"))
+        .filter(|(k, _)| {
+            reals
+                .get(k)
+                .is_none_or(|r| r.fract() == 0.0 && r.abs() <= 9.0e15)
+        })
         .collect();
     Ok(Outcome {
         statuses,

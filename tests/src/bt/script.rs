@@ -71,6 +71,10 @@ pub enum Expr {
     Logic(bool, Box<Expr>, Box<Expr>),
     /// `c ? a : b`.
     Ite(Box<Expr>, Box<Expr>, Box<Expr>),
+    /// `~e` ([`bits`]).
+    BitNot(Box<Expr>),
+    /// `a & b`, `a | b`, `a ^ b` ([`bits`]).
+    Bit(char, Box<Expr>, Box<Expr>),
     /// `name op e` with op one of `:=`, `=`, `+=`, `-=`, `*=`, `/=`.
     Assign(String, &'static str, Box<Expr>),
 }
@@ -97,9 +101,9 @@ enum Tok {
     Op(&'static str),
 }
 
-const OPS: [&str; 23] = [
+const OPS: [&str; 27] = [
     ":=", "+=", "-=", "*=", "/=", "==", "!=", "<=", ">=", "&&", "||", "=", "<", ">", "+", "-", "*",
-    "/", "!", "(", ")", "?", ":",
+    "/", "!", "(", ")", "?", ":", "~", "&", "|", "^",
 ];
 
 /// A number literal at `s` (BT.CPP 4's `Grammar::Real` and `Grammar::Integer` in
@@ -286,19 +290,51 @@ impl P {
     }
 
     fn cmp(&mut self) -> Result<Expr, String> {
-        let first = self.add()?;
+        let first = self.bit_or()?;
         let mut xs = vec![first];
         let mut ops = Vec::new();
         while let Some(Tok::Op(op @ ("==" | "!=" | "<" | "<=" | ">" | ">="))) = self.peek() {
             ops.push(*op);
             self.at += 1;
-            xs.push(self.add()?);
+            xs.push(self.bit_or()?);
         }
         Ok(if ops.is_empty() {
             xs.pop().expect("one operand")
         } else {
             Expr::Cmp(xs, ops)
         })
+    }
+
+    /// `|` and `^`: one level, grouped to the left, looser than `&` (BT.CPP 4.10
+    /// `Grammar::Expression`, `bit_or` over `bit_and`; 4.8.2: `1 | 1 ^ 1` is 0,
+    /// `1 ^ 1 | 1` is 1, `1 | 2 & 4` is 1). The bit operators are `!`'s operator group:
+    /// they do not mix with the arithmetic ones (4.8.2 refuses `1 + 2 & 3` and `-1 & 3`
+    /// at load).
+    fn bit_or(&mut self) -> Result<Expr, String> {
+        let mut a = self.bit_and()?;
+        loop {
+            let op = if self.eat("|") {
+                '|'
+            } else if self.eat("^") {
+                '^'
+            } else {
+                return Ok(a);
+            };
+            self.group(true)?;
+            let b = self.bit_and()?;
+            a = Expr::Bit(op, Box::new(a), Box::new(b));
+        }
+    }
+
+    /// `&`, grouped to the left.
+    fn bit_and(&mut self) -> Result<Expr, String> {
+        let mut a = self.add()?;
+        while self.eat("&") {
+            self.group(true)?;
+            let b = self.add()?;
+            a = Expr::Bit('&', Box::new(a), Box::new(b));
+        }
+        Ok(a)
     }
 
     /// `+` and `-`, grouped to the right: BT.CPP 4.8.2 computes `10 - 4 - 2` as
@@ -335,6 +371,10 @@ impl P {
     }
 
     fn unary(&mut self) -> Result<Expr, String> {
+        if self.eat("~") {
+            self.group(true)?;
+            return Ok(Expr::BitNot(Box::new(self.unary()?)));
+        }
         if self.eat("-") {
             self.group(false)?;
             return Ok(Expr::Neg(Box::new(self.unary()?)));
@@ -403,8 +443,8 @@ impl Expr {
         match self {
             Expr::Num(_) | Expr::Real(_) => {}
             Expr::Var(v) => *v = f(v),
-            Expr::Neg(a) | Expr::Not(a) => a.rename(f),
-            Expr::Arith(_, a, b) | Expr::Logic(_, a, b) => {
+            Expr::Neg(a) | Expr::Not(a) | Expr::BitNot(a) => a.rename(f),
+            Expr::Arith(_, a, b) | Expr::Logic(_, a, b) | Expr::Bit(_, a, b) => {
                 a.rename(f);
                 b.rename(f);
             }
@@ -441,7 +481,9 @@ impl Expr {
             Expr::Num(v) => return Ok(V::Num(*v)),
             Expr::Real(bits) => f64::from_bits(*bits),
             Expr::Var(v) => match (env.vals.get(v), texts.get(v)) {
-                (Some(x), None) if env.dbl.contains(v) => *x as f64,
+                (Some(x), None) if env.dbl.contains(v) => {
+                    env.reals.get(v).copied().unwrap_or(*x as f64)
+                }
                 (Some(x), None) => return Ok(V::Num(*x)),
                 (None, Some(Some(t))) => return Ok(V::Text(t.clone())),
                 (None, Some(None)) => return Ok(V::Empty),
@@ -575,6 +617,7 @@ impl Expr {
                     b.eval(env, texts)
                 };
             }
+            Expr::BitNot(_) | Expr::Bit(..) => return bits(self, env, texts),
             Expr::Assign(v, op, e) => return assign(v, op, e, env, texts),
         }))
     }
@@ -625,6 +668,9 @@ pub struct Env<'a> {
     pub vals: &'a mut BTreeMap<String, i64>,
     /// The entries holding a `double`.
     pub dbl: &'a mut BTreeSet<String>,
+    /// The exact value of each entry holding a `double` (its sign of zero, its fraction,
+    /// NaN, infinities); `vals` holds it truncated (0 for NaN).
+    pub reals: &'a mut BTreeMap<String, f64>,
 }
 
 /// `v op e`, as BT.CPP 4.10 `ExprAssignment::evaluate` makes it.
@@ -658,7 +704,7 @@ fn assign(v: &str, op: &str, e: &Expr, env: &mut Env<'_>, texts: &Texts) -> Resu
         (":=" | "=", Some(_)) => (x, env.dbl.contains(v)),
         (_, Some(o)) => {
             let o = if env.dbl.contains(v) {
-                o as f64
+                env.reals.get(v).copied().unwrap_or(o as f64)
             } else {
                 exact(o)?
             };
@@ -680,16 +726,28 @@ fn assign(v: &str, op: &str, e: &Expr, env: &mut Env<'_>, texts: &Texts) -> Resu
     // throws (4.8.2: "Invalid floating point to integer conversion" for `x:=5; x/=2`).
     let stored = match new {
         V::Num(n) => n,
-        V::Dbl(r) if r.is_finite() && r.fract() == 0.0 && r.abs() <= LIMIT => r as i64,
-        V::Dbl(_) if dbl => {
-            return Err(Fault::Model(format!(
-                "a script stores a number other than a whole one in `{v}`: not modelled"
-            )))
+        // A `double` entry holds any double, exactly (4.8.2: `a := 5/2` holds 2.5,
+        // `a := 1.5; a := 7/2` 3.5, `a := 0+0; a /= 0` NaN, `a := 0+0; a := -a` -0.0).
+        V::Dbl(r) if dbl => {
+            env.vals.insert(v.to_string(), r as i64);
+            env.dbl.insert(v.to_string());
+            env.reals.insert(v.to_string(), r);
+            return Ok(V::Dbl(r));
         }
+        V::Dbl(r) if r.is_finite() && r.fract() == 0.0 && r.abs() <= LIMIT => r as i64,
         V::Dbl(r) if r.is_finite() && r.fract() == 0.0 => {
             return Err(Fault::Model(format!(
                 "a whole number beyond 2^53 stored in `{v}`"
             )))
+        }
+        // 4.8.2: `=` and `:=` say "Error assigning a value to entry [a] with type
+        // [long]. The right operand has type [double] and can't be converted to [long]"
+        // (`a := 1; a := 5/2`), `+=` ... `/=` "Invalid floating point to integer
+        // conversion" (`a := 1; a /= 2`).
+        V::Dbl(_) if matches!(op, ":=" | "=") => {
+            return Err(Fault::Throws(
+                "The right operand has type [double] and can't be converted".into(),
+            ))
         }
         V::Dbl(_) => {
             return Err(Fault::Throws(
@@ -702,12 +760,75 @@ fn assign(v: &str, op: &str, e: &Expr, env: &mut Env<'_>, texts: &Texts) -> Resu
     // dividing by it, and the lowering divides by number literals only (the generator
     // writes no other divisor).
     env.vals.insert(v.to_string(), stored);
+    env.reals.remove(v);
     if dbl {
         env.dbl.insert(v.to_string());
         Ok(V::Dbl(stored as f64))
     } else {
         env.dbl.remove(v);
         Ok(V::Num(stored))
+    }
+}
+
+/// 2^63: a double at or beyond it (in size) is out of `int64_t`'s range.
+const I64_END: f64 = 9_223_372_036_854_775_808.0;
+
+/// `~e`, `a & b`, `a | b`, `a ^ b` as BT.CPP 4.10 computes them
+/// (`scripting/operators.hpp`: `ExprUnaryArithmetic::evaluate` truncates the double to
+/// an `int64_t` for `complement`; `ExprBinaryArithmetic::evaluate` converts both operands
+/// with `Any::cast<int64_t>` for `bit_and`, `bit_or`, `bit_xor`, throwing "Binary
+/// operators are not allowed if one of the operands is not an integer"); each gives a
+/// `double`. As 4.8.2 answers (measured through `behaviortreepy`): `6 & 3` is 2,
+/// `(4/2) & 1` 0, `2.5 & 1`, `(0/0) & 1`, `(1/0) & 1` and `1e19 & 1` throw, `9e18 & 1`
+/// is 0; `~5` is -6, `~2.5` -3, `~(-2.5)` 1, `~(0/0)` 2^63 (x86's integer for NaN,
+/// complemented), `~(1/0)` and `~1e19` throw.
+fn bits(e: &Expr, env: &mut Env<'_>, texts: &Texts) -> Result<V, Fault> {
+    // A number as `cast<double>` reads it first (`isNumber`); a string throws.
+    let number = |v: V, unary: bool| -> Result<(f64, Option<i64>), Fault> {
+        match v {
+            V::Num(n) => Ok((exact(n)?, Some(n))),
+            V::Dbl(x) => Ok((x, None)),
+            V::Empty => Err(empty()),
+            V::Text(_) if unary => Err(Fault::Throws("Invalid operator for std::string".into())),
+            V::Text(_) => Err(Fault::Throws("Operation not permitted".into())),
+        }
+    };
+    let not_int = || {
+        Fault::Throws(
+            "Binary operators are not allowed if one of the operands is not an integer".into(),
+        )
+    };
+    match e {
+        Expr::BitNot(a) => {
+            let (x, _) = number(a.eval(env, texts)?, true)?;
+            if x.is_nan() {
+                return Ok(V::Dbl(I64_END));
+            }
+            if x.abs() >= I64_END {
+                return Err(Fault::Throws(
+                    "Number out of range for bitwise operation".into(),
+                ));
+            }
+            Ok(V::Dbl(!(x.trunc() as i64) as f64))
+        }
+        Expr::Bit(op, a, b) => {
+            let (a, b) = (a.eval(env, texts)?, b.eval(env, texts)?);
+            let (x, xi) = number(a, false)?;
+            let (y, yi) = number(b, false)?;
+            let int = |v: f64, i: Option<i64>| match i {
+                Some(i) => Ok(i),
+                None if v.fract() == 0.0 && v.abs() < I64_END => Ok(v as i64),
+                None => Err(not_int()),
+            };
+            let (l, r) = (int(x, xi)?, int(y, yi)?);
+            let v = match op {
+                '&' => l & r,
+                '|' => l | r,
+                _ => l ^ r,
+            };
+            Ok(V::Dbl(v as f64))
+        }
+        _ => unreachable!("only the bit operators"),
     }
 }
 
@@ -814,6 +935,7 @@ mod tests {
         let mut env = Env {
             vals: &mut vals,
             dbl: &mut dbl,
+            reals: &mut BTreeMap::new(),
         };
         match parse(src).expect("parses").run(&mut env, &Texts::new())? {
             V::Num(v) => Ok((v, vals)),
@@ -828,6 +950,7 @@ mod tests {
         let mut env = Env {
             vals: &mut vals,
             dbl: &mut dbl,
+            reals: &mut BTreeMap::new(),
         };
         parse(src).expect("parses").holds(&mut env, &Texts::new())
     }
@@ -837,6 +960,7 @@ mod tests {
         let mut env = Env {
             vals: &mut vals,
             dbl: &mut dbl,
+            reals: &mut BTreeMap::new(),
         };
         parse(src).expect("parses").run(&mut env, &Texts::new())
     }
@@ -919,25 +1043,21 @@ mod tests {
         ] {
             assert_eq!(run(s).map(|r| r.0), Ok(v), "{s}");
         }
-        assert_eq!(
-            value("a := 7 / 2 * 2"),
-            Err(Fault::Model(
-                "a script stores a number other than a whole one in `a`: not modelled".into()
-            ))
-        );
+        assert_eq!(value("a := 7 / 2 * 2"), Ok(V::Dbl(1.75)));
         assert_eq!(value("7 / 2 * 2"), Ok(V::Dbl(1.75)));
         assert_eq!(value("1 - 1 / 2"), Ok(V::Dbl(0.5)));
         // Stored into an integer entry, a double must be whole.
         assert_eq!(run("x := 6; x /= 2").unwrap().1["x"], 3);
         assert_eq!(run("x := 6; x := 6 / 2").unwrap().0, 3);
-        for s in [
-            "x := 5; x /= 2",
-            "x := 1; x += 0.5",
-            "x := 1; x := 1.5",
-            "x := 1; x := 0/0",
-        ] {
+        for s in ["x := 5; x /= 2", "x := 1; x += 0.5"] {
             assert!(
                 matches!(run(s), Err(Fault::Throws(t)) if t.contains("Invalid floating point")),
+                "{s}"
+            );
+        }
+        for s in ["x := 1; x := 1.5", "x := 1; x := 0/0"] {
+            assert!(
+                matches!(run(s), Err(Fault::Throws(t)) if t.contains("can't be converted")),
                 "{s}"
             );
         }
@@ -953,6 +1073,112 @@ mod tests {
             "a := 1e-400",
         ] {
             assert!(parse(s).is_err(), "{s}");
+        }
+    }
+
+    #[test]
+    fn bit_operators_and_stored_reals_as_the_real_library_answers() {
+        // Each answer below is what BT.CPP 4.8.2 gave for the same script (measured
+        // through `behaviortreepy`): the value of `a` (`Dbl` for a double entry).
+        let throws = |src: &str, what: &str| {
+            assert!(
+                matches!(value(src), Err(Fault::Throws(t)) if t.contains(what)),
+                "{src}: {:?}",
+                value(src)
+            )
+        };
+        for (src, v) in [
+            ("a := 6 & 3", 2.0),
+            ("a := 6 | 3", 7.0),
+            ("a := 6 ^ 3", 5.0),
+            ("a := ~5", -6.0),
+            ("a := ~0", -1.0),
+            ("a := (4/2) & 1", 0.0),
+            ("a := ~2.5", -3.0),
+            ("a := ~(-2.5)", 1.0),
+            ("a := ~(0/0)", 9.223372036854776e18),
+            ("a := (0-2) & 7", 6.0),
+            ("a := 1 | 1 ^ 1", 0.0),
+            ("a := 1 ^ 1 | 1", 1.0),
+            ("a := 1 | 2 & 4", 1.0),
+            ("a := 6 & 3 | 8", 10.0),
+            ("a := 2 & 6 ^ 4", 6.0),
+            ("a := 7 & 3 ^ 1 | 8", 10.0),
+            ("a := !1 & 1", 0.0),
+            ("a := !0 | 2", 3.0),
+            ("a := 6 & 3 == 2", 1.0),
+            ("a := true & 1", 1.0),
+            ("a := ~true", -2.0),
+            ("a := 1e18 & 1", 0.0),
+            ("a := 9e18 & 1", 0.0),
+            ("a := ~ ~ 5", 5.0),
+            ("a := 5/2", 2.5),
+            ("a := 1.5; a /= 2", 0.75),
+            ("a := 1.5; a := 3", 3.0),
+            ("a := 1.5; a := 7/2", 3.5),
+            ("a := 0+0; a := 1 / a", f64::INFINITY),
+            ("a := 2.5; a += 1", 3.5),
+            ("a := 2.5; a -= 0.5", 2.0),
+            ("a := 2.5; a := true", 1.0),
+            ("a := 1e308; a *= 10", f64::INFINITY),
+            ("a := 0; b := 1 / -a", f64::NEG_INFINITY),
+            ("a := 0; b := 1 / (0 - a)", f64::INFINITY),
+            ("a := 0; b := 1 / (a * -1)", f64::NEG_INFINITY),
+            ("a := 0.0; b := 1 / -a", f64::NEG_INFINITY),
+            ("a := -0.0; b := 1 / a", f64::NEG_INFINITY),
+            ("a := 0 * -1; b := 1 / a", f64::NEG_INFINITY),
+            ("a := 0 - 0.0; b := 1 / a", f64::INFINITY),
+            ("a := 0+0; a := -a; b := 1 / a", f64::NEG_INFINITY),
+        ] {
+            let got = match value(src) {
+                Ok(V::Dbl(x)) => x,
+                Ok(V::Num(n)) => n as f64,
+                r => panic!("{src}: {r:?}"),
+            };
+            assert_eq!(got, v, "{src}");
+        }
+        // An integer entry stores a double converted: whole, or it throws; a negative
+        // zero loses its sign there (`1 / a` is then +inf).
+        assert_eq!(run("a := 0; a := -a; b := 1 / a > 0").unwrap().0, 1);
+        assert_eq!(run("a := 1; a := 2 / 2").unwrap().0, 1);
+        assert!(value("a := 0+0; a /= 0").is_ok_and(|v| matches!(v, V::Dbl(x) if x.is_nan())));
+        for (src, what) in [
+            ("a := 2.5 & 1", "Binary operators are not allowed"),
+            ("a := (5/2) & 1", "Binary operators are not allowed"),
+            ("a := (0/0) & 1", "Binary operators are not allowed"),
+            ("a := (1/0) & 1", "Binary operators are not allowed"),
+            ("a := (1e19) & 1", "Binary operators are not allowed"),
+            ("a := ~(1/0)", "Number out of range for bitwise operation"),
+            ("a := ~1e19", "Number out of range for bitwise operation"),
+            ("a := 3 && 1 & 1", "Logic operators"),
+            ("a := 1; a := 5/2", "can't be converted"),
+            ("a := 1; a := 1/0", "can't be converted"),
+            ("a := true; a := 2.5", "can't be converted"),
+            ("a := 0; a := 1 / a", "can't be converted"),
+            (
+                "a := 1; a /= 2",
+                "Invalid floating point to integer conversion",
+            ),
+            (
+                "a := 1; a /= 0",
+                "Invalid floating point to integer conversion",
+            ),
+        ] {
+            throws(src, what);
+        }
+        // 4.8.2 refuses these at load: `-`, `+`, `*`, `/` do not mix with `~ & | ^ !`.
+        for src in [
+            "a := -2 & 7",
+            "a := 1 + 2 & 3",
+            "a := 1 & 2 + 3",
+            "a := ~-1",
+            "a := -~1",
+            "a := ~1 == -2",
+        ] {
+            assert!(
+                parse(src).is_err_and(|e| e.contains("cannot be mixed")),
+                "{src}"
+            );
         }
     }
 
@@ -987,6 +1213,7 @@ mod tests {
         let mut env = Env {
             vals: &mut vals,
             dbl: &mut dbl,
+            reals: &mut BTreeMap::new(),
         };
         assert!(parse("3").unwrap().holds(&mut env, &none).is_err());
         assert!(parse("5-5").unwrap().holds(&mut env, &none) == Ok(false));
@@ -1006,6 +1233,7 @@ mod tests {
             let mut env = Env {
                 vals: &mut vals,
                 dbl: &mut dbl,
+                reals: &mut BTreeMap::new(),
             };
             parse(src).expect("parses").run(&mut env, &texts)
         };
@@ -1033,6 +1261,7 @@ mod tests {
         let mut env = Env {
             vals: &mut vals,
             dbl: &mut dbl,
+            reals: &mut BTreeMap::new(),
         };
         assert!(matches!(
             parse("k").unwrap().holds(&mut env, &texts),

@@ -395,6 +395,19 @@ impl Compiler<'_, '_> {
                 code: Code::Float(Box::new(move |e| Ok(-f(e)?))),
             }),
             (UnOp::Plus, code @ (Code::Int(_) | Code::Float(_))) => Ok(Typed { ty: t.ty, code }),
+            // Two's complement of the 64-bit integer (ECMAScript's `~` on a value within
+            // 32 bits gives the same).
+            (UnOp::BitNot, Code::Int(f)) => Ok(Typed {
+                ty: Ty::Int,
+                code: Code::Int(Box::new(move |e| Ok(!f(e)?))),
+            }),
+            (UnOp::BitNot, _) => Err(cerr(
+                at,
+                format!(
+                    "`~` needs an integer, found {} (use Math.trunc for a float)",
+                    self.tname(&t.ty)
+                ),
+            )),
             (UnOp::Not, _) => Err(cerr(
                 at,
                 format!("`!` needs a bool, found {}", self.tname(&t.ty)),
@@ -440,6 +453,23 @@ impl Compiler<'_, '_> {
                         Box::new(move |e| Ok(x(e)? || y(e)?))
                     }),
                 }),
+                _ => Err(type_err(self, &ta.ty, &tb.ty)),
+            },
+            // Bitwise operators take integers only (a float is never silently narrowed:
+            // use Math.trunc) and work on the 64-bit two's complement, which for values
+            // within 32 bits is ECMAScript's `ToInt32` result.
+            BinOp::BitAnd | BinOp::BitOr | BinOp::BitXor => match (ta.code, tb.code) {
+                (Code::Int(x), Code::Int(y)) => {
+                    let f: IntFn = match op {
+                        BinOp::BitAnd => Box::new(move |e| Ok(x(e)? & y(e)?)),
+                        BinOp::BitOr => Box::new(move |e| Ok(x(e)? | y(e)?)),
+                        _ => Box::new(move |e| Ok(x(e)? ^ y(e)?)),
+                    };
+                    Ok(Typed {
+                        ty: Ty::Int,
+                        code: Code::Int(f),
+                    })
+                }
                 _ => Err(type_err(self, &ta.ty, &tb.ty)),
             },
             BinOp::Add | BinOp::Sub | BinOp::Mul | BinOp::Div | BinOp::Rem => {

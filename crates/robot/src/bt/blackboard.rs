@@ -67,6 +67,9 @@ pub(crate) struct Blackboard {
     /// Entries scripts read or write: the machine keeps whether each holds a value
     /// (`btcpp4_script.rs`).
     pub script_entries: Vec<String>,
+    /// Entries only scripts create that hold a number that need not be whole: the
+    /// machine keeps them as `float64` (`btcpp4_script/num.rs`, `float_entries`).
+    pub floats: Vec<String>,
     /// The transitions that run the tree's scripts (`btcpp4_script.rs`).
     pub scripts: Vec<Element>,
     /// Entries whose update counter the machine keeps (`bt_seq__<entry>`, one more at

@@ -72,6 +72,7 @@ pub(super) fn prepare(
     bb: &mut Blackboard,
     errs: &mut Vec<Diagnostic>,
 ) {
+    super::btcpp4_script::float_entries(tree, bb);
     for (i, n) in tree.nodes.iter().enumerate() {
         match n.kind {
             Kind::Control(Control::Btcpp4(Btcpp4::Updated(_))) => {
@@ -355,7 +356,7 @@ pub(super) fn unset(
         Some(_) => {}
         None => bb.entries.push(Entry {
             name: g.clone(),
-            ty: "int64".into(),
+            ty: super::btcpp4_script::entry_type(bb, &g).into(),
             span: p.span,
             why: "a script".into(),
         }),

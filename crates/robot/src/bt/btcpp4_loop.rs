@@ -96,7 +96,7 @@ pub(super) fn prepare(
             if bb.entry(g).is_none() && scripted {
                 bb.entries.push(Entry {
                     name: g.clone(),
-                    ty: "int64".into(),
+                    ty: super::btcpp4_script::entry_type(bb, g).into(),
                     span: p.span,
                     why: SCRIPT.into(),
                 });

@@ -65,6 +65,9 @@ use crate::model::source::{Diagnostic, SourceMap, Span};
 use crate::model::types::Scalar;
 use crate::model::xml::Element;
 
+mod num;
+pub(crate) use num::{entry_type, float_entries};
+
 /// The blackboard machine's flag: a script threw.
 pub(crate) const FAULT: &str = "bt_script_fault";
 
@@ -103,14 +106,13 @@ pub(crate) fn dbl(e: &str) -> String {
 /// Why an operator over an entry SetBlackboard wrote cannot be modelled.
 const TWO_TEXTS: &str = "two entries SetBlackboard wrote: BT.CPP 4 holds their texts and compares or joins them as strings, which is not modelled";
 
-/// Why the bit operators are refused.
-const BITS: &str = "the bit operators (`~`, `&`, `|`, `^`) are not modelled: the model's expression language has no bitwise operations";
+/// An operator the parser gives and the lowering does not know (none today).
+const BITS: &str = "this operator is not modelled";
 
-/// Why a value that need not be whole cannot be stored.
-const STORE_REAL: &str = "the model's script entries are integers, and BT.CPP would store a double here (or throw converting it to an integer entry); `/` and real numbers are modelled only where the value is compared, tested or cast to a condition, not stored";
-
-/// Why a divisor other than a literal is refused.
-const DIVISOR: &str = "a divisor other than a number literal other than 0 is not modelled: BT.CPP divides in doubles, where the sign of a zero shows (`1/-0.0` is -inf), and the model holds whole numbers as integers, which have no negative zero";
+/// Why a value that need not be whole cannot be stored in an entry of an integer type
+/// a port, a Loop node or UnsetBlackboard gives (entries only scripts write hold it:
+/// [`float_entries`]).
+const STORE_REAL: &str = "the entry has an integer type a port, a Loop node or UnsetBlackboard gives it, and BT.CPP converts a double stored there (throwing unless it is whole), which is not modelled for those entries";
 
 /// A number literal other than 0, possibly negated: a divisor the model's floats divide
 /// by as BT.CPP's doubles do (no zero, so no sign of zero to lose).
@@ -179,7 +181,7 @@ fn cast_bool(v: &Val) -> (Option<String>, String) {
     let x = &v.x;
     match (v.t, v.d.as_str()) {
         (Ty::Bool, _) => (None, x.clone()),
-        (Ty::Real, _) | (_, "true") => (Some(format!("{x} < 0")), format!("({x} != 0)")),
+        (_, "true") => (Some(format!("{x} < 0")), format!("({x} != 0)")),
         (_, "false") => (Some(format!("{x} != 0 && {x} != 1")), format!("({x} != 0)")),
         (_, d) => (
             Some(format!(
@@ -346,13 +348,25 @@ impl Tr<'_> {
                     _ => val(format!("({} == 0)", v.x), Ty::Bool, "true"),
                 }
             }
+            K::Un("~", a) => {
+                let v = self.number(a, guard)?;
+                self.complement(v, guard)
+            }
             K::Un(..) => return refuse(BITS),
             K::Bin(op @ ("+" | "-" | "*" | "/"), a, b) => {
                 if self.is_text(a) && self.is_text(b) {
                     return Err((e.at, format!("`{op}` over {TWO_TEXTS}")));
                 }
                 if *op == "/" && !nonzero_literal(b) {
-                    return Err((b.at, DIVISOR.to_string()));
+                    // Any other divisor: computed exactly as BT.CPP's double, sign of zero
+                    // included (`exact`).
+                    let x = self.number(a, guard)?;
+                    let y = self.exact_number(b, guard)?;
+                    return Ok(val(
+                        format!("({} / {})", int(&x.x, x.t), y.x),
+                        Ty::Real,
+                        "true",
+                    ));
                 }
                 let x = self.number(a, guard)?;
                 let y = self.number(b, guard)?;
@@ -374,6 +388,13 @@ impl Tr<'_> {
                 let x = self.logic_operand(a, guard)?;
                 let y = self.logic_operand(b, guard)?;
                 val(format!("({x} {op} {y})"), Ty::Bool, "true")
+            }
+            K::Bin(op @ ("&" | "|" | "^"), a, b) => {
+                let x = self.number(a, guard)?;
+                let y = self.number(b, guard)?;
+                let x = self.int64(x, guard);
+                let y = self.int64(y, guard);
+                val(format!("({x} {op} {y})"), Ty::Int, "true")
             }
             K::Bin(..) => return refuse(BITS),
             K::Cmp(xs, ops) => {
@@ -459,6 +480,11 @@ fn statement(names: &[Name], s: &Stmt) -> Result<Lowered, Refuse> {
         names,
         checks: Vec::new(),
     };
+    if let Some((target, op, _)) = &s.assign {
+        if tr.entry(target).1 == Ty::Real {
+            return num::float_statement(tr, target, op, &s.e);
+        }
+    }
     let v = tr.ex(&s.e, "")?;
     let Some((target, op, at)) = &s.assign else {
         return Ok(Lowered {
@@ -562,16 +588,22 @@ fn resolve(
         let dynamic = bb.entry(&g).is_none_or(|e| e.why == "a script");
         let t = match bb.entry(&g) {
             None => {
+                let ty = entry_type(bb, &g);
                 bb.entries.push(super::blackboard::Entry {
                     name: g.clone(),
-                    ty: "int64".into(),
+                    ty: ty.into(),
                     span,
                     why: "a script".into(),
                 });
-                Ty::Int
+                if ty == "float64" {
+                    Ty::Real
+                } else {
+                    Ty::Int
+                }
             }
             Some(e) => match Scalar::from_name(e.ty.trim()) {
                 Some(Scalar::Bool) => Ty::Bool,
+                Some(Scalar::F64) if dynamic => Ty::Real,
                 Some(s) if s.int_range().is_some() => Ty::Int,
                 _ => {
                     let at = sm.diag(e.span, "");

@@ -7,10 +7,11 @@
 //! real library 4.8.2 parses it (`tests/tests/bt_real.rs` holds the oracle's own reader
 //! to it): statements separated by `;` (no trailing `;`); a statement is `name` followed
 //! by one of `:= = += -= *= /=` and an expression, or an expression; expressions have
-//! `? :`, `|| &&`, comparisons, `| & ^`, `+ -`, `* /`, the prefixes `- ! ~`, parentheses,
-//! numbers, `'strings'`, `true`, `false` and names. `!` does not mix with the arithmetic
-//! operators in one expression ("operator cannot be mixed with previous operators");
-//! parentheses and the middle part of `c ? a : b` start a new one.
+//! `? :`, `|| &&`, comparisons, `| ^`, `&`, `+ -`, `* /`, the prefixes `- ! ~`,
+//! parentheses, numbers, `'strings'`, `true`, `false` and names. `! ~ & | ^` do not mix
+//! with the arithmetic operators `- + * /` in one expression ("operator cannot be mixed
+//! with previous operators"); parentheses and the middle part of `c ? a : b` start a new
+//! one.
 //!
 //! [`parse`] gives the statements as a tree ([`Stmt`], [`Ex`]); `&&` and `||` are one
 //! level, read left to right (BT.CPP 4.8.2: `true || false && false` is false), `+ -`
@@ -159,22 +160,33 @@ fn tokens(s: &str) -> Result<Vec<(T<'_>, usize)>, SyntaxError> {
     Ok(out)
 }
 
-/// The precedence levels of the binary operators, loosest first.
-const LEVELS: [&[&str]; 6] = [
+/// The precedence levels of the binary operators, loosest first: `| ^` one level and
+/// `&` tighter, each grouping to the left (BT.CPP 4.8.2: `1 | 1 ^ 1` is 0, `1 ^ 1 | 1`
+/// is 1, `1 | 2 & 4` is 1; 4.10 `scripting/operators.hpp`, `Grammar::Expression`,
+/// `bit_or` and `bit_and`).
+const LEVELS: [&[&str]; 7] = [
     &["||", "&&"],
     &["==", "!=", "<", "<=", ">", ">="],
-    &["|", "&", "^"],
+    &["|", "^"],
+    &["&"],
     &["+", "-"],
     &["*", "/"],
     &[],
 ];
+
+/// The first level of the arithmetic operators in [`LEVELS`]; the levels before it
+/// and after the comparisons are the bit operators, which share an operator group with
+/// `!` and `~` (BT.CPP's `dsl::groups<math_sum, bit_or>`: an expression holds one group
+/// or the other, "operator cannot be mixed with previous operators").
+const ARITH: usize = 4;
 
 struct Parser<'s> {
     toks: Vec<(T<'s>, usize)>,
     pos: usize,
     end: usize,
     src: &'s str,
-    /// Per open expression: it has a `!`; it has an arithmetic operator.
+    /// Per open expression: it has a `!`, `~` or bit operator; it has an arithmetic
+    /// operator.
     open: Vec<[bool; 2]>,
 }
 
@@ -194,7 +206,8 @@ impl<'s> Parser<'s> {
         })
     }
 
-    /// Records an operator of group 0 (`!`) or 1 (arithmetic) at the current token.
+    /// Records an operator of group 0 (`! ~ & | ^`) or 1 (arithmetic) at the current
+    /// token.
     fn note(&mut self, group: usize) -> Result<(), SyntaxError> {
         let g = self.open.last_mut().expect("an open expression");
         g[group] = true;
@@ -265,11 +278,11 @@ impl<'s> Parser<'s> {
             let Some(op) = LEVELS[level].iter().copied().find(|o| o == op) else {
                 break;
             };
-            if level >= 3 {
-                self.note(1)?;
+            if level >= 2 {
+                self.note(usize::from(level >= ARITH))?;
             }
             self.pos += 1;
-            if level >= 3 {
+            if level >= ARITH {
                 // `+ -` and `* /` group to the right: BT.CPP 4.8.2 computes
                 // `10 - 4 - 2` as `10 - (4 - 2)`, 8, and `12 / 2 / 3` as 18 (the oracle's
                 // `script_operators_agree_with_the_library` holds it to the library).
@@ -307,7 +320,8 @@ impl<'s> Parser<'s> {
         let at = self.at();
         match self.toks.get(self.pos).map(|t| t.0) {
             Some(T::Sym(op @ ("-" | "!" | "~"))) => {
-                self.note(usize::from(op != "!"))?;
+                // `!` and `~` are one group (`bit_prefix`), `-` the other.
+                self.note(usize::from(op == "-"))?;
                 self.pos += 1;
                 let e = self.prefix()?;
                 Ok(Ex {
@@ -482,6 +496,36 @@ mod tests {
         assert_eq!(at("a:= !true + 1"), 10);
         assert_eq!(at("x := (!f ? -1 : -x)"), 16);
         assert_eq!(at("a := 'open"), 5);
+        // `~ & | ^` are `!`'s group: they do not mix with `- + * /` (4.8.2 refuses each
+        // of these at load).
+        for s in [
+            "a := 1 + 2 & 3",
+            "a := 1 & 2 + 3",
+            "a := -1 & 3",
+            "a := ~-1",
+            "a := -~1",
+            "a := ~1 == -2",
+        ] {
+            assert!(check(s).is_err(), "{s}");
+        }
+        for s in [
+            "a := !1 & 1",
+            "a := ~ ~ 5",
+            "a := (1 + 2) & 3",
+            "a := 6 & 3 == 2",
+            "a := 3 && 1 & 1",
+        ] {
+            assert_eq!(check(s), Ok(()), "{s}");
+        }
+    }
+
+    #[test]
+    fn bit_operators_group_as_btcpp_does() {
+        // 4.8.2: `1 | 2 & 4` is 1 (`&` tighter), `1 | 1 ^ 1` is 0 (one level, left).
+        let s = parse("1 | 2 & 4").unwrap();
+        assert!(matches!(&s[0].e.k, K::Bin("|", _, r) if matches!(r.k, K::Bin("&", ..))));
+        let s = parse("1 | 1 ^ 1").unwrap();
+        assert!(matches!(&s[0].e.k, K::Bin("^", l, _) if matches!(l.k, K::Bin("|", ..))));
     }
 
     #[test]
