@@ -7,7 +7,7 @@
 //! recording has N `std_msgs/Int32` messages on `/level` (1 ms apart, every fourth one
 //! also a `std_msgs/Bool` on `/followed`), written in memory with the `mcap` crate
 //! (zstd chunks, as rosbag2 writes them); the CSV holds the same points. Both go through
-//! the code `hindsight replay` runs (`hindsight_ros2::feed` and `hindsight::tracefile`,
+//! the code `hindsight replay` runs (`hindsight_ros2::feed` and `hindsight::verify::tracefile`,
 //! then one `Monitor::try_step` a point) with a spec of two properties, from bytes in
 //! memory (reading the file is left out of both). Passes alternate and the median of R
 //! is reported, so that load on a shared machine falls on both alike.
@@ -157,7 +157,8 @@ fn main() {
         assert_eq!(count, points);
         mcap_times.push(s);
         let (s, count, v_csv) = judge(&mut |step| {
-            let trace = hindsight::tracefile::parse_csv(&csv, "bench.csv", &compiled).unwrap();
+            let trace =
+                hindsight::verify::tracefile::parse_csv(&csv, "bench.csv", &compiled).unwrap();
             for p in &trace {
                 step(p.time, &p.sets);
             }

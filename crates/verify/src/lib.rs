@@ -4,7 +4,8 @@
 //! model) and its property file, [`observe`] judges a simulated run with the compiled
 //! monitors, [`study`] runs studies under stopping rules, [`schedulers`] and
 //! [`sched_fixed`] bound the probabilities over schedulers, [`record`] writes a run as CSV
-//! and [`result`] is a study's result as `verify --json` prints it. Nothing here prints:
+//! and [`result`] is a study's result as `verify --json` prints it; [`tracefile`] reads
+//! such a CSV (or any trace) back as points for `replay`. Nothing here prints:
 //! errors are values ([`load::LoadError`] carries the files' diagnostics), warnings come
 //! back with what was loaded ([`load::Loaded::warnings`]) and progress goes to a callback.
 //!
@@ -41,6 +42,7 @@ pub mod sched_fixed;
 pub mod schedulers;
 mod split;
 pub mod study;
+pub mod tracefile;
 
 // The crates below this one, under the paths its modules name them by.
 pub use hindsight_expr as expr;

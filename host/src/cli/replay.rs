@@ -30,7 +30,7 @@ use ros2::feed::{Port as BagPort, Read, ServiceSide, TimeSource};
 
 use super::{compile_spec_file, read_file, CliError};
 use crate::props::{PortKind, PropertyFile};
-use crate::tracefile;
+use crate::verify::tracefile;
 
 /// Arguments of `hindsight replay`.
 #[derive(Debug, clap::Args)]

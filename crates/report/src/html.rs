@@ -8,7 +8,7 @@ use super::plot;
 
 /// Escapes text for HTML content and attribute values (every attribute the page writes
 /// is double-quoted): the one markup escaper, `model::xml::escape`.
-pub use crate::model::xml::escape as esc;
+pub use hindsight_verify::model::xml::escape as esc;
 
 /// An id fragment for a name: letters, digits, `-` and `_` kept, anything else `_`.
 pub fn anchor(name: &str) -> String {
@@ -42,7 +42,7 @@ pub fn page(data: &ReportData) -> String {
          style-src 'unsafe-inline'; script-src 'unsafe-inline'; img-src data:\">\n\
          <title>{}</title>\n<style>\n{}</style>\n</head>\n<body data-errors=\"0\">\n",
         esc(&data.title),
-        include_str!("page.css")
+        crate::PAGE_CSS
     );
     let _ = writeln!(
         o,
@@ -103,7 +103,7 @@ pub fn page(data: &ReportData) -> String {
         o,
         "<script type=\"application/json\" id=\"hindsight-runs\">{runs}</script>\n\
          <script>\n{}</script>\n</body>\n</html>\n",
-        include_str!("page.js")
+        crate::PAGE_JS
     );
     o
 }
@@ -145,7 +145,7 @@ fn bounds(o: &mut String, s: &Study) {
     );
     let num = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.4}"));
     for (p, b) in rows {
-        let side = |x: &crate::verify::schedulers::Bound| {
+        let side = |x: &hindsight_verify::schedulers::Bound| {
             format!(
                 "{} [{:.4}, {:.4}]<br><code>{}</code>",
                 num(x.probability),
@@ -154,7 +154,8 @@ fn bounds(o: &mut String, s: &Study) {
                 esc(&x.scheduler)
             )
         };
-        let why = crate::verify::schedulers::explain(&b.sources, s.precision).unwrap_or_default();
+        let why =
+            hindsight_verify::schedulers::explain(&b.sources, s.precision).unwrap_or_default();
         let _ = writeln!(
             o,
             "<tr class=\"{}\"><td><b>{}</b></td><td class=\"prob\">{}</td><td>{}</td><td>{}</td>\

@@ -333,12 +333,12 @@ pub fn page(title: &str, spec: &codegen::Compiled) -> String {
     let data = data.to_string().replace('<', "\\u003c");
     // The title last: nothing it holds is taken for a placeholder.
     include_str!("page.html")
-        .replace("__CSS__", include_str!("../report/page.css"))
+        .replace("__CSS__", crate::report::PAGE_CSS)
         .replace("__LIVE_JS__", include_str!("page_live.js"))
-        .replace("__JS__", include_str!("../report/page.js"))
+        .replace("__JS__", crate::report::PAGE_JS)
         .replace("__SPEC__", &data)
         .replace("__VERSION__", env!("CARGO_PKG_VERSION"))
-        .replace("__TITLE__", &crate::report::html::esc(title))
+        .replace("__TITLE__", &crate::model::xml::escape(title))
 }
 
 /// Why `--serve ADDR` names no address: the text as given, and what the resolver said
@@ -1089,7 +1089,7 @@ mod tests {
         )
         .unwrap();
         let page = page("museum <guide>", &spec);
-        assert!(page.contains(include_str!("../report/page.js")));
+        assert!(page.contains(crate::report::PAGE_JS));
         assert!(page.contains(include_str!("page_live.js")));
         assert!(page.contains("hindsight monitor: museum &lt;guide&gt;"));
         assert!(page.contains(

@@ -7,7 +7,7 @@
 use codegen::diag::Diagnostic;
 use serde::{Deserialize, Serialize};
 
-pub use crate::verify::result::{PropertyRow, Study};
+pub use hindsight_verify::result::{PropertyRow, Study};
 
 /// Everything one page shows.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
@@ -124,7 +124,7 @@ pub struct Run {
     /// property, the subformula whose value at the first false point explains it
     /// (bounds in ticks), and that value.
     #[serde(default)]
-    pub culprits: Vec<crate::verify::record::Culprit>,
+    pub culprits: Vec<hindsight_verify::record::Culprit>,
 }
 
 /// A property's first false point in a run.

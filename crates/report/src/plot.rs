@@ -2,7 +2,7 @@
 
 use std::fmt::Write;
 
-use crate::model::xml::escape as esc;
+use hindsight_verify::model::xml::escape as esc;
 
 /// One measured point of a curve.
 #[derive(Clone, Debug)]

@@ -24,6 +24,36 @@
 //! full tap buffer drops the tap's oldest sample. Lost samples are found from a
 //! sequence counter in the payload when the config names one, otherwise from a
 //! drain that found the buffer full (a conservative "may have lost").
+//!
+//! # Crate
+//!
+//! `hindsight-live` depends on `monitor-core`, `codegen`, `hindsight-ros2` and the crates
+//! a paced run needs (`hindsight-expr`, `hindsight-sim`, `hindsight-props`,
+//! `hindsight-robot`), and on `hindsight-report` for the live page's script; not on
+//! `hindsight-verify`. `hindsight`'s command line drives it (`monitor`, `run`).
+//!
+//! A monitor stepped from a compiled spec, point by point, as the sidecar does:
+//!
+//! ```
+//! use hindsight_live::engine::{Engine, Verdict};
+//! use monitor_core::Value;
+//!
+//! let spec = codegen::compile_spec(
+//!     "unit 1ms; state x: int = 0; property low = H({x < 10});",
+//!     "t.hspec",
+//! )
+//! .unwrap();
+//! let x = spec.var_index("x").unwrap();
+//! let mut engine = Engine::new(&spec, false).unwrap();
+//! let mut out = Vec::new();
+//! engine.point(0, &[(x, Value::Int(3))], "tick", &mut out).unwrap();
+//! assert_eq!(out.last().unwrap().verdict, Verdict::CurrentlyTrue);
+//! engine.point(5, &[(x, Value::Int(12))], "tick", &mut out).unwrap();
+//! assert_eq!((out.last().unwrap().time, out.last().unwrap().verdict), (5, Verdict::False));
+//! // Time going backwards is an error value, and changes nothing.
+//! assert!(engine.point(4, &[], "tick", &mut out).is_err());
+//! assert_eq!(engine.verdicts(), &[Some(Verdict::False)]);
+//! ```
 
 pub mod bench;
 mod clock;
@@ -38,6 +68,14 @@ pub mod publish_dds;
 pub mod record;
 pub mod serve;
 pub mod serve_dds;
+
+// The crates below this one, under the paths its modules name them by (crate-private:
+// this crate's API is its own modules).
+use hindsight_expr as expr;
+use hindsight_props as props;
+use hindsight_report as report;
+use hindsight_robot as robot;
+use hindsight_sim::{model, sim};
 
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};
