@@ -52,8 +52,8 @@ pub struct ActionFields {
 
 /// Where the ROS lowering finds message layouts. Type names are as written in models:
 /// `std_msgs/Int32`, `std_msgs/msg/Int32`, `example_interfaces/srv/AddTwoInts`. An error
-/// is a [`LookupError`] (`no message type `std_msgs/Int33`: ...`); the caller adds the
-/// span of the tag that named the type.
+/// is a [`LookupError`] (its message: no message type `std_msgs/Int33`, why, and close
+/// names); the caller adds the span of the tag that named the type.
 pub trait InterfaceLookup {
     /// A message type's leaf fields, in declaration order.
     fn message(&self, type_name: &str) -> Result<Vec<FlatField>, LookupError>;
