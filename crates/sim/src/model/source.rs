@@ -68,7 +68,7 @@ pub fn reference(rest: &str) -> Option<Result<(char, usize), BadReference>> {
     })
 }
 
-/// What is wrong with a reference in XML text ([`reference`], [`unescape`]).
+/// What is wrong with a reference in XML text ([`reference()`], [`unescape`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum BadReference {
     /// An `&` that starts no reference (no `;` close after it).
