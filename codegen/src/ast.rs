@@ -87,7 +87,7 @@ impl Interval {
     }
 
     /// `true` for `[0, inf)`.
-    pub fn is_unbounded(&self) -> bool {
+    pub(crate) fn is_unbounded(&self) -> bool {
         *self == Self::ALWAYS
     }
 }

@@ -88,13 +88,6 @@ impl std::fmt::Display for TimeLitError {
     }
 }
 
-/// The message, for the checker's [`Sink`].
-impl From<TimeLitError> for String {
-    fn from(e: TimeLitError) -> String {
-        e.to_string()
-    }
-}
-
 /// Converts a bound end to ticks of `tick_ns` exactly.
 pub(crate) fn lit_ticks(t: &TimeLit, tick_ns: u64) -> Result<u64, TimeLitError> {
     let text = lit_text(t);
@@ -136,24 +129,17 @@ fn unit_ns(t: &TimeLit) -> Result<u64, TimeLitError> {
 
 /// Resolves a declared type name to its run-time type and, for integers, its range.
 fn resolve_type(name: &str) -> Option<(Ty, Option<(i128, i128)>)> {
-    use crate::scalar::Scalar;
+    use crate::scalar::{Scalar, ScalarKind};
     match name {
         "int" => Some((Ty::Int, Some((i64::MIN.into(), i64::MAX.into())))),
         "float" => Some((Ty::Float, None)),
         _ => {
             let scalar = Scalar::from_spec_name(name)?;
-            let ty = match scalar {
-                Scalar::Bool => Ty::Bool,
-                Scalar::F32 | Scalar::F64 => Ty::Float,
-                Scalar::Str => Ty::Str,
-                Scalar::I8
-                | Scalar::I16
-                | Scalar::I32
-                | Scalar::I64
-                | Scalar::U8
-                | Scalar::U16
-                | Scalar::U32
-                | Scalar::U64 => Ty::Int,
+            let ty = match scalar.kind() {
+                ScalarKind::Bool => Ty::Bool,
+                ScalarKind::Float => Ty::Float,
+                ScalarKind::Str => Ty::Str,
+                ScalarKind::Int => Ty::Int,
             };
             // Stored as i64: the upper half of u64 is out of reach.
             let range = scalar
@@ -195,7 +181,7 @@ pub(crate) fn check(syn: &SpecSyntax, sources: &SourceMap, sink: &mut Sink) -> C
         }
         match unit_ns(u) {
             Ok(ns) => ck.tick_ns = ns,
-            Err(m) => ck.sink.error(u.span, m),
+            Err(m) => ck.sink.error(u.span, m.to_string()),
         }
     }
     for d in &syn.decls {
@@ -371,7 +357,7 @@ impl Checker<'_> {
                 Some(t) => match lit_ticks(t, self.tick_ns) {
                     Ok(v) => Some(Some(v)),
                     Err(m) => {
-                        self.sink.error(t.span, m);
+                        self.sink.error(t.span, m.to_string());
                         None
                     }
                 },

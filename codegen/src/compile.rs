@@ -4,7 +4,9 @@ use std::collections::BTreeSet;
 use std::sync::Mutex;
 
 use monitor_core::table::TABLE_VERSION;
-use monitor_core::{Atom, Instr, Monitor, Node, NodeId, Program, Property, StepError, Var};
+use monitor_core::{
+    Atom, Instr, Monitor, Node, NodeId, Program, Property, StepError, TableError, Var,
+};
 
 use crate::ast::{self, CheckedSpec, VarDecl};
 use crate::diag::Diagnostics;
@@ -65,13 +67,34 @@ pub struct Compiled {
     warnings: Diagnostics,
 }
 
+/// Why [`Compiled::build`] refused a laid-out network: a compiler bug, never bad input.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) enum BuildError {
+    /// The monitor refused the program.
+    Refused(TableError),
+    /// The compiler and the monitor disagree on the state size (bytes).
+    StateSize { compiler: usize, monitor: usize },
+}
+
+impl std::fmt::Display for BuildError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BuildError::Refused(e) => write!(f, "{e}"),
+            BuildError::StateSize { compiler, monitor } => write!(
+                f,
+                "state size mismatch: compiler {compiler} bytes, monitor {monitor} bytes"
+            ),
+        }
+    }
+}
+
 impl Compiled {
     /// Packages a laid-out network; `Err` carries the monitor's complaint (a compiler bug).
     pub(crate) fn build(
         checked: CheckedSpec,
         net: Net,
         warnings: Diagnostics,
-    ) -> Result<Compiled, String> {
+    ) -> Result<Compiled, BuildError> {
         let strings: Vec<&'static str> = checked.strings.iter().map(|s| intern(s)).collect();
         let core_vars = checked
             .vars
@@ -116,13 +139,12 @@ impl Compiled {
             state_bytes: (net.state_words * 8) as usize,
             warnings,
         };
-        let m = Monitor::try_new(c.program()).map_err(|e| e.to_string())?;
+        let m = Monitor::try_new(c.program()).map_err(BuildError::Refused)?;
         if m.state_bytes() != c.state_bytes {
-            return Err(format!(
-                "state size mismatch: compiler {} bytes, monitor {} bytes",
-                c.state_bytes,
-                m.state_bytes()
-            ));
+            return Err(BuildError::StateSize {
+                compiler: c.state_bytes,
+                monitor: m.state_bytes(),
+            });
         }
         Ok(c)
     }
@@ -198,7 +220,7 @@ impl Compiled {
     }
 
     /// The expression of each atom, in atom order (after deduplication).
-    pub fn atom_exprs(&self) -> &[ast::Expr] {
+    pub(crate) fn atom_exprs(&self) -> &[ast::Expr] {
         &self.atom_exprs
     }
 

@@ -395,7 +395,7 @@ pub fn read_source(path: &Path) -> Result<String, Diagnostic> {
 
 /// `bytes` as text, without a leading UTF-8 byte order mark; `Err` gives the line and
 /// column of the first byte that is not UTF-8, and what is wrong.
-pub fn decode_source(mut bytes: Vec<u8>) -> Result<String, ((u32, u32), String)> {
+pub(crate) fn decode_source(mut bytes: Vec<u8>) -> Result<String, ((u32, u32), String)> {
     if bytes.starts_with(b"\xEF\xBB\xBF") {
         bytes.drain(..3);
     }
@@ -566,7 +566,7 @@ pub const SNIPPET_WIDTH: usize = 200;
 
 /// The most characters of a message a diagnostic prints: a longer one (a message
 /// quoting a huge attribute) is cut in the middle.
-pub const MESSAGE_WIDTH: usize = 1000;
+pub(crate) const MESSAGE_WIDTH: usize = 1000;
 
 /// The most diagnostics a list prints; the rest are counted (`... and N more`).
 pub const MAX_SHOWN: usize = 20;

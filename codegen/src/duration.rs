@@ -70,7 +70,7 @@ impl TimeUnit {
 /// `(numerator, denominator)`: the value is `numerator / denominator`, the denominator
 /// `10^k` for the fraction's `k` significant digits. `None` when it overflows `u128`.
 /// [`decimal_times`] and the formula checker's bounds in ticks both compute with it.
-pub fn scaled_decimal(int: &str, frac: &str, scale: u64) -> Option<(u128, u128)> {
+pub(crate) fn scaled_decimal(int: &str, frac: &str, scale: u64) -> Option<(u128, u128)> {
     let frac = frac.trim_end_matches('0');
     let pow = 10u128.checked_pow(u32::try_from(frac.len()).ok()?)?;
     let int_v: u128 = if int.is_empty() { 0 } else { int.parse().ok()? };
@@ -132,13 +132,6 @@ impl std::fmt::Display for DurationError {
 }
 
 impl std::error::Error for DurationError {}
-
-/// The message, for a [`crate::diag::Diagnostic`] (`sm.diag(span, e)`).
-impl From<DurationError> for String {
-    fn from(e: DurationError) -> String {
-        e.to_string()
-    }
-}
 
 /// The decimal `text` (`100`, `2.5`, `.5`) times `scale` nanoseconds, exactly; an error
 /// when it is negative, not a plain decimal, not a whole number of nanoseconds or too
@@ -296,7 +289,7 @@ mod tests {
             Err(DurationError::FinerThanNanosecond("1.5".into()))
         );
         assert_eq!(
-            String::from(parse("5h").unwrap_err()),
+            parse("5h").unwrap_err().to_string(),
             "unknown time unit `h` (use ns, us, ms, s or min)"
         );
         for ns in [

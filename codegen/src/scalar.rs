@@ -128,6 +128,37 @@ impl Scalar {
             Scalar::Bool | Scalar::F32 | Scalar::F64 | Scalar::Str => return None,
         })
     }
+
+    /// What the scalar holds, whatever its width: how the formula checker and the
+    /// simulator store it.
+    pub fn kind(self) -> ScalarKind {
+        match self {
+            Scalar::Bool => ScalarKind::Bool,
+            Scalar::F32 | Scalar::F64 => ScalarKind::Float,
+            Scalar::Str => ScalarKind::Str,
+            Scalar::I8
+            | Scalar::I16
+            | Scalar::I32
+            | Scalar::I64
+            | Scalar::U8
+            | Scalar::U16
+            | Scalar::U32
+            | Scalar::U64 => ScalarKind::Int,
+        }
+    }
+}
+
+/// What a [`Scalar`] holds, whatever its width ([`Scalar::kind`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ScalarKind {
+    /// `bool`.
+    Bool,
+    /// A signed or unsigned integer of any width.
+    Int,
+    /// `float32` or `float64`.
+    Float,
+    /// `string`.
+    Str,
 }
 
 #[cfg(test)]

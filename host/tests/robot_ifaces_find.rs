@@ -232,7 +232,7 @@ fn the_first_place_wins_a_clash() {
         "int64"
     );
     assert_eq!(ifs.message("std_msgs/Bool").unwrap()[0].scxml_type, "bool");
-    let e = ifs.message("odd_msgs/Odd").unwrap_err();
+    let e = ifs.message("odd_msgs/Odd").unwrap_err().to_string();
     assert!(e.contains("did not read"), "{e}");
     let _ = std::fs::remove_dir_all(&root);
 }

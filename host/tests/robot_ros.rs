@@ -9,7 +9,9 @@ use hindsight::model::source::{Diagnostic, SourceMap};
 use hindsight::model::xml::{self, Element};
 use hindsight::model::{Diagnostics, ModelSource};
 use hindsight::robot::ros::{lower, RosInput, RosOutput};
-use hindsight::robot::types::{ActionFields, FlatField, InterfaceLookup, ServiceFields};
+use hindsight::robot::types::{
+    ActionFields, FlatField, InterfaceLookup, LookupError, ServiceFields,
+};
 use hindsight::sim::{CompiledModel, Flow, Observer, RunConfig, SentMessage, Simulator};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -211,20 +213,37 @@ impl TestInterfaces {
     }
 }
 
-impl InterfaceLookup for TestInterfaces {
-    fn message(&self, type_name: &str) -> Result<Vec<FlatField>, String> {
-        Ok(self.parts(type_name, "msg", 1)?.remove(0))
+/// The lookup error of a type the test interfaces do not have (`kind`: its noun).
+fn missing(type_name: &str, kind: &'static str) -> impl FnOnce(String) -> LookupError {
+    let type_name = type_name.to_string();
+    move |why| LookupError::Unknown {
+        type_name,
+        kind,
+        why,
     }
-    fn service(&self, type_name: &str) -> Result<ServiceFields, String> {
-        let mut p = self.parts(type_name, "srv", 2)?;
+}
+
+impl InterfaceLookup for TestInterfaces {
+    fn message(&self, type_name: &str) -> Result<Vec<FlatField>, LookupError> {
+        let mut p = self
+            .parts(type_name, "msg", 1)
+            .map_err(missing(type_name, "message"))?;
+        Ok(p.remove(0))
+    }
+    fn service(&self, type_name: &str) -> Result<ServiceFields, LookupError> {
+        let mut p = self
+            .parts(type_name, "srv", 2)
+            .map_err(missing(type_name, "service"))?;
         let response = p.pop().unwrap();
         Ok(ServiceFields {
             request: p.pop().unwrap(),
             response,
         })
     }
-    fn action(&self, type_name: &str) -> Result<ActionFields, String> {
-        let mut p = self.parts(type_name, "action", 3)?;
+    fn action(&self, type_name: &str) -> Result<ActionFields, LookupError> {
+        let mut p = self
+            .parts(type_name, "action", 3)
+            .map_err(missing(type_name, "action"))?;
         let feedback = p.pop().unwrap();
         let result = p.pop().unwrap();
         Ok(ActionFields {
@@ -883,7 +902,7 @@ fn bad_models_give_positioned_errors() {
   <ros_topic_subscriber topic="/t" type="std_msgs/Int33"/>
   <state id="a"/>
 </ascxml>"#,
-            "s.ascxml:2:42: no interface std_msgs/Int33",
+            "s.ascxml:2:42: no message type `std_msgs/Int33`: no interface std_msgs/Int33",
         ),
         // A subscriber whose type is not the publisher's.
         (

@@ -29,7 +29,7 @@ impl<R: rand_core::Rng + ?Sized> Entropy for R {
 }
 
 /// A uniform float in `[0, 1)` with 53 random bits.
-pub fn unit_f64(rng: &mut dyn Entropy) -> f64 {
+pub(crate) fn unit_f64(rng: &mut dyn Entropy) -> f64 {
     (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 
@@ -318,7 +318,7 @@ pub fn compile_as(
 }
 
 /// Converts to `target` when allowed; `Err(found type)` otherwise.
-pub fn coerce(t: Typed, target: &Ty, types: &TypeTable) -> Result<Typed, Ty> {
+pub(crate) fn coerce(t: Typed, target: &Ty, types: &TypeTable) -> Result<Typed, Ty> {
     if assignable(&t.ty, target) {
         return Ok(match (t.code, target) {
             (Code::Int(f), Ty::Float) => Typed {
@@ -367,7 +367,7 @@ pub fn compile_cell(
 }
 
 /// True when a value of type `from` may be stored where `to` is expected.
-pub fn assignable(from: &Ty, to: &Ty) -> bool {
+pub(crate) fn assignable(from: &Ty, to: &Ty) -> bool {
     match (from, to) {
         (a, b) if a == b => true,
         (Ty::Int, Ty::Float) => true,
@@ -399,6 +399,24 @@ pub fn unify(a: &Ty, b: &Ty) -> Option<Ty> {
         }
         _ => None,
     }
+}
+
+/// The code of an array or object literal: a list of what `fns` write, in order, built
+/// in place (a destination that is already a list keeps its allocation).
+fn list_of(fns: Vec<CellFn>) -> Code {
+    let n = fns.len();
+    Code::Comp(Box::new(move |env, dest| {
+        if !matches!(dest, Cell::List(_)) {
+            *dest = Cell::list(Vec::with_capacity(n));
+        }
+        if let Cell::List(v) = dest {
+            v.set_len(n);
+            for (f, slot) in fns.iter().zip(v.iter_mut()) {
+                f(env, slot)?;
+            }
+        }
+        Ok(())
+    }))
 }
 
 fn as_float(t: Typed) -> Option<FloatFn> {
@@ -551,21 +569,9 @@ impl Compiler<'_, '_> {
             })?;
             fns.push(c.into_cell_fn());
         }
-        let n = fns.len();
         Ok(Typed {
             ty: Ty::Array(Box::new(elem_ty), bound),
-            code: Code::Comp(Box::new(move |env, dest| {
-                if !matches!(dest, Cell::List(_)) {
-                    *dest = Cell::list(Vec::with_capacity(n));
-                }
-                if let Cell::List(v) = dest {
-                    v.set_len(n);
-                    for (f, slot) in fns.iter().zip(v.iter_mut()) {
-                        f(env, slot)?;
-                    }
-                }
-                Ok(())
-            })),
+            code: list_of(fns),
         })
     }
 
@@ -651,21 +657,9 @@ impl Compiler<'_, '_> {
             ));
         }
         let fns: Vec<CellFn> = fns.into_iter().flatten().collect();
-        let n = fns.len();
         Ok(Typed {
             ty: Ty::Struct(s),
-            code: Code::Comp(Box::new(move |env, dest| {
-                if !matches!(dest, Cell::List(_)) {
-                    *dest = Cell::list(Vec::with_capacity(n));
-                }
-                if let Cell::List(v) = dest {
-                    v.set_len(n);
-                    for (f, slot) in fns.iter().zip(v.iter_mut()) {
-                        f(env, slot)?;
-                    }
-                }
-                Ok(())
-            })),
+            code: list_of(fns),
         })
     }
 

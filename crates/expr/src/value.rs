@@ -87,7 +87,7 @@ pub enum Ty {
 
 impl Ty {
     /// True for `Int` and `Float`.
-    pub fn is_numeric(&self) -> bool {
+    pub(crate) fn is_numeric(&self) -> bool {
         matches!(self, Ty::Int | Ty::Float)
     }
 }
@@ -252,7 +252,7 @@ impl List {
     }
 
     /// Appends a copy of `value`, into a set-aside element when there is one.
-    pub fn push_copy(&mut self, value: &Cell) {
+    pub(crate) fn push_copy(&mut self, value: &Cell) {
         match self.items.get_mut(self.len) {
             Some(c) => c.clone_from(value),
             None => self.items.push(value.clone()),
@@ -262,7 +262,7 @@ impl List {
 
     /// Grows to `n` elements with whatever set-aside elements hold (each is overwritten
     /// by the caller), then `Int(0)`s; or shrinks to `n`.
-    pub fn set_len(&mut self, n: usize) {
+    pub(crate) fn set_len(&mut self, n: usize) {
         while self.items.len() < n {
             self.items.push(Cell::Int(0));
         }

@@ -435,27 +435,8 @@ impl<'p, 'a> FileReader<'p, 'a> {
         let origin = self.required_name(element, "origin");
         let target = self.required_name(element, "target");
         for var in element.elements() {
-            let kind = match var.name.as_str() {
-                "state_var" => {
-                    self.check_attrs(var, &["id", "param", "type", "expr"]);
-                    let param = self.required_name(var, "param");
-                    let ty = self.declared_type(var);
-                    let init = self.required(var, "expr");
-                    match (param, ty, init) {
-                        (Some(param), Some((ty, _)), Some((init, _))) => {
-                            Some(PortKind::State { param, ty, init })
-                        }
-                        _ => None,
-                    }
-                }
-                "event_var" => {
-                    self.check_attrs(var, &["id"]);
-                    Some(PortKind::Event)
-                }
-                _ => {
-                    self.unknown_child(var, element, "<state_var> or <event_var>");
-                    continue;
-                }
+            let Some(kind) = self.port_variable(element, var, "param", |param| param) else {
+                continue;
             };
             let id = self.required_id(var);
             if let (Some(id), Some(kind), Some(event), Some(origin), Some(target)) =
@@ -469,6 +450,43 @@ impl<'p, 'a> FileReader<'p, 'a> {
                     target: target.clone(),
                     at: self.at(var.span),
                 });
+            }
+        }
+    }
+
+    /// The kind of port variable `var`, a child of `element`: a `<state_var id type expr>`
+    /// whose attribute `param` names the event parameter (`param_name` of its value) or
+    /// an `<event_var id>`; `Some(None)` when one is incomplete, `None` for any other
+    /// element (each reported).
+    pub(super) fn port_variable(
+        &mut self,
+        element: &Element,
+        var: &Element,
+        param: &'static str,
+        param_name: impl FnOnce(String) -> String,
+    ) -> Option<Option<PortKind>> {
+        match var.name.as_str() {
+            "state_var" => {
+                self.check_attrs(var, &["id", param, "type", "expr"]);
+                let name = self.required_name(var, param);
+                let ty = self.declared_type(var);
+                let init = self.required(var, "expr");
+                Some(match (name, ty, init) {
+                    (Some(name), Some((ty, _)), Some((init, _))) => Some(PortKind::State {
+                        param: param_name(name),
+                        ty,
+                        init,
+                    }),
+                    _ => None,
+                })
+            }
+            "event_var" => {
+                self.check_attrs(var, &["id"]);
+                Some(Some(PortKind::Event))
+            }
+            _ => {
+                self.unknown_child(var, element, "<state_var> or <event_var>");
+                None
             }
         }
     }

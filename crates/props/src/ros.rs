@@ -33,7 +33,7 @@
 use super::error::PropsErrorKind;
 use super::read::FileReader;
 use super::source::{Location, SourceText};
-use super::{Port, PortKind, Property, ANY};
+use super::{Port, Property, ANY};
 use crate::model::xml::Element;
 
 /// The message name of a ROS topic in the translated model: `/a/b` -> `topic_a__b_msg`.
@@ -199,29 +199,10 @@ impl<'a> FileReader<'_, 'a> {
     /// The `<state_var id type field expr>` and `<event_var id>` children of a ROS port.
     fn ros_variables(&mut self, element: &Element, event: &str, ports: &mut Vec<Port>) {
         for var in element.elements() {
-            let kind = match var.name.as_str() {
-                "state_var" => {
-                    self.check_attrs(var, &["id", "type", "field", "expr"]);
-                    let field = self.required_name(var, "field");
-                    let ty = self.declared_type(var);
-                    let init = self.required(var, "expr");
-                    match (field, ty, init) {
-                        (Some(field), Some((ty, _)), Some((init, _))) => Some(PortKind::State {
-                            param: format!("ros_fields__{}", field.replace('.', "__")),
-                            ty,
-                            init,
-                        }),
-                        _ => None,
-                    }
-                }
-                "event_var" => {
-                    self.check_attrs(var, &["id"]);
-                    Some(PortKind::Event)
-                }
-                _ => {
-                    self.unknown_child(var, element, "<state_var> or <event_var>");
-                    continue;
-                }
+            let Some(kind) = self.port_variable(element, var, "field", |field| {
+                format!("ros_fields__{}", field.replace('.', "__"))
+            }) else {
+                continue;
             };
             if let (Some(id), Some(kind)) = (self.required_id(var), kind) {
                 ports.push(Port {

@@ -220,7 +220,7 @@ pub(crate) fn unescape_attribute(
     let mut at = offset;
     while !rest.is_empty() {
         if let Some(decoded) = crate::model::source::reference(rest) {
-            let (decoded, consumed) = decoded.map_err(|message| (at, message))?;
+            let (decoded, consumed) = decoded.map_err(|e| (at, e.to_string()))?;
             let mut buffer = [0u8; 4];
             out.push_exact(decoded.encode_utf8(&mut buffer), lines.location(at));
             rest = &rest[consumed..];

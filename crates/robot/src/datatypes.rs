@@ -209,7 +209,7 @@ fn read_xml(
                     uses.push((t.clone(), fty.value_span));
                     fields.push((fid.value.clone(), t));
                 }
-                Err(msg) => errs.push(sm.diag(fty.value_span, msg)),
+                Err(msg) => errs.push(sm.diag(fty.value_span, msg.to_string())),
             }
         }
         declare(sm, defs, &id, fields, el.span, &mut errs);
@@ -329,8 +329,8 @@ fn json_type(v: &JsonNode) -> Result<TypeExpr, JsonError> {
     Ok(match t {
         "string" => TypeExpr::Base(BaseType::Str),
         "boolean" => TypeExpr::Base(BaseType::Bool),
-        "integer" => TypeExpr::parse("int32").map_err(|m| (tat, m.into()))?,
-        "number" => TypeExpr::parse("float32").map_err(|m| (tat, m.into()))?,
+        "integer" => TypeExpr::parse("int32").map_err(|m| (tat, m.to_string()))?,
+        "number" => TypeExpr::parse("float32").map_err(|m| (tat, m.to_string()))?,
         "array" => {
             let items = v
                 .get("items")

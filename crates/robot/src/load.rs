@@ -32,7 +32,7 @@ pub struct RobotModel {
     /// [`MainFile::warnings`]); a command prints them.
     pub warnings: Vec<Diagnostic>,
     /// Where the behavior tree's runs under AS2FM's node models and under
-    /// BehaviorTree.CPP 4 are known to differ ([`bt::semantics_notes`]); `validate`
+    /// BehaviorTree.CPP 4 are known to differ (`bt::semantics_notes`); `validate`
     /// prints them.
     pub bt_notes: Vec<Diagnostic>,
 }
@@ -165,19 +165,6 @@ pub fn load_with(main_path: &Path, halts: Halts) -> Result<RobotModel, Diagnosti
     .map(|(m, _)| m)
 }
 
-/// [`load`] with the behavior tree lowered under `semantics` (AS2FM's node models, or
-/// BehaviorTree.CPP 4's rules and tick mode; see [`BtSemantics`]).
-pub fn load_bt(main_path: &Path, semantics: BtSemantics) -> Result<RobotModel, Diagnostics> {
-    load_full(
-        main_path,
-        &[],
-        Halts::default(),
-        semantics,
-        &Search::from_env(Vec::new()),
-    )
-    .map(|(m, _)| m)
-}
-
 /// What a node model declares that a process replacing it must speak (topics, services
 /// and actions, either side), or an error at a declaration without its required
 /// attributes.
@@ -196,35 +183,26 @@ fn external_component(
         calls_actions: Vec::new(),
     };
     for el in root.elements() {
-        match el.name.as_str() {
+        // Each declaration's name attribute, and its lists: the side that provides
+        // (publisher, server), then the side that uses (subscriber, client).
+        let (attr, provides, uses) = match el.name.as_str() {
             "ros_topic_publisher" | "ros_topic_subscriber" => {
-                let topic = el.required(sm, "topic")?.value.trim().to_string();
-                let ty = el.required(sm, "type")?.value.trim().to_string();
-                if el.name == "ros_topic_publisher" {
-                    c.publishes.push((topic, ty));
-                } else {
-                    c.subscribes.push((topic, ty));
-                }
+                ("topic", &mut c.publishes, &mut c.subscribes)
             }
             "ros_service_server" | "ros_service_client" => {
-                let service = el.required(sm, "service_name")?.value.trim().to_string();
-                let ty = el.required(sm, "type")?.value.trim().to_string();
-                if el.name == "ros_service_server" {
-                    c.serves.push((service, ty));
-                } else {
-                    c.calls.push((service, ty));
-                }
+                ("service_name", &mut c.serves, &mut c.calls)
             }
             "ros_action_server" | "ros_action_client" => {
-                let action = el.required(sm, "action_name")?.value.trim().to_string();
-                let ty = el.required(sm, "type")?.value.trim().to_string();
-                if el.name == "ros_action_server" {
-                    c.serves_actions.push((action, ty));
-                } else {
-                    c.calls_actions.push((action, ty));
-                }
+                ("action_name", &mut c.serves_actions, &mut c.calls_actions)
             }
-            _ => {}
+            _ => continue,
+        };
+        let key = el.required(sm, attr)?.value.trim().to_string();
+        let ty = el.required(sm, "type")?.value.trim().to_string();
+        if el.name.ends_with("_publisher") || el.name.ends_with("_server") {
+            provides.push((key, ty));
+        } else {
+            uses.push((key, ty));
         }
     }
     Ok(c)

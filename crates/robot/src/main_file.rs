@@ -58,7 +58,7 @@ pub const DEFAULT_BT_TICK_RATE_HZ: f64 = 1.0;
 pub const DEFAULT_BT_TICK_IF_NOT_RUNNING: bool = false;
 
 /// The length bound of unbounded arrays AS2FM uses when `max_array_size` is absent.
-pub const DEFAULT_MAX_ARRAY_SIZE: u32 = 100;
+pub(crate) const DEFAULT_MAX_ARRAY_SIZE: u32 = 100;
 
 /// Which of the two main file formats a file is written in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -172,7 +172,7 @@ impl Parameters {
     }
 
     /// The tick rate in Hz, or the default.
-    pub fn bt_tick_rate_hz(&self) -> f64 {
+    pub(crate) fn bt_tick_rate_hz(&self) -> f64 {
         self.bt_tick_rate
             .as_ref()
             .map_or(DEFAULT_BT_TICK_RATE_HZ, |p| p.value.hz)
@@ -535,7 +535,7 @@ impl<'a> Reader<'a> {
                         )),
                         Some(unit) => match duration::decimal_times(v, unit.nanos()) {
                             Ok(ns) => p.max_time_ns = Some(Param { value: ns, span }),
-                            Err(m) => self.errs.push(sm.diag(span, m)),
+                            Err(m) => self.errs.push(sm.diag(span, m.to_string())),
                         },
                     }
                 }
@@ -561,7 +561,7 @@ impl<'a> Reader<'a> {
                     }
                     match tick_rate(v) {
                         Ok(t) => p.bt_tick_rate = Some(Param { value: t, span }),
-                        Err(m) => self.errs.push(sm.diag(span, m)),
+                        Err(e) => self.errs.push(sm.diag(span, e.to_string())),
                     }
                 }
                 _ => {
@@ -675,7 +675,11 @@ impl<'a> Reader<'a> {
     }
 }
 
-fn tick_rate(text: &str) -> Result<TickRate, String> {
+fn tick_rate(text: &str) -> Result<TickRate, TickRateError> {
+    let refuse = |why| TickRateError {
+        text: text.to_string(),
+        why,
+    };
     match rate::period(text) {
         Ok(RatePeriod {
             hz,
@@ -689,25 +693,57 @@ fn tick_rate(text: &str) -> Result<TickRate, String> {
         // The model's time step is the greatest common divisor of its periods: a period
         // rounded to the nanosecond would make it 1 ns, and every run would end at the
         // step limit with no verdict. Refused here, at the attribute, instead.
-        Ok(p) => Err(format!(
-            "bt_tick_rate `{text}` ticks every {:.3} ns, not a whole number of \
-             nanoseconds: the model's time step would shrink to 1 ns and every run would \
-             stop at the step limit; use a rate whose period is whole, such as 2, 4, 5, \
-             10 or 0.5 ticks per second",
-            1e9 / p.hz
-        )),
-        Err(RateError::NotPositive) => Err(format!(
-            "bt_tick_rate must be a positive number of ticks per second, not `{text}`"
-        )),
-        Err(RateError::FasterThanNs) => Err(format!(
-            "bt_tick_rate `{text}` is faster than one tick per nanosecond"
-        )),
-        Err(RateError::TooSlow) => Err(format!(
-            "bt_tick_rate `{text}` is slower than the slowest rate hindsight can time \
-             (one tick per 2^64 ns, about 584 years)"
-        )),
+        Ok(p) => Err(refuse(TickRateWhy::Fraction(p.hz))),
+        Err(e) => Err(refuse(TickRateWhy::Rate(e))),
     }
 }
+
+/// A `bt_tick_rate` refused: the text, and why.
+#[derive(Clone, Debug, PartialEq)]
+struct TickRateError {
+    text: String,
+    why: TickRateWhy,
+}
+
+/// Why a `bt_tick_rate` was refused.
+#[derive(Clone, Debug, PartialEq)]
+enum TickRateWhy {
+    /// The rate reader's error.
+    Rate(RateError),
+    /// The rate, in hertz, of a period that is not a whole number of nanoseconds.
+    Fraction(f64),
+}
+
+impl std::fmt::Display for TickRateError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let text = &self.text;
+        match self.why {
+            TickRateWhy::Fraction(hz) => write!(
+                f,
+                "bt_tick_rate `{text}` ticks every {:.3} ns, not a whole number of \
+                 nanoseconds: the model's time step would shrink to 1 ns and every run would \
+                 stop at the step limit; use a rate whose period is whole, such as 2, 4, 5, \
+                 10 or 0.5 ticks per second",
+                1e9 / hz
+            ),
+            TickRateWhy::Rate(RateError::NotPositive) => write!(
+                f,
+                "bt_tick_rate must be a positive number of ticks per second, not `{text}`"
+            ),
+            TickRateWhy::Rate(RateError::FasterThanNs) => write!(
+                f,
+                "bt_tick_rate `{text}` is faster than one tick per nanosecond"
+            ),
+            TickRateWhy::Rate(RateError::TooSlow) => write!(
+                f,
+                "bt_tick_rate `{text}` is slower than the slowest rate hindsight can time \
+                 (one tick per 2^64 ns, about 584 years)"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for TickRateError {}
 
 #[cfg(test)]
 mod tests {
@@ -722,8 +758,14 @@ mod tests {
         let t = tick_rate("1e1").unwrap();
         assert_eq!((t.period_ns, t.exact), (100_000_000, true));
         // A period that is no whole number of nanoseconds, or does not fit in 64 bits.
-        assert!(tick_rate("3").unwrap_err().contains("333333333.333 ns"));
-        assert!(tick_rate("1e-12").unwrap_err().contains("584 years"));
+        assert!(tick_rate("3")
+            .unwrap_err()
+            .to_string()
+            .contains("333333333.333 ns"));
+        assert!(tick_rate("1e-12")
+            .unwrap_err()
+            .to_string()
+            .contains("584 years"));
         assert!(tick_rate("0").is_err());
         assert!(tick_rate("-1").is_err());
         assert!(tick_rate("fast").is_err());

@@ -47,7 +47,7 @@ pub fn ln_gamma(x: f64) -> f64 {
 }
 
 /// Natural logarithm of the beta function `B(a, b) = Γ(a) Γ(b) / Γ(a + b)`.
-pub fn ln_beta(a: f64, b: f64) -> f64 {
+pub(crate) fn ln_beta(a: f64, b: f64) -> f64 {
     ln_gamma(a) + ln_gamma(b) - ln_gamma(a + b)
 }
 

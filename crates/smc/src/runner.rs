@@ -282,7 +282,7 @@ impl Default for StudyConfig {
 
 impl StudyConfig {
     /// The number of worker threads this configuration asks for.
-    pub fn thread_count(&self) -> usize {
+    pub(crate) fn thread_count(&self) -> usize {
         if self.threads > 0 {
             self.threads
         } else {

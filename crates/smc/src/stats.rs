@@ -539,7 +539,7 @@ impl Sprt {
 
     /// The log-likelihood ratio `ln(L(p1) / L(p0))`; `NaN` when the counts are
     /// impossible under both hypotheses.
-    pub fn log_likelihood_ratio(&self, successes: u64, runs: u64) -> f64 {
+    pub(crate) fn log_likelihood_ratio(&self, successes: u64, runs: u64) -> f64 {
         let e = self.accuracy.precision;
         let p0 = (self.threshold + e).min(1.0);
         let p1 = (self.threshold - e).max(0.0);

@@ -51,7 +51,7 @@ pub struct LoadOptions {
 
 /// The event semantics for a property file when none is asked for: AS2FM's for a JANI
 /// property file (the model is then AS2FM's plain SCXML), SCAN's queues otherwise.
-pub fn default_events(props_path: &Path) -> EventSemantics {
+pub(crate) fn default_events(props_path: &Path) -> EventSemantics {
     if is_jani(props_path) {
         EventSemantics::As2fm
     } else {

@@ -126,39 +126,34 @@ pub fn spec_input(
     let mut decls = Vec::new();
     for p in &props.ports {
         let at = origin(p.at.line, p.at.column);
-        let (kind, type_name, init) = match &p.kind {
-            PortKind::Event => (VarKind::Event, "bool".to_string(), None),
-            PortKind::Sent => (
+        // A part or state port's declared type, as the spec language names it.
+        let declared = match &p.kind {
+            PortKind::Part { ty, .. } | PortKind::State { ty, .. } => match spec_type(ty) {
+                Some(t) => Some((ty, t)),
+                None => {
+                    errors.push(Diagnostic::error(
+                        file.as_str(),
+                        (p.at.line, p.at.column),
+                        format!("port `{}`: unsupported type `{ty}`", p.id),
+                    ));
+                    continue;
+                }
+            },
+            PortKind::Event | PortKind::Sent => None,
+        };
+        let (kind, type_name, init) = match (&p.kind, declared) {
+            (PortKind::Sent, _) => (
                 VarKind::State,
                 "bool".to_string(),
                 Some("false".to_string()),
             ),
-            PortKind::Part { ty, .. } => match spec_type(ty) {
-                Some(t) => (VarKind::State, t.to_string(), None),
-                None => {
-                    errors.push(Diagnostic::error(
-                        file.as_str(),
-                        (p.at.line, p.at.column),
-                        format!("port `{}`: unsupported type `{ty}`", p.id),
-                    ));
-                    continue;
-                }
-            },
-            PortKind::State { ty, init, param } => match spec_type(ty) {
-                Some(t) => (
-                    VarKind::State,
-                    state_type(p, param, ty, t).to_string(),
-                    Some(init.as_str().to_string()),
-                ),
-                None => {
-                    errors.push(Diagnostic::error(
-                        file.as_str(),
-                        (p.at.line, p.at.column),
-                        format!("port `{}`: unsupported type `{ty}`", p.id),
-                    ));
-                    continue;
-                }
-            },
+            (PortKind::Part { .. }, Some((_, t))) => (VarKind::State, t.to_string(), None),
+            (PortKind::State { init, param, .. }, Some((ty, t))) => (
+                VarKind::State,
+                state_type(p, param, ty, t).to_string(),
+                Some(init.as_str().to_string()),
+            ),
+            _ => (VarKind::Event, "bool".to_string(), None),
         };
         decls.push(DeclInput {
             kind,

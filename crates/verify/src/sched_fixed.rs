@@ -15,7 +15,7 @@
 //!    rounds as the sequential study ranks by);
 //! 3. the confirmation: runs `0..R` of each candidate on the estimate seed, a fixed-size
 //!    study per candidate, its interval that of the rule at the split confidence
-//!    ([`super::schedulers::split_rule`]), as in the sequential study but with `R` runs
+//!    (`schedulers::split_rule`), as in the sequential study but with `R` runs
 //!    instead of the rule's stopping point (a stopping point is a sequential decision that
 //!    one shard cannot take alone).
 //!
@@ -141,8 +141,10 @@ pub enum StageError {
     Missing(Vec<Shard>),
     /// A part whose counts its runs cannot give (what is wrong).
     Counts(Shard, String),
-    /// The model failed during a run (its message).
-    Model(String),
+    /// The model failed during a run.
+    Model(crate::study::ModelFailure),
+    /// A run failed and left no message.
+    Silent,
     /// The study is done: there is no stage left to run.
     Done,
 }
@@ -175,6 +177,7 @@ impl std::fmt::Display for StageError {
             }
             StageError::Counts(s, m) => write!(f, "shard {s} has counts its runs cannot give: {m}"),
             StageError::Model(m) => write!(f, "{m}"),
+            StageError::Silent => write!(f, "a run failed without a message"),
             StageError::Done => write!(f, "the plan's study is done: no stage is left to run"),
         }
     }
@@ -499,7 +502,7 @@ pub fn run_stage(
             why = runner.unfair_run(&sched);
             if why.is_none() {
                 runner.finish().map_err(StageError::Model)?;
-                return Err(StageError::Model("a run failed without a message".into()));
+                return Err(StageError::Silent);
             }
         }
         results.push((j, range, got, why));

@@ -326,7 +326,7 @@ impl Selection {
     }
 
     /// Leaves scheduler `i` out (unfair): off every side, no more runs.
-    pub fn leave_out(&mut self, i: usize) {
+    pub(crate) fn leave_out(&mut self, i: usize) {
         for side in self.sides.iter_mut().flatten() {
             side.retain(|&j| j != i);
         }
@@ -344,7 +344,7 @@ impl Selection {
     }
 
     /// Adds the counts of scheduler `i`'s runs of the current round.
-    pub fn absorb(&mut self, i: usize, got: &[PropertyCounts]) {
+    pub(crate) fn absorb(&mut self, i: usize, got: &[PropertyCounts]) {
         for (c, g) in self.counts[i].iter_mut().zip(got) {
             c.add(g);
         }
@@ -353,7 +353,7 @@ impl Selection {
 
     /// Ends the round: per property, keeps the lower and the upper half of each side
     /// (at least [`CANDIDATES`]) by the counts so far, ties by index.
-    pub fn halve(&mut self) {
+    pub(crate) fn halve(&mut self) {
         let counts = &self.counts;
         for (p, [low, high]) in self.sides.iter_mut().enumerate() {
             let rate = |i: &usize| {
@@ -438,7 +438,7 @@ pub fn split_count(sides: &[[Vec<usize>; 2]]) -> usize {
 
 /// The confidence of each fresh estimate: `1 - (1 - c) / m` over `m` intervals
 /// ([`split_count`]; Bonferroni's inequality).
-pub fn split_rule(rule: &RuleConfig, m: usize) -> RuleConfig {
+pub(crate) fn split_rule(rule: &RuleConfig, m: usize) -> RuleConfig {
     RuleConfig {
         confidence: 1.0 - (1.0 - rule.confidence) / m.max(1) as f64,
         ..*rule
@@ -448,8 +448,8 @@ pub fn split_rule(rule: &RuleConfig, m: usize) -> RuleConfig {
 /// Why [`bounds`] failed.
 #[derive(Debug)]
 pub enum BoundsError {
-    /// The model failed during a run (its message).
-    Model(String),
+    /// The model failed during a run.
+    Model(crate::study::ModelFailure),
     /// A run of this phase failed and left no message.
     Silent(&'static str),
     /// The stopping rule is invalid.
@@ -688,31 +688,36 @@ pub fn bounds(
                     [r.interval.lower, r.interval.upper],
                 )))
             };
-            let mut kinds = vec![(
-                "machine",
-                PutBack {
-                    machines: true,
-                    ..PutBack::default()
-                },
-            )];
-            if run_cfg.events == EventSemantics::As2fm {
-                kinds.push((
+            // Each choice put back to uniform, where the run's semantics makes it one.
+            let none = PutBack::default();
+            let kinds = [
+                (
+                    "machine",
+                    true,
+                    PutBack {
+                        machines: true,
+                        ..none
+                    },
+                ),
+                (
                     "delivery",
+                    run_cfg.events == EventSemantics::As2fm,
                     PutBack {
                         events: true,
-                        ..PutBack::default()
+                        ..none
                     },
-                ));
-            }
-            if run_cfg.transitions == TransitionChoice::Random {
-                kinds.push((
+                ),
+                (
                     "transition",
+                    run_cfg.transitions == TransitionChoice::Random,
                     PutBack {
                         transitions: true,
-                        ..PutBack::default()
+                        ..none
                     },
-                ));
-            }
+                ),
+            ]
+            .into_iter()
+            .filter_map(|(choice, made, uniform)| made.then_some((choice, uniform)));
             for (choice, uniform) in kinds {
                 let (probability, interval) = match estimate(uniform) {
                     Ok(Some(x)) => x,

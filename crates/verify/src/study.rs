@@ -11,7 +11,7 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::observe::{Judge, PropertySet};
 use crate::sim::{CompiledModel, EndReason, RunConfig, Scheduler, Simulator, SpinKind};
-use crate::smc::stats::RuleConfig;
+use crate::smc::stats::{RuleConfig, StatsError};
 use crate::smc::{
     run_study_until, Progress, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict,
 };
@@ -25,7 +25,7 @@ pub fn study(
     study_cfg: &StudyConfig,
     rule: &RuleConfig,
     progress: &mut dyn FnMut(&Progress<'_>),
-) -> Result<StudyResult, String> {
+) -> Result<StudyResult, StudyError> {
     study_until(
         model,
         set,
@@ -47,13 +47,13 @@ pub fn study_until(
     rule: &RuleConfig,
     progress: &mut dyn FnMut(&Progress<'_>),
     stop: &AtomicBool,
-) -> Result<StudyResult, String> {
+) -> Result<StudyResult, StudyError> {
     let rules = set
         .guarantee_names()
         .iter()
         .map(|_| rule.build())
         .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| format!("statistics: {e}"))?;
+        .map_err(StudyError::Rule)?;
     let runner = Runner::new(model, set, run_cfg);
     let result = run_study_until(
         study_cfg,
@@ -62,9 +62,54 @@ pub fn study_until(
         progress,
         stop,
     );
-    runner.finish()?;
+    runner.finish().map_err(StudyError::Model)?;
     Ok(result)
 }
+
+/// Why a [`study`] gave no result.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StudyError {
+    /// The stopping rule is invalid.
+    Rule(StatsError),
+    /// The model failed during a run (bad input: the model's fault).
+    Model(ModelFailure),
+}
+
+impl std::fmt::Display for StudyError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            StudyError::Rule(e) => write!(f, "statistics: {e}"),
+            StudyError::Model(m) => write!(f, "{m}"),
+        }
+    }
+}
+
+impl std::error::Error for StudyError {}
+
+/// The first model failure a [`Runner`]'s runs met (a spin, a run-time error, a value
+/// the monitors cannot take): the run, its scheduler, and what went wrong.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ModelFailure {
+    /// The run's index.
+    pub run: u64,
+    /// The scheduler it ran under.
+    pub scheduler: Scheduler,
+    /// What went wrong, as the simulator or the judge says it.
+    pub what: String,
+}
+
+impl std::fmt::Display for ModelFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "the model failed during simulation: run {}", self.run)?;
+        if self.scheduler != Scheduler::Uniform {
+            // A failure names the scheduler when it is not the uniform one.
+            write!(f, " (scheduler {})", self.scheduler)?;
+        }
+        write!(f, ": {}", self.what)
+    }
+}
+
+impl std::error::Error for ModelFailure {}
 
 /// Runs one simulation with its judge: the run function every study shares.
 ///
@@ -75,7 +120,7 @@ pub struct Runner<'m> {
     set: &'m PropertySet,
     run_cfg: &'m RunConfig,
     pool: Mutex<Vec<(Simulator<'m>, Judge<'m>)>>,
-    failure: Mutex<Option<String>>,
+    failure: Mutex<Option<ModelFailure>>,
     /// What a run that blocks time under a sampled scheduler does (see [`Unfair`]).
     unfair: Unfair,
     /// Per sampled scheduler, its first unfair run (lowest index) and why.
@@ -118,7 +163,7 @@ impl<'m> Runner<'m> {
     }
 
     /// This runner with `unfair` for runs that block time under a sampled scheduler.
-    pub fn with_unfair(mut self, unfair: Unfair) -> Self {
+    pub(crate) fn with_unfair(mut self, unfair: Unfair) -> Self {
         self.unfair = unfair;
         self
     }
@@ -136,7 +181,7 @@ impl<'m> Runner<'m> {
     }
 
     /// Run `k` with its stream under `scheduler` instead of the configuration's.
-    pub fn run_under(
+    pub(crate) fn run_under(
         &self,
         k: u64,
         rng: &mut Xoshiro256PlusPlus,
@@ -169,8 +214,11 @@ impl<'m> Runner<'m> {
                 };
                 sim.run(rng, &cfg, &mut judge)
             };
-            // A failure names the scheduler when it is not the uniform one.
-            let k = RunName(k, scheduler);
+            let failed = |what: String| ModelFailure {
+                run: k,
+                scheduler,
+                what,
+            };
             let end = match &out.end {
                 EndReason::Quiescent => Some(RunEnd::Quiescent),
                 EndReason::MaxTime => Some(RunEnd::TimeHorizon),
@@ -190,24 +238,24 @@ impl<'m> Runner<'m> {
                                 .or_insert((u64::MAX, String::new()));
                             // The lowest index: the run a study consuming in order meets
                             // first, whatever ran ahead on other threads.
-                            if k.0 < slot.0 {
-                                *slot = (k.0, s.to_string());
+                            if k < slot.0 {
+                                *slot = (k, s.to_string());
                             }
                         }
                         None
                     }
                 }
                 EndReason::Spin(s) => {
-                    record(&self.failure, format!("run {k}: {s}"));
+                    record(&self.failure, failed(s.to_string()));
                     None
                 }
                 EndReason::Error(e) => {
-                    record(&self.failure, format!("run {k}: {e}"));
+                    record(&self.failure, failed(e.to_string()));
                     None
                 }
             };
             if let Some(err) = &judge.error {
-                record(&self.failure, format!("run {k}: {err}"));
+                record(&self.failure, failed(err.clone()));
             }
             match end {
                 Some(end) if judge.error.is_none() => judge.outcome(end, out.steps, out.time),
@@ -221,30 +269,17 @@ impl<'m> Runner<'m> {
     }
 
     /// The first model failure any run met, as a bad-input error.
-    pub fn finish(self) -> Result<(), String> {
+    pub fn finish(self) -> Result<(), ModelFailure> {
         match self.failure.into_inner().ok().flatten() {
-            Some(msg) => Err(format!("the model failed during simulation: {msg}")),
+            Some(failure) => Err(failure),
             None => Ok(()),
         }
     }
 }
 
 /// Keeps the first failure.
-fn record(slot: &Mutex<Option<String>>, msg: String) {
+fn record(slot: &Mutex<Option<ModelFailure>>, failure: ModelFailure) {
     if let Ok(mut s) = slot.lock() {
-        s.get_or_insert(msg);
-    }
-}
-
-/// A run as a failure message names it: its index, and its scheduler unless uniform
-/// (formatted only when a failure is recorded).
-struct RunName(u64, Scheduler);
-
-impl std::fmt::Display for RunName {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.1 {
-            Scheduler::Uniform => write!(f, "{}", self.0),
-            s => write!(f, "{} (scheduler {s})", self.0),
-        }
+        s.get_or_insert(failure);
     }
 }

@@ -323,7 +323,7 @@ pub fn study(
 ) -> Result<StudyResult, CliError> {
     let mut bar = progress_bar(show_progress);
     crate::verify::study::study(model, set, run_cfg, study_cfg, rule, &mut |p| bar.update(p))
-        .map_err(CliError::Input)
+        .map_err(|e| CliError::Input(e.to_string()))
 }
 
 /// The progress bar of a study on standard error, or none (`--json`): the library reports
@@ -619,7 +619,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         &mut |p| bar.update(p),
         interrupt_flag(),
     )
-    .map_err(CliError::Input)?;
+    .map_err(|e| CliError::Input(e.to_string()))?;
     if result.interrupted && (args.save_failing > 0 || args.report.is_some()) {
         eprintln!("interrupted: --save-failing and --report are not written for a partial study");
     }

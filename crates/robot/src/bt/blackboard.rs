@@ -82,19 +82,19 @@ pub(crate) struct Blackboard {
 
 impl Blackboard {
     /// The entry called `name`.
-    pub fn entry(&self, name: &str) -> Option<&Entry> {
+    pub(crate) fn entry(&self, name: &str) -> Option<&Entry> {
         self.entries.iter().find(|e| e.name == name)
     }
 
     /// Records that `machine` reads the blackboard.
-    pub fn add_reader(&mut self, machine: &str) {
+    pub(crate) fn add_reader(&mut self, machine: &str) {
         if !self.readers.iter().any(|r| r == machine) {
             self.readers.push(machine.to_string());
         }
     }
 
     /// The blackboard machine, or `None` when the tree uses no entry.
-    pub fn machine(&self, b: B) -> Option<Element> {
+    pub(crate) fn machine(&self, b: B) -> Option<Element> {
         if self.entries.is_empty() && self.scripts.is_empty() && self.updated.is_empty() {
             return None;
         }
@@ -217,19 +217,41 @@ pub(crate) fn set_blackboard(ctx: &Ctx, entry: &str, value: &str) -> Element {
 /// own `NodeStatus` numbers differ (0 IDLE, 1 RUNNING, 2 SUCCESS, 3 FAILURE, 4 SKIPPED;
 /// `test_node.cpp`, `createTestNodeEnums`), but its `convertFromString<NodeStatus>` takes
 /// names only, so a number in a tree can only be AS2FM's.
-pub(crate) fn parse_status(v: &str) -> Result<u8, String> {
+pub(crate) fn parse_status(v: &str) -> Result<u8, BadStatus> {
     match v.trim() {
         "SUCCESS" | "1" => Ok(SUCCESS),
         "FAILURE" | "2" => Ok(FAILURE),
         "RUNNING" | "3" => Ok(RUNNING),
-        s @ ("IDLE" | "SKIPPED" | "0" | "4") => Err(format!(
-            "`{s}` is not a status a node can answer: write SUCCESS, FAILURE or RUNNING (or AS2FM's 1, 2, 3)"
-        )),
-        s => Err(format!(
-            "`{s}` is not a status: write SUCCESS, FAILURE or RUNNING (or AS2FM's numbers 1 SUCCESS, 2 FAILURE, 3 RUNNING)"
-        )),
+        s @ ("IDLE" | "SKIPPED" | "0" | "4") => Err(BadStatus::NotAnAnswer(s.to_string())),
+        s => Err(BadStatus::Unknown(s.to_string())),
     }
 }
+
+/// Why [`parse_status`] refused a status (the text, trimmed).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) enum BadStatus {
+    /// A status of BT.CPP's that no node answers (`IDLE`, `SKIPPED`, 0, 4).
+    NotAnAnswer(String),
+    /// No status at all.
+    Unknown(String),
+}
+
+impl std::fmt::Display for BadStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BadStatus::NotAnAnswer(s) => write!(
+                f,
+                "`{s}` is not a status a node can answer: write SUCCESS, FAILURE or RUNNING (or AS2FM's 1, 2, 3)"
+            ),
+            BadStatus::Unknown(s) => write!(
+                f,
+                "`{s}` is not a status: write SUCCESS, FAILURE or RUNNING (or AS2FM's numbers 1 SUCCESS, 2 FAILURE, 3 RUNNING)"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for BadStatus {}
 
 /// The type AS2FM gives constant `v` (see the module comment), or `string`.
 pub(crate) fn literal_type(v: &str) -> &'static str {

@@ -1,6 +1,7 @@
 //! The machines of the nodes whose BehaviorTree.CPP 4 rules differ from AS2FM's models
-//! ([`super::BtSemantics::Btcpp`]): SequenceWithMemory, Parallel, Repeat,
-//! RetryUntilSuccessful, and the root machine under `tickOnce`.
+//! ([`super::BtSemantics::Btcpp`]): SequenceWithMemory, Parallel, Repeat and
+//! RetryUntilSuccessful; the root machine under `tickOnce` is `control.rs`'s
+//! `root_machine` with the wake-up signal.
 //!
 //! The other built-in nodes keep AS2FM's machines, with every child's halt conditional on
 //! the child having last answered RUNNING (`child_<i>_running`, the `WhenRunning` rule
@@ -29,10 +30,9 @@
 //! did not reset is a two-child IfThenElse whose condition failed (`parallel.rs`,
 //! `if_then_else`).
 
-use super::build::B;
 use super::control::{
-    format_rate, init_state, n_children, on_child_skipped, Ctx, FAILURE, IS_SKIPPED, RUNNING,
-    SKIPPED_RUNNING, SKIP_COUNT, SUCCESS,
+    index_out_of_range, init_state, n_children, on_child_skipped, skip_to_next, Ctx, FAILURE,
+    IS_SKIPPED, RUNNING, SKIPPED_RUNNING, SKIP_COUNT, SUCCESS,
 };
 use crate::model::xml::Element;
 
@@ -40,7 +40,7 @@ use crate::model::xml::Element;
 pub(crate) const WAKE_UP: &str = "bt_wake_up";
 
 /// The root machine's flag: a wake-up signal is pending.
-const WAKE_PENDING: &str = "wake_pending";
+pub(super) const WAKE_PENDING: &str = "wake_pending";
 
 /// The variable naming child `i`'s RUNNING flag (every child has one under BT.CPP's
 /// rules).
@@ -128,12 +128,7 @@ pub(super) fn sequence_with_memory(ctx: &Ctx) -> Element {
     // 4.10 `SequenceWithMemory::tick`, `case NodeStatus::SKIPPED`: on to the next child,
     // counted in `skipped_count_` (cleared when the node starts IDLE: after it finished,
     // was halted, or failed and was reset by its parent).
-    on_child_skipped(ctx, &mut t, idx, "tick_children", || {
-        vec![
-            b.assign(idx, &format!("{idx} + 1")),
-            b.assign(SKIP_COUNT, &format!("{SKIP_COUNT} + 1")),
-        ]
-    });
+    skip_to_next(ctx, &mut t, idx, "tick_children");
     for i in 0..ctx.children.len() {
         let r = running(ctx, i);
         let resp = ctx.child_resp(i);
@@ -175,12 +170,7 @@ pub(super) fn sequence_with_memory(ctx: &Ctx) -> Element {
         Some("halting_on_success"),
         vec![b.assign(h, "0")],
     ));
-    t.push(b.tr(
-        None,
-        Some(&format!("{idx} < 0 || {idx} > children_count")),
-        Some("error"),
-        vec![],
-    ));
+    t.push(index_out_of_range(ctx, idx));
     m.push(t);
     // Every child skipped: SKIPPED (the node set itself RUNNING first).
     let all_skipped = b
@@ -239,32 +229,7 @@ pub(super) fn repeat(ctx: &Ctx, n: i64, retry: bool) -> Element {
         (SUCCESS, FAILURE)
     };
     let r = running(ctx, 0);
-    let mut m = b.scxml(&ctx.machine, "init");
-    m.push(b.datamodel(&[
-        ("children_count", "int8", n_children(ctx)),
-        (count, "int8", "0".into()),
-        (limit, "int8", n.to_string()),
-        (r.as_str(), "bool", "false".into()),
-    ]));
-    m.push(init_state(ctx, "children_count != 1"));
-    let mut w = b.state("wait_for_tick").with_child(b.tr(
-        Some(&ctx.tick_ev()),
-        None,
-        Some("start_tick"),
-        vec![],
-    ));
-    for t in ctx.halt_single("halting_child", vec![b.assign(count, "0")]) {
-        w.push(t);
-    }
-    m.push(w);
-    let mut halting = ctx.halt_child_body(0);
-    halting.push(b.assign(count, "0"));
-    m.push(b.state_entry("halting_child", halting).with_child(b.tr(
-        Some(&ctx.child_halt_resp(0)),
-        None,
-        Some("wait_for_tick"),
-        vec![ctx.respond_halted()],
-    )));
+    let mut m = super::decorators::repeat_head(ctx, count, limit, n, "start_tick");
     // `do_loop = count < limit || limit == -1`, checked before every attempt.
     m.push(
         b.state("start_tick")
@@ -518,73 +483,6 @@ pub(super) fn parallel(ctx: &Ctx, success: i64, failure: i64, success_neg: bool)
         finish.push(answer);
         m.push(halting_state(ctx, state, h, finish));
     }
-    m.push(b.state("error"));
-    m
-}
-
-/// The root machine under `tickOnce`: AS2FM's root machine (`control.rs`,
-/// `root_machine`) plus the wake-up signal: `bt_wake_up` sets `wake_pending` in any
-/// state; a RUNNING answer while it is set clears it and ticks the root again at once
-/// (BT.CPP 4 `bt_factory.cpp`, `Tree::tickRoot`, the inner `while` over
-/// `wake_up_->waitFor(0)`, which clears the signal it takes). A finished answer leaves
-/// the signal pending: `waitFor` is only called after a RUNNING one.
-pub(super) fn root_machine(
-    b: B,
-    name: &str,
-    timer: &str,
-    rate_hz: f64,
-    root: (&str, &str),
-    tick_if_not_running: bool,
-) -> Element {
-    let (id, machine) = root;
-    let resp = format!("bt_{id}_response");
-    let tick = || b.send(&format!("bt_{id}_tick"), machine);
-    let wake = || {
-        b.tr(
-            Some(WAKE_UP),
-            None,
-            None,
-            vec![b.assign(WAKE_PENDING, "true")],
-        )
-    };
-    let mut m = b.scxml(name, "idle");
-    m.push(b.datamodel(&[(WAKE_PENDING, "bool", "false".into())]));
-    m.push(b.el(
-        "ros_time_rate",
-        &[("name", timer), ("rate_hz", &format_rate(rate_hz))],
-    ));
-    let mut cb = b.el(
-        "ros_rate_callback",
-        &[("name", timer), ("target", "wait_tick_res")],
-    );
-    cb.push(tick());
-    m.push(
-        b.state("idle")
-            .with_child(cb)
-            .with_child(wake())
-            .with_child(b.tr(Some(&resp), None, Some("error"), vec![])),
-    );
-    let mut w = b.state("wait_tick_res").with_child(wake()).with_child(b.tr(
-        Some(&resp),
-        Some(&format!(
-            "_event.data.status == {RUNNING} && {WAKE_PENDING}"
-        )),
-        Some("wait_tick_res"),
-        vec![b.assign(WAKE_PENDING, "false"), tick()],
-    ));
-    if tick_if_not_running {
-        w.push(b.tr(Some(&resp), None, Some("idle"), vec![]));
-    } else {
-        w.push(b.tr(
-            Some(&resp),
-            Some(&format!("_event.data.status == {RUNNING}")),
-            Some("idle"),
-            vec![],
-        ));
-        w.push(b.tr(Some(&resp), None, Some("done"), vec![]));
-    }
-    m.push(w);
-    m.push(b.state("done").with_child(wake()));
     m.push(b.state("error"));
     m
 }

@@ -17,8 +17,8 @@ use super::blackboard::Blackboard;
 use super::btcpp::{halting_state, running, yield_running};
 use super::btcpp4_skip::SELF_RUNNING;
 use super::control::{
-    init_state, n_children, on_child_skipped, Ctx, FAILURE, IS_SKIPPED, RUNNING, SKIPPED,
-    SKIPPED_RUNNING, SKIP_COUNT, SUCCESS,
+    index_out_of_range, init_state, n_children, on_child_skipped, skip_to_next, Ctx, FAILURE,
+    IS_SKIPPED, RUNNING, SKIPPED, SKIPPED_RUNNING, SKIP_COUNT, SUCCESS,
 };
 use super::tree::{Btcpp4, PortValue, ScriptNode, TreeNode};
 use crate::model::source::{Diagnostic, SourceMap};
@@ -309,24 +309,14 @@ pub(super) fn async_sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
         ));
     }
     // `case NodeStatus::SKIPPED`: on to the next child, counted (`skipped_count_`).
-    on_child_skipped(ctx, &mut t, idx, "tick_children", || {
-        vec![
-            b.assign(idx, &format!("{idx} + 1")),
-            b.assign(SKIP_COUNT, &format!("{SKIP_COUNT} + 1")),
-        ]
-    });
+    skip_to_next(ctx, &mut t, idx, "tick_children");
     t.push(b.tr(
         None,
         Some(&format!("{idx} == children_count")),
         Some("halting_on_cont"),
         vec![b.assign(h, "0")],
     ));
-    t.push(b.tr(
-        None,
-        Some(&format!("{idx} < 0 || {idx} > children_count")),
-        Some("error"),
-        vec![],
-    ));
+    t.push(index_out_of_range(ctx, idx));
     m.push(t);
     // Every child skipped answers SKIPPED (the node set itself RUNNING first).
     let on_cont = b
@@ -666,18 +656,7 @@ pub(super) fn while_do_else(ctx: &Ctx) -> Element {
     let mut t = b.state_entry("tick_branch", vec![ctx.dispatch("branch", false)]);
     for i in 1..ctx.children.len() {
         let r = running(ctx, i);
-        for s in [SUCCESS, FAILURE] {
-            t.push(b.tr(
-                Some(&ctx.child_resp(i)),
-                Some(&format!("_event.data.status == {s} && branch == {i}")),
-                Some("halting_when_done"),
-                vec![
-                    b.assign(&r, "false"),
-                    b.assign("result", &s.to_string()),
-                    b.assign(h, "0"),
-                ],
-            ));
-        }
+        push_child_done(ctx, &mut t, "branch", i, h);
         t.push(b.tr(
             Some(&ctx.child_resp(i)),
             Some(&format!("_event.data.status == {RUNNING} && branch == {i}")),
@@ -795,6 +774,27 @@ pub(super) enum SwitchPick {
 /// and is not the one picked is halted first (`haltChild(running_child_)`); RUNNING
 /// remembers the child, a finished answer resets every child and forgets it.
 /// `SwitchNode::halt` forgets it and resets the children.
+/// Into state `t` of a node that ticks the one child `chosen` names: the transitions on
+/// child `i`'s SUCCESS and FAILURE, each the node's result, the child no longer running,
+/// then `halting_when_done` with halt index `h` from 0 (`WhileDoElseNode::tick`,
+/// `SwitchNode::tick`: a finished branch is the answer, the other children halted).
+fn push_child_done(ctx: &Ctx, t: &mut Element, chosen: &str, i: usize, h: &str) {
+    let b = &ctx.b;
+    let r = running(ctx, i);
+    for s in [SUCCESS, FAILURE] {
+        t.push(b.tr(
+            Some(&ctx.child_resp(i)),
+            Some(&format!("_event.data.status == {s} && {chosen} == {i}")),
+            Some("halting_when_done"),
+            vec![
+                b.assign(&r, "false"),
+                b.assign("result", &s.to_string()),
+                b.assign(h, "0"),
+            ],
+        ));
+    }
+}
+
 pub(super) fn switch(ctx: &Ctx, pick: &SwitchPick) -> Element {
     let b = &ctx.b;
     let h = "halt_idx";
@@ -886,18 +886,7 @@ pub(super) fn switch(ctx: &Ctx, pick: &SwitchPick) -> Element {
     let mut t = b.state_entry("tick_child", vec![ctx.dispatch("match_index", false)]);
     for i in 0..ctx.children.len() {
         let r = running(ctx, i);
-        for s in [SUCCESS, FAILURE] {
-            t.push(b.tr(
-                Some(&ctx.child_resp(i)),
-                Some(&format!("_event.data.status == {s} && match_index == {i}")),
-                Some("halting_when_done"),
-                vec![
-                    b.assign(&r, "false"),
-                    b.assign("result", &s.to_string()),
-                    b.assign(h, "0"),
-                ],
-            ));
-        }
+        push_child_done(ctx, &mut t, "match_index", i, h);
         t.push(b.tr(
             Some(&ctx.child_resp(i)),
             Some(&format!(

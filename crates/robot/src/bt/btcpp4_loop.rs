@@ -113,7 +113,7 @@ pub(super) fn prepare(
 /// Item `s` of a queue as `convertFromString<T>` reads it (a whole number, `true` or
 /// `false`, a decimal number with a point, a string's model expression); `Err` says why
 /// BT.CPP refuses it.
-fn item(t: LoopType, s: &str) -> Result<String, String> {
+fn item(t: LoopType, s: &str) -> Result<String, BadItem> {
     match t {
         // `convertFromString<int>`: a whole number in range, nothing around it.
         LoopType::Int => {
@@ -124,14 +124,14 @@ fn item(t: LoopType, s: &str) -> Result<String, String> {
             {
                 Ok(s.to_string())
             } else {
-                Err(format!("`{s}` is not a whole number of 32 bits"))
+                Err(BadItem::NotInt(s.to_string()))
             }
         }
         // `convertFromString<bool>`.
         LoopType::Bool => match s {
             "1" | "true" | "True" | "TRUE" => Ok("true".into()),
             "0" | "false" | "False" | "FALSE" => Ok("false".into()),
-            _ => Err(format!("`{s}` is not a boolean (true, false, 1, 0)")),
+            _ => Err(BadItem::NotBool(s.to_string())),
         },
         LoopType::Double => {
             let numeric = !s.is_empty()
@@ -142,7 +142,7 @@ fn item(t: LoopType, s: &str) -> Result<String, String> {
                     let d = format!("{x}");
                     Ok(if d.contains('.') { d } else { format!("{d}.0") })
                 }
-                _ => Err(format!("`{s}` is not a finite decimal number")),
+                _ => Err(BadItem::NotDouble(s.to_string())),
             }
         }
         LoopType::String => Ok(super::plugin::literal_expr(s, "string")),
@@ -151,7 +151,7 @@ fn item(t: LoopType, s: &str) -> Result<String, String> {
 
 /// Item `x` (as [`item`] reads it) written into entry `e`: its model expression, or why
 /// that is not modelled.
-fn written(t: LoopType, x: &str, e: &Entry) -> Result<String, String> {
+fn written(t: LoopType, x: &str, e: &Entry) -> Result<String, BadItem> {
     let s = Scalar::from_name(e.ty.trim());
     if e.why == SCRIPT {
         // A script's entry holds a number: an int or a bool item is written as one
@@ -162,9 +162,9 @@ fn written(t: LoopType, x: &str, e: &Entry) -> Result<String, String> {
             LoopType::Bool => Ok(if x == "true" { "1" } else { "0" }.into()),
             LoopType::Double => match x.parse::<f64>() {
                 Ok(d) if d.fract() == 0.0 && d.abs() < 9.0e15 => Ok(format!("{}", d as i64)),
-                _ => Err(format!("the item {x} is not whole, and BehaviorTree.CPP throws writing it into an entry a script holds a number in (\"Invalid floating point to integer conversion\"): not modelled")),
+                _ => Err(BadItem::NotWhole(x.to_string())),
             },
-            LoopType::String => Err("BehaviorTree.CPP throws writing a string into an entry a script holds a number in (\"Any::copyInto fails\"): not modelled".into()),
+            LoopType::String => Err(BadItem::StringInNumber),
         };
     }
     let fits = match t {
@@ -176,10 +176,37 @@ fn written(t: LoopType, x: &str, e: &Entry) -> Result<String, String> {
     if fits {
         Ok(x.to_string())
     } else {
-        Err(format!(
-            "a {} item in that entry is not modelled",
-            port_type(t)
-        ))
+        Err(BadItem::Unmodelled(port_type(t)))
+    }
+}
+
+/// Why [`item`] refuses a queue's item or [`written`] does not model writing it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum BadItem {
+    /// Not a whole number of 32 bits (the item).
+    NotInt(String),
+    /// Not a boolean.
+    NotBool(String),
+    /// Not a finite decimal number.
+    NotDouble(String),
+    /// A number not whole, written into an entry a script holds a number in.
+    NotWhole(String),
+    /// A string written into an entry a script holds a number in.
+    StringInNumber,
+    /// An item of this type in an entry of another.
+    Unmodelled(&'static str),
+}
+
+impl std::fmt::Display for BadItem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BadItem::NotInt(s) => write!(f, "`{s}` is not a whole number of 32 bits"),
+            BadItem::NotBool(s) => write!(f, "`{s}` is not a boolean (true, false, 1, 0)"),
+            BadItem::NotDouble(s) => write!(f, "`{s}` is not a finite decimal number"),
+            BadItem::NotWhole(x) => write!(f, "the item {x} is not whole, and BehaviorTree.CPP throws writing it into an entry a script holds a number in (\"Invalid floating point to integer conversion\"): not modelled"),
+            BadItem::StringInNumber => f.write_str("BehaviorTree.CPP throws writing a string into an entry a script holds a number in (\"Any::copyInto fails\"): not modelled"),
+            BadItem::Unmodelled(ty) => write!(f, "a {ty} item in that entry is not modelled"),
+        }
     }
 }
 

@@ -195,11 +195,11 @@ fn cast_bool(v: &Val) -> (Option<String>, String) {
 /// A real literal as BT.CPP 4 reads it (`scripting/any_types.hpp`, `Grammar::Real`:
 /// digits, then `.digits` and an optional exponent, or an exponent; `std::stod`, which
 /// refuses a value out of range) or a hexadecimal integer (`Grammar::Integer`).
-fn literal(t: &str) -> Result<(String, Ty), String> {
+fn literal(t: &str) -> Result<(String, Ty), BadNumber> {
     if let Some(h) = t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
         return i64::from_str_radix(h, 16)
             .map(|v| (v.to_string(), Ty::Int))
-            .map_err(|_| format!("the number `{t}` is not one BT.CPP 4 reads"));
+            .map_err(|_| BadNumber::Unread(t.to_string()));
     }
     let b = t.as_bytes();
     let digits = |mut i: usize| {
@@ -214,9 +214,7 @@ fn literal(t: &str) -> Result<(String, Ty), String> {
     if i < b.len() && b[i] == b'.' {
         let (j, some) = digits(i + 1);
         if !some {
-            return Err(format!(
-                "the number `{t}` is not one BT.CPP 4 reads (4.8.2 refuses it at load)"
-            ));
+            return Err(BadNumber::Refused(t.to_string()));
         }
         (i, real) = (j, true);
     }
@@ -224,30 +222,49 @@ fn literal(t: &str) -> Result<(String, Ty), String> {
         let j = i + 1 + usize::from(b.get(i + 1).is_some_and(|c| *c == b'+' || *c == b'-'));
         let (k, some) = digits(j);
         if !some {
-            return Err(format!(
-                "the number `{t}` is not one BT.CPP 4 reads (4.8.2 refuses it at load)"
-            ));
+            return Err(BadNumber::Refused(t.to_string()));
         }
         (i, real) = (k, true);
     }
     if i != b.len() || !real {
-        return Err(format!(
-            "the number `{t}` is not one BT.CPP 4 reads (4.8.2 refuses it at load)"
-        ));
+        return Err(BadNumber::Refused(t.to_string()));
     }
-    let v: f64 = t
-        .parse()
-        .map_err(|_| format!("the number `{t}` is not one BT.CPP 4 reads"))?;
+    let v: f64 = t.parse().map_err(|_| BadNumber::Unread(t.to_string()))?;
     let zero = t
         .split(['e', 'E'])
         .next()
         .is_some_and(|m| m.bytes().all(|c| c == b'0' || c == b'.'));
     if !v.is_finite() || (!v.is_normal() && !zero) {
-        return Err(format!(
-            "the number `{t}` is out of a double's range (BT.CPP's `std::stod` throws at load)"
-        ));
+        return Err(BadNumber::OutOfRange(t.to_string()));
     }
     Ok((format!("{v:?}"), Ty::Real))
+}
+
+/// Why [`literal`] refused a number (the number as written).
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum BadNumber {
+    /// Not a number BT.CPP 4 reads.
+    Unread(String),
+    /// Outside BT.CPP 4's grammar: 4.8.2 refuses it when the tree loads.
+    Refused(String),
+    /// Outside a double's range: `std::stod` throws when the tree loads.
+    OutOfRange(String),
+}
+
+impl std::fmt::Display for BadNumber {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BadNumber::Unread(t) => write!(f, "the number `{t}` is not one BT.CPP 4 reads"),
+            BadNumber::Refused(t) => write!(
+                f,
+                "the number `{t}` is not one BT.CPP 4 reads (4.8.2 refuses it at load)"
+            ),
+            BadNumber::OutOfRange(t) => write!(
+                f,
+                "the number `{t}` is out of a double's range (BT.CPP's `std::stod` throws at load)"
+            ),
+        }
+    }
 }
 
 /// A comparison of two numbers, one of them possibly not whole, as BT.CPP 4.10 makes it
@@ -319,7 +336,7 @@ impl Tr<'_> {
             K::Int(n) => val(n.to_string(), Ty::Int, "false"),
             K::Bool(b) => val(b.to_string(), Ty::Bool, "false"),
             K::Number(t) => {
-                let (x, ty) = literal(t).map_err(|w| (e.at, w))?;
+                let (x, ty) = literal(t).map_err(|w| (e.at, w.to_string()))?;
                 let d = if ty == Ty::Real { "true" } else { "false" };
                 val(x, ty, d)
             }

@@ -15,7 +15,7 @@ pub(crate) struct B {
 
 impl B {
     /// An element `name` with `attrs`.
-    pub fn el(&self, name: &str, attrs: &[(&str, &str)]) -> Element {
+    pub(crate) fn el(&self, name: &str, attrs: &[(&str, &str)]) -> Element {
         let mut e = Element::new(name, self.at);
         for (k, v) in attrs {
             e.set_attr(k, *v);
@@ -24,7 +24,7 @@ impl B {
     }
 
     /// `<scxml name initial version="1.0" model_src="" xmlns>`.
-    pub fn scxml(&self, name: &str, initial: &str) -> Element {
+    pub(crate) fn scxml(&self, name: &str, initial: &str) -> Element {
         self.el(
             "scxml",
             &[
@@ -39,7 +39,7 @@ impl B {
 
     /// A `<datamodel>` with one typed `<data>` per `(id, type, expr)`, typed by
     /// `<!-- TYPE id:type -->` comments as AS2FM writes them.
-    pub fn datamodel(&self, vars: &[(&str, &str, String)]) -> Element {
+    pub(crate) fn datamodel(&self, vars: &[(&str, &str, String)]) -> Element {
         let mut dm = self.el("datamodel", &[]);
         for (id, ty, expr) in vars {
             dm.push_comment(format!(" TYPE {id}:{ty} "));
@@ -49,12 +49,12 @@ impl B {
     }
 
     /// `<state id>`.
-    pub fn state(&self, id: &str) -> Element {
+    pub(crate) fn state(&self, id: &str) -> Element {
         self.el("state", &[("id", id)])
     }
 
     /// `<state id>` whose `<onentry>` holds `body`.
-    pub fn state_entry(&self, id: &str, body: Vec<Element>) -> Element {
+    pub(crate) fn state_entry(&self, id: &str, body: Vec<Element>) -> Element {
         let mut s = self.state(id);
         let mut on = self.el("onentry", &[]);
         for b in body {
@@ -65,7 +65,7 @@ impl B {
     }
 
     /// A `<transition>` with optional event, cond and target, and `body`.
-    pub fn tr(
+    pub(crate) fn tr(
         &self,
         event: Option<&str>,
         cond: Option<&str>,
@@ -89,17 +89,22 @@ impl B {
     }
 
     /// `<assign location expr>`.
-    pub fn assign(&self, location: &str, expr: &str) -> Element {
+    pub(crate) fn assign(&self, location: &str, expr: &str) -> Element {
         self.el("assign", &[("location", location), ("expr", expr)])
     }
 
     /// `<send event target>` without parameters.
-    pub fn send(&self, event: &str, target: &str) -> Element {
+    pub(crate) fn send(&self, event: &str, target: &str) -> Element {
         self.el("send", &[("event", event), ("target", target)])
     }
 
     /// `<send event target><param name expr/>...</send>`.
-    pub fn send_params(&self, event: &str, target: &str, params: &[(&str, &str)]) -> Element {
+    pub(crate) fn send_params(
+        &self,
+        event: &str,
+        target: &str,
+        params: &[(&str, &str)],
+    ) -> Element {
         let mut s = self.send(event, target);
         for (n, e) in params {
             s.push(self.el("param", &[("name", n), ("expr", e)]));
@@ -109,7 +114,7 @@ impl B {
 
     /// `<if cond=c0>b0<elseif cond=c1/>b1...<else/>other</if>`; `None` when `branches`
     /// is empty and `otherwise` too.
-    pub fn if_chain(
+    pub(crate) fn if_chain(
         &self,
         branches: Vec<(String, Vec<Element>)>,
         otherwise: Vec<Element>,
@@ -136,7 +141,7 @@ impl B {
     }
 
     /// `<if cond>body</if>`.
-    pub fn if_then(&self, cond: &str, body: Vec<Element>) -> Element {
+    pub(crate) fn if_then(&self, cond: &str, body: Vec<Element>) -> Element {
         let mut el = self.el("if", &[("cond", cond)]);
         for b in body {
             el.push(b);

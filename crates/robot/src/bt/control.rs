@@ -7,6 +7,7 @@
 //! 2 FAILURE, 3 RUNNING. A parent halts a child with `bt_<id>_halt` and waits for
 //! `bt_<id>_halt_response`; Sequence-like nodes halt every child when they finish.
 
+use super::btcpp::{WAKE_PENDING, WAKE_UP};
 use super::build::B;
 use super::decorators::{constant, decorator, repeat};
 use super::parallel::{if_then_else, parallel};
@@ -103,15 +104,15 @@ pub(crate) struct Ctx {
 
 impl Ctx {
     /// `bt_<id>_tick`.
-    pub fn tick_ev(&self) -> String {
+    pub(crate) fn tick_ev(&self) -> String {
         format!("bt_{}_tick", self.id)
     }
     /// `bt_<id>_halt`.
-    pub fn halt_ev(&self) -> String {
+    pub(crate) fn halt_ev(&self) -> String {
         format!("bt_{}_halt", self.id)
     }
     /// Sends `bt_<id>_response` with `status`.
-    pub fn respond(&self, status: u8) -> Element {
+    pub(crate) fn respond(&self, status: u8) -> Element {
         self.b.send_params(
             &format!("bt_{}_response", self.id),
             &self.parent,
@@ -119,7 +120,7 @@ impl Ctx {
         )
     }
     /// Sends `bt_<id>_response` with the status `expr` evaluates to.
-    pub fn respond_expr(&self, expr: &str) -> Element {
+    pub(crate) fn respond_expr(&self, expr: &str) -> Element {
         self.b.send_params(
             &format!("bt_{}_response", self.id),
             &self.parent,
@@ -127,22 +128,22 @@ impl Ctx {
         )
     }
     /// Sends `bt_<id>_halt_response`.
-    pub fn respond_halted(&self) -> Element {
+    pub(crate) fn respond_halted(&self) -> Element {
         self.b
             .send(&format!("bt_{}_halt_response", self.id), &self.halt_target)
     }
     /// Sends `bt_<child>_tick` to child `i`.
-    pub fn tick_child(&self, i: usize) -> Element {
+    pub(crate) fn tick_child(&self, i: usize) -> Element {
         let (id, m) = &self.children[i];
         self.b.send(&format!("bt_{id}_tick"), m)
     }
     /// Sends `bt_<child>_halt` to child `i`.
-    pub fn halt_child(&self, i: usize) -> Element {
+    pub(crate) fn halt_child(&self, i: usize) -> Element {
         let (id, m) = &self.children[i];
         self.b.send(&format!("bt_{id}_halt"), m)
     }
     /// What halting child `i` may change: always `Always` when every child is halted.
-    pub fn effect(&self, i: usize) -> HaltEffect {
+    pub(crate) fn effect(&self, i: usize) -> HaltEffect {
         self.effects.as_ref().map_or(HaltEffect::Always, |e| e[i])
     }
     /// The variable that says child `i` last answered RUNNING (kept for children whose
@@ -158,7 +159,7 @@ impl Ctx {
             .collect()
     }
     /// Records that child `i` answered `status` (for children whose flag is kept).
-    pub fn mark(&self, i: usize, status: u8) -> Option<Element> {
+    pub(crate) fn mark(&self, i: usize, status: u8) -> Option<Element> {
         let v = self.running_var(i)?;
         Some(
             self.b
@@ -179,7 +180,7 @@ impl Ctx {
             ))
     }
     /// Halts child `i`, forgetting that it ran.
-    pub fn halt_child_body(&self, i: usize) -> Vec<Element> {
+    pub(crate) fn halt_child_body(&self, i: usize) -> Vec<Element> {
         let mut v: Vec<Element> = self
             .running_var(i)
             .map(|r| self.b.assign(&r, "false"))
@@ -191,7 +192,7 @@ impl Ctx {
     /// The transitions on the node's own halt in the idle state of a one-child node:
     /// to `halting` (which halts the child and answers), or, when the child needs no
     /// halt, `also` and the answer at once.
-    pub fn halt_single(&self, halting: &str, also: Vec<Element>) -> Vec<Element> {
+    pub(crate) fn halt_single(&self, halting: &str, also: Vec<Element>) -> Vec<Element> {
         let b = &self.b;
         let at_once = |cond: Option<&str>| {
             let mut body = also.clone();
@@ -206,7 +207,7 @@ impl Ctx {
         }
     }
     /// Records that child `i` answered SKIPPED: RUNNING still when the code is 5.
-    pub fn mark_skipped(&self, i: usize) -> Option<Element> {
+    pub(crate) fn mark_skipped(&self, i: usize) -> Option<Element> {
         let v = self.running_var(i)?;
         Some(
             self.b
@@ -257,11 +258,11 @@ impl Ctx {
             .collect()
     }
     /// `bt_<child>_response` of child `i`.
-    pub fn child_resp(&self, i: usize) -> String {
+    pub(crate) fn child_resp(&self, i: usize) -> String {
         format!("bt_{}_response", self.children[i].0)
     }
     /// `bt_<child>_halt_response` of child `i`.
-    pub fn child_halt_resp(&self, i: usize) -> String {
+    pub(crate) fn child_halt_resp(&self, i: usize) -> String {
         format!("bt_{}_halt_response", self.children[i].0)
     }
     /// `if var == 0: send to child 0, elseif var == 1: ...`, ticking or halting.
@@ -329,6 +330,28 @@ pub(super) fn on_child_skipped(
             v,
         ));
     }
+}
+
+/// [`on_child_skipped`] of a sequence or fallback under BT.CPP 4 (`case
+/// NodeStatus::SKIPPED`): on to the next child, the skip counted in [`SKIP_COUNT`]
+/// (`skipped_count_`), back to `target`.
+pub(super) fn skip_to_next(ctx: &Ctx, t: &mut Element, idx: &str, target: &str) {
+    on_child_skipped(ctx, t, idx, target, || {
+        vec![
+            ctx.b.assign(idx, &format!("{idx} + 1")),
+            ctx.b.assign(SKIP_COUNT, &format!("{SKIP_COUNT} + 1")),
+        ]
+    });
+}
+
+/// The transition of a node whose child index `idx` left its range: to `error`.
+pub(super) fn index_out_of_range(ctx: &Ctx, idx: &str) -> Element {
+    ctx.b.tr(
+        None,
+        Some(&format!("{idx} < 0 || {idx} > children_count")),
+        Some("error"),
+        vec![],
+    )
 }
 
 /// One transition per child, as AS2FM writes them: the child's response with `status`
@@ -442,8 +465,15 @@ pub(super) fn init_state(ctx: &Ctx, bad: &str) -> Element {
 
 /// The machine that ticks the root node `root` (the stem of its events, `bt_<stem>_tick`,
 /// and its machine: `<id>_cond` and its conditions' machine for a root with pre/post
-/// conditions, `btcpp4_conds.rs`) at every `<stem>_tick` timer event. With `tick_if_not_running` false it stops after the first answer that is not
-/// RUNNING, as AS2FM's does.
+/// conditions, `btcpp4_conds.rs`) at every `<stem>_tick` timer event. With
+/// `tick_if_not_running` false it stops after the first answer that is not RUNNING, as
+/// AS2FM's does.
+///
+/// With `wake_up` (BT.CPP's `tickOnce`) it also keeps the wake-up signal: `bt_wake_up`
+/// sets `wake_pending` in any state; a RUNNING answer while it is set clears it and
+/// ticks the root again at once (BT.CPP 4 `bt_factory.cpp`, `Tree::tickRoot`, the inner
+/// `while` over `wake_up_->waitFor(0)`, which clears the signal it takes). A finished
+/// answer leaves the signal pending: `waitFor` is only called after a RUNNING one.
 pub(crate) fn root_machine(
     b: B,
     name: &str,
@@ -451,10 +481,28 @@ pub(crate) fn root_machine(
     rate_hz: f64,
     root: (&str, &str),
     tick_if_not_running: bool,
+    wake_up: bool,
 ) -> Element {
     let (id, machine) = root;
     let resp = format!("bt_{id}_response");
+    let tick = || b.send(&format!("bt_{id}_tick"), machine);
+    // A state that takes the wake-up signal whenever it comes.
+    let waking = |s: Element| {
+        if wake_up {
+            s.with_child(b.tr(
+                Some(WAKE_UP),
+                None,
+                None,
+                vec![b.assign(WAKE_PENDING, "true")],
+            ))
+        } else {
+            s
+        }
+    };
     let mut m = b.scxml(name, "idle");
+    if wake_up {
+        m.push(b.datamodel(&[(WAKE_PENDING, "bool", "false".into())]));
+    }
     m.push(b.el(
         "ros_time_rate",
         &[("name", timer), ("rate_hz", &format_rate(rate_hz))],
@@ -463,14 +511,24 @@ pub(crate) fn root_machine(
         "ros_rate_callback",
         &[("name", timer), ("target", "wait_tick_res")],
     );
-    cb.push(b.send(&format!("bt_{id}_tick"), machine));
-    m.push(b.state("idle").with_child(cb).with_child(b.tr(
+    cb.push(tick());
+    m.push(waking(b.state("idle").with_child(cb)).with_child(b.tr(
         Some(&resp),
         None,
         Some("error"),
         vec![],
     )));
-    let mut w = b.state("wait_tick_res");
+    let mut w = waking(b.state("wait_tick_res"));
+    if wake_up {
+        w.push(b.tr(
+            Some(&resp),
+            Some(&format!(
+                "_event.data.status == {RUNNING} && {WAKE_PENDING}"
+            )),
+            Some("wait_tick_res"),
+            vec![b.assign(WAKE_PENDING, "false"), tick()],
+        ));
+    }
     if tick_if_not_running {
         w.push(b.tr(Some(&resp), None, Some("idle"), vec![]));
     } else {
@@ -483,7 +541,7 @@ pub(crate) fn root_machine(
         w.push(b.tr(Some(&resp), None, Some("done"), vec![]));
     }
     m.push(w);
-    m.push(b.state("done"));
+    m.push(waking(b.state("done")));
     m.push(b.state("error"));
     m
 }

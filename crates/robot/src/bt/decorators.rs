@@ -152,8 +152,8 @@ fn retry_node(ctx: &Ctx, n: i64) -> Element {
 }
 
 /// The datamodel, init, `wait_for_tick` (a tick goes to `start`) and `halting_child` of
-/// Repeat and RetryUntilSuccessful.
-fn repeat_head(ctx: &Ctx, count: &str, limit: &str, n: i64, start: &str) -> Element {
+/// Repeat and RetryUntilSuccessful, AS2FM's and BT.CPP's alike.
+pub(super) fn repeat_head(ctx: &Ctx, count: &str, limit: &str, n: i64, start: &str) -> Element {
     let b = &ctx.b;
     let mut m = b.scxml(&ctx.machine, "init");
     let flags = ctx.running_data();

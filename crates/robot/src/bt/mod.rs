@@ -154,7 +154,7 @@ pub enum Halts {
 }
 
 /// The name of the machine that ticks the tree read from `tree`: `bt_root_fsm_<stem>`.
-pub fn root_machine_name(sm: &SourceMap, tree: FileId) -> String {
+pub(crate) fn root_machine_name(sm: &SourceMap, tree: FileId) -> String {
     format!("bt_root_fsm_{}", stem(sm, tree))
 }
 
@@ -255,24 +255,15 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
         (tree.nodes[0].id.to_string(), tree.nodes[0].machine.clone())
     };
     let root_node = (root_node.0.as_str(), root_node.1.as_str());
-    out.push(match input.semantics {
-        BtSemantics::Btcpp { tick: BtTick::Once } => btcpp::root_machine(
-            root_b,
-            &root_name,
-            &timer,
-            input.tick_rate_hz,
-            root_node,
-            input.tick_if_not_running,
-        ),
-        _ => control::root_machine(
-            root_b,
-            &root_name,
-            &timer,
-            input.tick_rate_hz,
-            root_node,
-            input.tick_if_not_running,
-        ),
-    });
+    out.push(control::root_machine(
+        root_b,
+        &root_name,
+        &timer,
+        input.tick_rate_hz,
+        root_node,
+        input.tick_if_not_running,
+        input.semantics == BtSemantics::Btcpp { tick: BtTick::Once },
+    ));
     if btcpp {
         errs.extend(btcpp4_skip::refusals(sm, &tree));
     }
@@ -419,7 +410,7 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
 /// Where the tree's runs under AS2FM's node models and under BehaviorTree.CPP 4 are known
 /// to differ (`notes.rs`): one note per construction, at the node. Empty when the tree
 /// or a plugin cannot be read ([`lower`] reports that).
-pub fn semantics_notes(sm: &SourceMap, input: &BtInput) -> Vec<Diagnostic> {
+pub(crate) fn semantics_notes(sm: &SourceMap, input: &BtInput) -> Vec<Diagnostic> {
     let mut plugins = Vec::new();
     for &f in &input.plugins {
         match plugin::read(sm, f) {

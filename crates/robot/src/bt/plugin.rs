@@ -55,7 +55,7 @@ pub(crate) struct Plugin {
 
 impl Plugin {
     /// The declared port `key`.
-    pub fn port(&self, key: &str) -> Option<&DeclaredPort> {
+    pub(crate) fn port(&self, key: &str) -> Option<&DeclaredPort> {
         self.ports.iter().find(|p| p.key == key)
     }
 
@@ -217,8 +217,24 @@ pub(crate) fn normalize(ty: &str) -> String {
     }
 }
 
+/// A constant that does not fit its port's or entry's type: the constant as written and
+/// the type.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct BadLiteral {
+    value: String,
+    ty: String,
+}
+
+impl std::fmt::Display for BadLiteral {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "`{}` is not a valid {}", self.value, self.ty)
+    }
+}
+
+impl std::error::Error for BadLiteral {}
+
 /// Whether constant `v` fits type `ty`.
-pub(crate) fn check_literal(v: &str, ty: &str) -> Result<(), String> {
+pub(crate) fn check_literal(v: &str, ty: &str) -> Result<(), BadLiteral> {
     let t = v.trim();
     let base = match TypeExpr::parse(ty) {
         Ok(TypeExpr::Base(b)) => b,
@@ -237,7 +253,10 @@ pub(crate) fn check_literal(v: &str, ty: &str) -> Result<(), String> {
     if ok {
         Ok(())
     } else {
-        Err(format!("`{v}` is not a valid {}", ty.trim()))
+        Err(BadLiteral {
+            value: v.to_string(),
+            ty: ty.trim().to_string(),
+        })
     }
 }
 

@@ -29,6 +29,17 @@ pub(crate) struct SyntaxError {
     pub what: String,
 }
 
+impl std::fmt::Display for SyntaxError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "script syntax error at column {} of the script: {}",
+            self.at + 1,
+            self.what
+        )
+    }
+}
+
 /// An expression and the byte offset (in the script) where it starts.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Ex {
@@ -445,17 +456,11 @@ pub(crate) fn port_error(node: &str, port: &str, value: &str) -> Option<String> 
 
 /// For a pre/post-condition attribute (`_skipIf`, ...): `Ok(())` for a well-formed
 /// script, `Err(syntax error)` for a malformed one; `None` for another attribute.
-pub(crate) fn condition_error(attr: &str, value: &str) -> Option<Result<(), String>> {
+pub(crate) fn condition_error(attr: &str, value: &str) -> Option<Result<(), SyntaxError>> {
     if !CONDITION_ATTRS.contains(&attr) {
         return None;
     }
-    Some(check(value).map_err(|e| {
-        format!(
-            "`{attr}`: script syntax error at column {} of the script: {}",
-            e.at + 1,
-            e.what
-        )
-    }))
+    Some(check(value))
 }
 
 #[cfg(test)]

@@ -2,9 +2,9 @@
 //! ReactiveFallback: the nodes that tick their children one after another.
 
 use super::control::{
-    answer_by_flags, init_state, n_children, on_child_skipped, on_child_status, reset_children,
-    sequence_head, Ctx, HaltEffect, FAILURE, IS_SKIPPED, RUNNING, SKIPPED_RUNNING, SKIP_COUNT,
-    SUCCESS,
+    answer_by_flags, index_out_of_range, init_state, n_children, on_child_status, reset_children,
+    sequence_head, skip_to_next, Ctx, HaltEffect, FAILURE, IS_SKIPPED, RUNNING, SKIPPED_RUNNING,
+    SKIP_COUNT, SUCCESS,
 };
 use crate::model::xml::Element;
 
@@ -86,12 +86,7 @@ pub(super) fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
     }
     // `case NodeStatus::SKIPPED`: on to the next child, counted.
     if ctx.btcpp {
-        on_child_skipped(ctx, &mut t, idx, "tick_children", || {
-            vec![
-                b.assign(idx, &format!("{idx} + 1")),
-                b.assign(SKIP_COUNT, &format!("{SKIP_COUNT} + 1")),
-            ]
-        });
+        skip_to_next(ctx, &mut t, idx, "tick_children");
     }
     t.push(b.tr(
         None,
@@ -99,12 +94,7 @@ pub(super) fn sequence(ctx: &Ctx, cont: u8, stop: u8) -> Element {
         Some("reset_children"),
         vec![b.assign(idx, "0"), b.assign(flag(cont), "true")],
     ));
-    t.push(b.tr(
-        None,
-        Some(&format!("{idx} < 0 || {idx} > children_count")),
-        Some("error"),
-        vec![],
-    ));
+    t.push(index_out_of_range(ctx, idx));
     m.push(t);
     m.push(b.state("error"));
     m
@@ -158,12 +148,7 @@ pub(super) fn sequence_with_memory(ctx: &Ctx) -> Element {
         Some("reset_children"),
         vec![b.assign(idx, "0"), b.assign("seq_success", "true")],
     ));
-    t.push(b.tr(
-        None,
-        Some(&format!("{idx} < 0 || {idx} > children_count")),
-        Some("error"),
-        vec![],
-    ));
+    t.push(index_out_of_range(ctx, idx));
     m.push(t);
     let mut h = b.state_entry("halt_current_child", vec![ctx.dispatch(idx, true)]);
     for i in 0..n {

@@ -132,7 +132,7 @@ pub(crate) enum CheckType {
 
 impl CheckType {
     /// The node's name.
-    pub fn node_name(self) -> &'static str {
+    pub(crate) fn node_name(self) -> &'static str {
         match self {
             CheckType::Int => "BlackboardCheckInt",
             CheckType::Double => "BlackboardCheckDouble",
@@ -141,7 +141,7 @@ impl CheckType {
         }
     }
     /// The port type of `value_A` and `value_B`.
-    pub fn port_type(self) -> &'static str {
+    pub(crate) fn port_type(self) -> &'static str {
         match self {
             CheckType::Int => "int32",
             CheckType::Double => "float64",
@@ -407,7 +407,7 @@ pub(crate) struct Cond {
 
 impl TreeNode {
     /// The port called `key`, if the tree sets it.
-    pub fn port(&self, key: &str) -> Option<&Port> {
+    pub(crate) fn port(&self, key: &str) -> Option<&Port> {
         self.ports.iter().find(|p| p.key == key)
     }
 }
@@ -722,7 +722,7 @@ impl Reader<'_> {
                         name_span: a.name_span,
                         span: a.value_span,
                     }),
-                    Some(Err(m)) => self.err(a.value_span, m),
+                    Some(Err(e)) => self.err(a.value_span, format!("`{}`: {e}", a.name)),
                     None => self.err(
                         a.name_span,
                         format!(

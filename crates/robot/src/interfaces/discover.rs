@@ -30,7 +30,8 @@ use super::{InterfaceKind, Interfaces};
 use crate::model::source::{Diagnostic, SourceMap};
 
 /// The folder names that hold interface packages, looked for beside and above a model.
-pub const INTERFACE_FOLDERS: &[&str] = &["ros_support_interfaces", "interfaces", "Interfaces"];
+pub(crate) const INTERFACE_FOLDERS: &[&str] =
+    &["ros_support_interfaces", "interfaces", "Interfaces"];
 
 /// How deep below a searched folder packages are looked for
 /// (`ros_support_interfaces/uc3_interfaces/<pkg>/srv/X.srv` is two).
@@ -241,7 +242,7 @@ impl Interfaces {
 
     /// Reads every `msg/*.msg`, `srv/*.srv` and `action/*.action` of the package folder
     /// `dir` as package `package`; returns how many interfaces were added.
-    pub fn add_package_dir(
+    pub(crate) fn add_package_dir(
         &mut self,
         sm: &mut SourceMap,
         dir: &Path,

@@ -55,7 +55,7 @@ pub use discover::Search;
 pub use ros2::interface::builtin;
 pub use ros2::interface::*;
 
-use super::types::{ActionFields, FlatField, InterfaceLookup, ServiceFields};
+use super::types::{ActionFields, FlatField, InterfaceLookup, LookupError, ServiceFields};
 use crate::model::source::{Diagnostic, SourceMap};
 
 /// Deepest nesting of messages followed when flattening (a deeper chain is a cycle).
@@ -157,7 +157,10 @@ impl Interfaces {
                             None
                         }
                     } else {
-                        Some(self.unknown(&format!("{package}/{name}"), InterfaceKind::Message))
+                        Some(
+                            self.unknown(&format!("{package}/{name}"), InterfaceKind::Message)
+                                .to_string(),
+                        )
                     };
                     if let Some(m) = msg {
                         let d = match def.file {
@@ -205,33 +208,27 @@ impl Interfaces {
     }
 
     /// The interface that `type_name` (`pkg/Type` or `pkg/msg/Type`) names, of kind `kind`.
-    pub fn get(&self, type_name: &str, kind: InterfaceKind) -> Result<&InterfaceDef, String> {
+    pub fn get(&self, type_name: &str, kind: InterfaceKind) -> Result<&InterfaceDef, LookupError> {
         let parts: Vec<&str> = type_name.trim().split('/').collect();
+        let not_a_name = |suggestion| LookupError::NotATypeName {
+            type_name: type_name.to_string(),
+            dir: kind.dir(),
+            suggestion,
+        };
+        let wrong_kind = |found: InterfaceKind, by_folder| LookupError::WrongKind {
+            type_name: type_name.to_string(),
+            found: found.noun(),
+            wanted: kind.noun(),
+            by_folder,
+        };
         let (pkg, name) = match parts.as_slice() {
             [pkg, name] => (*pkg, *name),
             [pkg, mid, name] => match InterfaceKind::from_dir(mid) {
                 Some(k) if k == kind => (*pkg, *name),
-                Some(k) => {
-                    return Err(format!(
-                        "`{type_name}` names a {}, but a {} type is needed here",
-                        k.noun(),
-                        kind.noun()
-                    ))
-                }
-                None => {
-                    return Err(format!(
-                        "`{type_name}` is not a type name (expected `package/Type` or `package/{}/Type`)",
-                        kind.dir()
-                    ))
-                }
+                Some(k) => return Err(wrong_kind(k, true)),
+                None => return Err(not_a_name(None)),
             },
-            _ => {
-                return Err(format!(
-                    "`{type_name}` is not a type name (expected `package/Type` or `package/{}/Type`); {}",
-                    kind.dir(),
-                    self.suggest(type_name, kind)
-                ))
-            }
+            _ => return Err(not_a_name(Some(self.suggest(type_name, kind)))),
         };
         let key = (pkg.to_string(), kind, name.to_string());
         if let Some(d) = self.defs.get(&key) {
@@ -247,25 +244,25 @@ impl Interfaces {
                     .defs
                     .contains_key(&(pkg.to_string(), other, name.to_string()))
             {
-                return Err(format!(
-                    "`{type_name}` is a {}, but a {} type is needed here",
-                    other.noun(),
-                    kind.noun()
-                ));
+                return Err(wrong_kind(other, false));
             }
         }
         Err(self.unknown(&format!("{pkg}/{name}"), kind))
     }
 
-    fn unknown(&self, type_name: &str, kind: InterfaceKind) -> String {
+    fn unknown(&self, type_name: &str, kind: InterfaceKind) -> LookupError {
         let pkg = type_name.split('/').next().unwrap_or("");
+        let unknown = |why| LookupError::Unknown {
+            type_name: type_name.to_string(),
+            kind: kind.noun(),
+            why,
+        };
         if let Some(errs) = self.broken.get(pkg) {
             let first = errs.first().map(|d| d.to_string()).unwrap_or_default();
-            return format!(
-                "no {} type `{type_name}`: package `{pkg}` of the sourced ROS workspace did not read ({} error(s), first: {first})",
-                kind.noun(),
+            return unknown(format!(
+                "package `{pkg}` of the sourced ROS workspace did not read ({} error(s), first: {first})",
                 errs.len()
-            );
+            ));
         }
         let known_pkg = self.defs.keys().any(|(p, _, _)| p == pkg);
         let place = match (known_pkg, self.origins.get(pkg)) {
@@ -282,15 +279,15 @@ impl Interfaces {
         } else {
             String::new()
         };
-        let mut msg = format!("no {} type `{type_name}`: {place}{suggestion}", kind.noun());
+        let mut why = format!("{place}{suggestion}");
         if !known_pkg {
             if self.searched_said.replace(true) {
-                msg.push_str(" (the places searched are listed above)");
+                why.push_str(" (the places searched are listed above)");
             } else {
-                msg.push_str(&self.searched_text());
+                why.push_str(&self.searched_text());
             }
         }
-        msg
+        unknown(why)
     }
 
     /// Whether a known package's name is one or two edits from `pkg` (a misspelt package:
@@ -352,7 +349,7 @@ impl Interfaces {
     }
 
     /// The constants of message `type_name`, as `(name, ECMAScript literal)`.
-    pub fn constants(&self, type_name: &str) -> Result<Vec<(String, String)>, String> {
+    pub fn constants(&self, type_name: &str) -> Result<Vec<(String, String)>, LookupError> {
         let def = self.get(type_name, InterfaceKind::Message)?;
         Ok(def.parts[0]
             .constants
@@ -362,7 +359,7 @@ impl Interfaces {
     }
 
     /// Flattens one part into leaf fields.
-    fn flatten(&self, part: &MessageDef) -> Result<Vec<FlatField>, String> {
+    fn flatten(&self, part: &MessageDef) -> Result<Vec<FlatField>, LookupError> {
         let mut out = Vec::new();
         let mut path = Vec::new();
         let mut dims = Vec::new();
@@ -377,19 +374,19 @@ impl Interfaces {
         dims: &mut Vec<ArraySize>,
         out: &mut Vec<FlatField>,
         depth: usize,
-    ) -> Result<(), String> {
+    ) -> Result<(), LookupError> {
         if depth > MAX_NESTING {
-            return Err(format!(
-                "messages nest deeper than {MAX_NESTING} levels at `{}` (a message contains itself?)",
-                path.join(".")
-            ));
+            return Err(LookupError::TooDeep {
+                at: path.join("."),
+                limit: MAX_NESTING,
+            });
         }
         for f in &part.fields {
             if out.len() >= MAX_LEAVES {
-                return Err(format!(
-                    "the message has more than {MAX_LEAVES} leaf fields (at `{}`)",
-                    path.join(".")
-                ));
+                return Err(LookupError::TooManyLeaves {
+                    at: path.join("."),
+                    limit: MAX_LEAVES,
+                });
             }
             path.push(f.name.clone());
             match &f.ty.base {
@@ -471,12 +468,12 @@ pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
 }
 
 impl InterfaceLookup for Interfaces {
-    fn message(&self, type_name: &str) -> Result<Vec<FlatField>, String> {
+    fn message(&self, type_name: &str) -> Result<Vec<FlatField>, LookupError> {
         let def = self.get(type_name, InterfaceKind::Message)?;
         self.flatten(&def.parts[0])
     }
 
-    fn service(&self, type_name: &str) -> Result<ServiceFields, String> {
+    fn service(&self, type_name: &str) -> Result<ServiceFields, LookupError> {
         let def = self.get(type_name, InterfaceKind::Service)?;
         Ok(ServiceFields {
             request: self.flatten(&def.parts[0])?,
@@ -484,7 +481,7 @@ impl InterfaceLookup for Interfaces {
         })
     }
 
-    fn action(&self, type_name: &str) -> Result<ActionFields, String> {
+    fn action(&self, type_name: &str) -> Result<ActionFields, LookupError> {
         let def = self.get(type_name, InterfaceKind::Action)?;
         Ok(ActionFields {
             goal: self.flatten(&def.parts[0])?,

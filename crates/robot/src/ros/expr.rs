@@ -50,14 +50,14 @@ fn match_leaf<'f>(fields: &'f [FlatField], path: &[&str]) -> Option<(&'f FlatFie
         .map(|f| (f, f.path.len()))
 }
 
-/// Rewrites `text`; an error is `(byte offset in text, message)`.
+/// Rewrites `text`; an error is the byte offset in text and what is wrong there.
 ///
 /// The text is read with the model's own expression parser ([`parse_expr`]); every chain
 /// `prefix.a.b` whose root is a pseudo-variable is replaced, in the text, over the byte
 /// range its syntax tree gives, so the rest of the text stays as the user wrote it. Text
 /// that does not parse is left alone: reading the plain machine reports the syntax error
 /// at its position.
-pub(crate) fn rewrite(text: &str, scope: &Scope) -> Result<String, (usize, String)> {
+pub(crate) fn rewrite(text: &str, scope: &Scope) -> Result<String, (usize, FieldError)> {
     let Ok(tree) = parse_expr(text) else {
         return Ok(text.to_string());
     };
@@ -80,7 +80,7 @@ fn collect(
     e: &Expr,
     scope: &Scope,
     edits: &mut Vec<(usize, usize, String)>,
-) -> Result<(), (usize, String)> {
+) -> Result<(), (usize, FieldError)> {
     // `root.a.b`: the member nodes from the outermost in, and the root.
     let mut members: Vec<(&str, &Expr)> = Vec::new();
     let mut root = e;
@@ -130,35 +130,25 @@ fn collect(
 }
 
 /// The replacement for `prefix.names...` and how many names it consumed.
-fn resolve(prefix: &str, names: &[&str], scope: &Scope) -> Result<(String, usize), String> {
-    let outside = || format!("`{prefix}` can only be used inside {}", owner(prefix));
+fn resolve(prefix: &str, names: &[&str], scope: &Scope) -> Result<(String, usize), FieldError> {
+    let outside = || FieldError::Outside(prefix.to_string());
     let leaf = |fields: &[FlatField], what: &str, path: &[&str], shown: &str| {
         if path.is_empty() {
-            return Err(format!(
-                "`{shown}` must name a field of {what} (`{shown}.<field>`)"
-            ));
+            return Err(FieldError::NoField {
+                shown: shown.to_string(),
+                what: what.to_string(),
+            });
         }
         match match_leaf(fields, path) {
             Some((f, n)) => Ok((format!("_event.data.{}", f.param_name()), n)),
-            None => {
-                let known: Vec<String> = fields.iter().map(|f| f.dotted()).collect();
-                let what_is = if fields.iter().any(|f| {
+            None => Err(FieldError::NotALeaf {
+                name: format!("{shown}.{}", path.join(".")),
+                message: fields.iter().any(|f| {
                     f.path.len() > path.len() && f.path.iter().zip(path).all(|(a, b)| a == b)
-                }) {
-                    "is a message, not a single field,"
-                } else {
-                    "is not a field"
-                };
-                Err(format!(
-                    "`{shown}.{}` {what_is} of {what} (fields: {})",
-                    path.join("."),
-                    if known.is_empty() {
-                        "none".to_string()
-                    } else {
-                        known.join(", ")
-                    }
-                ))
-            }
+                }),
+                what: what.to_string(),
+                known: fields.iter().map(|f| f.dotted()).collect(),
+            }),
         }
     };
     match prefix {
@@ -168,7 +158,7 @@ fn resolve(prefix: &str, names: &[&str], scope: &Scope) -> Result<(String, usize
             }
             match names.first() {
                 Some(&"goal_id") => Ok(("_event.data.goal_id".into(), 1)),
-                _ => Err("`_action` has only the field `goal_id`".into()),
+                _ => Err(FieldError::ActionFields),
             }
         }
         "_wrapped_result" => {
@@ -181,7 +171,7 @@ fn resolve(prefix: &str, names: &[&str], scope: &Scope) -> Result<(String, usize
                     let (r, n) = leaf(fields, what, &names[1..], "_wrapped_result.result")?;
                     Ok((r, n + 1))
                 }
-                _ => Err("`_wrapped_result` has the fields `code` and `result`".into()),
+                _ => Err(FieldError::WrappedResultFields),
             }
         }
         _ => {
@@ -192,6 +182,65 @@ fn resolve(prefix: &str, names: &[&str], scope: &Scope) -> Result<(String, usize
         }
     }
 }
+
+/// Why a pseudo-variable chain names no event parameter.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) enum FieldError {
+    /// The pseudo-variable (`_msg`, ...) outside the callback that has it.
+    Outside(String),
+    /// The chain `shown` stops before a field of `what`.
+    NoField { shown: String, what: String },
+    /// `name` is not a leaf field of `what`: a message (`message`) or nothing; `known`,
+    /// the leaf fields there are.
+    NotALeaf {
+        name: String,
+        message: bool,
+        what: String,
+        known: Vec<String>,
+    },
+    /// `_action.` something other than `goal_id`.
+    ActionFields,
+    /// `_wrapped_result.` something other than `code` or `result`.
+    WrappedResultFields,
+}
+
+impl std::fmt::Display for FieldError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FieldError::Outside(prefix) => {
+                write!(f, "`{prefix}` can only be used inside {}", owner(prefix))
+            }
+            FieldError::NoField { shown, what } => write!(
+                f,
+                "`{shown}` must name a field of {what} (`{shown}.<field>`)"
+            ),
+            FieldError::NotALeaf {
+                name,
+                message,
+                what,
+                known,
+            } => {
+                let what_is = if *message {
+                    "is a message, not a single field,"
+                } else {
+                    "is not a field"
+                };
+                let known = if known.is_empty() {
+                    "none".to_string()
+                } else {
+                    known.join(", ")
+                };
+                write!(f, "`{name}` {what_is} of {what} (fields: {known})")
+            }
+            FieldError::ActionFields => f.write_str("`_action` has only the field `goal_id`"),
+            FieldError::WrappedResultFields => {
+                f.write_str("`_wrapped_result` has the fields `code` and `result`")
+            }
+        }
+    }
+}
+
+impl std::error::Error for FieldError {}
 
 #[cfg(test)]
 mod tests {
@@ -235,14 +284,17 @@ mod tests {
         assert_eq!(rewrite("_msg.pose.x +", &scope).unwrap(), "_msg.pose.x +");
         let (at, m) = rewrite("1 + _msg.nope", &scope).unwrap_err();
         assert_eq!(at, 4);
+        let m = m.to_string();
         assert!(m.contains("not a field") && m.contains("pose.x"), "{m}");
         assert!(rewrite("_msg.pose", &scope)
             .unwrap_err()
             .1
+            .to_string()
             .contains("is a message"));
         assert!(rewrite("_req.a", &scope)
             .unwrap_err()
             .1
+            .to_string()
             .contains("only be used inside"));
     }
 

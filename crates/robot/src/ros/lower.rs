@@ -265,7 +265,7 @@ impl Cx<'_> {
                     Ok(v) => a.value = v,
                     Err((k, m)) => {
                         let at = unescaped_offset(self.sm, a.value_span, k as u32);
-                        self.err(at, m);
+                        self.err(at, m.to_string());
                     }
                 }
             }
@@ -280,7 +280,7 @@ impl Cx<'_> {
             Ok(v) => Some((v, span)),
             Err((k, m)) => {
                 let at = unescaped_offset(self.sm, span, k as u32);
-                self.err(at, m);
+                self.err(at, m.to_string());
                 None
             }
         }

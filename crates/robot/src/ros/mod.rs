@@ -56,7 +56,7 @@ mod lower;
 
 use crate::model::source::{Diagnostic, SourceMap, Span};
 use crate::model::xml::{Element, Node};
-use crate::types::{ActionFields, FlatField, InterfaceLookup, ServiceFields};
+use crate::types::{ActionFields, FlatField, InterfaceLookup, LookupError, ServiceFields};
 
 /// What the ROS lowering needs: the node models and how to find message layouts.
 pub struct RosInput<'a> {
@@ -195,7 +195,7 @@ fn route_in(el: &mut Element, handlers: &[(String, String)]) {
 }
 
 /// `/a/b` as AS2FM spells it in event and machine names: `a__b`.
-pub fn sanitize(name: &str) -> String {
+pub(crate) fn sanitize(name: &str) -> String {
     name.trim().trim_start_matches('/').replace('/', "__")
 }
 
@@ -278,7 +278,7 @@ type Action = Endpoint<ActionFields>;
 struct EndpointKind<F> {
     what: &'static str,
     all: for<'c, 'a> fn(&'c mut Cx<'a>) -> &'c mut Vec<Endpoint<F>>,
-    lookup: fn(&dyn InterfaceLookup, &str) -> Result<F, String>,
+    lookup: fn(&dyn InterfaceLookup, &str) -> Result<F, LookupError>,
 }
 
 const SERVICES: EndpointKind<ServiceFields> = EndpointKind {
@@ -503,8 +503,8 @@ impl Cx<'_> {
     }
 
     /// The fields an interface lookup found, or `None` with its error reported at `span`.
-    fn looked_up<F>(&mut self, span: Span, found: Result<F, String>) -> Option<F> {
-        found.map_err(|m| self.err(span, m)).ok()
+    fn looked_up<F>(&mut self, span: Span, found: Result<F, LookupError>) -> Option<F> {
+        found.map_err(|e| self.err(span, e.to_string())).ok()
     }
 
     /// A `<ros_service_server|client>` or `<ros_action_server|client>` tag `el` of machine

@@ -154,7 +154,7 @@ fn collect_scxml(dir: &Path, out: &mut Vec<PathBuf>, errs: &mut Diagnostics, dep
 }
 
 /// Reads every `.scxml` file under `dir` (sorted by path), `types.xml` and `properties.xml`.
-pub fn load_dir(dir: &Path) -> Result<ModelSource, Diagnostics> {
+pub(crate) fn load_dir(dir: &Path) -> Result<ModelSource, Diagnostics> {
     let mut m = ModelSource::default();
     let mut errs = Diagnostics::default();
     let mut files = Vec::new();
@@ -181,7 +181,7 @@ pub fn load_dir(dir: &Path) -> Result<ModelSource, Diagnostics> {
 }
 
 /// Reads a SCAN main file: `<specification>` with a process list, types and properties.
-pub fn load_spec(path: &Path) -> Result<ModelSource, Diagnostics> {
+pub(crate) fn load_spec(path: &Path) -> Result<ModelSource, Diagnostics> {
     let mut m = ModelSource::default();
     let mut errs = Diagnostics::default();
     let text = codegen::diag::read_source(path)?;

@@ -238,7 +238,7 @@ impl Reader<'_> {
         match t {
             Ok(ty) => Some(TypeAnn { ty, span }),
             Err(m) => {
-                self.err(span, m);
+                self.err(span, m.to_string());
                 None
             }
         }

@@ -54,21 +54,41 @@ pub fn unescaped_offset(sm: &SourceMap, span: Span, k: u32) -> Span {
 /// XML tree (`model::xml`, attribute values of every XML file read), by the property
 /// reader's position-keeping unescaping (formulas, element text) and by
 /// [`unescaped_offset`]; names are decoded by [`resolve_entity`].
-pub fn reference(rest: &str) -> Option<Result<(char, usize), String>> {
+pub fn reference(rest: &str) -> Option<Result<(char, usize), BadReference>> {
     let after = rest.strip_prefix('&')?;
     // A name longer than any entity or reasonable character reference is taken as a
     // stray `&`, so the message does not quote half a line.
     let Some(end) = after.find(';').filter(|&end| end <= 12) else {
-        return Some(Err(
-            "`&` that does not start a reference (write `&amp;`)".to_owned()
-        ));
+        return Some(Err(BadReference::Stray));
     };
     let name = &after[..end];
     Some(match resolve_entity(name) {
         Some(c) => Ok((c, end + 2)),
-        None => Err(format!("unknown reference `&{name};`")),
+        None => Err(BadReference::Unknown(name.to_string())),
     })
 }
+
+/// What is wrong with a reference in XML text ([`reference()`], [`unescape`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum BadReference {
+    /// An `&` that starts no reference (no `;` close after it).
+    Stray,
+    /// A name no entity or character reference has (the name, without `&` and `;`).
+    Unknown(String),
+}
+
+impl std::fmt::Display for BadReference {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BadReference::Stray => {
+                f.write_str("`&` that does not start a reference (write `&amp;`)")
+            }
+            BadReference::Unknown(name) => write!(f, "unknown reference `&{name};`"),
+        }
+    }
+}
+
+impl std::error::Error for BadReference {}
 
 /// The character an XML entity name (without `&` and `;`) stands for: the five
 /// predefined entities and character references (`&#65;`, `&#x41;`). `&#0;` is `None`:
@@ -117,7 +137,7 @@ pub fn normalised_space(rest: &str) -> Option<usize> {
 /// XML 1.0's attribute-value normalisation for CDATA attributes (sections 2.11 and
 /// 3.3.3), which AS2FM gets from lxml: an `expr` written over two lines reads the same
 /// in both tools. `Err` gives the byte offset of a bad reference and what is wrong.
-pub fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, String)> {
+pub fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, BadReference)> {
     if !raw.contains(ATTR_SPECIAL) {
         return Ok(std::borrow::Cow::Borrowed(raw));
     }
@@ -132,13 +152,13 @@ pub fn unescape(raw: &str) -> Result<std::borrow::Cow<'_, str>, (usize, String)>
             pos += consumed;
             continue;
         }
-        match reference(rest) {
-            Some(Ok((c, consumed))) => {
+        // `ATTR_SPECIAL` is `&` or a space `normalised_space` takes: here, an `&`.
+        match reference(rest).unwrap_or(Err(BadReference::Stray)) {
+            Ok((c, consumed)) => {
                 out.push(c);
                 pos += consumed;
             }
-            Some(Err(message)) => return Err((pos, message)),
-            None => return Err((pos, "malformed reference".to_owned())),
+            Err(e) => return Err((pos, e)),
         }
     }
     out.push_str(&raw[pos..]);
@@ -189,17 +209,17 @@ mod tests {
         assert_eq!(unescape("&#x41;&lt;").unwrap(), "A<");
         assert_eq!(
             unescape("a&#0;").unwrap_err(),
-            (1, "unknown reference `&#0;`".to_owned())
+            (1, BadReference::Unknown("#0".to_owned()))
         );
         assert_eq!(unescape("&#x0;").unwrap_err().0, 0);
         assert_eq!(unescape("x &#233;!").unwrap(), "x é!");
         assert_eq!(
             reference("&nbsp; b"),
-            Some(Err("unknown reference `&nbsp;`".to_owned()))
+            Some(Err(BadReference::Unknown("nbsp".to_owned())))
         );
         assert_eq!(reference("&amp;&lt;"), Some(Ok(('&', 5))));
         assert!(
-            matches!(reference("&a b c d e f g h i;"), Some(Err(m)) if m.contains("write `&amp;`"))
+            matches!(reference("&a b c d e f g h i;"), Some(Err(m)) if m.to_string().contains("write `&amp;`"))
         );
         assert_eq!(reference("a"), None);
     }

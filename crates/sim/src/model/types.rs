@@ -3,6 +3,7 @@
 use super::source::{Diagnostic, FileId, SourceMap, Span};
 use super::xml::{self, Node};
 pub use codegen::scalar::Scalar;
+use codegen::scalar::ScalarKind;
 
 /// A base (scalar) type as written in a model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -20,18 +21,11 @@ pub enum BaseType {
 /// How the simulator stores a scalar.
 impl From<Scalar> for BaseType {
     fn from(s: Scalar) -> BaseType {
-        match s {
-            Scalar::Bool => BaseType::Bool,
-            Scalar::I8
-            | Scalar::I16
-            | Scalar::I32
-            | Scalar::I64
-            | Scalar::U8
-            | Scalar::U16
-            | Scalar::U32
-            | Scalar::U64 => BaseType::Int,
-            Scalar::F32 | Scalar::F64 => BaseType::Float,
-            Scalar::Str => BaseType::Str,
+        match s.kind() {
+            ScalarKind::Bool => BaseType::Bool,
+            ScalarKind::Int => BaseType::Int,
+            ScalarKind::Float => BaseType::Float,
+            ScalarKind::Str => BaseType::Str,
         }
     }
 }
@@ -77,13 +71,6 @@ impl std::fmt::Display for TypeError {
 }
 
 impl std::error::Error for TypeError {}
-
-/// The message, for a diagnostic at the type's position.
-impl From<TypeError> for String {
-    fn from(e: TypeError) -> String {
-        e.to_string()
-    }
-}
 
 impl TypeExpr {
     /// Parses `int32`, `float64[]`, `string[3][]`, `MyStruct`, ...
@@ -284,7 +271,7 @@ impl TypeDefs {
                         }
                         match TypeExpr::parse(&fty.value) {
                             Ok(t) => fields.push((fid.value.clone(), t)),
-                            Err(m) => errs.push(sm.diag(fty.value_span, m)),
+                            Err(m) => errs.push(sm.diag(fty.value_span, m.to_string())),
                         }
                     }
                     self.defs.push((id, TypeDef::Struct { fields }, el.span));

@@ -264,7 +264,7 @@ pub fn parse_text(src: &str, file: FileId) -> Result<Element, XmlError> {
                     let value = match unescape(raw) {
                         Ok(v) => v.into_owned(),
                         Err((k, message)) => {
-                            return Err(fail(u64::from(val_off) + k as u64, message));
+                            return Err(fail(u64::from(val_off) + k as u64, message.to_string()));
                         }
                     };
                     attrs.push(Attr {

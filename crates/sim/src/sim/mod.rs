@@ -57,7 +57,8 @@ pub use compiled::CompiledModel;
 pub use ids::{EventId, MachineId, StateId};
 pub use observer::{Flow, Inbox, Observer, Scalar, SentMessage, EXTERNAL};
 pub use run::{
-    mix, EndReason, EventSemantics, Memory, PutBack, Quiescence, RunConfig, RunError, RunOutcome,
-    Sampled, Scheduler, Simulator, SpinKind, SpinReport, TransitionChoice,
+    mix, BadScheduler, EndReason, EventSemantics, Memory, PutBack, Quiescence, RunConfig, RunError,
+    RunOutcome, Sampled, Scheduler, SchedulerWhy, Simulator, SpinKind, SpinReport,
+    TransitionChoice,
 };
 pub use trace::{TraceRecorder, TraceRow};

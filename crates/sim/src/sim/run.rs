@@ -22,7 +22,7 @@ pub use config::{
     EndReason, EventSemantics, Quiescence, RunConfig, RunError, RunOutcome, SpinKind, SpinReport,
     TransitionChoice,
 };
-pub use sched::{mix, Memory, PutBack, Sampled, Scheduler};
+pub use sched::{mix, BadScheduler, Memory, PutBack, Sampled, Scheduler, SchedulerWhy};
 
 const IDLE: u32 = u32::MAX;
 const NO_MSG: u32 = u32::MAX;

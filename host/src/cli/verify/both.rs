@@ -54,7 +54,7 @@ pub(super) fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
             &mut |p| bar.update(p),
             stop,
         )
-        .map_err(CliError::Input)?;
+        .map_err(|e| CliError::Input(e.to_string()))?;
         let mut r = report(args, &loaded.props_path, &loaded.set, &result);
         r.settings.push(("bt".into(), bt.label().into()));
         if let Some(unit) = loaded.unit_ns {

@@ -47,21 +47,12 @@ impl From<MemoryArg> for Memory {
 }
 
 /// A `--scheduler` value that names no scheduler: the text and what is wrong with it.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct BadScheduler(pub String);
-
-impl std::fmt::Display for BadScheduler {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for BadScheduler {}
+pub use crate::sim::BadScheduler;
 
 /// Parses `--scheduler`: `uniform`, `memoryless:ID` or `history:ID` (with `+...`
 /// put-backs, as `--json` names them).
 pub fn parse_scheduler(text: &str) -> Result<Scheduler, BadScheduler> {
-    text.parse().map_err(BadScheduler)
+    text.parse()
 }
 
 /// Refuses combinations `--schedulers` does not support, with the reason.
@@ -302,7 +293,11 @@ pub(super) fn witness_runs(
         let Some(b) = row.schedulers.as_ref().filter(|b| b.order_sensitive) else {
             continue;
         };
-        let min: Scheduler = b.min.scheduler.parse().map_err(CliError::Failed)?;
+        let min: Scheduler = b
+            .min
+            .scheduler
+            .parse()
+            .map_err(|e: BadScheduler| CliError::Failed(e.to_string()))?;
         for (label, scheduler) in [
             (format!("min witness {min}"), min),
             ("uniform scheduler".to_string(), Scheduler::Uniform),

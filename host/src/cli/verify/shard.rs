@@ -138,7 +138,9 @@ pub(super) fn run_shard_cli(
         |k, rng| runner.run(k, rng),
         &mut |p| bar.update(p),
     );
-    runner.finish().map_err(CliError::Input)?;
+    runner
+        .finish()
+        .map_err(|e| CliError::Input(e.to_string()))?;
     Ok(part)
 }
 

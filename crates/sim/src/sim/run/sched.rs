@@ -152,10 +152,14 @@ impl std::fmt::Display for Scheduler {
 }
 
 impl std::str::FromStr for Scheduler {
-    type Err = String;
+    type Err = BadScheduler;
 
     /// Reads what [`Scheduler`]'s `Display` writes; a bare hex id is memoryless.
-    fn from_str(text: &str) -> Result<Self, String> {
+    fn from_str(text: &str) -> Result<Self, BadScheduler> {
+        let bad = |why| BadScheduler {
+            text: text.to_string(),
+            why,
+        };
         let t = text.trim();
         if t == "uniform" {
             return Ok(Scheduler::Uniform);
@@ -165,8 +169,12 @@ impl std::str::FromStr for Scheduler {
         let mut uniform = PutBack::default();
         for part in parts {
             let index = |v: &str| {
-                v.parse::<u32>()
-                    .map_err(|_| format!("`{text}`: `+{part}`: `{v}` is not an index"))
+                v.parse::<u32>().map_err(|_| {
+                    bad(SchedulerWhy::NotAnIndex {
+                        part: part.to_string(),
+                        value: v.to_string(),
+                    })
+                })
             };
             match part.split_once('=') {
                 None if part == "machines" => uniform.machines = true,
@@ -174,34 +182,21 @@ impl std::str::FromStr for Scheduler {
                 None if part == "transitions" => uniform.transitions = true,
                 Some(("machine", v)) => uniform.machine = Some(index(v)?),
                 Some(("event", v)) => uniform.event = Some(index(v)?),
-                _ => {
-                    return Err(format!(
-                        "`{text}`: unknown override `+{part}` (expected `+machines`, \
-                         `+events`, `+transitions`, `+machine=M` or `+event=E`)"
-                    ))
-                }
+                _ => return Err(bad(SchedulerWhy::UnknownOverride(part.to_string()))),
             }
         }
         let (memory, hex) = match t.split_once(':') {
             Some(("memoryless", h)) => (Memory::Memoryless, h),
             Some(("history", h)) => (Memory::History, h),
-            Some((k, _)) => {
-                return Err(format!(
-                    "`{text}`: unknown scheduler kind `{k}` (expected `uniform`, \
-                     `memoryless:ID` or `history:ID`, ID 1 to 16 hex digits)"
-                ))
-            }
+            Some((k, _)) => return Err(bad(SchedulerWhy::UnknownKind(k.to_string()))),
             None => (Memory::Memoryless, t),
         };
         let hex = hex.strip_prefix("0x").unwrap_or(hex);
         if hex.is_empty() || hex.len() > 16 {
-            return Err(format!(
-                "`{text}`: expected `uniform`, `memoryless:ID` or `history:ID`, ID 1 to 16 \
-                 hex digits"
-            ));
+            return Err(bad(SchedulerWhy::IdLength));
         }
-        let id = u64::from_str_radix(hex, 16)
-            .map_err(|_| format!("`{text}`: the id `{hex}` is not hexadecimal"))?;
+        let id =
+            u64::from_str_radix(hex, 16).map_err(|_| bad(SchedulerWhy::NotHex(hex.to_string())))?;
         Ok(Scheduler::Sampled(Sampled {
             id,
             memory,
@@ -209,6 +204,64 @@ impl std::str::FromStr for Scheduler {
         }))
     }
 }
+
+/// A text that names no [`Scheduler`] (as `--scheduler` reads it): the text and why.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BadScheduler {
+    /// The text as given.
+    pub text: String,
+    /// What is wrong with it.
+    pub why: SchedulerWhy,
+}
+
+/// What is wrong with a scheduler's text ([`BadScheduler`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SchedulerWhy {
+    /// `+part`'s value is not an index.
+    NotAnIndex {
+        /// The put-back (`machine=x`).
+        part: String,
+        /// Its value (`x`).
+        value: String,
+    },
+    /// A put-back of no known form (the text after `+`).
+    UnknownOverride(String),
+    /// A kind before `:` other than `memoryless` and `history`.
+    UnknownKind(String),
+    /// The id is empty or longer than 16 digits.
+    IdLength,
+    /// The id (without `0x`) is not hexadecimal.
+    NotHex(String),
+}
+
+impl std::fmt::Display for BadScheduler {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let text = &self.text;
+        match &self.why {
+            SchedulerWhy::NotAnIndex { part, value } => {
+                write!(f, "`{text}`: `+{part}`: `{value}` is not an index")
+            }
+            SchedulerWhy::UnknownOverride(part) => write!(
+                f,
+                "`{text}`: unknown override `+{part}` (expected `+machines`, \
+                 `+events`, `+transitions`, `+machine=M` or `+event=E`)"
+            ),
+            SchedulerWhy::UnknownKind(k) => write!(
+                f,
+                "`{text}`: unknown scheduler kind `{k}` (expected `uniform`, \
+                 `memoryless:ID` or `history:ID`, ID 1 to 16 hex digits)"
+            ),
+            SchedulerWhy::IdLength => write!(
+                f,
+                "`{text}`: expected `uniform`, `memoryless:ID` or `history:ID`, ID 1 to 16 \
+                 hex digits"
+            ),
+            SchedulerWhy::NotHex(hex) => write!(f, "`{text}`: the id `{hex}` is not hexadecimal"),
+        }
+    }
+}
+
+impl std::error::Error for BadScheduler {}
 
 /// Mixes `v` into `h`: the finaliser of SplitMix64 (Steele, Lea, Flood, "Fast splittable
 /// pseudorandom number generators", OOPSLA 2014) over `h` rotated plus `v`, so that
