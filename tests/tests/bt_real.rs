@@ -788,7 +788,7 @@ fn doubles_in_scripts_agree_with_the_real_library() {
 
 /// Strings in scripts (`gen::Options::strings`): the rules measured in 4.8.2 while
 /// writing them (`tests/src/bt/script.rs`; the lowering's `btcpp4_strings.rs`), then the
-/// format-4 trees of 2,000 seeds, each under both tick modes.
+/// format-4 trees of 10,000 seeds, each under both tick modes.
 #[test]
 fn strings_in_scripts_agree_with_the_real_library() {
     const CONDITIONS: [&str; 30] = [
@@ -836,7 +836,7 @@ fn strings_in_scripts_agree_with_the_real_library() {
             (format!("`{code}`"), xml, Scripts::new(), 1)
         })
         .collect();
-    let n = env("HINDSIGHT_BT_REAL_STRING_TREES", 2_000);
+    let n = env("HINDSIGHT_BT_REAL_STRING_TREES", 10_000);
     let seed0 = env("HINDSIGHT_BT_SEED", 0) + 6_000_000;
     let start = std::time::Instant::now();
     for seed in seed0..seed0 + n {

@@ -1094,6 +1094,7 @@ mod tests {
             let mut env = Env {
                 vals: &mut vals,
                 dbl: &mut dbl,
+                strs: &mut BTreeMap::new(),
             };
             parse(src).expect("parses").run(&mut env, &texts)
         };
