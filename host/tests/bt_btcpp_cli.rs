@@ -388,9 +388,9 @@ fn scripts_and_conditions_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         (
             "string",
             "btcpp",
-            "<Sequence>\n  <Script code=\"msg := 'hi'\"/>\n</Sequence>",
-            "msg := 'hi'",
-            "strings in scripts are not modelled: the model's expressions have no string operations",
+            "<Sequence>\n  <Script code=\"msg := 'hi' + '!'\"/>\n</Sequence>",
+            "msg := 'hi' + '!'",
+            "`+` over two strings joins them (BT.CPP 4's concatenation), which is not modelled",
         ),
         (
             "text",

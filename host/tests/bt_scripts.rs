@@ -107,7 +107,13 @@ fn scripts_the_btcpp_lowering_cannot_model_are_refused_saying_why() {
     // script and the reason.
     let btcpp = BtSemantics::Btcpp { tick: BtTick::Once };
     for (code, col, why) in [
-        ("x := 'abc'", 6, "no string operations"),
+        ("x := 'a' + 'b'", 6, "joins them"),
+        (
+            "x := 'a'; x := 1",
+            11,
+            "which a script also assigns strings",
+        ),
+        ("x := 1 == 'a3'", 11, "reads a prefix of a text as a number"),
         ("x := 1. &lt; 2", 6, "not one BT.CPP 4 reads"),
         ("x := 1e400 &gt; 0", 6, "out of a double's range"),
     ] {
@@ -133,6 +139,7 @@ fn scripts_the_btcpp_lowering_cannot_model_are_refused_saying_why() {
         "x := 1 &amp; 3 | ~2 ^ 1",
         "y := 0; x := 1 / y &gt; 0",
         "x := 1 / 0 &gt; 0; z := 1 / -x",
+        "x := 'abc' &lt; 'abd' &amp;&amp; ' 3' == 3",
     ] {
         let tree = format!(
             "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n<Script code=\"{code}\"/>\n</BehaviorTree>\n</root>\n"

@@ -521,6 +521,36 @@ fn scripts_read_the_text_setblackboard_wrote() {
 }
 
 #[test]
+fn scripts_compare_strings_as_btcpp_does() {
+    // Checked against the real library (BT.CPP 4.8.2): the texts `1` and `01` differ as
+    // strings and both read as 1 against a number; strings order byte by byte (`B`
+    // before `a`, `10` before `9`, a prefix first); `t` created from a string holds
+    // strings; a letter read as a number throws ("Any failed string to number
+    // conversion"): the tree stops after A.
+    let t = v4(
+        "<Sequence><SetBlackboard output_key=\"k\" value=\"1\"/>\
+         <SetBlackboard output_key=\"j\" value=\"01\"/><Script code=\"t := 'B'\"/>\
+         <ScriptCondition code=\"k != j &amp;&amp; k == 1 &amp;&amp; j == 1 &amp;&amp; j &lt; k\"/>\
+         <ScriptCondition code=\"t &lt; 'a' &amp;&amp; '10' &lt; '9' &amp;&amp; 'a' &lt; 'aa' &amp;&amp; t == 'B'\"/>\
+         <A/><ScriptCondition code=\"t == 1\"/></Sequence>",
+    );
+    let sc = scripts(&[("A", &[S])]);
+    assert_eq!(
+        lowered(&t, &sc, 2, BtTick::Once).unwrap(),
+        ran(&[], &[T(1006)])
+    );
+    // `?:` picks a text; a text read as the condition of `?:` is a number (` 1` is 1).
+    let t = v4(
+        "<Sequence><Script code=\"t := 'x'; t = (t == 'x' ? ' 1' : 'y')\"/>\
+         <ScriptCondition code=\"(t ? 1 : 0) == 1 &amp;&amp; t != '1'\"/><A/></Sequence>",
+    );
+    assert_eq!(
+        lowered(&t, &sc, 2, BtTick::Once).unwrap(),
+        ran(&[S, S], &[T(1003), T(1003)])
+    );
+}
+
+#[test]
 fn pre_and_post_conditions_run_around_the_node() {
     // A fails on its first tick: `_onFailure` counts it, and B's `_successIf` answers
     // SUCCESS without ticking B. On the second tick A succeeds.
@@ -805,6 +835,65 @@ fn random_trees_with_skipped_lower_to_what_btcpp_does() {
         ..Default::default()
     });
 }
+
+/// The same with strings in the scripts (`gen::Options::strings`): string literals in
+/// byte order and not, `t` created from a string, the texts SetBlackboard wrote (`1` and
+/// `01` equal as numbers, not as texts), compared with each other and with numbers.
+#[test]
+fn random_trees_with_strings_lower_to_what_btcpp_does() {
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        strings: true,
+        ..Default::default()
+    };
+    random_trees(opts);
+    // The trees held the new constructs (the same seeds, generated again).
+    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0);
+    let (mut two, mut with_number, mut assigned) = (0u64, 0u64, 0u64);
+    for seed in seed0..seed0 + n {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let c = gen::case_with_conds(
+            &mut rng,
+            4 + (seed % 12) as i64,
+            opts,
+            gen::Conditions::WithoutSkip,
+        );
+        let t = tree::read(&c.xml).expect("the oracle reads what it generates");
+        if t.nodes
+            .iter()
+            .any(|x| matches!(x.kind, Kind::SetBlackboard(_, Operand::Entry(_))))
+        {
+            continue;
+        }
+        let ops = ["==", "!=", "&lt;", "&lt;=", "&gt;", "&gt;="];
+        let seen = |l: &[&str], r: &[&str]| {
+            l.iter().any(|a| {
+                ops.iter()
+                    .any(|o| r.iter().any(|b| c.xml.contains(&format!("{a} {o} {b}"))))
+            })
+        };
+        // Two strings: an entry or a literal on each side.
+        two += u64::from(seen(&["t", "k0", "k1", "'"], &["t", "k0", "k1", "'"]));
+        // A string and a number, or a string as the condition of `?:`.
+        with_number += u64::from(
+            seen(&["t", "k0", "k1", "'"], &["0", "1", "2"])
+                || seen(&["0", "1", "2"], &["t", "k0", "k1"])
+                || ["t ? 1", "k0 ? 1", "k1 ? 1"]
+                    .iter()
+                    .any(|p| c.xml.contains(p)),
+        );
+        assigned += u64::from(c.xml.contains("t := t") || c.xml.contains("t = ("));
+    }
+    eprintln!(
+        "of the {n} trees (without a SetBlackboard copy): {two} compare two entries holding \
+         strings, {with_number} compare one with a number, {assigned} copy `t` into itself \
+         or pick a text for it with `?:`"
+    );
+    assert!(two >= n / 20 && with_number >= n / 20 && assigned >= n / 20);
+}
+
 
 /// The same with the timed nodes and TryCatch too (`gen::Options::time_nodes`,
 /// `try_catch`), so that SKIPPED reaches every parent that takes it: WhileDoElse,
@@ -1521,6 +1610,20 @@ fn random_trees_with_reals_lower_to_what_the_real_library_does() {
     real_library_with(true, false, false, false, (true, false), 1_000, 1_100_000);
 }
 
+/// The same with strings in the scripts (`gen::Options::strings`): literals, `t`
+/// created from a string, the texts SetBlackboard wrote, compared with strings (byte
+/// order) and with numbers (read as numbers, throwing for `'a'` and `''`).
+#[test]
+fn random_trees_with_strings_lower_to_what_the_real_library_does() {
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        strings: true,
+        ..Default::default()
+    };
+    real_library_opts(opts, 1_000, 1_300_000);
+}
+
 /// The same with UnsetBlackboard (`gen::Options::unset`) among the scripts.
 #[test]
 fn random_trees_with_unset_lower_to_what_the_real_library_does() {
@@ -1576,6 +1679,23 @@ fn real_library_with(
     default_n: u64,
     offset: u64,
 ) {
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts,
+        unset,
+        skipped,
+        root_skip: skipped,
+        bb_nodes: bb,
+        reals,
+        bits,
+        ..Default::default()
+    };
+    real_library_opts(opts, default_n, offset);
+}
+
+/// [`real_library_with`] for the trees `opts` draws (`btcpp4_nodes` among them).
+fn real_library_opts(opts: gen::Options, default_n: u64, offset: u64) {
+    let (scripts, unset, skipped, bb) = (opts.scripts, opts.unset, opts.skipped, opts.bb_nodes);
     let Some(mut lib) = harness() else { return };
     let n = env("HINDSIGHT_BT_REAL_LOWERING_TREES", default_n) as usize;
     let seed0 = env("HINDSIGHT_BT_SEED", 0) + offset;
@@ -1597,17 +1717,7 @@ fn real_library_with(
         let c = gen::case_with_conds(
             &mut rng,
             4 + (seed % 12) as i64,
-            gen::Options {
-                btcpp4_nodes: true,
-                scripts,
-                unset,
-                skipped,
-                root_skip: skipped,
-                bb_nodes: bb,
-                reals,
-                bits,
-                ..Default::default()
-            },
+            opts,
             if skipped {
                 gen::Conditions::All
             } else {

@@ -887,6 +887,96 @@ fn bits_and_stored_reals_agree_with_the_real_library() {
     assert!(counts.errors > 0 && counts.ran_all > 0);
 }
 
+/// Strings in scripts (`gen::Options::strings`): the rules measured in 4.8.2 while
+/// writing them (`tests/src/bt/script.rs`; the lowering's `btcpp4_strings.rs`), then the
+/// format-4 trees of 10,000 seeds, each under both tick modes.
+#[test]
+fn strings_in_scripts_agree_with_the_real_library() {
+    const CONDITIONS: [&str; 30] = [
+        "'a' == 'a'",
+        "'b' < 'a'",
+        "'B' < 'a'",
+        "'a' < 'aa'",
+        "'10' < '9'",
+        "'3' == '03'",
+        "'' == ''",
+        "'3' == 3",
+        "'03' == 3",
+        "' 3' == 3",
+        "'3 ' == 3",
+        "'+3' == 3",
+        "'-0' == 0",
+        "'3' < 10",
+        "'abc' == 3",
+        "'' == 0",
+        "' ' == 0",
+        "'a b' == 1",
+        "'a'",
+        "'1'",
+        "'0' ? true : false",
+        "'a' ? true : false",
+        "(true ? 'a' : 'b') == 'a'",
+        "2 < 1 < 'a'",
+        "1 < 2 < 'a'",
+        "'a' < 'b' == 1",
+        "-'a' == 1",
+        "'a' * 'b' == 1",
+        "t:='a'; t:='b'; t == 'b'",
+        "t:='a'; t:=3",
+    ];
+    let Some(mut real) = harness() else { return };
+    let mut cases: Vec<(String, String, Scripts, usize)> = CONDITIONS
+        .iter()
+        .map(|code| {
+            let xml = doc(&format!(
+                "<ScriptCondition code=\"{}\"/>",
+                code.replace('&', "&amp;")
+                    .replace('<', "&lt;")
+                    .replace('>', "&gt;")
+            ));
+            (format!("`{code}`"), xml, Scripts::new(), 1)
+        })
+        .collect();
+    let n = env("HINDSIGHT_BT_REAL_STRING_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0) + 6_000_000;
+    let start = std::time::Instant::now();
+    for seed in seed0..seed0 + n {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let opts = gen::Options {
+            btcpp4_nodes: true,
+            scripts: true,
+            strings: true,
+            ..Default::default()
+        };
+        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
+        if !c.xml.contains("BTCPP_format=\"3\"") {
+            cases.push((format!("strings seed {seed}"), c.xml, c.scripts, c.ticks));
+        }
+    }
+    let mut counts = Counts::default();
+    let fails = check_all(&mut real, &cases, &mut counts);
+    eprintln!(
+        "BehaviorTree.CPP {}: {} conditions and {} random trees with strings in scripts, each \
+         under tickOnce and tickExactlyOnce: {} runs ({} ran every tick, {} threw) in {:.1} s; \
+         {} disagreements",
+        real.version,
+        CONDITIONS.len(),
+        cases.len() - CONDITIONS.len(),
+        counts.runs,
+        counts.ran_all,
+        counts.errors,
+        start.elapsed().as_secs_f64(),
+        fails.len()
+    );
+    assert!(
+        fails.is_empty(),
+        "{} disagreements (first 5):\n{}",
+        fails.len(),
+        fails.iter().take(5).cloned().collect::<Vec<_>>().join("\n")
+    );
+    assert!(counts.errors > 0 && counts.ran_all > 0);
+}
+
 /// The executor period of [`timed_nodes_agree_with_the_real_library`], in the real
 /// library's wall-clock milliseconds; the oracle runs the same trees at its default
 /// 100 ms with every duration scaled by 100/60.

@@ -117,7 +117,19 @@ pub struct Options {
     /// either sign), and Script nodes that store a double into an integer entry (which
     /// throws unless it is whole). Off, the generator draws what it drew before.
     pub bits: bool,
+    /// Strings in the scripts, with [`Options::scripts`]: the main tree creates `t` from
+    /// a string (`t:='a'`, remapped into every SubTree); statements assign it literals,
+    /// `k0`/`k1` (the texts a SetBlackboard wrote, some now written `01`, `00`, `10`) and
+    /// `?:` over two literals; conditions compare strings with strings (byte order:
+    /// `'B' < 'a'`, `'10' < '9'`, `'01' != '1'`) and, risky, with numbers (a text read as
+    /// a number: `' 1'` and `'01'` are 1, `'a'` and `''` throw). No concatenation. Off,
+    /// the generator draws what it drew before.
+    pub strings: bool,
 }
+
+/// The texts [`Options::strings`] writes: letters (read as numbers they throw) and
+/// whole numbers with spaces or leading zeros, in an order other than byte order.
+const TEXTS: [&str; 11] = ["b", "a", "", "ab", "B", "9", "10", "1", "01", " 1", "0"];
 
 /// The script entries: `x`, `y` integers, `f` a boolean, all written first by the main
 /// tree and remapped into every SubTree.
@@ -168,6 +180,12 @@ impl<R: Rng> G<'_, R> {
 
     /// A write: an int constant or copy, or a constant of another type.
     fn set(&mut self) -> String {
+        if self.opts.strings && self.scripts_on() && self.below(4) == 0 {
+            // The same numbers written otherwise: equal as numbers, not as texts.
+            let key = self.pick(&["k0", "k1"]);
+            let value = self.pick(&["01", "00", "10", "1"]);
+            return format!("<SetBlackboard output_key=\"{key}\" value=\"{value}\"/>");
+        }
         let (key, value) = match self.below(7) {
             0 => ("d0", self.pick(&["0.5", "1.5", "1.50000005"]).to_string()),
             1 => ("s0", self.pick(&["a", "b"]).to_string()),
@@ -254,6 +272,9 @@ impl<R: Rng> G<'_, R> {
         }
         if self.opts.reals && self.below(4) == 0 {
             return self.real_cond(risky);
+        }
+        if self.opts.strings && self.below(4) == 0 {
+            return self.str_cond(risky);
         }
         // Now and then, in a condition (`risky`), an entry a SetBlackboard wrote (`k0`,
         // `k1`, `p0`): BT.CPP 4 holds its text, which a comparison reads as a number.
@@ -361,11 +382,53 @@ impl<R: Rng> G<'_, R> {
         }
     }
 
+    /// A string literal of [`TEXTS`].
+    fn text(&mut self) -> String {
+        format!("'{}'", self.pick(&TEXTS))
+    }
+
+    /// A string: a literal, `t`, or (`texts`) a SetBlackboard's text (`k0`, `k1`: not in
+    /// statements, which must not throw, and a SetBlackboard copy leaves them empty in
+    /// BT.CPP 4.8.2, where reading them throws).
+    fn str_atom(&mut self, texts: bool) -> String {
+        match self.below(if texts { 5 } else { 3 }) {
+            0 | 1 => self.text(),
+            2 => "t".into(),
+            _ => self.pick(&["k0", "k1"]).into(),
+        }
+    }
+
+    /// A comparison of strings ([`Options::strings`]); `risky`: with the texts
+    /// SetBlackboard wrote, and with one that compares a string with a number (a text
+    /// that is not one throws) or reads it as the condition of `?:`.
+    fn str_cond(&mut self, risky: bool) -> String {
+        let op = self.pick(&["==", "!=", "<", "<=", ">", ">="]);
+        match self.below(if risky { 6 } else { 3 }) {
+            0 => format!("t {op} {}", self.text()),
+            1 => format!("{} {op} {}", self.str_atom(risky), self.str_atom(risky)),
+            2 => format!("({} {op} {}) == f", self.str_atom(risky), self.text()),
+            3 => format!("{} {op} {}", self.str_atom(true), self.below(3)),
+            4 => format!("{} {op} {}", self.below(3), self.pick(&["t", "k0", "k1"])),
+            _ => format!("({} ? 1 : 0) == 1", self.pick(&["t", "k0", "k1"])),
+        }
+    }
+
     /// One to three statements.
     fn script(&mut self) -> String {
         let n = 1 + self.below(3);
         let stmts: Vec<String> = (0..n)
             .map(|_| match self.below(if self.opts.bits { 10 } else { 7 }) {
+                // A string into `t`: never throws.
+                _ if self.opts.strings && self.below(4) == 0 => match self.below(3) {
+                    0 => format!("t := {}", self.str_atom(false)),
+                    1 => format!(
+                        "t = ({} ? {} : {})",
+                        self.bool_expr(0, false),
+                        self.text(),
+                        self.text()
+                    ),
+                    _ => format!("t := {}", self.text()),
+                },
                 7..=9 => self.bits_statement(),
                 // Depth 2: chains such as `x - 1 + y - 2`, which BT.CPP groups to the right.
                 0 => format!("x := {}", self.int_expr(2)),
@@ -854,12 +917,12 @@ impl<R: Rng> G<'_, R> {
                 e.to_string()
             }
         };
-        let more = if self.scripts_on() && self.opts.bits {
-            " x=\"{x}\" y=\"{y}\" f=\"{f}\" r=\"{r}\""
-        } else if self.scripts_on() {
-            " x=\"{x}\" y=\"{y}\" f=\"{f}\""
-        } else {
-            ""
+        let more = match (self.scripts_on(), self.opts.bits, self.opts.strings) {
+            (true, true, true) => " x=\"{x}\" y=\"{y}\" f=\"{f}\" r=\"{r}\" t=\"{t}\"",
+            (true, true, false) => " x=\"{x}\" y=\"{y}\" f=\"{f}\" r=\"{r}\"",
+            (true, false, true) => " x=\"{x}\" y=\"{y}\" f=\"{f}\" t=\"{t}\"",
+            (true, false, false) => " x=\"{x}\" y=\"{y}\" f=\"{f}\"",
+            _ => "",
         };
         let remap = match self.below(3) {
             0 => format!("{flag}=\"true\""),
@@ -939,6 +1002,12 @@ pub fn case_with_conds<R: Rng>(rng: &mut R, size: i64, opts: Options, conds: Con
         format!("<Script code=\"{SCRIPT_INIT}\"/>")
     } else {
         String::new()
+    };
+    // `t`, created from a string (BT.CPP keeps the type an entry was created with).
+    let init = if g.scripts_on() && g.opts.strings {
+        format!("{init}<Script code=\"t:='a'\"/>")
+    } else {
+        init
     };
     // Every entry written first, so each has a value and a type.
     let xml = format!(

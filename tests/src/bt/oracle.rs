@@ -301,6 +301,8 @@ pub struct Oracle<'t> {
     dbl: std::collections::BTreeSet<String>,
     /// Their exact values (`script::Env::reals`).
     reals: BTreeMap<String, f64>,
+    /// The entries scripts created from a string, and their texts (`script::Env`).
+    pub strs: BTreeMap<String, String>,
     /// Sequences and fallbacks: children skipped so far (`skipped_count_`).
     skipped: Vec<usize>,
     /// A script a halt ran threw: surfaced when the tick returns.
@@ -382,6 +384,7 @@ impl<'t> Oracle<'t> {
             vars: BTreeMap::new(),
             dbl: Default::default(),
             reals: BTreeMap::new(),
+            strs: BTreeMap::new(),
             skipped: vec![0; n],
             fault: None,
             memo: vec![false; n],
@@ -665,20 +668,25 @@ impl<'t> Oracle<'t> {
         let mut last = super::script::V::Num(0);
         for s in &p.0 {
             if let Expr::Assign(v, op, _) = s {
-                if *op != ":=" && !self.vars.contains_key(v) {
+                if *op != ":=" && !self.vars.contains_key(v) && !self.strs.contains_key(v) {
                     return Err(Fault::Throws(format!(
                         "The blackboard entry [{v}] doesn't exist"
                     )));
                 }
             }
             let fresh = match s {
-                Expr::Assign(v, _, _) if !self.vars.contains_key(v) => Some(v.clone()),
+                Expr::Assign(v, _, _)
+                    if !self.vars.contains_key(v) && !self.strs.contains_key(v) =>
+                {
+                    Some(v.clone())
+                }
                 _ => None,
             };
             let mut env = super::script::Env {
                 vals: &mut self.vars,
                 dbl: &mut self.dbl,
                 reals: &mut self.reals,
+                strs: &mut self.strs,
             };
             last = match Program(vec![s.clone()]).run(&mut env, &texts) {
                 Ok(v) => v,
@@ -917,6 +925,7 @@ impl<'t> Oracle<'t> {
             Kind::Unset(key) => {
                 self.vars.remove(key);
                 self.reals.remove(key);
+                self.strs.remove(key);
                 self.bb.remove(key);
                 self.seq.remove(key);
                 Ok(Success)
@@ -971,7 +980,8 @@ impl<'t> Oracle<'t> {
     /// ([`Oracle::seq`]); one a port names in `{}` exists from load with counter 0, which
     /// answers the same.
     fn updated(&mut self, n: usize, e: &str) -> bool {
-        let exists = self.vars.contains_key(e) || self.bb.contains_key(e);
+        let exists =
+            self.vars.contains_key(e) || self.strs.contains_key(e) || self.bb.contains_key(e);
         if !exists {
             return false;
         }

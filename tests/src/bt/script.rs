@@ -77,6 +77,8 @@ pub enum Expr {
     Bit(char, Box<Expr>, Box<Expr>),
     /// `name op e` with op one of `:=`, `=`, `+=`, `-=`, `*=`, `/=`.
     Assign(String, &'static str, Box<Expr>),
+    /// A `'string'` literal: its text.
+    Str(String),
 }
 
 /// A parsed script: its statements.
@@ -96,6 +98,7 @@ pub enum Fault {
 #[derive(Clone, Debug, PartialEq)]
 enum Tok {
     Num(i64),
+    Str(String),
     Real(f64),
     Id(String),
     Op(&'static str),
@@ -174,6 +177,15 @@ fn lex(src: &str) -> Result<Vec<(Tok, usize)>, String> {
             let (t, end) = number(src, s)?;
             i = end;
             out.push((t, s));
+        } else if c == b'\'' {
+            // A string literal: everything up to the next `'` (BT.CPP 4
+            // `Grammar::StringLiteral`).
+            let s = i;
+            let end = src[s + 1..]
+                .find('\'')
+                .ok_or(format!("column {}: unterminated string", s + 1))?;
+            out.push((Tok::Str(src[s + 1..s + 1 + end].to_string()), s));
+            i = s + end + 2;
         } else if c.is_ascii_alphabetic() || c == b'_' {
             let s = i;
             while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
@@ -392,6 +404,10 @@ impl P {
                 self.at += 1;
                 Ok(Expr::Real(v.to_bits()))
             }
+            Some(Tok::Str(t)) => {
+                self.at += 1;
+                Ok(Expr::Str(t))
+            }
             Some(Tok::Id(id)) => {
                 self.at += 1;
                 Ok(match id.as_str() {
@@ -441,7 +457,7 @@ impl Expr {
     /// Renames every entry (a SubTree's remapping).
     pub fn rename(&mut self, f: &dyn Fn(&str) -> String) {
         match self {
-            Expr::Num(_) | Expr::Real(_) => {}
+            Expr::Num(_) | Expr::Real(_) | Expr::Str(_) => {}
             Expr::Var(v) => *v = f(v),
             Expr::Neg(a) | Expr::Not(a) | Expr::BitNot(a) => a.rename(f),
             Expr::Arith(_, a, b) | Expr::Logic(_, a, b) | Expr::Bit(_, a, b) => {
@@ -480,6 +496,15 @@ impl Expr {
         Ok(V::Dbl(match self {
             Expr::Num(v) => return Ok(V::Num(*v)),
             Expr::Real(bits) => f64::from_bits(*bits),
+            Expr::Str(t) => return Ok(V::Text(t.clone())),
+            Expr::Var(v) if env.strs.contains_key(v) => {
+                if texts.contains_key(v) {
+                    return Err(Fault::Model(format!(
+                        "a script reads `{v}`, which both a script and a SetBlackboard wrote: not modelled"
+                    )));
+                }
+                return Ok(V::Text(env.strs[v].clone()));
+            }
             Expr::Var(v) => match (env.vals.get(v), texts.get(v)) {
                 (Some(x), None) if env.dbl.contains(v) => {
                     env.reals.get(v).copied().unwrap_or(*x as f64)
@@ -513,8 +538,10 @@ impl Expr {
             }
             Expr::Arith(op, a, b) => {
                 let (a, b) = (a.eval(env, texts)?, b.eval(env, texts)?);
-                if matches!((&a, &b), (V::Text(_), V::Text(_))) {
-                    return Err(Fault::Model("an operator over two strings".into()));
+                // `+` of two strings joins them (4.8.2: `'a' + 'b' == 'ab'`; not in
+                // the oracle's subset); the other operators throw.
+                if *op == '+' && matches!((&a, &b), (V::Text(_), V::Text(_))) {
+                    return Err(Fault::Model("`+` joining two strings".into()));
                 }
                 let (a, b) = (num(a)?, num(b)?);
                 let r = match op {
@@ -542,6 +569,12 @@ impl Expr {
                 }
                 let mut all = true;
                 for (i, op) in ops.iter().enumerate() {
+                    // The chain stops at the first pair that fails (4.10
+                    // `ExprComparison::evaluate`; 4.8.2: `2 < 1 < 'a'` is false, `1 < 2
+                    // < 'a'` throws converting `a`).
+                    if !all {
+                        break;
+                    }
                     let as_num = |v: &V| -> Result<Option<f64>, Fault> {
                         Ok(match v {
                             V::Num(n) => Some(exact(*n)?),
@@ -671,6 +704,8 @@ pub struct Env<'a> {
     /// The exact value of each entry holding a `double` (its sign of zero, its fraction,
     /// NaN, infinities); `vals` holds it truncated (0 for NaN).
     pub reals: &'a mut BTreeMap<String, f64>,
+    /// The entries holding a string (created from one).
+    pub strs: &'a mut BTreeMap<String, String>,
 }
 
 /// `v op e`, as BT.CPP 4.10 `ExprAssignment::evaluate` makes it.
@@ -681,13 +716,50 @@ fn assign(v: &str, op: &str, e: &Expr, env: &mut Env<'_>, texts: &Texts) -> Resu
         )));
     }
     let x = match e.eval(env, texts)? {
-        V::Text(_) | V::Empty => {
+        V::Empty => {
             return Err(Fault::Model(format!(
-                "a script copies a string into `{v}`: not modelled"
+                "a script copies an empty entry into `{v}`: not modelled"
             )))
         }
         x => x,
     };
+    // Strings (BT.CPP 4.10 `ExprAssignment::evaluate`, and 4.8.2 as measured): an entry
+    // created from a string holds strings; a number assigned to it throws, and so do
+    // `-=`, `*=`, `/=` with a string and `+=` of a number to it; `+=` of two strings
+    // joins them (not in the subset). A string assigned to a number entry is converted
+    // (not in the subset); `+=` of one throws ("Any::copyInto fails").
+    let holds_text = env.strs.contains_key(v);
+    match (&x, holds_text, op) {
+        (V::Text(t), false, ":=") if !env.vals.contains_key(v) => {
+            env.strs.insert(v.to_string(), t.clone());
+            return Ok(x);
+        }
+        (V::Text(t), true, ":=" | "=") => {
+            env.strs.insert(v.to_string(), t.clone());
+            return Ok(x);
+        }
+        (V::Text(_), true, "+=") => return Err(Fault::Model("`+=` joining two strings".into())),
+        (V::Text(_), false, ":=" | "=") => {
+            return Err(Fault::Model(format!(
+                "a string assigned to `{v}`, which holds a number"
+            )))
+        }
+        (V::Text(_), false, "+=") => return Err(Fault::Throws("Any::copyInto fails".into())),
+        (V::Text(_), _, _) => {
+            return Err(Fault::Throws("Operator not supported for strings".into()))
+        }
+        (_, true, ":=" | "=") => {
+            return Err(Fault::Throws(format!(
+                "Error assigning a value to entry [{v}] with type [std::string]"
+            )))
+        }
+        (_, true, _) => {
+            return Err(Fault::Throws(
+                "This Assignment operator can't be used with a non-numeric type".into(),
+            ))
+        }
+        _ => {}
+    }
     let old = env.vals.get(v).copied();
     // The value to store, and whether it is a `double`.
     let (new, dbl) = match (op, old) {
@@ -864,12 +936,24 @@ pub enum V {
 /// number conversion" for `abc`); texts that are not whole numbers are outside the
 /// oracle's subset.
 fn text_number(t: &str) -> Result<i64, Fault> {
-    let t = t.trim();
-    if let Ok(n) = t.parse::<i64>() {
-        return Ok(n);
+    // 4.8.2 reads a prefix (`3abc` is 3, `0x10` 16, `true` 1, `nan` a NaN): only whole
+    // decimal numbers with spaces around them (up to 2^53: beyond, "Loss of precision")
+    // and texts that cannot begin a number are in the subset.
+    let s = t.trim_matches(' ');
+    let digits = s.strip_prefix(['+', '-']).unwrap_or(s);
+    if !digits.is_empty() && digits.bytes().all(|c| c.is_ascii_digit()) {
+        return match s.parse::<i64>() {
+            Ok(n) if n.unsigned_abs() <= 1 << 53 => Ok(n),
+            _ => Err(Fault::Model(format!("the text `{t}` read as a number"))),
+        };
     }
-    if t.parse::<f64>().is_ok() || t == "true" || t == "false" {
-        return Err(Fault::Model(format!("the text `{t}` read as a number")));
+    // The empty text, spaces, and letters and spaces that do not begin `inf`, `nan`,
+    // `true` or `false` (4.8.2: ``, ` `, `abc`, `a b`, `e` throw).
+    let words = s.bytes().all(|c| c.is_ascii_alphabetic() || c == b' ');
+    match s.bytes().next().map(|c| c.to_ascii_lowercase()) {
+        None => {}
+        Some(c) if words && !b"intf".contains(&c) => {}
+        _ => return Err(Fault::Model(format!("the text `{t}` read as a number"))),
     }
     Err(Fault::Throws(
         "Any failed string to number conversion".into(),
@@ -936,6 +1020,7 @@ mod tests {
             vals: &mut vals,
             dbl: &mut dbl,
             reals: &mut BTreeMap::new(),
+            strs: &mut BTreeMap::new(),
         };
         match parse(src).expect("parses").run(&mut env, &Texts::new())? {
             V::Num(v) => Ok((v, vals)),
@@ -951,6 +1036,7 @@ mod tests {
             vals: &mut vals,
             dbl: &mut dbl,
             reals: &mut BTreeMap::new(),
+            strs: &mut BTreeMap::new(),
         };
         parse(src).expect("parses").holds(&mut env, &Texts::new())
     }
@@ -961,6 +1047,7 @@ mod tests {
             vals: &mut vals,
             dbl: &mut dbl,
             reals: &mut BTreeMap::new(),
+            strs: &mut BTreeMap::new(),
         };
         parse(src).expect("parses").run(&mut env, &Texts::new())
     }
@@ -1214,6 +1301,7 @@ mod tests {
             vals: &mut vals,
             dbl: &mut dbl,
             reals: &mut BTreeMap::new(),
+            strs: &mut BTreeMap::new(),
         };
         assert!(parse("3").unwrap().holds(&mut env, &none).is_err());
         assert!(parse("5-5").unwrap().holds(&mut env, &none) == Ok(false));
@@ -1234,6 +1322,7 @@ mod tests {
                 vals: &mut vals,
                 dbl: &mut dbl,
                 reals: &mut BTreeMap::new(),
+                strs: &mut BTreeMap::new(),
             };
             parse(src).expect("parses").run(&mut env, &texts)
         };
@@ -1262,6 +1351,7 @@ mod tests {
             vals: &mut vals,
             dbl: &mut dbl,
             reals: &mut BTreeMap::new(),
+            strs: &mut BTreeMap::new(),
         };
         assert!(matches!(
             parse("k").unwrap().holds(&mut env, &texts),

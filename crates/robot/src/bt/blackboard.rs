@@ -78,6 +78,9 @@ pub(crate) struct Blackboard {
     /// The entry-updated nodes: id, entry, machine; each gets a transition that compares
     /// the entry's counter with the one it saw last (`btcpp4_blackboard.rs`).
     pub updated: Vec<(u32, String, String)>,
+    /// The tree's texts and the entries holding strings in scripts
+    /// (`btcpp4_strings.rs`).
+    pub strings: super::btcpp4_strings::Strings,
 }
 
 impl Blackboard {
@@ -114,6 +117,12 @@ impl Blackboard {
                 .iter()
                 .map(|f| (f.as_str(), "bool", "false".to_string())),
         );
+        // String entries: their texts' ranks (`btcpp4_strings.rs`).
+        let sids: Vec<String> = (self.strings.set_entries.iter())
+            .chain(&self.strings.script_entries)
+            .map(|e| super::btcpp4_strings::sid(e))
+            .collect();
+        vars.extend(sids.iter().map(|v| (v.as_str(), "int64", "0".to_string())));
         if !self.scripts.is_empty() {
             vars.push((super::btcpp4_script::FAULT, "bool", "false".to_string()));
         }
@@ -127,6 +136,9 @@ impl Blackboard {
         let mut idle = b.state("idle");
         for e in &self.entries {
             let mut body = vec![b.assign(&e.name, "_event.data.value")];
+            if self.strings.set_entries.contains(&e.name) {
+                body.push(b.assign(&super::btcpp4_strings::sid(&e.name), "_event.data.sid"));
+            }
             if self.script_entries.contains(&e.name) {
                 body.push(b.assign(&super::btcpp4_script::has(&e.name), "true"));
             }
@@ -187,6 +199,11 @@ pub(crate) fn default_value(ty: &str) -> String {
 /// SetBlackboard: on every tick writes `value` (an expression) to `entry`, answers
 /// SUCCESS.
 pub(crate) fn set_blackboard(ctx: &Ctx, entry: &str, value: &str) -> Element {
+    set_blackboard_params(ctx, entry, &[("value", value)])
+}
+
+/// SetBlackboard sending `params` with its write.
+fn set_blackboard_params(ctx: &Ctx, entry: &str, params: &[(&str, &str)]) -> Element {
     let b = &ctx.b;
     let mut m = b.scxml(&ctx.machine, "idle");
     m.push(
@@ -196,7 +213,7 @@ pub(crate) fn set_blackboard(ctx: &Ctx, entry: &str, value: &str) -> Element {
                 None,
                 Some("idle"),
                 vec![
-                    b.send_params(&set_event(entry), MACHINE, &[("value", value)]),
+                    b.send_params(&set_event(entry), MACHINE, params),
                     ctx.respond(SUCCESS),
                 ],
             ))
@@ -512,6 +529,17 @@ pub(crate) fn lower_set(
     let (entry, e, value) = typed_entry(sm, n, bb, errs)?;
     match &value.value {
         PortValue::Literal(v) => match plugin::check_literal(v, &e.ty) {
+            // An entry scripts read as a string: its text's rank too
+            // (`btcpp4_strings.rs`).
+            Ok(()) if bb.strings.set_entries.contains(&entry) => {
+                let id = bb.strings.id(v).to_string();
+                let value = plugin::literal_expr(v, &e.ty);
+                Some(set_blackboard_params(
+                    ctx,
+                    &entry,
+                    &[("value", &value), ("sid", &id)],
+                ))
+            }
             Ok(()) => Some(set_blackboard(ctx, &entry, &plugin::literal_expr(v, &e.ty))),
             Err(_) if bb.conflicted.contains(&entry) => None,
             Err(m) => {

@@ -37,19 +37,21 @@
 //! - Reading an entry that holds no value throws ("Variable not found"); so does `=`,
 //!   `+=`, `-=`, `*=` on one (`:=` creates it).
 //! - `+ -` and `*` group to the right (`10 - 4 - 2` is 8, `1 - 1 + 1` is -1).
-//! - An entry SetBlackboard wrote holds a string (BT.CPP 4 stores SetBlackboard's value
-//!   as text). Where every write is an integer constant, a script may read it: compared
-//!   with a number it reads as that number (the text `3` equals 3), as the condition of
-//!   `c ? a : b` it is true unless 0; an arithmetic or logic operator, `-`, `!` over it,
-//!   or a condition whose value it is, throws ("Operation not permitted", "Invalid
-//!   operator for std::string", "no known safe conversion"). Refused: comparing two such
-//!   entries (a string comparison), copying one (`y := k`), writing one from a script.
+//! - Strings (`btcpp4_strings.rs`): a literal, an entry SetBlackboard wrote (BT.CPP 4
+//!   stores SetBlackboard's value as text) or one a script assigns strings to is a
+//!   [`Ty::Text`], the model expression holding its rank among the tree's texts in byte
+//!   order, so two strings compare as their ranks; compared with a number, or as the
+//!   condition of `c ? a : b`, a string reads as a number (the text `3` equals 3, `abc`
+//!   throws); an arithmetic or logic operator, `-`, `!` over it, or a condition whose
+//!   value it is, throws ("Operation not permitted", "Invalid operator for std::string",
+//!   "no known safe conversion"). Refused: joining strings, an entry whose type would
+//!   change, writing from a script an entry SetBlackboard writes.
 //!
 //! Where BT.CPP throws, the exception ends the tree's execution: the blackboard machine
 //! goes to its `error` state (`bt_script_fault` set), the node never answers, and the
 //! tree stops. Refused when the tree is read, each at the script's attribute with the
-//! column in the script and why: strings (the model's expressions have no string
-//! operations), the bit operators (nor bitwise ones), storing a number that need not be
+//! column in the script and why: joining strings (the texts a tree can make must be
+//! known when it is lowered), the bit operators (no bitwise operations in the model), storing a number that need not be
 //! whole (`x := 5/2`, `x /= 2`: the model's script entries are integers), a divisor
 //! other than a number literal other than 0, a number
 //! literal BT.CPP refuses at load, an entry SetBlackboard writes other than as above,
@@ -90,8 +92,9 @@ fn done_event(id: u32) -> String {
 enum Ty {
     Int,
     Bool,
-    /// An entry SetBlackboard wrote an integer constant to: BT.CPP 4 holds its text
-    /// (the model variable holds the number the text reads as).
+    /// A string: the model expression is its text's rank among the tree's texts
+    /// (`btcpp4_strings.rs`): a literal, an entry a SetBlackboard writes (read from
+    /// `bt_sid__<entry>`) or one a script assigns strings to.
     Text,
     /// A `double` that need not be whole (the value of `/`, a real literal, or an
     /// operator over one): a `float64` expression in the model, never stored.
@@ -103,8 +106,8 @@ pub(crate) fn dbl(e: &str) -> String {
     format!("bt_dbl__{e}")
 }
 
-/// Why an operator over an entry SetBlackboard wrote cannot be modelled.
-const TWO_TEXTS: &str = "two entries SetBlackboard wrote: BT.CPP 4 holds their texts and compares or joins them as strings, which is not modelled";
+/// Why joining two strings cannot be modelled.
+const CONCAT: &str = "`+` over two strings joins them (BT.CPP 4's concatenation), which is not modelled: the model holds a string as its rank among the texts written in the tree, so every text a tree can make must be known when it is lowered";
 
 /// An operator the parser gives and the lowering does not know (none today).
 const BITS: &str = "this operator is not modelled";
@@ -160,6 +163,8 @@ type Name = (String, String, Ty, bool);
 struct Tr<'a> {
     /// The script's entry names.
     names: &'a [Name],
+    /// The tree's texts (`btcpp4_strings.rs`).
+    strs: &'a super::btcpp4_strings::Strings,
     /// Conditions under which the statement being translated throws.
     checks: Vec<String>,
 }
@@ -293,9 +298,30 @@ impl Tr<'_> {
         (g.clone(), *t, *dynamic)
     }
 
-    /// `e` is an entry SetBlackboard wrote, read as it is (a string in BT.CPP 4).
+    /// `e` is a string by its form (a literal, an entry holding strings, `?:` with a
+    /// string on either side: `ex` gives it [`Ty::Text`] or refuses it).
     fn is_text(&self, e: &Ex) -> bool {
-        matches!(&e.k, K::Name(n) if self.entry(n).1 == Ty::Text)
+        match &e.k {
+            K::Str(_) => true,
+            K::Name(n) => self.entry(n).1 == Ty::Text,
+            K::Ite(_, a, b) => self.is_text(a) || self.is_text(b),
+            _ => false,
+        }
+    }
+
+    /// The string `v` (the value of `e`) read as a number, as a comparison with a
+    /// number and the condition of `?:` read it (`btcpp4_strings.rs`, `as_number`):
+    /// where it throws, under `guard`, and the number.
+    fn text_number(&mut self, e: &Ex, v: &Val, guard: &str) -> Result<String, Refuse> {
+        let texts: Vec<&str> = match &e.k {
+            K::Str(t) => vec![t.as_str()],
+            _ => self.strs.texts.iter().map(String::as_str).collect(),
+        };
+        let (throws, n) = self.strs.number(&v.x, &texts).map_err(|w| (e.at, w))?;
+        if let Some(c) = throws {
+            self.check(guard, c);
+        }
+        Ok(n)
     }
 
     fn check(&mut self, guard: &str, cond: String) {
@@ -340,17 +366,21 @@ impl Tr<'_> {
                 let d = if ty == Ty::Real { "true" } else { "false" };
                 val(x, ty, d)
             }
-            K::Str => {
-                return refuse(
-                    "strings in scripts are not modelled: the model's expressions have no string operations (BT.CPP joins them with `+`/`..` and orders them)",
-                )
-            }
+            // A string: its rank (`btcpp4_strings.rs`).
+            K::Str(t) => val(self.strs.id(t).to_string(), Ty::Text, "false"),
             K::Name(n) => {
                 let (g, t, dynamic) = self.entry(n);
                 // "Variable not found".
                 self.check(guard, format!("!{}", has(&g)));
                 let d = if dynamic { dbl(&g) } else { "false".into() };
-                Val { x: g, t, d }
+                // An entry a SetBlackboard writes keeps its text's rank beside the
+                // value other nodes read.
+                let x = if t == Ty::Text && !dynamic {
+                    super::btcpp4_strings::sid(&g)
+                } else {
+                    g
+                };
+                Val { x, t, d }
             }
             K::Un("-", a) => {
                 let v = self.number(a, guard)?;
@@ -371,8 +401,10 @@ impl Tr<'_> {
             }
             K::Un(..) => return refuse(BITS),
             K::Bin(op @ ("+" | "-" | "*" | "/"), a, b) => {
-                if self.is_text(a) && self.is_text(b) {
-                    return Err((e.at, format!("`{op}` over {TWO_TEXTS}")));
+                // Two strings: `+` joins them; the other operators throw ("Operation
+                // not permitted"), as does any of them over a string and a number.
+                if *op == "+" && self.is_text(a) && self.is_text(b) {
+                    return Err((e.at, CONCAT.to_string()));
                 }
                 if *op == "/" && !nonzero_literal(b) {
                     // Any other divisor: computed exactly as BT.CPP's double, sign of zero
@@ -416,28 +448,46 @@ impl Tr<'_> {
             K::Bin(..) => return refuse(BITS),
             K::Cmp(xs, ops) => {
                 // A string compared with a number is read as one (BT.CPP 4.8.2: the text
-                // `3` equals 3): the model variable's number. Two strings compare as
-                // strings.
-                if let Some(w) = xs.windows(2).find(|w| self.is_text(&w[0]) && self.is_text(&w[1])) {
-                    return Err((w[0].at, format!("comparing {TWO_TEXTS}")));
-                }
+                // `3` equals 3, `abc` throws); two strings compare as strings, byte by
+                // byte: their ranks (`btcpp4_strings.rs`).
                 let mut vs = Vec::with_capacity(xs.len());
                 for x in xs {
-                    let v = self.ex(x, guard)?;
-                    vs.push((int(&v.x, v.t), v.t == Ty::Real));
+                    vs.push(self.ex(x, guard)?);
                 }
-                let parts: Vec<String> = ops
-                    .iter()
-                    .enumerate()
-                    .map(|(i, op)| {
-                        let ((l, lr), (r, rr)) = (&vs[i], &vs[i + 1]);
-                        if *lr || *rr {
-                            compare_real(op, l, r)
+                let mut parts: Vec<String> = Vec::with_capacity(ops.len());
+                for (i, op) in ops.iter().enumerate() {
+                    let (l, r) = (&vs[i], &vs[i + 1]);
+                    if l.t == Ty::Text && r.t == Ty::Text {
+                        parts.push(format!("{} {op} {}", l.x, r.x));
+                        continue;
+                    }
+                    // A pair is compared only while the ones before it held
+                    // (`ExprComparison::evaluate` returns false at the first that
+                    // fails; 4.8.2: `2 < 1 < 'a'` is false, `1 < 2 < 'a'` throws).
+                    let mut g = guard.to_string();
+                    if !parts.is_empty() {
+                        let held = parts.join(" && ");
+                        g = if g.is_empty() {
+                            held
                         } else {
-                            format!("{l} {op} {r}")
-                        }
-                    })
-                    .collect();
+                            format!("({g}) && {held}")
+                        };
+                    }
+                    let side = |tr: &mut Self, v: &Val, x: &Ex| -> Result<(String, bool), Refuse> {
+                        Ok(if v.t == Ty::Text {
+                            (tr.text_number(x, v, &g)?, false)
+                        } else {
+                            (int(&v.x, v.t), v.t == Ty::Real)
+                        })
+                    };
+                    let (l, lr) = side(self, l, &xs[i])?;
+                    let (r, rr) = side(self, r, &xs[i + 1])?;
+                    parts.push(if lr || rr {
+                        compare_real(op, &l, &r)
+                    } else {
+                        format!("{l} {op} {r}")
+                    });
+                }
                 val(format!("({})", parts.join(" && ")), Ty::Bool, "true")
             }
             K::Ite(c, a, b) => {
@@ -447,7 +497,8 @@ impl Tr<'_> {
                 let cv = self.ex(c, guard)?;
                 let cond = match cv.t {
                     Ty::Bool => cv.x,
-                    Ty::Int | Ty::Text | Ty::Real => format!("({} != 0)", cv.x),
+                    Ty::Text => format!("({} != 0)", self.text_number(c, &cv, guard)?),
+                    Ty::Int | Ty::Real => format!("({} != 0)", cv.x),
                 };
                 let join = |g: &str, c: &str| {
                     if g.is_empty() {
@@ -457,11 +508,22 @@ impl Tr<'_> {
                     }
                 };
                 // Only the branch taken is evaluated: its checks only count then.
-                if let Some(x) = [a, b].into_iter().find(|x| self.is_text(x)) {
-                    return Err((x.at, "a SetBlackboard's text as the value of `?:`: BT.CPP 4 gives the string, and strings in scripts are not modelled yet".into()));
-                }
                 let x = self.ex(a, &join(guard, &cond))?;
                 let y = self.ex(b, &join(guard, &format!("!{cond}")))?;
+                match (x.t == Ty::Text, y.t == Ty::Text) {
+                    (true, true) => {
+                        return Ok(val(
+                            format!("({cond} ? {} : {})", x.x, y.x),
+                            Ty::Text,
+                            "false",
+                        ))
+                    }
+                    (false, false) => {}
+                    _ => {
+                        let at = if x.t == Ty::Text { a.at } else { b.at };
+                        return Err((at, "a string on one side of `?:` and a number on the other: the value's type would depend on the condition, which is not modelled".into()));
+                    }
+                }
                 let d = match (x.d.as_str(), y.d.as_str()) {
                     (l, r) if l == r => l.to_string(),
                     (l, r) => format!("({cond} ? {l} : {r})"),
@@ -492,9 +554,14 @@ struct Lowered {
     value: Val,
 }
 
-fn statement(names: &[Name], s: &Stmt) -> Result<Lowered, Refuse> {
+fn statement(
+    names: &[Name],
+    strs: &super::btcpp4_strings::Strings,
+    s: &Stmt,
+) -> Result<Lowered, Refuse> {
     let mut tr = Tr {
         names,
+        strs,
         checks: Vec::new(),
     };
     if let Some((target, op, _)) = &s.assign {
@@ -512,11 +579,11 @@ fn statement(names: &[Name], s: &Stmt) -> Result<Lowered, Refuse> {
     };
     let (g, et, dynamic) = tr.entry(target);
     let (x, t) = (v.x.as_str(), v.t);
-    if et == Ty::Text {
+    if et == Ty::Text && !dynamic {
         return Err((*at, format!("a script writing `{g}`, which a SetBlackboard writes: BT.CPP 4 holds a string there (4.8.2 refuses to assign it a number), which is not modelled")));
     }
-    if t == Ty::Text {
-        return Err((s.e.at, format!("assigning a SetBlackboard's text to `{g}`: BT.CPP 4 copies the string, and strings in scripts are not modelled yet")));
+    if et == Ty::Text || t == Ty::Text {
+        return assign_text(tr.checks, &g, et == Ty::Text, v, op, *at);
     }
     if t == Ty::Real || *op == "/=" {
         return Err((
@@ -558,6 +625,50 @@ fn statement(names: &[Name], s: &Stmt) -> Result<Lowered, Refuse> {
     })
 }
 
+/// An assignment where a string meets an entry (BT.CPP 4.10 `ExprAssignment::evaluate`
+/// and 4.8.2, measured): `entry_text`, the entry holds strings (a script creates it);
+/// else it holds numbers and `v` is a string. `=`, `:=` of a string to a string entry
+/// store its rank; `+=` of two strings joins them (not modelled); `-=`, `*=`, `/=` with
+/// a string, and `+=` of a number to a string entry, throw ("Operator not supported for
+/// strings", "can't be used with a non-numeric type"), as does `+=` of a string to a
+/// number ("Any::copyInto fails"). A number stored in a string entry, or a string in a
+/// number entry (4.8.2 converts it), is refused: the entry's type would change.
+fn assign_text(
+    mut checks: Vec<String>,
+    g: &str,
+    entry_text: bool,
+    v: Val,
+    op: &str,
+    at: usize,
+) -> Result<Lowered, Refuse> {
+    let text = v.t == Ty::Text;
+    let throws = |mut checks: Vec<String>, v: Val| {
+        checks.push("true".into());
+        Ok(Lowered {
+            checks,
+            assigns: Vec::new(),
+            value: v,
+        })
+    };
+    match (entry_text, text, op) {
+        (true, true, ":=" | "=") => {
+            if op == "=" {
+                // "The blackboard entry [..] doesn't exist".
+                checks.push(format!("!{}", has(g)));
+            }
+            Ok(Lowered {
+                checks,
+                assigns: vec![(g.to_string(), v.x), (has(g), "true".into())],
+                value: val(g.to_string(), Ty::Text, "false"),
+            })
+        }
+        (true, true, "+=") => Err((at, CONCAT.to_string())),
+        (_, _, ":=" | "=") if entry_text => Err((at, format!("assigning a number to `{g}`, which a script also assigns strings: BT.CPP 4 throws where it holds a string and stores the number where it holds none, and an entry whose type changes is not modelled"))),
+        (_, _, ":=" | "=") => Err((at, format!("assigning a string to `{g}`, which holds numbers: BT.CPP 4.8.2 converts the text to the entry's type, which is not modelled"))),
+        _ => throws(checks, v),
+    }
+}
+
 /// Resolves node `n`'s script names to entries with their types, registering the
 /// entries only scripts write (`int64`); an error at `span` for a name that cannot be
 /// modelled.
@@ -579,20 +690,13 @@ fn resolve(
             }
         };
         if bb.texts.contains(&g) {
-            // BT.CPP 4 holds SetBlackboard's text; a script reads a string there. Modelled
-            // where every write is an integer constant (typed `int32`/`int64` by
-            // `blackboard::type_entries`, the model variable holding the number the text
-            // reads as; a BlackboardCheck may read it too), no plugin port types it
-            // (a plugin's output would store a number), and no SetBlackboard copies to or
-            // from it (4.8.2's copies leave entries a script cannot read,
-            // `tests/bt/real/set_blackboard.toml`).
-            let e = bb.entry(&g);
-            let ints = e.is_some_and(|e| {
-                !e.why.contains("of plugin")
-                    && Scalar::from_name(e.ty.trim()).is_some_and(|s| s.int_range().is_some())
-            });
-            if !ints || bb.copies.contains(&g) || bb.conflicted.contains(&g) {
-                errs.push(sm.diag(span, format!("the script uses the entry `{g}`, which a SetBlackboard writes: BT.CPP 4 stores SetBlackboard's value as text; scripts read it only where every write is an integer constant and no SetBlackboard copies to or from it (strings and reals in scripts are not modelled yet)")));
+            // BT.CPP 4 holds SetBlackboard's text; a script reads a string there, its
+            // rank kept beside the value other nodes read (`btcpp4_strings.rs`), where
+            // no plugin port types the entry (a plugin's output would store a number)
+            // and no SetBlackboard copies to or from it (4.8.2's copies leave entries a
+            // script cannot read, `tests/bt/real/set_blackboard.toml`).
+            if !bb.strings.set_entries.contains(&g) {
+                errs.push(sm.diag(span, format!("the script uses the entry `{g}`, which a SetBlackboard writes: BT.CPP 4 stores SetBlackboard's value as text; scripts read it only where no plugin's port types it and no SetBlackboard copies to or from it")));
                 continue;
             }
             if !bb.script_entries.contains(&g) {
@@ -603,6 +707,29 @@ fn resolve(
         }
         // An entry no port types: BT.CPP's script creates it (`PortInfo()`, any type).
         let dynamic = bb.entry(&g).is_none_or(|e| e.why == "a script");
+        if bb.strings.script_entries.contains(&g) {
+            // A script assigns it strings: it holds its text's rank
+            // (`btcpp4_strings.rs`).
+            match bb.entry(&g) {
+                None => bb.entries.push(super::blackboard::Entry {
+                    name: g.clone(),
+                    ty: "int64".into(),
+                    span,
+                    why: "a script".into(),
+                }),
+                Some(e) if e.why == "a script" => {}
+                Some(e) => {
+                    let at = sm.diag(e.span, "");
+                    errs.push(sm.diag(span, format!("a script assigns a string to the entry `{g}`, which is {} at {}:{}:{} ({}): a string in an entry a port types is not modelled", e.ty, at.file, at.line, at.col, e.why)));
+                    continue;
+                }
+            }
+            if !bb.script_entries.contains(&g) {
+                bb.script_entries.push(g.clone());
+            }
+            out.push((name.clone(), g, Ty::Text, true));
+            continue;
+        }
         let t = match bb.entry(&g) {
             None => {
                 let ty = entry_type(bb, &g);
@@ -660,7 +787,7 @@ pub(super) fn compile(
     let names = resolve(sm, n, span, bb, errs)?;
     let mut lowered = Vec::new();
     for s in &stmts {
-        match statement(&names, s) {
+        match statement(&names, &bb.strings, s) {
             Ok(l) => lowered.push(l),
             Err((at, why)) => {
                 errs.push(sm.diag(

@@ -41,6 +41,7 @@ mod btcpp4_conds;
 mod btcpp4_loop;
 mod btcpp4_script;
 mod btcpp4_skip;
+mod btcpp4_strings;
 mod btcpp4_time;
 mod build;
 mod control;
@@ -225,6 +226,7 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
     // Then the entries the entry-updated nodes watch and the Loop nodes write.
     if input.semantics != BtSemantics::As2fm {
         btcpp4_blackboard::prepare(sm, &tree, &mut bb, &mut errs);
+        btcpp4_strings::prepare(&tree, &mut bb);
     }
     let effects = halt_effects(&tree, &plugins);
     // The clock of the timed nodes (Timeout, Delay, Sleep), kept by the root machine.

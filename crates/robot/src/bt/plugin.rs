@@ -279,7 +279,11 @@ pub(crate) fn literal_expr(v: &str, ty: &str) -> String {
             "True" | "true" | "1" => "true".into(),
             _ => "false".into(),
         },
-        Ok(TypeExpr::Base(BaseType::Int | BaseType::Float)) => t.to_string(),
+        // `01`, `+1`: the number, written as the model's expressions read it.
+        Ok(TypeExpr::Base(BaseType::Int)) => {
+            t.parse::<i64>().map_or(t.to_string(), |n| n.to_string())
+        }
+        Ok(TypeExpr::Base(BaseType::Float)) => t.to_string(),
         _ if ty.trim() == "string" => format!("'{}'", v.replace('\\', "\\\\").replace('\'', "\\'")),
         _ => t.to_string(),
     }

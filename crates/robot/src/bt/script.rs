@@ -58,8 +58,8 @@ pub(crate) enum K {
     Bool(bool),
     /// Another number literal (real, hexadecimal, too large), as written.
     Number(String),
-    /// A `'string'`.
-    Str,
+    /// A `'string'`: its text, between the quotes.
+    Str(String),
     /// A blackboard entry.
     Name(String),
     /// A prefix operator (`-`, `!`, `~`) and its operand.
@@ -99,7 +99,7 @@ pub(crate) const CONDITION_ATTRS: [&str; 8] = [
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
 enum T<'s> {
     Num,
-    Str,
+    Str(&'s str),
     Name(&'s str),
     Sym(&'static str),
 }
@@ -152,12 +152,19 @@ fn tokens(s: &str) -> Result<Vec<(T<'_>, usize)>, SyntaxError> {
                 });
             }
             i += 1;
-            out.push((T::Str, start));
+            out.push((T::Str(&s[start + 1..i - 1]), start));
         } else if c.is_ascii_alphabetic() || c == b'_' {
             while i < b.len() && (b[i].is_ascii_alphanumeric() || b[i] == b'_') {
                 i += 1;
             }
             out.push((T::Name(&s[start..i]), start));
+        } else if s[i..].starts_with("..") {
+            // BT.CPP 4.8.2 joins strings with `..` (`'a'..'b' == 'ab'`; it does not mix
+            // with `+`): not modelled (`btcpp4_strings.rs`).
+            return Err(SyntaxError {
+                at: start,
+                what: "`..` (BT.CPP's string concatenation) is not supported: the texts a tree can make must be known when it is lowered".into(),
+            });
         } else if let Some(sym) = SYMS.iter().find(|x| s[i..].starts_with(**x)) {
             i += sym.len();
             out.push((T::Sym(sym), start));
@@ -352,9 +359,12 @@ impl<'s> Parser<'s> {
                 };
                 Ok(Ex { at, k })
             }
-            Some(T::Str) => {
+            Some(T::Str(t)) => {
                 self.pos += 1;
-                Ok(Ex { at, k: K::Str })
+                Ok(Ex {
+                    at,
+                    k: K::Str(t.to_string()),
+                })
             }
             Some(T::Name(n)) => {
                 self.pos += 1;

@@ -1,0 +1,268 @@
+//! Strings in BehaviorTree.CPP 4's script language under [`super::BtSemantics::Btcpp`]:
+//! every text a tree can hold, interned as an integer in byte order.
+//!
+//! The model's expressions have no string operations, but without concatenation every
+//! string a script or a SetBlackboard can put in an entry is a text written in the tree:
+//! a script's `'literal'` or a SetBlackboard's `value`. [`prepare`] collects them, sorts
+//! them as `std::string` compares them (byte by byte, a prefix first: BT.CPP 4.10
+//! `scripting/operators.hpp`, `ExprComparison::evaluate` compares two strings with the
+//! `SimpleString` operators; 4.8.2 measured: `'B' < 'a'`, `'a' < 'aa'`, `'10' < '9'`)
+//! and gives each its rank, so that `==`, `!=`, `<`, `<=`, `>`, `>=` over ranks are
+//! BT.CPP's comparisons over the texts. A string entry holds its text's rank in the
+//! blackboard machine's `bt_sid__<entry>` ([`sid`]).
+//!
+//! Which entries hold strings is decided once, before any node is lowered:
+//! - an entry a SetBlackboard writes (BT.CPP 4 stores `value` as text) that a script
+//!   reads, unless a plugin's port types it or a SetBlackboard copies to or from it
+//!   (4.8.2's copies leave entries a script cannot read): every constant written to it
+//!   is interned, and the SetBlackboard sends its text's rank beside the value other
+//!   nodes read ([`Strings::set_entries`]);
+//! - an entry a script assigns a string to (`t := 'a'`, `t := k`, `t := c ? 'a' : 'b'`),
+//!   created by scripts ([`Strings::script_entries`]).
+//!
+//! The rules where a string meets a number (4.8.2 measured, `tests/tests/bt_real.rs`
+//! `strings_in_scripts_agree_with_the_real_library`): a comparison, and the condition of
+//! `c ? a : b`, read the string as a number ([`number`]), which throws "Any failed string
+//! to number conversion" for a text that is not one; the arithmetic and logic operators,
+//! `-` and `!` throw ("Operation not permitted", "Invalid operator for std::string"); a
+//! condition whose value is a string throws ("no known safe conversion"); assigning a
+//! number to an entry holding a string throws, and so do `-=`, `*=`, `/=` with a string
+//! and `+=` of a number to a string.
+
+use super::blackboard::Blackboard;
+use super::script::{self, Ex, K};
+use super::tree::{Btcpp4, Control, Kind, PortValue, Tree};
+
+/// The blackboard machine's variable holding string entry `e`'s text, as its rank.
+pub(crate) fn sid(e: &str) -> String {
+    format!("bt_sid__{e}")
+}
+
+/// The strings of one tree.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Strings {
+    /// Every text, in byte order: a text's rank is its index.
+    pub texts: Vec<String>,
+    /// Entries a SetBlackboard writes that scripts read as strings.
+    pub set_entries: Vec<String>,
+    /// Entries scripts create that hold strings.
+    pub script_entries: Vec<String>,
+}
+
+/// What BT.CPP 4.8.2 makes of a text read as a number.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum AsNumber {
+    /// This whole number.
+    Int(i64),
+    /// It throws ("Any failed string to number conversion").
+    Throws,
+    /// Something the model does not know the rule of.
+    Unknown,
+}
+
+/// A text read as a number (4.8.2 measured; the conversion reads a prefix, so `3abc` is
+/// 3, `0x10` 16, `true` 1, `1e2` 100, `nan` a NaN): a whole decimal number with an
+/// optional sign and spaces around it is that number (` 3`, `3 `, `+3`, `-0`, `007`),
+/// up to 2^53 (beyond it 4.8.2 throws "Loss of precision"); the empty text, spaces, and
+/// letters and spaces that begin with a letter other than `i`, `n`, `t`, `f` (the
+/// beginnings of `inf`, `nan`, `true`, `false`) throw; the rest is
+/// [`AsNumber::Unknown`].
+pub(crate) fn as_number(t: &str) -> AsNumber {
+    let s = t.trim_matches(' ');
+    let digits = s.strip_prefix(['+', '-']).unwrap_or(s);
+    if !digits.is_empty() && digits.bytes().all(|c| c.is_ascii_digit()) {
+        return match s.parse::<i64>() {
+            Ok(n) if n.unsigned_abs() <= 1 << 53 => AsNumber::Int(n),
+            _ => AsNumber::Unknown,
+        };
+    }
+    let words = s.bytes().all(|c| c.is_ascii_alphabetic() || c == b' ');
+    let first = s.bytes().next().map(|c| c.to_ascii_lowercase());
+    match first {
+        None => AsNumber::Throws,
+        Some(c) if words && !b"intf".contains(&c) => AsNumber::Throws,
+        _ => AsNumber::Unknown,
+    }
+}
+
+impl Strings {
+    /// The rank of `text` (interned by [`prepare`]).
+    pub fn id(&self, text: &str) -> i64 {
+        self.texts
+            .binary_search_by(|t| t.as_str().cmp(text))
+            .map(|i| i as i64)
+            .expect("every text of the tree was interned")
+    }
+
+    /// Entry `g` holds strings.
+    pub fn holds(&self, g: &str) -> bool {
+        self.set_entries.iter().any(|e| e == g) || self.script_entries.iter().any(|e| e == g)
+    }
+
+    /// The string whose rank is `x` (a model expression) read as a number, when it is
+    /// one of `texts`: the condition under which BT.CPP throws and the number; `Err`
+    /// naming a text whose number the model does not know.
+    pub fn number(&self, x: &str, texts: &[&str]) -> Result<(Option<String>, String), String> {
+        let mut throws = Vec::new();
+        let mut value = "0".to_string();
+        for t in texts.iter().rev() {
+            let id = self.id(t);
+            match as_number(t) {
+                AsNumber::Int(n) => value = format!("({x} == {id} ? {n} : {value})"),
+                AsNumber::Throws => throws.push(format!("{x} == {id}")),
+                AsNumber::Unknown => {
+                    return Err(format!(
+                        "the string `{t}` read as a number: BT.CPP 4.8.2 reads a prefix of a text as a number by rules the model does not know (`3abc` is 3, `0x10` 16, `true` 1); modelled are whole decimal numbers with spaces around them, and texts of letters (which throw)"
+                    ))
+                }
+            }
+        }
+        if texts.len() == 1 {
+            // A literal: a constant.
+            if let AsNumber::Int(n) = as_number(texts[0]) {
+                value = n.to_string();
+            }
+        }
+        let throws = (!throws.is_empty()).then(|| throws.join(" || "));
+        Ok((throws, value))
+    }
+}
+
+/// Every script of node `i` (its `code` / `if` port and its pre/post conditions).
+fn scripts(tree: &Tree, i: usize) -> Vec<&str> {
+    let n = &tree.nodes[i];
+    let mut out: Vec<&str> = n.conds.iter().map(|c| c.code.as_str()).collect();
+    if let Kind::Control(Control::Btcpp4(Btcpp4::Script(_))) = n.kind {
+        for p in &n.ports {
+            if let (PortValue::Literal(code), "code" | "if") = (&p.value, p.key.as_str()) {
+                out.push(code);
+            }
+        }
+    }
+    out
+}
+
+fn literals<'e>(e: &'e Ex, out: &mut Vec<&'e str>) {
+    match &e.k {
+        K::Str(t) => out.push(t),
+        K::Un(_, a) => literals(a, out),
+        K::Bin(_, a, b) => {
+            literals(a, out);
+            literals(b, out);
+        }
+        K::Cmp(xs, _) => xs.iter().for_each(|x| literals(x, out)),
+        K::Ite(c, a, b) => {
+            literals(c, out);
+            literals(a, out);
+            literals(b, out);
+        }
+        _ => {}
+    }
+}
+
+/// Whether `e` is a string by its form: a literal, an entry holding strings, or `?:`
+/// with a string on either side (`global` maps a script name to its entry).
+fn stringy(e: &Ex, global: &dyn Fn(&str) -> Option<String>, s: &Strings) -> bool {
+    match &e.k {
+        K::Str(_) => true,
+        K::Name(n) => global(n).is_some_and(|g| s.holds(&g)),
+        K::Ite(_, a, b) => stringy(a, global, s) || stringy(b, global, s),
+        _ => false,
+    }
+}
+
+/// Before any node is lowered: the texts of the tree and the entries that hold strings
+/// (see the module comment). Nothing is reported here; the script lowering refuses what
+/// it cannot model, at the script.
+pub(super) fn prepare(tree: &Tree, bb: &mut Blackboard) {
+    let mut s = Strings::default();
+    let mut texts: Vec<String> = Vec::new();
+    // The scripts, parsed, with their nodes' names.
+    let mut parsed = Vec::new();
+    for i in 0..tree.nodes.len() {
+        for code in scripts(tree, i) {
+            if let Ok(stmts) = script::parse(code) {
+                for st in &stmts {
+                    let mut ls = Vec::new();
+                    literals(&st.e, &mut ls);
+                    texts.extend(ls.into_iter().map(str::to_string));
+                }
+                parsed.push((i, stmts));
+            }
+        }
+    }
+    let global = |i: usize, name: &str| -> Option<String> {
+        tree.nodes[i]
+            .script_names
+            .iter()
+            .find(|(n, _)| n == name)
+            .and_then(|(_, v)| match v {
+                PortValue::Blackboard(g) => Some(g.clone()),
+                PortValue::Literal(_) => None,
+            })
+    };
+    // SetBlackboard entries scripts read.
+    let used: Vec<String> = tree
+        .nodes
+        .iter()
+        .flat_map(|n| n.script_names.iter())
+        .filter_map(|(_, v)| match v {
+            PortValue::Blackboard(g) => Some(g.clone()),
+            PortValue::Literal(_) => None,
+        })
+        .collect();
+    for g in &used {
+        if !bb.texts.contains(g) || s.set_entries.contains(g) {
+            continue;
+        }
+        let ok = bb.entry(g).is_some_and(|e| !e.why.contains("of plugin"))
+            && !bb.copies.contains(g)
+            && !bb.conflicted.contains(g);
+        if !ok {
+            continue;
+        }
+        s.set_entries.push(g.clone());
+        for n in &tree.nodes {
+            if n.kind != Kind::Control(Control::SetBlackboard) {
+                continue;
+            }
+            let (Some(k), Some(v)) = (n.port("output_key"), n.port("value")) else {
+                continue;
+            };
+            let key = match &k.value {
+                PortValue::Literal(v) => v.trim().to_string(),
+                PortValue::Blackboard(b) => b.clone(),
+            };
+            if key == *g {
+                if let PortValue::Literal(v) = &v.value {
+                    texts.push(v.clone());
+                }
+            }
+        }
+    }
+    // Entries scripts assign strings to, until nothing changes (`t := k` after
+    // `k := 'a'`).
+    loop {
+        let mut changed = false;
+        for (i, stmts) in &parsed {
+            let g = |n: &str| global(*i, n);
+            for st in stmts {
+                let Some((target, _, _)) = &st.assign else {
+                    continue;
+                };
+                let Some(t) = g(target) else { continue };
+                if !s.holds(&t) && stringy(&st.e, &g, &s) {
+                    s.script_entries.push(t);
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    texts.sort();
+    texts.dedup();
+    s.texts = texts;
+    bb.strings = s;
+}
