@@ -894,7 +894,6 @@ fn random_trees_with_strings_lower_to_what_btcpp_does() {
     assert!(two >= n / 20 && with_number >= n / 20 && assigned >= n / 20);
 }
 
-
 /// The same with the timed nodes and TryCatch too (`gen::Options::time_nodes`,
 /// `try_catch`), so that SKIPPED reaches every parent that takes it: WhileDoElse,
 /// Switch, TryCatch, Timeout, Delay and Precondition among them (`SKIP_PARENTS`), run
