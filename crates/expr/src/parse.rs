@@ -192,22 +192,38 @@ impl P {
         ops: &[(&str, BinOp)],
         next: fn(&mut P, &'a str) -> R<'a, Expr>,
     ) -> R<'a, Expr> {
+        // Operators are ordered longest first, so `<` never swallows `<=`.
+        let find = |r: &'a str| {
+            ops.iter()
+                .find(|(s, _)| r.starts_with(s))
+                .map(|(s, op)| (&r[s.len()..], *op))
+        };
+        self.chain(i, find, next)
+    }
+
+    /// `next (op next)*`, left-associative, where `find` recognises an operator at the
+    /// start of a text and gives the text after it.
+    fn chain<'a>(
+        &mut self,
+        i: &'a str,
+        find: impl Fn(&'a str) -> Option<(&'a str, BinOp)>,
+        next: fn(&mut P, &'a str) -> R<'a, Expr>,
+    ) -> R<'a, Expr> {
         let start = self.off(i);
         let (mut rest, mut lhs) = next(self, i)?;
         // Each operator in a chain nests the tree one level deeper: count them all.
         let depth = self.depth;
         loop {
             let r = self.ws(rest);
-            // Operators are ordered longest first, so `<` never swallows `<=`.
-            let Some((sym, op)) = ops.iter().find(|(s, _)| r.starts_with(s)) else {
+            let Some((after, op)) = find(r) else {
                 self.depth = depth;
                 return Ok((rest, lhs));
             };
-            let after = self.ws(&r[sym.len()..]);
+            let after = self.ws(after);
             self.enter(after)?;
             let (r2, rhs) = next(self, after)?;
             lhs = self.node(
-                ExprKind::Binary(*op, Box::new(lhs), Box::new(rhs)),
+                ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
                 start,
                 r2,
             );
@@ -233,25 +249,12 @@ impl P {
         op: BinOp,
         next: fn(&mut P, &'a str) -> R<'a, Expr>,
     ) -> R<'a, Expr> {
-        let start = self.off(i);
-        let (mut rest, mut lhs) = next(self, i)?;
-        let depth = self.depth;
-        loop {
-            let r = self.ws(rest);
-            let Some(after) = r.strip_prefix(sym).filter(|a| !a.starts_with(not)) else {
-                self.depth = depth;
-                return Ok((rest, lhs));
-            };
-            let after = self.ws(after);
-            self.enter(after)?;
-            let (r2, rhs) = next(self, after)?;
-            lhs = self.node(
-                ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
-                start,
-                r2,
-            );
-            rest = r2;
-        }
+        let find = |r: &'a str| {
+            r.strip_prefix(sym)
+                .filter(|a| !a.starts_with(not))
+                .map(|a| (a, op))
+        };
+        self.chain(i, find, next)
     }
 
     fn bit_or<'a>(&mut self, i: &'a str) -> R<'a, Expr> {
