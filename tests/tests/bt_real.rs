@@ -197,6 +197,53 @@ impl Counts {
     }
 }
 
+/// One case per script condition, a `ScriptCondition` alone in a tree ticked once.
+fn condition_cases(conditions: &[&str]) -> Vec<(String, String, Scripts, usize)> {
+    conditions
+        .iter()
+        .map(|code| {
+            let xml = doc(&format!(
+                "<ScriptCondition code=\"{}\"/>",
+                code.replace('&', "&amp;")
+                    .replace('<', "&lt;")
+                    .replace('>', "&gt;")
+            ));
+            (format!("`{code}`"), xml, Scripts::new(), 1)
+        })
+        .collect()
+}
+
+/// The format-4 trees `opts` draws from the seeds `seed0..seed0 + n` (format-3 trees
+/// left out), each named `label seed N`.
+fn format4_cases(
+    opts: gen::Options,
+    label: &str,
+    seed0: u64,
+    n: u64,
+) -> Vec<(String, String, Scripts, usize)> {
+    let mut cases = Vec::new();
+    for seed in seed0..seed0 + n {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
+        if !c.xml.contains("BTCPP_format=\"3\"") {
+            cases.push((format!("{label} seed {seed}"), c.xml, c.scripts, c.ticks));
+        }
+    }
+    cases
+}
+
+/// No disagreement (the first five shown if any), and the runs both threw and ran every
+/// tick (so the comparison saw both ends).
+fn assert_agreed(fails: &[String], counts: &Counts) {
+    assert!(
+        fails.is_empty(),
+        "{} disagreements (first 5):\n{}",
+        fails.len(),
+        fails.iter().take(5).cloned().collect::<Vec<_>>().join("\n")
+    );
+    assert!(counts.errors > 0 && counts.ran_all > 0);
+}
+
 /// Runs `cases` (name, xml, scripts, ticks) in both modes through BT.CPP and the oracle;
 /// the disagreements.
 fn check_all(
@@ -732,34 +779,17 @@ fn doubles_in_scripts_agree_with_the_real_library() {
         "x:=5; x/=2; x == 2",
     ];
     let Some(mut real) = harness() else { return };
-    let mut cases: Vec<(String, String, Scripts, usize)> = CONDITIONS
-        .iter()
-        .map(|code| {
-            let xml = doc(&format!(
-                "<ScriptCondition code=\"{}\"/>",
-                code.replace('&', "&amp;")
-                    .replace('<', "&lt;")
-                    .replace('>', "&gt;")
-            ));
-            (format!("`{code}`"), xml, Scripts::new(), 1)
-        })
-        .collect();
+    let mut cases = condition_cases(&CONDITIONS);
     let n = env("HINDSIGHT_BT_REAL_REAL_TREES", 10_000);
     let seed0 = env("HINDSIGHT_BT_SEED", 0) + 5_000_000;
     let start = std::time::Instant::now();
-    for seed in seed0..seed0 + n {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let opts = gen::Options {
-            btcpp4_nodes: true,
-            scripts: true,
-            reals: true,
-            ..Default::default()
-        };
-        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
-        if !c.xml.contains("BTCPP_format=\"3\"") {
-            cases.push((format!("reals seed {seed}"), c.xml, c.scripts, c.ticks));
-        }
-    }
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        reals: true,
+        ..Default::default()
+    };
+    cases.extend(format4_cases(opts, "reals", seed0, n));
     let mut counts = Counts::default();
     let fails = check_all(&mut real, &cases, &mut counts);
     let with = |pat: &str| cases.iter().filter(|c| c.1.contains(pat)).count();
@@ -778,13 +808,7 @@ fn doubles_in_scripts_agree_with_the_real_library() {
         start.elapsed().as_secs_f64(),
         fails.len()
     );
-    assert!(
-        fails.is_empty(),
-        "{} disagreements (first 5):\n{}",
-        fails.len(),
-        fails.iter().take(5).cloned().collect::<Vec<_>>().join("\n")
-    );
-    assert!(counts.errors > 0 && counts.ran_all > 0);
+    assert_agreed(&fails, &counts);
 }
 
 /// The bit operators (`~ & | ^`), numbers that are not whole stored in entries, and
@@ -840,19 +864,13 @@ fn bits_and_stored_reals_agree_with_the_real_library() {
     let n = env("HINDSIGHT_BT_REAL_BITS_TREES", 10_000);
     let seed0 = env("HINDSIGHT_BT_SEED", 0) + 6_000_000;
     let start = std::time::Instant::now();
-    for seed in seed0..seed0 + n {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let opts = gen::Options {
-            btcpp4_nodes: true,
-            scripts: true,
-            bits: true,
-            ..Default::default()
-        };
-        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
-        if !c.xml.contains("BTCPP_format=\"3\"") {
-            cases.push((format!("bits seed {seed}"), c.xml, c.scripts, c.ticks));
-        }
-    }
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        bits: true,
+        ..Default::default()
+    };
+    cases.extend(format4_cases(opts, "bits", seed0, n));
     let mut counts = Counts::default();
     let fails = check_all(&mut real, &cases, &mut counts);
     let with = |pats: &[&str]| {
@@ -878,13 +896,7 @@ fn bits_and_stored_reals_agree_with_the_real_library() {
         start.elapsed().as_secs_f64(),
         fails.len()
     );
-    assert!(
-        fails.is_empty(),
-        "{} disagreements (first 5):\n{}",
-        fails.len(),
-        fails.iter().take(5).cloned().collect::<Vec<_>>().join("\n")
-    );
-    assert!(counts.errors > 0 && counts.ran_all > 0);
+    assert_agreed(&fails, &counts);
 }
 
 /// Strings in scripts (`gen::Options::strings`): the rules measured in 4.8.2 while
@@ -925,34 +937,17 @@ fn strings_in_scripts_agree_with_the_real_library() {
         "t:='a'; t:=3",
     ];
     let Some(mut real) = harness() else { return };
-    let mut cases: Vec<(String, String, Scripts, usize)> = CONDITIONS
-        .iter()
-        .map(|code| {
-            let xml = doc(&format!(
-                "<ScriptCondition code=\"{}\"/>",
-                code.replace('&', "&amp;")
-                    .replace('<', "&lt;")
-                    .replace('>', "&gt;")
-            ));
-            (format!("`{code}`"), xml, Scripts::new(), 1)
-        })
-        .collect();
+    let mut cases = condition_cases(&CONDITIONS);
     let n = env("HINDSIGHT_BT_REAL_STRING_TREES", 10_000);
     let seed0 = env("HINDSIGHT_BT_SEED", 0) + 6_000_000;
     let start = std::time::Instant::now();
-    for seed in seed0..seed0 + n {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let opts = gen::Options {
-            btcpp4_nodes: true,
-            scripts: true,
-            strings: true,
-            ..Default::default()
-        };
-        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
-        if !c.xml.contains("BTCPP_format=\"3\"") {
-            cases.push((format!("strings seed {seed}"), c.xml, c.scripts, c.ticks));
-        }
-    }
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        strings: true,
+        ..Default::default()
+    };
+    cases.extend(format4_cases(opts, "strings", seed0, n));
     let mut counts = Counts::default();
     let fails = check_all(&mut real, &cases, &mut counts);
     eprintln!(
@@ -968,13 +963,7 @@ fn strings_in_scripts_agree_with_the_real_library() {
         start.elapsed().as_secs_f64(),
         fails.len()
     );
-    assert!(
-        fails.is_empty(),
-        "{} disagreements (first 5):\n{}",
-        fails.len(),
-        fails.iter().take(5).cloned().collect::<Vec<_>>().join("\n")
-    );
-    assert!(counts.errors > 0 && counts.ran_all > 0);
+    assert_agreed(&fails, &counts);
 }
 
 /// The executor period of [`timed_nodes_agree_with_the_real_library`], in the real
