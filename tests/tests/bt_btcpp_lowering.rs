@@ -735,16 +735,8 @@ fn random_trees_with_reals_lower_to_what_btcpp_does() {
     random_trees(opts);
     // The trees held the new constructs (the same seeds, generated again).
     let n = env("HINDSIGHT_BT_TREES", 10_000);
-    let seed0 = env("HINDSIGHT_BT_SEED", 0);
     let (mut division, mut real_lit, mut double_init) = (0u64, 0u64, 0u64);
-    for seed in seed0..seed0 + n {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let c = gen::case_with_conds(
-            &mut rng,
-            4 + (seed % 12) as i64,
-            opts,
-            gen::Conditions::WithoutSkip,
-        );
+    for c in drawn_again(opts, gen::Conditions::WithoutSkip) {
         division += u64::from(c.xml.contains(" / "));
         real_lit += u64::from(
             ["0.5", "2.5e-1", "1e1", "0.0", "1e308"]
@@ -781,16 +773,8 @@ fn random_trees_with_bits_and_stored_reals_lower_to_what_btcpp_does() {
     };
     random_trees(opts);
     let n = env("HINDSIGHT_BT_TREES", 10_000);
-    let seed0 = env("HINDSIGHT_BT_SEED", 0);
     let (mut bits, mut stored, mut var_div, mut int_store) = (0u64, 0u64, 0u64, 0u64);
-    for seed in seed0..seed0 + n {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let c = gen::case_with_conds(
-            &mut rng,
-            4 + (seed % 12) as i64,
-            opts,
-            gen::Conditions::WithoutSkip,
-        );
+    for c in drawn_again(opts, gen::Conditions::WithoutSkip) {
         bits += u64::from(
             ["&amp; ", " | ", " ^ ", "~"]
                 .iter()
@@ -850,16 +834,8 @@ fn random_trees_with_strings_lower_to_what_btcpp_does() {
     random_trees(opts);
     // The trees held the new constructs (the same seeds, generated again).
     let n = env("HINDSIGHT_BT_TREES", 10_000);
-    let seed0 = env("HINDSIGHT_BT_SEED", 0);
     let (mut two, mut with_number, mut assigned) = (0u64, 0u64, 0u64);
-    for seed in seed0..seed0 + n {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let c = gen::case_with_conds(
-            &mut rng,
-            4 + (seed % 12) as i64,
-            opts,
-            gen::Conditions::WithoutSkip,
-        );
+    for c in drawn_again(opts, gen::Conditions::WithoutSkip) {
         let t = tree::read(&c.xml).expect("the oracle reads what it generates");
         if t.nodes
             .iter()
@@ -1108,12 +1084,8 @@ fn bb_kind(k: &Kind) -> Option<usize> {
 /// How many of the random trees (as [`random_trees`] draws them for `opts`, the ones it
 /// compares) hold each of [`BB_KINDS`].
 fn bb_coverage(opts: gen::Options, conds: gen::Conditions) -> [u64; 8] {
-    let n = env("HINDSIGHT_BT_TREES", 10_000);
-    let seed0 = env("HINDSIGHT_BT_SEED", 0);
     let mut out = [0u64; 8];
-    for seed in seed0..seed0 + n {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let c = gen::case_with_conds(&mut rng, 4 + (seed % 12) as i64, opts, conds);
+    for c in drawn_again(opts, conds) {
         let t = tree::read(&c.xml).expect("the oracle reads what it generates");
         if conds_refused(&t)
             || loop_refused(&t)
@@ -1157,6 +1129,17 @@ fn script_features(xml: &str) -> (bool, bool) {
             .any(|st| st.matches(" + ").count() + st.matches(" - ").count() >= 2);
     }
     (texts, chains)
+}
+
+/// The trees [`random_trees`] drew for `opts` (`HINDSIGHT_BT_TREES` seeds from
+/// `HINDSIGHT_BT_SEED`), generated again, so a test can count what they held.
+fn drawn_again(opts: gen::Options, conds: gen::Conditions) -> impl Iterator<Item = gen::Case> {
+    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0);
+    (seed0..seed0 + n).map(move |seed| {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        gen::case_with_conds(&mut rng, 4 + (seed % 12) as i64, opts, conds)
+    })
 }
 
 /// `HINDSIGHT_BT_TREES` random trees from `HINDSIGHT_BT_SEED`, each lowered under both
