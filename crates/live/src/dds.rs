@@ -180,17 +180,7 @@ pub fn run(
                 )?;
             }
         }
-        if settings.heartbeat > 0 && (run.started || !settings.from_first_message) {
-            let now = run.clock.now();
-            let due = run
-                .engine
-                .last_time()
-                .is_none_or(|l| now >= l + settings.heartbeat);
-            if due {
-                let time = run.now();
-                run.feed(Input::Tick { time })?;
-            }
-        }
+        run.heartbeat(settings.heartbeat, settings.from_first_message)?;
         if busy {
             idle_since_flush = false;
             continue;

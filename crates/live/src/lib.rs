@@ -380,6 +380,20 @@ impl Run<'_, '_> {
         self.engine.last_time().map_or(t, |l| t.max(l))
     }
 
+    /// A `Tick` when `heartbeat` (> 0) time units passed since the engine's last point;
+    /// with `from_first_message`, none before the system's first message.
+    fn heartbeat(&mut self, heartbeat: u64, from_first_message: bool) -> Result<(), LiveError> {
+        if heartbeat == 0 || (from_first_message && !self.started) {
+            return Ok(());
+        }
+        let now = self.clock.now();
+        if self.engine.last_time().is_none_or(|l| now >= l + heartbeat) {
+            let time = self.now();
+            self.feed(Input::Tick { time })?;
+        }
+        Ok(())
+    }
+
     fn drain_tap(
         &mut self,
         tap: &mut Tap,
@@ -796,18 +810,7 @@ impl Sidecar {
             for px in &mut self.proxies {
                 busy |= run.serve(px, &mut self.taps, &mut sets)?;
             }
-            // With `from_first_message`, no heartbeat before the system's first message.
-            if config.heartbeat > 0 && (run.started || !config.from_first_message) {
-                let now = run.clock.now();
-                let due = run
-                    .engine
-                    .last_time()
-                    .is_none_or(|l| now >= l + config.heartbeat);
-                if due {
-                    let time = run.now();
-                    run.feed(Input::Tick { time })?;
-                }
-            }
+            run.heartbeat(config.heartbeat, config.from_first_message)?;
             if last_cleanup.elapsed() >= Duration::from_secs(1) {
                 // Dead publishers' resources go, so a restarted one can connect.
                 let _ = Node::<Ipc>::try_cleanup_dead_nodes(self.node.config());
