@@ -8,6 +8,8 @@ use codegen::diag::Diagnostic;
 use serde::{Deserialize, Serialize};
 
 pub use hindsight_verify::result::{PropertyRow, Study};
+/// A sweep's curves and points are the types `sweep` computes them as.
+pub use hindsight_verify::sweep::{SweepCurve, SweepPoint};
 
 /// Everything one page shows.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
@@ -42,36 +44,6 @@ pub struct Sweep {
     pub logs: Vec<String>,
     /// One curve per property.
     pub properties: Vec<SweepCurve>,
-}
-
-/// One property's sweep.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-pub struct SweepCurve {
-    /// The property's id.
-    pub property: String,
-    /// The smallest bound from which every run succeeded at every larger bound.
-    pub threshold: Option<String>,
-    /// One point per bound, in increasing order.
-    pub points: Vec<SweepPoint>,
-}
-
-/// One bound's counts.
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-pub struct SweepPoint {
-    /// The bound as written (`62`, `6.2s`).
-    pub bound: String,
-    /// Runs that satisfied the variant.
-    pub successes: u64,
-    /// Runs that violated it.
-    pub failures: u64,
-    /// Runs whose verdict stayed open.
-    pub unknown: u64,
-    /// Estimated probability.
-    pub probability: Option<f64>,
-    /// Lower end of the interval.
-    pub lower: f64,
-    /// Upper end of the interval.
-    pub upper: f64,
 }
 
 /// The bound on a chart's x axis: model units, or seconds for a duration.

@@ -121,11 +121,7 @@ fn run_title(r: &Run) -> String {
 /// the sampled schedulers, their witnesses, and where an order-sensitive property's
 /// order comes from (nothing without `--schedulers`).
 fn bounds(o: &mut String, s: &Study) {
-    let rows: Vec<_> = s
-        .properties
-        .iter()
-        .filter_map(|p| p.schedulers.as_ref().map(|b| (p, b)))
-        .collect();
+    let rows = s.scheduler_rows();
     let Some((_, first)) = rows.first() else {
         return;
     };

@@ -2,19 +2,26 @@
 //!
 //! The off-line pipeline as a library: [`load`] reads a model (plain SCXML or a robot
 //! model) and its property file, [`observe`] judges a simulated run with the compiled
-//! monitors, [`study`] runs studies under stopping rules, [`schedulers`] and
-//! [`sched_fixed`] bound the probabilities over schedulers, [`record`] writes a run as CSV
-//! and [`result`] is a study's result as `verify --json` prints it; [`tracefile`] reads
-//! such a CSV (or any trace) back as points for `replay`. Nothing here prints:
-//! errors are values ([`load::LoadError`] carries the files' diagnostics), warnings come
-//! back with what was loaded ([`load::Loaded::warnings`]) and progress goes to a callback.
+//! monitors, [`options`] holds a study's settings (set once, turned into the
+//! simulator's and the runner's configurations), [`study`] runs studies under stopping
+//! rules (sequential, or one shard of a fixed-size study: every study goes through its
+//! `Runner`), [`fixed`] identifies a fixed-size study across its shards, [`schedulers`]
+//! and [`sched_fixed`] bound the probabilities over schedulers, [`sweep`] sweeps a
+//! guarantee's time bounds, [`record`] writes a run as CSV, [`replay`] replays the runs a
+//! study kept (and the witnesses' failing runs) as such CSV, and [`result`] is a study's
+//! result as `verify --json` prints it, assembled there; [`tracefile`] reads such a CSV
+//! (or any trace) back as points for `replay`. Nothing here prints: errors are values
+//! ([`load::LoadError`] carries the files' diagnostics), warnings come back with what was
+//! loaded ([`load::Loaded::warnings`]), files written come back as their paths and
+//! progress goes to a callback.
 //!
 //! # Crate
 //!
 //! `hindsight-verify` depends on `monitor-core`, `codegen` and the crates below it in the
 //! pipeline, re-exported here under the paths its modules name them by: [`expr`],
 //! [`model`], [`sim`], [`props`], [`robot`] and [`smc`]; on no other crate of the project.
-//! `hindsight`'s command line drives it.
+//! `hindsight`'s command line drives it, and names the crates below through these
+//! re-exports (and [`codegen`], [`monitor_core`]), never as dependencies of its own.
 //!
 //! One run of the museum example, judged by its five requirements:
 //!
@@ -34,14 +41,18 @@
 //! runner.finish().unwrap();
 //! ```
 
+pub mod fixed;
 pub mod load;
 pub mod observe;
+pub mod options;
 pub mod record;
+pub mod replay;
 pub mod result;
 pub mod sched_fixed;
 pub mod schedulers;
 mod split;
 pub mod study;
+pub mod sweep;
 pub mod tracefile;
 
 // The crates below this one, under the paths its modules name them by.
@@ -50,3 +61,7 @@ pub use hindsight_props as props;
 pub use hindsight_robot as robot;
 pub use hindsight_sim::{model, sim};
 pub use hindsight_smc as smc;
+// The compiler and the monitors' runtime, for the command line (`compile`, `replay`),
+// which depends on this crate instead of on them.
+pub use codegen;
+pub use monitor_core;

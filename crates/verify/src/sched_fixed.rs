@@ -331,6 +331,17 @@ impl Plan {
         }
     }
 
+    /// The result of a finished study: the uniform study as `merge` reports a
+    /// fixed-size one ([`crate::result::Study::merged`]), each property with its bounds.
+    pub fn study(&self) -> Result<crate::result::Study, BoundsError> {
+        let (merged, bounds) = self.report()?;
+        let mut study = crate::result::Study::merged(&merged);
+        for (row, b) in study.properties.iter_mut().zip(bounds) {
+            row.schedulers = Some(b);
+        }
+        Ok(study)
+    }
+
     /// The uniform study as `merge` reports a fixed-size study, and each property's
     /// bounds (an error before the last stage, or with a side emptied by unfair ones).
     pub fn report(&self) -> Result<(MergedResult, Vec<SchedulerBounds>), BoundsError> {

@@ -2,7 +2,8 @@
 //!
 //! [`Runner`] runs one simulation with its [`Judge`] (the function every study
 //! shares: `verify`, `sweep`, shards, the benches); [`study`] hands it to
-//! [`crate::smc::run_study`] with one stopping rule per guarantee.
+//! [`crate::smc::run_study`] with one stopping rule per guarantee, [`study_shard`] to
+//! [`crate::smc::shard::run_shard`] for one slice of a fixed-size study.
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Mutex;
@@ -11,6 +12,7 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 
 use super::observe::{Judge, PropertySet};
 use crate::sim::{CompiledModel, EndReason, RunConfig, Scheduler, Simulator, SpinKind};
+use crate::smc::shard::{run_shard, FixedStudy, PartialResult, Shard};
 use crate::smc::stats::{RuleConfig, StatsError};
 use crate::smc::{
     run_study_until, Progress, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict,
@@ -64,6 +66,30 @@ pub fn study_until(
     );
     runner.finish().map_err(StudyError::Model)?;
     Ok(result)
+}
+
+/// Shard `shard` of the fixed-size study `fixed` (`verify --runs R [--shard I/N]`):
+/// its runs judged by the same [`Runner`] as every study, counted by
+/// [`crate::smc::shard::run_shard`] (no early stop; `fixed` gives the seed).
+pub fn study_shard(
+    model: &CompiledModel,
+    set: &PropertySet,
+    run_cfg: &RunConfig,
+    study_cfg: &StudyConfig,
+    fixed: &FixedStudy,
+    shard: Shard,
+    progress: &mut dyn FnMut(&Progress<'_>),
+) -> Result<PartialResult, ModelFailure> {
+    let runner = Runner::new(model, set, run_cfg);
+    let part = run_shard(
+        study_cfg,
+        fixed,
+        shard,
+        |k, rng| runner.run(k, rng),
+        progress,
+    );
+    runner.finish()?;
+    Ok(part)
 }
 
 /// Why a [`study`] gave no result.

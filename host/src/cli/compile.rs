@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use codegen::emit_rust::{emit_rust, EmitOptions};
 
 use super::{compile_spec_file, CliError};
+use crate::codegen;
 
 /// What `compile` writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]

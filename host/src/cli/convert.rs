@@ -3,15 +3,16 @@
 
 use std::path::PathBuf;
 
-use super::sweep::BoundValue;
 use super::CliError;
+use crate::codegen::bounds::map_bounds;
+use crate::codegen::duration::{seconds, StepsOrDuration};
 use crate::model::xml::Element;
 use crate::props::{self, PortKind, PropertyFile, ANY};
 use crate::robot::interfaces::Search;
 use crate::robot::load::{load_searching_bt, main_file_of};
 use crate::robot::main_file::InputKind;
 use crate::robot::write::{escape_into, to_xml, types_xml};
-use codegen::bounds::map_bounds;
+use crate::verify::sweep::parse_bound;
 
 /// Arguments of `hindsight convert`.
 #[derive(Debug, clap::Args)]
@@ -138,7 +139,7 @@ pub fn run(args: &ConvertArgs) -> Result<(), CliError> {
     model.push_str("</specification>\n");
     write("model.xml", &model)?;
 
-    let unit = BoundValue::Nanos(robot.time_unit_ns).display();
+    let unit = seconds(robot.time_unit_ns);
     eprintln!(
         "wrote {} machines, model.xml{} to {} (one step is {unit}; runs last {} steps)",
         names.len(),
@@ -196,7 +197,7 @@ fn scan_properties(
     out.push_str(&esc(&path.to_string()));
     out.push_str(&format!(
         ": ports name machines, bounds are steps of {}. -->\n<properties>\n  <ports>\n",
-        BoundValue::Nanos(unit_ns).display()
+        seconds(unit_ns)
     ));
     for port in &file.ports {
         let (origin, target) = if port.origin == ANY || port.target == ANY {
@@ -289,12 +290,12 @@ fn scan_properties(
 
 /// A bound as written (`62`, `6.2s`) in steps of `unit_ns`.
 fn to_steps(bound: &str, unit_ns: u64) -> Result<String, String> {
-    match BoundValue::parse(bound)? {
-        BoundValue::Units(v) => Ok(v.to_string()),
-        BoundValue::Nanos(ns) if ns % unit_ns == 0 => Ok((ns / unit_ns).to_string()),
-        BoundValue::Nanos(_) => Err(format!(
+    match parse_bound(bound).map_err(|e| e.to_string())? {
+        StepsOrDuration::Steps(v) => Ok(v.to_string()),
+        StepsOrDuration::Nanos(ns) if ns % unit_ns == 0 => Ok((ns / unit_ns).to_string()),
+        StepsOrDuration::Nanos(_) => Err(format!(
             "bound `{bound}` is not a whole number of steps of {}",
-            BoundValue::Nanos(unit_ns).display()
+            seconds(unit_ns)
         )),
     }
 }

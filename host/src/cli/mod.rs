@@ -15,6 +15,7 @@ use std::fmt;
 
 use codegen::diag::{Diagnostic, Diagnostics, Severity};
 
+use crate::codegen;
 use crate::robot::load::ExternalComponent;
 use crate::verify::load::{LoadError, LoadOptions, Loaded};
 

@@ -1,5 +1,6 @@
 //! `hindsight monitor`: the on-line sidecar over iceoryx2, its off-line replay and its benchmark.
 
+use crate::{codegen, iceoryx2};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;

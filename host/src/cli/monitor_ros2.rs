@@ -7,6 +7,7 @@
 //! subscribe). A service port reads the service's introspection events
 //! (`/<service>/_service_event`), as it does in a recording.
 
+use crate::{codegen, ros2};
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::Path;

@@ -20,6 +20,7 @@
 //! unit (`within="1" time_unit="s"`, `[6.2s:]`) are converted exactly to it, as `verify`
 //! converts them to a model's unit.
 
+use crate::{codegen, monitor_core, ros2};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

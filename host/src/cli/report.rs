@@ -4,8 +4,10 @@
 use std::path::{Path, PathBuf};
 
 use super::CliError;
+use crate::codegen;
 use crate::report::{self, ReportData, Run, Study, Sweep};
 use crate::verify::load::Loaded;
+use crate::verify::replay::Failing;
 
 /// Arguments of `hindsight report`.
 #[derive(Debug, clap::Args)]
@@ -88,7 +90,9 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let mut data = ReportData::default();
     if let Some(path) = &args.study {
         let mut study: Study = read_json(path, "`verify --json`")?;
-        formulas_from_file(&mut study);
+        if let Err(e) = study.read_formulas() {
+            eprintln!("warning: formulas not shown: {e}");
+        }
         data.study = Some(study);
     }
     for path in &args.sweeps {
@@ -118,47 +122,11 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     write(&args.output, &data)
 }
 
-/// Fills formulas from the study's property file, when it is SCAN XML that reads.
-fn formulas_from_file(study: &mut Study) {
-    let path = Path::new(&study.properties_file);
-    if study.properties.iter().all(|p| p.formula.is_some())
-        || path.extension().is_none_or(|e| e != "xml")
-        || !path.is_file()
-    {
-        return;
-    }
-    match crate::props::parse_file(path) {
-        Ok(file) => {
-            for p in &mut study.properties {
-                if let Some(g) = file.guarantees.iter().find(|g| g.id == p.property) {
-                    p.formula
-                        .get_or_insert_with(|| g.formula.as_str().to_string());
-                }
-            }
-        }
-        Err(e) => eprintln!("warning: formulas not shown: {e}"),
-    }
-}
-
 fn write(path: &Path, data: &ReportData) -> Result<(), CliError> {
     super::write_whole(path, report::render(data).as_bytes())
         .map_err(|e| CliError::Failed(format!("{}: cannot write: {e}", path.display())))?;
     eprintln!("wrote {}", path.display());
     Ok(())
-}
-
-/// One failing run replayed by `verify`: its property, run index, file name and CSV.
-pub struct Failing {
-    /// The property it was kept for.
-    pub property: String,
-    /// Its index in the study.
-    pub run: u64,
-    /// The file it was written to, or would be.
-    pub file: String,
-    /// The CSV text.
-    pub csv: String,
-    /// Per property that turned false: the subformula that explains it, and its value.
-    pub culprits: Vec<crate::verify::record::Culprit>,
 }
 
 /// `verify --report FILE`: the study in memory (`report` is what `--json` prints), each
@@ -172,15 +140,7 @@ pub fn from_verify(
 ) -> Result<(), CliError> {
     let mut study = report.clone();
     study.settings = settings;
-    let checked = loaded.set.compiled().checked();
-    for p in &mut study.properties {
-        if let Some(g) = loaded.file.guarantees.iter().find(|g| g.id == p.property) {
-            p.formula = Some(g.formula.as_str().to_string());
-        }
-        if let Some(def) = checked.properties.iter().find(|d| d.name == p.property) {
-            p.compiled = Some(codegen::print::formula(&def.formula, checked));
-        }
-    }
+    study.add_formulas(loaded);
     let mut data = ReportData {
         title: format!("hindsight verify: {}", study.model),
         ..ReportData::default()

@@ -23,6 +23,7 @@ use crate::live::publish_dds::{declared_types, plan, DdsPaced, DdsPublisher};
 use crate::live::{check_speed, Clock};
 use crate::props::ros::{action_event, service_client_event, service_event, topic_event};
 use crate::sim::{EndReason, EventSemantics, Quiescence, RunConfig, Simulator};
+use crate::{iceoryx2, ros2};
 
 /// Arguments of `hindsight run`.
 #[derive(Debug, clap::Args)]

@@ -1,9 +1,8 @@
 //! `hindsight verify`: estimate each guarantee's probability on a plain SCXML model.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Once;
-use std::time::Duration;
 
 mod both;
 mod schedulers;
@@ -11,18 +10,20 @@ mod shard;
 
 pub use schedulers::{parse_scheduler, BadScheduler, MemoryArg};
 pub use shard::{merge, MergeArgs};
-use shard::{merged_report, run_shard_cli};
 
 use super::CliError;
+use crate::codegen;
 use crate::robot::bt::{BtSemantics, BtTick};
 use crate::robot::load::ExternalComponent;
-use crate::sim::{CompiledModel, EventSemantics, RunConfig, Scheduler, Simulator};
+use crate::sim::{EventSemantics, Scheduler};
 use crate::smc::stats::{RuleConfig, RuleKind};
-use crate::smc::{StudyConfig, StudyResult};
-use crate::verify::load::{LoadOptions, Loaded};
-use crate::verify::observe::{Judge, PropertySet};
-use crate::verify::result::{PropertyRow, Study};
-use crate::verify::study::study_until;
+use crate::verify::fixed::fixed_study;
+use crate::verify::load::{LoadOptions, Loaded, MaxTimeError};
+use crate::verify::options::VerifyOptions;
+use crate::verify::replay::{failing_runs, replay_csv, witness_runs};
+use crate::verify::result::Study;
+use crate::verify::schedulers::SchedulerOptions;
+use crate::verify::study::{study_shard, study_until, Unfair};
 
 /// The stopping rule, as named on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -206,6 +207,47 @@ pub struct VerifyArgs {
     pub scheduler: Option<Scheduler>,
 }
 
+impl VerifyArgs {
+    /// The study's settings, read from the arguments once: every step of `verify` takes
+    /// them from here.
+    pub fn options(&self) -> VerifyOptions {
+        VerifyOptions {
+            rule: RuleConfig {
+                kind: match (self.threshold, self.rule) {
+                    (Some(threshold), _) => RuleKind::Sprt { threshold },
+                    (None, Rule::Adaptive) => RuleKind::Adaptive,
+                    (None, Rule::Okamoto) => RuleKind::Okamoto,
+                    (None, Rule::Wilson) => RuleKind::Wilson,
+                    (None, Rule::ClopperPearson) => RuleKind::ClopperPearson,
+                },
+                confidence: self.confidence,
+                precision: self.precision,
+            },
+            seed: self.seed,
+            threads: self.threads,
+            max_runs: self.max_runs,
+            max_time: self.max_time.clone(),
+            max_steps: self.max_steps,
+            max_instant_steps: self.max_instant_steps,
+            scheduler: self.scheduler,
+            keep_failing: match self.report {
+                Some(_) => self.save_failing.max(1),
+                None => self.save_failing,
+            },
+            schedulers: self.schedulers.map(|count| SchedulerOptions {
+                count,
+                memory: self.scheduler_memory.into(),
+                selection_runs: self.selection_runs,
+                unfair: if self.keep_unfair {
+                    Unfair::Keep
+                } else {
+                    Unfair::LeaveOut
+                },
+            }),
+        }
+    }
+}
+
 /// The model and property arguments every command that loads a model takes.
 #[derive(Debug, Default, clap::Args)]
 pub struct ModelArgs {
@@ -312,23 +354,9 @@ pub fn load_without(
     super::load_model_without(&args.options()?, external)
 }
 
-/// [`crate::verify::study::study`], its failure a bad-input error.
-pub fn study(
-    model: &CompiledModel,
-    set: &PropertySet,
-    run_cfg: &RunConfig,
-    study_cfg: &StudyConfig,
-    rule: &RuleConfig,
-    show_progress: bool,
-) -> Result<StudyResult, CliError> {
-    let mut bar = progress_bar(show_progress);
-    crate::verify::study::study(model, set, run_cfg, study_cfg, rule, &mut |p| bar.update(p))
-        .map_err(|e| CliError::Input(e.to_string()))
-}
-
 /// The progress bar of a study on standard error, or none (`--json`): the library reports
 /// progress to a callback and prints nothing.
-fn progress_bar(show: bool) -> crate::smc::progress::TerminalProgress {
+pub(super) fn progress_bar(show: bool) -> crate::smc::progress::TerminalProgress {
     if show {
         crate::smc::progress::TerminalProgress::stderr()
     } else {
@@ -408,17 +436,16 @@ pub struct TraceArgs {
 /// Runs `hindsight trace`: one run of the study, every point as CSV.
 pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
     let loaded = load(&args.input)?;
-    let (model, set) = (&loaded.model, &loaded.set);
-    let run_cfg = RunConfig {
-        max_time: loaded
-            .max_time(args.max_time.as_deref())
-            .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
+    let opts = VerifyOptions {
+        seed: args.seed,
+        max_time: args.max_time.clone(),
         max_steps: args.max_steps,
-        events: loaded.events,
-        scheduler: args.scheduler.unwrap_or_default(),
-        ..RunConfig::default()
+        scheduler: args.scheduler,
+        ..VerifyOptions::default()
     };
-    let (csv, _) = replay_csv(model, set, &run_cfg, args.seed, args.run)?;
+    let run_cfg = opts.run_config(&loaded).map_err(max_time_error)?;
+    let (csv, _) = replay_csv(&loaded.model, &loaded.set, &run_cfg, opts.seed, args.run)
+        .map_err(|e| CliError::Failed(e.to_string()))?;
     match &args.output {
         Some(p) => {
             std::fs::write(p, csv).map_err(|e| CliError::Failed(format!("{}: {e}", p.display())))?
@@ -428,155 +455,33 @@ pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Replays run `k` of a study with `seed` and returns its CSV (see `verify::record`)
-/// and, per property that turned false, the subformula that explains it.
-fn replay_csv(
-    model: &CompiledModel,
-    set: &PropertySet,
-    run_cfg: &RunConfig,
-    seed: u64,
-    k: u64,
-) -> Result<(String, Vec<crate::verify::record::Culprit>), CliError> {
-    let mut judge = Judge::new(set).map_err(|e| CliError::Failed(e.to_string()))?;
-    let mut rec = crate::verify::record::Recorder::new(&mut judge, model);
-    rec.start();
-    let mut rng = crate::smc::runner::stream(seed, k);
-    Simulator::new(model).run(&mut rng, run_cfg, &mut rec);
-    Ok((rec.csv, rec.culprits))
-}
-
-/// `id` as a file name inside `--out`: ids are checked where declared
-/// (`props::is_valid_id`), so this changes nothing for them; any other character (a
-/// name from elsewhere) becomes `_`, and a leading `.` too, so no name is a path
-/// (`../x`, `/etc/x`) or a hidden file.
-fn file_stem(id: &str) -> String {
-    let stem: String = id
-        .chars()
-        .enumerate()
-        .map(|(i, c)| match c {
-            'a'..='z' | 'A'..='Z' | '0'..='9' | '_' | '-' => c,
-            '.' if i > 0 => c,
-            _ => '_',
-        })
-        .take(crate::props::MAX_ID_LEN)
-        .collect();
-    if stem.is_empty() {
-        "property".to_owned()
-    } else {
-        stem
-    }
-}
-
-/// Replays each kept failing run (run k is stream k of the seed) and, with
-/// --save-failing, writes its CSV.
-fn save_failing(
-    args: &VerifyArgs,
-    model: &CompiledModel,
-    set: &PropertySet,
-    run_cfg: &RunConfig,
-    result: &StudyResult,
-) -> Result<Vec<super::report::Failing>, CliError> {
-    let io = |e: std::io::Error| CliError::Failed(format!("{}: {e}", args.out.display()));
-    if args.save_failing > 0 {
-        std::fs::create_dir_all(&args.out).map_err(io)?;
-    }
-    let mut kept = Vec::new();
-    for (name, p) in set.guarantee_names().iter().zip(&result.properties) {
-        for &k in &p.failing_runs {
-            let (csv, culprits) = replay_csv(model, set, run_cfg, args.seed, k)?;
-            let path = args.out.join(format!("{}-run{k}.csv", file_stem(name)));
-            if args.save_failing > 0 {
-                std::fs::write(&path, &csv).map_err(io)?;
-                eprintln!("wrote {}", path.display());
-            }
-            let file = path.display().to_string();
-            kept.push(super::report::Failing {
-                property: name.clone(),
-                run: k,
-                file,
-                csv,
-                culprits,
-            });
-        }
-    }
-    Ok(kept)
-}
-
-/// The stopping rule `verify`'s options ask for (`--threshold` makes it Wald's SPRT).
-fn rule_config(args: &VerifyArgs) -> RuleConfig {
-    RuleConfig {
-        kind: match (args.threshold, args.rule) {
-            (Some(threshold), _) => RuleKind::Sprt { threshold },
-            (None, Rule::Adaptive) => RuleKind::Adaptive,
-            (None, Rule::Okamoto) => RuleKind::Okamoto,
-            (None, Rule::Wilson) => RuleKind::Wilson,
-            (None, Rule::ClopperPearson) => RuleKind::ClopperPearson,
-        },
-        confidence: args.confidence,
-        precision: args.precision,
-    }
-}
-
-/// How each run of `loaded` is bounded and which event semantics it follows.
-fn run_config(args: &VerifyArgs, loaded: &Loaded) -> Result<RunConfig, CliError> {
-    Ok(RunConfig {
-        max_time: loaded
-            .max_time(args.max_time.as_deref())
-            .map_err(|m| CliError::Input(format!("--max-time: {m}")))?,
-        max_steps: args.max_steps,
-        max_steps_per_instant: args.max_instant_steps,
-        events: loaded.events,
-        scheduler: args.scheduler.unwrap_or_default(),
-        ..RunConfig::default()
-    })
+/// A run length (`--max-time`) that is not a number of model steps: bad input.
+pub fn max_time_error(e: MaxTimeError) -> CliError {
+    CliError::Input(format!("--max-time: {e}"))
 }
 
 /// Runs `hindsight verify`.
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     schedulers::check(args)?;
+    let opts = args.options();
     if args.input.bt == BtArg::Both {
-        return both::run_both(args);
+        return both::run_both(args, &opts);
     }
     let loaded = load(&args.input)?;
     let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
-    let rule = rule_config(args);
-    let run_cfg = run_config(args, &loaded)?;
-    let study_cfg = StudyConfig {
-        seed: args.seed,
-        threads: args.threads,
-        max_runs: args.max_runs,
-        keep_failing: match args.report {
-            Some(_) => args.save_failing.max(1),
-            None => args.save_failing,
-        },
-        progress_every: Duration::from_millis(200),
-    };
-    // The page's settings lines.
-    let settings = || {
-        [
-            ("rule", format!("{:?}", rule.kind).to_lowercase()),
-            ("run length in steps", run_cfg.max_time.to_string()),
-            ("step limit", args.max_steps.to_string()),
-            ("events", format!("{:?}", run_cfg.events).to_lowercase()),
-        ]
-        .map(|(k, v)| (k.to_string(), v))
-        .into_iter()
-        .chain(
-            args.scheduler
-                .map(|s| ("scheduler".to_string(), s.to_string())),
-        )
-        .collect::<Vec<_>>()
-    };
-    if let (Some(_), Some(runs)) = (args.schedulers, args.runs) {
+    let run_cfg = opts.run_config(&loaded).map_err(max_time_error)?;
+    let study_cfg = opts.study_config();
+    if let (Some(_), Some(runs)) = (opts.schedulers, args.runs) {
         // A fixed-size scheduler study: one shard of one stage, or every stage here.
-        let Some(mut report) = schedulers::run_fixed(args, &loaded, &run_cfg, &study_cfg, runs)?
+        let Some(mut report) =
+            schedulers::run_fixed(args, &opts, &loaded, &run_cfg, &study_cfg, runs)?
         else {
             return Ok(());
         };
         report.model = args.input.model.display().to_string();
         report.properties_file = props_path.display().to_string();
         if let Some(path) = &args.report {
-            super::report::from_verify(path, &report, &loaded, settings(), &[])?;
+            super::report::from_verify(path, &report, &loaded, opts.settings(&run_cfg), &[])?;
         }
         return print_report(&report, args.json);
     }
@@ -584,9 +489,19 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         // A fixed-size study: one shard of it, or all of it (shard 0/1) reported as
         // `merge` reports the shards of one, so both give the same numbers.
         let shard = args.shard.unwrap_or(crate::smc::shard::Shard::WHOLE);
-        let part = run_shard_cli(
-            args, model, set, props_path, &run_cfg, &study_cfg, &rule, shard, runs,
-        )?;
+        let fixed = fixed_study(
+            &loaded,
+            &args.input.model,
+            opts.seed,
+            &run_cfg,
+            &opts.rule,
+            runs,
+        );
+        let mut bar = crate::smc::progress::TerminalProgress::stderr();
+        let part = study_shard(model, set, &run_cfg, &study_cfg, &fixed, shard, &mut |p| {
+            bar.update(p)
+        })
+        .map_err(|e| CliError::Input(e.to_string()))?;
         if args.shard.is_some() {
             let json = part.to_json();
             return match &args.partial {
@@ -600,12 +515,12 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         }
         let m = crate::smc::shard::merge(&[part], 0)
             .map_err(|e| CliError::Input(format!("--runs: {e}")))?;
-        let mut report = merged_report(&m);
+        let mut report = Study::merged(&m);
         report.model = args.input.model.display().to_string();
         report.properties_file = props_path.display().to_string();
         if let Some(path) = &args.report {
             // A fixed-size study keeps counts, not runs: the page has no timelines.
-            super::report::from_verify(path, &report, &loaded, settings(), &[])?;
+            super::report::from_verify(path, &report, &loaded, opts.settings(&run_cfg), &[])?;
         }
         return print_report(&report, args.json);
     }
@@ -615,7 +530,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         set,
         &run_cfg,
         &study_cfg,
-        &rule,
+        &opts.rule,
         &mut |p| bar.update(p),
         interrupt_flag(),
     )
@@ -624,14 +539,32 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         eprintln!("interrupted: --save-failing and --report are not written for a partial study");
     }
     let failing = if !result.interrupted && (args.save_failing > 0 || args.report.is_some()) {
-        save_failing(args, model, set, &run_cfg, &result)?
+        let kept = failing_runs(model, set, &run_cfg, opts.seed, &result, &args.out)
+            .map_err(|e| CliError::Failed(e.to_string()))?;
+        if args.save_failing > 0 {
+            let written = crate::verify::replay::save(&args.out, &kept)
+                .map_err(|e| CliError::Failed(format!("{}: {e}", args.out.display())))?;
+            for path in written {
+                eprintln!("wrote {}", path.display());
+            }
+        }
+        kept
     } else {
         Vec::new()
     };
-    let mut report = report(args, props_path, set, &result);
+    let mut report = Study::of_result(
+        &args.input.model,
+        props_path,
+        set,
+        &opts.rule,
+        opts.seed,
+        opts.scheduler,
+        &result,
+    );
     if !result.interrupted
         && !schedulers::add_bounds(
-            args,
+            &opts,
+            !args.json,
             &loaded,
             &run_cfg,
             &study_cfg,
@@ -647,52 +580,24 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             report.settings.push(("bt".into(), bt.label().into()));
         }
     }
-    if let Some(unit) = loaded.unit_ns {
-        report.step_seconds = Some(unit as f64 / 1e9);
-        report.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
-    }
+    report.set_time_unit(loaded.unit_ns, run_cfg.max_time);
     if let Some(path) = args.report.as_ref().filter(|_| !result.interrupted) {
         // With --schedulers: a failing run under each order-sensitive property's min
         // witness beside one under the uniform scheduler.
         let mut failing = failing;
         if !report.interrupted {
-            failing.extend(schedulers::witness_runs(args, &loaded, &run_cfg, &report)?);
+            failing.extend(
+                witness_runs(model, set, &run_cfg, opts.seed, &report)
+                    .map_err(|e| CliError::Failed(e.to_string()))?,
+            );
         }
-        super::report::from_verify(path, &report, &loaded, settings(), &failing)?;
+        super::report::from_verify(path, &report, &loaded, opts.settings(&run_cfg), &failing)?;
     }
     print_report(&report, args.json)?;
     if report.interrupted {
         return Err(interrupted_error(report.runs));
     }
     Ok(())
-}
-
-fn report(args: &VerifyArgs, props: &Path, set: &PropertySet, r: &StudyResult) -> Study {
-    Study {
-        step_seconds: None,
-        max_time_seconds: None,
-        model: args.input.model.display().to_string(),
-        properties_file: props.display().to_string(),
-        seed: args.seed,
-        confidence: args.confidence,
-        precision: args.precision,
-        runs: r.runs.runs,
-        discarded: r.runs.discarded,
-        time_horizon: r.runs.time_horizon,
-        step_limit: r.runs.step_limit,
-        decided: r.runs.decided,
-        quiescent: r.runs.quiescent,
-        interrupted: r.interrupted,
-        scheduler: args.scheduler.map(|s| s.to_string()),
-        seconds: r.elapsed.as_secs_f64(),
-        settings: Vec::new(),
-        properties: set
-            .guarantee_names()
-            .iter()
-            .zip(&r.properties)
-            .map(|(name, p)| PropertyRow::new(name, &p.estimate, &p.interval, &p.counts))
-            .collect(),
-    }
 }
 
 /// Prints a report as JSON or as the table.

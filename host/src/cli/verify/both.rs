@@ -1,21 +1,18 @@
 //! `hindsight verify --bt both`: one study under AS2FM's node models and one under
 //! BehaviorTree.CPP 4, side by side, and which properties are semantics-sensitive.
 
-use std::time::Duration;
-
 use super::{
-    interrupt_flag, interrupted_error, interrupted_line, report, rule_config, run_config,
-    study_until, VerifyArgs,
+    interrupt_flag, interrupted_error, interrupted_line, max_time_error, study_until, VerifyArgs,
 };
 use crate::cli::CliError;
-use crate::smc::StudyConfig;
-use crate::verify::result::PropertyRow;
+use crate::verify::options::VerifyOptions;
+use crate::verify::result::{PropertyRow, Study};
 
 /// `verify --bt both`: the study under AS2FM's node models and under BehaviorTree.CPP 4,
 /// each with the same seed and settings, and per property both probabilities and
 /// whether they differ beyond the precision (the two intervals are disjoint:
 /// "semantics-sensitive").
-pub(super) fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
+pub(super) fn run_both(args: &VerifyArgs, opts: &VerifyOptions) -> Result<(), CliError> {
     let refuse = |what: &str| {
         Err(CliError::Input(format!(
             "--bt both: not with {what} (run each semantics with --bt as2fm / --bt btcpp)"
@@ -31,15 +28,9 @@ pub(super) fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
     let stop = interrupt_flag();
     for bt in args.input.semantics()? {
         let loaded = crate::cli::load_model(&args.input.options_with(bt)?)?;
-        let rule = rule_config(args);
-        let run_cfg = run_config(args, &loaded)?;
-        let study_cfg = StudyConfig {
-            seed: args.seed,
-            threads: args.threads,
-            max_runs: args.max_runs,
-            keep_failing: 0,
-            progress_every: Duration::from_millis(200),
-        };
+        let run_cfg = opts.run_config(&loaded).map_err(max_time_error)?;
+        // `--report` and `--save-failing` are refused above: no failing run is kept.
+        let study_cfg = opts.study_config();
         if !args.json {
             eprintln!("--bt {}:", bt.label());
         }
@@ -50,20 +41,27 @@ pub(super) fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
             &loaded.set,
             &run_cfg,
             &study_cfg,
-            &rule,
+            &opts.rule,
             &mut |p| bar.update(p),
             stop,
         )
         .map_err(|e| CliError::Input(e.to_string()))?;
-        let mut r = report(args, &loaded.props_path, &loaded.set, &result);
+        let mut r = Study::of_result(
+            &args.input.model,
+            &loaded.props_path,
+            &loaded.set,
+            &opts.rule,
+            opts.seed,
+            opts.scheduler,
+            &result,
+        );
         r.settings.push(("bt".into(), bt.label().into()));
-        if let Some(unit) = loaded.unit_ns {
-            r.step_seconds = Some(unit as f64 / 1e9);
-            r.max_time_seconds = Some(run_cfg.max_time as f64 * unit as f64 / 1e9);
-        }
+        r.set_time_unit(loaded.unit_ns, run_cfg.max_time);
         // `--schedulers`: the bounds under each semantics, on the same seed.
         if !result.interrupted
-            && !super::schedulers::add_bounds(args, &loaded, &run_cfg, &study_cfg, &mut r, stop)?
+            && !super::schedulers::add_bounds(
+                opts, !args.json, &loaded, &run_cfg, &study_cfg, &mut r, stop,
+            )?
         {
             eprintln!("interrupted: the bounds over schedulers are left out");
             r.interrupted = true;
@@ -137,9 +135,9 @@ pub(super) fn run_both(args: &VerifyArgs) -> Result<(), CliError> {
         a.runs,
         bt.label(),
         b.runs,
-        args.seed,
-        args.confidence,
-        args.precision
+        opts.seed,
+        opts.rule.confidence,
+        opts.rule.precision
     );
     for (bt, s) in &studies {
         if s.properties.iter().any(|p| p.schedulers.is_some()) {

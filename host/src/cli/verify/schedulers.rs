@@ -2,15 +2,15 @@
 //! scheduler beside the smallest and largest found among N sampled deterministic
 //! schedulers, and which properties are order-sensitive.
 
-use super::shard::{fixed_study, merged_report};
 use super::{CliError, VerifyArgs};
 use crate::sim::{Memory, Scheduler};
 use crate::smc::stats::RuleKind;
+use crate::verify::fixed::fixed_study;
 use crate::verify::load::Loaded;
+use crate::verify::options::VerifyOptions;
 use crate::verify::result::Study;
 use crate::verify::sched_fixed::{run_all, run_stage, Plan, StageError};
-use crate::verify::schedulers::{bounds, explain, BoundsError, SchedulerOptions, Stage};
-use crate::verify::study::Unfair;
+use crate::verify::schedulers::{bounds, explain, BoundsError, Stage};
 
 impl From<BoundsError> for CliError {
     fn from(e: BoundsError) -> Self {
@@ -95,32 +95,21 @@ pub(super) fn check(args: &VerifyArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Runs the bounds of `--schedulers` and adds them to `report`'s rows; `Ok(false)` when
-/// interrupted.
+/// Runs the bounds of `--schedulers` and adds them to `report`'s rows, their progress on
+/// standard error when `show`; `Ok(false)` when interrupted.
 pub(super) fn add_bounds(
-    args: &VerifyArgs,
+    opts: &VerifyOptions,
+    show: bool,
     loaded: &Loaded,
     run_cfg: &crate::sim::RunConfig,
     study_cfg: &crate::smc::StudyConfig,
     report: &mut Study,
     stop: &std::sync::atomic::AtomicBool,
 ) -> Result<bool, CliError> {
-    let Some(count) = args.schedulers else {
+    let Some(sched) = &opts.schedulers else {
         return Ok(true);
     };
-    let rule = super::rule_config(args);
-    debug_assert!(!matches!(rule.kind, RuleKind::Sprt { .. }));
-    let opts = SchedulerOptions {
-        count,
-        memory: args.scheduler_memory.into(),
-        selection_runs: args.selection_runs,
-        unfair: if args.keep_unfair {
-            Unfair::Keep
-        } else {
-            Unfair::LeaveOut
-        },
-    };
-    let show = !args.json;
+    debug_assert!(!matches!(opts.rule.kind, RuleKind::Sprt { .. }));
     let mut progress = |s: Stage<'_>| {
         if !show {
             return;
@@ -145,8 +134,8 @@ pub(super) fn add_bounds(
         &loaded.set,
         run_cfg,
         study_cfg,
-        &rule,
-        &opts,
+        &opts.rule,
+        sched,
         stop,
         &mut progress,
     )?;
@@ -161,11 +150,7 @@ pub(super) fn add_bounds(
 
 /// The table of bounds under the study's table (nothing without `--schedulers`).
 pub(super) fn print_bounds(r: &Study) {
-    let rows: Vec<_> = r
-        .properties
-        .iter()
-        .filter_map(|p| p.schedulers.as_ref().map(|b| (p, b)))
-        .collect();
+    let rows = r.scheduler_rows();
     let Some((_, first)) = rows.first() else {
         return;
     };
@@ -272,93 +257,29 @@ pub(super) fn print_bounds(r: &Study) {
     );
 }
 
-/// Runs searched for a failing one under each scheduler ([`witness_runs`]).
-const SEARCH: u64 = 500;
-
-/// For `--report` with `--schedulers`: per order-sensitive property, the first failing run
-/// of the study's seed under its minimising witness and the first under the uniform
-/// scheduler, one after the other, named by their scheduler, so that the page shows how
-/// the witness's order fails the property beside how a uniformly random one does.
-/// `verify --scheduler ID --save-failing 1` writes the same runs (run k is stream k of
-/// the seed whatever the scheduler). A scheduler with no failing run among the first
-/// [`SEARCH`] adds none.
-pub(super) fn witness_runs(
-    args: &VerifyArgs,
-    loaded: &Loaded,
-    run_cfg: &crate::sim::RunConfig,
-    report: &Study,
-) -> Result<Vec<crate::cli::report::Failing>, CliError> {
-    let mut out = Vec::new();
-    for row in &report.properties {
-        let Some(b) = row.schedulers.as_ref().filter(|b| b.order_sensitive) else {
-            continue;
-        };
-        let min: Scheduler = b
-            .min
-            .scheduler
-            .parse()
-            .map_err(|e: BadScheduler| CliError::Failed(e.to_string()))?;
-        for (label, scheduler) in [
-            (format!("min witness {min}"), min),
-            ("uniform scheduler".to_string(), Scheduler::Uniform),
-        ] {
-            let cfg = crate::sim::RunConfig {
-                scheduler,
-                ..run_cfg.clone()
-            };
-            for k in 0..SEARCH {
-                let (csv, culprits) =
-                    super::replay_csv(&loaded.model, &loaded.set, &cfg, args.seed, k)?;
-                if culprits.iter().any(|c| c.property == row.property) {
-                    out.push(crate::cli::report::Failing {
-                        property: row.property.clone(),
-                        run: k,
-                        file: format!("{} under the {label}, run {k}", row.property),
-                        csv,
-                        culprits,
-                    });
-                    break;
-                }
-            }
-        }
-    }
-    Ok(out)
-}
-
 /// `verify --schedulers N --runs R [--shard I/K [--plan FILE]]`: the fixed-size scheduler
 /// study ([`crate::verify::sched_fixed`]). With `--shard`, runs that shard of the plan's
 /// current stage (stage 0 without `--plan`) and writes its part (`Ok(None)`); without,
 /// runs every stage here and returns the report `merge` gives for the shards.
 pub(super) fn run_fixed(
     args: &VerifyArgs,
+    opts: &VerifyOptions,
     loaded: &Loaded,
     run_cfg: &crate::sim::RunConfig,
     study_cfg: &crate::smc::StudyConfig,
     runs: u64,
 ) -> Result<Option<Study>, CliError> {
-    let Some(count) = args.schedulers else {
+    let Some(sched) = &opts.schedulers else {
         return Ok(None);
     };
-    let rule = super::rule_config(args);
     let fixed = fixed_study(
-        args,
-        &loaded.model,
-        &loaded.set,
-        &loaded.props_path,
+        loaded,
+        &args.input.model,
+        opts.seed,
         run_cfg,
-        &rule,
+        &opts.rule,
         runs,
     );
-    let opts = SchedulerOptions {
-        count,
-        memory: args.scheduler_memory.into(),
-        selection_runs: args.selection_runs,
-        unfair: if args.keep_unfair {
-            Unfair::Keep
-        } else {
-            Unfair::LeaveOut
-        },
-    };
     let plan = match &args.plan {
         Some(p) => {
             let text = crate::cli::read_file(p)?;
@@ -368,11 +289,11 @@ pub(super) fn run_fixed(
                     p.display()
                 ))
             })?;
-            plan.check(&fixed, &opts)
+            plan.check(&fixed, sched)
                 .map_err(|e| CliError::Input(format!("{}: {e}", p.display())))?;
             plan
         }
-        None => Plan::new(fixed, &opts),
+        None => Plan::new(fixed, sched),
     };
     if let Some(shard) = args.shard {
         let part = run_stage(&loaded.model, &loaded.set, run_cfg, study_cfg, &plan, shard)?;
@@ -402,16 +323,5 @@ pub(super) fn run_fixed(
             }
         },
     )?;
-    fixed_report(&plan).map(Some)
-}
-
-/// The report of a finished fixed-size scheduler study: the uniform study as `merge`
-/// reports a fixed-size one, each property with its bounds.
-pub(super) fn fixed_report(plan: &Plan) -> Result<Study, CliError> {
-    let (merged, bounds) = plan.report()?;
-    let mut report = merged_report(&merged);
-    for (row, b) in report.properties.iter_mut().zip(bounds) {
-        row.schedulers = Some(b);
-    }
-    Ok(report)
+    Ok(Some(plan.study()?))
 }

@@ -1,18 +1,13 @@
-//! `verify --shard I/N --runs R` and `hindsight merge`: a fixed-size study run as shards,
-//! fingerprinted so that `merge` refuses to mix studies, and the merged study's report.
+//! `hindsight merge`: the parts `verify --shard I/N --runs R` wrote (a fixed-size study
+//! run as shards, fingerprinted by `verify::fixed` so that `merge` refuses to mix
+//! studies), checked and reported as one study (`verify::result::Study::merged`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use super::super::CliError;
-use super::{print_report, VerifyArgs};
-use crate::sim::{CompiledModel, RunConfig, Scheduler};
-use crate::smc::progress::TerminalProgress;
-use crate::smc::stats::RuleConfig;
-use crate::smc::StudyConfig;
-use crate::verify::observe::PropertySet;
-use crate::verify::result::{PropertyRow, Study};
+use super::print_report;
+use crate::verify::result::Study;
 use crate::verify::sched_fixed::{merge_stage, StagePart, PART_FORMAT};
-use crate::verify::study::Runner;
 
 /// `merge` of the parts of one stage of a scheduler study: the next stage's plan to
 /// `--next`, or the report after the last stage.
@@ -34,7 +29,7 @@ fn merge_stage_cli(args: &MergeArgs, texts: &[String], staged: &[bool]) -> Resul
     }
     let plan = merge_stage(&parts).map_err(|e| CliError::Input(format!("merge: {e}")))?;
     if plan.done() {
-        let report = super::schedulers::fixed_report(&plan)?;
+        let report = plan.study()?;
         return print_report(&report, args.json);
     }
     let Some(next) = &args.next else {
@@ -56,92 +51,6 @@ fn merge_stage_cli(args: &MergeArgs, texts: &[String], staged: &[bool]) -> Resul
         next.display()
     );
     Ok(())
-}
-
-/// FNV-1a over bytes: a stable fingerprint so `merge` can refuse mixed studies.
-fn fingerprint(parts: &[&[u8]]) -> String {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for p in parts {
-        for b in p.iter().chain(&[0xff]) {
-            h ^= *b as u64;
-            h = h.wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-    format!("{h:016x}")
-}
-
-/// What identifies the fixed-size study of `runs` runs that `args` describe: what `merge`
-/// compares across shards.
-pub(super) fn fixed_study(
-    args: &VerifyArgs,
-    model: &CompiledModel,
-    set: &PropertySet,
-    props_path: &Path,
-    run_cfg: &RunConfig,
-    rule: &RuleConfig,
-    runs: u64,
-) -> crate::smc::shard::FixedStudy {
-    use crate::smc::shard::{FixedStudy, PropertySpec};
-    let props_text = std::fs::read(props_path).unwrap_or_default();
-    let mut model_desc = format!(
-        "{} machines, {} events, max_time {}, max_steps {}",
-        model.machine_count(),
-        model.event_count(),
-        run_cfg.max_time,
-        run_cfg.max_steps
-    );
-    // Shards under different schedulers are different studies: `merge` refuses to mix
-    // them (the uniform scheduler's description is unchanged).
-    if run_cfg.scheduler != Scheduler::Uniform {
-        model_desc.push_str(&format!(", scheduler {}", run_cfg.scheduler));
-    }
-    FixedStudy {
-        seed: args.seed,
-        study_runs: runs,
-        model: format!("{} ({model_desc})", fingerprint(&[model_desc.as_bytes()])),
-        properties_fingerprint: fingerprint(&[&props_text]),
-        properties: set
-            .guarantee_names()
-            .iter()
-            .map(|id| PropertySpec {
-                id: id.clone(),
-                rule: *rule,
-            })
-            .collect(),
-        paths: Some(crate::smc::shard::StudyPaths {
-            model: args.input.model.display().to_string(),
-            properties: props_path.display().to_string(),
-        }),
-    }
-}
-
-#[allow(clippy::too_many_arguments)]
-pub(super) fn run_shard_cli(
-    args: &VerifyArgs,
-    model: &CompiledModel,
-    set: &PropertySet,
-    props_path: &Path,
-    run_cfg: &RunConfig,
-    study_cfg: &StudyConfig,
-    rule: &RuleConfig,
-    shard: crate::smc::shard::Shard,
-    runs: u64,
-) -> Result<crate::smc::shard::PartialResult, CliError> {
-    use crate::smc::shard::run_shard;
-    let fixed = fixed_study(args, model, set, props_path, run_cfg, rule, runs);
-    let runner = Runner::new(model, set, run_cfg);
-    let mut bar = TerminalProgress::stderr();
-    let part = run_shard(
-        study_cfg,
-        &fixed,
-        shard,
-        |k, rng| runner.run(k, rng),
-        &mut |p| bar.update(p),
-    );
-    runner
-        .finish()
-        .map_err(|e| CliError::Input(e.to_string()))?;
-    Ok(part)
 }
 
 /// Arguments of `hindsight merge`.
@@ -215,40 +124,5 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
             files_of(shard)
         );
     }
-    print_report(&merged_report(&m), args.json)
-}
-
-/// The report of a merged fixed-size study (`merge`, and `verify --runs R` alone).
-pub(super) fn merged_report(m: &crate::smc::shard::MergedResult) -> Study {
-    let (model, properties_file) = match &m.study.paths {
-        Some(p) => (p.model.clone(), p.properties.clone()),
-        None => (
-            m.study.model.clone(),
-            m.study.properties_fingerprint.clone(),
-        ),
-    };
-    Study {
-        model,
-        properties_file,
-        seed: m.study.seed,
-        confidence: m.properties.first().map_or(0.0, |p| p.rule.confidence),
-        precision: m.properties.first().map_or(0.0, |p| p.rule.precision),
-        runs: m.runs.runs,
-        discarded: m.runs.discarded,
-        time_horizon: m.runs.time_horizon,
-        step_limit: m.runs.step_limit,
-        decided: m.runs.decided,
-        quiescent: m.runs.quiescent,
-        interrupted: false,
-        scheduler: None,
-        seconds: 0.0,
-        step_seconds: None,
-        max_time_seconds: None,
-        settings: Vec::new(),
-        properties: m
-            .properties
-            .iter()
-            .map(|p| PropertyRow::new(&p.id, &p.estimate, &p.interval, &p.counts))
-            .collect(),
-    }
+    print_report(&Study::merged(&m), args.json)
 }
