@@ -328,11 +328,11 @@ pub fn study(
 
 /// The progress bar of a study on standard error, or none (`--json`): the library reports
 /// progress to a callback and prints nothing.
-fn progress_bar(show: bool) -> crate::smc::progress::TerminalProgress {
+fn progress_bar(show: bool) -> super::progress::TerminalProgress {
     if show {
-        crate::smc::progress::TerminalProgress::stderr()
+        super::progress::TerminalProgress::stderr()
     } else {
-        crate::smc::progress::TerminalProgress::hidden()
+        super::progress::TerminalProgress::hidden()
     }
 }
 

@@ -5,8 +5,8 @@ use std::path::{Path, PathBuf};
 
 use super::super::CliError;
 use super::{print_report, VerifyArgs};
+use crate::cli::progress::TerminalProgress;
 use crate::sim::{CompiledModel, RunConfig, Scheduler};
-use crate::smc::progress::TerminalProgress;
 use crate::smc::stats::RuleConfig;
 use crate::smc::StudyConfig;
 use crate::verify::observe::PropertySet;
