@@ -32,8 +32,8 @@ pub struct Record {
 }
 
 /// Reads CSV text (RFC 4180: quoted fields may hold `,`, `""` and line breaks); empty
-/// lines are skipped. An unterminated quote is an error `(line, column, message)`.
-pub fn records(text: &str) -> Result<Vec<Record>, (usize, usize, String)> {
+/// lines are skipped. An unterminated quote is an error at the quote's line and column.
+pub fn records(text: &str) -> Result<Vec<Record>, Unterminated> {
     let mut out = Vec::new();
     let (mut line, mut col) = (1usize, 1usize);
     let mut chars = text.chars().peekable();
@@ -59,7 +59,10 @@ pub fn records(text: &str) -> Result<Vec<Record>, (usize, usize, String)> {
                 loop {
                     match chars.next() {
                         None => {
-                            return Err((open_line, open_col, "unterminated quoted field".into()))
+                            return Err(Unterminated {
+                                line: open_line,
+                                column: open_col,
+                            })
                         }
                         Some('"') => {
                             col += 1;
@@ -110,6 +113,23 @@ pub fn records(text: &str) -> Result<Vec<Record>, (usize, usize, String)> {
     Ok(out)
 }
 
+/// A quoted field that the text ends inside: where its opening quote is (1-based).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Unterminated {
+    /// The quote's line.
+    pub line: usize,
+    /// The quote's column, in characters.
+    pub column: usize,
+}
+
+impl std::fmt::Display for Unterminated {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("unterminated quoted field")
+    }
+}
+
+impl std::error::Error for Unterminated {}
+
 /// The rows of the CSV file `file` (its name, for errors) with text `text`: its
 /// [`records`], after a UTF-8 byte order mark, without comment lines (a first field
 /// starting with `#`) and rows whose every field is blank. The one reader of CSV files:
@@ -118,7 +138,7 @@ pub fn records(text: &str) -> Result<Vec<Record>, (usize, usize, String)> {
 pub fn rows(file: &str, text: &str) -> Result<Vec<Record>, Diagnostic> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let all = records(text)
-        .map_err(|(line, col, m)| Diagnostic::error(file, (line as u32, col as u32), m))?;
+        .map_err(|u| Diagnostic::error(file, (u.line as u32, u.column as u32), u.to_string()))?;
     Ok(all
         .into_iter()
         .filter(|r| {
@@ -154,7 +174,7 @@ mod tests {
         );
         assert_eq!(
             records("a,\"open\n"),
-            Err((1, 3, "unterminated quoted field".into()))
+            Err(Unterminated { line: 1, column: 3 })
         );
     }
 

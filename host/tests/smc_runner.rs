@@ -389,7 +389,7 @@ fn progress_reports_end_with_a_final_one() {
     let mut reports = Vec::new();
     let mut expected = Vec::new();
     // Draws only if the test's standard error is a terminal.
-    let mut bar = hindsight::smc::progress::TerminalProgress::stderr();
+    let mut bar = hindsight::cli::progress::TerminalProgress::stderr();
     let result = run_study(
         &study,
         &rules(RuleKind::Adaptive, 0.95, 0.05, 1),

@@ -109,45 +109,44 @@ struct Phase {
 
 fn phase(service: &str, n: u64, rate: Option<f64>) -> Result<Phase, LiveError> {
     // The benchmark's own spec and config: an error in either is a bug.
-    let spec =
-        codegen::compile_spec(SPEC, "bench.hspec").map_err(|d| LiveError::Engine(d.to_string()))?;
-    let config = Config::parse(&config_text(service), "bench.toml", &spec)
-        .map_err(|d| LiveError::Engine(d.to_string()))?;
+    let spec = codegen::compile_spec(SPEC, "bench.hspec").map_err(LiveError::Spec)?;
+    let config =
+        Config::parse(&config_text(service), "bench.toml", &spec).map_err(LiveError::Spec)?;
     let epoch = Instant::now();
     let stop = Arc::new(AtomicBool::new(false));
     let ready = Arc::new(AtomicU64::new(0));
     let node = NodeBuilder::new()
         .signal_handling_mode(SignalHandlingMode::Disabled)
         .create::<ipc::Service>()
-        .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
+        .map_err(|e| LiveError::ipc(service, e))?;
     let name = super::service_name(service)?;
     let factory = node
         .service_builder(&name)
         .publish_subscribe::<[u8]>()
         .subscriber_max_buffer_size(1024)
         .open_or_create()
-        .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
+        .map_err(|e| LiveError::ipc(service, e))?;
     let publisher = factory
         .publisher_builder()
         .initial_max_slice_len(24)
         .create()
-        .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
+        .map_err(|e| LiveError::ipc(service, e))?;
     let plain = {
         let (stop, ready, service) = (stop.clone(), ready.clone(), service.to_string());
         std::thread::spawn(move || -> Result<Vec<u64>, LiveError> {
             let node = NodeBuilder::new()
                 .signal_handling_mode(SignalHandlingMode::Disabled)
                 .create::<ipc::Service>()
-                .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
+                .map_err(|e| LiveError::ipc(service.as_str(), e))?;
             let f = node
                 .service_builder(&super::service_name(&service)?)
                 .publish_subscribe::<[u8]>()
                 .open()
-                .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
+                .map_err(|e| LiveError::ipc(service.as_str(), e))?;
             let sub = f
                 .subscriber_builder()
                 .create()
-                .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
+                .map_err(|e| LiveError::ipc(service.as_str(), e))?;
             ready.fetch_add(1, Ordering::SeqCst);
             let mut lat = Vec::new();
             while !stop.load(Ordering::Relaxed) {
@@ -199,20 +198,20 @@ fn phase(service: &str, n: u64, rate: Option<f64>) -> Result<Phase, LiveError> {
         buf[16..24].copy_from_slice(&(epoch.elapsed().as_nanos() as u64).to_le_bytes());
         let s = publisher
             .loan_slice_uninit(24)
-            .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
+            .map_err(|e| LiveError::ipc(service, e))?;
         s.write_from_slice(&buf)
             .send()
-            .map_err(|e| LiveError::Ipc(format!("{e:?}")))?;
+            .map_err(|e| LiveError::ipc(service, e))?;
     }
     let send_secs = start.elapsed().as_secs_f64();
     std::thread::sleep(Duration::from_millis(300));
     stop.store(true, Ordering::SeqCst);
     let plain = plain
         .join()
-        .map_err(|_| LiveError::Engine("the plain subscriber panicked".into()))??;
+        .map_err(|_| LiveError::Thread("the plain subscriber"))??;
     let report = side
         .join()
-        .map_err(|_| LiveError::Engine("the sidecar panicked".into()))??;
+        .map_err(|_| LiveError::Thread("the sidecar"))??;
     let st = &report.sources[0];
     Ok(Phase {
         plain,

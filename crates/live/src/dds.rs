@@ -3,7 +3,7 @@
 //! One DDS participant ([`ros2::dds::Participant`]) reads every topic a port names
 //! (`rt/<topic>`, ROS 2's type names and default QoS); each sample is CDR-decoded by the
 //! recordings' reader ([`ros2::feed::TopicFeed`]), stamped with the iceoryx2 sidecar's
-//! [`Clock`] and judged by the same steps as an iceoryx2 sample (`Run`), so the verdict
+//! [`Clock`](crate::Clock) and judged by the same steps as an iceoryx2 sample (`Run`), so the verdict
 //! lines, the input log for `--serve`, heartbeats, losses and restarts are the
 //! sidecar's:
 //!
@@ -45,9 +45,8 @@ use ros2::dds::{Participant, Qos, Reader, Received};
 use ros2::feed::TopicFeed;
 use ros2::write::McapWriter;
 
-use super::engine::Engine;
 use super::record::Input;
-use super::{Clock, LiveError, Options, Report, Run, SourceStats};
+use super::{LiveError, Options, Report, Run, SourceStats};
 
 /// One topic to read and what its samples set.
 pub struct TopicSource {
@@ -114,7 +113,7 @@ pub fn run(
             None => None,
             Some(m) => Some(
                 m.add_topic(&source.topic, &source.type_name, &source.schema_text)
-                    .map_err(|e| LiveError::Io(e.to_string()))?,
+                    .map_err(LiveError::Mcap)?,
             ),
         };
         taps.push(Tap {
@@ -130,25 +129,14 @@ pub fn run(
             channel,
         });
     }
-    let engine = Engine::new(spec, opts.every_point).map_err(LiveError::Engine)?;
     let poll = opts.poll;
-    let mut run = Run {
+    let mut run = Run::start(
         spec,
-        engine,
         opts,
-        clock: Clock::with_speed(spec.tick_ns(), settings.speed),
-        changes: Vec::new(),
-        verdict_pub: None,
-        points: 0,
-        lines: 0,
-        probed: Vec::new(),
-        started: false,
-        anchor_pending: settings.from_first_message,
-    };
-    run.write_record(&Input::Start {
-        unit_ns: spec.tick_ns(),
-        speed: settings.speed,
-    })?;
+        settings.speed,
+        settings.from_first_message,
+        None,
+    )?;
     run.note(format!(
         "ready: {} topics read on DDS domain {}",
         taps.len(),
@@ -159,7 +147,6 @@ pub fn run(
     // The recording's clock: the wall-clock time of the first sample recorded, minus its
     // judged time (see `sample`).
     let mut record_base: Option<u64> = None;
-    let mut idle_since_flush = false;
     let result = loop {
         if stop.load(Ordering::Relaxed) {
             break Ok(());
@@ -181,13 +168,8 @@ pub fn run(
             }
         }
         run.heartbeat(settings.heartbeat, settings.from_first_message)?;
-        if busy {
-            idle_since_flush = false;
+        if run.after_pass(busy) {
             continue;
-        }
-        if !idle_since_flush {
-            let _ = run.opts.verdicts.flush();
-            idle_since_flush = true;
         }
         std::thread::sleep(if poll.is_zero() {
             Duration::from_micros(10)
@@ -195,13 +177,9 @@ pub fn run(
             poll
         });
     };
-    let flush = |w: &mut dyn Write| w.flush().map_err(|e| LiveError::Io(e.to_string()));
-    flush(&mut run.opts.verdicts)?;
-    if let Some(r) = run.opts.record.as_mut() {
-        flush(r)?;
-    }
+    run.flush()?;
     if let Some(m) = mcap {
-        m.finish().map_err(|e| LiveError::Io(e.to_string()))?;
+        m.finish().map_err(LiveError::Mcap)?;
     }
     let sources: Vec<SourceStats> = taps.iter().map(|t| t.stats.clone()).collect();
     for s in &sources {
@@ -338,7 +316,7 @@ fn sample(
             base.saturating_add(at),
             &r.data,
         )
-        .map_err(|e| LiveError::Io(e.to_string()))?;
+        .map_err(LiveError::Mcap)?;
     }
     match decoded {
         Ok(sets) => {

@@ -20,7 +20,21 @@
 //! Unaffected properties are never disturbed.
 
 use codegen::Compiled;
-use monitor_core::{analysis, valuation, Monitor, StepError, Value};
+use monitor_core::{analysis, valuation, Monitor, StepError, TableError, Value};
+
+/// Why [`Engine::new`] could not build the monitors of a spec: the compiled program was
+/// refused by [`Monitor::try_new_planned`] (a compiler bug: `codegen` validates what it
+/// emits).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct EngineError(pub TableError);
+
+impl std::fmt::Display for EngineError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "internal: compiled program rejected: {}", self.0)
+    }
+}
+
+impl std::error::Error for EngineError {}
 
 /// A property's verdict as the sidecar reports it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -109,10 +123,9 @@ pub struct Engine<'c> {
 impl<'c> Engine<'c> {
     /// An engine for `spec`; `every_point` reports every verdict at every point,
     /// otherwise only changes (and every property's first verdict).
-    pub fn new(spec: &'c Compiled, every_point: bool) -> Result<Self, String> {
+    pub fn new(spec: &'c Compiled, every_point: bool) -> Result<Self, EngineError> {
         let program = spec.program();
-        let monitor = Monitor::try_new_planned(program)
-            .map_err(|e| format!("internal: compiled program rejected: {e}"))?;
+        let monitor = Monitor::try_new_planned(program).map_err(EngineError)?;
         let mut vals = vec![Value::Bool(false); program.vars.len()];
         valuation::init(program.vars, &mut vals);
         let n = monitor.properties();

@@ -58,7 +58,7 @@ impl TopicSubscriber {
         node: &Node<Ipc>,
         layouts: Vec<TopicLayout>,
         prefix: &str,
-    ) -> Result<TopicSubscriber, String> {
+    ) -> Result<TopicSubscriber, LiveError> {
         let mut topics = Vec::new();
         for l in layouts {
             let svc = l.service(prefix);
@@ -66,7 +66,7 @@ impl TopicSubscriber {
             let sub = factory
                 .subscriber_builder()
                 .create()
-                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
+                .map_err(|e| LiveError::ipc(&svc, e))?;
             let stats = InboundStats {
                 service: svc,
                 ..InboundStats::default()
@@ -83,7 +83,7 @@ impl TopicSubscriber {
                 let sample = match sub.receive() {
                     Ok(Some(s)) => s,
                     Ok(None) => break,
-                    Err(e) => return Err(LiveError::Ipc(format!("{}: {e:?}", stats.service))),
+                    Err(e) => return Err(LiveError::ipc(&stats.service, e)),
                 };
                 match layout.decode(sample.payload()) {
                     Some((params, seq)) => {
@@ -137,18 +137,23 @@ struct Outgoing<T> {
 
 impl<T> Outgoing<T> {
     /// A client of `prefix/path`, the service opened or created.
-    fn open(node: &Node<Ipc>, prefix: &str, path: String, max_len: usize) -> Result<Self, String> {
+    fn open(
+        node: &Node<Ipc>,
+        prefix: &str,
+        path: String,
+        max_len: usize,
+    ) -> Result<Self, LiveError> {
         let svc = prefixed(prefix, path);
-        let name = super::service_name(&svc).map_err(|e| e.to_string())?;
+        let name = super::service_name(&svc)?;
         let client = node
             .service_builder(&name)
             .request_response::<[u8], [u8]>()
             .open_or_create()
-            .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?
+            .map_err(|e| LiveError::ipc(&svc, e))?
             .client_builder()
             .initial_max_slice_len(max_len)
             .create()
-            .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
+            .map_err(|e| LiveError::ipc(&svc, e))?;
         Ok(Outgoing {
             client,
             pending: VecDeque::new(),
@@ -173,12 +178,11 @@ impl<T> Outgoing<T> {
         let pending = self
             .client
             .loan_slice_uninit(layout.size)
-            .map_err(|e| LiveError::Ipc(format!("{service}: {e:?}")))
+            .map_err(|e| LiveError::ipc(service, e))
             .and_then(|r| {
                 let mut r = r.write_from_fn(|_| 0u8);
                 layout.encode(msg, seq, r.payload_mut());
-                r.send()
-                    .map_err(|e| LiveError::Ipc(format!("{service}: {e:?}")))
+                r.send().map_err(|e| LiveError::ipc(service, e))
             })?;
         self.stats.requests += 1;
         if pending.number_of_server_connections() == 0 {
@@ -261,7 +265,7 @@ impl ServiceBridge {
         event_count: usize,
         services: Vec<(String, TopicLayout, TopicLayout)>,
         prefix: &str,
-    ) -> Result<ServiceBridge, String> {
+    ) -> Result<ServiceBridge, LiveError> {
         let mut out = ByEvent::new(event_count);
         for (path, request, response) in services {
             let client = Outgoing::open(node, prefix, path, request.size)?;
@@ -355,20 +359,20 @@ impl ServiceServers {
         event_count: usize,
         services: Vec<(String, TopicLayout, Answer)>,
         prefix: &str,
-    ) -> Result<ServiceServers, String> {
+    ) -> Result<ServiceServers, LiveError> {
         let mut out = ByEvent::new(event_count);
         for (path, request, response) in services {
             let svc = prefixed(prefix, path);
-            let name = super::service_name(&svc).map_err(|e| e.to_string())?;
+            let name = super::service_name(&svc)?;
             let server = node
                 .service_builder(&name)
                 .request_response::<[u8], [u8]>()
                 .open_or_create()
-                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?
+                .map_err(|e| LiveError::ipc(&svc, e))?
                 .server_builder()
                 .initial_max_slice_len(response.size())
                 .create()
-                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
+                .map_err(|e| LiveError::ipc(&svc, e))?;
             let served = Served {
                 request,
                 waiting: VecDeque::new(),
@@ -420,7 +424,7 @@ impl ServiceServers {
         }
         let response = &s.response;
         req.loan_slice_uninit(response.size())
-            .map_err(|e| LiveError::Ipc(format!("{}: {e:?}", s.stats.service)))
+            .map_err(|e| LiveError::ipc(&s.stats.service, e))
             .and_then(|r| {
                 let mut r = r.write_from_fn(|_| 0u8);
                 let out = r.payload_mut();
@@ -431,8 +435,7 @@ impl ServiceServers {
                         out[1..9].copy_from_slice(&seq.to_le_bytes());
                     }
                 }
-                r.send()
-                    .map_err(|e| LiveError::Ipc(format!("{}: {e:?}", s.stats.service)))
+                r.send().map_err(|e| LiveError::ipc(&s.stats.service, e))
             })?;
         s.stats.answered += 1;
         Ok(())
@@ -481,7 +484,7 @@ impl GoalBridge {
         node: &Node<Ipc>,
         routes: Vec<GoalRoute>,
         prefix: &str,
-    ) -> Result<GoalBridge, String> {
+    ) -> Result<GoalBridge, LiveError> {
         let mut actions = Vec::new();
         for route in routes {
             let client = Outgoing::open(node, prefix, route.path.clone(), route.goal.size)?;

@@ -60,6 +60,7 @@ mod clock;
 pub mod config;
 pub mod dds;
 pub mod engine;
+mod error;
 pub mod http;
 pub mod inject;
 pub mod pace;
@@ -98,6 +99,8 @@ pub use clock::{check_speed, Clock, SPEED_RANGE};
 use config::{Action, Config, Layout, Wire};
 use engine::{Change, Engine};
 pub use iceoryx2;
+use error::ipc;
+pub use error::LiveError;
 use record::Input;
 pub use ros2;
 
@@ -168,39 +171,9 @@ pub struct Probe {
     pub epoch: Instant,
 }
 
-/// Why the sidecar could not run.
-#[derive(Debug)]
-pub enum LiveError {
-    /// iceoryx2 refused a node, service or port.
-    Ipc(String),
-    /// Writing an output failed.
-    Io(String),
-    /// The DDS participant, a reader or a writer could not be created.
-    Dds(ros2::dds::DdsError),
-    /// The engine rejected a point (a bug: the config checks types).
-    Engine(String),
-}
-
-impl std::fmt::Display for LiveError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            LiveError::Ipc(m) => write!(f, "iceoryx2: {m}"),
-            LiveError::Io(m) => write!(f, "output: {m}"),
-            LiveError::Dds(e) => write!(f, "{e}"),
-            LiveError::Engine(m) => write!(f, "monitor: {m}"),
-        }
-    }
-}
-
-impl std::error::Error for LiveError {}
-
-fn ipc<E: std::fmt::Debug>(what: &str) -> impl Fn(E) -> LiveError + '_ {
-    move |e| LiveError::Ipc(format!("{what}: {e:?}"))
-}
-
 /// Parses an iceoryx2 service name.
 pub fn service_name(s: &str) -> Result<ServiceName, LiveError> {
-    ServiceName::new(s).map_err(|e| LiveError::Ipc(format!("service name `{s}`: {e:?}")))
+    ServiceName::new(s).map_err(|e| LiveError::ipc(format!("service name `{s}`"), e))
 }
 
 /// Opens the `[u8]` publish-subscribe service `svc` on `node`, or creates it with
@@ -208,13 +181,33 @@ pub fn service_name(s: &str) -> Result<ServiceName, LiveError> {
 pub(crate) fn open_raw_topic(
     node: &Node<Ipc>,
     svc: &str,
-) -> Result<iceoryx2::service::port_factory::publish_subscribe::PortFactory<Ipc, [u8], ()>, String>
+) -> Result<iceoryx2::service::port_factory::publish_subscribe::PortFactory<Ipc, [u8], ()>, LiveError>
 {
-    let name = service_name(svc).map_err(|e| e.to_string())?;
+    let name = service_name(svc)?;
     node.service_builder(&name)
         .publish_subscribe::<[u8]>()
         .open_or_create()
-        .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))
+        .map_err(ipc(svc))
+}
+
+/// Opens the `[u8]` publish-subscribe service `svc` on `node`, or creates it with room
+/// for `buffer` samples per subscriber; one that exists with a smaller buffer is taken as
+/// it is.
+fn open_buffered_topic(
+    node: &Node<Ipc>,
+    svc: &str,
+    buffer: usize,
+) -> Result<iceoryx2::service::port_factory::publish_subscribe::PortFactory<Ipc, [u8], ()>, LiveError>
+{
+    let name = service_name(svc)?;
+    let service = || node.service_builder(&name).publish_subscribe::<[u8]>();
+    match service()
+        .subscriber_max_buffer_size(buffer)
+        .open_or_create()
+    {
+        Ok(f) => Ok(f),
+        Err(_) => service().open().map_err(ipc(svc)),
+    }
 }
 
 struct Tap {
@@ -258,14 +251,71 @@ struct Run<'c, 'o> {
     probed: Vec<(u64, u64)>,
     /// A sample or request has been judged.
     started: bool,
+    /// The verdict lines were flushed since the last pass that found something.
+    idle_flushed: bool,
 }
 
-impl Run<'_, '_> {
+impl<'c, 'o> Run<'c, 'o> {
+    /// A run of `spec`'s monitors writing to `opts`, its input log opened with the
+    /// `Start` record (the clock at `speed`; anchored at the first message when
+    /// `from_first_message`).
+    fn start(
+        spec: &'c Compiled,
+        opts: &'o mut Options,
+        speed: f64,
+        from_first_message: bool,
+        verdict_pub: Option<Publisher<Ipc, [u8], ()>>,
+    ) -> Result<Self, LiveError> {
+        let engine = Engine::new(spec, opts.every_point).map_err(LiveError::Engine)?;
+        let mut run = Run {
+            spec,
+            engine,
+            opts,
+            clock: Clock::with_speed(spec.tick_ns(), speed),
+            changes: Vec::new(),
+            verdict_pub,
+            points: 0,
+            lines: 0,
+            probed: Vec::new(),
+            started: false,
+            anchor_pending: from_first_message,
+            idle_flushed: false,
+        };
+        run.write_record(&Input::Start {
+            unit_ns: spec.tick_ns(),
+            speed,
+        })?;
+        Ok(run)
+    }
+
+    /// After one pass over the sources: `true` when something arrived (pass again at
+    /// once); otherwise flushes the verdict lines, once per idle spell, and `false`.
+    fn after_pass(&mut self, busy: bool) -> bool {
+        if busy {
+            self.idle_flushed = false;
+            return true;
+        }
+        if !self.idle_flushed {
+            let _ = self.opts.verdicts.flush();
+            self.idle_flushed = true;
+        }
+        false
+    }
+
+    /// Flushes the verdict lines and the input log.
+    fn flush(&mut self) -> Result<(), LiveError> {
+        self.opts.verdicts.flush()?;
+        if let Some(r) = self.opts.record.as_mut() {
+            r.flush()?;
+        }
+        Ok(())
+    }
+
     /// Writes one record to the input log, when recording.
     fn write_record(&mut self, input: &Input) -> Result<(), LiveError> {
         if let Some(rec) = self.opts.record.as_mut() {
-            let line = serde_json::to_string(input).map_err(|e| LiveError::Io(e.to_string()))?;
-            writeln!(rec, "{line}").map_err(|e| LiveError::Io(e.to_string()))?;
+            let line = serde_json::to_string(input).map_err(std::io::Error::from)?;
+            writeln!(rec, "{line}")?;
         }
         Ok(())
     }
@@ -275,7 +325,7 @@ impl Run<'_, '_> {
         self.write_record(&input)?;
         self.changes.clear();
         record::apply(self.spec, &mut self.engine, &input, &mut self.changes)
-            .map_err(|e| LiveError::Engine(e.to_string()))?;
+            .map_err(LiveError::Record)?;
         let point = matches!(input, Input::Tick { .. });
         let judged = matches!(input, Input::Loss { .. });
         self.emit(point, judged)
@@ -309,7 +359,9 @@ impl Run<'_, '_> {
         }
         self.changes.clear();
         self.started = true;
-        let step = |e: monitor_core::StepError| LiveError::Engine(self.spec.describe(&e));
+        let step = |e: monitor_core::StepError| {
+            LiveError::Record(record::RecordError::Step(self.spec.describe(&e)))
+        };
         let ok = match request {
             None => {
                 self.engine
@@ -332,7 +384,7 @@ impl Run<'_, '_> {
         }
         for c in &self.changes {
             let line = record::verdict_line(self.spec, c);
-            writeln!(self.opts.verdicts, "{line}").map_err(|e| LiveError::Io(e.to_string()))?;
+            writeln!(self.opts.verdicts, "{line}")?;
             self.lines += 1;
             if let Some(p) = &self.verdict_pub {
                 // A verdict subscriber that is gone or slow must not stop the monitor.
@@ -637,28 +689,15 @@ impl Sidecar {
         };
         let mut taps = Vec::new();
         for t in &config.topics {
-            let name = service_name(&t.service)?;
-            let factory = match node
-                .service_builder(&name)
-                .publish_subscribe::<[u8]>()
-                .subscriber_max_buffer_size(t.buffer)
-                .open_or_create()
-            {
-                Ok(f) => f,
-                // It exists with a smaller buffer: take it as it is.
-                Err(_) => node
-                    .service_builder(&name)
-                    .publish_subscribe::<[u8]>()
-                    .open()
-                    .map_err(ipc(&t.service))?,
-            };
+            let factory = open_buffered_topic(&node, &t.service, t.buffer)?;
             if !factory.static_config().has_safe_overflow() {
                 // A slow tap on such a service would make its publisher wait or drop for everyone.
-                return Err(LiveError::Ipc(format!(
-                    "{}: the service has no safe overflow, so a tap could block its publisher; \
-                     create it with safe overflow (the iceoryx2 default)",
-                    t.service
-                )));
+                return Err(LiveError::Ipc {
+                    at: t.service.clone(),
+                    reason: "the service has no safe overflow, so a tap could block its \
+                             publisher; create it with safe overflow (the iceoryx2 default)"
+                        .into(),
+                });
             }
             let sub = factory
                 .subscriber_builder()
@@ -728,20 +767,7 @@ impl Sidecar {
         let verdict_pub = match &config.verdict_service {
             None => None,
             Some(v) => {
-                let name = service_name(v)?;
-                let f = match node
-                    .service_builder(&name)
-                    .publish_subscribe::<[u8]>()
-                    .subscriber_max_buffer_size(256)
-                    .open_or_create()
-                {
-                    Ok(f) => f,
-                    Err(_) => node
-                        .service_builder(&name)
-                        .publish_subscribe::<[u8]>()
-                        .open()
-                        .map_err(ipc(v))?,
-                };
+                let f = open_buffered_topic(&node, v, 256)?;
                 Some(
                     f.publisher_builder()
                         .initial_max_slice_len(256)
@@ -770,25 +796,15 @@ impl Sidecar {
         opts: &mut Options,
         stop: &AtomicBool,
     ) -> Result<Report, LiveError> {
-        let engine = Engine::new(spec, opts.every_point).map_err(LiveError::Engine)?;
         let poll = opts.poll;
-        let mut run = Run {
+        let verdict_pub = self.verdict_pub.take();
+        let mut run = Run::start(
             spec,
-            engine,
             opts,
-            clock: Clock::with_speed(spec.tick_ns(), config.speed),
-            changes: Vec::new(),
-            verdict_pub: self.verdict_pub.take(),
-            points: 0,
-            lines: 0,
-            probed: Vec::new(),
-            started: false,
-            anchor_pending: config.from_first_message,
-        };
-        run.write_record(&Input::Start {
-            unit_ns: spec.tick_ns(),
-            speed: config.speed,
-        })?;
+            config.speed,
+            config.from_first_message,
+            verdict_pub,
+        )?;
         // Scripts start the monitored system after this line: every tap exists now.
         run.note(format!(
             "ready: {} topics tapped, {} services proxied",
@@ -798,7 +814,6 @@ impl Sidecar {
         let _ = run.opts.log.flush();
         let mut sets = Vec::new();
         let mut last_cleanup = Instant::now();
-        let mut idle_since_flush = false;
         let mut idle_spins = 0u64;
         let result = loop {
             if stop.load(Ordering::Relaxed) {
@@ -820,13 +835,8 @@ impl Sidecar {
                 let _ = Node::<Ipc>::try_cleanup_dead_nodes(self.node.config());
                 last_cleanup = Instant::now();
             }
-            if busy {
-                idle_since_flush = false;
+            if run.after_pass(busy) {
                 continue;
-            }
-            if !idle_since_flush {
-                let _ = run.opts.verdicts.flush();
-                idle_since_flush = true;
             }
             if poll.is_zero() {
                 // Busy polling: yield instead of sleeping (a zero sleep still costs the
@@ -841,11 +851,7 @@ impl Sidecar {
                 break Ok(());
             }
         };
-        let flush = |w: &mut dyn Write| w.flush().map_err(|e| LiveError::Io(e.to_string()));
-        flush(&mut run.opts.verdicts)?;
-        if let Some(r) = run.opts.record.as_mut() {
-            flush(r)?;
-        }
+        run.flush()?;
         // The verdict publisher goes before the node does.
         drop(run.verdict_pub.take());
         let mut sources: Vec<SourceStats> = self.taps.iter().map(|t| t.stats.clone()).collect();

@@ -5,7 +5,6 @@
 //! ROS message, forwards requests and goals to the processes that serve them, and
 //! hands what those processes send back to the simulator through [`Inbox`].
 
-use std::io::Write;
 use std::time::{Duration, Instant};
 
 use iceoryx2::prelude::*;
@@ -35,39 +34,88 @@ pub struct Paced<'n> {
     pub inbound_error: Option<super::LiveError>,
     /// Model time on the wall clock (the sidecar's clock, at the run's speed).
     pub clock: Clock,
-    /// Nanoseconds per model time unit (for the progress line).
-    pub unit_ns: u64,
     /// Set when a signal stopped the run.
     pub stopped: bool,
-    /// When the last progress line was written.
-    pub last_progress: Instant,
-    /// Whether stderr is a terminal (progress overwrites one line).
-    pub tty: bool,
+    /// Where the run's progress goes (the binary draws it).
+    pub on_progress: ProgressReports<'n>,
 }
 
 impl Paced<'_> {
-    /// Writes a progress line (at most every 500 ms unless `force`).
+    /// Reports the progress at model time `time` (at most every [`PROGRESS_EVERY`]
+    /// unless `force`).
     pub fn progress(&mut self, time: u64, force: bool) {
-        if !force && self.last_progress.elapsed() < Duration::from_millis(500) {
+        let (publisher, inbound) = (&self.publisher, &self.inbound);
+        self.on_progress.report(force, || RunProgress {
+            time,
+            published: publisher.published(),
+            received: inbound
+                .stats()
+                .next()
+                .is_some()
+                .then(|| inbound.stats().map(|s| s.received).sum()),
+            dds: false,
+        });
+    }
+}
+
+/// How often a paced run reports its progress.
+pub const PROGRESS_EVERY: Duration = Duration::from_millis(500);
+
+/// Where a paced run is, for the binary to draw as one line ([`RunProgress::line`]: `run:
+/// model time 1.5 s (1500 steps), 12 samples published, 3 received`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RunProgress {
+    /// Model time, in the model's units.
+    pub time: u64,
+    /// Samples published so far.
+    pub published: u64,
+    /// Samples received from processes, when some topic comes in from one.
+    pub received: Option<u64>,
+    /// Published on DDS (`run --ros2`), not iceoryx2.
+    pub dds: bool,
+}
+
+impl RunProgress {
+    /// The line, with model time in seconds at `unit_ns` nanoseconds a unit.
+    pub fn line(&self, unit_ns: u64) -> String {
+        let secs = self.time as f64 * unit_ns as f64 / 1e9;
+        let mut line = format!(
+            "run: model time {secs:.1} s ({} steps), {} samples published",
+            self.time, self.published
+        );
+        if self.dds {
+            line.push_str(" on DDS");
+        }
+        if let Some(r) = self.received {
+            line.push_str(&format!(", {r} received"));
+        }
+        line
+    }
+}
+
+/// Hands a paced run's [`RunProgress`] to a callback, at most every [`PROGRESS_EVERY`]
+/// unless forced: the observer's side of the progress line.
+pub struct ProgressReports<'p> {
+    last: Instant,
+    sink: Box<dyn FnMut(&RunProgress) + 'p>,
+}
+
+impl<'p> ProgressReports<'p> {
+    /// Reports to `sink`, the first time [`PROGRESS_EVERY`] from now.
+    pub fn new(sink: impl FnMut(&RunProgress) + 'p) -> Self {
+        ProgressReports {
+            last: Instant::now(),
+            sink: Box::new(sink),
+        }
+    }
+
+    /// Calls the sink with `progress()` if it is due or `force`d.
+    pub(crate) fn report(&mut self, force: bool, progress: impl FnOnce() -> RunProgress) {
+        if !force && self.last.elapsed() < PROGRESS_EVERY {
             return;
         }
-        self.last_progress = Instant::now();
-        let secs = time as f64 * self.unit_ns as f64 / 1e9;
-        let received: u64 = self.inbound.stats().map(|s| s.received).sum();
-        let mut line = format!(
-            "run: model time {secs:.1} s ({time} steps), {} samples published",
-            self.publisher.published()
-        );
-        if self.inbound.stats().next().is_some() {
-            line.push_str(&format!(", {received} received"));
-        }
-        let mut err = std::io::stderr().lock();
-        let _ = if self.tty {
-            write!(err, "\r{line}")
-        } else {
-            writeln!(err, "{line}")
-        };
-        let _ = err.flush();
+        self.last = Instant::now();
+        (self.sink)(&progress());
     }
 }
 
@@ -111,5 +159,57 @@ impl Observer for Paced<'_> {
         self.services.poll(inbox);
         self.servers.poll(inbox);
         self.goals.poll(inbox);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_progress_line_says_time_samples_and_where() {
+        let p = RunProgress {
+            time: 1500,
+            published: 12,
+            received: Some(3),
+            dds: false,
+        };
+        assert_eq!(
+            p.line(1_000_000),
+            "run: model time 1.5 s (1500 steps), 12 samples published, 3 received"
+        );
+        let dds = RunProgress {
+            received: None,
+            dds: true,
+            ..p
+        };
+        assert_eq!(
+            dds.line(1_000_000),
+            "run: model time 1.5 s (1500 steps), 12 samples published on DDS"
+        );
+    }
+
+    #[test]
+    fn reports_are_spaced_unless_forced() {
+        let mut seen = Vec::new();
+        {
+            let mut reports = ProgressReports::new(|p: &RunProgress| seen.push(p.time));
+            let at = |time| {
+                move || RunProgress {
+                    time,
+                    published: 0,
+                    received: None,
+                    dds: false,
+                }
+            };
+            // Not yet due: the first report comes PROGRESS_EVERY after the start.
+            reports.report(false, at(1));
+            reports.report(true, at(2));
+            // Just reported: the next unforced one is not due.
+            reports.report(false, at(3));
+            reports.last -= PROGRESS_EVERY;
+            reports.report(false, at(4));
+        }
+        assert_eq!(seen, [2, 4]);
     }
 }

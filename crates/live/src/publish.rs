@@ -407,7 +407,7 @@ impl TopicPublisher {
         model: &CompiledModel,
         layouts: Vec<TopicLayout>,
         prefix: &str,
-    ) -> Result<TopicPublisher, String> {
+    ) -> Result<TopicPublisher, super::LiveError> {
         let mut by_event = vec![None; model.event_count()];
         let mut topics = Vec::new();
         for l in layouts {
@@ -417,7 +417,7 @@ impl TopicPublisher {
                 .publisher_builder()
                 .initial_max_slice_len(l.size)
                 .create()
-                .map_err(|e| format!("iceoryx2: {svc}: {e:?}"))?;
+                .map_err(|e| super::LiveError::ipc(&svc, e))?;
             by_event[l.event.0 as usize] = Some(topics.len());
             topics.push((l, publisher, 0));
         }

@@ -33,14 +33,14 @@
 //! readers that join later.
 
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant, SystemTime};
 
-use ros2::cdr_write::{encode, Val};
+use ros2::cdr_write::{encode, EncodeError, Val};
 use ros2::dds::{DdsError, Participant, Qos, Writer};
 use ros2::schema::{Definitions, Schema};
 
+use super::pace::{ProgressReports, RunProgress};
 use super::publish::{wire_name, WireKind};
 use super::Clock;
 use crate::expr::{Ty, Value};
@@ -123,7 +123,7 @@ pub fn declared_types(main: &crate::robot::main_file::MainFile) -> BTreeMap<Stri
 }
 
 /// `ros_fields__pose__x` -> `pose.x`; other parameters are not message fields.
-fn field_path(param: &str) -> Option<String> {
+pub(crate) fn field_path(param: &str) -> Option<String> {
     param
         .strip_prefix("ros_fields__")
         .map(|p| p.replace("__", "."))
@@ -247,6 +247,27 @@ fn publishable(ty: &Ty) -> bool {
     }
 }
 
+/// The message of `schema` that `msg` sends: the type's zeros with each of `fields`
+/// (`(parameter, field path)`) set from the message's parameter, and the last field
+/// that could not be set.
+pub(crate) fn message_val(
+    model: &CompiledModel,
+    msg: &SentMessage<'_>,
+    schema: &Schema,
+    fields: &[(usize, String)],
+) -> (Val, Result<(), EncodeError>) {
+    let mut v = Val::zero(schema, 0);
+    let mut result = Ok(());
+    for (param, path) in fields {
+        if let Some(x) = msg.param(*param).and_then(|x| val(model, x)) {
+            if let Err(e) = v.set(schema, path, x) {
+                result = Err(e);
+            }
+        }
+    }
+    (v, result)
+}
+
 /// A model value as a message value.
 fn val(model: &CompiledModel, v: Value<'_>) -> Option<Val> {
     Some(match v {
@@ -362,15 +383,7 @@ impl DdsPublisher {
             return;
         };
         let (route, w) = &self.routes[*i];
-        let mut v = Val::zero(&route.schema, 0);
-        let mut result = Ok(());
-        for (param, path) in &route.fields {
-            if let Some(x) = msg.param(*param).and_then(|x| val(model, x)) {
-                if let Err(e) = v.set(&route.schema, path, x) {
-                    result = Err(e);
-                }
-            }
-        }
+        let (mut v, mut result) = message_val(model, msg, &route.schema, &route.fields);
         if let Some((kind, service)) = &route.service {
             let seq = self.service_seq.entry(service.clone()).or_insert(0);
             if *kind == REQUEST_RECEIVED {
@@ -418,37 +431,25 @@ pub struct DdsPaced<'m> {
     pub services: Option<super::serve_dds::DdsServices>,
     /// Model time on the wall clock.
     pub clock: Clock,
-    /// Nanoseconds per model time unit (for the progress line).
-    pub unit_ns: u64,
     /// Set by SIGINT / SIGTERM.
     pub stop: &'static AtomicBool,
     /// Set when a signal stopped the run.
     pub stopped: bool,
-    /// When the last progress line was written.
-    pub last_progress: Instant,
-    /// Whether stderr is a terminal (progress overwrites one line).
-    pub tty: bool,
+    /// Where the run's progress goes (the binary draws it).
+    pub on_progress: ProgressReports<'m>,
 }
 
 impl DdsPaced<'_> {
-    /// Writes a progress line (at most every 500 ms unless `force`).
+    /// Reports the progress at model time `time` (at most every
+    /// [`super::pace::PROGRESS_EVERY`] unless `force`).
     pub fn progress(&mut self, time: u64, force: bool) {
-        if !force && self.last_progress.elapsed() < Duration::from_millis(500) {
-            return;
-        }
-        self.last_progress = Instant::now();
-        let secs = time as f64 * self.unit_ns as f64 / 1e9;
-        let line = format!(
-            "run: model time {secs:.1} s ({time} steps), {} samples published on DDS",
-            self.publisher.published()
-        );
-        let mut err = std::io::stderr().lock();
-        let _ = if self.tty {
-            write!(err, "\r{line}")
-        } else {
-            writeln!(err, "{line}")
-        };
-        let _ = err.flush();
+        let published = self.publisher.published();
+        self.on_progress.report(force, || RunProgress {
+            time,
+            published,
+            received: None,
+            dds: true,
+        });
     }
 }
 

@@ -22,7 +22,7 @@ use codegen::Compiled;
 use monitor_core::{Ty, Value};
 use serde::{Deserialize, Serialize};
 
-use super::engine::{Change, Engine, Verdict};
+use super::engine::{Change, Engine, EngineError, Verdict};
 
 /// What makes one record unjudgeable by a spec ([`apply`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -49,8 +49,6 @@ pub enum RecordError {
     },
     /// The monitors refused the point (time going backwards), as the spec describes it.
     Step(String),
-    /// The spec's monitors could not be built.
-    Engine(String),
 }
 
 impl std::fmt::Display for RecordError {
@@ -68,7 +66,7 @@ impl std::fmt::Display for RecordError {
                 codegen::duration::format(*log_ns),
                 codegen::duration::format(*spec_ns)
             ),
-            RecordError::Step(m) | RecordError::Engine(m) => f.write_str(m),
+            RecordError::Step(m) => f.write_str(m),
         }
     }
 }
@@ -99,7 +97,7 @@ pub enum LogError {
         error: RecordError,
     },
     /// The spec's monitors could not be built (before any record).
-    Engine(String),
+    Engine(EngineError),
 }
 
 impl std::fmt::Display for LogError {
@@ -112,7 +110,7 @@ impl std::fmt::Display for LogError {
                 message,
             } => write!(f, "{file}:{line}:{column}: {message}"),
             LogError::Record { file, line, error } => write!(f, "{file}:{line}:1: {error}"),
-            LogError::Engine(m) => f.write_str(m),
+            LogError::Engine(e) => e.fmt(f),
         }
     }
 }
@@ -368,11 +366,31 @@ pub fn parse_log(text: &str, file: &str) -> Result<Vec<(usize, Input)>, LogError
     Ok(out)
 }
 
+/// The warning [`complete_records`] returns: the log's last line is a partial record.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct CutRecord {
+    /// The log's name.
+    pub file: String,
+    /// The 1-based line of the partial record.
+    pub line: usize,
+}
+
+impl std::fmt::Display for CutRecord {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{}:{}:1: warning: the last record is cut short (the recorder stopped \
+             mid-line): replaying the complete records before it",
+            self.file, self.line
+        )
+    }
+}
+
 /// The complete records of a log whose recorder may have been stopped mid-line (killed,
 /// out of disk): the text up to its last line break, and a warning naming the cut tail
 /// when the text ends in a partial record (no line break, not a record). A last record
 /// that is whole but lacks its line break is kept.
-pub fn complete_records<'t>(text: &'t str, file: &str) -> (&'t str, Option<String>) {
+pub fn complete_records<'t>(text: &'t str, file: &str) -> (&'t str, Option<CutRecord>) {
     let start = text.rfind('\n').map_or(0, |i| i + 1);
     let tail = &text[start..];
     if tail.trim().is_empty() || serde_json::from_str::<Input>(tail).is_ok() {
@@ -381,10 +399,10 @@ pub fn complete_records<'t>(text: &'t str, file: &str) -> (&'t str, Option<Strin
     let line = text[..start].matches('\n').count() + 1;
     (
         &text[..start],
-        Some(format!(
-            "{file}:{line}:1: warning: the last record is cut short (the recorder stopped \
-             mid-line): replaying the complete records before it"
-        )),
+        Some(CutRecord {
+            file: file.to_string(),
+            line,
+        }),
     )
 }
 

@@ -31,11 +31,13 @@ use std::collections::VecDeque;
 use monitor_core::Value as MValue;
 use ros2::cdr::Decoder;
 use ros2::cdr_write::{encode, Val};
-use ros2::dds::{service_topics, type_name, DdsError, Participant, Qos, Reader, Received, Writer};
+use ros2::dds::{service_topics, type_name, Participant, Qos, Reader, Received, Writer};
 use ros2::schema::{Definitions, Schema};
 
-use crate::expr::{Ty, Value};
+use crate::expr::Ty;
+use crate::publish_dds::{field_path, message_val};
 use crate::sim::{CompiledModel, EventId, Inbox, Scalar, SentMessage};
+use crate::LiveError;
 
 /// The request id header's length: `uint64 guid`, `int64 seq`.
 const HEADER: usize = 16;
@@ -89,13 +91,6 @@ pub struct DdsServices {
     buf: Vec<Received>,
 }
 
-/// `ros_fields__a__b` -> `a.b`.
-fn field_path(param: &str) -> Option<String> {
-    param
-        .strip_prefix("ros_fields__")
-        .map(|p| p.replace("__", "."))
-}
-
 fn scalar_ty(ty: &Ty) -> Option<monitor_core::Ty> {
     match ty {
         Ty::Bool => Some(monitor_core::Ty::Bool),
@@ -120,19 +115,19 @@ impl DdsServices {
         routes: Vec<ServiceRoute>,
         defs: &dyn Definitions,
         warnings: &mut Vec<String>,
-    ) -> Result<DdsServices, String> {
-        let participant = Participant::new(domain).map_err(|e| e.to_string())?;
+    ) -> Result<DdsServices, LiveError> {
+        let participant = Participant::new(domain).map_err(LiveError::Dds)?;
         let mut served = Vec::new();
         for route in routes {
             let s = &route.service;
-            let req_type =
-                part_type(&route.type_name, "Request").map_err(|e| format!("service {s}: {e}"))?;
-            let resp_type =
-                part_type(&route.type_name, "Response").map_err(|e| format!("service {s}: {e}"))?;
-            let req_schema =
-                Schema::resolve(&req_type, defs).map_err(|e| format!("service {s}: {e}"))?;
-            let reply_schema =
-                Schema::resolve(&resp_type, defs).map_err(|e| format!("service {s}: {e}"))?;
+            let schema = |error| LiveError::Service {
+                service: s.clone(),
+                error,
+            };
+            let req_type = part_type(&route.type_name, "Request").map_err(schema)?;
+            let resp_type = part_type(&route.type_name, "Response").map_err(schema)?;
+            let req_schema = Schema::resolve(&req_type, defs).map_err(schema)?;
+            let reply_schema = Schema::resolve(&resp_type, defs).map_err(schema)?;
             let mut decoder = Decoder::new(req_schema, &[]);
             let mut params = Vec::new();
             for (i, (pname, ty)) in model.event_params(route.request).iter().enumerate() {
@@ -170,7 +165,7 @@ impl DdsServices {
                 }
             }
             let (rq, rr) = service_topics(s);
-            let dds = |e: DdsError| e.to_string();
+            let dds = LiveError::Dds;
             let reader = participant
                 .dds_reader(&rq, type_name(&req_type).map_err(dds)?, Qos::ros_default())
                 .map_err(dds)?;
@@ -215,9 +210,9 @@ impl DdsServices {
                         inbox.push(s.route.request, params);
                         s.waiting.push_back(header);
                     }
-                    Err(m) => {
+                    Err(e) => {
                         s.stats.malformed += 1;
-                        s.stats.last_error = Some(m);
+                        s.stats.last_error = Some(e.to_string());
                     }
                 }
             }
@@ -237,15 +232,7 @@ impl DdsServices {
         let Some(header) = s.waiting.pop_front() else {
             return;
         };
-        let mut v = Val::zero(&s.reply_schema, 0);
-        let mut result = Ok(());
-        for (param, path) in &s.reply_fields {
-            if let Some(x) = msg.param(*param).and_then(|x| val(model, x)) {
-                if let Err(e) = v.set(&s.reply_schema, path, x) {
-                    result = Err(e);
-                }
-            }
-        }
+        let (v, result) = message_val(model, msg, &s.reply_schema, &s.reply_fields);
         let sent = result
             .and_then(|()| encode(&s.reply_schema, &v))
             .map_err(|e| e.to_string())
@@ -278,20 +265,42 @@ impl DdsServices {
 /// A request: its id header and its fields as the model's parameters.
 type Request = ([u8; HEADER], Vec<(usize, Scalar)>);
 
+/// Why a request sample was not posted into the model.
+#[derive(Debug)]
+enum RequestError {
+    /// Shorter than the encapsulation and the request id: its length.
+    Short(usize),
+    /// The fields do not decode as the service's request.
+    Cdr {
+        service: String,
+        error: ros2::cdr::CdrError,
+    },
+}
+
+impl std::fmt::Display for RequestError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RequestError::Short(n) => write!(
+                f,
+                "a request of {n} byte(s) is shorter than the encapsulation and the 16-byte \
+                 request id"
+            ),
+            RequestError::Cdr { service, error } => write!(f, "{service}: {error}"),
+        }
+    }
+}
+
 /// A request's header and its fields as the model's parameters.
-fn decode_request(s: &Served, data: &[u8]) -> Result<Request, String> {
-    let (header, body) = split_header(data).ok_or_else(|| {
-        format!(
-            "a request of {} byte(s) is shorter than the encapsulation and the 16-byte \
-             request id",
-            data.len()
-        )
-    })?;
+fn decode_request(s: &Served, data: &[u8]) -> Result<Request, RequestError> {
+    let (header, body) = split_header(data).ok_or(RequestError::Short(data.len()))?;
     let mut out = vec![MValue::Bool(false); s.decoder.slots()];
     let mut present = vec![false; s.decoder.slots()];
     s.decoder
         .decode(&body, &mut out, &mut present)
-        .map_err(|e| format!("{}: {e}", s.route.service))?;
+        .map_err(|error| RequestError::Cdr {
+            service: s.route.service.clone(),
+            error,
+        })?;
     let params = s
         .params
         .iter()
@@ -329,17 +338,6 @@ fn with_header(cdr: &[u8], header: &[u8; HEADER]) -> Vec<u8> {
     out.extend_from_slice(header);
     out.extend_from_slice(cdr.get(4..).unwrap_or_default());
     out
-}
-
-/// A model value as a message value.
-fn val(model: &CompiledModel, v: Value<'_>) -> Option<Val> {
-    Some(match v {
-        Value::Bool(b) => Val::Bool(b),
-        Value::Int(i) => Val::Int(i),
-        Value::Float(x) => Val::Float(x),
-        Value::Str(s) => Val::Str(model.strings().get(s).to_string()),
-        Value::List(l) => Val::Seq(l.iter().map(|x| val(model, x)).collect::<Option<_>>()?),
-    })
 }
 
 #[cfg(test)]

@@ -172,9 +172,9 @@ impl<'p, 'a> FileReader<'p, 'a> {
     fn value(&mut self, raw: &str, offset: usize) -> Option<SourceText> {
         match unescape_attribute(raw, offset, self.lines) {
             Ok(value) => Some(value),
-            Err((offset, message)) => {
+            Err((offset, bad)) => {
                 let at = self.lines.location(offset);
-                self.error(at, PropsErrorKind::Xml(message));
+                self.error(at, PropsErrorKind::Xml(bad.to_string()));
                 None
             }
         }

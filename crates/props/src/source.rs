@@ -209,18 +209,18 @@ impl fmt::Display for SourceText {
 /// Unescapes an attribute value (`raw` starts at byte `offset` of the file) into a
 /// [`SourceText`]: predefined entities and character references are replaced, and tabs
 /// and line breaks become spaces (XML attribute-value normalisation). On a bad
-/// reference, returns its byte offset in the file and a description.
+/// reference, returns its byte offset in the file and what is wrong with it.
 pub(crate) fn unescape_attribute(
     raw: &str,
     offset: usize,
     lines: &SourceFile<'_>,
-) -> Result<SourceText, (usize, String)> {
+) -> Result<SourceText, (usize, crate::model::source::BadReference)> {
     let mut out = SourceText::empty();
     let mut rest = raw;
     let mut at = offset;
     while !rest.is_empty() {
         if let Some(decoded) = crate::model::source::reference(rest) {
-            let (decoded, consumed) = decoded.map_err(|e| (at, e.to_string()))?;
+            let (decoded, consumed) = decoded.map_err(|e| (at, e))?;
             let mut buffer = [0u8; 4];
             out.push_exact(decoded.encode_utf8(&mut buffer), lines.location(at));
             rest = &rest[consumed..];

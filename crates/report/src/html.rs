@@ -8,10 +8,10 @@ use super::plot;
 
 /// Escapes text for HTML content and attribute values (every attribute the page writes
 /// is double-quoted): the one markup escaper, `model::xml::escape`.
-pub use hindsight_verify::model::xml::escape as esc;
+pub(crate) use hindsight_verify::model::xml::escape as esc;
 
 /// An id fragment for a name: letters, digits, `-` and `_` kept, anything else `_`.
-pub fn anchor(name: &str) -> String {
+pub(crate) fn anchor(name: &str) -> String {
     name.chars()
         .map(|c| {
             if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
@@ -24,7 +24,7 @@ pub fn anchor(name: &str) -> String {
 }
 
 /// A model time as the page writes it: seconds when the step is known, else steps.
-pub fn time_text(t: u64, step_seconds: Option<f64>) -> String {
+pub(crate) fn time_text(t: u64, step_seconds: Option<f64>) -> String {
     match step_seconds {
         Some(s) => format!("{} s", plot::label(t as f64 * s)),
         None => format!("{t} (steps)"),
@@ -32,7 +32,7 @@ pub fn time_text(t: u64, step_seconds: Option<f64>) -> String {
 }
 
 /// The whole page.
-pub fn page(data: &ReportData) -> String {
+pub(crate) fn page(data: &ReportData) -> String {
     let mut o = String::new();
     let _ = write!(
         o,

@@ -13,8 +13,7 @@
 //!   [`StudyResult`].
 //! - [`run_shard`], [`merge`] and [`run_fixed_study`]: a fixed-size study of `N` runs,
 //!   split into [`Shard`]s whose [`PartialResult`]s (JSON) merge into a [`MergedResult`].
-//! - [`stream`]: the random stream of run `k`; [`progress::TerminalProgress`]: the
-//!   progress bar.
+//! - [`stream`]: the random stream of run `k`; [`progress`]: a progress report as text.
 //!
 //! ```
 //! use hindsight_smc::{run_study, RuleConfig, RunEnd, RunOutcome, StudyConfig, Verdict};
@@ -53,8 +52,9 @@
 //! 4. **Fixed-size study, sharded** ([`shard`]): [`run_shard`] runs slice `i/n` and
 //!    returns a [`PartialResult`] (JSON); [`merge`] checks and combines them.
 //!
-//! 5. **Progress** ([`progress`]): [`progress::TerminalProgress`] draws the reports as a
-//!    bar on a terminal and stays silent otherwise.
+//! 5. **Progress** ([`progress`]): a study hands its [`Progress`] reports to a callback;
+//!    [`progress::log_line`] and [`progress::message`] spell one as text. The crate prints
+//!    nothing (`hindsight` draws the bar).
 //!
 //! Discarded runs (assumptions violated) and runs cut short (step limit) are counted,
 //! never silently judged: see [`runner`] for the policy.

@@ -4,6 +4,7 @@ pub mod compile;
 pub mod convert;
 pub mod monitor;
 pub mod monitor_ros2;
+pub mod progress;
 pub mod replay;
 pub mod report;
 pub mod run;

@@ -399,15 +399,7 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         let log = record.unwrap_or_else(|| Box::new(std::io::sink()));
         record = Some(Box::new(Tee::new(log, server.hub, Stream::Input)));
     }
-    let mut opts = Options {
-        verdicts: out,
-        record,
-        every_point: args.every_point,
-        poll: Duration::from_micros(args.poll_us),
-        log: Box::new(std::io::stderr()),
-        probe: None,
-        progress: None,
-    };
+    let mut opts = options(args, out, record);
     let sidecar =
         Sidecar::new(&config, &spec, true).map_err(|e| CliError::Failed(e.to_string()))?;
     let stop = AtomicBool::new(false);
@@ -415,4 +407,22 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         .run(&config, &spec, &mut opts, &stop)
         .map(|_| ())
         .map_err(|e| CliError::Failed(e.to_string()))
+}
+
+/// The sidecar's outputs: verdict lines to `verdicts`, the input log to `record`, notes on
+/// standard error, waiting `--poll-us` when idle.
+pub(super) fn options(
+    args: &MonitorArgs,
+    verdicts: Box<dyn Write + Send>,
+    record: Option<Box<dyn Write + Send>>,
+) -> Options {
+    Options {
+        verdicts,
+        record,
+        every_point: args.every_point,
+        poll: Duration::from_micros(args.poll_us),
+        log: Box::new(std::io::stderr()),
+        probe: None,
+        progress: None,
+    }
 }

@@ -18,10 +18,10 @@ use std::time::Duration;
 use ros2::feed::{Port as BagPort, TopicFeed};
 
 use super::monitor::MonitorArgs;
-use super::replay::{bind_ports, file_ports, load_props_at, Packages};
+use super::replay::{bind_ports, discover_packages, file_ports, load_props_at, Packages};
 use super::CliError;
+use crate::live;
 use crate::live::dds::{Settings, TopicSource};
-use crate::live::{self, Options};
 use crate::props::PropertyFile;
 
 /// A property file's tick on DDS when `--time-unit` does not name one: 1 ms.
@@ -30,7 +30,9 @@ const DEFAULT_UNIT_NS: u64 = 1_000_000;
 /// Set by SIGINT / SIGTERM: the monitor flushes its outputs and exits 0.
 static STOP: AtomicBool = AtomicBool::new(false);
 
-fn stop_flag() -> &'static AtomicBool {
+/// The flag SIGINT / SIGTERM set, the handler installed on the first call (`monitor
+/// --ros2`, `run --ros2`).
+pub(crate) fn stop_flag() -> &'static AtomicBool {
     static INSTALL: Once = Once::new();
     INSTALL.call_once(|| {
         // ctrlc runs this on its own thread: only the flag is set here.
@@ -201,19 +203,7 @@ pub fn run(
             *qos = qos.with_list(list).map_err(|e| input(e.to_string()))?;
         }
     }
-    let mut sm = codegen::diag::SourceMap::new();
-    let search = crate::robot::interfaces::Search::from_env(args.interfaces.clone());
-    let packages = crate::robot::interfaces::Interfaces::discover_with(
-        &mut sm, props_path, &search,
-    )
-    .map_err(|errs| {
-        CliError::Input(
-            errs.iter()
-                .map(|d| d.to_string())
-                .collect::<Vec<_>>()
-                .join("\n"),
-        )
-    })?;
+    let packages = discover_packages(props_path, args.interfaces.clone())?;
     let defs = Packages(packages);
     let mut sources = Vec::new();
     for (topic, type_name, qos) in topics {
@@ -287,15 +277,7 @@ pub fn run(
             Stream::Input,
         )));
     }
-    let mut opts = Options {
-        verdicts: out,
-        record,
-        every_point: args.every_point,
-        poll: Duration::from_micros(args.poll_us),
-        log: Box::new(std::io::stderr()),
-        probe: None,
-        progress: None,
-    };
+    let mut opts = super::monitor::options(args, out, record);
     live::dds::run(spec, sources, &settings, &mut opts, mcap, stop_flag())
         .map(|_| ())
         .map_err(|e| CliError::Failed(e.to_string()))

@@ -290,6 +290,24 @@ pub(crate) fn bind_ports(binds: &[String], compiled: &Compiled) -> Result<Vec<Ba
 /// folders beside and above PROPS, the sourced workspace, the built-ins.
 pub(crate) struct Packages(pub(crate) crate::robot::interfaces::Interfaces);
 
+/// The interface packages found for `path` (beside and above it, `--interfaces`,
+/// `AMENT_PREFIX_PATH`, the built-ins); a package that does not read is an input error.
+pub(crate) fn discover_packages(
+    path: &Path,
+    interfaces: Vec<PathBuf>,
+) -> Result<crate::robot::interfaces::Interfaces, CliError> {
+    let mut sm = codegen::diag::SourceMap::new();
+    let search = crate::robot::interfaces::Search::from_env(interfaces);
+    crate::robot::interfaces::Interfaces::discover_with(&mut sm, path, &search).map_err(|errs| {
+        CliError::Input(
+            errs.iter()
+                .map(|d| d.to_string())
+                .collect::<Vec<_>>()
+                .join("\n"),
+        )
+    })
+}
+
 impl ros2::schema::Definitions for Packages {
     fn message(&self, package: &str, name: &str) -> Option<ros2::interface::MessageDef> {
         use crate::robot::interfaces::InterfaceKind;
@@ -354,18 +372,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
                     args.spec.display()
                 );
             }
-            let mut sm = codegen::diag::SourceMap::new();
-            let search = crate::robot::interfaces::Search::from_env(args.interfaces.clone());
-            let packages =
-                crate::robot::interfaces::Interfaces::discover_with(&mut sm, &args.spec, &search)
-                    .map_err(|errs| {
-                    CliError::Input(
-                        errs.iter()
-                            .map(|d| d.to_string())
-                            .collect::<Vec<_>>()
-                            .join("\n"),
-                    )
-                })?;
+            let packages = discover_packages(&args.spec, args.interfaces.clone())?;
             let time = match args.time {
                 TimeArg::Log => TimeSource::Log,
                 TimeArg::Header => TimeSource::Header,

@@ -2,20 +2,20 @@
 
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Once;
+use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use iceoryx2::prelude::*;
 
 type Ipc = ipc::Service;
 
+use super::progress::draw_line;
 use super::verify::{load_without, ModelArgs};
 use super::CliError;
 use crate::live::inject::{
     Answer, GoalBridge, GoalRoute, ServiceBridge, ServiceServers, TopicSubscriber,
 };
-use crate::live::pace::Paced;
+use crate::live::pace::{Paced, ProgressReports};
 use crate::live::publish::{
     layout_of, layout_toml, layouts, name_from_ports, TopicLayout, TopicPublisher, WireKind,
 };
@@ -407,18 +407,21 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         .map_err(|e| CliError::Failed(format!("iceoryx2: node: {e:?}")))?;
     let publisher = TopicPublisher::new(&node, model, topics, &args.prefix)
         .map_err(|e| CliError::Failed(e.to_string()))?;
-    let inbound = TopicSubscriber::new(&node, inbound, &args.prefix).map_err(CliError::Failed)?;
+    let inbound = TopicSubscriber::new(&node, inbound, &args.prefix)
+        .map_err(|e| CliError::Failed(e.to_string()))?;
     let services = ServiceBridge::new(&node, model.event_count(), served, &args.prefix)
-        .map_err(CliError::Failed)?;
+        .map_err(|e| CliError::Failed(e.to_string()))?;
     let servers = ServiceServers::new(&node, model.event_count(), called, &args.prefix)
-        .map_err(CliError::Failed)?;
-    let goals = GoalBridge::new(&node, routes, &args.prefix).map_err(CliError::Failed)?;
+        .map_err(|e| CliError::Failed(e.to_string()))?;
+    let goals = GoalBridge::new(&node, routes, &args.prefix)
+        .map_err(|e| CliError::Failed(e.to_string()))?;
     let cfg = RunConfig {
         max_time,
         events: loaded.events,
         quiescence: Quiescence::AdvanceTime,
         ..RunConfig::default()
     };
+    let tty = std::io::stderr().is_terminal();
     let mut live = Paced {
         node: &node,
         publisher,
@@ -428,15 +431,13 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         goals,
         inbound_error: None,
         clock: Clock::with_speed(unit_ns, args.speed),
-        unit_ns,
         stopped: false,
-        last_progress: Instant::now(),
-        tty: std::io::stderr().is_terminal(),
+        on_progress: ProgressReports::new(move |p| draw_line(&p.line(unit_ns), tty)),
     };
     let mut rng = crate::smc::runner::stream(args.seed, args.run);
     let outcome = Simulator::new(model).run(&mut rng, &cfg, &mut live);
     live.progress(outcome.time, true);
-    if live.tty {
+    if tty {
         eprintln!();
     }
     let (failed, why) = live.publisher.failed();
@@ -483,18 +484,6 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     };
     eprintln!("run: ended at model step {}: {how}", outcome.time);
     Ok(())
-}
-
-/// Set by SIGINT / SIGTERM during `run --ros2`: the run stops at its next step, exit 0.
-static STOP: AtomicBool = AtomicBool::new(false);
-
-fn stop_flag() -> &'static AtomicBool {
-    static INSTALL: Once = Once::new();
-    INSTALL.call_once(|| {
-        // ctrlc runs this on its own thread: only the flag is set here.
-        let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed));
-    });
-    &STOP
 }
 
 /// How long `--wait-match` waits after the writers matched their subscribers, for the
@@ -593,7 +582,7 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
                 &defs,
                 &mut warnings,
             )
-            .map_err(CliError::Failed)?,
+            .map_err(|e| CliError::Failed(e.to_string()))?,
         )
     };
     for w in &warnings {
@@ -653,7 +642,8 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
         topics.len(),
         topics.join(", ")
     );
-    let stop = stop_flag();
+    // Set by SIGINT / SIGTERM: the run stops at its next step, exit 0.
+    let stop = super::monitor_ros2::stop_flag();
     let start = Instant::now();
     loop {
         let missing = publisher.unmatched(&args.wait_match);
@@ -693,21 +683,20 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
         quiescence: Quiescence::AdvanceTime,
         ..RunConfig::default()
     };
+    let tty = std::io::stderr().is_terminal();
     let mut live = DdsPaced {
         model,
         publisher,
         services,
         clock: Clock::with_speed(unit_ns, args.speed),
-        unit_ns,
         stop,
         stopped: false,
-        last_progress: Instant::now(),
-        tty: std::io::stderr().is_terminal(),
+        on_progress: ProgressReports::new(move |p| draw_line(&p.line(unit_ns), tty)),
     };
     let mut rng = crate::smc::runner::stream(args.seed, args.run);
     let outcome = Simulator::new(model).run(&mut rng, &cfg, &mut live);
     live.progress(outcome.time, true);
-    if live.tty {
+    if tty {
         eprintln!();
     }
     // Reliable delivery of the last messages before the participant goes.

@@ -356,11 +356,11 @@ pub fn load_without(
 
 /// The progress bar of a study on standard error, or none (`--json`): the library reports
 /// progress to a callback and prints nothing.
-pub(super) fn progress_bar(show: bool) -> crate::smc::progress::TerminalProgress {
+pub(super) fn progress_bar(show: bool) -> super::progress::TerminalProgress {
     if show {
-        crate::smc::progress::TerminalProgress::stderr()
+        super::progress::TerminalProgress::stderr()
     } else {
-        crate::smc::progress::TerminalProgress::hidden()
+        super::progress::TerminalProgress::hidden()
     }
 }
 
@@ -497,7 +497,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             &opts.rule,
             runs,
         );
-        let mut bar = crate::smc::progress::TerminalProgress::stderr();
+        let mut bar = super::progress::TerminalProgress::stderr();
         let part = study_shard(model, set, &run_cfg, &study_cfg, &fixed, shard, &mut |p| {
             bar.update(p)
         })

@@ -243,35 +243,33 @@ impl Compiler<'_, '_> {
                     code: Code::Int(Box::new(move |e| Ok(g(x(e)?) as i64))),
                 })
             }
-            "abs" => {
+            "abs" | "sign" => {
                 arity(1)?;
                 let a = num_args.remove(0);
+                let abs = fname == "abs";
                 match a.code {
-                    Code::Int(f) => Ok(Typed {
-                        ty: Ty::Int,
-                        code: Code::Int(Box::new(move |e| Ok(f(e)?.wrapping_abs()))),
-                    }),
-                    _ => Ok(float1(f64::abs, vec![a])),
-                }
-            }
-            "sign" => {
-                arity(1)?;
-                let a = num_args.remove(0);
-                match a.code {
-                    Code::Int(f) => Ok(Typed {
-                        ty: Ty::Int,
-                        code: Code::Int(Box::new(move |e| Ok(f(e)?.signum()))),
-                    }),
-                    _ => Ok(float1(
-                        |v| {
-                            if v == 0.0 || v.is_nan() {
-                                v
-                            } else {
-                                v.signum()
+                    Code::Int(f) => {
+                        let int: fn(i64) -> i64 = if abs { i64::wrapping_abs } else { i64::signum };
+                        Ok(Typed {
+                            ty: Ty::Int,
+                            code: Code::Int(Box::new(move |e| Ok(int(f(e)?)))),
+                        })
+                    }
+                    _ => {
+                        let float: fn(f64) -> f64 = if abs {
+                            f64::abs
+                        } else {
+                            // ECMAScript's sign keeps zeros and NaN as they are.
+                            |v| {
+                                if v == 0.0 || v.is_nan() {
+                                    v
+                                } else {
+                                    v.signum()
+                                }
                             }
-                        },
-                        vec![a],
-                    )),
+                        };
+                        Ok(float1(float, vec![a]))
+                    }
                 }
             }
             "min" | "max" => {

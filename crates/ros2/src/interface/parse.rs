@@ -80,7 +80,7 @@ pub fn parse_interface(
                     part.constants.push(c);
                 }
             }
-            Err((offset, msg)) => errs.push(sm.diag(at(offset), msg)),
+            Err(e) => errs.push(sm.diag(at(e.offset), e.message)),
         }
     }
     if parts.len() < kind.parts() && errs.is_empty() {
@@ -110,22 +110,31 @@ pub fn parse_interface(
 
 /// The line without its comment (a `#` outside quotes starts one).
 fn strip_comment(line: &str) -> &str {
+    match unquoted(line).find(|&(_, c)| c == '#') {
+        Some((i, _)) => &line[..i],
+        None => line,
+    }
+}
+
+/// The characters of `text` outside quoted strings (`"..."` or `'...'`, with `\`
+/// escapes inside), with their byte offsets.
+fn unquoted(text: &str) -> impl Iterator<Item = (usize, char)> + '_ {
     let mut quote: Option<char> = None;
     let mut escaped = false;
-    for (i, c) in line.char_indices() {
+    text.char_indices().filter(move |&(_, c)| {
         if escaped {
             escaped = false;
-            continue;
+            return false;
         }
         match (quote, c) {
             (Some(_), '\\') => escaped = true,
             (Some(q), c) if c == q => quote = None,
             (None, '"') | (None, '\'') => quote = Some(c),
-            (None, '#') => return &line[..i],
+            (None, _) => return true,
             _ => {}
         }
-    }
-    line
+        false
+    })
 }
 
 enum Item {
@@ -133,7 +142,17 @@ enum Item {
     Constant(Constant),
 }
 
-type LineError = (usize, String);
+/// A fault in one line: the byte offset in the file it points at, and what is wrong.
+struct LineError {
+    offset: usize,
+    message: String,
+}
+
+impl LineError {
+    fn at(offset: usize, message: String) -> LineError {
+        LineError { offset, message }
+    }
+}
 
 /// Parses one non-empty, comment-free, trimmed line that starts at byte `base` of the file.
 /// Spans in the result hold absolute offsets with a placeholder file.
@@ -144,7 +163,7 @@ fn parse_line(line: &str, base: usize, package: &str) -> Result<Item, LineError>
     let rest = rest_full.trim_start();
     let name_off = base + ty_end + (rest_full.len() - rest.len());
     if rest.is_empty() {
-        return Err((
+        return Err(LineError::at(
             base + ty_end,
             format!("expected a field name after the type `{ty_text}`"),
         ));
@@ -157,12 +176,15 @@ fn parse_line(line: &str, base: usize, package: &str) -> Result<Item, LineError>
     let after = rest[name_end..].trim_start();
     let after_off = name_off + name_end + (rest[name_end..].len() - after.len());
     if name.is_empty() {
-        return Err((name_off, "expected a field or constant name".into()));
+        return Err(LineError::at(
+            name_off,
+            "expected a field or constant name".into(),
+        ));
     }
     if let Some(value) = after.strip_prefix('=') {
         // A constant.
         if !valid_constant_name(name) {
-            return Err((
+            return Err(LineError::at(
                 name_off,
                 format!("`{name}` is not a valid constant name (upper-case letters, digits and `_`, starting with a letter)"),
             ));
@@ -170,7 +192,7 @@ fn parse_line(line: &str, base: usize, package: &str) -> Result<Item, LineError>
         let prim = match (&ty.base, ty.array) {
             (BaseType::Primitive { prim, .. }, ArraySize::Scalar) => *prim,
             _ => {
-                return Err((
+                return Err(LineError::at(
                     base,
                     "a constant must have a primitive, non-array type".into(),
                 ))
@@ -179,7 +201,10 @@ fn parse_line(line: &str, base: usize, package: &str) -> Result<Item, LineError>
         let v = value.trim();
         let v_off = after_off + 1 + (value.len() - value.trim_start().len());
         if v.is_empty() {
-            return Err((after_off, format!("constant `{name}` has no value")));
+            return Err(LineError::at(
+                after_off,
+                format!("constant `{name}` has no value"),
+            ));
         }
         let value = parse_scalar(prim, string_bound(&ty), v, v_off, true)?;
         return Ok(Item::Constant(Constant {
@@ -190,7 +215,7 @@ fn parse_line(line: &str, base: usize, package: &str) -> Result<Item, LineError>
         }));
     }
     if !valid_field_name(name) {
-        return Err((
+        return Err(LineError::at(
             name_off,
             format!(
                 "`{name}` is not a valid field name (lower-case letters, digits and single `_`, starting with a letter)"
@@ -275,13 +300,16 @@ fn parse_type(text: &str, base: usize, package: &str) -> Result<FieldType, LineE
             .strip_prefix('[')
             .and_then(|s| s.strip_suffix(']'))
         else {
-            return Err((
+            return Err(LineError::at(
                 array_off,
                 format!("malformed array size `{array_text}` (expected `[]`, `[N]` or `[<=N]`)"),
             ));
         };
         if inner.contains('[') || inner.contains(']') {
-            return Err((array_off, "arrays of arrays are not allowed".into()));
+            return Err(LineError::at(
+                array_off,
+                "arrays of arrays are not allowed".into(),
+            ));
         }
         if inner.is_empty() {
             ArraySize::Unbounded
@@ -290,7 +318,7 @@ fn parse_type(text: &str, base: usize, package: &str) -> Result<FieldType, LineE
         } else {
             let n = parse_len(inner, array_off)?;
             if n > MAX_FIXED_LEN {
-                return Err((
+                return Err(LineError::at(
                     array_off,
                     format!("fixed array length {n} is larger than {MAX_FIXED_LEN}"),
                 ));
@@ -301,7 +329,7 @@ fn parse_type(text: &str, base: usize, package: &str) -> Result<FieldType, LineE
     let (elem_name, string_bound) = match elem.split_once("<=") {
         Some((e, n)) => {
             if e != "string" && e != "wstring" {
-                return Err((
+                return Err(LineError::at(
                     base,
                     format!("only strings can be bounded with `<=`, not `{e}`"),
                 ));
@@ -311,7 +339,7 @@ fn parse_type(text: &str, base: usize, package: &str) -> Result<FieldType, LineE
         None => (elem, None),
     };
     if elem_name.is_empty() {
-        return Err((base, "missing type name".into()));
+        return Err(LineError::at(base, "missing type name".into()));
     }
     if let Some(prim) = Primitive::from_name(elem_name) {
         return Ok(FieldType {
@@ -332,7 +360,7 @@ fn parse_type(text: &str, base: usize, package: &str) -> Result<FieldType, LineE
         [pkg, name] => (*pkg, *name),
         [pkg, "msg", name] => (*pkg, *name),
         _ => {
-            return Err((
+            return Err(LineError::at(
                 base,
                 format!(
                     "`{elem_name}` is not a type (expected a primitive, `Type` or `package/Type`)"
@@ -341,7 +369,7 @@ fn parse_type(text: &str, base: usize, package: &str) -> Result<FieldType, LineE
         }
     };
     if !valid_generated_type_name(name) || !valid_package_name(pkg) {
-        return Err((
+        return Err(LineError::at(
             base,
             format!("`{elem_name}` is not a primitive type or a message name (`package/Type`, the type starting with an upper-case letter)"),
         ));
@@ -358,7 +386,7 @@ fn parse_type(text: &str, base: usize, package: &str) -> Result<FieldType, LineE
 fn parse_len(text: &str, offset: usize) -> Result<u32, LineError> {
     text.trim()
         .parse::<u32>()
-        .map_err(|_| (offset, format!("`{text}` is not an array or string length")))
+        .map_err(|_| LineError::at(offset, format!("`{text}` is not an array or string length")))
 }
 
 /// Parses a field's default value (after the name) into an ECMAScript literal.
@@ -366,7 +394,7 @@ fn parse_default(ty: &FieldType, text: &str, offset: usize) -> Result<String, Li
     let (prim, sbound) = match &ty.base {
         BaseType::Primitive { prim, string_bound } => (*prim, *string_bound),
         BaseType::Message { .. } => {
-            return Err((
+            return Err(LineError::at(
                 offset,
                 "only fields of primitive types can have default values".into(),
             ))
@@ -376,7 +404,7 @@ fn parse_default(ty: &FieldType, text: &str, offset: usize) -> Result<String, Li
         ArraySize::Scalar => parse_scalar(prim, sbound, text, offset, false),
         size => {
             let Some(inner) = text.strip_prefix('[').and_then(|s| s.strip_suffix(']')) else {
-                return Err((
+                return Err(LineError::at(
                     offset,
                     format!("an array default is written `[a, b, ...]`, found `{text}`"),
                 ));
@@ -389,14 +417,14 @@ fn parse_default(ty: &FieldType, text: &str, offset: usize) -> Result<String, Li
                     if inner.trim().is_empty() {
                         break;
                     }
-                    return Err((offset + 1 + k, "empty array element".into()));
+                    return Err(LineError::at(offset + 1 + k, "empty array element".into()));
                 }
                 let lead = item.len() - item.trim_start().len();
                 out.push(parse_scalar(prim, sbound, t, offset + 1 + k + lead, false)?);
             }
             match size {
                 ArraySize::Fixed(n) if out.len() != n as usize => {
-                    return Err((
+                    return Err(LineError::at(
                         offset,
                         format!(
                             "the default has {} elements, the array has exactly {n}",
@@ -405,7 +433,7 @@ fn parse_default(ty: &FieldType, text: &str, offset: usize) -> Result<String, Li
                     ))
                 }
                 ArraySize::Bounded(n) if out.len() > n as usize => {
-                    return Err((
+                    return Err(LineError::at(
                         offset,
                         format!(
                             "the default has {} elements, the array has at most {n}",
@@ -423,24 +451,10 @@ fn parse_default(ty: &FieldType, text: &str, offset: usize) -> Result<String, Li
 /// Splits `a, 'b,c', d` at top-level commas; each item with its byte offset in `text`.
 fn split_items(text: &str) -> Vec<(usize, &str)> {
     let mut out = Vec::new();
-    let mut quote: Option<char> = None;
-    let mut escaped = false;
     let mut start = 0;
-    for (i, c) in text.char_indices() {
-        if escaped {
-            escaped = false;
-            continue;
-        }
-        match (quote, c) {
-            (Some(_), '\\') => escaped = true,
-            (Some(q), c) if c == q => quote = None,
-            (None, '"') | (None, '\'') => quote = Some(c),
-            (None, ',') => {
-                out.push((start, &text[start..i]));
-                start = i + 1;
-            }
-            _ => {}
-        }
+    for (i, _) in unquoted(text).filter(|&(_, c)| c == ',') {
+        out.push((start, &text[start..i]));
+        start = i + 1;
     }
     out.push((start, &text[start..]));
     out
@@ -455,7 +469,7 @@ fn parse_scalar(
     offset: usize,
     constant: bool,
 ) -> Result<String, LineError> {
-    let bad = |what: &str| (offset, format!("`{text}` is not {what}"));
+    let bad = |what: &str| LineError::at(offset, format!("`{text}` is not {what}"));
     if prim.is_string() {
         let value = match unquote(text) {
             Some(Ok(v)) => v,
@@ -465,7 +479,10 @@ fn parse_scalar(
         };
         if let Some(n) = string_bound {
             if value.chars().count() > n as usize {
-                return Err((offset, format!("the string is longer than its bound {n}")));
+                return Err(LineError::at(
+                    offset,
+                    format!("the string is longer than its bound {n}"),
+                ));
             }
         }
         return Ok(ecma_string(&value));
@@ -490,7 +507,7 @@ fn parse_scalar(
             let (lo, hi) = prim.int_range().ok_or_else(|| bad("a value"))?;
             let v: i128 = text.parse().map_err(|_| bad("an integer"))?;
             if v < lo || v > hi {
-                return Err((
+                return Err(LineError::at(
                     offset,
                     format!(
                         "{v} is out of range for {} ({lo} to {hi})",
