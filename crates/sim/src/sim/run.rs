@@ -180,6 +180,16 @@ fn env<'s>(
     env_of(r, params, rng, strings)
 }
 
+/// The parameters of machine record `r`'s current message (empty: none).
+#[inline(always)]
+fn params_of<'p>(r: &MachineRt, pool: &'p [Slot]) -> &'p [Cell] {
+    if r.cur == NO_MSG {
+        &[]
+    } else {
+        pool.get(r.cur as usize).map_or(&[], |s| &s.params)
+    }
+}
+
 /// Machine record `r`'s environment, `params` being its current message's parameters.
 #[inline(always)]
 fn env_of<'s>(
@@ -203,6 +213,40 @@ fn env_of<'s>(
 #[inline]
 fn scratch_cell(scratch: &mut [Vec<Cell>], m: usize, sc: u32) -> Option<&mut Cell> {
     scratch.get_mut(m).and_then(|v| v.get_mut(sc as usize))
+}
+
+/// Keeps machine `m`'s place in `runnable` true to whether it can move: a function over
+/// the two fields so that a step holding others may call it. Called after nearly every
+/// step and delivery (on UC3 about 4 times per step), so always inlined: the call itself
+/// cost a third of it.
+#[inline(always)]
+fn refresh_in(ms: &mut [MachineRt], runnable: &mut Vec<u32>, m: usize) {
+    let r = &ms[m];
+    let can =
+        !r.waiting && !r.blocked && (r.pc != IDLE || !r.intq.is_empty() || !r.extq.is_empty());
+    let pos = r.rpos;
+    if can && pos == NOT_RUNNABLE {
+        ms[m].rpos = runnable.len() as u32;
+        runnable.push(m as u32);
+    } else if !can && pos != NOT_RUNNABLE {
+        let last = runnable.len() - 1;
+        runnable.swap(pos as usize, last);
+        let moved = runnable[pos as usize] as usize;
+        ms[moved].rpos = pos;
+        runnable.pop();
+        ms[m].rpos = NOT_RUNNABLE;
+    }
+}
+
+/// Marks machine `m`'s cached state hash stale, as [`Simulator::touch`] does, over the two
+/// fields it needs.
+#[inline(always)]
+fn touch_in(ms: &mut [MachineRt], dirty: &mut Vec<u32>, m: usize) {
+    let r = &mut ms[m];
+    if !r.dirty {
+        r.dirty = true;
+        dirty.push(m as u32);
+    }
 }
 
 /// Evaluates a send's parameter expressions into `out` (the message's cells), stopping at
@@ -260,25 +304,9 @@ impl<'m> Simulator<'m> {
     }
 
     /// Keeps machine `m`'s place in [`Simulator::runnable`] true to whether it can move.
-    /// Called after nearly every step and delivery (on UC3 about 4 times per step), so
-    /// always inlined: the call itself cost a third of it.
     #[inline(always)]
     fn refresh(&mut self, m: usize) {
-        let r = &self.ms[m];
-        let can =
-            !r.waiting && !r.blocked && (r.pc != IDLE || !r.intq.is_empty() || !r.extq.is_empty());
-        let pos = r.rpos;
-        if can && pos == NOT_RUNNABLE {
-            self.ms[m].rpos = self.runnable.len() as u32;
-            self.runnable.push(m as u32);
-        } else if !can && pos != NOT_RUNNABLE {
-            let last = self.runnable.len() - 1;
-            self.runnable.swap(pos as usize, last);
-            let moved = self.runnable[pos as usize] as usize;
-            self.ms[moved].rpos = pos;
-            self.runnable.pop();
-            self.ms[m].rpos = NOT_RUNNABLE;
-        }
+        refresh_in(&mut self.ms, &mut self.runnable, m);
     }
 
     fn free_slot(&mut self, slot: u32) {

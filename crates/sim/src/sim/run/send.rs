@@ -63,6 +63,9 @@ impl Simulator<'_> {
     /// [`EventSemantics::Queues`]: evaluates the send's target and parameters, reports the
     /// send and appends the message to its target's queue (one target per call for a
     /// broadcast). `None`: nobody receives the event, the machine goes on at once.
+    ///
+    /// Works over split borrows of the simulator's fields (the sender's record, the pool,
+    /// the free lists, the target's record), each taken once.
     #[inline]
     pub(super) fn queue_send<O: Observer + ?Sized>(
         &mut self,
@@ -73,18 +76,30 @@ impl Simulator<'_> {
         obs: &mut O,
     ) -> Result<Option<Flow>, Stop> {
         let model = self.model;
-        let def = &model.machines[m];
+        let Simulator {
+            ms,
+            pool,
+            free,
+            runnable,
+            dirty,
+            time,
+            steps,
+            instant_steps,
+            reserved,
+            ..
+        } = self;
+        let r = &ms[m];
         let mut broadcast_len = 0usize;
         let target: Option<u32> = match &sd.to {
             SendTo::Machine(t) => Some(*t),
             SendTo::Sink => None,
             SendTo::Broadcast(list) => {
                 broadcast_len = list.len();
-                match list.get(self.ms[m].bcast as usize) {
+                match list.get(r.bcast as usize) {
                     Some(&t) => Some(t),
                     None => {
                         // Nobody receives this event: nothing is sent.
-                        let r = &mut self.ms[m];
+                        let r = &mut ms[m];
                         r.bcast = 0;
                         r.delay_done = false;
                         r.pc = pc + 1;
@@ -94,7 +109,7 @@ impl Simulator<'_> {
             }
             SendTo::Expr(f) => {
                 let res = {
-                    let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
+                    let mut env = env_of(r, params_of(r, pool), &mut *rng, &model.strings);
                     f(&mut env)
                 };
                 let s = match res {
@@ -104,92 +119,75 @@ impl Simulator<'_> {
                 match model.machine_of_str.get(s.0 as usize) {
                     Some(&t) if t != u32::MAX => Some(t),
                     _ if s == model.none_str => None,
-                    _ => {
-                        let span = def
-                            .code_spans
-                            .get(pc as usize)
-                            .copied()
-                            .unwrap_or(def.file.at(0));
-                        return Err(Stop::End(Box::new(EndReason::Error(RunError {
-                            machine: MachineId(m as u32),
-                            time: self.time,
-                            diagnostic: model.sources.diag(
-                                span,
-                                format!(
-                                    "targetexpr evaluated to `{}`, which is not a machine",
-                                    model.strings.get(s)
-                                ),
-                            ),
-                        }))));
-                    }
+                    _ => return Err(self.not_a_machine(m, pc, s)),
                 }
             }
         };
         let Some(evdef) = model.events.get(sd.event as usize) else {
-            return Err(self.diag_error(
-                m,
-                Some(pc as usize),
-                EvalError {
-                    at: 0,
-                    kind: EvalErrorKind::Internal,
-                },
-            ));
+            return Err(self.internal(m, pc));
         };
         // Slots are reused per event, so their cells keep their shapes (no allocation).
-        let slot = match self.free.get_mut(sd.event as usize).and_then(|f| f.pop()) {
+        let slot = match free.get_mut(sd.event as usize).and_then(|f| f.pop()) {
             Some(s) => s,
             None => {
-                self.pool.push(Slot {
+                pool.push(Slot {
                     event: sd.event,
                     origin: 0,
                     target: 0,
                     params: evdef.defaults.clone(),
                 });
-                self.pool.len() as u32 - 1
+                pool.len() as u32 - 1
             }
         };
+        let (s, params) = write_and_read(pool, slot as usize, r.cur);
+        for &i in &sd.missing {
+            if let (Some(dst), Some(d)) =
+                (s.params.get_mut(i as usize), evdef.defaults.get(i as usize))
+            {
+                dst.clone_from(d);
+            }
+        }
         let res = {
-            let r = &self.ms[m];
-            let (s, params) = write_and_read(&mut self.pool, slot as usize, r.cur);
-            for &i in &sd.missing {
-                if let (Some(dst), Some(d)) =
-                    (s.params.get_mut(i as usize), evdef.defaults.get(i as usize))
-                {
-                    dst.clone_from(d);
-                }
-            }
             let mut env = env_of(r, params, &mut *rng, &model.strings);
-            let res = eval_params(sd, &mut env, &mut s.params);
-            s.event = sd.event;
-            s.origin = m as u32;
-            s.target = target.unwrap_or(u32::MAX);
-            res
+            eval_params(sd, &mut env, &mut s.params)
         };
+        s.event = sd.event;
+        s.origin = m as u32;
+        s.target = target.unwrap_or(u32::MAX);
         if let Err(e) = res {
             self.free_slot(slot);
             return Err(self.diag_error(m, Some(pc as usize), e));
         }
-        self.steps += 1;
-        self.instant_steps += 1;
+        *steps += 1;
+        *instant_steps += 1;
         let flow = obs.on_send(
-            self.time,
+            *time,
             &SentMessage {
                 model,
                 event: EventId(sd.event),
                 origin: MachineId(m as u32),
                 target: target.map(MachineId),
-                params: &self.pool[slot as usize].params,
+                params: &s.params,
             },
         );
         match target {
             Some(t) => {
-                self.ms[t as usize].extq.push_back(slot);
-                self.touch(t as usize);
-                self.refresh(t as usize);
+                let t = t as usize;
+                ms[t].extq.push_back(slot);
+                touch_in(ms, dirty, t);
+                refresh_in(ms, runnable, t);
             }
-            None => self.free_slot(slot),
+            None => {
+                // The `NONE` sink: the slot is free again at once (never a reserved one:
+                // those exist only under `EventSemantics::As2fm`).
+                if slot as usize >= *reserved {
+                    if let Some(f) = free.get_mut(sd.event as usize) {
+                        f.push(slot);
+                    }
+                }
+            }
         }
-        let r = &mut self.ms[m];
+        let r = &mut ms[m];
         if broadcast_len > 0 && (r.bcast as usize) + 1 < broadcast_len {
             r.bcast += 1;
         } else {
@@ -198,5 +196,28 @@ impl Simulator<'_> {
             r.pc = pc + 1;
         }
         Ok(Some(flow))
+    }
+
+    /// The error of a `targetexpr` that named no machine (nor `NONE`).
+    #[cold]
+    fn not_a_machine(&self, m: usize, pc: u32, s: StrId) -> Stop {
+        let model = self.model;
+        let def = &model.machines[m];
+        let span = def
+            .code_spans
+            .get(pc as usize)
+            .copied()
+            .unwrap_or(def.file.at(0));
+        Stop::End(Box::new(EndReason::Error(RunError {
+            machine: MachineId(m as u32),
+            time: self.time,
+            diagnostic: model.sources.diag(
+                span,
+                format!(
+                    "targetexpr evaluated to `{}`, which is not a machine",
+                    model.strings.get(s)
+                ),
+            ),
+        })))
     }
 }

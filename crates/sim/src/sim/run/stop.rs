@@ -53,15 +53,4 @@ impl Simulator<'_> {
             },
         )
     }
-
-    pub(super) fn too_long(&self, m: usize, pc: u32, bound: u32) -> Stop {
-        self.diag_error(
-            m,
-            Some(pc as usize),
-            EvalError {
-                at: 0,
-                kind: EvalErrorKind::TooLong { bound },
-            },
-        )
-    }
 }
