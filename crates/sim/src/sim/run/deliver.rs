@@ -128,8 +128,16 @@ impl Simulator<'_> {
         // The state's transitions on `e` and the drop rule, worked out once per model.
         let case = self.rx_cases[self.rx_first[i] as usize + state];
         let list = &def.dispatch[case.start as usize..case.end as usize];
+        // What `take_current` does, with the event known to exist.
         let origin = self.pool[e as usize].origin;
-        self.take_current(m, e, e, origin);
+        let rt = &mut self.ms[m];
+        rt.cur = e;
+        rt.cur_event = model.events[e as usize].name_str;
+        rt.cur_origin = model
+            .machines
+            .get(origin as usize)
+            .map_or(StrId(0), |d| d.name_str);
+        self.touch(m);
         if let Some(t) = self.select(m, def, list, rng, cfg)? {
             return Ok(Some(Some(t)));
         }
