@@ -13,6 +13,7 @@ use std::collections::VecDeque;
 mod config;
 mod deliver;
 mod init;
+mod receivers;
 mod sched;
 mod send;
 mod step;
@@ -99,8 +100,6 @@ pub struct Simulator<'m> {
     as2fm: bool,
     /// Per event: [`EV_TIMER`], [`EV_SYNCHED`], [`EV_BB_REQ`], [`EV_BB_SET`] flags.
     ev_flags: Vec<u8>,
-    /// Per machine: never discards events (BT roots and ROS interface handlers).
-    no_discard: Vec<bool>,
     /// Per event: pending (as2fm).
     pending: Vec<bool>,
     /// Pending events, in the order they were sent.
@@ -119,6 +118,12 @@ pub struct Simulator<'m> {
     ev_scratch: Vec<Vec<Cell>>,
     /// Per event: the pool slot of its first receiver's copy of a delivered message.
     rx_base: Vec<u32>,
+    /// Per receiver slot (pool slot past the events' buffers): where its states' cases
+    /// start in [`Simulator::rx_cases`] (see `run/receivers.rs`).
+    rx_first: Vec<u32>,
+    /// Per receiver slot and state of the receiver: its transitions on the event and
+    /// whether it may drop it.
+    rx_cases: Vec<receivers::RxCase>,
     /// Pool slots reserved for [`EventSemantics::As2fm`] (never freed).
     reserved: usize,
     /// No transition condition draws random numbers: with [`TransitionChoice::DocumentOrder`]

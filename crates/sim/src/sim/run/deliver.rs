@@ -102,13 +102,15 @@ impl Simulator<'_> {
         !self.pending[e as usize] && !bb_blocked
     }
 
-    /// What receiver `r` does with pending event `e` now: `Some(Some(t))` fires
-    /// transition `t`, `Some(None)` discards it, `None` cannot take it yet.
-    /// Points the receiver's `_event` at the event's global buffer.
+    /// What receiver `r` (receiver slot `i`, see [`receivers::receiver_table`]) does with
+    /// pending event `e` now: `Some(Some(t))` fires transition `t`, `Some(None)` discards
+    /// it, `None` cannot take it yet. Points the receiver's `_event` at the event's global
+    /// buffer.
     pub(super) fn receive_choice(
         &mut self,
         r: u32,
         e: u32,
+        i: usize,
         rng: &mut dyn Entropy,
         cfg: &RunConfig,
     ) -> Result<Option<Option<u32>>, Stop> {
@@ -119,18 +121,27 @@ impl Simulator<'_> {
             return Ok(None);
         }
         let def = &model.machines[m];
-        let Some(st) = def.states.get(rt.state as usize) else {
+        let state = rt.state as usize;
+        if state >= def.states.len() {
             return Ok(None);
-        };
-        let list = st.transitions(e, &def.dispatch);
-        let has = !list.is_empty();
+        }
+        // The state's transitions on `e` and the drop rule, worked out once per model.
+        let case = self.rx_cases[self.rx_first[i] as usize + state];
+        let list = &def.dispatch[case.start as usize..case.end as usize];
+        // What `take_current` does, with the event known to exist.
         let origin = self.pool[e as usize].origin;
-        self.take_current(m, e, e, origin);
+        let rt = &mut self.ms[m];
+        rt.cur = e;
+        rt.cur_event = model.events[e as usize].name_str;
+        rt.cur_origin = model
+            .machines
+            .get(origin as usize)
+            .map_or(StrId(0), |d| d.name_str);
+        self.touch(m);
         if let Some(t) = self.select(m, def, list, rng, cfg)? {
             return Ok(Some(Some(t)));
         }
-        let discard = may_discard(self.no_discard[m], has, self.ev_flags[e as usize]);
-        Ok(discard.then_some(None))
+        Ok(case.discard.then_some(None))
     }
 
     /// Whether pending event `e` can be delivered now (every receiver can take it).
@@ -144,8 +155,9 @@ impl Simulator<'_> {
             return Ok(false);
         }
         let model = self.model;
-        for &r in &model.events[e as usize].receivers {
-            if self.receive_choice(r, e, rng, cfg)?.is_none() {
+        let base = self.rx_base[e as usize] as usize - model.events.len();
+        for (k, &r) in model.events[e as usize].receivers.iter().enumerate() {
+            if self.receive_choice(r, e, base + k, rng, cfg)?.is_none() {
                 return Ok(false);
             }
         }
@@ -174,7 +186,7 @@ impl Simulator<'_> {
             let choice = if at != 0 && self.ms[r as usize].changed < at {
                 self.choice_kept[base + k]
             } else {
-                let c = match self.receive_choice(r, e, rng, cfg)? {
+                let c = match self.receive_choice(r, e, base + k, rng, cfg)? {
                     Some(Some(t)) => t,
                     Some(None) => NO_TRANS,
                     None => CANNOT_TAKE,
@@ -216,7 +228,8 @@ impl Simulator<'_> {
                     .map_or(StrId(0), |d| d.name_str);
                 (kept != NO_TRANS).then_some(kept)
             } else {
-                self.receive_choice(r, e, rng, cfg)?.flatten()
+                let i = self.rx_base[e as usize] as usize - model.events.len() + k;
+                self.receive_choice(r, e, i, rng, cfg)?.flatten()
             };
             self.ms[m].changed = self.clock;
             // The receiver keeps its own copy: JANI assigns it with the receive itself.

@@ -6,6 +6,7 @@ impl<'m> Simulator<'m> {
     /// A simulator for `model` (allocates its buffers once).
     pub fn new(model: &'m CompiledModel) -> Self {
         let n = model.machines.len();
+        let (rx_first, rx_cases) = receivers::receiver_table(model);
         Simulator {
             model,
             ms: model
@@ -62,6 +63,8 @@ impl<'m> Simulator<'m> {
                     Some(base)
                 })
                 .collect(),
+            rx_first,
+            rx_cases,
             reserved: model.events.len()
                 + model
                     .events
@@ -83,11 +86,6 @@ impl<'m> Simulator<'m> {
             idx: [0; MAX_PATH],
             as2fm: false,
             ev_flags: model.events.iter().map(|e| event_flags(&e.name)).collect(),
-            no_discard: model
-                .machines
-                .iter()
-                .map(|d| never_discards(&d.name))
-                .collect(),
             pending: vec![false; model.events.len()],
             pending_list: Vec::with_capacity(model.events.len()),
             pending_regular: 0,
