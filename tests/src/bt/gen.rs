@@ -618,6 +618,24 @@ impl<R: Rng> G<'_, R> {
                 "_onHalted",
             ]
         };
+        // On a SubTree, `_onHalted` and the pre-conditions more often: what a body's
+        // SKIPPED, which leaves the SubTree node RUNNING, shows through.
+        let names: &[&str] = if subtree && skip && self.conds == Conditions::All {
+            &[
+                "_onHalted",
+                "_onHalted",
+                "_onHalted",
+                "_skipIf",
+                "_while",
+                "_failureIf",
+                "_successIf",
+                "_onSuccess",
+                "_onFailure",
+                "_post",
+            ]
+        } else {
+            names
+        };
         let mut name = self.pick(names);
         // With UnsetBlackboard, an `_onHalted` script could read an erased entry and
         // throw inside a halt, which BT.CPP may meet in a destructor (and the oracle
@@ -641,13 +659,13 @@ impl<R: Rng> G<'_, R> {
     }
 
     /// A SubTree's body root `seq` (a `<Sequence>`) that, with [`Options::subtree_conds`]
-    /// and SKIPPED on, may answer SKIPPED one time in three (`_skipIf` or `_while`), so
+    /// and SKIPPED on, may answer SKIPPED one time in two (`_skipIf` or `_while`), so
     /// that a body's SKIPPED leaves the SubTree node RUNNING. Off, nothing is drawn.
     fn body_skip(&mut self, seq: String) -> String {
         if !self.opts.subtree_conds
             || !self.scripts_on()
             || self.conds != Conditions::All
-            || self.below(3) != 0
+            || self.below(2) != 0
         {
             return seq;
         }
