@@ -1677,6 +1677,16 @@ fn real_library_with(
 
 /// [`real_library_with`] for the trees `opts` draws (`btcpp4_nodes` among them).
 fn real_library_opts(opts: gen::Options, default_n: u64, offset: u64) {
+    real_library_where(opts, default_n, offset, |_| true);
+}
+
+/// [`real_library_opts`] for the trees `keep` accepts.
+fn real_library_where(
+    opts: gen::Options,
+    default_n: u64,
+    offset: u64,
+    keep: fn(&tree::Tree) -> bool,
+) {
     let (scripts, unset, skipped, bb) = (opts.scripts, opts.unset, opts.skipped, opts.bb_nodes);
     let Some(mut lib) = harness() else { return };
     let n = env("HINDSIGHT_BT_REAL_LOWERING_TREES", default_n) as usize;
@@ -1710,7 +1720,8 @@ fn real_library_opts(opts: gen::Options, default_n: u64, offset: u64) {
             continue;
         }
         let t = tree::read(&c.xml).expect("the oracle reads what it generates");
-        if oracle::btcpp4_refuses(&t, &c.scripts).is_some()
+        if !keep(&t)
+            || oracle::btcpp4_refuses(&t, &c.scripts).is_some()
             || conds_refused(&t)
             || loop_refused(&t)
             || t.nodes
@@ -1930,10 +1941,25 @@ struct GtestFile {
 /// reading (tree built from XML, `tickOnce`) and in the `--bt btcpp` lowering.
 #[test]
 fn skipping_gtests_hold_in_the_oracle_and_the_lowering() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("bt/btcpp4/skipping.toml");
+    gtest_file_holds("skipping.toml", 7);
+}
+
+/// Pre/post conditions on `<SubTree>` nodes (`tests/bt/btcpp4/subtree.toml`: BT.CPP
+/// 4.10's `SubTree.SubtreeIssue592` and cases measured in 4.8.2), as
+/// [`skipping_gtests_hold_in_the_oracle_and_the_lowering`].
+#[test]
+fn subtree_condition_cases_hold_in_the_oracle_and_the_lowering() {
+    gtest_file_holds("subtree.toml", 5);
+}
+
+/// The cases of `tests/bt/btcpp4/<file>` (at least `min`) in the oracle and the lowering.
+fn gtest_file_holds(file: &str, min: usize) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("bt/btcpp4")
+        .join(file);
     let text = std::fs::read_to_string(&path).expect("read");
     let f: GtestFile = toml::from_str(&text).expect("toml");
-    assert!(f.case.len() >= 7, "{} cases", f.case.len());
+    assert!(f.case.len() >= min, "{} cases", f.case.len());
     let mut fails = Vec::new();
     for c in &f.case {
         let xml = if c.tree.trim_start().starts_with("<root") {
@@ -2112,4 +2138,198 @@ fn blackboard_and_loop_cases_hold_in_the_lowering() {
     );
     assert!(fails.is_empty(), "{}", fails.join("\n"));
     assert!(ran >= 20 && stopped >= 2, "{ran} ran, {stopped} stopped");
+}
+
+/// The options of the trees with pre/post conditions on `<SubTree>` nodes: BT.CPP 4's
+/// own nodes, scripts, the SKIPPED-making constructs (so a body may answer SKIPPED), and
+/// `gen::Options::subtree_conds`.
+const SUBTREE_CONDS: gen::Options = gen::Options {
+    btcpp4_nodes: true,
+    scripts: true,
+    unset: false,
+    skipped: true,
+    root_skip: true,
+    time_nodes: false,
+    try_catch: false,
+    bb_nodes: false,
+    reals: false,
+    bits: false,
+    strings: false,
+    subtree_conds: true,
+};
+
+/// What a tree with SubTree nodes of its own holds: SubTree nodes with each of
+/// `_failureIf`, `_successIf`, `_skipIf`, `_while` (as `tree::PRE`), `_onHalted`,
+/// `_onFailure`, `_onSuccess`, `_post` (as `tree::POST`); one BT.CPP ticks again without
+/// resetting it (the condition of a two-child IfThenElse or of a WhileDoElse); one whose
+/// body may answer SKIPPED itself (its root has `_skipIf` or `_while`).
+fn subtree_kinds(t: &tree::Tree) -> [bool; 10] {
+    let mut out = [false; 10];
+    for (i, x) in t.nodes.iter().enumerate() {
+        if x.kind != Kind::SubTree {
+            continue;
+        }
+        for (k, p) in x.conds.pre.iter().chain(&x.conds.post).enumerate() {
+            out[k] |= p.is_some();
+        }
+        out[8] |= t.nodes.iter().any(|p| {
+            p.children.first() == Some(&i)
+                && (p.kind == Kind::WhileDoElse
+                    || (p.kind == Kind::IfThenElse && p.children.len() == 2))
+        });
+        let body = &t.nodes[x.children[0]];
+        out[9] |= body.conds.pre[2].is_some() || body.conds.pre[3].is_some();
+    }
+    out
+}
+
+/// The labels of [`subtree_kinds`].
+const SUBTREE_KINDS: [&str; 10] = [
+    "_failureIf",
+    "_successIf",
+    "_skipIf",
+    "_while",
+    "_onHalted",
+    "_onFailure",
+    "_onSuccess",
+    "_post",
+    "ticked again without a reset",
+    "a body that may skip",
+];
+
+/// Pre/post conditions on `<SubTree>` nodes (`btcpp4_subtree.rs`; the oracle's
+/// `subtree_cond.rs`): `HINDSIGHT_BT_TREES` random trees (default 10,000) drawn with
+/// `gen::Options::subtree_conds`, those with a SubTree node of their own (with
+/// conditions) lowered under both tick modes and compared with the oracle's BT.CPP 4
+/// reading (the others are the trees of `random_trees_with_skipped_...` with another
+/// random stream: not run again).
+#[test]
+fn random_trees_with_subtree_conditions_lower_to_what_btcpp_does() {
+    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0);
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |p| p.get())
+        .min(4) as u64;
+    let start = std::time::Instant::now();
+    use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
+    // Trees compared, runs, runs where BT.CPP throws, trees left out (a SetBlackboard
+    // copy; what the lowering refuses under a BlackboardCheck).
+    let counts: [AtomicUsize; 4] = Default::default();
+    let kinds: [AtomicUsize; 10] = Default::default();
+    let (counts, kinds) = (&counts, &kinds);
+    let fails: Vec<String> = std::thread::scope(|s| {
+        let hs: Vec<_> = (0..threads)
+            .map(|th| {
+                s.spawn(move || {
+                    let mut fails = Vec::new();
+                    let mut i = th;
+                    while i < n && fails.len() < 3 {
+                        let seed = seed0 + i;
+                        i += threads;
+                        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+                        let c = gen::case_with_conds(
+                            &mut rng,
+                            4 + (seed % 12) as i64,
+                            SUBTREE_CONDS,
+                            gen::Conditions::All,
+                        );
+                        let t = tree::read(&c.xml).expect("the oracle reads what it generates");
+                        if !t.nodes.iter().any(|x| x.kind == Kind::SubTree) {
+                            continue;
+                        }
+                        if conds_refused(&t)
+                            || t.nodes.iter().any(|x| {
+                                matches!(x.kind, Kind::SetBlackboard(_, Operand::Entry(_)))
+                            })
+                        {
+                            counts[3].fetch_add(1, Relaxed);
+                            continue;
+                        }
+                        let mut runs = Vec::new();
+                        let mut left_out = false;
+                        for (tick, mode) in [
+                            (BtTick::Once, TickMode::Once),
+                            (BtTick::ExactlyOnce, TickMode::ExactlyOnce),
+                        ] {
+                            let problem = match (
+                                oracle::run_with(&t, &c.scripts, Options::xml4(mode), c.ticks),
+                                lowered(&c.xml, &c.scripts, c.ticks, tick),
+                            ) {
+                                (_, Err(e)) if e.contains("may answer SKIPPED") => {
+                                    left_out = true;
+                                    break;
+                                }
+                                (Ok(w), Ok(g)) => {
+                                    runs.push(matches!(w.end, Some(End::Error { .. })));
+                                    compare(&w, &g)
+                                }
+                                (Err(e), _) => Some(format!("oracle: {e}")),
+                                (_, Err(e)) => Some(format!("lowering: {e}")),
+                            };
+                            if let Some(p) = problem {
+                                fails.push(format!(
+                                    "seed {seed} ({tick:?}): {p}\n{}",
+                                    show(&c.xml, &c.scripts, c.ticks)
+                                ));
+                            }
+                        }
+                        if left_out {
+                            counts[3].fetch_add(1, Relaxed);
+                            continue;
+                        }
+                        counts[0].fetch_add(1, Relaxed);
+                        counts[1].fetch_add(runs.len(), Relaxed);
+                        counts[2].fetch_add(runs.iter().filter(|e| **e).count(), Relaxed);
+                        for (k, x) in subtree_kinds(&t).iter().enumerate() {
+                            kinds[k].fetch_add(usize::from(*x), Relaxed);
+                        }
+                    }
+                    fails
+                })
+            })
+            .collect();
+        hs.into_iter()
+            .flat_map(|h| h.join().expect("worker"))
+            .collect()
+    });
+    let [trees, runs, errors, left_out] = counts.each_ref().map(|c| c.load(Relaxed));
+    let kinds = kinds.each_ref().map(|c| c.load(Relaxed));
+    eprintln!(
+        "{n} random trees in {:.1} s: {trees} with pre/post conditions on a SubTree node \
+         compared ({runs} runs, {errors} where BT.CPP throws), {left_out} left out; SubTree \
+         nodes with {}",
+        start.elapsed().as_secs_f64(),
+        SUBTREE_KINDS
+            .iter()
+            .zip(kinds)
+            .map(|(k, c)| format!("{k} {c}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    assert!(
+        fails.is_empty(),
+        "{} disagreements:\n{}",
+        fails.len(),
+        fails.join("\n")
+    );
+    if n >= 1000 {
+        assert!(trees as u64 >= n / 20, "only {trees} trees compared");
+        for (k, c) in SUBTREE_KINDS.iter().zip(kinds) {
+            assert!(
+                c as u64 >= floor(n, 500),
+                "only {c} compared trees with a SubTree node with {k}"
+            );
+        }
+    }
+}
+
+/// Pre/post conditions on `<SubTree>` nodes straight against the real library:
+/// `HINDSIGHT_BT_REAL_LOWERING_TREES` (default 500) format-4 trees with a SubTree node of
+/// their own (`gen::Options::subtree_conds`), lowered and run in BT.CPP 4.8.2, both tick
+/// modes.
+#[test]
+fn random_trees_with_subtree_conditions_lower_to_what_the_real_library_does() {
+    real_library_where(SUBTREE_CONDS, 500, 1_500_000, |t| {
+        t.nodes.iter().any(|x| x.kind == Kind::SubTree)
+    });
 }

@@ -1156,3 +1156,68 @@ fn timed_nodes_agree_with_the_real_library() {
         reqs.len()
     );
 }
+
+/// Pre/post conditions on `<SubTree>` nodes as 4.8.2 runs them (the oracle's
+/// `subtree_cond.rs`): format-4 random trees drawn with `gen::Options::subtree_conds`
+/// until `HINDSIGHT_BT_REAL_SUBTREE_TREES` (default 1,000) of them have a SubTree node
+/// with conditions, both tick modes: root statuses, leaf events (the body's leaves
+/// mapped by BT.CPP's UIDs, the SubTree node counted), how a run ends and the script
+/// entries at the end must agree.
+#[test]
+fn subtree_conditions_agree_with_the_real_library() {
+    let Some(mut real) = harness() else { return };
+    let n = env("HINDSIGHT_BT_REAL_SUBTREE_TREES", 1_000) as usize;
+    let seed0 = env("HINDSIGHT_BT_SEED", 0) + 7_000_000;
+    let start = std::time::Instant::now();
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        skipped: true,
+        subtree_conds: true,
+        ..Default::default()
+    };
+    let mut cases = Vec::new();
+    let mut drawn = 0;
+    for seed in seed0.. {
+        if cases.len() >= n {
+            break;
+        }
+        drawn += 1;
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let c = gen::case_with(&mut rng, 4 + (seed % 12) as i64, opts);
+        let with = tree::read(&c.xml)
+            .map(|t| t.nodes.iter().any(|x| x.kind == tree::Kind::SubTree))
+            .unwrap_or(false);
+        if with {
+            cases.push((format!("subtree seed {seed}"), c.xml, c.scripts, c.ticks));
+        }
+    }
+    let mut counts = Counts::default();
+    let fails = check_all(&mut real, &cases, &mut counts);
+    let with = |pat: &str| {
+        cases
+            .iter()
+            .filter(|c| c.1.contains(&format!("<SubTree {pat}=")))
+            .count()
+    };
+    eprintln!(
+        "BehaviorTree.CPP {}: {} random trees with pre/post conditions on a SubTree node \
+         (of {drawn} drawn; `_skipIf` {}, `_while` {}, `_failureIf` {}, `_successIf` {}, \
+         `_onHalted` {}), each under tickOnce and tickExactlyOnce: {} runs ({} ran every \
+         tick, {} threw, {} refused at load) in {:.1} s; {} disagreements",
+        real.version,
+        cases.len(),
+        with("_skipIf"),
+        with("_while"),
+        with("_failureIf"),
+        with("_successIf"),
+        with("_onHalted"),
+        counts.runs,
+        counts.ran_all,
+        counts.errors,
+        counts.refused,
+        start.elapsed().as_secs_f64(),
+        fails.len()
+    );
+    assert_agreed(&fails, &counts);
+}

@@ -65,7 +65,8 @@ pub struct Options {
     pub btcpp4_nodes: bool,
     /// Scripts (format-4 trees only): `Script` and `ScriptCondition` leaves,
     /// `Precondition`, and the `_failureIf` ... `_post` attributes (`_skipIf` and `_while`
-    /// among them, so SKIPPED reaches every kind of parent) on any node but a SubTree;
+    /// among them, so SKIPPED reaches every kind of parent) on any node but a SubTree (see
+    /// [`Options::subtree_conds`]);
     /// children of sequences, fallbacks and parallels after the first get a second
     /// chance of `_skipIf` / `_while`. Scripts keep the integers
     /// small (no product of two entries), so nothing overflows. Off, the generator draws
@@ -125,6 +126,11 @@ pub struct Options {
     /// a number: `' 1'` and `'01'` are 1, `'a'` and `''` throw). No concatenation. Off,
     /// the generator draws what it drew before.
     pub strings: bool,
+    /// Pre/post conditions on `<SubTree>` nodes too, with [`Options::scripts`] (format-4
+    /// trees): three SubTree references in four get one (the node's conditions run in
+    /// the caller's blackboard, where `x`, `y`, `f` are the caller's). Off, the generator
+    /// draws what it drew before.
+    pub subtree_conds: bool,
 }
 
 /// The texts [`Options::strings`] writes: letters (read as numbers they throw) and
@@ -572,14 +578,21 @@ impl<R: Rng> G<'_, R> {
         }
     }
 
-    /// `node` with now and then a pre/post-condition attribute (never on a SubTree);
+    /// `node` with now and then a pre/post-condition attribute (on a SubTree only with
+    /// [`Options::subtree_conds`]);
     /// `skip` allows `_skipIf` and `_while`.
     fn with_conds(&mut self, node: String, skip: bool) -> String {
+        let subtree = node.starts_with("<SubTree");
         if !self.scripts_on()
             || self.conds == Conditions::Off
-            || node.starts_with("<SubTree")
-            || self.below(4) != 0
+            || (subtree && !self.opts.subtree_conds)
         {
+            return node;
+        }
+        // One node in four gets a condition; a SubTree ([`Options::subtree_conds`]) three
+        // in four.
+        let draw = self.below(4);
+        if (subtree && draw == 0) || (!subtree && draw != 0) {
             return node;
         }
         let names: &[&str] = if skip && self.conds == Conditions::All {
@@ -605,6 +618,24 @@ impl<R: Rng> G<'_, R> {
                 "_onHalted",
             ]
         };
+        // On a SubTree, `_onHalted` and the pre-conditions more often: what a body's
+        // SKIPPED, which leaves the SubTree node RUNNING, shows through.
+        let names: &[&str] = if subtree && skip && self.conds == Conditions::All {
+            &[
+                "_onHalted",
+                "_onHalted",
+                "_onHalted",
+                "_skipIf",
+                "_while",
+                "_failureIf",
+                "_successIf",
+                "_onSuccess",
+                "_onFailure",
+                "_post",
+            ]
+        } else {
+            names
+        };
         let mut name = self.pick(names);
         // With UnsetBlackboard, an `_onHalted` script could read an erased entry and
         // throw inside a halt, which BT.CPP may meet in a destructor (and the oracle
@@ -625,6 +656,22 @@ impl<R: Rng> G<'_, R> {
             return node;
         }
         format!("{} {name}=\"{}\"{}", &node[..at], esc(&code), &node[at..])
+    }
+
+    /// A SubTree's body root `seq` (a `<Sequence>`) that, with [`Options::subtree_conds`]
+    /// and SKIPPED on, may answer SKIPPED one time in two (`_skipIf` or `_while`), so
+    /// that a body's SKIPPED leaves the SubTree node RUNNING. Off, nothing is drawn.
+    fn body_skip(&mut self, seq: String) -> String {
+        if !self.opts.subtree_conds
+            || !self.scripts_on()
+            || self.conds != Conditions::All
+            || self.below(2) != 0
+        {
+            return seq;
+        }
+        let name = self.pick(&["_skipIf", "_while"]);
+        let code = esc(&self.bool_expr(1, false));
+        format!("<Sequence {name}=\"{code}\"{}", &seq["<Sequence".len()..])
     }
 
     /// Children of a sequence, fallback or parallel: with scripts, those after the first
@@ -978,9 +1025,10 @@ pub fn case_with_conds<R: Rng>(rng: &mut R, size: i64, opts: Options, conds: Con
         let p0 = g.below(3);
         let body = g.node(1);
         // The instance's own `p0` written before anything reads it.
-        defs += &format!(
-            "<BehaviorTree ID=\"S{i}\"><Sequence><SetBlackboard output_key=\"p0\" value=\"{p0}\"/>{body}</Sequence></BehaviorTree>"
-        );
+        let seq = g.body_skip(format!(
+            "<Sequence><SetBlackboard output_key=\"p0\" value=\"{p0}\"/>{body}</Sequence>"
+        ));
+        defs += &format!("<BehaviorTree ID=\"S{i}\">{seq}</BehaviorTree>");
         g.subtrees.push(format!("S{i}"));
     }
     g.budget = size;

@@ -7,4 +7,5 @@ pub mod model;
 pub mod oracle;
 pub mod real;
 pub mod script;
+pub mod subtree_cond;
 pub mod tree;

@@ -604,6 +604,7 @@ impl<'t> Oracle<'t> {
         if s != Status::Skipped {
             self.status[n] = Some(s);
         }
+        super::subtree_cond::reset_finished_body(self.tree, self.btcpp(), n, s, &mut self.status);
         Ok(s)
     }
 
@@ -882,6 +883,9 @@ impl<'t> Oracle<'t> {
             &Kind::Parallel(s, f) if self.reading == Reading::Btcpp3 => self.parallel3(n, s, f),
             &Kind::Parallel(s, f) => self.parallel(n, s, f),
             Kind::IfThenElse => self.if_then_else(n),
+            // 4.10 `SubTreeNode::tick`: the body's answer passed on, the body reset
+            // once it finished, the node RUNNING (set when IDLE) after a SKIPPED.
+            Kind::SubTree => self.decorate(n, |s| s),
             Kind::Inverter => self.decorate(n, |s| match s {
                 Success => Failure,
                 Failure => Success,

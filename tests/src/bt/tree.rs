@@ -156,6 +156,11 @@ pub enum Kind {
     /// tree (`queue="1;2;3"`): the type, the items as text, the `value` entry, `if_empty`
     /// (BT.CPP 4).
     Loop(LoopType, Vec<String>, Option<String>, Status),
+    /// A `<SubTree>` node that carries pre/post conditions (BT.CPP 4 `SubTreeNode`, a
+    /// decorator over the body): kept as a node of its own so that its conditions wrap
+    /// the body, run in the caller's blackboard (`subtree_cond.rs`). A SubTree without
+    /// conditions is inlined.
+    SubTree,
 }
 
 /// The item type of a `Loop<T>` node.
@@ -194,6 +199,7 @@ impl Kind {
                 | Kind::EntryUpdated(_)
                 | Kind::Updated(..)
                 | Kind::Loop(..)
+                | Kind::SubTree
         )
     }
 }
@@ -215,6 +221,9 @@ pub struct Node {
     pub children: Vec<usize>,
     /// Its pre- and post-condition scripts (BT.CPP 4).
     pub conds: Conds,
+    /// The root of a SubTree's body: BT.CPP's `SubTreeNode::tick` resets it once it
+    /// finished (`subtree_cond.rs`).
+    pub subtree_body: bool,
 }
 
 /// The scripts of a node's pre/post-condition attributes (BT.CPP 4 `tree_node.h`,
@@ -752,6 +761,7 @@ impl Flat<'_> {
             kind,
             children: Vec::new(),
             conds,
+            subtree_body: false,
         });
         if let Some(p) = parent {
             self.tree.nodes[p].children.push(i);
@@ -763,6 +773,8 @@ impl Flat<'_> {
     }
 
     fn subtree(&mut self, el: &El, parent: Option<usize>) -> Result<(), String> {
+        let with_conds = el;
+        let el = &super::subtree_cond::without_conds(el, self.v3);
         if self.scopes.len() > 16 {
             return Err("SubTrees nested too deep".into());
         }
@@ -798,10 +810,50 @@ impl Flat<'_> {
                 }
             }
         }
+        // A format-4 SubTree with pre/post conditions is a node of its own
+        // (`subtree_cond.rs`): its conditions read the caller's names.
+        let parent = match self.subtree_node(with_conds, parent)? {
+            Some(i) => Some(i),
+            None => parent,
+        };
         self.scopes.push(scope);
         let first = body.children.first().ok_or("empty <BehaviorTree>")?;
+        let at = self.tree.nodes.len();
         let r = self.node(first, parent);
         self.scopes.pop();
+        if let Some(b) = self.tree.nodes.get_mut(at) {
+            b.subtree_body = true;
+        }
         r
+    }
+}
+
+impl Flat<'_> {
+    /// The node a format-4 `<SubTree>` with pre/post conditions becomes (BT.CPP 4
+    /// `xml_parsing.cpp`, `XMLParser::PImpl::createNodeFromXML`: the SubTree node is
+    /// created with the caller's blackboard and takes its `_skipIf` ... `_onHalted`
+    /// attributes as conditions, not as remapped ports), pushed under `parent`, with the
+    /// UID counted for the SubTree; `None` when it has none (the body is inlined).
+    fn subtree_node(&mut self, el: &El, parent: Option<usize>) -> Result<Option<usize>, String> {
+        let conds = super::subtree_cond::conds(el, self.v3, &|v: &str| {
+            self.global(v, self.scopes.len() - 1)
+        })?;
+        let Some(conds) = conds else {
+            return Ok(None);
+        };
+        let i = self.tree.nodes.len();
+        self.tree.nodes.push(Node {
+            id: 1000 + i as u32,
+            uid: self.uids,
+            tag: "SubTree".into(),
+            kind: Kind::SubTree,
+            children: Vec::new(),
+            conds,
+            subtree_body: false,
+        });
+        if let Some(p) = parent {
+            self.tree.nodes[p].children.push(i);
+        }
+        Ok(Some(i))
     }
 }

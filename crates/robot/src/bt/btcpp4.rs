@@ -41,6 +41,7 @@ pub(super) fn node_name(k: Btcpp4) -> String {
         Btcpp4::Unset => "UnsetBlackboard".into(),
         Btcpp4::Updated(u) => super::btcpp4_blackboard::updated_name(u).into(),
         Btcpp4::Loop(t) => super::btcpp4_loop::loop_name(t).into(),
+        Btcpp4::SubTree => "SubTree (with pre/post conditions)".into(),
         Btcpp4::Script(s) => match s {
             ScriptNode::Script => "Script".into(),
             ScriptNode::Condition => "ScriptCondition".into(),
@@ -128,6 +129,7 @@ pub(super) fn lower(
         Btcpp4::Unset => super::btcpp4_blackboard::unset(sm, n, ctx, bb, errs),
         Btcpp4::Updated(u) => super::btcpp4_blackboard::updated(sm, u, n, ctx, bb, errs),
         Btcpp4::Loop(t) => super::btcpp4_loop::lower(sm, t, n, ctx, bb, errs),
+        Btcpp4::SubTree => Some(super::btcpp4_subtree::machine(ctx)),
         Btcpp4::Switch(cases) => {
             let pick = switch_pick(sm, k, cases as usize, n, bb, errs)?;
             if matches!(pick, SwitchPick::Entry(..)) {

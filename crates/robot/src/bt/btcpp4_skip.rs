@@ -115,7 +115,11 @@ pub(super) fn may_skip(tree: &Tree) -> Vec<bool> {
                 | Control::RetryUntilSuccessful
                 | Control::BlackboardCheck(_)
                 | Control::Btcpp4(
-                    Btcpp4::WhileDoElse | Btcpp4::Switch(_) | Btcpp4::Timeout | Btcpp4::Delay,
+                    Btcpp4::WhileDoElse
+                    | Btcpp4::Switch(_)
+                    | Btcpp4::Timeout
+                    | Btcpp4::Delay
+                    | Btcpp4::SubTree,
                 ) => any,
                 // `else="SKIPPED"`, or a skipped child passed on.
                 Control::Btcpp4(Btcpp4::Script(ScriptNode::Precondition)) => {
@@ -224,6 +228,11 @@ pub(super) fn stale(tree: &Tree, i: usize) -> bool {
     let Some(p) = tree.nodes[i].parent else {
         return false;
     };
+    // A SubTree's body is reset by the SubTree node once it finished
+    // (`btcpp4_subtree.rs`, `body_reset`).
+    if super::btcpp4_subtree::body_reset(tree, i) {
+        return false;
+    }
     let p = &tree.nodes[p];
     let first = p.children.first() == Some(&i);
     match p.kind {

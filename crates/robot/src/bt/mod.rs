@@ -42,6 +42,7 @@ mod btcpp4_loop;
 mod btcpp4_script;
 mod btcpp4_skip;
 mod btcpp4_strings;
+mod btcpp4_subtree;
 mod btcpp4_time;
 mod build;
 mod control;
@@ -336,7 +337,7 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
                 // answers for it where it is ticked again without a reset.
                 n.children
                     .iter()
-                    .map(|&c| stateful(c) && !wrapped(c))
+                    .map(|&c| stateful(c) && !wrapped(c) && !btcpp4_subtree::body_reset(&tree, c))
                     .collect()
             },
             stale: inner_told(idx),

@@ -78,6 +78,9 @@ pub(crate) enum Btcpp4 {
     /// `LoopInt`, `LoopBool`, `LoopDouble`, `LoopString` over a queue written in the tree
     /// (`btcpp4_loop.rs`).
     Loop(LoopType),
+    /// A `<SubTree>` node with pre/post conditions (BT.CPP 4 `SubTreeNode`, a decorator
+    /// over the inlined body; `btcpp4_subtree.rs`). A SubTree without them is inlined.
+    SubTree,
 }
 
 /// The nodes that look at an entry's update counter.
@@ -238,6 +241,7 @@ impl Control {
                 | self::Btcpp4::Timeout
                 | self::Btcpp4::Delay
                 | self::Btcpp4::Loop(_)
+                | self::Btcpp4::SubTree
                 | self::Btcpp4::Updated(UpdatedNode::Skip | UpdatedNode::Wait) => (1, 1),
                 self::Btcpp4::Sleep
                 | self::Btcpp4::Unset
@@ -389,6 +393,9 @@ pub(crate) struct TreeNode {
     /// Its pre/post conditions (`_failureIf`, ... `_post`), syntax checked, in the order
     /// written (`btcpp4_conds.rs`).
     pub conds: Vec<Cond>,
+    /// The root of a SubTree's inlined body, which BT.CPP's SubTree node resets once it
+    /// finished (`btcpp4_subtree.rs`).
+    pub subtree_body: bool,
 }
 
 /// A pre/post-condition attribute of a node.
@@ -855,6 +862,7 @@ impl Reader<'_> {
             parent,
             script_names,
             conds,
+            subtree_body: false,
         });
         if let Some(p) = parent {
             self.nodes[p].children.push(idx);
@@ -962,12 +970,13 @@ impl Reader<'_> {
                             .join(" or ")
                     ),
                 ),
-                // BT.CPP 4's `SubTreeNode` is a node of its own whose pre/post
-                // conditions run around the whole body (4.10 `gtest_skipping.cpp`,
-                // `SkippingLogic.SkipSubtree`); the lowering inlines the body.
+                // Pre/post conditions (format 4): the SubTree node's own
+                // (`btcpp4_subtree.rs`, `subtree_node`), read below.
+                n if self.format != Format::V3
+                    && super::script::condition_error(n, "").is_some() => {}
                 n if n.starts_with('_') => self.err(
                     a.name_span,
-                    format!("`{n}` (a BehaviorTree.cpp script attribute) is not supported on a <SubTree>: the lowering inlines the SubTree's body, and pre/post conditions around a SubTree node are not modelled yet"),
+                    format!("`{n}` (a BehaviorTree.cpp script attribute) is not supported on a <SubTree>{}", if self.format == Format::V3 { " in BTCPP_format 3 (BehaviorTree.CPP 3 has no pre/post conditions)" } else { "" }),
                 ),
                 n if v3_plain => {
                     // `inner="outer"`: the caller's entry `outer` (braces tolerated).
@@ -1007,8 +1016,78 @@ impl Reader<'_> {
         }
         self.subtree_count += 1;
         scope.prefix = format!("{}_{}_", sanitize(id.value.trim()), self.subtree_count);
+        // With pre/post conditions, a node of its own between the caller and the body.
+        let parent = self.subtree_node(el, parent).or(parent);
         self.scopes.push(scope);
+        let at = self.nodes.len();
         self.tree_body(t, parent, depth + 1);
+        if let Some(b) = self.nodes.get_mut(at) {
+            b.subtree_body = true;
+        }
         self.scopes.pop();
+    }
+}
+
+impl Reader<'_> {
+    /// The node a format-4 `<SubTree>` with pre/post conditions becomes, pushed under
+    /// `parent` (its index), or `None` when it has none (the body is inlined). BT.CPP 4
+    /// `xml_parsing.cpp`, `XMLParser::PImpl::createNodeFromXML`: the SubTree node is
+    /// created with the caller's blackboard and takes `_skipIf` ... `_onHalted` as its
+    /// conditions (not as remapped ports), so their names are resolved in the caller's
+    /// scope, whatever the SubTree remaps (`btcpp4_subtree.rs`).
+    fn subtree_node(&mut self, el: &Element, parent: Option<usize>) -> Option<usize> {
+        if self.format == Format::V3 {
+            return None;
+        }
+        let mut conds = Vec::new();
+        for a in &el.attrs {
+            match super::script::condition_error(&a.name, &a.value) {
+                Some(Ok(_)) => conds.push(Cond {
+                    attr: a.name.clone(),
+                    code: a.value.clone(),
+                    name_span: a.name_span,
+                    span: a.value_span,
+                }),
+                Some(Err(e)) => self.err(a.value_span, format!("`{}`: {e}", a.name)),
+                None => {}
+            }
+        }
+        if conds.is_empty() {
+            return None;
+        }
+        let mut script_names: Vec<(String, PortValue)> = Vec::new();
+        for c in &conds {
+            for name in super::script::names(&c.code) {
+                if !script_names.iter().any(|(n, _)| *n == name) {
+                    let v = self.resolve_bb(&name, self.scopes.len());
+                    script_names.push((name, v));
+                }
+            }
+        }
+        let idx = self.nodes.len();
+        let id = FIRST_ID + idx as u32;
+        let label = match el.attr_value("name") {
+            Some(n) if !n.trim().is_empty() => sanitize(n.trim()),
+            _ => format!(
+                "SubTree_{}",
+                sanitize(el.attr_value("ID").unwrap_or("").trim())
+            ),
+        };
+        self.nodes.push(TreeNode {
+            id,
+            kind: Kind::Control(Control::Btcpp4(Btcpp4::SubTree)),
+            machine: format!("BT_plugin_{id}_{label}"),
+            span: el.span,
+            ports: Vec::new(),
+            children: Vec::new(),
+            parent,
+            script_names,
+            conds,
+            subtree_body: false,
+        });
+        if let Some(p) = parent {
+            self.nodes[p].children.push(idx);
+        }
+        Some(idx)
     }
 }
