@@ -112,7 +112,15 @@ fn what_is_not_modelled_is_refused_at_its_place() {
         ),
         (
             "<Sequence><Script code=\"x:=0\"/><LoopString queue=\"7\" value=\"{x}\"><Act/></LoopString></Sequence>",
-            "tree.xml:3:61: `value` of LoopString writes its items to `x`, which is int64",
+            "assigning a number to `x`, which holds strings (a script or a LoopString writes them)",
+        ),
+        (
+            "<IfThenElse><LoopInt _failureIf=\"true\" queue=\"1\"><Act/></LoopInt><Act/></IfThenElse>",
+            "`_failureIf` on LoopInt as the condition of a two-child IfThenElse",
+        ),
+        (
+            "<Sequence><Script code=\"t:='a'\"/><LoopInt queue=\"1\" value=\"{t}\"><Act/></LoopInt></Sequence>",
+            "tree.xml:3:60: `value` of LoopInt writes its items to `t`, which is int64 at tree.xml:3:60 (a script): a script assigns strings to that entry",
         ),
         (
             "<Sequence><Script code=\"x:=0\"/><LoopDouble queue=\"1.5\" value=\"{x}\"><Act/></LoopDouble></Sequence>",

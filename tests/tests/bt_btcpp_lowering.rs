@@ -686,6 +686,37 @@ fn random_trees_with_unset_lower_to_what_btcpp_does() {
     assert!(with >= n / 10, "only {with} of {n} trees unset an entry");
 }
 
+/// The trees of `gen::Options::loop_strings`: BT.CPP 4's blackboard nodes and strings
+/// in the scripts, LoopString nodes writing `t`, the string entry the scripts compare.
+fn loop_strings() -> gen::Options {
+    gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        bb_nodes: true,
+        strings: true,
+        loop_strings: true,
+        ..Default::default()
+    }
+}
+
+/// The same with LoopString nodes writing their items into `t`, the string entry the
+/// scripts compare (`gen::Options::loop_strings`; `btcpp4_loop.rs`, `script_strings`):
+/// the items join the tree's interned texts; at least one tree in twenty writes `t`.
+#[test]
+fn random_trees_with_loop_strings_lower_to_what_btcpp_does() {
+    let opts = loop_strings();
+    random_trees(opts);
+    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let with = drawn_again(opts, gen::Conditions::WithoutSkip)
+        .filter(|c| c.xml.contains("value=\"{t}\""))
+        .count() as u64;
+    eprintln!("{with} of the {n} trees have a LoopString writing `t`");
+    assert!(
+        with >= n / 20,
+        "only {with} of {n} trees write `t` in a LoopString"
+    );
+}
+
 /// The same with BT.CPP 4's blackboard nodes (`gen::Options::bb_nodes`: UnsetBlackboard,
 /// WasEntryUpdated, SkipUnlessUpdated, WaitValueUpdate, and LoopInt, LoopBool,
 /// LoopDouble, LoopString over queues written in the tree) among the scripts, with the
@@ -1005,13 +1036,27 @@ fn conds_refused(t: &tree::Tree) -> bool {
 }
 
 /// Whether the lowering refuses a Loop node (`btcpp4_loop.rs`): under a BlackboardCheck
-/// (BT.CPP 3's node). A Loop BT.CPP may tick again without resetting it is compared.
+/// (BT.CPP 3's node), or with `_failureIf` / `_successIf` where BT.CPP may tick it again
+/// without resetting it (the condition of a two-child IfThenElse or of a WhileDoElse;
+/// found by `random_trees_with_loop_strings_lower_to_what_btcpp_does`, seed 2050). Other
+/// Loops BT.CPP may tick again without resetting are compared.
 fn loop_refused(t: &tree::Tree) -> bool {
     t.nodes.iter().any(|p| {
-        matches!(p.kind, Kind::Check(..))
-            && p.children
-                .iter()
-                .any(|&c| matches!(t.nodes[c].kind, Kind::Loop(..)))
+        let cond = match p.kind {
+            Kind::IfThenElse if p.children.len() == 2 => p.children.first(),
+            Kind::WhileDoElse => p.children.first(),
+            _ => None,
+        };
+        let answering = cond.is_some_and(|&c| {
+            let x = &t.nodes[c];
+            matches!(x.kind, Kind::Loop(..))
+                && (x.conds.pre[0].is_some() || x.conds.pre[1].is_some())
+        });
+        answering
+            || (matches!(p.kind, Kind::Check(..))
+                && p.children
+                    .iter()
+                    .any(|&c| matches!(t.nodes[c].kind, Kind::Loop(..))))
     })
 }
 
@@ -1604,6 +1649,13 @@ fn random_trees_with_strings_lower_to_what_the_real_library_does() {
         ..Default::default()
     };
     real_library_opts(opts, 1_000, 1_300_000);
+}
+
+/// The same with LoopString nodes writing `t`, the string entry the scripts compare
+/// (`gen::Options::loop_strings`).
+#[test]
+fn random_trees_with_loop_strings_lower_to_what_the_real_library_does() {
+    real_library_opts(loop_strings(), 500, 1_400_000);
 }
 
 /// The same with UnsetBlackboard (`gen::Options::unset`) among the scripts.

@@ -131,7 +131,17 @@ pub struct Options {
     /// the caller's blackboard, where `x`, `y`, `f` are the caller's). Off, the generator
     /// draws what it drew before.
     pub subtree_conds: bool,
+    /// With [`Options::bb_nodes`] and [`Options::strings`]: LoopString nodes (drawn
+    /// more often) write their items, texts of [`LOOP_TEXTS`], into `t`, the string
+    /// entry the scripts compare, now and then (BT.CPP 4 creates it as a `std::string`
+    /// when it loads the tree, the Loop's `value` port typing it). Off, the generator
+    /// draws what it drew before.
+    pub loop_strings: bool,
 }
+
+/// The items [`Options::loop_strings`] writes in LoopString queues: texts of
+/// [`TEXTS`] that need no escaping in a queue (no empty part, no space).
+const LOOP_TEXTS: [&str; 9] = ["b", "a", "ab", "B", "9", "10", "1", "01", "0"];
 
 /// The texts [`Options::strings`] writes: letters (read as numbers they throw) and
 /// whole numbers with spaces or leading zeros, in an order other than byte order.
@@ -235,6 +245,11 @@ impl<R: Rng> G<'_, R> {
         format!(
             "<BlackboardCheck{tag} value_A=\"{{{a}}}\" value_B=\"{b}\" return_on_mismatch=\"{m}\">{child}</BlackboardCheck{tag}>"
         )
+    }
+
+    /// LoopString nodes writing the scripts' string entry ([`Options::loop_strings`]).
+    fn loop_strings_on(&self) -> bool {
+        self.opts.loop_strings && self.opts.strings && self.scripts_on()
     }
 
     fn scripts_on(&self) -> bool {
@@ -783,11 +798,19 @@ impl<R: Rng> G<'_, R> {
                 format!("<SkipUnlessUpdated entry=\"{e}\">{child}</SkipUnlessUpdated>")
             }
             _ => {
-                let (tag, items, values): (_, &[&str], &[&str]) = match self.below(6) {
+                let k = if self.loop_strings_on() && self.below(2) == 0 {
+                    2
+                } else {
+                    self.below(6)
+                };
+                let (tag, items, values): (_, &[&str], &[&str]) = match k {
                     // One item type per entry: BT.CPP refuses a tree whose Loop nodes write one
                     // entry with two types ("was initially created with type").
                     0 => ("LoopBool", &["true", "false", "1", "0"], &["{f}"]),
                     1 => ("LoopDouble", &["1.5", "2.0", "-0.5"], &["{ld}"]),
+                    2 if self.loop_strings_on() => {
+                        ("LoopString", &LOOP_TEXTS, &["{t}", "{t}", "{ls}"])
+                    }
                     2 => ("LoopString", &["a", "b"], &["{ls}"]),
                     _ => ("LoopInt", &["0", "1", "2", "-3"], &["{x}", "{y}"]),
                 };

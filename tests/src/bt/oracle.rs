@@ -702,6 +702,12 @@ impl<'t> Oracle<'t> {
                 {
                     return Err(Fault::Throws("Error in script".into()));
                 }
+                // A Loop's `value` entry exists from the load, without a value until
+                // the first pop (its port creates it: 4.8.2 "The left operand of the
+                // operator [==] is not initialized").
+                Err(Fault::Throws(t)) if self.loop_value(&t) => {
+                    return Err(Fault::Throws("is not initialized".into()));
+                }
                 Err(f) => return Err(f),
             };
             if let Expr::Assign(v, ..) = s {
@@ -709,6 +715,17 @@ impl<'t> Oracle<'t> {
             }
         }
         Ok(last)
+    }
+
+    /// Whether `t` is "Variable not found" for an entry a Loop node's `value` names.
+    fn loop_value(&self, t: &str) -> bool {
+        let Some(v) = t.strip_prefix("Variable not found: ") else {
+            return false;
+        };
+        self.tree
+            .nodes
+            .iter()
+            .any(|x| matches!(&x.kind, Kind::Loop(_, _, Some(e), _) if e == v))
     }
 
     /// A script run as a condition.
@@ -1076,6 +1093,9 @@ impl<'t> Oracle<'t> {
     ) -> Result<(), Stop> {
         use super::tree::LoopType;
         let number = matches!(ty, LoopType::Int | LoopType::Bool);
+        if ty == LoopType::String && self.loop_string(key, item) {
+            return Ok(());
+        }
         if number || self.vars.contains_key(key) {
             let v = match ty {
                 LoopType::Int => item
@@ -1102,6 +1122,22 @@ impl<'t> Oracle<'t> {
         }
         *self.seq.entry(key.to_string()).or_default() += 1;
         Ok(())
+    }
+
+    /// A LoopString's item written into `key` when the entry holds strings for scripts
+    /// (`true`; one more on its counter): BT.CPP 4 creates the entry as a `std::string`
+    /// when it loads the tree (4.10 `src/xml_parsing.cpp`,
+    /// `XMLParser::PImpl::createNodeFromXML`: a remapped port's entry gets the port's
+    /// type, here `OutputPort<std::string>("value")`), so scripts compare it as a
+    /// string and store strings in it (4.8.2, measured). `false` where a script holds a
+    /// number there (the write throws).
+    fn loop_string(&mut self, key: &str, item: &str) -> bool {
+        if self.vars.contains_key(key) {
+            return false;
+        }
+        self.strs.insert(key.to_string(), item.to_string());
+        *self.seq.entry(key.to_string()).or_default() += 1;
+        true
     }
 
     /// `PreconditionNode::tick` (4.10; 4.8.2 alike, as the real-library differential

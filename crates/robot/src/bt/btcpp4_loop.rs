@@ -25,14 +25,20 @@
 //! condition of a two-child IfThenElse or of a WhileDoElse, `btcpp4_skip.rs`, `stale`)
 //! a finished answer leaves it active too (`loop_finished`), so the next tick goes on
 //! with the rest of its queue, and the parent halts it at every reset, which makes it
-//! IDLE. Refused: a Loop under a BlackboardCheck (BT.CPP 3's node), a queue held in an
-//! entry (`queue="{q}"`),
-//! an item that BT.CPP would not convert, and a `value` entry whose type is not the
-//! node's item type (the node's port types an entry no one else types).
+//! IDLE. A LoopString whose `value` entry a script names writes there its item's rank
+//! among the tree's texts (`btcpp4_strings.rs`): BT.CPP creates that entry as a
+//! `std::string` when it loads the tree, so the scripts read a string
+//! ([`script_strings`]). Refused: a Loop under a BlackboardCheck (BT.CPP 3's node), a
+//! queue held in an entry (`queue="{q}"`), an item that BT.CPP would not convert, a
+//! number written into an entry scripts assign strings to, `_failureIf` / `_successIf`
+//! on a Loop in such a place (BT.CPP then pops the queue its last run left), and a
+//! `value` entry whose type is not the node's item type (the node's port types an entry
+//! no one else types).
 
 use super::blackboard::{register, set_event, Blackboard, Entry, MACHINE};
+use super::btcpp4_strings::Strings;
 use super::control::{Ctx, FAILURE, IS_SKIPPED, RUNNING, SKIPPED, SKIPPED_RUNNING, SUCCESS};
-use super::tree::{LoopType, PortValue, Tree, TreeNode};
+use super::tree::{Btcpp4, Control, Kind, LoopType, PortValue, Tree, TreeNode};
 use crate::model::source::{Diagnostic, SourceMap};
 use crate::model::types::Scalar;
 use crate::model::xml::Element;
@@ -86,14 +92,25 @@ pub(super) fn prepare(
             format!("{}: {}", loop_name(t), super::btcpp4_skip::BB_CHECK),
         ));
     }
+    // Where BT.CPP may tick the node again without resetting it (`btcpp4_skip.rs`,
+    // `stale`), a `_failureIf` / `_successIf` that answers while it is IDLE leaves its
+    // status FAILURE / SUCCESS without running `LoopNode::tick`: the next tick finds it
+    // not IDLE and pops from the queue its last run left, none before its first run
+    // (4.8.2 measured: `<IfThenElse><LoopInt _failureIf="true" queue="1">..` answers
+    // FAILURE, then SUCCESS from `if_empty`). The model starts a fresh queue there.
+    if super::btcpp4_skip::stale(tree, i) {
+        for c in &n.conds {
+            if c.attr == "_failureIf" || c.attr == "_successIf" {
+                errs.push(sm.diag(
+                    c.name_span,
+                    format!("`{}` on {} as the condition of a two-child IfThenElse or of a WhileDoElse: when it answers, BehaviorTree.CPP keeps that status and ticks the Loop next time without a reset, popping the queue its last run left (none before its first run), which is not modelled", c.attr, loop_name(t)),
+                ));
+            }
+        }
+    }
     if let Some(p) = n.port("value") {
         if let PortValue::Blackboard(g) = &p.value {
-            let scripted = tree.nodes.iter().any(|m| {
-                m.script_names
-                    .iter()
-                    .any(|(_, v)| matches!(v, PortValue::Blackboard(x) if x == g))
-            });
-            if bb.entry(g).is_none() && scripted {
+            if bb.entry(g).is_none() && scripted(tree, g) {
                 bb.entries.push(Entry {
                     name: g.clone(),
                     ty: super::btcpp4_script::entry_type(bb, g).into(),
@@ -108,6 +125,57 @@ pub(super) fn prepare(
             }
         }
     }
+}
+
+/// The parts of a queue written in the tree: split on `;` (`splitString`), 4.8.2 dropping
+/// a last empty part (`"1;2;"` is two items).
+fn parts(q: &str) -> Vec<&str> {
+    let mut parts: Vec<&str> = q.split(';').collect();
+    if parts.last() == Some(&"") {
+        parts.pop();
+    }
+    parts
+}
+
+/// Before the scripts' strings are interned (`btcpp4_strings.rs`, `prepare`): each
+/// LoopString whose `value` is an entry a script names, with the texts of its queue.
+/// BT.CPP 4 creates that entry as a `std::string` when it loads the tree (the node's
+/// `OutputPort<std::string>("value")`, BT.CPP 4.10 `src/xml_parsing.cpp`,
+/// `XMLParser::PImpl::createNodeFromXML`, creates a remapped entry with the port's
+/// type), so it holds strings: a script compares it as a string, a script's string is
+/// stored there, and a number assigned to it throws (4.8.2, measured:
+/// `tests/tests/bt_real.rs`, `loop_strings_in_scripts_agree_with_the_real_library`).
+/// Entries a SetBlackboard writes are left out (the lowering refuses them, [`lower`]).
+pub(super) fn script_strings(tree: &Tree, bb: &Blackboard) -> Vec<(String, Vec<String>)> {
+    let mut out = Vec::new();
+    for n in &tree.nodes {
+        if n.kind != Kind::Control(Control::Btcpp4(Btcpp4::Loop(LoopType::String))) {
+            continue;
+        }
+        let (Some(PortValue::Blackboard(g)), Some(PortValue::Literal(q))) = (
+            n.port("value").map(|p| &p.value),
+            n.port("queue").map(|p| &p.value),
+        ) else {
+            continue;
+        };
+        if bb.texts.contains(g) || !scripted(tree, g) {
+            continue;
+        }
+        out.push((
+            g.clone(),
+            parts(q).into_iter().map(str::to_string).collect(),
+        ));
+    }
+    out
+}
+
+/// Whether a script of the tree names entry `g`.
+fn scripted(tree: &Tree, g: &str) -> bool {
+    tree.nodes.iter().any(|m| {
+        m.script_names
+            .iter()
+            .any(|(_, v)| matches!(v, PortValue::Blackboard(x) if x == g))
+    })
 }
 
 /// Item `s` of a queue as `convertFromString<T>` reads it (a whole number, `true` or
@@ -149,9 +217,17 @@ fn item(t: LoopType, s: &str) -> Result<String, BadItem> {
     }
 }
 
-/// Item `x` (as [`item`] reads it) written into entry `e`: its model expression, or why
-/// that is not modelled.
-fn written(t: LoopType, x: &str, e: &Entry) -> Result<String, BadItem> {
+/// Item `x` (as [`item`] reads it; `raw`, as the queue writes it) written into entry
+/// `e`: its model expression, or why that is not modelled.
+fn written(t: LoopType, raw: &str, x: &str, e: &Entry, strs: &Strings) -> Result<String, BadItem> {
+    if strs.holds(&e.name) {
+        // An entry holding strings that scripts read (see [`script_strings`]): a
+        // LoopString's item is stored as its text's rank (`btcpp4_strings.rs`).
+        return match t {
+            LoopType::String => Ok(strs.id(raw).to_string()),
+            _ => Err(BadItem::NumberInText),
+        };
+    }
     let s = Scalar::from_name(e.ty.trim());
     if e.why == SCRIPT {
         // A script's entry holds a number: an int or a bool item is written as one
@@ -193,6 +269,8 @@ enum BadItem {
     NotWhole(String),
     /// A string written into an entry a script holds a number in.
     StringInNumber,
+    /// A number written into an entry a script assigns strings to.
+    NumberInText,
     /// An item of this type in an entry of another.
     Unmodelled(&'static str),
 }
@@ -205,6 +283,7 @@ impl std::fmt::Display for BadItem {
             BadItem::NotDouble(s) => write!(f, "`{s}` is not a finite decimal number"),
             BadItem::NotWhole(x) => write!(f, "the item {x} is not whole, and BehaviorTree.CPP throws writing it into an entry a script holds a number in (\"Invalid floating point to integer conversion\"): not modelled"),
             BadItem::StringInNumber => f.write_str("BehaviorTree.CPP throws writing a string into an entry a script holds a number in (\"Any::copyInto fails\"): not modelled"),
+            BadItem::NumberInText => f.write_str("a script assigns strings to that entry, which BehaviorTree.CPP 4 creates with the Loop's item type when it loads the tree (`OutputPort<T>(\"value\")`), and then converts the script's text to it (4.8.2: \"Can't convert string [a] to integer\"): not modelled"),
             BadItem::Unmodelled(ty) => write!(f, "a {ty} item in that entry is not modelled"),
         }
     }
@@ -221,6 +300,7 @@ pub(super) fn lower(
 ) -> Option<Element> {
     let name = loop_name(t);
     let before = errs.len();
+    let mut raw: Vec<&str> = Vec::new();
     let items: Vec<String> = match n.port("queue").map(|p| (&p.value, p.span)) {
         None => {
             errs.push(sm.diag(n.span, format!("{name} needs `queue`")));
@@ -229,20 +309,18 @@ pub(super) fn lower(
         Some((PortValue::Blackboard(q), span)) => {
             errs.push(sm.diag(
                 span,
-                format!("`queue` of {name} is the entry `{{{q}}}`: a queue held in the blackboard (written by C++ code, or a string converted at the node's first pop) is not modelled; write the items in the tree (`queue=\"1;2;3\"`)"),
+                format!("`queue` of {name} is the entry `{{{q}}}`: a queue held in the blackboard is not modelled; write the items in the tree (`queue=\"1;2;3\"`). In BT.CPP 4.8.2 the port types `{q}` as a queue when the tree loads, every text written there (SetBlackboard, a script) becomes a fresh queue at the write (an item that does not convert throws there), and the node pops that queue in place: a restart without a new write finds it empty, a write while it loops replaces what is left (4.10 converts a text at its first pop instead, into a copy of its own)"),
             ));
             return None;
         }
         Some((PortValue::Literal(q), span)) => {
-            let mut parts: Vec<&str> = q.split(';').collect();
-            // 4.8.2 drops a last empty part.
-            if parts.last() == Some(&"") {
-                parts.pop();
-            }
             let mut out = Vec::new();
-            for (k, p) in parts.iter().enumerate() {
+            for (k, p) in parts(q).into_iter().enumerate() {
                 match item(t, p) {
-                    Ok(x) => out.push(x),
+                    Ok(x) => {
+                        out.push(x);
+                        raw.push(p);
+                    }
                     Err(why) => errs.push(sm.diag(
                         span,
                         format!("item {} of the `queue` of {name}: {why}, so BehaviorTree.CPP refuses the tree when it loads it (`convertFromString`)", k + 1),
@@ -301,8 +379,8 @@ pub(super) fn lower(
             }
             Some(e) => {
                 let mut exprs = Vec::with_capacity(items.len());
-                for x in &items {
-                    match written(t, x, &e) {
+                for (x, r) in items.iter().zip(&raw) {
+                    match written(t, r, x, &e, &bb.strings) {
                         Ok(v) => exprs.push(v),
                         Err(why) => {
                             let at = sm.diag(e.span, "");

@@ -663,7 +663,7 @@ fn assign_text(
             })
         }
         (true, true, "+=") => Err((at, CONCAT.to_string())),
-        (_, _, ":=" | "=") if entry_text => Err((at, format!("assigning a number to `{g}`, which a script also assigns strings: BT.CPP 4 throws where it holds a string and stores the number where it holds none, and an entry whose type changes is not modelled"))),
+        (_, _, ":=" | "=") if entry_text => Err((at, format!("assigning a number to `{g}`, which holds strings (a script or a LoopString writes them): BT.CPP 4 throws where it holds a string and stores the number where it holds none, and an entry whose type changes is not modelled"))),
         (_, _, ":=" | "=") => Err((at, format!("assigning a string to `{g}`, which holds numbers: BT.CPP 4.8.2 converts the text to the entry's type, which is not modelled"))),
         _ => throws(checks, v),
     }

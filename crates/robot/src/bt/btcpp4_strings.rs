@@ -18,7 +18,8 @@
 //!   is interned, and the SetBlackboard sends its text's rank beside the value other
 //!   nodes read ([`Strings::set_entries`]);
 //! - an entry a script assigns a string to (`t := 'a'`, `t := k`, `t := c ? 'a' : 'b'`),
-//!   created by scripts ([`Strings::script_entries`]).
+//!   created by scripts, or a LoopString writes its items to (`btcpp4_loop.rs`,
+//!   `script_strings`) ([`Strings::script_entries`]).
 //!
 //! The rules where a string meets a number (4.8.2 measured, `tests/tests/bt_real.rs`
 //! `strings_in_scripts_agree_with_the_real_library`): a comparison, and the condition of
@@ -238,6 +239,13 @@ pub(super) fn prepare(tree: &Tree, bb: &mut Blackboard) {
                     texts.push(v.clone());
                 }
             }
+        }
+    }
+    // Entries a LoopString writes that scripts name (`btcpp4_loop.rs`).
+    for (g, items) in super::btcpp4_loop::script_strings(tree, bb) {
+        texts.extend(items);
+        if !s.holds(&g) {
+            s.script_entries.push(g);
         }
     }
     // Entries scripts assign strings to, until nothing changes (`t := k` after
