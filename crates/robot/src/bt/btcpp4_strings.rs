@@ -278,7 +278,7 @@ pub(super) fn prepare(tree: &Tree, bb: &mut Blackboard) {
     for g in &s.set_entries {
         sets.insert(g.clone(), set_texts(tree, g).into_iter().collect());
     }
-    let globals: Vec<Box<dyn Fn(&str) -> Option<String> + '_>> = parsed
+    let globals: Vec<Global<'_>> = parsed
         .iter()
         .map(|(i, _)| {
             let (i, s) = (*i, &s);
@@ -313,6 +313,9 @@ pub(super) fn prepare(tree: &Tree, bb: &mut Blackboard) {
     s.overflow = overflow;
     bb.strings = s;
 }
+
+/// A script's names to the string entries they stand for.
+type Global<'a> = Box<dyn Fn(&str) -> Option<String> + 'a>;
 
 /// The texts the SetBlackboard nodes write to entry `g`.
 fn set_texts(tree: &Tree, g: &str) -> Vec<String> {
