@@ -388,9 +388,9 @@ fn scripts_and_conditions_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         (
             "string",
             "btcpp",
-            "<Sequence>\n  <Script code=\"msg := 'hi' + '!'\"/>\n</Sequence>",
-            "msg := 'hi' + '!'",
-            "`+` over two strings joins them (BT.CPP 4's concatenation), which is not modelled",
+            "<Sequence>\n  <Script code=\"msg := 'hi'\"/>\n  <Script code=\"msg := msg .. '!'\"/>\n</Sequence>",
+            "msg := msg .. '!'",
+            "the texts `msg` can hold do not settle",
         ),
         (
             "text",

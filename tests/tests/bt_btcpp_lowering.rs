@@ -551,6 +551,65 @@ fn scripts_compare_strings_as_btcpp_does() {
 }
 
 #[test]
+fn scripts_join_strings_as_btcpp_does() {
+    // Checked against the real library (BT.CPP 4.8.2): `..` joins strings, and a string
+    // with a number literal (an integer as its digits, `true` as 1, a double as `%f`);
+    // `+` of two strings and `+=` on a string entry join too; `..` groups to the left
+    // and is tighter than the comparisons. The last condition is false: the tree fails
+    // after A at every tick.
+    let t = v4(
+        "<Sequence><Script code=\"t := 'a'; u := t .. 3; u += 'b'; v := t + 'c'\"/>\
+         <ScriptCondition code=\"u == 'a3b' &amp;&amp; v == 'ac' &amp;&amp; 'x' .. 1.5 == 'x1.500000' \
+         &amp;&amp; t .. true .. (-2) == 'a1-2.000000' &amp;&amp; u .. v &gt; 'a3b'\"/>\
+         <A/><ScriptCondition code=\"u .. 'c' &lt; u\"/></Sequence>",
+    );
+    let sc = scripts(&[("A", &[S])]);
+    assert_eq!(
+        lowered(&t, &sc, 2, BtTick::Once).unwrap(),
+        ran(&[F, F], &[T(1003), T(1003)])
+    );
+    // A join's texts follow the entries' texts: `w` is `b` or `bb` by the branch taken,
+    // and the joins over it rank among the texts byte by byte (`'b' .. w` is `bb` or
+    // `bbb`).
+    let t = v4(
+        "<Sequence><Script code=\"t := 'b'; f := true\"/><Script code=\"w := (f ? t .. 'b' : 'b')\"/>\
+         <ScriptCondition code=\"'b' .. w == 'bbb' &amp;&amp; w .. w == 'bbbb'\"/><A/></Sequence>",
+    );
+    assert_eq!(
+        lowered(&t, &sc, 1, BtTick::Once).unwrap(),
+        ran(&[S], &[T(1004)])
+    );
+}
+
+#[test]
+fn joins_whose_texts_are_unbounded_are_refused() {
+    // Ticked again, `s := s .. 'a'` makes a new text each time: refused at the script.
+    let t = v4("<Sequence><Script code=\"s := ''\"/><Script code=\"s := s .. 'a'\"/></Sequence>");
+    let sc = scripts(&[]);
+    let e = lowered(&t, &sc, 2, BtTick::Once).unwrap_err();
+    assert!(e.contains("the texts `s` can hold do not settle"), "{e}");
+    assert!(e.contains("at column 6 of the script"), "{e}");
+    // Within one script, what an earlier statement stored is known: bounded.
+    let t = v4(
+        "<Sequence><Script code=\"s := 'x'; s := s .. 'a'; s += s\"/>\
+         <ScriptCondition code=\"s == 'xaxa'\"/><A/></Sequence>",
+    );
+    let sc = scripts(&[("A", &[S])]);
+    assert_eq!(
+        lowered(&t, &sc, 1, BtTick::Once).unwrap(),
+        ran(&[S], &[T(1003)])
+    );
+    // A number other than a literal: its text is not computed.
+    let t = v4("<Sequence><Script code=\"x := 1; s := 'a' .. x\"/></Sequence>");
+    let e = lowered(&t, &sc, 1, BtTick::Once).unwrap_err();
+    assert!(e.contains("a number that is not a literal"), "{e}");
+    // Two numbers: 4.8.2 gives no value.
+    let t = v4("<Sequence><Script code=\"s := 3 .. 4\"/></Sequence>");
+    let e = lowered(&t, &sc, 1, BtTick::Once).unwrap_err();
+    assert!(e.contains("`..` over two numbers"), "{e}");
+}
+
+#[test]
 fn pre_and_post_conditions_run_around_the_node() {
     // A fails on its first tick: `_onFailure` counts it, and B's `_successIf` answers
     // SUCCESS without ticking B. On the second tick A succeeds.
@@ -899,6 +958,49 @@ fn random_trees_with_strings_lower_to_what_btcpp_does() {
          or pick a text for it with `?:`"
     );
     assert!(two >= n / 20 && with_number >= n / 20 && assigned >= n / 20);
+}
+
+/// The generator's options with joins (`gen::Options::joins`).
+fn joins_opts() -> gen::Options {
+    gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        strings: true,
+        joins: true,
+        ..Default::default()
+    }
+}
+
+/// The same with joins (`gen::Options::joins`): `u` stores joins of `t`, literals and
+/// number literals (`..`, `+` of two strings, `+=`), and conditions compare joins; the
+/// closure of the texts a tree can make is what ranks them.
+#[test]
+fn random_trees_with_joins_lower_to_what_btcpp_does() {
+    random_trees(joins_opts());
+    // The trees held the new constructs (the same seeds, generated again).
+    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let (mut joined, mut numbers, mut compared) = (0u64, 0u64, 0u64);
+    for c in drawn_again(joins_opts(), gen::Conditions::WithoutSkip) {
+        joined += u64::from(c.xml.contains("u := ") || c.xml.contains("u = "));
+        numbers += u64::from(
+            [
+                "t .. 3",
+                "t .. 1.5",
+                "t .. (-2)",
+                "t .. true",
+                "7 .. t",
+                "2.25 .. t",
+            ]
+            .iter()
+            .any(|p| c.xml.contains(p)),
+        );
+        compared += u64::from(c.xml.contains(" u)") || c.xml.contains("(u "));
+    }
+    eprintln!(
+        "of the {n} trees: {joined} store a join in `u`, {numbers} join a number literal, \
+         {compared} compare `u` in a condition"
+    );
+    assert!(joined >= n / 20 && numbers >= n / 50 && compared >= n / 20);
 }
 
 /// The same with the timed nodes and TryCatch too (`gen::Options::time_nodes`,
@@ -1658,6 +1760,13 @@ fn random_trees_with_loop_strings_lower_to_what_the_real_library_does() {
     real_library_opts(loop_strings(), 500, 1_400_000);
 }
 
+/// The same with joins (`gen::Options::joins`): `..`, `+` of two strings and `+=` on
+/// `u`, over `t`, literals and number literals, and conditions comparing joins.
+#[test]
+fn random_trees_with_joins_lower_to_what_the_real_library_does() {
+    real_library_opts(joins_opts(), 500, 1_600_000);
+}
+
 /// The same with UnsetBlackboard (`gen::Options::unset`) among the scripts.
 #[test]
 fn random_trees_with_unset_lower_to_what_the_real_library_does() {
@@ -2208,6 +2317,8 @@ const SUBTREE_CONDS: gen::Options = gen::Options {
     bits: false,
     strings: false,
     subtree_conds: true,
+    loop_strings: false,
+    joins: false,
 };
 
 /// What a tree with SubTree nodes of its own holds: SubTree nodes with each of

@@ -966,6 +966,68 @@ fn strings_in_scripts_agree_with_the_real_library() {
     assert_agreed(&fails, &counts);
 }
 
+/// Joins (`..`, `+` of two strings, `+=`) in the oracle against 4.8.2: the conditions
+/// measured while writing the rules (`tests/src/bt/script.rs`, `join`), and the
+/// format-4 trees of `gen::Options::joins`.
+#[test]
+fn joins_in_scripts_agree_with_the_real_library() {
+    const CONDITIONS: [&str; 24] = [
+        "('a' .. 'b') == 'ab'",
+        "'a' .. 'b' == 'ab'",
+        "'a' + 'b' == 'ab'",
+        "'a' .. 3 == 'a3'",
+        "3 .. 'a' == '3a'",
+        "'a' .. true == 'a1'",
+        "'a' .. 1.5 == 'a1.500000'",
+        "'a' .. (1+2) == 'a3.000000'",
+        "'a' .. (-2) == 'a-2.000000'",
+        "'a' .. 1e3 == 'a1000.000000'",
+        "'a' .. (1/0) == 'ainf'",
+        "'a' .. 'b' .. 'c' == 'abc'",
+        "'a' .. 1 .. 2 == 'a12'",
+        "'ab' .. 'cd' == 'a' .. 'bcd'",
+        "'a' .. 'b' < 'b'",
+        "'x' .. (true ? 'a' : 'b') == 'xa'",
+        "x := 5; x -= 8; 'a' .. x == 'a-3'",
+        "s := 'a'; s += 'b'; s == 'ab'",
+        "(3 .. 4) == 'x'",
+        "1 .. 2 .. 'a' == 'x'",
+        "'a' + 1 == 'a1'",
+        "'a' .. 'b'",
+        "s := 'a'; s += 3",
+        "('a' .. 'b') ? true : false",
+    ];
+    let Some(mut real) = harness() else { return };
+    let mut cases = condition_cases(&CONDITIONS);
+    let n = env("HINDSIGHT_BT_REAL_JOIN_TREES", 10_000);
+    let seed0 = env("HINDSIGHT_BT_SEED", 0) + 7_000_000;
+    let start = std::time::Instant::now();
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        strings: true,
+        joins: true,
+        ..Default::default()
+    };
+    cases.extend(format4_cases(opts, "joins", seed0, n));
+    let mut counts = Counts::default();
+    let fails = check_all(&mut real, &cases, &mut counts);
+    eprintln!(
+        "BehaviorTree.CPP {}: {} conditions and {} random trees with joins in scripts, each \
+         under tickOnce and tickExactlyOnce: {} runs ({} ran every tick, {} threw) in {:.1} s; \
+         {} disagreements",
+        real.version,
+        CONDITIONS.len(),
+        cases.len() - CONDITIONS.len(),
+        counts.runs,
+        counts.ran_all,
+        counts.errors,
+        start.elapsed().as_secs_f64(),
+        fails.len()
+    );
+    assert_agreed(&fails, &counts);
+}
+
 /// The executor period of [`timed_nodes_agree_with_the_real_library`], in the real
 /// library's wall-clock milliseconds; the oracle runs the same trees at its default
 /// 100 ms with every duration scaled by 100/60.

@@ -98,9 +98,9 @@ pub use clock::{check_speed, Clock, SPEED_RANGE};
 // participant and recordings (`replay`, `monitor --ros2`) and the IPC (`run`, `monitor`).
 use config::{Action, Config, Layout, Wire};
 use engine::{Change, Engine};
-pub use iceoryx2;
 use error::ipc;
 pub use error::LiveError;
+pub use iceoryx2;
 use record::Input;
 pub use ros2;
 

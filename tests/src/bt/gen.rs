@@ -123,8 +123,8 @@ pub struct Options {
     /// `k0`/`k1` (the texts a SetBlackboard wrote, some now written `01`, `00`, `10`) and
     /// `?:` over two literals; conditions compare strings with strings (byte order:
     /// `'B' < 'a'`, `'10' < '9'`, `'01' != '1'`) and, risky, with numbers (a text read as
-    /// a number: `' 1'` and `'01'` are 1, `'a'` and `''` throw). No concatenation. Off,
-    /// the generator draws what it drew before.
+    /// a number: `' 1'` and `'01'` are 1, `'a'` and `''` throw). Off, the generator
+    /// draws what it drew before.
     pub strings: bool,
     /// Pre/post conditions on `<SubTree>` nodes too, with [`Options::scripts`] (format-4
     /// trees): three SubTree references in four get one (the node's conditions run in
@@ -137,6 +137,13 @@ pub struct Options {
     /// when it loads the tree, the Loop's `value` port typing it). Off, the generator
     /// draws what it drew before.
     pub loop_strings: bool,
+    /// Joins, with [`Options::strings`]: the main tree also creates `u` from a string
+    /// (`u:=''`, remapped into every SubTree); statements store in `u` joins of `t`,
+    /// literals and number literals (`t .. 'a'`, `t .. 3`, `t .. 1.5`, `t + 'b'`,
+    /// `(f ? 'a' : 'b') .. t`, `u := t; u += '1'`), whose texts are bounded; conditions
+    /// compare `u` and joins with strings, and, risky, join `k0`/`k1` (BT.CPP throws
+    /// where they hold no value). Off, the generator draws what it drew before.
+    pub joins: bool,
 }
 
 /// The items [`Options::loop_strings`] writes in LoopString queues: texts of
@@ -419,10 +426,51 @@ impl<R: Rng> G<'_, R> {
         }
     }
 
+    /// A join ([`Options::joins`]) of `t`, literals and number literals: a statement's
+    /// value, never throwing, with texts bounded (`u` is never joined).
+    fn join_expr(&mut self) -> String {
+        match self.below(8) {
+            0 => format!("t .. {}", self.text()),
+            1 => format!("{} .. t", self.text()),
+            2 => format!(
+                "t .. {}",
+                self.pick(&["3", "0", "true", "false", "1.5", "(-2)"])
+            ),
+            3 => format!("{} .. t", self.pick(&["7", "2.25", "1e3"])),
+            4 => format!("t + {}", self.text()),
+            5 => format!(
+                "({} ? {} : {}) .. t",
+                self.bool_expr(0, false),
+                self.text(),
+                self.text()
+            ),
+            6 => "t .. t".into(),
+            _ => format!("{} .. t .. {}", self.text(), self.below(3)),
+        }
+    }
+
+    /// A condition over joins ([`Options::joins`]): `u` or a join compared with a
+    /// string; `risky`: joining `k0`/`k1`, which BT.CPP 4.8.2 throws on where they hold
+    /// no value.
+    fn join_cond(&mut self, risky: bool) -> String {
+        // Parenthesized: `..` and `+` do not mix with other operator groups.
+        let op = self.pick(&["==", "!=", "<", "<=", ">", ">="]);
+        match self.below(if risky { 5 } else { 4 }) {
+            0 => format!("(u {op} {})", self.text()),
+            1 => format!("({} {op} u)", self.join_expr()),
+            2 => format!("(({}) {op} {})", self.join_expr(), self.text()),
+            3 => format!("(u {op} t + {})", self.text()),
+            _ => format!("({} .. {} {op} u)", self.pick(&["k0", "k1"]), self.text()),
+        }
+    }
+
     /// A comparison of strings ([`Options::strings`]); `risky`: with the texts
     /// SetBlackboard wrote, and with one that compares a string with a number (a text
     /// that is not one throws) or reads it as the condition of `?:`.
     fn str_cond(&mut self, risky: bool) -> String {
+        if self.opts.joins && self.below(3) == 0 {
+            return self.join_cond(risky);
+        }
         let op = self.pick(&["==", "!=", "<", "<=", ">", ">="]);
         match self.below(if risky { 6 } else { 3 }) {
             0 => format!("t {op} {}", self.text()),
@@ -439,6 +487,12 @@ impl<R: Rng> G<'_, R> {
         let n = 1 + self.below(3);
         let stmts: Vec<String> = (0..n)
             .map(|_| match self.below(if self.opts.bits { 10 } else { 7 }) {
+                // A join into `u`: never throws.
+                _ if self.opts.joins && self.below(6) == 0 => match self.below(4) {
+                    0 => format!("u := t; u += {}", self.text()),
+                    1 => format!("u = {}", self.join_expr()),
+                    _ => format!("u := {}", self.join_expr()),
+                },
                 // A string into `t`: never throws.
                 _ if self.opts.strings && self.below(4) == 0 => match self.below(3) {
                     0 => format!("t := {}", self.str_atom(false)),
@@ -1013,6 +1067,11 @@ impl<R: Rng> G<'_, R> {
                 v("b0")
             ),
         };
+        let more = if self.opts.joins && self.opts.strings && self.scripts_on() {
+            format!("{more} u=\"{{u}}\"")
+        } else {
+            more.to_string()
+        };
         format!("<{tag} ID=\"S{i}\" {remap}{more}/>")
     }
 }
@@ -1075,7 +1134,9 @@ pub fn case_with_conds<R: Rng>(rng: &mut R, size: i64, opts: Options, conds: Con
         String::new()
     };
     // `t`, created from a string (BT.CPP keeps the type an entry was created with).
-    let init = if g.scripts_on() && g.opts.strings {
+    let init = if g.scripts_on() && g.opts.strings && g.opts.joins {
+        format!("{init}<Script code=\"t:='a'; u:=''\"/>")
+    } else if g.scripts_on() && g.opts.strings {
         format!("{init}<Script code=\"t:='a'\"/>")
     } else {
         init

@@ -35,7 +35,9 @@
 //! text), which scripts read ([`Texts`]): compared with a number it is read as one (the
 //! text `3` equals 3; `abc` throws "Any failed string to number conversion"), two strings
 //! compare as strings, `c ? a : b` reads it as a number, and the arithmetic and logic
-//! operators, `-`, `!` and a condition's cast to bool throw (4.8.2's answers).
+//! operators, `-`, `!` and a condition's cast to bool throw (4.8.2's answers). Strings
+//! join ([`join`]): `a .. b` over two strings or a string and a number, `+` of two
+//! strings and `+=` on an entry holding a string; `..` is an operator group of its own.
 //!
 //! Values are `int64_t` or `double` as in BT.CPP ([`V::Num`], [`V::Dbl`]): every operator
 //! computes in doubles and gives one (4.10 `scripting/operators.hpp`), `/` included
@@ -79,6 +81,8 @@ pub enum Expr {
     Assign(String, &'static str, Box<Expr>),
     /// A `'string'` literal: its text.
     Str(String),
+    /// `a .. b` ([`join`]).
+    Join(Box<Expr>, Box<Expr>),
 }
 
 /// A parsed script: its statements.
@@ -104,9 +108,9 @@ enum Tok {
     Op(&'static str),
 }
 
-const OPS: [&str; 27] = [
-    ":=", "+=", "-=", "*=", "/=", "==", "!=", "<=", ">=", "&&", "||", "=", "<", ">", "+", "-", "*",
-    "/", "!", "(", ")", "?", ":", "~", "&", "|", "^",
+const OPS: [&str; 28] = [
+    "..", ":=", "+=", "-=", "*=", "/=", "==", "!=", "<=", ">=", "&&", "||", "=", "<", ">", "+",
+    "-", "*", "/", "!", "(", ")", "?", ":", "~", "&", "|", "^",
 ];
 
 /// A number literal at `s` (BT.CPP 4's `Grammar::Real` and `Grammar::Integer` in
@@ -210,8 +214,9 @@ struct P {
     toks: Vec<(Tok, usize)>,
     at: usize,
     len: usize,
-    /// Per open expression: whether it has a `!`, an arithmetic operator.
-    groups: Vec<(bool, bool)>,
+    /// Per open expression: whether it has a `!` (or a bit operator), an arithmetic
+    /// operator, `..`.
+    groups: Vec<[bool; 3]>,
 }
 
 impl P {
@@ -229,13 +234,17 @@ impl P {
     /// Notes an operator of the group `!` (`not`) or arithmetic at the token just
     /// eaten; mixing the two in one expression is a syntax error there.
     fn group(&mut self, not: bool) -> Result<(), String> {
+        self.group_of(usize::from(!not))
+    }
+
+    /// Notes an operator of group `k` (0: `!`, `~` and the bit operators, 1: the
+    /// arithmetic ones, 2: `..`) at the token just eaten; an expression holds one group
+    /// only (BT.CPP's `dsl::groups`; 4.8.2 refuses `'a' .. 1 + 2`, `'a' .. -3`,
+    /// `'a' .. 1 & 3` at load).
+    fn group_of(&mut self, k: usize) -> Result<(), String> {
         let g = self.groups.last_mut().expect("inside an expression");
-        let clash = if not { g.1 } else { g.0 };
-        if not {
-            g.0 = true;
-        } else {
-            g.1 = true;
-        }
+        let clash = (0..3).any(|o| o != k && g[o]);
+        g[k] = true;
         if clash {
             self.at -= 1;
             return self.err("operator cannot be mixed with previous operators");
@@ -262,7 +271,7 @@ impl P {
     }
 
     fn expr(&mut self) -> Result<Expr, String> {
-        self.groups.push((false, false));
+        self.groups.push([false; 3]);
         let r = self.expr_in();
         self.groups.pop();
         r
@@ -302,19 +311,32 @@ impl P {
     }
 
     fn cmp(&mut self) -> Result<Expr, String> {
-        let first = self.bit_or()?;
+        let first = self.join()?;
         let mut xs = vec![first];
         let mut ops = Vec::new();
         while let Some(Tok::Op(op @ ("==" | "!=" | "<" | "<=" | ">" | ">="))) = self.peek() {
             ops.push(*op);
             self.at += 1;
-            xs.push(self.bit_or()?);
+            xs.push(self.join()?);
         }
         Ok(if ops.is_empty() {
             xs.pop().expect("one operand")
         } else {
             Expr::Cmp(xs, ops)
         })
+    }
+
+    /// `..`: tighter than the comparisons, grouped to the left, an operator group of its
+    /// own (BT.CPP 4.10 `Grammar::Expression`, `string_concat`; 4.8.2: `1 .. 2 .. 'a'`
+    /// throws, as `1 .. 2` has no value, and `'a' .. 'b' == 'ab'` holds).
+    fn join(&mut self) -> Result<Expr, String> {
+        let mut a = self.bit_or()?;
+        while self.eat("..") {
+            self.group_of(2)?;
+            let b = self.bit_or()?;
+            a = Expr::Join(Box::new(a), Box::new(b));
+        }
+        Ok(a)
     }
 
     /// `|` and `^`: one level, grouped to the left, looser than `&` (BT.CPP 4.10
@@ -460,7 +482,7 @@ impl Expr {
             Expr::Num(_) | Expr::Real(_) | Expr::Str(_) => {}
             Expr::Var(v) => *v = f(v),
             Expr::Neg(a) | Expr::Not(a) | Expr::BitNot(a) => a.rename(f),
-            Expr::Arith(_, a, b) | Expr::Logic(_, a, b) | Expr::Bit(_, a, b) => {
+            Expr::Arith(_, a, b) | Expr::Logic(_, a, b) | Expr::Bit(_, a, b) | Expr::Join(a, b) => {
                 a.rename(f);
                 b.rename(f);
             }
@@ -538,10 +560,10 @@ impl Expr {
             }
             Expr::Arith(op, a, b) => {
                 let (a, b) = (a.eval(env, texts)?, b.eval(env, texts)?);
-                // `+` of two strings joins them (4.8.2: `'a' + 'b' == 'ab'`; not in
-                // the oracle's subset); the other operators throw.
-                if *op == '+' && matches!((&a, &b), (V::Text(_), V::Text(_))) {
-                    return Err(Fault::Model("`+` joining two strings".into()));
+                // `+` of two strings joins them (4.8.2: `'a' + 'b' == 'ab'`); the
+                // other operators throw.
+                if let ('+', V::Text(x), V::Text(y)) = (op, &a, &b) {
+                    return Ok(V::Text(format!("{x}{y}")));
                 }
                 let (a, b) = (num(a)?, num(b)?);
                 let r = match op {
@@ -651,6 +673,10 @@ impl Expr {
                 };
             }
             Expr::BitNot(_) | Expr::Bit(..) => return bits(self, env, texts),
+            Expr::Join(a, b) => {
+                let (a, b) = (a.eval(env, texts)?, b.eval(env, texts)?);
+                return join(a, b);
+            }
             Expr::Assign(v, op, e) => return assign(v, op, e, env, texts),
         }))
     }
@@ -738,7 +764,12 @@ fn assign(v: &str, op: &str, e: &Expr, env: &mut Env<'_>, texts: &Texts) -> Resu
             env.strs.insert(v.to_string(), t.clone());
             return Ok(x);
         }
-        (V::Text(_), true, "+=") => return Err(Fault::Model("`+=` joining two strings".into())),
+        // `+=` of two strings joins them (4.8.2: `s := 'a'; s += 'b'` holds `ab`).
+        (V::Text(t), true, "+=") => {
+            let joined = format!("{}{t}", env.strs[v]);
+            env.strs.insert(v.to_string(), joined.clone());
+            return Ok(V::Text(joined));
+        }
         (V::Text(_), false, ":=" | "=") => {
             return Err(Fault::Model(format!(
                 "a string assigned to `{v}`, which holds a number"
@@ -839,6 +870,39 @@ fn assign(v: &str, op: &str, e: &Expr, env: &mut Env<'_>, texts: &Texts) -> Resu
     } else {
         env.dbl.remove(v);
         Ok(V::Num(stored))
+    }
+}
+
+/// `a .. b` as BT.CPP 4.8.2 makes it (4.10 `scripting/operators.hpp`,
+/// `ExprBinaryArithmetic::evaluate`, `concat`: two strings, or a string and a number,
+/// joined with `Any::cast<std::string>`), measured through `behaviortreepy`: an
+/// `int64_t` joins as its digits (`'a' .. 3` is `a3`, `'a' .. true` `a1`), a `double` as
+/// `%f` (`'a' .. 1.5` is `a1.500000`, `'a' .. (1/0)` `ainf`; NaN, `-nan` or `nan` by its
+/// sign, is outside the subset); two numbers give no value (4.10's source throws
+/// "Operation not permitted", 4.8.2 returns an empty value that throws "not
+/// initialized" where it is used: [`V::Empty`]); an operand that holds no value throws.
+fn join(a: V, b: V) -> Result<V, Fault> {
+    let text = |v: &V| -> Result<Option<String>, Fault> {
+        Ok(match v {
+            V::Text(t) => Some(t.clone()),
+            V::Num(n) => Some(n.to_string()),
+            V::Dbl(x) if x.is_nan() => return Err(Fault::Model("a NaN joined to a string".into())),
+            V::Dbl(x) if x.is_infinite() => Some(if *x > 0.0 { "inf" } else { "-inf" }.into()),
+            V::Dbl(x) => Some(format!("{x:.6}")),
+            V::Empty => None,
+        })
+    };
+    if a == V::Empty || b == V::Empty {
+        return Err(Fault::Throws(
+            "operand of the operator [..] is not initialized".into(),
+        ));
+    }
+    if !matches!(a, V::Text(_)) && !matches!(b, V::Text(_)) {
+        return Ok(V::Empty);
+    }
+    match (text(&a)?, text(&b)?) {
+        (Some(x), Some(y)) => Ok(V::Text(format!("{x}{y}"))),
+        _ => unreachable!("empty operands throw above"),
     }
 }
 
@@ -1305,6 +1369,76 @@ mod tests {
         };
         assert!(parse("3").unwrap().holds(&mut env, &none).is_err());
         assert!(parse("5-5").unwrap().holds(&mut env, &none) == Ok(false));
+    }
+
+    #[test]
+    fn joins_as_the_real_library_answers() {
+        // Each answer below is what BT.CPP 4.8.2 gave (`behaviortreepy`), `k` written
+        // `7` by a SetBlackboard.
+        let texts: Texts = [("k".to_string(), Some("7".to_string()))].into();
+        let go = |src: &str| {
+            let (mut vals, mut dbl) = (BTreeMap::new(), BTreeSet::new());
+            let mut env = Env {
+                vals: &mut vals,
+                dbl: &mut dbl,
+                reals: &mut BTreeMap::new(),
+                strs: &mut BTreeMap::new(),
+            };
+            parse(src).expect("parses").run(&mut env, &texts)
+        };
+        let text = |src: &str, want: &str| assert_eq!(go(src), Ok(V::Text(want.into())), "{src}");
+        text("'a' .. 'b'", "ab");
+        text("'a' + 'b'", "ab");
+        text("'a' .. 3", "a3");
+        text("3 .. 'a'", "3a");
+        text("'a' .. true", "a1");
+        text("'a' .. false", "a0");
+        text("'a' .. 1.5", "a1.500000");
+        text("'a' .. (1+2)", "a3.000000");
+        text("'a' .. (1/3)", "a0.333333");
+        text("'a' .. (0-0)", "a0.000000");
+        text("'a' .. (1/0)", "ainf");
+        text("'a' .. 1e20", "a100000000000000000000.000000");
+        text("'a' .. 0.1", "a0.100000");
+        text("x := 3; x += 1; 'a' .. x", "a4");
+        text("x := 5; x -= 8; 'a' .. x", "a-3");
+        text("x := 2.5; 'a' .. x", "a2.500000");
+        text("'a' .. 'b' .. 'c'", "abc");
+        text("'a' .. 1 .. 2", "a12");
+        text("'x' .. (true ? 'a' : 'b')", "xa");
+        text("k .. k", "77");
+        text("k + k", "77");
+        text("'a' .. k", "a7");
+        text("s := 'a'; s += 'b'", "ab");
+        text("s := 'a'; s += s", "aa");
+        text("s := 'a'; s = s .. 'c'", "ac");
+        assert_eq!(go("'a' .. 'b' == 'ab'"), Ok(V::Dbl(1.0)));
+        assert_eq!(go("'ab' .. 'cd' == 'a' .. 'bcd'"), Ok(V::Dbl(1.0)));
+        // Two numbers give no value, which throws where it is used.
+        assert_eq!(go("3 .. 4"), Ok(V::Empty));
+        let throws = |src: &str, what: &str| {
+            assert!(
+                matches!(go(src), Err(Fault::Throws(t)) if t.contains(what)),
+                "{src}: {:?}",
+                go(src)
+            )
+        };
+        throws("1 .. 2 .. 'a'", "is not initialized");
+        throws("(3 .. 4) == 1", "is not initialized");
+        throws("'a' + 1", "Operation not permitted");
+        throws("s := 'a'; s += 3", "can't be used with a non-numeric type");
+        throws("s := 3; s += 'a'", "Any::copyInto fails");
+        throws("'a' .. u", "Variable not found: u");
+        // At load (syntax): `..` mixes with no other operator group.
+        for src in [
+            "'a' .. 1 + 2",
+            "'a' .. -3",
+            "-'a' .. 'b'",
+            "'a' .. 1 & 3",
+            "'a' .. !1",
+        ] {
+            assert!(parse(src).is_err(), "{src}");
+        }
     }
 
     #[test]

@@ -44,14 +44,15 @@
 //!   condition of `c ? a : b`, a string reads as a number (the text `3` equals 3, `abc`
 //!   throws); an arithmetic or logic operator, `-`, `!` over it, or a condition whose
 //!   value it is, throws ("Operation not permitted", "Invalid operator for std::string",
-//!   "no known safe conversion"). Refused: joining strings, an entry whose type would
-//!   change, writing from a script an entry SetBlackboard writes.
+//!   "no known safe conversion"). Joining strings (`..`, `+` of two strings, `+=`)
+//!   lowers as a table over ranks (`btcpp4_script/join.rs`). Refused: an entry whose
+//!   type would change, writing from a script an entry SetBlackboard writes.
 //!
 //! Where BT.CPP throws, the exception ends the tree's execution: the blackboard machine
 //! goes to its `error` state (`bt_script_fault` set), the node never answers, and the
 //! tree stops. Refused when the tree is read, each at the script's attribute with the
-//! column in the script and why: joining strings (the texts a tree can make must be
-//! known when it is lowered), the bit operators (no bitwise operations in the model), storing a number that need not be
+//! column in the script and why: joins whose texts are unbounded or too many, or that
+//! join a number other than a literal (`join.rs`), the bit operators (no bitwise operations in the model), storing a number that need not be
 //! whole (`x := 5/2`, `x /= 2`: the model's script entries are integers), a divisor
 //! other than a number literal other than 0, a number
 //! literal BT.CPP refuses at load, an entry SetBlackboard writes other than as above,
@@ -67,7 +68,9 @@ use crate::model::source::{Diagnostic, SourceMap, Span};
 use crate::model::types::Scalar;
 use crate::model::xml::Element;
 
+mod join;
 mod num;
+pub(crate) use join::{closure, Overflow, Script, CAP};
 pub(crate) use num::{entry_type, float_entries};
 
 /// The blackboard machine's flag: a script threw.
@@ -105,9 +108,6 @@ enum Ty {
 pub(crate) fn dbl(e: &str) -> String {
     format!("bt_dbl__{e}")
 }
-
-/// Why joining two strings cannot be modelled.
-const CONCAT: &str = "`+` over two strings joins them (BT.CPP 4's concatenation), which is not modelled: the model holds a string as its rank among the texts written in the tree, so every text a tree can make must be known when it is lowered";
 
 /// An operator the parser gives and the lowering does not know (none today).
 const BITS: &str = "this operator is not modelled";
@@ -305,6 +305,9 @@ impl Tr<'_> {
             K::Str(_) => true,
             K::Name(n) => self.entry(n).1 == Ty::Text,
             K::Ite(_, a, b) => self.is_text(a) || self.is_text(b),
+            // A join gives a string (`btcpp4_script/join.rs`).
+            K::Bin("..", ..) => true,
+            K::Bin("+", a, b) => self.is_text(a) && self.is_text(b),
             _ => false,
         }
     }
@@ -313,8 +316,11 @@ impl Tr<'_> {
     /// number and the condition of `?:` read it (`btcpp4_strings.rs`, `as_number`):
     /// where it throws, under `guard`, and the number.
     fn text_number(&mut self, e: &Ex, v: &Val, guard: &str) -> Result<String, Refuse> {
-        let texts: Vec<&str> = match &e.k {
-            K::Str(t) => vec![t.as_str()],
+        // The texts the closure says it may hold (`join.rs`), else every text.
+        let possible = self.possible_texts(e);
+        let texts: Vec<&str> = match (&e.k, &possible) {
+            (K::Str(t), _) => vec![t.as_str()],
+            (_, Some(ts)) => ts.iter().map(String::as_str).collect(),
             _ => self.strs.texts.iter().map(String::as_str).collect(),
         };
         let (throws, n) = self.strs.number(&v.x, &texts).map_err(|w| (e.at, w))?;
@@ -401,10 +407,11 @@ impl Tr<'_> {
             }
             K::Un(..) => return refuse(BITS),
             K::Bin(op @ ("+" | "-" | "*" | "/"), a, b) => {
-                // Two strings: `+` joins them; the other operators throw ("Operation
-                // not permitted"), as does any of them over a string and a number.
+                // Two strings: `+` joins them (`join.rs`); the other operators throw
+                // ("Operation not permitted"), as does any of them over a string and a
+                // number.
                 if *op == "+" && self.is_text(a) && self.is_text(b) {
-                    return Err((e.at, CONCAT.to_string()));
+                    return self.join(e, a, b, guard);
                 }
                 if *op == "/" && !nonzero_literal(b) {
                     // Any other divisor: computed exactly as BT.CPP's double, sign of zero
@@ -433,6 +440,7 @@ impl Tr<'_> {
                     "true",
                 )
             }
+            K::Bin("..", a, b) => return self.join(e, a, b, guard),
             K::Bin(op @ ("&&" | "||"), a, b) => {
                 let x = self.logic_operand(a, guard)?;
                 let y = self.logic_operand(b, guard)?;
@@ -582,6 +590,9 @@ fn statement(
     if et == Ty::Text && !dynamic {
         return Err((*at, format!("a script writing `{g}`, which a SetBlackboard writes: BT.CPP 4 holds a string there (4.8.2 refuses to assign it a number), which is not modelled")));
     }
+    if et == Ty::Text && t == Ty::Text && *op == "+=" {
+        return tr.plus_assign(&g, v, &s.e, *at);
+    }
     if et == Ty::Text || t == Ty::Text {
         return assign_text(tr.checks, &g, et == Ty::Text, v, op, *at);
     }
@@ -628,7 +639,7 @@ fn statement(
 /// An assignment where a string meets an entry (BT.CPP 4.10 `ExprAssignment::evaluate`
 /// and 4.8.2, measured): `entry_text`, the entry holds strings (a script creates it);
 /// else it holds numbers and `v` is a string. `=`, `:=` of a string to a string entry
-/// store its rank; `+=` of two strings joins them (not modelled); `-=`, `*=`, `/=` with
+/// store its rank; `+=` of two strings joins them (`join.rs`, handled before); `-=`, `*=`, `/=` with
 /// a string, and `+=` of a number to a string entry, throw ("Operator not supported for
 /// strings", "can't be used with a non-numeric type"), as does `+=` of a string to a
 /// number ("Any::copyInto fails"). A number stored in a string entry, or a string in a
@@ -662,7 +673,6 @@ fn assign_text(
                 value: val(g.to_string(), Ty::Text, "false"),
             })
         }
-        (true, true, "+=") => Err((at, CONCAT.to_string())),
         (_, _, ":=" | "=") if entry_text => Err((at, format!("assigning a number to `{g}`, which holds strings (a script or a LoopString writes them): BT.CPP 4 throws where it holds a string and stores the number where it holds none, and an entry whose type changes is not modelled"))),
         (_, _, ":=" | "=") => Err((at, format!("assigning a string to `{g}`, which holds numbers: BT.CPP 4.8.2 converts the text to the entry's type, which is not modelled"))),
         _ => throws(checks, v),

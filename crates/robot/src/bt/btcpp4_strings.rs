@@ -1,9 +1,11 @@
 //! Strings in BehaviorTree.CPP 4's script language under [`super::BtSemantics::Btcpp`]:
 //! every text a tree can hold, interned as an integer in byte order.
 //!
-//! The model's expressions have no string operations, but without concatenation every
-//! string a script or a SetBlackboard can put in an entry is a text written in the tree:
-//! a script's `'literal'` or a SetBlackboard's `value`. [`prepare`] collects them, sorts
+//! The model's expressions have no string operations. Without joins every string a
+//! script or a SetBlackboard can put in an entry is a text written in the tree: a
+//! script's `'literal'` or a SetBlackboard's `value`; with joins (`..`, `+` of two
+//! strings, `+=`) [`prepare`] adds the closed set of texts they make
+//! (`btcpp4_script/join.rs`, `closure`). [`prepare`] collects them, sorts
 //! them as `std::string` compares them (byte by byte, a prefix first: BT.CPP 4.10
 //! `scripting/operators.hpp`, `ExprComparison::evaluate` compares two strings with the
 //! `SimpleString` operators; 4.8.2 measured: `'B' < 'a'`, `'a' < 'aa'`, `'10' < '9'`)
@@ -33,6 +35,7 @@
 use super::blackboard::Blackboard;
 use super::script::{self, Ex, K};
 use super::tree::{Btcpp4, Control, Kind, PortValue, Tree};
+use std::collections::{BTreeMap, BTreeSet};
 
 /// The blackboard machine's variable holding string entry `e`'s text, as its rank.
 pub(crate) fn sid(e: &str) -> String {
@@ -48,6 +51,11 @@ pub(crate) struct Strings {
     pub set_entries: Vec<String>,
     /// Entries scripts create that hold strings.
     pub script_entries: Vec<String>,
+    /// The texts each string entry may hold (the closure over the scripts' joins).
+    pub sets: std::collections::BTreeMap<String, std::collections::BTreeSet<String>>,
+    /// Why the tree's texts cannot be closed (unbounded, or beyond the cap): every
+    /// join is refused with it.
+    pub overflow: Option<String>,
 }
 
 /// What BT.CPP 4.8.2 makes of a text read as a number.
@@ -168,6 +176,9 @@ fn stringy(e: &Ex, global: &dyn Fn(&str) -> Option<String>, s: &Strings) -> bool
         K::Str(_) => true,
         K::Name(n) => global(n).is_some_and(|g| s.holds(&g)),
         K::Ite(_, a, b) => stringy(a, global, s) || stringy(b, global, s),
+        // A join gives a string (`btcpp4_script/join.rs`).
+        K::Bin("..", ..) => true,
+        K::Bin("+", a, b) => stringy(a, global, s) && stringy(b, global, s),
         _ => false,
     }
 }
@@ -269,8 +280,70 @@ pub(super) fn prepare(tree: &Tree, bb: &mut Blackboard) {
             break;
         }
     }
+    // The closed set of texts (`btcpp4_script/join.rs`): what each string entry may
+    // hold, and what every join may make.
+    let mut sets: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+    for g in &s.set_entries {
+        sets.insert(g.clone(), set_texts(tree, g).into_iter().collect());
+    }
+    let globals: Vec<Global<'_>> = parsed
+        .iter()
+        .map(|(i, _)| {
+            let (i, s) = (*i, &s);
+            Box::new(move |n: &str| global(i, n).filter(|g| s.holds(g)))
+                as Box<dyn Fn(&str) -> Option<String>>
+        })
+        .collect();
+    let scripts: Vec<super::btcpp4_script::Script<'_>> = parsed
+        .iter()
+        .zip(&globals)
+        .map(|((_, stmts), g)| (stmts.as_slice(), g.as_ref()))
+        .collect();
+    let mut overflow = None;
+    match super::btcpp4_script::closure(&scripts, &s.script_entries, &mut sets) {
+        Ok(made) => texts.extend(made),
+        Err(super::btcpp4_script::Overflow(why)) => overflow = Some(why),
+    }
+    drop(scripts);
+    drop(globals);
+    texts.extend(sets.values().flatten().cloned());
     texts.sort();
     texts.dedup();
+    if overflow.is_none() && texts.len() > super::btcpp4_script::CAP {
+        overflow = Some(format!(
+            "the tree's scripts may hold {} texts, more than {}, which is not modelled",
+            texts.len(),
+            super::btcpp4_script::CAP
+        ));
+    }
     s.texts = texts;
+    s.sets = sets;
+    s.overflow = overflow;
     bb.strings = s;
+}
+
+/// A script's names to the string entries they stand for.
+type Global<'a> = Box<dyn Fn(&str) -> Option<String> + 'a>;
+
+/// The texts the SetBlackboard nodes write to entry `g`.
+fn set_texts(tree: &Tree, g: &str) -> Vec<String> {
+    let mut out = Vec::new();
+    for n in &tree.nodes {
+        if n.kind != Kind::Control(Control::SetBlackboard) {
+            continue;
+        }
+        let (Some(k), Some(v)) = (n.port("output_key"), n.port("value")) else {
+            continue;
+        };
+        let key = match &k.value {
+            PortValue::Literal(v) => v.trim().to_string(),
+            PortValue::Blackboard(b) => b.clone(),
+        };
+        if key == g {
+            if let PortValue::Literal(v) = &v.value {
+                out.push(v.clone());
+            }
+        }
+    }
+    out
 }

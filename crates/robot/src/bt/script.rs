@@ -64,7 +64,7 @@ pub(crate) enum K {
     Name(String),
     /// A prefix operator (`-`, `!`, `~`) and its operand.
     Un(&'static str, Box<Ex>),
-    /// A binary operator (`+ - * / | & ^ && ||`).
+    /// A binary operator (`+ - * / | & ^ && || ..`).
     Bin(&'static str, Box<Ex>, Box<Ex>),
     /// A comparison chain: operands and the operators between them (`a < b < c` is
     /// `a < b && b < c`).
@@ -159,12 +159,9 @@ fn tokens(s: &str) -> Result<Vec<(T<'_>, usize)>, SyntaxError> {
             }
             out.push((T::Name(&s[start..i]), start));
         } else if s[i..].starts_with("..") {
-            // BT.CPP 4.8.2 joins strings with `..` (`'a'..'b' == 'ab'`; it does not mix
-            // with `+`): not modelled (`btcpp4_strings.rs`).
-            return Err(SyntaxError {
-                at: start,
-                what: "`..` (BT.CPP's string concatenation) is not supported: the texts a tree can make must be known when it is lowered".into(),
-            });
+            // BT.CPP 4.8.2 joins strings with `..` (`btcpp4_script/join.rs`).
+            i += 2;
+            out.push((T::Sym(".."), start));
         } else if let Some(sym) = SYMS.iter().find(|x| s[i..].starts_with(**x)) {
             i += sym.len();
             out.push((T::Sym(sym), start));
@@ -182,9 +179,10 @@ fn tokens(s: &str) -> Result<Vec<(T<'_>, usize)>, SyntaxError> {
 /// `&` tighter, each grouping to the left (BT.CPP 4.8.2: `1 | 1 ^ 1` is 0, `1 ^ 1 | 1`
 /// is 1, `1 | 2 & 4` is 1; 4.10 `scripting/operators.hpp`, `Grammar::Expression`,
 /// `bit_or` and `bit_and`).
-const LEVELS: [&[&str]; 7] = [
+const LEVELS: [&[&str]; 8] = [
     &["||", "&&"],
     &["==", "!=", "<", "<=", ">", ">="],
+    &[".."],
     &["|", "^"],
     &["&"],
     &["+", "-"],
@@ -196,7 +194,16 @@ const LEVELS: [&[&str]; 7] = [
 /// and after the comparisons are the bit operators, which share an operator group with
 /// `!` and `~` (BT.CPP's `dsl::groups<math_sum, bit_or>`: an expression holds one group
 /// or the other, "operator cannot be mixed with previous operators").
-const ARITH: usize = 4;
+const ARITH: usize = 5;
+
+/// The level of `..` in [`LEVELS`]: an operator group of its own, tighter than the
+/// comparisons and grouping to the left (4.10 `scripting/operators.hpp`,
+/// `Grammar::Expression`, `string_concat`). 4.8.2, measured: `'a' .. 'b' == 'ab'` holds,
+/// `1 .. 2 .. 'a'` throws (`1 .. 2` has no value), and `'a' .. 1 + 2`, `'a' .. -3`,
+/// `'a' .. !1`, `'a' .. 1 & 3`, `-'a' .. 'b'` and `'a' .. 'b' + 'c'` are refused at
+/// load: `..` mixes with neither the arithmetic nor the bit operators nor `-`, `!`, `~`
+/// (`'a' .. (1 + 2)` is a script).
+const CONCAT: usize = 2;
 
 struct Parser<'s> {
     toks: Vec<(T<'s>, usize)>,
@@ -204,8 +211,8 @@ struct Parser<'s> {
     end: usize,
     src: &'s str,
     /// Per open expression: it has a `!`, `~` or bit operator; it has an arithmetic
-    /// operator.
-    open: Vec<[bool; 2]>,
+    /// operator; it has `..`.
+    open: Vec<[bool; 3]>,
 }
 
 impl<'s> Parser<'s> {
@@ -224,12 +231,12 @@ impl<'s> Parser<'s> {
         })
     }
 
-    /// Records an operator of group 0 (`! ~ & | ^`) or 1 (arithmetic) at the current
-    /// token.
+    /// Records an operator of group 0 (`! ~ & | ^`), 1 (arithmetic) or 2 (`..`) at the
+    /// current token.
     fn note(&mut self, group: usize) -> Result<(), SyntaxError> {
         let g = self.open.last_mut().expect("an open expression");
         g[group] = true;
-        if g[1 - group] {
+        if (0..3).any(|o| o != group && g[o]) {
             return self.fail("operator cannot be mixed with previous operators");
         }
         Ok(())
@@ -253,7 +260,7 @@ impl<'s> Parser<'s> {
     }
 
     fn expression(&mut self) -> Result<Ex, SyntaxError> {
-        self.open.push([false; 2]);
+        self.open.push([false; 3]);
         let r = self.expression_rest();
         self.open.pop();
         r
@@ -296,7 +303,9 @@ impl<'s> Parser<'s> {
             let Some(op) = LEVELS[level].iter().copied().find(|o| o == op) else {
                 break;
             };
-            if level >= 2 {
+            if level == CONCAT {
+                self.note(2)?;
+            } else if level > CONCAT {
                 self.note(usize::from(level >= ARITH))?;
             }
             self.pos += 1;
@@ -532,6 +541,41 @@ mod tests {
         ] {
             assert_eq!(check(s), Ok(()), "{s}");
         }
+    }
+
+    #[test]
+    fn joins_group_as_btcpp_does() {
+        // 4.8.2 refuses each of these at load: `..` mixes with no other operator group.
+        for s in [
+            "s := 'a' .. 1 + 2",
+            "s := 1 + 2 .. 'a'",
+            "s := 'a' .. -3",
+            "s := -'a' .. 'b'",
+            "s := 'a' .. !1",
+            "s := 'a' .. 1 & 3",
+            "s := 'a' .. 'b' | 'c'",
+            "s := 'a' .. 'b' + 'c'",
+            "s := 'a' + 'b' .. 'c'",
+            "s := 'a' ... 'b'",
+        ] {
+            assert!(check(s).is_err(), "{s}");
+        }
+        for s in [
+            "s := 'a'..'b'",
+            "s := 'a' .. (1 + 2)",
+            "s := 'a' .. (-3)",
+            "s := 'a' .. 'b' == 'ab' && true",
+            "s := true ? 'a' .. 'b' : 'c'",
+        ] {
+            assert_eq!(check(s), Ok(()), "{s}");
+        }
+        // Left to right (4.8.2: `1 .. 2 .. 'a'` throws, `1 .. 2` having no value), and
+        // tighter than the comparisons.
+        let s = parse("1 .. 2 .. 'a' == 'x'").unwrap();
+        let K::Cmp(xs, _) = &s[0].e.k else {
+            panic!("a comparison")
+        };
+        assert!(matches!(&xs[0].k, K::Bin("..", l, _) if matches!(l.k, K::Bin("..", ..))));
     }
 
     #[test]
