@@ -253,10 +253,11 @@ pub(super) fn prepare(tree: &Tree, bb: &mut Blackboard) {
         }
     }
     // Entries a LoopString writes that scripts name (`btcpp4_loop.rs`).
-    for (g, items) in super::btcpp4_loop::script_strings(tree, bb) {
-        texts.extend(items);
-        if !s.holds(&g) {
-            s.script_entries.push(g);
+    let looped = super::btcpp4_loop::script_strings(tree, bb);
+    for (g, items) in &looped {
+        texts.extend(items.iter().cloned());
+        if !s.holds(g) {
+            s.script_entries.push(g.clone());
         }
     }
     // Entries scripts assign strings to, until nothing changes (`t := k` after
@@ -285,6 +286,11 @@ pub(super) fn prepare(tree: &Tree, bb: &mut Blackboard) {
     let mut sets: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     for g in &s.set_entries {
         sets.insert(g.clone(), set_texts(tree, g).into_iter().collect());
+    }
+    // What a LoopString writes is among what its entry may hold, for the joins and for
+    // reading it as a number.
+    for (g, items) in looped {
+        sets.entry(g).or_default().extend(items);
     }
     let globals: Vec<Global<'_>> = parsed
         .iter()
