@@ -12,7 +12,7 @@
 
 use super::plugin::Plugin;
 use crate::model::source::{Diagnostic, SourceMap, Span};
-use crate::model::xml::Element;
+use crate::model::xml::{Attr, Element};
 use std::collections::HashMap;
 
 /// The id of the tree's root node.
@@ -722,21 +722,14 @@ impl Reader<'_> {
                 continue;
             }
             if a.name.starts_with('_') {
-                match super::script::condition_error(&a.name, &a.value) {
-                    Some(Ok(_)) => conds.push(Cond {
-                        attr: a.name.clone(),
-                        code: a.value.clone(),
-                        name_span: a.name_span,
-                        span: a.value_span,
-                    }),
-                    Some(Err(e)) => self.err(a.value_span, format!("`{}`: {e}", a.name)),
-                    None => self.err(
+                if !self.condition(a, &mut conds) {
+                    self.err(
                         a.name_span,
                         format!(
                             "`{}` (a BehaviorTree.cpp script attribute) is not supported",
                             a.name
                         ),
-                    ),
+                    );
                 }
                 continue;
             }
@@ -1029,6 +1022,23 @@ impl Reader<'_> {
 }
 
 impl Reader<'_> {
+    /// `a` as a pre/post condition (`_skipIf` ... `_onHalted`): pushed on `conds` when
+    /// its script parses, an error at its value when not; `false` when `a` names no
+    /// condition.
+    fn condition(&mut self, a: &Attr, conds: &mut Vec<Cond>) -> bool {
+        match super::script::condition_error(&a.name, &a.value) {
+            Some(Ok(_)) => conds.push(Cond {
+                attr: a.name.clone(),
+                code: a.value.clone(),
+                name_span: a.name_span,
+                span: a.value_span,
+            }),
+            Some(Err(e)) => self.err(a.value_span, format!("`{}`: {e}", a.name)),
+            None => return false,
+        }
+        true
+    }
+
     /// The node a format-4 `<SubTree>` with pre/post conditions becomes, pushed under
     /// `parent` (its index), or `None` when it has none (the body is inlined). BT.CPP 4
     /// `xml_parsing.cpp`, `XMLParser::PImpl::createNodeFromXML`: the SubTree node is
@@ -1041,16 +1051,7 @@ impl Reader<'_> {
         }
         let mut conds = Vec::new();
         for a in &el.attrs {
-            match super::script::condition_error(&a.name, &a.value) {
-                Some(Ok(_)) => conds.push(Cond {
-                    attr: a.name.clone(),
-                    code: a.value.clone(),
-                    name_span: a.name_span,
-                    span: a.value_span,
-                }),
-                Some(Err(e)) => self.err(a.value_span, format!("`{}`: {e}", a.name)),
-                None => {}
-            }
+            self.condition(a, &mut conds);
         }
         if conds.is_empty() {
             return None;
