@@ -334,6 +334,53 @@ impl PropertySet {
     }
 }
 
+/// Why the judge stopped a run: the run's failure, reported with its run index
+/// (`study::ModelFailure`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunError {
+    /// A message's parameter is not a value of the property variable's type.
+    Payload {
+        /// The model time of the message.
+        time: u64,
+        /// The event.
+        event: String,
+        /// The machine that sent it.
+        origin: String,
+        /// The machine it was sent to.
+        target: String,
+        /// The property variable.
+        var: String,
+        /// The variable's type.
+        ty: Ty,
+    },
+    /// The monitor refused a step.
+    Step {
+        /// The point's time.
+        time: u64,
+        /// `Compiled::describe` of the monitor's error.
+        what: String,
+    },
+}
+
+impl std::fmt::Display for RunError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RunError::Payload {
+                time,
+                event,
+                origin,
+                target,
+                var,
+                ty,
+            } => write!(
+                f,
+                "time {time}: `{event}` from {origin} to {target}: parameter for `{var}` is not a {ty:?}"
+            ),
+            RunError::Step { time, what } => write!(f, "monitor step at time {time}: {what}"),
+        }
+    }
+}
+
 /// Judges one run: an [`Observer`] stepping the monitors at every point.
 ///
 /// Each property is its own monitor (`verify::split`), stepped only at the points where the
@@ -355,8 +402,8 @@ pub struct Judge<'a> {
     verdicts: Vec<bool>,
     /// Per node, its final value as of the last point ([`analysis::settle`]).
     finals: Vec<Option<bool>>,
-    /// The first error (a payload of the wrong type, a timestamp going back).
-    pub error: Option<String>,
+    /// The first error (a payload of the wrong type, a monitor step refused).
+    pub error: Option<RunError>,
     decided: bool,
     /// The time of the last point.
     last_time: u64,
@@ -538,10 +585,10 @@ impl<'a> Judge<'a> {
     #[cold]
     #[inline(never)]
     fn fail(&mut self, time: u64, e: monitor_core::StepError) -> Flow {
-        self.error = Some(format!(
-            "monitor step at time {time}: {}",
-            self.set.compiled.describe(&e)
-        ));
+        self.error = Some(RunError::Step {
+            time,
+            what: self.set.compiled.describe(&e),
+        });
         Flow::Stop
     }
 
@@ -764,14 +811,14 @@ impl Judge<'_> {
             match value {
                 Some(v) => self.write(port.var, v),
                 None => {
-                    self.error = Some(format!(
-                        "time {time}: `{}` from {} to {}: parameter for `{}` is not a {:?}",
-                        msg.event_name(),
-                        msg.origin_name(),
-                        msg.target_name(),
-                        decl.name,
-                        decl.ty
-                    ));
+                    self.error = Some(RunError::Payload {
+                        time,
+                        event: msg.event_name().to_string(),
+                        origin: msg.origin_name().to_string(),
+                        target: msg.target_name().to_string(),
+                        var: decl.name.to_string(),
+                        ty: decl.ty,
+                    });
                     return Flow::Stop;
                 }
             }

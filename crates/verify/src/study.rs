@@ -281,7 +281,7 @@ impl<'m> Runner<'m> {
                 }
             };
             if let Some(err) = &judge.error {
-                record(&self.failure, failed(err.clone()));
+                record(&self.failure, failed(err.to_string()));
             }
             match end {
                 Some(end) if judge.error.is_none() => judge.outcome(end, out.steps, out.time),

@@ -102,7 +102,8 @@ pub fn parse_csv(text: &str, file: &str, spec: &Compiled) -> Result<Vec<TracePoi
             if cell.trim().is_empty() {
                 continue;
             }
-            let value = parse_value(cell.trim(), spec, var).map_err(|m| at(*col, m))?;
+            let value = parse_value(cell.trim(), spec, var)
+                .map_err(|b| at(*col, bad_cell(b, cell.trim(), spec, var)))?;
             sets.push((var, value));
         }
         points.push(TracePoint {
@@ -120,33 +121,46 @@ fn is_recorder_column(name: &str) -> bool {
         || name.starts_with("verdict_")
 }
 
-fn parse_value(cell: &str, spec: &Compiled, var: usize) -> Result<Value, String> {
-    let decl = &spec.vars()[var];
-    let bad = || {
-        format!(
-            "`{cell}` is not a value of type `{}` for `{}`",
-            decl.type_name, decl.name
-        )
-    };
-    match decl.ty {
+/// Why a cell is no value of its column's variable.
+enum BadCell {
+    /// Not a literal of the variable's type.
+    OfType,
+    /// A NaN or an infinity for a float variable.
+    NotFinite,
+}
+
+fn parse_value(cell: &str, spec: &Compiled, var: usize) -> Result<Value, BadCell> {
+    match spec.vars()[var].ty {
         Ty::Bool => match cell {
             "true" | "1" => Ok(Value::Bool(true)),
             "false" | "0" => Ok(Value::Bool(false)),
-            _ => Err(bad()),
+            _ => Err(BadCell::OfType),
         },
-        Ty::Int => cell.parse().map(Value::Int).map_err(|_| bad()),
+        Ty::Int => cell.parse().map(Value::Int).map_err(|_| BadCell::OfType),
         // A trace records measurements: a NaN or an infinity is a broken sensor or
         // logger, not a value to judge silently (every comparison with NaN is false).
         Ty::Float => match cell.parse::<f64>() {
             Ok(x) if x.is_finite() => Ok(Value::Float(x)),
-            Ok(_) => Err(format!(
-                "`{cell}` for `{}` is not a finite number: NaN and infinities are refused \
-                 (every comparison with NaN is false, so a verdict over it would mean nothing)",
-                decl.name
-            )),
-            Err(_) => Err(bad()),
+            Ok(_) => Err(BadCell::NotFinite),
+            Err(_) => Err(BadCell::OfType),
         },
         // Strings the spec never mentions get an id past every constant: equal to none.
         Ty::Str => Ok(Value::Str(spec.string_id(cell).unwrap_or(u32::MAX))),
+    }
+}
+
+/// What is wrong with `cell` for variable `var`, in words.
+fn bad_cell(why: BadCell, cell: &str, spec: &Compiled, var: usize) -> String {
+    let decl = &spec.vars()[var];
+    match why {
+        BadCell::OfType => format!(
+            "`{cell}` is not a value of type `{}` for `{}`",
+            decl.type_name, decl.name
+        ),
+        BadCell::NotFinite => format!(
+            "`{cell}` for `{}` is not a finite number: NaN and infinities are refused \
+             (every comparison with NaN is false, so a verdict over it would mean nothing)",
+            decl.name
+        ),
     }
 }

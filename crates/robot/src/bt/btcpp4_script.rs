@@ -323,7 +323,10 @@ impl Tr<'_> {
             (_, Some(ts)) => ts.iter().map(String::as_str).collect(),
             _ => self.strs.texts.iter().map(String::as_str).collect(),
         };
-        let (throws, n) = self.strs.number(&v.x, &texts).map_err(|w| (e.at, w))?;
+        let (throws, n) = self
+            .strs
+            .number(&v.x, &texts)
+            .map_err(|w| (e.at, w.to_string()))?;
         if let Some(c) = throws {
             self.check(guard, c);
         }

@@ -110,8 +110,12 @@ impl Strings {
 
     /// The string whose rank is `x` (a model expression) read as a number, when it is
     /// one of `texts`: the condition under which BT.CPP throws and the number; `Err`
-    /// naming a text whose number the model does not know.
-    pub fn number(&self, x: &str, texts: &[&str]) -> Result<(Option<String>, String), String> {
+    /// with a text whose number the model does not know.
+    pub fn number(
+        &self,
+        x: &str,
+        texts: &[&str],
+    ) -> Result<(Option<String>, String), UnknownNumber> {
         let mut throws = Vec::new();
         let mut value = "0".to_string();
         for t in texts.iter().rev() {
@@ -119,11 +123,7 @@ impl Strings {
             match as_number(t) {
                 AsNumber::Int(n) => value = format!("({x} == {id} ? {n} : {value})"),
                 AsNumber::Throws => throws.push(format!("{x} == {id}")),
-                AsNumber::Unknown => {
-                    return Err(format!(
-                        "the string `{t}` read as a number: BT.CPP 4.8.2 reads a prefix of a text as a number by rules the model does not know (`3abc` is 3, `0x10` 16, `true` 1); modelled are whole decimal numbers with spaces around them, and texts of letters (which throw)"
-                    ))
-                }
+                AsNumber::Unknown => return Err(UnknownNumber(t.to_string())),
             }
         }
         if texts.len() == 1 {
@@ -134,6 +134,21 @@ impl Strings {
         }
         let throws = (!throws.is_empty()).then(|| throws.join(" || "));
         Ok((throws, value))
+    }
+}
+
+/// A text read as a number by rules the model does not know (the text), for the
+/// refusal: [`Strings::number`].
+#[derive(Debug, Clone)]
+pub(crate) struct UnknownNumber(pub String);
+
+impl std::fmt::Display for UnknownNumber {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the string `{}` read as a number: BT.CPP 4.8.2 reads a prefix of a text as a number by rules the model does not know (`3abc` is 3, `0x10` 16, `true` 1); modelled are whole decimal numbers with spaces around them, and texts of letters (which throw)",
+            self.0
+        )
     }
 }
 
@@ -234,23 +249,7 @@ pub(super) fn prepare(tree: &Tree, bb: &mut Blackboard) {
             continue;
         }
         s.set_entries.push(g.clone());
-        for n in &tree.nodes {
-            if n.kind != Kind::Control(Control::SetBlackboard) {
-                continue;
-            }
-            let (Some(k), Some(v)) = (n.port("output_key"), n.port("value")) else {
-                continue;
-            };
-            let key = match &k.value {
-                PortValue::Literal(v) => v.trim().to_string(),
-                PortValue::Blackboard(b) => b.clone(),
-            };
-            if key == *g {
-                if let PortValue::Literal(v) = &v.value {
-                    texts.push(v.clone());
-                }
-            }
-        }
+        texts.extend(set_texts(tree, g));
     }
     // Entries a LoopString writes that scripts name (`btcpp4_loop.rs`).
     let looped = super::btcpp4_loop::script_strings(tree, bb);

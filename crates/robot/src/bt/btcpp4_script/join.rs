@@ -275,7 +275,7 @@ impl Side {
 /// a `?:` per text the left may hold, over one per text the right may hold; pairs whose
 /// text is not among the tree's texts cannot happen (the closure holds every text a
 /// join can make) and are left out.
-fn table(s: &Strings, l: &Side, r: &Side) -> Result<String, String> {
+fn table(s: &Strings, l: &Side, r: &Side) -> Result<String, Overflow> {
     let rank = |t: &str| s.texts.binary_search_by(|x| x.as_str().cmp(t)).ok();
     let chain = |x: &str, items: Vec<(i64, String)>| -> Option<String> {
         let (last, rest) = items.split_last()?;
@@ -287,7 +287,7 @@ fn table(s: &Strings, l: &Side, r: &Side) -> Result<String, String> {
     };
     let n = l.cases().len() * r.cases().len();
     if n > TABLE {
-        return Err(format!("a join whose operands may hold {n} pairs of texts: more than {TABLE}, which is not modelled"));
+        return Err(Overflow(format!("a join whose operands may hold {n} pairs of texts: more than {TABLE}, which is not modelled")));
     }
     let mut outer = Vec::new();
     for a in l.cases() {
@@ -371,7 +371,7 @@ impl Tr<'_> {
         }
         let l = self.side(a, guard)?;
         let r = self.side(b, guard)?;
-        let x = table(self.strs, &l, &r).map_err(|w| (e.at, w))?;
+        let x = table(self.strs, &l, &r).map_err(|Overflow(w)| (e.at, w))?;
         Ok(val(x, Ty::Text, "false"))
     }
 
@@ -399,7 +399,7 @@ impl Tr<'_> {
             &Side::Var(g.to_string(), old),
             &Side::Var(v.x, ts),
         )
-        .map_err(|w| (at, w))?;
+        .map_err(|Overflow(w)| (at, w))?;
         self.checks.push(format!("!{}", super::has(g)));
         Ok(Lowered {
             checks: self.checks,
