@@ -107,12 +107,12 @@ fn scripts_the_btcpp_lowering_cannot_model_are_refused_saying_why() {
     // script and the reason.
     let btcpp = BtSemantics::Btcpp { tick: BtTick::Once };
     for (code, col, why) in [
-        ("x := 'a' + 'b'", 6, "joins them"),
         (
-            "x := 'a'; x := 1",
-            11,
-            "which a script also assigns strings",
+            "y := 1; x := 'a' .. y",
+            21,
+            "a number that is not a literal",
         ),
+        ("x := 'a'; x := 1", 11, "which holds strings"),
         ("x := 1 == 'a3'", 11, "reads a prefix of a text as a number"),
         ("x := 1. &lt; 2", 6, "not one BT.CPP 4 reads"),
         ("x := 1e400 &gt; 0", 6, "out of a double's range"),
