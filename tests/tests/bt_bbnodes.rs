@@ -60,10 +60,15 @@ fn load() -> Vec<(String, Case)> {
 
 /// Where the oracle departs from the case's facts, if anywhere.
 fn check(c: &Case) -> Result<(), String> {
-    let xml = format!(
-        "<root BTCPP_format=\"4\"><BehaviorTree ID=\"Main\">{}</BehaviorTree></root>",
-        c.tree
-    );
+    // A case with SubTrees is a whole document (`subtree.toml`).
+    let xml = if c.tree.trim_start().starts_with("<root") {
+        c.tree.clone()
+    } else {
+        format!(
+            "<root BTCPP_format=\"4\"><BehaviorTree ID=\"Main\">{}</BehaviorTree></root>",
+            c.tree
+        )
+    };
     let scripts: Scripts = c
         .scripts
         .iter()

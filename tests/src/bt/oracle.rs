@@ -275,6 +275,9 @@ pub struct Oracle<'t> {
     idx: Vec<i64>,
     /// Parallel's finished children (BT.CPP readings) and counts.
     done: Vec<Vec<bool>>,
+    /// 3.8 Parallel: the status a finished child keeps (`child_node->status()`), which
+    /// for a SubTree is the SubtreeNode's own: its body was reset when it finished.
+    kept: Vec<Vec<Option<Status>>>,
     counts: Vec<(i64, i64)>,
     /// Ticks each leaf instance received.
     leaf_ticks: Vec<usize>,
@@ -362,6 +365,11 @@ impl<'t> Oracle<'t> {
                 .nodes
                 .iter()
                 .map(|x| vec![false; x.children.len()])
+                .collect(),
+            kept: tree
+                .nodes
+                .iter()
+                .map(|x| vec![None; x.children.len()])
                 .collect(),
             counts: vec![(0, 0); n],
             leaf_ticks: vec![0; n],
@@ -1718,10 +1726,13 @@ impl<'t> Oracle<'t> {
         for i in 0..len as usize {
             let c = self.child(n, i);
             let st = if self.done[n][i] {
-                self.status[c].ok_or_else(|| Stop::Model("skipped child is idle".into()))?
+                self.kept[n][i].ok_or_else(|| Stop::Model("skipped child is idle".into()))?
             } else {
                 self.tick(c)?
             };
+            if matches!(st, Status::Success | Status::Failure) {
+                self.kept[n][i] = Some(st);
+            }
             match st {
                 Status::Skipped => return Err(Stop::Model("SKIPPED: not modelled here".into())),
                 Status::Success => {
