@@ -2113,6 +2113,13 @@ fn subtree_condition_cases_hold_in_the_oracle_and_the_lowering() {
     gtest_file_holds("subtree.toml", 5);
 }
 
+/// Entries named as words the model's expressions reserve (`tests/bt/btcpp4/names.toml`,
+/// measured in 4.8.2), as [`skipping_gtests_hold_in_the_oracle_and_the_lowering`].
+#[test]
+fn entry_name_cases_hold_in_the_oracle_and_the_lowering() {
+    gtest_file_holds("names.toml", 5);
+}
+
 /// The cases of `tests/bt/btcpp4/<file>` (at least `min`) in the oracle and the lowering.
 fn gtest_file_holds(file: &str, min: usize) {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -102,5 +102,5 @@ mod parse;
 pub mod value;
 
 pub use compile::Entropy;
-pub use parse::{parse_expr, ParseError, MAX_NESTING};
+pub use parse::{is_reserved, parse_expr, ParseError, MAX_NESTING};
 pub use value::{ListRef, OwnedValue, StrId, Strings, StructDef, Ty, TypeTable, Value};

@@ -84,6 +84,28 @@ fn ident_char(c: char) -> bool {
     c.is_ascii_alphanumeric() || c == '_' || c == '$'
 }
 
+/// Whether `word` is reserved by the expression language, so that it cannot name a
+/// variable: the literals `true` and `false`, and the ECMAScript words it refuses
+/// (`null`, `NaN`, `var`, ...). A lowering that names model variables after names of
+/// another language (behavior tree entries) renames these.
+pub fn is_reserved(word: &str) -> bool {
+    matches!(
+        word,
+        "true"
+            | "false"
+            | "null"
+            | "undefined"
+            | "NaN"
+            | "Infinity"
+            | "new"
+            | "function"
+            | "this"
+            | "typeof"
+            | "var"
+            | "let"
+    )
+}
+
 fn name(i: &str) -> IResult<&str, &str> {
     recognize(pair(take_while1(ident_start), take_while(ident_char))).parse(i)
 }
@@ -508,8 +530,7 @@ impl P {
             let kind = match n {
                 "true" => ExprKind::Bool(true),
                 "false" => ExprKind::Bool(false),
-                "null" | "undefined" | "NaN" | "Infinity" | "new" | "function" | "this"
-                | "typeof" | "var" | "let" => {
+                n if is_reserved(n) => {
                     return Err(self.err(i, format!("`{n}` is not supported")));
                 }
                 _ => ExprKind::Ident(n.to_string()),

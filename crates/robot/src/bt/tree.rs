@@ -579,6 +579,19 @@ fn is_ident(s: &str) -> bool {
         && cs.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
+/// The model variable of the main tree's entry `name`: the entry's own name, but for a
+/// word the model's expressions reserve (`var`, `NaN`, ...: `hindsight_expr::is_reserved`),
+/// which BehaviorTree.CPP takes as an entry name (4.10's `gtest_subtree.cpp`
+/// `SubtreeIssue592` writes `var`) and which becomes `bb__` and the word. A SubTree's own
+/// entries carry its prefix, so they are never reserved.
+pub(crate) fn root_entry(name: &str) -> String {
+    if hindsight_expr::is_reserved(name) {
+        format!("bb__{name}")
+    } else {
+        name.to_string()
+    }
+}
+
 /// A port value as text (an entry as `{entry}`).
 fn lit(v: &PortValue) -> String {
     match v {
@@ -629,7 +642,7 @@ impl Reader<'_> {
 
     fn resolve_bb(&self, name: &str, depth: usize) -> PortValue {
         if depth == 0 {
-            return PortValue::Blackboard(name.to_string());
+            return PortValue::Blackboard(root_entry(name));
         }
         let s = &self.scopes[depth - 1];
         if let Some(v) = s.map.get(name) {
@@ -807,7 +820,8 @@ impl Reader<'_> {
                     let k = k.trim().to_string();
                     if self.scopes.is_empty() && is_ident(&k) {
                         if !script_names.iter().any(|(n, _)| *n == k) {
-                            script_names.push((k.clone(), PortValue::Blackboard(k)));
+                            let v = self.resolve_bb(&k, 0);
+                            script_names.push((k, v));
                         }
                     } else if !self.scopes.is_empty() {
                         self.err(p.span, "UnsetBlackboard inside a SubTree is not modelled (BehaviorTree.CPP erases the SubTree's own entry only, which a remapped key may or may not be)".to_string());
