@@ -65,13 +65,16 @@ use super::control::{init_state, n_children, Ctx, FAILURE, RUNNING, SUCCESS};
 use super::script::{self, Ex, Stmt, K};
 use super::tree::{PortValue, ScriptNode, TreeNode};
 use crate::model::source::{Diagnostic, SourceMap, Span};
-use crate::model::types::Scalar;
 use crate::model::xml::Element;
 
+mod entries;
 mod join;
 mod num;
+
+use entries::{assign_text, resolve};
 pub(crate) use join::{closure, Overflow, Script, CAP};
 pub(crate) use num::{entry_type, float_entries};
+use num::{literal, nonzero_literal};
 
 /// The blackboard machine's flag: a script threw.
 pub(crate) const FAULT: &str = "bt_script_fault";
@@ -116,17 +119,6 @@ const BITS: &str = "this operator is not modelled";
 /// a port, a Loop node or UnsetBlackboard gives (entries only scripts write hold it:
 /// [`float_entries`]).
 const STORE_REAL: &str = "the entry has an integer type a port, a Loop node or UnsetBlackboard gives it, and BT.CPP converts a double stored there (throwing unless it is whole), which is not modelled for those entries";
-
-/// A number literal other than 0, possibly negated: a divisor the model's floats divide
-/// by as BT.CPP's doubles do (no zero, so no sign of zero to lose).
-fn nonzero_literal(e: &Ex) -> bool {
-    match &e.k {
-        K::Int(n) => *n != 0,
-        K::Number(t) => literal(t).is_ok_and(|(x, _)| x.parse::<f64>().is_ok_and(|v| v != 0.0)),
-        K::Un("-", a) => nonzero_literal(a),
-        _ => false,
-    }
-}
 
 /// `f32::EPSILON`, within which BT.CPP 4.10 counts two doubles equal
 /// (`scripting/operators.hpp`, `IsSame`).
@@ -194,81 +186,6 @@ fn cast_bool(v: &Val) -> (Option<String>, String) {
             )),
             format!("({x} != 0)"),
         ),
-    }
-}
-
-/// A real literal as BT.CPP 4 reads it (`scripting/any_types.hpp`, `Grammar::Real`:
-/// digits, then `.digits` and an optional exponent, or an exponent; `std::stod`, which
-/// refuses a value out of range) or a hexadecimal integer (`Grammar::Integer`).
-fn literal(t: &str) -> Result<(String, Ty), BadNumber> {
-    if let Some(h) = t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
-        return i64::from_str_radix(h, 16)
-            .map(|v| (v.to_string(), Ty::Int))
-            .map_err(|_| BadNumber::Unread(t.to_string()));
-    }
-    let b = t.as_bytes();
-    let digits = |mut i: usize| {
-        let s = i;
-        while i < b.len() && b[i].is_ascii_digit() {
-            i += 1;
-        }
-        (i, i > s)
-    };
-    let (mut i, _) = digits(0);
-    let mut real = false;
-    if i < b.len() && b[i] == b'.' {
-        let (j, some) = digits(i + 1);
-        if !some {
-            return Err(BadNumber::Refused(t.to_string()));
-        }
-        (i, real) = (j, true);
-    }
-    if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
-        let j = i + 1 + usize::from(b.get(i + 1).is_some_and(|c| *c == b'+' || *c == b'-'));
-        let (k, some) = digits(j);
-        if !some {
-            return Err(BadNumber::Refused(t.to_string()));
-        }
-        (i, real) = (k, true);
-    }
-    if i != b.len() || !real {
-        return Err(BadNumber::Refused(t.to_string()));
-    }
-    let v: f64 = t.parse().map_err(|_| BadNumber::Unread(t.to_string()))?;
-    let zero = t
-        .split(['e', 'E'])
-        .next()
-        .is_some_and(|m| m.bytes().all(|c| c == b'0' || c == b'.'));
-    if !v.is_finite() || (!v.is_normal() && !zero) {
-        return Err(BadNumber::OutOfRange(t.to_string()));
-    }
-    Ok((format!("{v:?}"), Ty::Real))
-}
-
-/// Why [`literal`] refused a number (the number as written).
-#[derive(Debug, Clone, PartialEq, Eq)]
-enum BadNumber {
-    /// Not a number BT.CPP 4 reads.
-    Unread(String),
-    /// Outside BT.CPP 4's grammar: 4.8.2 refuses it when the tree loads.
-    Refused(String),
-    /// Outside a double's range: `std::stod` throws when the tree loads.
-    OutOfRange(String),
-}
-
-impl std::fmt::Display for BadNumber {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            BadNumber::Unread(t) => write!(f, "the number `{t}` is not one BT.CPP 4 reads"),
-            BadNumber::Refused(t) => write!(
-                f,
-                "the number `{t}` is not one BT.CPP 4 reads (4.8.2 refuses it at load)"
-            ),
-            BadNumber::OutOfRange(t) => write!(
-                f,
-                "the number `{t}` is out of a double's range (BT.CPP's `std::stod` throws at load)"
-            ),
-        }
     }
 }
 
@@ -637,144 +554,6 @@ fn statement(
         assigns,
         value: Val { x: g, t: et, d },
     })
-}
-
-/// An assignment where a string meets an entry (BT.CPP 4.10 `ExprAssignment::evaluate`
-/// and 4.8.2, measured): `entry_text`, the entry holds strings (a script creates it);
-/// else it holds numbers and `v` is a string. `=`, `:=` of a string to a string entry
-/// store its rank; `+=` of two strings joins them (`join.rs`, handled before); `-=`, `*=`, `/=` with
-/// a string, and `+=` of a number to a string entry, throw ("Operator not supported for
-/// strings", "can't be used with a non-numeric type"), as does `+=` of a string to a
-/// number ("Any::copyInto fails"). A number stored in a string entry, or a string in a
-/// number entry (4.8.2 converts it), is refused: the entry's type would change.
-fn assign_text(
-    mut checks: Vec<String>,
-    g: &str,
-    entry_text: bool,
-    v: Val,
-    op: &str,
-    at: usize,
-) -> Result<Lowered, Refuse> {
-    let text = v.t == Ty::Text;
-    let throws = |mut checks: Vec<String>, v: Val| {
-        checks.push("true".into());
-        Ok(Lowered {
-            checks,
-            assigns: Vec::new(),
-            value: v,
-        })
-    };
-    match (entry_text, text, op) {
-        (true, true, ":=" | "=") => {
-            if op == "=" {
-                // "The blackboard entry [..] doesn't exist".
-                checks.push(format!("!{}", has(g)));
-            }
-            Ok(Lowered {
-                checks,
-                assigns: vec![(g.to_string(), v.x), (has(g), "true".into())],
-                value: val(g.to_string(), Ty::Text, "false"),
-            })
-        }
-        (_, _, ":=" | "=") if entry_text => Err((at, format!("assigning a number to `{g}`, which holds strings (a script or a LoopString writes them): BT.CPP 4 throws where it holds a string and stores the number where it holds none, and an entry whose type changes is not modelled"))),
-        (_, _, ":=" | "=") => Err((at, format!("assigning a string to `{g}`, which holds numbers: BT.CPP 4.8.2 converts the text to the entry's type, which is not modelled"))),
-        _ => throws(checks, v),
-    }
-}
-
-/// Resolves node `n`'s script names to entries with their types, registering the
-/// entries only scripts write (`int64`); an error at `span` for a name that cannot be
-/// modelled.
-fn resolve(
-    sm: &SourceMap,
-    n: &TreeNode,
-    span: Span,
-    bb: &mut Blackboard,
-    errs: &mut Vec<Diagnostic>,
-) -> Option<Vec<Name>> {
-    let mut out = Vec::new();
-    let before = errs.len();
-    for (name, v) in &n.script_names {
-        let g = match v {
-            PortValue::Blackboard(g) => g.clone(),
-            PortValue::Literal(c) => {
-                errs.push(sm.diag(span, format!("the script's entry `{name}` is the constant `{c}` its SubTree sets: a script over a SubTree's constant port is not modelled (map it to an entry, `{{...}}`)")));
-                continue;
-            }
-        };
-        if bb.texts.contains(&g) {
-            // BT.CPP 4 holds SetBlackboard's text; a script reads a string there, its
-            // rank kept beside the value other nodes read (`btcpp4_strings.rs`), where
-            // no plugin port types the entry (a plugin's output would store a number)
-            // and no SetBlackboard copies to or from it (4.8.2's copies leave entries a
-            // script cannot read, `tests/bt/real/set_blackboard.toml`).
-            if !bb.strings.set_entries.contains(&g) {
-                errs.push(sm.diag(span, format!("the script uses the entry `{g}`, which a SetBlackboard writes: BT.CPP 4 stores SetBlackboard's value as text; scripts read it only where no plugin's port types it and no SetBlackboard copies to or from it")));
-                continue;
-            }
-            if !bb.script_entries.contains(&g) {
-                bb.script_entries.push(g.clone());
-            }
-            out.push((name.clone(), g, Ty::Text, false));
-            continue;
-        }
-        // An entry no port types: BT.CPP's script creates it (`PortInfo()`, any type).
-        let dynamic = bb.entry(&g).is_none_or(|e| e.why == "a script");
-        if bb.strings.script_entries.contains(&g) {
-            // A script assigns it strings: it holds its text's rank
-            // (`btcpp4_strings.rs`).
-            match bb.entry(&g) {
-                None => bb.entries.push(super::blackboard::Entry {
-                    name: g.clone(),
-                    ty: "int64".into(),
-                    span,
-                    why: "a script".into(),
-                }),
-                Some(e) if e.why == "a script" => {}
-                Some(e) => {
-                    let at = sm.diag(e.span, "");
-                    errs.push(sm.diag(span, format!("a script assigns a string to the entry `{g}`, which is {} at {}:{}:{} ({}): a string in an entry a port types is not modelled", e.ty, at.file, at.line, at.col, e.why)));
-                    continue;
-                }
-            }
-            if !bb.script_entries.contains(&g) {
-                bb.script_entries.push(g.clone());
-            }
-            out.push((name.clone(), g, Ty::Text, true));
-            continue;
-        }
-        let t = match bb.entry(&g) {
-            None => {
-                let ty = entry_type(bb, &g);
-                bb.entries.push(super::blackboard::Entry {
-                    name: g.clone(),
-                    ty: ty.into(),
-                    span,
-                    why: "a script".into(),
-                });
-                if ty == "float64" {
-                    Ty::Real
-                } else {
-                    Ty::Int
-                }
-            }
-            Some(e) => match Scalar::from_name(e.ty.trim()) {
-                Some(Scalar::Bool) => Ty::Bool,
-                Some(Scalar::F64) if dynamic => Ty::Real,
-                Some(s) if s.int_range().is_some() => Ty::Int,
-                _ => {
-                    let at = sm.diag(e.span, "");
-                    errs.push(sm.diag(span, format!("the script uses the entry `{g}`, which is {} at {}:{}:{} ({}): scripts over entries other than integers and booleans are not modelled yet", e.ty, at.file, at.line, at.col, e.why)));
-                    continue;
-                }
-            },
-        };
-        if !bb.script_entries.contains(&g) {
-            bb.script_entries.push(g.clone());
-        }
-        out.push((name.clone(), g, t, dynamic));
-    }
-    (errs.len() == before).then_some(out)
 }
 
 /// The body of a blackboard-machine transition that runs `code` (a script of node `n`

@@ -43,6 +43,7 @@ mod btcpp4_script;
 mod btcpp4_skip;
 mod btcpp4_strings;
 mod btcpp4_subtree;
+mod btcpp4_switch;
 mod btcpp4_time;
 mod build;
 mod control;

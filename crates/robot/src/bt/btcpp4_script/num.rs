@@ -38,7 +38,7 @@
 use super::super::blackboard::Blackboard;
 use super::super::script::{self, Ex, K};
 use super::super::tree::{Btcpp4, Control, Kind, PortValue, Tree};
-use super::{dbl, has, int, literal, nonzero_literal, val, Lowered, Refuse, Tr, Ty, Val};
+use super::{dbl, has, int, val, Lowered, Refuse, Tr, Ty, Val};
 
 /// 2^63: a double at or beyond it (in size) is out of `int64_t`'s range.
 const I64_END: &str = "9223372036854775808.0";
@@ -315,4 +315,90 @@ pub(super) fn float_statement(
             d,
         },
     })
+}
+
+/// A number literal other than 0, possibly negated: a divisor the model's floats divide
+/// by as BT.CPP's doubles do (no zero, so no sign of zero to lose).
+pub(super) fn nonzero_literal(e: &Ex) -> bool {
+    match &e.k {
+        K::Int(n) => *n != 0,
+        K::Number(t) => literal(t).is_ok_and(|(x, _)| x.parse::<f64>().is_ok_and(|v| v != 0.0)),
+        K::Un("-", a) => nonzero_literal(a),
+        _ => false,
+    }
+}
+
+/// A real literal as BT.CPP 4 reads it (`scripting/any_types.hpp`, `Grammar::Real`:
+/// digits, then `.digits` and an optional exponent, or an exponent; `std::stod`, which
+/// refuses a value out of range) or a hexadecimal integer (`Grammar::Integer`).
+pub(super) fn literal(t: &str) -> Result<(String, Ty), BadNumber> {
+    if let Some(h) = t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
+        return i64::from_str_radix(h, 16)
+            .map(|v| (v.to_string(), Ty::Int))
+            .map_err(|_| BadNumber::Unread(t.to_string()));
+    }
+    let b = t.as_bytes();
+    let digits = |mut i: usize| {
+        let s = i;
+        while i < b.len() && b[i].is_ascii_digit() {
+            i += 1;
+        }
+        (i, i > s)
+    };
+    let (mut i, _) = digits(0);
+    let mut real = false;
+    if i < b.len() && b[i] == b'.' {
+        let (j, some) = digits(i + 1);
+        if !some {
+            return Err(BadNumber::Refused(t.to_string()));
+        }
+        (i, real) = (j, true);
+    }
+    if i < b.len() && (b[i] == b'e' || b[i] == b'E') {
+        let j = i + 1 + usize::from(b.get(i + 1).is_some_and(|c| *c == b'+' || *c == b'-'));
+        let (k, some) = digits(j);
+        if !some {
+            return Err(BadNumber::Refused(t.to_string()));
+        }
+        (i, real) = (k, true);
+    }
+    if i != b.len() || !real {
+        return Err(BadNumber::Refused(t.to_string()));
+    }
+    let v: f64 = t.parse().map_err(|_| BadNumber::Unread(t.to_string()))?;
+    let zero = t
+        .split(['e', 'E'])
+        .next()
+        .is_some_and(|m| m.bytes().all(|c| c == b'0' || c == b'.'));
+    if !v.is_finite() || (!v.is_normal() && !zero) {
+        return Err(BadNumber::OutOfRange(t.to_string()));
+    }
+    Ok((format!("{v:?}"), Ty::Real))
+}
+
+/// Why [`literal`] refused a number (the number as written).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(super) enum BadNumber {
+    /// Not a number BT.CPP 4 reads.
+    Unread(String),
+    /// Outside BT.CPP 4's grammar: 4.8.2 refuses it when the tree loads.
+    Refused(String),
+    /// Outside a double's range: `std::stod` throws when the tree loads.
+    OutOfRange(String),
+}
+
+impl std::fmt::Display for BadNumber {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BadNumber::Unread(t) => write!(f, "the number `{t}` is not one BT.CPP 4 reads"),
+            BadNumber::Refused(t) => write!(
+                f,
+                "the number `{t}` is not one BT.CPP 4 reads (4.8.2 refuses it at load)"
+            ),
+            BadNumber::OutOfRange(t) => write!(
+                f,
+                "the number `{t}` is out of a double's range (BT.CPP's `std::stod` throws at load)"
+            ),
+        }
+    }
 }
