@@ -5,8 +5,9 @@
 //! `tickExactlyOnce`): root status per executor tick and every leaf tick and halt must
 //! agree.
 //!
-//! `HINDSIGHT_BT_TREES` sets how many random trees (default 10,000); `HINDSIGHT_BT_SEED`
-//! the first seed. Trees with Timeout, Delay, Sleep and TryCatch run with the lowered root
+//! `HINDSIGHT_BT_TREES` sets how many random trees (default 10,000 of the nodes AS2FM and
+//! BT.CPP share; 3,000 for each test of one more feature, `HINDSIGHT_BT_FEATURE_TREES`
+//! for those alone: [`trees`]); `HINDSIGHT_BT_SEED` the first seed. Trees with Timeout, Delay, Sleep and TryCatch run with the lowered root
 //! machine itself, which keeps the timers' clock in model time
 //! (`bt_common::lower_and_run_clocked`, 10 Hz, the oracle's default period).
 //!
@@ -727,7 +728,7 @@ fn random_trees_with_unset_lower_to_what_btcpp_does() {
     };
     random_trees(opts);
     // The trees held UnsetBlackboard (the same seeds, generated again).
-    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let n = trees(opts);
     let seed0 = env("HINDSIGHT_BT_SEED", 0);
     let with = (seed0..seed0 + n)
         .filter(|&seed| {
@@ -765,7 +766,7 @@ fn loop_strings() -> gen::Options {
 fn random_trees_with_loop_strings_lower_to_what_btcpp_does() {
     let opts = loop_strings();
     random_trees(opts);
-    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let n = trees(opts);
     let with = drawn_again(opts, gen::Conditions::WithoutSkip)
         .filter(|c| c.xml.contains("value=\"{t}\""))
         .count() as u64;
@@ -791,7 +792,7 @@ fn random_trees_with_bb_nodes_lower_to_what_btcpp_does() {
         ..Default::default()
     };
     random_trees(opts);
-    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let n = trees(opts);
     let cov = bb_coverage(opts, gen::Conditions::All);
     eprintln!(
         "trees with BT.CPP 4's blackboard nodes: {}",
@@ -824,7 +825,7 @@ fn random_trees_with_reals_lower_to_what_btcpp_does() {
     };
     random_trees(opts);
     // The trees held the new constructs (the same seeds, generated again).
-    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let n = trees(opts);
     let (mut division, mut real_lit, mut double_init) = (0u64, 0u64, 0u64);
     for c in drawn_again(opts, gen::Conditions::WithoutSkip) {
         division += u64::from(c.xml.contains(" / "));
@@ -862,7 +863,7 @@ fn random_trees_with_bits_and_stored_reals_lower_to_what_btcpp_does() {
         ..Default::default()
     };
     random_trees(opts);
-    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let n = trees(opts);
     let (mut bits, mut stored, mut var_div, mut int_store) = (0u64, 0u64, 0u64, 0u64);
     for c in drawn_again(opts, gen::Conditions::WithoutSkip) {
         bits += u64::from(
@@ -923,7 +924,7 @@ fn random_trees_with_strings_lower_to_what_btcpp_does() {
     };
     random_trees(opts);
     // The trees held the new constructs (the same seeds, generated again).
-    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let n = trees(opts);
     let (mut two, mut with_number, mut assigned) = (0u64, 0u64, 0u64);
     for c in drawn_again(opts, gen::Conditions::WithoutSkip) {
         let t = tree::read(&c.xml).expect("the oracle reads what it generates");
@@ -978,7 +979,7 @@ fn joins_opts() -> gen::Options {
 fn random_trees_with_joins_lower_to_what_btcpp_does() {
     random_trees(joins_opts());
     // The trees held the new constructs (the same seeds, generated again).
-    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let n = trees(joins_opts());
     let (mut joined, mut numbers, mut compared) = (0u64, 0u64, 0u64);
     for c in drawn_again(joins_opts(), gen::Conditions::WithoutSkip) {
         joined += u64::from(c.xml.contains("u := ") || c.xml.contains("u = "));
@@ -1278,10 +1279,27 @@ fn script_features(xml: &str) -> (bool, bool) {
     (texts, chains)
 }
 
+/// How many random trees the test of `opts` draws: `HINDSIGHT_BT_TREES` (default
+/// 10,000) for the trees of the nodes AS2FM and BT.CPP share (`gen::Options::default()`);
+/// for the trees of one more feature each (scripts, strings, the blackboard nodes, time
+/// nodes, ...), `HINDSIGHT_BT_FEATURE_TREES`, else `HINDSIGHT_BT_TREES`, else 3,000, so
+/// that the many such tests fit the CI budget (each held 0 disagreements on 10,000
+/// when it landed; set either variable to run more).
+fn trees(opts: gen::Options) -> u64 {
+    if opts == gen::Options::default() {
+        env("HINDSIGHT_BT_TREES", 10_000)
+    } else {
+        env(
+            "HINDSIGHT_BT_FEATURE_TREES",
+            env("HINDSIGHT_BT_TREES", 3_000),
+        )
+    }
+}
+
 /// The trees [`random_trees`] drew for `opts` (`HINDSIGHT_BT_TREES` seeds from
 /// `HINDSIGHT_BT_SEED`), generated again, so a test can count what they held.
 fn drawn_again(opts: gen::Options, conds: gen::Conditions) -> impl Iterator<Item = gen::Case> {
-    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let n = trees(opts);
     let seed0 = env("HINDSIGHT_BT_SEED", 0);
     (seed0..seed0 + n).map(move |seed| {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
@@ -1292,7 +1310,7 @@ fn drawn_again(opts: gen::Options, conds: gen::Conditions) -> impl Iterator<Item
 /// `HINDSIGHT_BT_TREES` random trees from `HINDSIGHT_BT_SEED`, each lowered under both
 /// tick modes and compared with the oracle's BT.CPP 4 reading.
 fn random_trees(opts: gen::Options) {
-    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let n = trees(opts);
     let timed = opts.time_nodes || opts.try_catch;
     let seed0 = env("HINDSIGHT_BT_SEED", 0);
     let threads = std::thread::available_parallelism()
@@ -2368,14 +2386,17 @@ const SUBTREE_KINDS: [&str; 10] = [
 ];
 
 /// Pre/post conditions on `<SubTree>` nodes (`btcpp4_subtree.rs`; the oracle's
-/// `subtree_cond.rs`): `HINDSIGHT_BT_TREES` random trees (default 10,000) drawn with
+/// `subtree_cond.rs`): [`trees`] random trees (default 3,000) drawn with
 /// `gen::Options::subtree_conds`, those with a SubTree node of their own (with
 /// conditions) lowered under both tick modes and compared with the oracle's BT.CPP 4
 /// reading (the others are the trees of `random_trees_with_skipped_...` with another
 /// random stream: not run again).
 #[test]
 fn random_trees_with_subtree_conditions_lower_to_what_btcpp_does() {
-    let n = env("HINDSIGHT_BT_TREES", 10_000);
+    let n = trees(gen::Options {
+        subtree_conds: true,
+        ..Default::default()
+    });
     let seed0 = env("HINDSIGHT_BT_SEED", 0);
     let threads = std::thread::available_parallelism()
         .map_or(1, |p| p.get())
