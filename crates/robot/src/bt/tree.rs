@@ -417,6 +417,23 @@ pub(crate) struct Cond {
 }
 
 impl TreeNode {
+    /// Node `id` of `kind` written at `span` under `parent`, its machine named after
+    /// `label`: no ports, children, script names or conditions yet.
+    fn new(id: u32, kind: Kind, label: &str, span: Span, parent: Option<usize>) -> TreeNode {
+        TreeNode {
+            id,
+            kind,
+            machine: format!("BT_plugin_{id}_{label}"),
+            span,
+            ports: Vec::new(),
+            children: Vec::new(),
+            parent,
+            script_names: Vec::new(),
+            conds: Vec::new(),
+            subtree_body: false,
+        }
+    }
+
     /// The port called `key`, if the tree sets it.
     pub(crate) fn port(&self, key: &str) -> Option<&Port> {
         self.ports.iter().find(|p| p.key == key)
@@ -595,6 +612,16 @@ fn lit(v: &PortValue) -> String {
 }
 
 impl Reader<'_> {
+    /// Pushes `n` (numbered for the next index) as the last child of its parent.
+    fn push_node(&mut self, n: TreeNode) {
+        let idx = self.nodes.len();
+        debug_assert_eq!(n.id, FIRST_ID + idx as u32);
+        if let Some(p) = n.parent {
+            self.nodes[p].children.push(idx);
+        }
+        self.nodes.push(n);
+    }
+
     fn err(&mut self, span: Span, msg: impl Into<String>) {
         self.errs.push(self.sm.diag(span, msg));
     }
@@ -853,21 +880,12 @@ impl Reader<'_> {
                 }
             }
         }
-        self.nodes.push(TreeNode {
-            id,
-            kind,
-            machine: format!("BT_plugin_{id}_{label}"),
-            span: el.span,
+        self.push_node(TreeNode {
             ports,
-            children: Vec::new(),
-            parent,
             script_names,
             conds,
-            subtree_body: false,
+            ..TreeNode::new(id, kind, &label, el.span, parent)
         });
-        if let Some(p) = parent {
-            self.nodes[p].children.push(idx);
-        }
         let kids: Vec<&Element> = el.elements().collect();
         for k in &kids {
             self.node(k, Some(idx), depth);

@@ -211,21 +211,12 @@ impl Reader<'_> {
                 sanitize(el.attr_value("ID").unwrap_or("").trim())
             ),
         };
-        self.nodes.push(TreeNode {
-            id,
-            kind: Kind::Control(Control::Btcpp4(Btcpp4::SubTree)),
-            machine: format!("BT_plugin_{id}_{label}"),
-            span: el.span,
-            ports: Vec::new(),
-            children: Vec::new(),
-            parent,
+        let kind = Kind::Control(Control::Btcpp4(Btcpp4::SubTree));
+        self.push_node(TreeNode {
             script_names,
             conds,
-            subtree_body: false,
+            ..TreeNode::new(id, kind, &label, el.span, parent)
         });
-        if let Some(p) = parent {
-            self.nodes[p].children.push(idx);
-        }
         Some(idx)
     }
 }
