@@ -102,15 +102,11 @@ use iceoryx2::prelude::*;
 use monitor_core::Value;
 
 pub use clock::{check_speed, Clock, SPEED_RANGE};
-// For `hindsight`'s command line, which depends on this crate instead of on them: the DDS
-// participant and recordings (`replay`, `monitor --ros2`) and the IPC (`run`, `monitor`).
 use config::{Action, Config, Layout, Wire};
 use engine::{Change, Engine};
 use error::ipc;
 pub use error::LiveError;
-pub use iceoryx2;
 use record::Input;
-pub use ros2;
 
 type Ipc = ipc::Service;
 type Req = ActiveRequest<Ipc, [u8], (), [u8], ()>;
