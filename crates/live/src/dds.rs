@@ -45,8 +45,9 @@ use ros2::dds::{Participant, Reader, Received};
 use ros2::feed::TopicFeed;
 
 // The items of `hindsight-ros2` that `hindsight`'s command line names (it depends on this
-// crate, not on `hindsight-ros2`): the DDS domain (`ROS_DOMAIN_ID`), QoS in ROS 2's names,
-// a service's request and reply topics, and the MCAP writer of `--record`.
+// crate, not on `hindsight-ros2`): the DDS domain (`ROS_DOMAIN_ID`), a service's request
+// and reply topics, and the MCAP writer of `--record`; and `Qos`, the type of a
+// `TopicSource`'s field.
 pub use ros2::dds::{domain_id, service_topics, Qos};
 pub use ros2::write::McapWriter;
 
