@@ -5,10 +5,10 @@
 //! each saying why. (What the lowered nodes do is held to the oracle and the real library
 //! by `tests/tests/bt_btcpp_lowering.rs`.)
 
-use hindsight::model::source::SourceMap;
-use hindsight::model::xml::Element;
-use hindsight::model::Diagnostics;
 use hindsight::robot::bt::{self, BtInput, BtSemantics, BtTick, Halts};
+use hindsight::verify::model::source::SourceMap;
+use hindsight::verify::model::xml::Element;
+use hindsight::verify::model::Diagnostics;
 
 const LEAF: &str = r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="Act">
 <state id="s"><bt_tick target="s"><bt_return_status status="SUCCESS"/></bt_tick></state>

@@ -5,9 +5,9 @@ mod common;
 
 use std::path::Path;
 
-use hindsight::model::ModelSource;
 use hindsight::props::{self, PortKind, ANY};
 use hindsight::sim::CompiledModel;
+use hindsight::verify::model::ModelSource;
 use hindsight::verify::observe::PropertySet;
 
 fn model() -> CompiledModel {

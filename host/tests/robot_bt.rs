@@ -5,12 +5,12 @@
 
 mod common;
 
-use hindsight::model::source::{FileId, SourceMap};
-use hindsight::model::xml::{self, Element, Node};
-use hindsight::model::{Diagnostics, ModelSource};
 use hindsight::robot::bt::{self, BtInput, Halts};
 use hindsight::robot::write;
 use hindsight::sim::{CompiledModel, Flow, Observer, RunConfig, SentMessage, Simulator};
+use hindsight::verify::model::source::{FileId, SourceMap};
+use hindsight::verify::model::xml::{self, Element, Node};
+use hindsight::verify::model::{Diagnostics, ModelSource};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::collections::{BTreeMap, BTreeSet};
@@ -785,7 +785,7 @@ const COUNT: &str = r#"<ascxml name="Count" initial="s">
 fn lower_texts(
     tree: &str,
     plugins: &[&str],
-) -> Result<Vec<Element>, Vec<hindsight::model::Diagnostic>> {
+) -> Result<Vec<Element>, Vec<hindsight::verify::model::Diagnostic>> {
     let mut sm = SourceMap::new();
     let t = sm.add("t.xml", tree.to_string());
     let plugins = plugins

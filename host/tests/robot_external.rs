@@ -34,7 +34,7 @@ impl Observer for FakeBattery {
         if msg.event() == self.battery {
             if msg.origin() == EXTERNAL {
                 let level = match msg.param(0) {
-                    Some(hindsight::expr::Value::Int(v)) => v,
+                    Some(hindsight::verify::expr::Value::Int(v)) => v,
                     other => panic!("battery level {other:?}"),
                 };
                 self.posted.push((time, level));

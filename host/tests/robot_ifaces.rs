@@ -4,9 +4,9 @@
 
 mod common;
 
-use hindsight::model::source::SourceMap;
 use hindsight::robot::interfaces::{InterfaceKind, Interfaces};
 use hindsight::robot::types::{FlatField, InterfaceLookup};
+use hindsight::verify::model::source::SourceMap;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -631,9 +631,9 @@ fn data_declarations_read() {
     if common::corpus_or_skip().is_none() {
         return;
     }
-    use hindsight::model::types::{TypeDef, TypeDefs};
     use hindsight::robot::datatypes::{read_data_declarations, read_main_declarations, DataFormat};
     use hindsight::robot::main_file::MainFile;
+    use hindsight::verify::model::types::{TypeDef, TypeDefs};
     let mut read = 0;
     for main in main_files() {
         let mut sm = SourceMap::new();
@@ -801,10 +801,10 @@ fn printed_definitions_read_back() {
         d.file = None;
         for p in &mut d.parts {
             for f in &mut p.fields {
-                f.span = hindsight::model::source::FileId(0).at(0);
+                f.span = hindsight::verify::model::source::FileId(0).at(0);
             }
             for c in &mut p.constants {
-                c.span = hindsight::model::source::FileId(0).at(0);
+                c.span = hindsight::verify::model::source::FileId(0).at(0);
             }
         }
         d

@@ -8,9 +8,9 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use hindsight::model::source::SourceMap;
 use hindsight::robot::interfaces::{Interfaces, Search};
 use hindsight::robot::types::InterfaceLookup;
+use hindsight::verify::model::source::SourceMap;
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("hindsight-find-{}-{name}", std::process::id()));

@@ -5,14 +5,14 @@
 mod common;
 
 use common::canon::{canon, parse_file};
-use hindsight::model::source::{Diagnostic, SourceMap};
-use hindsight::model::xml::{self, Element};
-use hindsight::model::{Diagnostics, ModelSource};
 use hindsight::robot::ros::{lower, RosInput, RosOutput};
 use hindsight::robot::types::{
     ActionFields, FlatField, InterfaceLookup, LookupError, ServiceFields,
 };
 use hindsight::sim::{CompiledModel, Flow, Observer, RunConfig, SentMessage, Simulator};
+use hindsight::verify::model::source::{Diagnostic, SourceMap};
+use hindsight::verify::model::xml::{self, Element};
+use hindsight::verify::model::{Diagnostics, ModelSource};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::collections::BTreeMap;
@@ -296,7 +296,7 @@ fn model_of(sm: SourceMap, machines: &[Element]) -> Result<CompiledModel, Diagno
     };
     let mut errs = Diagnostics::default();
     for m in machines {
-        let file = hindsight::model::FileId::of(m.span);
+        let file = hindsight::verify::model::FileId::of(m.span);
         src.add_machine_tree(m, file, &mut errs);
     }
     if !errs.is_empty() {
@@ -438,7 +438,7 @@ fn every_case_without_a_tree_lowers_reads_and_compiles() {
                         sm.add(&p, std::fs::read_to_string(&p).unwrap());
                         sm
                     },
-                    hindsight::model::FileId(0),
+                    hindsight::verify::model::FileId(0),
                 )
                 .unwrap();
                 root.attr_value("name").unwrap().to_string()
@@ -487,9 +487,9 @@ impl Observer for Until<'_> {
             .collect();
         for (i, name) in names.iter().enumerate() {
             let v = match msg.param(i) {
-                Some(hindsight::expr::Value::Int(v)) => v as f64,
-                Some(hindsight::expr::Value::Float(v)) => v,
-                Some(hindsight::expr::Value::Bool(b)) => b as u8 as f64,
+                Some(hindsight::verify::expr::Value::Int(v)) => v as f64,
+                Some(hindsight::verify::expr::Value::Float(v)) => v,
+                Some(hindsight::verify::expr::Value::Bool(b)) => b as u8 as f64,
                 _ => continue,
             };
             self.topics.values.insert(format!("{ev}.{name}"), v);
@@ -632,8 +632,8 @@ impl Observer for Sends {
         let params: Vec<String> = msg
             .params()
             .map(|v| match v {
-                hindsight::expr::Value::Int(i) => format!("{:?}", i as f64),
-                hindsight::expr::Value::Float(f) => format!("{f:?}"),
+                hindsight::verify::expr::Value::Int(i) => format!("{:?}", i as f64),
+                hindsight::verify::expr::Value::Float(f) => format!("{f:?}"),
                 v => format!("{v:?}"),
             })
             .collect();

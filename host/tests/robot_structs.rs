@@ -5,11 +5,11 @@
 
 mod common;
 
-use hindsight::expr::{OwnedValue, Strings, Ty, TypeTable};
 use hindsight::robot::load::{load, RobotModel};
 use hindsight::sim::{
     CompiledModel, EndReason, EventSemantics, Flow, Observer, RunConfig, SentMessage, Simulator,
 };
+use hindsight::verify::expr::{OwnedValue, Strings, Ty, TypeTable};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::collections::BTreeMap;

@@ -1,10 +1,10 @@
 //! `EventSemantics::As2fm` on small models: targets ignored, all receivers at once,
 //! senders blocked while their event is pending, discards, and deadlocks.
 
-use hindsight::model::ModelSource;
 use hindsight::sim::{
     CompiledModel, EndReason, EventSemantics, Flow, Observer, RunConfig, SentMessage, Simulator,
 };
+use hindsight::verify::model::ModelSource;
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
@@ -175,7 +175,7 @@ fn receivers_keep_the_data_they_took() {
     impl Observer for Seen {
         fn on_send(&mut self, _: u64, m: &SentMessage<'_>) -> Flow {
             if m.event_name() == "seen" {
-                if let Some(hindsight::expr::Value::Int(v)) = m.param(0) {
+                if let Some(hindsight::verify::expr::Value::Int(v)) = m.param(0) {
                     self.0.push(v);
                 }
             }

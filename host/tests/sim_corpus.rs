@@ -36,7 +36,7 @@ fn as2fm_plain_models_compile_and_run() {
     for dir in &dirs {
         if !has_scxml(dir) {
             // A case AS2FM translated to JANI only: a clear error, not a panic.
-            let err = hindsight::model::load(dir).unwrap_err();
+            let err = hindsight::verify::model::load(dir).unwrap_err();
             assert!(err.to_string().contains("no .scxml file"), "{err}");
             continue;
         }
@@ -128,7 +128,7 @@ fn museum_runs() {
             .iter()
             .filter(|r| r.event == battery)
             .map(|r| match r.params[data] {
-                hindsight::expr::OwnedValue::Int(v) => (r.time, v),
+                hindsight::verify::expr::OwnedValue::Int(v) => (r.time, v),
                 ref v => panic!("{v:?}"),
             })
             .collect();

@@ -1,7 +1,7 @@
 //! Bad models are errors with file, line and column, never panics (including mutated inputs).
 
-use hindsight::model::{Diagnostics, ModelSource};
 use hindsight::sim::{CompiledModel, RunConfig, Simulator};
+use hindsight::verify::model::{Diagnostics, ModelSource};
 use rand_core::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
@@ -235,7 +235,7 @@ fn mutated_expressions_never_panic() {
             }
         }
         let text = String::from_utf8_lossy(&t);
-        if let Err(e) = hindsight::expr::parse_expr(&text) {
+        if let Err(e) = hindsight::verify::expr::parse_expr(&text) {
             assert!(e.offset as usize <= text.len());
         }
     }

@@ -1,10 +1,10 @@
 //! The simulator's semantics on small models with known behaviour (host/tests/data/sim).
 
-use hindsight::expr::{OwnedValue, Value};
 use hindsight::sim::{
     CompiledModel, EndReason, Flow, MachineId, Observer, Quiescence, RunConfig, RunOutcome,
     SentMessage, Simulator, SpinKind, TraceRecorder, TransitionChoice,
 };
+use hindsight::verify::expr::{OwnedValue, Value};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::path::Path;
@@ -511,7 +511,7 @@ fn scan_main_file_lists_processes_types_and_properties() {
     let (out, rec) = run(&m, 0, &RunConfig::default());
     assert_eq!(out.end, EndReason::Quiescent);
     assert_eq!(rec.rows.len(), 21);
-    let err = hindsight::model::load(&dir.join("bad_model.xml")).unwrap_err();
+    let err = hindsight::verify::model::load(&dir.join("bad_model.xml")).unwrap_err();
     let msgs: Vec<String> = err
         .iter()
         .map(|d| format!("{}:{}: {}", d.line, d.col, d.message))
@@ -562,7 +562,7 @@ fn attribute_line_breaks_are_spaces_in_expressions() {
         <assign location=\"crlf_is_space\" expr=\"s ==\n'x y'\"/>\
         <assign location=\"ref_is_newline\" expr=\"t != 'p q'\"/>\
         </onentry></state></scxml>";
-    let src = hindsight::model::ModelSource::from_texts([("a.scxml", text)]).unwrap();
+    let src = hindsight::verify::model::ModelSource::from_texts([("a.scxml", text)]).unwrap();
     let m = CompiledModel::compile(src).unwrap();
     let mut sim = Simulator::new(&m);
     sim.run(

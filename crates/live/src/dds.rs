@@ -41,9 +41,15 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, SystemTime};
 
 use codegen::Compiled;
-use ros2::dds::{Participant, Qos, Reader, Received};
+use ros2::dds::{Participant, Reader, Received};
 use ros2::feed::TopicFeed;
-use ros2::write::McapWriter;
+
+// The items of `hindsight-ros2` that `hindsight`'s command line names (it depends on this
+// crate, not on `hindsight-ros2`): the DDS domain (`ROS_DOMAIN_ID`), a service's request
+// and reply topics, and the MCAP writer of `--record`; and `Qos`, the type of a
+// `TopicSource`'s field.
+pub use ros2::dds::{domain_id, service_topics, Qos};
+pub use ros2::write::McapWriter;
 
 use super::record::Input;
 use super::{LiveError, Options, Report, Run, SourceStats};

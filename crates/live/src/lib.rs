@@ -14,9 +14,14 @@
 //! - [`engine`]: five-valued verdicts and the loss rule (see its docs).
 //! - [`record`]: the verdict line and input log formats; replay.
 //! - [`mod@bench`]: throughput and added latency against a plain subscriber.
-//! - [`dds`]: the same judging over a live ROS 2 graph (DDS), `monitor --ros2`.
+//! - [`dds`]: the same judging over a live ROS 2 graph (DDS), `monitor --ros2`;
+//!   [`readers`]: its readers planned from the properties' ports.
+//! - [`recording`]: properties judged over ROS 2 recordings (`replay`), and the ports
+//!   that read topics and services.
 //! - [`pace`]: `hindsight run`'s observer, pacing a simulation on the same [`Clock`];
 //!   [`publish_dds`] and [`serve_dds`]: `run --ros2`'s topics and services on DDS.
+//! - [`wiring`]: what `hindsight run` connects before its first step (publishers,
+//!   the bridges to processes playing node models, DDS writers and services).
 //! - [`serve`]: the live page (`--serve`): verdict lines streamed to a browser;
 //!   [`http`]: its HTTP plumbing and limits.
 //!
@@ -66,9 +71,12 @@ pub mod inject;
 pub mod pace;
 pub mod publish;
 pub mod publish_dds;
+pub mod readers;
 pub mod record;
+pub mod recording;
 pub mod serve;
 pub mod serve_dds;
+pub mod wiring;
 
 // The crates below this one, under the paths its modules name them by (crate-private:
 // this crate's API is its own modules).
@@ -94,19 +102,21 @@ use iceoryx2::prelude::*;
 use monitor_core::Value;
 
 pub use clock::{check_speed, Clock, SPEED_RANGE};
-// For `hindsight`'s command line, which depends on this crate instead of on them: the DDS
-// participant and recordings (`replay`, `monitor --ros2`) and the IPC (`run`, `monitor`).
 use config::{Action, Config, Layout, Wire};
 use engine::{Change, Engine};
 use error::ipc;
 pub use error::LiveError;
-pub use iceoryx2;
 use record::Input;
-pub use ros2;
 
 type Ipc = ipc::Service;
 type Req = ActiveRequest<Ipc, [u8], (), [u8], ()>;
 type Pending = PendingResponse<Ipc, [u8], (), [u8], ()>;
+
+/// iceoryx2's own log to errors only, unless `IOX2_LOG_LEVEL` names a level (iceoryx2
+/// warns on stderr about a missing config file); `monitor` and `run` call it first.
+pub fn quiet_ipc_log() {
+    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
+}
 
 /// Counts for one tapped topic or proxied service.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]

@@ -10,7 +10,9 @@
 //! guarantee's time bounds, [`record`] writes a run as CSV, [`replay`] replays the runs a
 //! study kept (and the witnesses' failing runs) as such CSV, and [`result`] is a study's
 //! result as `verify --json` prints it, assembled there; [`tracefile`] reads such a CSV
-//! (or any trace) back as points for `replay`. Nothing here prints: errors are values
+//! (or any trace) back as points for `replay`, and [`trace_judge`] judges them. [`spec`]
+//! compiles properties without a model (`compile`, `replay`, `monitor --ros2`) and
+//! [`convert`] writes a robot model as plain SCXML. Nothing here prints: errors are values
 //! ([`load::LoadError`] carries the files' diagnostics), warnings come back with what was
 //! loaded ([`load::Loaded::warnings`]), files written come back as their paths and
 //! progress goes to a callback.
@@ -20,8 +22,9 @@
 //! `hindsight-verify` depends on `monitor-core`, `codegen` and the crates below it in the
 //! pipeline, re-exported here under the paths its modules name them by: [`expr`],
 //! [`model`], [`sim`], [`props`], [`robot`] and [`smc`]; on no other crate of the project.
-//! `hindsight`'s command line drives it, and names the crates below through these
-//! re-exports (and [`codegen`], [`monitor_core`]), never as dependencies of its own.
+//! `hindsight`'s command line drives it, and names the few items of the crates below it
+//! needs (an option's type, a diagnostic) through these re-exports (and [`codegen`]),
+//! never as dependencies of its own.
 //!
 //! One run of the museum example, judged by its five requirements:
 //!
@@ -41,6 +44,7 @@
 //! runner.finish().unwrap();
 //! ```
 
+pub mod convert;
 pub mod fixed;
 pub mod load;
 pub mod observe;
@@ -50,9 +54,11 @@ pub mod replay;
 pub mod result;
 pub mod sched_fixed;
 pub mod schedulers;
+pub mod spec;
 mod split;
 pub mod study;
 pub mod sweep;
+pub mod trace_judge;
 pub mod tracefile;
 
 // The crates below this one, under the paths its modules name them by.

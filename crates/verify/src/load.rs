@@ -412,7 +412,7 @@ fn compile_properties(
 }
 
 /// A property reader's errors, their kinds as messages.
-fn props_diagnostics(d: props::Diagnostics) -> Diagnostics {
+pub(crate) fn props_diagnostics(d: props::Diagnostics) -> Diagnostics {
     d.into_iter()
         .map(|e| e.map(|kind| kind.to_string()))
         .collect::<Vec<_>>()

@@ -2,7 +2,8 @@
 //! [`replay_csv`] for `trace` (run k of a seed is stream k, whatever ran before it), the
 //! failing runs a study kept for `--save-failing` and `--report` ([`failing_runs`],
 //! [`save`]) and, under `--schedulers`, a failing run under each order-sensitive
-//! property's witness ([`witness_runs`]). Nothing here prints: the files written come
+//! property's witness ([`witness_runs`]); [`play_run`] plays one run to an observer of
+//! the caller's (`hindsight run` paces it in wall-clock time). Nothing here prints: the files written come
 //! back as values.
 //!
 //! ```
@@ -26,7 +27,10 @@ use std::path::{Path, PathBuf};
 use crate::observe::{Judge, JudgeError, PropertySet};
 use crate::record::{Culprit, Recorder};
 use crate::result::Study;
-use crate::sim::{BadScheduler, CompiledModel, RunConfig, Scheduler, Simulator};
+use crate::sim::{
+    BadScheduler, CompiledModel, EndReason, EventSemantics, Observer, Quiescence, RunConfig,
+    RunOutcome, Scheduler, Simulator,
+};
 use crate::smc::StudyResult;
 
 /// One failing run replayed: its property, run index, file name and CSV.
@@ -86,6 +90,36 @@ pub fn replay_csv(
     let mut rng = crate::smc::runner::stream(seed, k);
     Simulator::new(model).run(&mut rng, run_cfg, &mut rec);
     Ok((rec.csv, rec.culprits))
+}
+
+/// Plays run `k` of a study with `seed` (the run `verify --seed` numbers `k`: the same
+/// choices) once, up to model time `max_time` under `events`, reporting every point to
+/// `observer`. Time advances when no machine can move (the run waits for its next timer,
+/// or for what `observer` posts into it), as a system running in real time does.
+pub fn play_run<O: Observer + ?Sized>(
+    model: &CompiledModel,
+    events: EventSemantics,
+    max_time: u64,
+    (seed, k): (u64, u64),
+    observer: &mut O,
+) -> RunOutcome {
+    let cfg = RunConfig {
+        max_time,
+        events,
+        quiescence: Quiescence::AdvanceTime,
+        ..RunConfig::default()
+    };
+    let mut rng = crate::smc::runner::stream(seed, k);
+    Simulator::new(model).run(&mut rng, &cfg, observer)
+}
+
+/// Why a played run ended, as `hindsight run` says it: `reached the duration` at its
+/// `max_time`, else the simulator's reason.
+pub fn end_text(end: &EndReason) -> String {
+    match end {
+        EndReason::MaxTime => "reached the duration".to_string(),
+        other => format!("{other:?}"),
+    }
 }
 
 /// `id` as a file name: ids are checked where declared (`props::is_valid_id`), so this

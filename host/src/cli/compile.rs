@@ -1,12 +1,10 @@
 //! `hindsight compile`: a spec file to a monitor table, Rust source or the printed IR.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
-
-use codegen::emit_rust::{emit_rust, EmitOptions};
+use std::path::PathBuf;
 
 use super::{compile_spec_file, CliError};
-use crate::codegen;
+use crate::verify::spec::{emit, module_name, Output};
 
 /// What `compile` writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -55,20 +53,19 @@ pub fn run(args: &CompileArgs) -> Result<(), CliError> {
         ));
     }
     let compiled = compile_spec_file(&args.spec)?;
-    let bytes = match args.emit {
-        Emit::Table => compiled.to_table_bytes(),
-        Emit::Ir => compiled.ir().into_bytes(),
-        Emit::Rust => {
-            let module = match &args.module {
+    let output = match args.emit {
+        Emit::Table => Output::Table,
+        Emit::Ir => Output::Ir,
+        Emit::Rust => Output::Rust {
+            module: match &args.module {
                 Some(m) => m.clone(),
                 None => module_name(&args.spec),
-            };
-            let opts = EmitOptions::new(module, command_line(args));
-            emit_rust(&compiled.program(), &opts)
-                .map_err(|e| CliError::Input(format!("{}: {e}", args.spec.display())))?
-                .into_bytes()
-        }
+            },
+            command: command_line(args),
+        },
     };
+    let bytes = emit(&compiled, &output)
+        .map_err(|e| CliError::Input(format!("{}: {e}", args.spec.display())))?;
     match &args.output {
         Some(path) => std::fs::write(path, &bytes)
             .map_err(|e| CliError::Failed(format!("{}: cannot write: {e}", path.display())))?,
@@ -113,54 +110,9 @@ fn shell_word(s: &str) -> String {
     }
 }
 
-/// A module name from a spec path: the file stem's ASCII letters and digits,
-/// lower-cased, words joined by single `_`; a leading digit gets `m_` before
-/// it, a Rust keyword gets `_monitor` after it, nothing left gives `monitor`.
-pub fn module_name(spec: &Path) -> String {
-    let stem = spec
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let mut name = String::new();
-    for word in stem
-        .split(|c: char| !c.is_ascii_alphanumeric())
-        .filter(|w| !w.is_empty())
-    {
-        if !name.is_empty() {
-            name.push('_');
-        }
-        name.push_str(&word.to_ascii_lowercase());
-    }
-    if name.is_empty() {
-        return "monitor".into();
-    }
-    if name.starts_with(|c: char| c.is_ascii_digit()) {
-        name.insert_str(0, "m_");
-    }
-    if codegen::emit_rust::is_rust_keyword(&name) {
-        name.push_str("_monitor");
-    }
-    name
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn module_names_are_identifiers() {
-        let cases = [
-            ("specs/museum.hspec", "museum"),
-            ("Museum-Guide v2.hspec", "museum_guide_v2"),
-            ("2024_run.hspec", "m_2024_run"),
-            ("type.hspec", "type_monitor"),
-            ("__.hspec", "monitor"),
-            ("a__b.hspec", "a_b"),
-        ];
-        for (path, want) in cases {
-            assert_eq!(module_name(Path::new(path)), want, "{path}");
-        }
-    }
 
     #[test]
     fn shell_words_quote_only_when_needed() {

@@ -172,13 +172,17 @@ pub fn write_whole(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> 
     written
 }
 
-/// Compiles a `.hspec` file, printing warnings to stderr.
+/// Compiles a `.hspec` file ([`crate::verify::spec::compile_spec_file`]), printing its
+/// warnings to stderr.
 pub fn compile_spec_file(path: &std::path::Path) -> Result<codegen::Compiled, CliError> {
-    let src = read_file(path)?;
-    let compiled = codegen::compile_spec(&src, &path.display().to_string())
-        .map_err(|d| CliError::Input(d.to_string()))?;
+    let compiled = crate::verify::spec::compile_spec_file(path)?;
+    print_spec_warnings(&compiled);
+    Ok(compiled)
+}
+
+/// Prints a compiled spec's warnings to stderr, as `compile`, `replay` and `monitor` do.
+pub fn print_spec_warnings(compiled: &codegen::Compiled) {
     if !compiled.warnings().is_empty() {
         eprint!("{}", compiled.warnings());
     }
-    Ok(compiled)
 }

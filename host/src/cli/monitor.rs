@@ -1,6 +1,6 @@
 //! `hindsight monitor`: the on-line sidecar over iceoryx2, its off-line replay and its benchmark.
 
-use crate::{codegen, iceoryx2};
+use crate::codegen;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
@@ -308,7 +308,7 @@ pub fn guarantees_spec(args: &ModelArgs) -> Result<Compiled, CliError> {
 /// Runs `hindsight monitor`.
 pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
     // iceoryx2 warns on stderr about a missing config file; RUST_LOG-style `IOX2_LOG_LEVEL` overrides.
-    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
+    live::quiet_ipc_log();
     if args.bench {
         let prefix = format!("hindsight-bench/{}", std::process::id());
         let r = live::bench::run(

@@ -7,22 +7,19 @@
 //! subscribe). A service port reads the service's introspection events
 //! (`/<service>/_service_event`), as it does in a recording.
 
-use crate::{codegen, ros2};
-use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Once;
 use std::time::Duration;
 
-use ros2::feed::{Port as BagPort, TopicFeed};
-
 use super::monitor::MonitorArgs;
-use super::replay::{bind_ports, discover_packages, file_ports, load_props_at, Packages};
+use super::replay::load_props_at;
 use super::CliError;
+use crate::codegen;
 use crate::live;
-use crate::live::dds::{Settings, TopicSource};
-use crate::props::PropertyFile;
+use crate::live::dds::Settings;
+use crate::live::readers::{plan, ReaderInput};
 
 /// A property file's tick on DDS when `--time-unit` does not name one: 1 ms.
 const DEFAULT_UNIT_NS: u64 = 1_000_000;
@@ -39,38 +36,6 @@ pub(crate) fn stop_flag() -> &'static AtomicBool {
         let _ = ctrlc::set_handler(|| STOP.store(true, Ordering::Relaxed));
     });
     &STOP
-}
-
-/// A ROS type as DDS and the recordings name it: `pkg/msg/Type`, or for a service port
-/// the service's event type `pkg/srv/Name_Event`.
-fn full_type(written: &str, service: bool) -> Result<String, ros2::schema::SchemaError> {
-    let (pkg, name) = ros2::schema::split_type_name(written)?;
-    Ok(if service {
-        format!("{pkg}/srv/{name}_Event")
-    } else {
-        format!("{pkg}/msg/{name}")
-    })
-}
-
-/// A port's declared type, whether it is a service's, and the QoS it names.
-type Declared = (String, bool, Vec<(String, String)>);
-
-/// The type of each port of a property file: the `type` of the `<ros_topic>` or
-/// `<ros_service>` element that declares it, with the QoS it names. The reader records
-/// one type per element, at its start tag, before the element's variables: a port's
-/// type is the last one written before it.
-fn file_types(file: &PropertyFile) -> Vec<Option<Declared>> {
-    file.ports
-        .iter()
-        .map(|p| {
-            let at = (p.at.line, p.at.column);
-            file.ros_types
-                .iter()
-                .rev()
-                .find(|t| (t.at.line, t.at.column) < at)
-                .map(|t| (t.type_name.clone(), t.service, t.qos.clone()))
-        })
-        .collect()
 }
 
 /// Runs `hindsight monitor --ros2 PROPS`.
@@ -92,143 +57,26 @@ pub fn run(
         !args.bind.is_empty(),
     )?;
     let spec = &props.compiled;
-    // Each port, its topic's type and the QoS its port names.
-    let mut port_qos: Vec<Vec<(String, String)>> = Vec::new();
-    let (ports, types): (Vec<BagPort>, Vec<Option<String>>) = match &props.file {
-        Some(file) => {
-            let ports = file_ports(file, spec)?;
-            let declared = file_types(file);
-            port_qos = declared
-                .iter()
-                .map(|t| t.as_ref().map(|t| t.2.clone()).unwrap_or_default())
-                .collect();
-            let types = declared
-                .into_iter()
-                .zip(&ports)
-                .map(|(t, p)| {
-                    t.map(|(name, service, _)| full_type(&name, service || p.service.is_some()))
-                        .transpose()
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| input(e.to_string()))?;
-            (ports, types)
-        }
-        None => {
-            if !args.topic_type.is_empty() && args.bind.is_empty() {
-                return Err(input("--topic-type goes with --bind".into()));
-            }
-            let ports = bind_ports(&args.bind, spec)?;
-            let mut named: BTreeMap<String, String> = BTreeMap::new();
-            for t in &args.topic_type {
-                let Some((topic, ty)) = t.split_once('=') else {
-                    return Err(input(format!(
-                        "--topic-type {t}: expected /topic=pkg/msg/Type"
-                    )));
-                };
-                named.insert(topic.trim().to_string(), ty.trim().to_string());
-            }
-            let types = ports
-                .iter()
-                .map(|p| match named.get(&p.topic) {
-                    Some(t) => full_type(t, p.service.is_some())
-                        .map(Some)
-                        .map_err(|e| format!("--topic-type {}={t}: {e}", p.topic)),
-                    None => Err(format!(
-                        "--bind: DDS needs the type of `{}`: add --topic-type {}=pkg/msg/Type",
-                        p.topic, p.topic
-                    )),
-                })
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(input)?;
-            (ports, types)
-        }
-    };
-    if ports.is_empty() {
-        return Err(input(format!(
-            "{}: no variable reads a topic, so there is nothing to monitor",
-            props_path.display()
-        )));
+    if props.file.is_none() && !args.topic_type.is_empty() && args.bind.is_empty() {
+        return Err(input("--topic-type goes with --bind".into()));
     }
-    // `--qos /topic=settings`, over what the ports name.
-    let mut qos_flags: BTreeMap<String, String> = BTreeMap::new();
-    for q in &args.qos {
-        let Some((topic, settings)) = q.split_once('=') else {
-            return Err(input(format!(
-                "--qos {q}: expected /topic=reliability=best_effort,durability=transient_local,..."
-            )));
-        };
-        let topic = topic.trim().to_string();
-        ros2::dds::Qos::ros_default()
-            .with_list(settings)
-            .map_err(|e| input(format!("--qos {q}: {e}")))?;
-        if !ports.iter().any(|p| p.recorded_topic() == topic) {
-            return Err(input(format!("--qos {q}: no port reads `{topic}`")));
+    let sources = plan(ReaderInput {
+        path: props_path,
+        file: props.file.as_ref(),
+        compiled: spec,
+        bind: &args.bind,
+        topic_type: &args.topic_type,
+        qos: &args.qos,
+        interfaces: args.interfaces.clone(),
+    })
+    .map_err(|e| {
+        if e.is_internal() {
+            CliError::Failed(e.to_string())
+        } else {
+            input(e.to_string())
         }
-        let all = qos_flags.entry(topic).or_default();
-        all.push(',');
-        all.push_str(settings);
-    }
-    // One reader per topic as recorded, with one type and one QoS.
-    let mut topics: Vec<(String, String, ros2::dds::Qos)> = Vec::new();
-    for (i, (p, t)) in ports.iter().zip(&types).enumerate() {
-        let topic = p.recorded_topic();
-        let Some(t) = t else {
-            return Err(input(format!("port `{}`: its type is not written", p.name)));
-        };
-        let mut qos = ros2::dds::Qos::ros_default();
-        for (k, v) in port_qos.get(i).map(Vec::as_slice).unwrap_or_default() {
-            qos.set(k, v)
-                .map_err(|e| input(format!("port `{}`: {e}", p.name)))?;
-        }
-        match topics.iter().find(|(name, _, _)| *name == topic) {
-            Some((_, other, _)) if other != t => {
-                return Err(input(format!(
-                    "topic `{topic}` is read as `{other}` and as `{t}`: one topic has one type"
-                )))
-            }
-            Some((_, _, other)) if *other != qos => {
-                return Err(input(format!(
-                    "topic `{topic}` is read with QoS {} and with {}: one topic has one reader \
-                     (name the same QoS on every port of it)",
-                    other.describe(),
-                    qos.describe()
-                )))
-            }
-            Some(_) => {}
-            None => topics.push((topic, t.clone(), qos)),
-        }
-    }
-    for (topic, _, qos) in &mut topics {
-        if let Some(list) = qos_flags.get(topic.as_str()) {
-            *qos = qos.with_list(list).map_err(|e| input(e.to_string()))?;
-        }
-    }
-    let packages = discover_packages(props_path, args.interfaces.clone())?;
-    let defs = Packages(packages);
-    let mut sources = Vec::new();
-    for (topic, type_name, qos) in topics {
-        let feed = TopicFeed::new(&topic, &type_name, &ports, &defs, spec.strings())
-            .map_err(|e| input(format!("topic `{topic}`: {e}")))?;
-        let schema = ros2::schema::Schema::resolve(&type_name, &defs).map_err(|e| {
-            input(format!(
-                "topic `{topic}`: {e}: name its package's folder with --interfaces"
-            ))
-        })?;
-        let vars = ports
-            .iter()
-            .filter(|p| p.recorded_topic() == topic)
-            .map(|p| p.name.clone())
-            .collect();
-        sources.push(TopicSource {
-            topic,
-            type_name,
-            feed,
-            vars,
-            schema_text: schema.ros2msg_text(),
-            qos,
-        });
-    }
-    let domain = ros2::dds::domain_id().map_err(|e| input(e.to_string()))?;
+    })?;
+    let domain = live::dds::domain_id().map_err(|e| input(e.to_string()))?;
     let max_latency = match codegen::duration::parse(&args.max_latency) {
         Ok(ns) => Duration::from_nanos(ns),
         Err(m) => return Err(input(format!("--max-latency {}: {m}", args.max_latency))),
@@ -250,7 +98,7 @@ pub fn run(
     let mcap = args
         .record
         .as_deref()
-        .map(ros2::write::McapWriter::create)
+        .map(live::dds::McapWriter::create)
         .transpose()
         .map_err(|e| CliError::Failed(e.to_string()))?;
     let mut out: Box<dyn Write + Send> = match &args.output {

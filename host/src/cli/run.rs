@@ -1,29 +1,22 @@
 //! `hindsight run`: one seeded simulation of a model, paced in wall-clock time, its ROS topics published over iceoryx2 (or, with `--ros2`, on DDS as a ROS 2 robot publishes them: [`crate::live::publish_dds`]).
 
-use std::collections::BTreeMap;
 use std::io::IsTerminal;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-use iceoryx2::prelude::*;
-
-type Ipc = ipc::Service;
-
 use super::progress::draw_line;
 use super::verify::{load_without, ModelArgs};
 use super::CliError;
-use crate::live::inject::{
-    Answer, GoalBridge, GoalRoute, ServiceBridge, ServiceServers, TopicSubscriber,
-};
+use crate::live::dds::{domain_id, service_topics};
 use crate::live::pace::{Paced, ProgressReports};
-use crate::live::publish::{
-    layout_of, layout_toml, layouts, name_from_ports, TopicLayout, TopicPublisher, WireKind,
+use crate::live::publish::layout_toml;
+use crate::live::publish_dds::{DdsPaced, DdsPublisher};
+use crate::live::serve_dds::DdsServices;
+use crate::live::wiring::{
+    dds_services, describe, node, topic_layouts, topic_qos, Bridges, DdsPlan, Wiring,
 };
-use crate::live::publish_dds::{declared_types, plan, DdsPaced, DdsPublisher};
-use crate::live::{check_speed, Clock};
-use crate::props::ros::{action_event, service_client_event, service_event, topic_event};
-use crate::sim::{EndReason, EventSemantics, Quiescence, RunConfig, Simulator};
-use crate::{iceoryx2, ros2};
+use crate::live::{check_speed, quiet_ipc_log, Clock};
+use crate::verify::replay::{end_text, play_run};
 
 /// Arguments of `hindsight run`.
 #[derive(Debug, clap::Args)]
@@ -160,209 +153,20 @@ Plain SCXML models need --time-unit (e.g. 100ms) to be paced.
 Exit codes: 0 the run ended (or was stopped); 2 bad model or argument; 1 iceoryx2 or DDS
 failure.";
 
-/// The layouts of the topics the external components publish, taken out of `topics` (the
-/// run does not publish them: their processes do).
-fn inbound_layouts(
-    topics: &mut Vec<TopicLayout>,
-    external: &[crate::robot::load::ExternalComponent],
-) -> Vec<TopicLayout> {
-    let mut inbound = Vec::new();
-    for c in external {
-        // A served action's feedback and results are topics its process publishes.
-        let action_topics = c.serves_actions.iter().flat_map(|(a, _)| {
-            ["feedback", "result"].map(|part| (action_event(a, part), format!("{a}/{part}")))
-        });
-        for (event, topic) in c
-            .publishes
-            .iter()
-            .map(|(t, _)| (topic_event(t), t.clone()))
-            .chain(action_topics)
-        {
-            match topics.iter().position(|l| l.event_name == event) {
-                Some(i) => inbound.push(topics.remove(i)),
-                None => eprintln!(
-                    "warning: --external {}: nothing in the model subscribes to {topic}; \
-                     its samples are not read",
-                    c.name
-                ),
-            }
-        }
-    }
-    inbound
-}
-
-/// What a process playing `c` speaks, for the start of a run.
-fn describe(c: &crate::robot::load::ExternalComponent) -> String {
-    let parts = [
-        ("publishes", &c.publishes),
-        ("subscribes to", &c.subscribes),
-        ("serves", &c.serves),
-        ("calls", &c.calls),
-        ("serves action", &c.serves_actions),
-        ("calls action", &c.calls_actions),
-    ];
-    let said: Vec<String> = parts
-        .iter()
-        .filter(|(_, l)| !l.is_empty())
-        .map(|(verb, l)| {
-            let names: Vec<&str> = l.iter().map(|(n, _)| n.as_str()).collect();
-            format!("{verb} {}", names.join(", "))
-        })
-        .collect();
-    if said.is_empty() {
-        "no ROS interface".to_string()
-    } else {
-        said.join("; ")
-    }
-}
-
-/// The services the external components serve: `(service path, request layout, response
-/// layout)`. Their mirrors stay in `topics`: the run publishes requests and responses.
-fn bridged_services(
-    topics: &[TopicLayout],
-    external: &[crate::robot::load::ExternalComponent],
-) -> Vec<(String, TopicLayout, TopicLayout)> {
-    let mut out = Vec::new();
-    for c in external {
-        for (service, _) in &c.serves {
-            let find = |response: bool| {
-                let event = service_event(service, response);
-                topics.iter().find(|l| l.event_name == event).cloned()
-            };
-            match (find(false), find(true)) {
-                (Some(req), Some(resp)) => {
-                    out.push((service.trim_start_matches('/').to_string(), req, resp))
-                }
-                _ => eprintln!(
-                    "warning: --external {}: nothing in the model calls {service}; it is not \
-                     bridged",
-                    c.name
-                ),
-            }
-        }
-    }
-    out
-}
-
-/// The services and actions the external components call: `(service or action path, the
-/// client's request or goal layout, how the model's answer is sent back)`.
-fn called_services(
-    model: &crate::sim::CompiledModel,
-    external: &[crate::robot::load::ExternalComponent],
-) -> Vec<(String, TopicLayout, Answer)> {
-    let mut out = Vec::new();
-    let mut warnings = Vec::new();
-    for c in external {
-        for (service, _) in &c.calls {
-            let event =
-                |response| model.event_id(&service_client_event(service, &c.name, response));
-            let path = service.trim_start_matches('/').to_string();
-            match (event(false), event(true)) {
-                (Some(req), Some(resp)) => out.push((
-                    path.clone(),
-                    layout_of(model, req, path.clone(), WireKind::Request, &mut warnings),
-                    Answer::Layout(layout_of(
-                        model,
-                        resp,
-                        path,
-                        WireKind::Response,
-                        &mut warnings,
-                    )),
-                )),
-                _ => eprintln!(
-                    "warning: --external {}: nothing in the model serves {service}; it is not \
-                     bridged",
-                    c.name
-                ),
-            }
-        }
-        for (action, _) in &c.calls_actions {
-            let event = |part: &str| {
-                model.event_id(&action_event(action, &format!("{part}_client_{}", c.name)))
-            };
-            let path = action.trim_start_matches('/').to_string();
-            match (
-                event("goal_req"),
-                event("goal_accept"),
-                event("goal_reject"),
-            ) {
-                (Some(goal), Some(accept), Some(reject)) => out.push((
-                    path.clone(),
-                    layout_of(model, goal, path, WireKind::Goal, &mut warnings),
-                    Answer::Goal { accept, reject },
-                )),
-                _ => eprintln!(
-                    "warning: --external {}: nothing in the model serves {action}; it is not \
-                     bridged",
-                    c.name
-                ),
-            }
-        }
-    }
-    for w in warnings {
-        eprintln!("warning: {w}");
-    }
-    out
-}
-
-/// The goal routes of the actions the external components serve.
-fn goal_routes(
-    model: &crate::sim::CompiledModel,
-    topics: &[TopicLayout],
-    external: &[crate::robot::load::ExternalComponent],
-) -> Vec<GoalRoute> {
-    let mut out = Vec::new();
-    for c in external {
-        for (action, _) in &c.serves_actions {
-            let goal = topics
-                .iter()
-                .find(|l| l.event_name == action_event(action, "goal_handle"));
-            let with_id = |part: &str| {
-                let e = model.event_id(&action_event(action, part))?;
-                Some((e, model.param_index(e, "goal_id")?))
-            };
-            let goal_id = goal.and_then(|g| model.param_index(g.event, "goal_id"));
-            match (
-                goal,
-                goal_id,
-                with_id("goal_accepted"),
-                with_id("goal_rejected"),
-            ) {
-                (Some(goal), Some(goal_id), Some(accepted), Some(rejected)) => {
-                    out.push(GoalRoute {
-                        path: action.trim_start_matches('/').to_string(),
-                        goal: goal.clone(),
-                        goal_id,
-                        accepted,
-                        rejected,
-                    })
-                }
-                _ => eprintln!(
-                    "warning: --external {}: nothing in the model sends goals to {action}; \
-                     it is not bridged",
-                    c.name
-                ),
-            }
-        }
-    }
-    out
-}
-
 /// Runs `hindsight run`.
 pub fn run(args: &RunArgs) -> Result<(), CliError> {
     if args.ros2 {
         return run_ros2(args);
     }
-    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
+    quiet_ipc_log();
     check_speed(args.speed).map_err(|m| CliError::Input(format!("--speed: {m}")))?;
     let (loaded, external) = load_without(&args.input, &args.external)?;
     let model = &loaded.model;
-    let (mut topics, warnings) = layouts(model);
-    name_from_ports(&mut topics, model, &loaded.file.ports);
+    let (topics, warnings) = topic_layouts(model, &loaded.file.ports);
     for w in &warnings {
         eprintln!("warning: {w}");
     }
-    if !external.is_empty() && loaded.events != EventSemantics::As2fm {
+    if !external.is_empty() && loaded.events != crate::sim::EventSemantics::As2fm {
         return Err(CliError::Input(
             "--external needs --events as2fm (messages from processes are posted as AS2FM's \
              translation sends them)"
@@ -383,17 +187,17 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     for c in &external {
         eprintln!("run: {} is played by a process: {}", c.name, describe(c));
     }
-    let inbound = inbound_layouts(&mut topics, &external);
-    let served = bridged_services(&topics, &external);
-    let called = called_services(model, &external);
-    let routes = goal_routes(model, &topics, &external);
+    let wiring = Wiring::plan(model, topics, &external);
+    for w in &wiring.warnings {
+        eprintln!("warning: {w}");
+    }
     let Some(unit_ns) = loaded.unit_ns else {
         return Err(CliError::Input(format!(
             "{}: the model has no time unit; give --time-unit (e.g. 100ms) to pace it",
             args.input.model.display()
         )));
     };
-    if topics.is_empty() {
+    if wiring.topics.is_empty() {
         eprintln!(
             "warning: the model has no ROS topics (events `topic_*_msg`); nothing is published"
         );
@@ -401,41 +205,29 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let max_time = loaded
         .max_time(args.duration.as_deref())
         .map_err(|m| CliError::Input(format!("--duration: {m}")))?;
-    let node = NodeBuilder::new()
-        .signal_handling_mode(SignalHandlingMode::HandleTerminationRequests)
-        .create::<Ipc>()
-        .map_err(|e| CliError::Failed(format!("iceoryx2: node: {e:?}")))?;
-    let publisher = TopicPublisher::new(&node, model, topics, &args.prefix)
+    let node = node().map_err(|e| CliError::Failed(e.to_string()))?;
+    let bridges = Bridges::open(&node, model, wiring, &args.prefix)
         .map_err(|e| CliError::Failed(e.to_string()))?;
-    let inbound = TopicSubscriber::new(&node, inbound, &args.prefix)
-        .map_err(|e| CliError::Failed(e.to_string()))?;
-    let services = ServiceBridge::new(&node, model.event_count(), served, &args.prefix)
-        .map_err(|e| CliError::Failed(e.to_string()))?;
-    let servers = ServiceServers::new(&node, model.event_count(), called, &args.prefix)
-        .map_err(|e| CliError::Failed(e.to_string()))?;
-    let goals = GoalBridge::new(&node, routes, &args.prefix)
-        .map_err(|e| CliError::Failed(e.to_string()))?;
-    let cfg = RunConfig {
-        max_time,
-        events: loaded.events,
-        quiescence: Quiescence::AdvanceTime,
-        ..RunConfig::default()
-    };
     let tty = std::io::stderr().is_terminal();
     let mut live = Paced {
         node: &node,
-        publisher,
-        inbound,
-        services,
-        servers,
-        goals,
+        publisher: bridges.publisher,
+        inbound: bridges.inbound,
+        services: bridges.services,
+        servers: bridges.servers,
+        goals: bridges.goals,
         inbound_error: None,
         clock: Clock::with_speed(unit_ns, args.speed),
         stopped: false,
         on_progress: ProgressReports::new(move |p| draw_line(&p.line(unit_ns), tty)),
     };
-    let mut rng = crate::smc::runner::stream(args.seed, args.run);
-    let outcome = Simulator::new(model).run(&mut rng, &cfg, &mut live);
+    let outcome = play_run(
+        model,
+        loaded.events,
+        max_time,
+        (args.seed, args.run),
+        &mut live,
+    );
     live.progress(outcome.time, true);
     if tty {
         eprintln!();
@@ -477,10 +269,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let how = if live.stopped {
         "stopped by a signal".to_string()
     } else {
-        match &outcome.end {
-            EndReason::MaxTime => "reached the duration".to_string(),
-            other => format!("{other:?}"),
-        }
+        end_text(&outcome.end)
     };
     eprintln!("run: ended at model step {}: {how}", outcome.time);
     Ok(())
@@ -502,7 +291,7 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
                 .into(),
         ));
     }
-    let domain = ros2::dds::domain_id().map_err(|e| input(e.to_string()))?;
+    let domain = domain_id().map_err(|e| input(e.to_string()))?;
     let Some(main_path) = crate::robot::load::main_file_of(&args.input.model) else {
         return Err(input(format!(
             "{}: --ros2 needs a robot model (a main file whose node models declare their \
@@ -514,75 +303,22 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
     let model = &loaded.model;
     // Over DDS a node played by a ROS 2 process may call the model's services; what else
     // it does is not bridged (said, not silent).
-    let mut service_routes = Vec::new();
-    for c in &external {
-        for (what, list) in [
-            ("publishes", &c.publishes),
-            ("subscribes to", &c.subscribes),
-            ("serves", &c.serves),
-            ("serves action", &c.serves_actions),
-            ("calls action", &c.calls_actions),
-        ] {
-            for (name, _) in list.iter() {
-                eprintln!(
-                    "warning: --external {}: it {what} {name}, which is not bridged over DDS \
-                     (only the services it calls are served to ROS 2 clients)",
-                    c.name
-                );
-            }
-        }
-        for (service, ty) in &c.calls {
-            let event = |response| {
-                model.event_id(&crate::props::ros::service_client_event(
-                    service, &c.name, response,
-                ))
-            };
-            match (event(false), event(true)) {
-                (Some(request), Some(response)) => {
-                    service_routes.push(crate::live::serve_dds::ServiceRoute {
-                        service: service.clone(),
-                        type_name: ty.clone(),
-                        request,
-                        response,
-                    })
-                }
-                _ => eprintln!(
-                    "warning: --external {}: nothing in the model serves {service}; it is not \
-                     served on DDS",
-                    c.name
-                ),
-            }
-        }
+    let (service_routes, said) = dds_services(model, &external);
+    for w in &said {
+        eprintln!("warning: {w}");
     }
-    let diags = |errs: Vec<crate::model::Diagnostic>| {
-        CliError::Input(
-            errs.iter()
-                .map(|d| d.to_string())
-                .collect::<Vec<_>>()
-                .join("\n"),
-        )
-    };
-    let mut sm = crate::model::SourceMap::new();
-    let main = crate::robot::main_file::MainFile::read(&mut sm, &main_path).map_err(diags)?;
-    let types = declared_types(&main);
-    let search = crate::robot::interfaces::Search::from_env(args.input.interfaces.clone());
-    let packages =
-        crate::robot::interfaces::Interfaces::discover_with(&mut sm, &main_path, &search)
-            .map_err(diags)?;
-    let defs = super::replay::Packages(packages);
-    let (routes, mut warnings) = plan(model, &types, &defs);
+    let DdsPlan {
+        routes,
+        packages,
+        mut warnings,
+    } = DdsPlan::new(&main_path, args.input.interfaces.clone(), model)
+        .map_err(|e| input(e.to_string()))?;
     let services = if service_routes.is_empty() {
         None
     } else {
         Some(
-            crate::live::serve_dds::DdsServices::new(
-                domain,
-                model,
-                service_routes,
-                &defs,
-                &mut warnings,
-            )
-            .map_err(|e| CliError::Failed(e.to_string()))?,
+            DdsServices::new(domain, model, service_routes, &packages, &mut warnings)
+                .map_err(|e| CliError::Failed(e.to_string()))?,
         )
     };
     for w in &warnings {
@@ -590,7 +326,7 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
     }
     if let Some(s) = &services {
         for st in s.stats() {
-            let (rq, rr) = ros2::dds::service_topics(&st.service);
+            let (rq, rr) = service_topics(&st.service);
             eprintln!(
                 "run: serving {} to ROS 2 clients on {rq} and {rr}",
                 st.service
@@ -606,26 +342,7 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
     let max_time = loaded
         .max_time(args.duration.as_deref())
         .map_err(|m| input(format!("--duration: {m}")))?;
-    let mut qos: BTreeMap<String, ros2::dds::Qos> = BTreeMap::new();
-    for q in &args.qos {
-        let Some((topic, settings)) = q.split_once('=') else {
-            return Err(input(format!(
-                "--qos {q}: expected /topic=reliability=best_effort,durability=transient_local,..."
-            )));
-        };
-        let topic = topic.trim();
-        if !routes.iter().any(|r| r.topic == topic) {
-            return Err(input(format!(
-                "--qos {q}: the run does not publish `{topic}`"
-            )));
-        }
-        let entry = qos
-            .entry(topic.to_string())
-            .or_insert_with(ros2::dds::Qos::ros_default);
-        *entry = entry
-            .with_list(settings)
-            .map_err(|e| input(format!("--qos {q}: {e}")))?;
-    }
+    let qos = topic_qos(&args.qos, &routes).map_err(|e| input(e.to_string()))?;
     let publisher = DdsPublisher::new(domain, model, routes, &qos)
         .map_err(|e| CliError::Failed(e.to_string()))?;
     let topics: Vec<&str> = publisher.topics().collect();
@@ -677,12 +394,6 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
             std::thread::sleep(std::time::Duration::from_millis(20));
         }
     }
-    let cfg = RunConfig {
-        max_time,
-        events: loaded.events,
-        quiescence: Quiescence::AdvanceTime,
-        ..RunConfig::default()
-    };
     let tty = std::io::stderr().is_terminal();
     let mut live = DdsPaced {
         model,
@@ -693,8 +404,13 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
         stopped: false,
         on_progress: ProgressReports::new(move |p| draw_line(&p.line(unit_ns), tty)),
     };
-    let mut rng = crate::smc::runner::stream(args.seed, args.run);
-    let outcome = Simulator::new(model).run(&mut rng, &cfg, &mut live);
+    let outcome = play_run(
+        model,
+        loaded.events,
+        max_time,
+        (args.seed, args.run),
+        &mut live,
+    );
     live.progress(outcome.time, true);
     if tty {
         eprintln!();
@@ -726,10 +442,7 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
     let how = if live.stopped {
         "stopped by a signal".to_string()
     } else {
-        match &outcome.end {
-            EndReason::MaxTime => "reached the duration".to_string(),
-            other => format!("{other:?}"),
-        }
+        end_text(&outcome.end)
     };
     eprintln!("run: ended at model step {}: {how}", outcome.time);
     Ok(())

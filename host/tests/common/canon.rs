@@ -9,10 +9,10 @@
 //! (`1` and `1.0`); and the order of the copies of one `<send>` that differ only in their
 //! target (see [`canon`]).
 
-use hindsight::expr::ast::{Expr, ExprKind};
-use hindsight::expr::parse_expr;
-use hindsight::model::source::SourceMap;
-use hindsight::model::xml::{self, Element, Node};
+use hindsight::verify::expr::ast::{Expr, ExprKind};
+use hindsight::verify::expr::parse_expr;
+use hindsight::verify::model::source::SourceMap;
+use hindsight::verify::model::xml::{self, Element, Node};
 use std::path::Path;
 
 /// Attributes that hold expressions.

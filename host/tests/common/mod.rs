@@ -63,7 +63,7 @@ pub fn museum_fixed() -> hindsight::sim::CompiledModel {
         .iter()
         .map(|p| (p.display().to_string(), std::fs::read_to_string(p).unwrap()))
         .collect();
-    let src = hindsight::model::ModelSource::from_texts(
+    let src = hindsight::verify::model::ModelSource::from_texts(
         files.iter().map(|(a, b)| (a.as_str(), b.as_str())),
     )
     .unwrap();

@@ -4,11 +4,11 @@
 
 #![allow(dead_code)]
 
-use hindsight::expr::Value;
-use hindsight::model::source::{FileId, SourceMap};
-use hindsight::model::{xml, Diagnostics, ModelSource};
 use hindsight::robot::bt::{self, BtInput, BtSemantics, Halts};
 use hindsight::sim::{CompiledModel, EndReason, Flow, Observer, RunConfig, SentMessage, Simulator};
+use hindsight::verify::expr::Value;
+use hindsight::verify::model::source::{FileId, SourceMap};
+use hindsight::verify::model::{xml, Diagnostics, ModelSource};
 use hindsight_tests::bt::model;
 use hindsight_tests::bt::oracle::{self, LeafEvent, Reading, Scripts};
 use hindsight_tests::bt::tree::{self, Kind, Status, Tree};
