@@ -123,7 +123,9 @@ fn what_is_not_modelled_is_refused_at_its_place() {
             "tree.xml:3:60: `value` of LoopInt writes its items to `t`, which is int64 at tree.xml:3:60 (a script): a script assigns strings to that entry",
         ),
         (
-            "<Sequence><Script code=\"x:=0\"/><LoopDouble queue=\"1.5\" value=\"{x}\"><Act/></LoopDouble></Sequence>",
+            // `x` only UnsetBlackboard names: an integer entry, not a float (a script's
+            // `x` lowers, the LoopDouble storing into it as BT.CPP does).
+            "<Sequence><UnsetBlackboard key=\"x\"/><LoopDouble queue=\"1.5\" value=\"{x}\"><Act/></LoopDouble></Sequence>",
             "Invalid floating point to integer conversion",
         ),
         (

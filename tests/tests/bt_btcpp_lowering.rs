@@ -777,6 +777,38 @@ fn random_trees_with_loop_strings_lower_to_what_btcpp_does() {
     );
 }
 
+/// The trees of `gen::Options::loop_doubles`: BT.CPP 4's blackboard nodes and doubles in
+/// the scripts (`gen::Options::bits`), LoopDouble nodes writing `r`, the double entry
+/// the scripts store numbers in, and `ld`, which risky conditions compare.
+fn loop_doubles() -> gen::Options {
+    gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        bb_nodes: true,
+        bits: true,
+        loop_doubles: true,
+        ..Default::default()
+    }
+}
+
+/// The same with LoopDouble nodes writing the scripts' double entries
+/// (`gen::Options::loop_doubles`; `btcpp4_loop.rs`, `Store`): at least one tree in
+/// twenty writes `r`.
+#[test]
+fn random_trees_with_loop_doubles_lower_to_what_btcpp_does() {
+    let opts = loop_doubles();
+    random_trees(opts);
+    let n = trees(opts);
+    let with = drawn_again(opts, gen::Conditions::WithoutSkip)
+        .filter(|c| c.xml.contains("value=\"{r}\""))
+        .count() as u64;
+    eprintln!("{with} of the {n} trees have a LoopDouble writing `r`");
+    assert!(
+        with >= n / 20,
+        "only {with} of {n} trees write `r` in a LoopDouble"
+    );
+}
+
 /// The same with BT.CPP 4's blackboard nodes (`gen::Options::bb_nodes`: UnsetBlackboard,
 /// WasEntryUpdated, SkipUnlessUpdated, WaitValueUpdate, and LoopInt, LoopBool,
 /// LoopDouble, LoopString over queues written in the tree) among the scripts, with the
@@ -1778,6 +1810,13 @@ fn random_trees_with_loop_strings_lower_to_what_the_real_library_does() {
     real_library_opts(loop_strings(), 500, 1_400_000);
 }
 
+/// The same with LoopDouble nodes writing the scripts' double entries
+/// (`gen::Options::loop_doubles`).
+#[test]
+fn random_trees_with_loop_doubles_lower_to_what_the_real_library_does() {
+    real_library_opts(loop_doubles(), 500, 1_700_000);
+}
+
 /// The same with joins (`gen::Options::joins`): `..`, `+` of two strings and `+=` on
 /// `u`, over `t`, literals and number literals, and conditions comparing joins.
 #[test]
@@ -2343,6 +2382,7 @@ const SUBTREE_CONDS: gen::Options = gen::Options {
     strings: false,
     subtree_conds: true,
     loop_strings: false,
+    loop_doubles: false,
     joins: false,
 };
 

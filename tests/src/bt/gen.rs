@@ -137,6 +137,12 @@ pub struct Options {
     /// when it loads the tree, the Loop's `value` port typing it). Off, the generator
     /// draws what it drew before.
     pub loop_strings: bool,
+    /// With [`Options::bb_nodes`] and [`Options::bits`]: LoopDouble nodes (drawn more
+    /// often) write their items into `r`, the double entry the scripts store numbers in,
+    /// two times in three, else into `ld`, which risky conditions compare (BT.CPP 4
+    /// throws reading it before the first write: the Loop's port created it empty when
+    /// the tree was loaded). Off, the generator draws what it drew before.
+    pub loop_doubles: bool,
     /// Joins, with [`Options::strings`]: the main tree also creates `u` from a string
     /// (`u:=''`, remapped into every SubTree); statements store in `u` joins of `t`,
     /// literals and number literals (`t .. 'a'`, `t .. 3`, `t .. 1.5`, `t + 'b'`,
@@ -257,6 +263,11 @@ impl<R: Rng> G<'_, R> {
     /// LoopString nodes writing the scripts' string entry ([`Options::loop_strings`]).
     fn loop_strings_on(&self) -> bool {
         self.opts.loop_strings && self.opts.strings && self.scripts_on()
+    }
+
+    /// LoopDouble nodes writing the scripts' double entries ([`Options::loop_doubles`]).
+    fn loop_doubles_on(&self) -> bool {
+        self.opts.loop_doubles && self.opts.bits && self.opts.bb_nodes && self.scripts_on()
     }
 
     fn scripts_on(&self) -> bool {
@@ -582,9 +593,13 @@ impl<R: Rng> G<'_, R> {
     }
 
     /// A condition of [`Options::bits`]; `risky`: with ones that throw (a bit operator
-    /// over a double that is not whole, NaN or infinite; `r` cast to bool when negative).
+    /// over a double that is not whole, NaN or infinite; `r` cast to bool when negative;
+    /// with [`Options::loop_doubles`], `ld` compared, which throws before its first write).
     fn bits_cond(&mut self, risky: bool) -> String {
         let op = self.pick(&["==", "!=", "<", "<=", ">", ">="]);
+        if risky && self.loop_doubles_on() && self.below(4) == 0 {
+            return format!("ld {op} {}", self.pick(&["1.5", "0", "r", "x", "2"]));
+        }
         match self.below(if risky { 10 } else { 7 }) {
             0 => format!(
                 "{} {op} {}",
@@ -854,6 +869,8 @@ impl<R: Rng> G<'_, R> {
             _ => {
                 let k = if self.loop_strings_on() && self.below(2) == 0 {
                     2
+                } else if self.loop_doubles_on() && self.below(2) == 0 {
+                    1
                 } else {
                     self.below(6)
                 };
@@ -861,6 +878,11 @@ impl<R: Rng> G<'_, R> {
                     // One item type per entry: BT.CPP refuses a tree whose Loop nodes write one
                     // entry with two types ("was initially created with type").
                     0 => ("LoopBool", &["true", "false", "1", "0"], &["{f}"]),
+                    1 if self.loop_doubles_on() => (
+                        "LoopDouble",
+                        &["1.5", "2.0", "-0.5"],
+                        &["{r}", "{r}", "{ld}"],
+                    ),
                     1 => ("LoopDouble", &["1.5", "2.0", "-0.5"], &["{ld}"]),
                     2 if self.loop_strings_on() => {
                         ("LoopString", &LOOP_TEXTS, &["{t}", "{t}", "{ls}"])

@@ -1089,10 +1089,13 @@ impl<'t> Oracle<'t> {
 
     /// `setOutput("value", item)`: the entry written (one more on its counter). An entry
     /// scripts use holds a number: an int or bool item is written as one (a bool as 0 or
-    /// 1, as the real library reads it back), a double only if it is whole ("Invalid
-    /// floating point to integer conversion" otherwise), a string throws ("Any::copyInto
-    /// fails"), all as found against the real library (4.8.2). Any other entry keeps the
-    /// text.
+    /// 1, as the real library reads it back), a double into an entry holding an integer
+    /// only if it is whole ("Invalid floating point to integer conversion" otherwise), a
+    /// string throws ("Any::copyInto fails"), all as found against the real library
+    /// (4.8.2). A double into an entry holding a double, or holding nothing yet (the
+    /// port created it empty when the tree was loaded; `Any::copyInto` into an empty
+    /// `Any` stores the value as it is), is stored as a double, which scripts then read
+    /// (4.8.2, `tests/bt/btcpp4/loop.toml`). Any other entry keeps the text.
     fn write_output(
         &mut self,
         key: &str,
@@ -1104,7 +1107,7 @@ impl<'t> Oracle<'t> {
         if ty == LoopType::String && self.loop_string(key, item) {
             return Ok(());
         }
-        if number || self.vars.contains_key(key) {
+        if number || ty == LoopType::Double || self.vars.contains_key(key) {
             let v = match ty {
                 LoopType::Int => item
                     .parse::<i64>()
@@ -1114,6 +1117,13 @@ impl<'t> Oracle<'t> {
                     let d: f64 = item
                         .parse()
                         .map_err(|_| Stop::Model(format!("queue item {item}")))?;
+                    if self.dbl.contains(key) || !self.vars.contains_key(key) {
+                        self.vars.insert(key.to_string(), d as i64);
+                        self.dbl.insert(key.to_string());
+                        self.reals.insert(key.to_string(), d);
+                        *self.seq.entry(key.to_string()).or_default() += 1;
+                        return Ok(());
+                    }
                     if d.fract() != 0.0 {
                         return Err(Stop::Error(
                             "Invalid floating point to integer conversion".into(),

@@ -70,7 +70,8 @@ pub(crate) struct Blackboard {
     /// Entries only scripts create that hold a number that need not be whole: the
     /// machine keeps them as `float64` (`btcpp4_script/num.rs`, `float_entries`).
     pub floats: Vec<String>,
-    /// The transitions that run the tree's scripts (`btcpp4_script.rs`).
+    /// The transitions that run the tree's scripts (`btcpp4_script.rs`) and store Loop
+    /// items in float entries (`btcpp4_loop.rs`, `Store`): each may throw.
     pub scripts: Vec<Element>,
     /// Entries whose update counter the machine keeps (`bt_seq__<entry>`, one more at
     /// every write): the ones an entry-updated node looks at (`btcpp4_blackboard.rs`).

@@ -28,7 +28,9 @@
 //! IDLE. A LoopString whose `value` entry a script names writes there its item's rank
 //! among the tree's texts (`btcpp4_strings.rs`): BT.CPP creates that entry as a
 //! `std::string` when it loads the tree, so the scripts read a string
-//! ([`script_strings`]). Refused: a Loop under a BlackboardCheck (BT.CPP 3's node), a
+//! ([`script_strings`]). A LoopDouble whose `value` entry a script names stores its items
+//! there as BT.CPP does, through the blackboard machine, which may throw ([`Store`]).
+//! Refused: a Loop under a BlackboardCheck (BT.CPP 3's node), a
 //! queue held in an entry (`queue="{q}"`), an item that BT.CPP would not convert, a
 //! number written into an entry scripts assign strings to, `_failureIf` / `_successIf`
 //! on a Loop in such a place (BT.CPP then pops the queue its last run left), and a
@@ -229,6 +231,16 @@ fn written(t: LoopType, raw: &str, x: &str, e: &Entry, strs: &Strings) -> Result
         };
     }
     let s = Scalar::from_name(e.ty.trim());
+    if float_entry(e) {
+        // A script's entry kept as a float (`btcpp4_script/num.rs`): every number goes
+        // in as one, the blackboard machine deciding what BT.CPP stores ([`Store`]).
+        return match t {
+            LoopType::Int => Ok(format!("{x}.0")),
+            LoopType::Bool => Ok(if x == "true" { "1.0" } else { "0.0" }.into()),
+            LoopType::Double => Ok(x.to_string()),
+            LoopType::String => Err(BadItem::StringInNumber),
+        };
+    }
     if e.why == SCRIPT {
         // A script's entry holds a number: an int or a bool item is written as one
         // (true is 1), a double only when whole (BT.CPP throws "Invalid floating point
@@ -254,6 +266,78 @@ fn written(t: LoopType, raw: &str, x: &str, e: &Entry, strs: &Strings) -> Result
     } else {
         Err(BadItem::Unmodelled(port_type(t)))
     }
+}
+
+/// Whether `e` is an entry only scripts and Loop nodes write that the model keeps as a
+/// float beside its `bt_dbl__` flag (`btcpp4_script/num.rs`, `float_entries`: among
+/// them every entry a LoopDouble writes and a script names).
+fn float_entry(e: &Entry) -> bool {
+    e.why == SCRIPT && e.ty == "float64"
+}
+
+/// A Loop's write into a float entry ([`float_entry`]), which the blackboard machine
+/// makes as BT.CPP 4.10 `LoopNode<T>::tick` does it (`setOutput`, `Blackboard::set`,
+/// then `Any::copyInto` into the entry's value): into an entry holding nothing (the
+/// port created it empty when the tree was loaded, or UnsetBlackboard erased it) the
+/// item goes in as it is, so the entry then holds a `double` for a LoopDouble and an
+/// integer for a LoopInt or LoopBool; into an entry holding a `double` any item is
+/// converted to one; into an entry holding an integer a double must be whole, else
+/// BT.CPP throws ("Invalid floating point to integer conversion", 4.8.2 measured:
+/// `tests/bt/btcpp4/loop.toml`). The node waits for the machine's answer before it
+/// ticks its child, so a throw stops the tree before the child runs, as BT.CPP's does.
+#[derive(Clone, Copy, Debug)]
+struct Store {
+    /// The item is a `double` (a LoopDouble's).
+    dbl: bool,
+    /// The item converts to an integer (`int64_t`) without a throw.
+    whole: bool,
+}
+
+impl Store {
+    fn of(t: LoopType, x: &str) -> Store {
+        match t {
+            LoopType::Double => Store {
+                dbl: true,
+                whole: x
+                    .parse::<f64>()
+                    .is_ok_and(|d| d.fract() == 0.0 && d.abs() < 9.223_372_036_854_776e18),
+            },
+            _ => Store {
+                dbl: false,
+                whole: true,
+            },
+        }
+    }
+}
+
+/// The event Loop node `id` sends the blackboard machine to store an item in a float
+/// entry ([`Store`]), with the item (`value`) and what it is (`dbl`, `whole`).
+fn store_event(id: u32) -> String {
+    format!("bt_loop_{id}_store")
+}
+
+/// The blackboard machine's answer to Loop node `id`: the item is stored.
+fn stored_event(id: u32) -> String {
+    format!("bt_loop_{id}_stored")
+}
+
+/// The blackboard machine's transition that stores Loop node `id`'s items in float
+/// entry `g` and answers `me` ([`Store`]).
+fn store_transition(b: super::build::B, bb: &Blackboard, id: u32, g: &str, me: &str) -> Element {
+    use super::btcpp4_script::{dbl, has, FAULT};
+    let (h, d) = (has(g), dbl(g));
+    let mut body = vec![
+        b.assign(&d, &format!("({h} ? {d} : _event.data.dbl)")),
+        b.assign(g, "_event.data.value"),
+        b.assign(&h, "true"),
+    ];
+    body.extend(super::btcpp4_blackboard::count_write(bb, b, g));
+    body.push(b.send(&stored_event(id), me));
+    let throws = format!("{h} && !{d} && !_event.data.whole");
+    let chain = b
+        .if_chain(vec![(throws, vec![b.assign(FAULT, "true")])], body)
+        .expect("one branch");
+    b.tr(Some(&store_event(id)), None, Some("idle"), vec![chain])
 }
 
 /// Why [`item`] refuses a queue's item or [`written`] does not model writing it.
@@ -379,9 +463,10 @@ pub(super) fn lower(
             }
             Some(e) => {
                 let mut exprs = Vec::with_capacity(items.len());
+                let float = float_entry(&e);
                 for (x, r) in items.iter().zip(&raw) {
                     match written(t, r, x, &e, &bb.strings) {
-                        Ok(v) => exprs.push(v),
+                        Ok(v) => exprs.push((v, float.then(|| Store::of(t, x)))),
                         Err(why) => {
                             let at = sm.diag(e.span, "");
                             errs.push(sm.diag(
@@ -397,17 +482,45 @@ pub(super) fn lower(
         },
     };
     (errs.len() == before).then(|| {
-        let writes = value.map_or_else(
+        let writes: Vec<Option<Write>> = value.map_or_else(
             || vec![None; items.len()],
-            |(g, xs)| xs.into_iter().map(|x| Some((g.clone(), x))).collect(),
+            |(g, xs)| {
+                xs.into_iter()
+                    .map(|(value, store)| {
+                        Some(Write {
+                            entry: g.clone(),
+                            value,
+                            store,
+                        })
+                    })
+                    .collect()
+            },
         );
+        if let Some(Some(w)) = writes
+            .iter()
+            .find(|w| w.as_ref().is_some_and(|w| w.store.is_some()))
+        {
+            bb.scripts
+                .push(store_transition(ctx.b, bb, ctx.id, &w.entry, &ctx.machine));
+        }
         machine(ctx, &writes, if_empty)
     })
 }
 
-/// The Loop node's machine over the queue's items: each item's write (the entry and the
-/// model expression), if `value` is given.
-fn machine(ctx: &Ctx, items: &[Option<(String, String)>], if_empty: u8) -> Element {
+/// One item's write into the `value` entry.
+#[derive(Clone, Debug)]
+struct Write {
+    entry: String,
+    /// The item's model expression.
+    value: String,
+    /// `Some` for a float entry: the blackboard machine stores it and answers
+    /// ([`Store`]); `None`: sent as any other write of the entry.
+    store: Option<Store>,
+}
+
+/// The Loop node's machine over the queue's items: each item's write, if `value` is
+/// given.
+fn machine(ctx: &Ctx, items: &[Option<Write>], if_empty: u8) -> Element {
     let b = &ctx.b;
     let (pos, cr, active, fin) = (
         "queue_pos",
@@ -483,15 +596,26 @@ fn machine(ctx: &Ctx, items: &[Option<(String, String)>], if_empty: u8) -> Eleme
     let mut p = b.state("popping");
     // Pop the front item into `value`.
     let mut pop = Vec::new();
+    // A store into a float entry waits for the blackboard machine's answer ([`Store`]).
+    let stores = items.iter().flatten().any(|w| w.store.is_some());
     let writes = items
         .iter()
         .enumerate()
         .filter_map(|(i, w)| {
-            let (g, x) = w.as_ref()?;
-            Some((
-                format!("{pos} == {i}"),
-                vec![b.send_params(&set_event(g), MACHINE, &[("value", x)])],
-            ))
+            let w = w.as_ref()?;
+            let send = match w.store {
+                None => b.send_params(&set_event(&w.entry), MACHINE, &[("value", &w.value)]),
+                Some(s) => b.send_params(
+                    &store_event(ctx.id),
+                    MACHINE,
+                    &[
+                        ("value", &w.value),
+                        ("dbl", if s.dbl { "true" } else { "false" }),
+                        ("whole", if s.whole { "true" } else { "false" }),
+                    ],
+                ),
+            };
+            Some((format!("{pos} == {i}"), vec![send]))
         })
         .collect();
     pop.extend(b.if_chain(writes, Vec::new()));
@@ -501,7 +625,7 @@ fn machine(ctx: &Ctx, items: &[Option<(String, String)>], if_empty: u8) -> Eleme
     p.push(b.tr(
         None,
         Some(&format!("!{cr} && {pos} < {len}")),
-        Some("tick_child"),
+        Some(if stores { "storing" } else { "tick_child" }),
         pop,
     ));
     p.push(b.tr(
@@ -536,6 +660,14 @@ fn machine(ctx: &Ctx, items: &[Option<(String, String)>], if_empty: u8) -> Eleme
     };
     p.push(b.tr(None, None, Some("wait_for_tick"), empty));
     m.push(p);
+    if stores {
+        m.push(b.state("storing").with_child(b.tr(
+            Some(&stored_event(ctx.id)),
+            None,
+            Some("tick_child"),
+            vec![],
+        )));
+    }
     let mut t = b.state_entry("tick_child", vec![ctx.tick_child(0)]);
     for (s, answer) in [(SUCCESS, RUNNING), (FAILURE, FAILURE), (RUNNING, RUNNING)] {
         let mut body = vec![b.assign(cr, if s == RUNNING { "true" } else { "false" })];

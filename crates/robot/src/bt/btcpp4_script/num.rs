@@ -30,14 +30,16 @@
 //!   `1/a` is -inf).
 //!
 //! Which entries are floats is decided before any script is lowered
-//! ([`float_entries`]): an entry only scripts create that some script may store a double
-//! that need not be whole in (`/=`, or a value with `/`, a real literal, or a float entry
-//! in it), and every entry only scripts create when some script divides by something
-//! other than a number literal (any double stored then may be a negative zero).
+//! ([`float_entries`]): an entry a LoopDouble writes and a script names (the Loop may
+//! store a double there, `btcpp4_loop.rs`, `Store`), an entry only scripts create that
+//! some script may store a double that need not be whole in (`/=`, or a value with `/`,
+//! a real literal, or a float entry in it), and every entry only scripts create when
+//! some script divides by something other than a number literal (any double stored then
+//! may be a negative zero).
 
 use super::super::blackboard::Blackboard;
 use super::super::script::{self, Ex, K};
-use super::super::tree::{Btcpp4, Control, Kind, PortValue, Tree};
+use super::super::tree::{Btcpp4, Control, Kind, LoopType, PortValue, Tree};
 use super::{dbl, has, int, val, Lowered, Refuse, Tr, Ty, Val};
 
 /// 2^63: a double at or beyond it (in size) is out of `int64_t`'s range.
@@ -129,7 +131,26 @@ pub(crate) fn float_entries(tree: &Tree, bb: &mut Blackboard) {
             }
         }
     }
+    // Every entry a LoopDouble writes and a script names: the Loop may store a double
+    // there (`btcpp4_loop.rs`, `Store`).
     let mut floats: Vec<String> = Vec::new();
+    let named = |g: &str| {
+        all.iter().any(|(_, names)| {
+            names
+                .iter()
+                .any(|(_, v)| matches!(v, PortValue::Blackboard(x) if x == g))
+        })
+    };
+    for n in &tree.nodes {
+        if n.kind != Kind::Control(Control::Btcpp4(Btcpp4::Loop(LoopType::Double))) {
+            continue;
+        }
+        if let Some(PortValue::Blackboard(g)) = n.port("value").map(|p| &p.value) {
+            if named(g) && scripts_only(bb, g) && !floats.contains(g) {
+                floats.push(g.clone());
+            }
+        }
+    }
     loop {
         let mut grew = false;
         for (g, op, e, names) in &writes {
