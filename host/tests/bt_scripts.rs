@@ -163,3 +163,57 @@ fn scripts_the_btcpp_lowering_cannot_model_are_refused_saying_why() {
         }
     }
 }
+
+/// A leaf whose `float64` port `out` writes 1.5 and answers SUCCESS.
+const WRITER: &str = r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="Gauge">
+<bt_declare_port_out key="out" type="float64"/>
+<state id="s"><bt_tick target="s"><bt_set_output key="out" expr="1.5"/><bt_return_status status="SUCCESS"/></bt_tick></state>
+</ascxml>"#;
+
+/// Lowers `body` under BT.CPP's rules with the `Gauge` plugin: the errors, if any.
+fn with_gauge(body: &str) -> Result<(), String> {
+    let tree = format!(
+        "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n{body}\n</BehaviorTree>\n</root>\n"
+    );
+    let mut sm = SourceMap::new();
+    let t = sm.add("tree.xml", tree);
+    let plugins = vec![sm.add("gauge.ascxml", WRITER.to_string())];
+    bt::lower(
+        &sm,
+        &BtInput {
+            tree: t,
+            plugins,
+            tick_rate_hz: 1.0,
+            tick_if_not_running: false,
+            halts: Halts::As2fm,
+            semantics: BtSemantics::Btcpp { tick: BtTick::Once },
+        },
+    )
+    .map(|_| ())
+    .map_err(|ds| Diagnostics(ds).to_string())
+}
+
+#[test]
+fn scripts_read_a_double_a_plugin_port_writes_and_may_not_write_it() {
+    // Read: compared, in arithmetic, stored into an entry only scripts write (a float).
+    for code in [
+        "level &gt; 0.3",
+        "level * 2 - 1 &lt; 0.5",
+        "y := level / 2; y &gt; 0",
+    ] {
+        let body = format!(
+            "<Sequence><Gauge out=\"{{level}}\"/><ScriptCondition code=\"{code}\"/></Sequence>"
+        );
+        with_gauge(&body).unwrap_or_else(|e| panic!("{code}: {e}"));
+    }
+    // Written by a script: refused at the script, with the column of the assignment.
+    let e = with_gauge(
+        "<Sequence><Gauge out=\"{level}\"/><Script code=\"x := 1; level := 0.5\"/></Sequence>",
+    )
+    .expect_err("a script writing the port's entry");
+    assert!(
+        e.contains("tree.xml:3:47: `code` of Script: a script writing `level`, which a plugin's port types as a double")
+            && e.contains("(at column 9 of the script)"),
+        "{e}"
+    );
+}

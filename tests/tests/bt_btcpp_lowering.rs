@@ -809,6 +809,29 @@ fn random_trees_with_loop_doubles_lower_to_what_btcpp_does() {
     );
 }
 
+/// The same with leaves whose `float64` port writes `v`, which risky conditions compare
+/// (`gen::Options::port_doubles`; `btcpp4_script/entries.rs`, `resolve`): at least one
+/// tree in twenty has such a leaf. The real library's harness has no leaves with ports;
+/// the oracle writes their values as `setOutput` writes a LoopDouble's items, which the
+/// LoopDouble tests hold to 4.8.2.
+#[test]
+fn random_trees_with_port_doubles_lower_to_what_btcpp_does() {
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        bits: true,
+        port_doubles: true,
+        ..Default::default()
+    };
+    random_trees(opts);
+    let n = trees(opts);
+    let with = drawn_again(opts, gen::Conditions::WithoutSkip)
+        .filter(|c| c.xml.contains("out=\"{v}\""))
+        .count() as u64;
+    eprintln!("{with} of the {n} trees have a leaf writing `v`");
+    assert!(with >= n / 20, "only {with} of {n} trees write `v`");
+}
+
 /// The same with BT.CPP 4's blackboard nodes (`gen::Options::bb_nodes`: UnsetBlackboard,
 /// WasEntryUpdated, SkipUnlessUpdated, WaitValueUpdate, and LoopInt, LoopBool,
 /// LoopDouble, LoopString over queues written in the tree) among the scripts, with the
@@ -2383,6 +2406,7 @@ const SUBTREE_CONDS: gen::Options = gen::Options {
     subtree_conds: true,
     loop_strings: false,
     loop_doubles: false,
+    port_doubles: false,
     joins: false,
 };
 

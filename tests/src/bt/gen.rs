@@ -143,6 +143,13 @@ pub struct Options {
     /// throws reading it before the first write: the Loop's port created it empty when
     /// the tree was loaded). Off, the generator draws what it drew before.
     pub loop_doubles: bool,
+    /// With [`Options::bits`]: leaves with an output port `out` of type `float64`
+    /// (types `O0`, `O1`, ...: `model::has_out`) writing `model::OUT_VALUES` into `v`,
+    /// one leaf in four, and risky conditions comparing `v` (BT.CPP throws reading it
+    /// before the first write: the port created it empty when the tree was loaded).
+    /// The real library's harness has no leaves with ports: these trees go to the oracle
+    /// and the lowering only. Off, the generator draws what it drew before.
+    pub port_doubles: bool,
     /// Joins, with [`Options::strings`]: the main tree also creates `u` from a string
     /// (`u:=''`, remapped into every SubTree); statements store in `u` joins of `t`,
     /// literals and number literals (`t .. 'a'`, `t .. 3`, `t .. 1.5`, `t + 'b'`,
@@ -184,7 +191,14 @@ impl<R: Rng> G<'_, R> {
     /// A fresh leaf type; `N...` types have no `<bt_halt>` (see `model::plugin`). With
     /// `stop`, its script ends with it or RUNNING, so a count of -1 above it ends.
     fn leaf_with(&mut self, stop: Option<Status>) -> String {
-        let tag = if self.below(4) == 0 { "N" } else { "L" };
+        let out = self.port_doubles_on() && self.below(4) == 0;
+        let tag = if out {
+            "O"
+        } else if self.below(4) == 0 {
+            "N"
+        } else {
+            "L"
+        };
         let name = format!("{tag}{}", self.scripts.len());
         let len = 1 + self.below(4) as usize;
         let mut script: Vec<Status> = (0..len).map(|_| self.status()).collect();
@@ -196,7 +210,11 @@ impl<R: Rng> G<'_, R> {
             };
         }
         self.scripts.insert(name.clone(), script);
-        format!("<{name}/>")
+        if out {
+            format!("<{name} out=\"{{v}}\"/>")
+        } else {
+            format!("<{name}/>")
+        }
     }
 
     fn leaf(&mut self) -> String {
@@ -270,6 +288,11 @@ impl<R: Rng> G<'_, R> {
         self.opts.loop_doubles && self.opts.bits && self.opts.bb_nodes && self.scripts_on()
     }
 
+    /// Leaves writing the double `v` through a port ([`Options::port_doubles`]).
+    fn port_doubles_on(&self) -> bool {
+        self.opts.port_doubles && self.opts.bits && self.scripts_on()
+    }
+
     fn scripts_on(&self) -> bool {
         self.opts.scripts && !self.v3
     }
@@ -306,6 +329,9 @@ impl<R: Rng> G<'_, R> {
     /// throw (the real-library harness relies on it: `Tree::haltTree` runs every
     /// `_onHalted` script, and a throw from the tree's destructor aborts).
     fn bool_expr(&mut self, d: u32, risky: bool) -> String {
+        if risky && self.port_doubles_on() && self.below(2) == 0 {
+            return self.v_cond();
+        }
         if self.opts.bits && self.below(4) == 0 {
             return self.bits_cond(risky);
         }
@@ -491,6 +517,17 @@ impl<R: Rng> G<'_, R> {
             4 => format!("{} {op} {}", self.below(3), self.pick(&["t", "k0", "k1"])),
             _ => format!("({} ? 1 : 0) == 1", self.pick(&["t", "k0", "k1"])),
         }
+    }
+
+    /// A condition over `v`, the double the leaves' ports write
+    /// ([`Options::port_doubles`]): it throws before the first write.
+    fn v_cond(&mut self) -> String {
+        let op = self.pick(&["==", "!=", "<", "<=", ">", ">="]);
+        let v = self.pick(&["v", "v", "(v * 2)", "(v - r)", "-v", "v / 2"]);
+        format!(
+            "{v} {op} {}",
+            self.pick(&["1.5", "0.5", "0", "r", "x", "-2", "3.25"])
+        )
     }
 
     /// One to three statements.

@@ -12,8 +12,19 @@ pub fn has_halt(name: &str) -> bool {
     !(b.len() > 1 && b[0] == b'N' && b[1].is_ascii_digit())
 }
 
-/// The plugin of leaf type `name`: on its k-th tick it answers `script[k % len]`; a halt
-/// is answered and does not move it. A type named `N<digit>...` has no `<bt_halt>` ([`has_halt`]), as older
+/// What a leaf with an `out` port (a type named `O<digit>...`, [`has_out`]) writes there
+/// at its k-th callback: `OUT_VALUES[k % 4]`, a double (the plugin's port is `float64`).
+pub const OUT_VALUES: [&str; 4] = ["1.5", "0.5", "-2.0", "3.25"];
+
+/// Whether leaf type `name` has an output port `out` of type `float64` ([`OUT_VALUES`]).
+pub fn has_out(name: &str) -> bool {
+    let b = name.as_bytes();
+    b.len() > 1 && b[0] == b'O' && b[1].is_ascii_digit()
+}
+
+/// The plugin of leaf type `name`: on its k-th tick it answers `script[k % len]` (after
+/// writing `OUT_VALUES[k % 4]` to its port `out`, [`has_out`]); a halt is answered and
+/// does not move it. A type named `N<digit>...` has no `<bt_halt>` ([`has_halt`]), as older
 /// AS2FM plugins have none (the lowering answers their halts in every state).
 pub fn plugin(name: &str, script: &[super::tree::Status]) -> String {
     let len = script.len();
@@ -42,11 +53,32 @@ pub fn plugin(name: &str, script: &[super::tree::Status]) -> String {
     } else {
         "<bt_halt target=\"s\"><bt_return_halted/></bt_halt>\n"
     };
+    let j = if has_out(name) {
+        "<data id=\"j\" type=\"int32\" expr=\"0\"/>"
+    } else {
+        ""
+    };
+    let (port, write) = if has_out(name) {
+        let n = OUT_VALUES.len();
+        let mut w = String::new();
+        for (i, v) in OUT_VALUES.iter().enumerate() {
+            let head = match i {
+                0 => format!("<if cond=\"j == {i}\">"),
+                _ if i + 1 == n => "<else/>".to_string(),
+                _ => format!("<elseif cond=\"j == {i}\"/>"),
+            };
+            w += &format!("{head}<bt_set_output key=\"out\" expr=\"{v}\"/>");
+        }
+        w += &format!("</if><assign location=\"j\" expr=\"(j + 1) % {n}\"/>");
+        ("<bt_declare_port_out key=\"out\" type=\"float64\"/>\n", w)
+    } else {
+        ("", String::new())
+    };
     format!(
         r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="{name}">
-<datamodel><data id="k" type="int32" expr="0"/></datamodel>
+{port}<datamodel><data id="k" type="int32" expr="0"/>{j}</datamodel>
 <state id="s">
-<bt_tick target="s">{branches}</bt_tick>
+<bt_tick target="s">{write}{branches}</bt_tick>
 {halt}</state>
 </ascxml>"#
     )

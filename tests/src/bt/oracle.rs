@@ -871,8 +871,20 @@ impl<'t> Oracle<'t> {
                     .get(ty)
                     .filter(|s| !s.is_empty())
                     .ok_or(format!("no script for leaf {ty}"))?;
-                let s = script[self.leaf_ticks[n] % script.len()];
+                let k = self.leaf_ticks[n];
+                let s = script[k % script.len()];
                 self.leaf_ticks[n] += 1;
+                // A leaf with an `out` port (`model::plugin`): `setOutput<double>` of
+                // its k-th value, which `Blackboard::set` stores as a LoopDouble's item
+                // is (both write through `setOutput`).
+                if let Some(key) = self.tree.nodes[n].out.clone() {
+                    let values = super::model::OUT_VALUES;
+                    self.write_output(
+                        &key,
+                        super::tree::LoopType::Double,
+                        values[k % values.len()],
+                    )?;
+                }
                 Ok(s)
             }
             Kind::Sequence => self.sequence(n, Success, Failure, false),

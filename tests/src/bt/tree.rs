@@ -224,6 +224,9 @@ pub struct Node {
     /// The root of a SubTree's body: BT.CPP's `SubTreeNode::tick` resets it once it
     /// finished (`subtree_cond.rs`).
     pub subtree_body: bool,
+    /// A leaf's `out` port: the entry (after SubTree remapping) where it writes a double
+    /// at every callback ([`super::model::OUT_VALUES`]).
+    pub out: Option<String>,
 }
 
 /// The scripts of a node's pre/post-condition attributes (BT.CPP 4 `tree_node.h`,
@@ -752,6 +755,10 @@ impl Flat<'_> {
                 }
             }
         }
+        let out = match (&kind, attrs.get("out").and_then(|v| entry(v))) {
+            (Kind::Leaf(_), Some(e)) => Some(e.to_string()),
+            _ => None,
+        };
         let i = self.tree.nodes.len();
         self.uids += 1;
         self.tree.nodes.push(Node {
@@ -762,6 +769,7 @@ impl Flat<'_> {
             children: Vec::new(),
             conds,
             subtree_body: false,
+            out,
         });
         if let Some(p) = parent {
             self.tree.nodes[p].children.push(i);
@@ -850,6 +858,7 @@ impl Flat<'_> {
             children: Vec::new(),
             conds,
             subtree_body: false,
+            out: None,
         });
         if let Some(p) = parent {
             self.tree.nodes[p].children.push(i);

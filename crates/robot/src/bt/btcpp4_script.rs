@@ -1,6 +1,8 @@
 //! BehaviorTree.CPP 4's script language lowered under [`super::BtSemantics::Btcpp`]:
-//! the `Script`, `ScriptCondition` and `Precondition` nodes over integer and boolean
-//! blackboard entries, with doubles (`/`, real literals) where they are not stored.
+//! the `Script`, `ScriptCondition` and `Precondition` nodes over integer, boolean,
+//! double and string blackboard entries (a double a plugin's `float64` port writes is
+//! read, never written: `entries.rs`), with doubles (`/`, real literals) computed as
+//! BT.CPP computes them.
 //!
 //! # Where a script runs
 //! In the blackboard machine (`blackboard.rs`), which holds every entry: the node sends
@@ -56,7 +58,8 @@
 //! whole (`x := 5/2`, `x /= 2`: the model's script entries are integers), a divisor
 //! other than a number literal other than 0, a number
 //! literal BT.CPP refuses at load, an entry SetBlackboard writes other than as above,
-//! an entry of a type other than integer or boolean, an entry a SubTree maps to a
+//! an entry of a type other than integer, boolean or `float64`, a script writing a
+//! plugin's `float64` port entry, an entry a SubTree maps to a
 //! constant.
 
 use super::blackboard::{Blackboard, MACHINE};
@@ -298,7 +301,12 @@ impl Tr<'_> {
                 let (g, t, dynamic) = self.entry(n);
                 // "Variable not found".
                 self.check(guard, format!("!{}", has(&g)));
-                let d = if dynamic { dbl(&g) } else { "false".into() };
+                // A plugin's `double` port entry always holds a double.
+                let d = match (dynamic, t) {
+                    (true, _) => dbl(&g),
+                    (false, Ty::Real) => "true".into(),
+                    (false, _) => "false".into(),
+                };
                 // An entry a SetBlackboard writes keeps its text's rank beside the
                 // value other nodes read.
                 let x = if t == Ty::Text && !dynamic {
@@ -492,7 +500,10 @@ fn statement(
         strs,
         checks: Vec::new(),
     };
-    if let Some((target, op, _)) = &s.assign {
+    if let Some((target, op, at)) = &s.assign {
+        if let (g, Ty::Real, false) = tr.entry(target) {
+            return Err((*at, format!("a script writing `{g}`, which a plugin's port types as a double: BT.CPP 4 would store the script's value as it is where the entry holds nothing yet and convert the plugin's later doubles to its type, which is not modelled (read it in scripts; write another entry)")));
+        }
         if tr.entry(target).1 == Ty::Real {
             return num::float_statement(tr, target, op, &s.e);
         }

@@ -1,6 +1,6 @@
 //! Which entries a script's names are, with the type each holds (`resolve`: an integer,
-//! a boolean, a double only scripts create, a string a SetBlackboard or a script writes,
-//! else refused at the script), and an assignment where a string meets an entry
+//! a boolean, a double scripts create or a plugin's port types, a string a SetBlackboard
+//! or a script writes, else refused at the script), and an assignment where a string meets an entry
 //! (`assign_text`).
 
 use super::super::blackboard::{Blackboard, Entry};
@@ -88,11 +88,14 @@ pub(super) fn resolve(
             }
             Some(e) => match Scalar::from_name(e.ty.trim()) {
                 Some(Scalar::Bool) => Ty::Bool,
-                Some(Scalar::F64) if dynamic => Ty::Real,
+                // A `double` a plugin's port types: the plugin stores doubles there
+                // (`setOutput<double>`), which scripts read; a script writing it is
+                // refused (`statement`).
+                Some(Scalar::F64) => Ty::Real,
                 Some(s) if s.int_range().is_some() => Ty::Int,
                 _ => {
                     let at = sm.diag(e.span, "");
-                    errs.push(sm.diag(span, format!("the script uses the entry `{g}`, which is {} at {}:{}:{} ({}): scripts over entries other than integers and booleans are not modelled yet", e.ty, at.file, at.line, at.col, e.why)));
+                    errs.push(sm.diag(span, format!("the script uses the entry `{g}`, which is {} at {}:{}:{} ({}): scripts over entries other than integers, booleans and doubles (`float64`) are not modelled yet", e.ty, at.file, at.line, at.col, e.why)));
                     continue;
                 }
             },

@@ -162,7 +162,9 @@ pub(crate) fn float_entries(tree: &Tree, bb: &mut Blackboard) {
                 real |= match &x.k {
                     K::Bin("/", ..) => true,
                     K::Number(t) => literal(t).is_ok_and(|(_, ty)| ty == Ty::Real),
-                    K::Name(n) => entry(names, n).is_some_and(|h| floats.contains(&h)),
+                    K::Name(n) => {
+                        entry(names, n).is_some_and(|h| floats.contains(&h) || port_double(bb, &h))
+                    }
                     _ => false,
                 }
             });
@@ -176,6 +178,12 @@ pub(crate) fn float_entries(tree: &Tree, bb: &mut Blackboard) {
         }
     }
     bb.floats = floats;
+}
+
+/// Whether entry `g` is a `double` a plugin's port types (scripts read it as one).
+fn port_double(bb: &Blackboard, g: &str) -> bool {
+    bb.entry(g)
+        .is_some_and(|e| e.why != "a script" && e.ty.trim() == "float64")
 }
 
 impl Tr<'_> {
