@@ -5,39 +5,11 @@
 //! each saying why. (What the lowered nodes do is held to the oracle and the real library
 //! by `tests/tests/bt_btcpp_lowering.rs`.)
 
-use hindsight::robot::bt::{self, BtInput, BtSemantics, BtTick, Halts};
-use hindsight::verify::model::source::SourceMap;
+mod common;
+
+use common::bt::{lower_act as lower, BTCPP};
+use hindsight::robot::bt::BtSemantics;
 use hindsight::verify::model::xml::Element;
-use hindsight::verify::model::Diagnostics;
-
-const LEAF: &str = r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="Act">
-<state id="s"><bt_tick target="s"><bt_return_status status="SUCCESS"/></bt_tick></state>
-</ascxml>"#;
-
-const BTCPP: BtSemantics = BtSemantics::Btcpp { tick: BtTick::Once };
-
-/// Lowers a document (`body` inside the main tree, `more` after it): the machines, or
-/// the errors.
-fn lower(body: &str, more: &str, semantics: BtSemantics) -> Result<Vec<Element>, String> {
-    let tree = format!(
-        "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n{body}\n</BehaviorTree>\n{more}</root>\n"
-    );
-    let mut sm = SourceMap::new();
-    let t = sm.add("tree.xml", tree);
-    let plugins = vec![sm.add("act.ascxml", LEAF.to_string())];
-    bt::lower(
-        &sm,
-        &BtInput {
-            tree: t,
-            plugins,
-            tick_rate_hz: 1.0,
-            tick_if_not_running: false,
-            halts: Halts::As2fm,
-            semantics,
-        },
-    )
-    .map_err(|ds| Diagnostics(ds).to_string())
-}
 
 /// The `<data>` ids of machine `name`.
 fn data(ms: &[Element], name: &str) -> Vec<String> {

@@ -5,35 +5,16 @@
 //! `--bt btcpp`, which lowers it (or refuses, at the attribute, what it does not model
 //! yet).
 
-use hindsight::robot::bt::{self, BtInput, BtSemantics, BtTick, Halts};
-use hindsight::verify::model::source::SourceMap;
-use hindsight::verify::model::Diagnostics;
+mod common;
 
-const LEAF: &str = r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="Act">
-<state id="s"><bt_tick target="s"><bt_return_status status="SUCCESS"/></bt_tick></state>
-</ascxml>"#;
+use common::bt::{lower_act, lower_doc, BTCPP};
+use hindsight::robot::bt::{BtSemantics, BtTick};
 
 /// The errors lowering `body` gives under `semantics`.
 fn errors(body: &str, semantics: BtSemantics) -> String {
-    let tree = format!(
-        "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n{body}\n</BehaviorTree>\n</root>\n"
-    );
-    let mut sm = SourceMap::new();
-    let t = sm.add("tree.xml", tree);
-    let plugins = vec![sm.add("act.ascxml", LEAF.to_string())];
-    match bt::lower(
-        &sm,
-        &BtInput {
-            tree: t,
-            plugins,
-            tick_rate_hz: 1.0,
-            tick_if_not_running: false,
-            halts: Halts::As2fm,
-            semantics,
-        },
-    ) {
+    match lower_act(body, "", semantics) {
         Ok(_) => panic!("lowered: {body}"),
-        Err(ds) => Diagnostics(ds).to_string(),
+        Err(e) => e,
     }
 }
 
@@ -141,25 +122,8 @@ fn scripts_the_btcpp_lowering_cannot_model_are_refused_saying_why() {
         "x := 1 / 0 &gt; 0; z := 1 / -x",
         "x := 'abc' &lt; 'abd' &amp;&amp; ' 3' == 3",
     ] {
-        let tree = format!(
-            "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n<Script code=\"{code}\"/>\n</BehaviorTree>\n</root>\n"
-        );
-        let mut sm = SourceMap::new();
-        let t = sm.add("tree.xml", tree);
-        let plugins = vec![sm.add("act.ascxml", LEAF.to_string())];
-        let r = bt::lower(
-            &sm,
-            &BtInput {
-                tree: t,
-                plugins,
-                tick_rate_hz: 1.0,
-                tick_if_not_running: false,
-                halts: Halts::As2fm,
-                semantics: btcpp,
-            },
-        );
-        if let Err(ds) = r {
-            panic!("{code}: {}", Diagnostics(ds));
+        if let Err(e) = lower_act(&format!("<Script code=\"{code}\"/>"), "", btcpp) {
+            panic!("{code}: {e}");
         }
     }
 }
@@ -172,25 +136,7 @@ const WRITER: &str = r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial=
 
 /// Lowers `body` under BT.CPP's rules with the `Gauge` plugin: the errors, if any.
 fn with_gauge(body: &str) -> Result<(), String> {
-    let tree = format!(
-        "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n{body}\n</BehaviorTree>\n</root>\n"
-    );
-    let mut sm = SourceMap::new();
-    let t = sm.add("tree.xml", tree);
-    let plugins = vec![sm.add("gauge.ascxml", WRITER.to_string())];
-    bt::lower(
-        &sm,
-        &BtInput {
-            tree: t,
-            plugins,
-            tick_rate_hz: 1.0,
-            tick_if_not_running: false,
-            halts: Halts::As2fm,
-            semantics: BtSemantics::Btcpp { tick: BtTick::Once },
-        },
-    )
-    .map(|_| ())
-    .map_err(|ds| Diagnostics(ds).to_string())
+    lower_doc(body, "", &[("gauge.ascxml", WRITER)], BTCPP).map(|_| ())
 }
 
 #[test]

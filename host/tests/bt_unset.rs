@@ -4,38 +4,10 @@
 //! nodes BT.CPP does not register are refused, saying why. (What the lowered node does
 //! is held to the oracle by `tests/tests/bt_btcpp_lowering.rs`.)
 
-use hindsight::robot::bt::{self, BtInput, BtSemantics, BtTick, Halts};
-use hindsight::verify::model::source::SourceMap;
-use hindsight::verify::model::Diagnostics;
+mod common;
 
-const LEAF: &str = r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="Act">
-<state id="s"><bt_tick target="s"><bt_return_status status="SUCCESS"/></bt_tick></state>
-</ascxml>"#;
-
-const BTCPP: BtSemantics = BtSemantics::Btcpp { tick: BtTick::Once };
-
-/// Lowers a document (`body` inside the main tree, `more` after it); the errors, if any.
-fn lower(body: &str, more: &str, semantics: BtSemantics) -> Result<(), String> {
-    let tree = format!(
-        "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n{body}\n</BehaviorTree>\n{more}</root>\n"
-    );
-    let mut sm = SourceMap::new();
-    let t = sm.add("tree.xml", tree);
-    let plugins = vec![sm.add("act.ascxml", LEAF.to_string())];
-    bt::lower(
-        &sm,
-        &BtInput {
-            tree: t,
-            plugins,
-            tick_rate_hz: 1.0,
-            tick_if_not_running: false,
-            halts: Halts::As2fm,
-            semantics,
-        },
-    )
-    .map(|_| ())
-    .map_err(|ds| Diagnostics(ds).to_string())
-}
+use common::bt::{lower_act as lower, BTCPP};
+use hindsight::robot::bt::BtSemantics;
 
 #[test]
 fn unset_lowers_under_btcpp_over_a_script_entry() {

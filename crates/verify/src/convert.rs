@@ -304,14 +304,50 @@ fn scan_properties(
     Ok(out)
 }
 
+/// Why a property's bound has no SCAN equivalent ([`to_steps`]).
+enum BadBound {
+    /// The bound does not read (the reader's message).
+    Unread(crate::sweep::SweepError),
+    /// A duration that is not a whole number of steps: the bound, the step in ns.
+    NotWhole(String, u64),
+}
+
+impl fmt::Display for BadBound {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BadBound::Unread(e) => e.fmt(f),
+            BadBound::NotWhole(bound, unit_ns) => write!(
+                f,
+                "bound `{bound}` is not a whole number of steps of {}",
+                seconds(*unit_ns)
+            ),
+        }
+    }
+}
+
 /// A bound as written (`62`, `6.2s`) in steps of `unit_ns`.
-fn to_steps(bound: &str, unit_ns: u64) -> Result<String, String> {
-    match parse_bound(bound).map_err(|e| e.to_string())? {
+fn to_steps(bound: &str, unit_ns: u64) -> Result<String, BadBound> {
+    match parse_bound(bound).map_err(BadBound::Unread)? {
         StepsOrDuration::Steps(v) => Ok(v.to_string()),
         StepsOrDuration::Nanos(ns) if ns % unit_ns == 0 => Ok((ns / unit_ns).to_string()),
-        StepsOrDuration::Nanos(_) => Err(format!(
-            "bound `{bound}` is not a whole number of steps of {}",
-            seconds(unit_ns)
-        )),
+        StepsOrDuration::Nanos(_) => Err(BadBound::NotWhole(bound.to_string(), unit_ns)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::to_steps;
+
+    #[test]
+    fn a_bound_becomes_whole_steps_or_says_why_not() {
+        let tick = 100_000_000;
+        assert_eq!(to_steps("6.2s", tick).ok().as_deref(), Some("62"));
+        assert_eq!(to_steps("62", tick).ok().as_deref(), Some("62"));
+        let e = to_steps("6.25s", tick).err().map(|e| e.to_string());
+        assert_eq!(
+            e.as_deref(),
+            Some("bound `6.25s` is not a whole number of steps of 0.1s")
+        );
+        assert!(to_steps("6.2 parsecs", tick).is_err());
     }
 }

@@ -8,6 +8,7 @@
 #![allow(dead_code)]
 
 pub mod alloc;
+pub mod bt;
 pub mod canon;
 pub mod corpus;
 pub mod dds;
