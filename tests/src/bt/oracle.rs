@@ -304,6 +304,9 @@ pub struct Oracle<'t> {
     dbl: std::collections::BTreeSet<String>,
     /// Their exact values (`script::Env::reals`).
     reals: BTreeMap<String, f64>,
+    /// The entries UnsetBlackboard erased (a port's entry then no longer exists until
+    /// written again).
+    erased: std::collections::BTreeSet<String>,
     /// The entries scripts created from a string, and their texts (`script::Env`).
     pub strs: BTreeMap<String, String>,
     /// Sequences and fallbacks: children skipped so far (`skipped_count_`).
@@ -392,6 +395,7 @@ impl<'t> Oracle<'t> {
             vars: BTreeMap::new(),
             dbl: Default::default(),
             reals: BTreeMap::new(),
+            erased: Default::default(),
             strs: BTreeMap::new(),
             skipped: vec![0; n],
             fault: None,
@@ -676,14 +680,24 @@ impl<'t> Oracle<'t> {
         let texts = self.texts();
         let mut last = super::script::V::Num(0);
         for s in &p.0 {
-            if let Expr::Assign(v, op, _) = s {
+            let mut s = s.clone();
+            if let Expr::Assign(v, op, e) = &s {
                 if *op != ":=" && !self.vars.contains_key(v) && !self.strs.contains_key(v) {
-                    return Err(Fault::Throws(format!(
-                        "The blackboard entry [{v}] doesn't exist"
-                    )));
+                    // An entry a port created when the tree was loaded exists without a
+                    // value (4.8.2, `tests/bt/btcpp4/loop.toml`): `=` stores as `:=`
+                    // does, `+=` ... find it empty.
+                    if !self.declared(v) || self.erased.contains(v) {
+                        return Err(Fault::Throws(format!(
+                            "The blackboard entry [{v}] doesn't exist"
+                        )));
+                    }
+                    if *op != "=" {
+                        return Err(Fault::Throws("is not initialized".into()));
+                    }
+                    s = Expr::Assign(v.clone(), ":=", e.clone());
                 }
             }
-            let fresh = match s {
+            let fresh = match &s {
                 Expr::Assign(v, _, _)
                     if !self.vars.contains_key(v) && !self.strs.contains_key(v) =>
                 {
@@ -718,11 +732,19 @@ impl<'t> Oracle<'t> {
                 }
                 Err(f) => return Err(f),
             };
-            if let Expr::Assign(v, ..) = s {
+            if let Expr::Assign(v, ..) = &s {
                 *self.seq.entry(v.clone()).or_default() += 1;
             }
         }
         Ok(last)
+    }
+
+    /// Whether a port of the tree names entry `v` in `{}` (a Loop's `value`, a leaf's
+    /// `out`): BT.CPP creates it, without a value, when it loads the tree.
+    fn declared(&self, v: &str) -> bool {
+        self.tree.nodes.iter().any(|x| {
+            x.out.as_deref() == Some(v) || matches!(&x.kind, Kind::Loop(_, _, Some(e), _) if e == v)
+        })
     }
 
     /// Whether `t` is "Variable not found" for an entry a Loop node's `value` names.
@@ -964,6 +986,7 @@ impl<'t> Oracle<'t> {
             // `UnsetBlackboardNode::tick`: `blackboard->unset(key)` erases the entry (a
             // missing one is no error), SUCCESS.
             Kind::Unset(key) => {
+                self.erased.insert(key.clone());
                 self.vars.remove(key);
                 self.reals.remove(key);
                 self.strs.remove(key);

@@ -67,6 +67,13 @@ pub(crate) struct Blackboard {
     /// Entries scripts read or write: the machine keeps whether each holds a value
     /// (`btcpp4_script.rs`).
     pub script_entries: Vec<String>,
+    /// Entries a port of the tree names in `{}` (a Loop's `value`, a plugin's port):
+    /// BT.CPP 4 creates them, without a value, when it loads the tree, so `=` on one
+    /// does not throw (`btcpp4_script.rs`, `exists`).
+    pub declared: Vec<String>,
+    /// Those of them an UnsetBlackboard erases: the machine keeps whether it did
+    /// (`bt_gone__<entry>`).
+    pub gone: Vec<String>,
     /// Entries only scripts create that hold a number that need not be whole: the
     /// machine keeps them as `float64` (`btcpp4_script/num.rs`, `float_entries`).
     pub floats: Vec<String>,
@@ -107,6 +114,7 @@ impl Blackboard {
             .script_entries
             .iter()
             .flat_map(|e| [super::btcpp4_script::has(e), super::btcpp4_script::dbl(e)])
+            .chain(self.gone.iter().map(|e| super::btcpp4_script::gone(e)))
             .collect();
         let mut vars: Vec<(&str, &str, String)> = self
             .entries

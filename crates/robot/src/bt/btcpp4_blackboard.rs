@@ -88,6 +88,29 @@ pub(super) fn prepare(
             _ => {}
         }
     }
+    // The entries a port created that an UnsetBlackboard erases (`Blackboard::gone`).
+    for n in &tree.nodes {
+        if n.kind != Kind::Control(Control::Btcpp4(Btcpp4::Unset)) {
+            continue;
+        }
+        if let Some(g) = unset_key(n) {
+            if bb.declared.contains(&g) && !bb.gone.contains(&g) {
+                bb.gone.push(g);
+            }
+        }
+    }
+}
+
+/// The entry UnsetBlackboard node `n` erases, as the tree reader resolved its `key`
+/// (`script_names`); `None` where it did not (it reported why) or `key` is not a name.
+fn unset_key(n: &TreeNode) -> Option<String> {
+    let PortValue::Literal(k) = &n.port("key")?.value else {
+        return None;
+    };
+    match n.script_names.iter().find(|(name, _)| name == k.trim()) {
+        Some((_, PortValue::Blackboard(g))) => Some(g.clone()),
+        _ => None,
+    }
 }
 
 /// The counters' variables: one per watched entry, one per entry-updated node.
@@ -315,20 +338,10 @@ pub(super) fn unset(
         ));
         return None;
     };
-    // The tree reader resolved the key's entry (`script_names`): a SubTree's key was
-    // refused there.
-    let resolved = |k: &str| {
-        n.script_names
-            .iter()
-            .find(|(name, _)| name == k.trim())
-            .map(|(_, v)| v)
-    };
     let g = match &p.value {
-        // Unresolved: the tree reader reported why.
-        PortValue::Literal(k) => match resolved(k) {
-            Some(PortValue::Blackboard(g)) => g.clone(),
-            _ => return None,
-        },
+        // The tree reader resolved the key's entry (`script_names`): a SubTree's key was
+        // refused there, and an unresolved one reported.
+        PortValue::Literal(_) => unset_key(n)?,
         PortValue::Blackboard(e) => {
             errs.push(sm.diag(
                 p.span,
@@ -368,6 +381,9 @@ pub(super) fn unset(
     // none), and one created again counts its writes from 0; then SUCCESS.
     let b = &ctx.b;
     let mut body = vec![b.assign(&super::btcpp4_script::has(&g), "false")];
+    if bb.gone.contains(&g) {
+        body.push(b.assign(&super::btcpp4_script::gone(&g), "true"));
+    }
     if bb.watched.contains(&g) {
         body.push(b.assign(&seq(&g), "0"));
     }

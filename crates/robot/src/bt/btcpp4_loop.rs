@@ -112,6 +112,9 @@ pub(super) fn prepare(
     }
     if let Some(p) = n.port("value") {
         if let PortValue::Blackboard(g) = &p.value {
+            if !bb.declared.contains(g) {
+                bb.declared.push(g.clone());
+            }
             if bb.entry(g).is_none() && scripted(tree, g) {
                 bb.entries.push(Entry {
                     name: g.clone(),

@@ -36,8 +36,10 @@
 //!   `<`, `>`, `<=`, `>=`; never stored; divisors are number literals other than 0
 //!   (the model's integers have no negative zero, whose sign BT.CPP's doubles show in
 //!   `1/-0.0`).
-//! - Reading an entry that holds no value throws ("Variable not found"); so does `=`,
-//!   `+=`, `-=`, `*=` on one (`:=` creates it).
+//! - Reading an entry that holds no value throws ("Variable not found"); so does `+=`,
+//!   `-=`, `*=` on one (`:=` creates it), and `=` on one that does not exist: an entry a
+//!   port names in `{}` exists from the load until an UnsetBlackboard erases it
+//!   ([`exists`]).
 //! - `+ -` and `*` group to the right (`10 - 4 - 2` is 8, `1 - 1 + 1` is -1).
 //! - Strings (`btcpp4_strings.rs`): a literal, an entry SetBlackboard wrote (BT.CPP 4
 //!   stores SetBlackboard's value as text) or one a script assigns strings to is a
@@ -85,6 +87,26 @@ pub(crate) const FAULT: &str = "bt_script_fault";
 /// The blackboard machine's flag: entry `e` holds a value.
 pub(crate) fn has(e: &str) -> String {
     format!("bt_has__{e}")
+}
+
+/// Whether entry `g` exists (`=` on one that does not throws): it holds a value
+/// ([`has`]), or a port names it in `{}` (`Blackboard::declared`: BT.CPP 4 creates it,
+/// empty, when it loads the tree; 4.8.2 measured, `tests/bt/btcpp4/loop.toml`) and no
+/// UnsetBlackboard erased it since (`bt_gone__<entry>`, kept where one may).
+pub(crate) fn exists(bb: &Blackboard, g: &str) -> String {
+    if !bb.declared.iter().any(|d| d == g) {
+        has(g)
+    } else if bb.gone.iter().any(|d| d == g) {
+        format!("({} || !{})", has(g), gone(g))
+    } else {
+        "true".into()
+    }
+}
+
+/// The blackboard machine's flag: UnsetBlackboard erased entry `e`, which a port created
+/// when the tree was loaded ([`exists`]).
+pub(crate) fn gone(e: &str) -> String {
+    format!("bt_gone__{e}")
 }
 
 /// The event asking the blackboard machine to run node `id`'s script.
@@ -160,6 +182,8 @@ struct Tr<'a> {
     names: &'a [Name],
     /// The tree's texts (`btcpp4_strings.rs`).
     strs: &'a super::btcpp4_strings::Strings,
+    /// The blackboard, for which entries exist from the load ([`Tr::exists`]).
+    bb: &'a Blackboard,
     /// Conditions under which the statement being translated throws.
     checks: Vec<String>,
 }
@@ -209,6 +233,13 @@ fn compare_real(op: &str, l: &str, r: &str) -> String {
 }
 
 impl Tr<'_> {
+    /// Whether entry `g` exists, for `=` ("The blackboard entry [..] doesn't exist"
+    /// otherwise): it holds a value, or a port of the tree created it when the tree was
+    /// loaded and no UnsetBlackboard erased it since ([`exists`]).
+    fn exists(&self, g: &str) -> String {
+        exists(self.bb, g)
+    }
+
     fn entry(&self, name: &str) -> (String, Ty, bool) {
         let (_, g, t, dynamic) = self
             .names
@@ -490,14 +521,11 @@ struct Lowered {
     value: Val,
 }
 
-fn statement(
-    names: &[Name],
-    strs: &super::btcpp4_strings::Strings,
-    s: &Stmt,
-) -> Result<Lowered, Refuse> {
+fn statement(names: &[Name], bb: &Blackboard, s: &Stmt) -> Result<Lowered, Refuse> {
     let mut tr = Tr {
         names,
-        strs,
+        strs: &bb.strings,
+        bb,
         checks: Vec::new(),
     };
     if let Some((target, op, at)) = &s.assign {
@@ -525,7 +553,8 @@ fn statement(
         return tr.plus_assign(&g, v, &s.e, *at);
     }
     if et == Ty::Text || t == Ty::Text {
-        return assign_text(tr.checks, &g, et == Ty::Text, v, op, *at);
+        let exists = tr.exists(&g);
+        return assign_text(tr.checks, &g, &exists, et == Ty::Text, v, op, *at);
     }
     if t == Ty::Real || *op == "/=" {
         return Err((
@@ -533,9 +562,12 @@ fn statement(
             format!("`{op}` storing a number that need not be whole in `{g}`: {STORE_REAL}"),
         ));
     }
-    if *op != ":=" {
+    match *op {
+        ":=" => {}
         // "The blackboard entry [..] doesn't exist".
-        tr.checks.push(format!("!{}", has(&g)));
+        "=" => tr.checks.push(format!("!{}", tr.exists(&g))),
+        // It exists without a value: "The left operand [..] is not initialized".
+        _ => tr.checks.push(format!("!{}", has(&g))),
     }
     let new = match (*op, et, t) {
         (":=" | "=", Ty::Int, _) => int(x, t),
@@ -590,7 +622,7 @@ pub(super) fn compile(
     let names = resolve(sm, n, span, bb, errs)?;
     let mut lowered = Vec::new();
     for s in &stmts {
-        match statement(&names, &bb.strings, s) {
+        match statement(&names, bb, s) {
             Ok(l) => lowered.push(l),
             Err((at, why)) => {
                 errs.push(sm.diag(

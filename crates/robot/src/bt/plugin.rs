@@ -202,6 +202,9 @@ pub(crate) fn check_ports(
                 }
             }
             PortValue::Blackboard(name) => {
+                if !bb.declared.contains(name) {
+                    bb.declared.push(name.clone());
+                }
                 let why = format!("port `{}` of plugin `{}`", p.key, plugin.name);
                 blackboard::register(sm, bb, name, &decl.ty, p.span, &why, errs)
             }

@@ -119,6 +119,7 @@ pub(super) fn resolve(
 pub(super) fn assign_text(
     mut checks: Vec<String>,
     g: &str,
+    exists: &str,
     entry_text: bool,
     v: Val,
     op: &str,
@@ -136,8 +137,8 @@ pub(super) fn assign_text(
     match (entry_text, text, op) {
         (true, true, ":=" | "=") => {
             if op == "=" {
-                // "The blackboard entry [..] doesn't exist".
-                checks.push(format!("!{}", has(g)));
+                // "The blackboard entry [..] doesn't exist" (`super::exists`).
+                checks.push(format!("!{exists}"));
             }
             Ok(Lowered {
                 checks,

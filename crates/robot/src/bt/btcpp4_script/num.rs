@@ -314,9 +314,12 @@ pub(super) fn float_statement(
     }
     let v = tr.exact(e, "")?;
     let (h, d) = (has(&g), dbl(&g));
-    if op != ":=" {
+    match op {
+        ":=" => {}
         // "The blackboard entry [..] doesn't exist".
-        tr.checks.push(format!("!{h}"));
+        "=" => tr.checks.push(format!("!{}", tr.exists(&g))),
+        // "The left operand [..] is not initialized".
+        _ => tr.checks.push(format!("!{h}")),
     }
     let new = match op {
         ":=" | "=" => v.x.clone(),
