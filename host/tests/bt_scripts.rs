@@ -158,8 +158,43 @@ fn scripts_read_a_double_a_plugin_port_writes_and_may_not_write_it() {
     )
     .expect_err("a script writing the port's entry");
     assert!(
-        e.contains("tree.xml:3:47: `code` of Script: a script writing `level`, which a plugin's port types as a double")
+        e.contains("tree.xml:3:47: `code` of Script: a script writing `level`, which a plugin's output port types as a double")
             && e.contains("(at column 9 of the script)"),
+        "{e}"
+    );
+}
+
+/// A leaf whose `float64` input port `speed` it only reads, answering SUCCESS.
+const READER: &str = r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="Drive">
+<bt_declare_port_in key="speed" type="float64"/>
+<state id="s"><bt_tick target="s"><bt_return_status status="SUCCESS"/></bt_tick></state>
+</ascxml>"#;
+
+#[test]
+fn scripts_write_a_double_only_plugin_input_ports_name() {
+    // A script setting an action's parameter: `:=` and, as the port created the entry
+    // when the tree was loaded, `=` too; then read back in a condition.
+    for code in [
+        "speed := 0.5",
+        "speed = 1.5",
+        "speed := 2; speed = speed / 4",
+        "speed = 0.25; speed &lt; 1",
+    ] {
+        let body =
+            format!("<Sequence><Script code=\"{code}\"/><Drive speed=\"{{speed}}\"/></Sequence>");
+        lower_doc(&body, "", &[("drive.ascxml", READER)], BTCPP)
+            .unwrap_or_else(|e| panic!("{code}: {e}"));
+    }
+    // Once another plugin's output port writes the entry too, a script may not.
+    let e = lower_doc(
+        "<Sequence><Gauge out=\"{speed}\"/><Script code=\"speed := 0.5\"/><Drive speed=\"{speed}\"/></Sequence>",
+        "",
+        &[("gauge.ascxml", WRITER), ("drive.ascxml", READER)],
+        BTCPP,
+    )
+    .expect_err("a script writing an entry a plugin's output port writes");
+    assert!(
+        e.contains("a script writing `speed`, which a plugin's output port types as a double"),
         "{e}"
     );
 }

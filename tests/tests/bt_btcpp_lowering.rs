@@ -809,9 +809,11 @@ fn random_trees_with_loop_doubles_lower_to_what_btcpp_does() {
     );
 }
 
-/// The same with leaves whose `float64` port writes `v`, which risky conditions compare
-/// (`gen::Options::port_doubles`; `btcpp4_script/entries.rs`, `resolve`): at least one
-/// tree in twenty has such a leaf. The real library's harness has no leaves with ports;
+/// The same with leaves whose `float64` port writes `v`, and leaves whose `float64` input
+/// port names `w`, which scripts write doubles into, `=` included (the port created it),
+/// while risky conditions compare both (`gen::Options::port_doubles`;
+/// `btcpp4_script/entries.rs`, `resolve`): at least one tree in twenty has a leaf writing
+/// `v`, one in fifty a leaf reading `w` that a script assigns with `=`. The real library's harness has no leaves with ports;
 /// the oracle writes their values as `setOutput` writes a LoopDouble's items, which the
 /// LoopDouble tests hold to 4.8.2.
 #[test]
@@ -828,8 +830,18 @@ fn random_trees_with_port_doubles_lower_to_what_btcpp_does() {
     let with = drawn_again(opts, gen::Conditions::WithoutSkip)
         .filter(|c| c.xml.contains("out=\"{v}\""))
         .count() as u64;
-    eprintln!("{with} of the {n} trees have a leaf writing `v`");
+    let reading = drawn_again(opts, gen::Conditions::WithoutSkip)
+        .filter(|c| c.xml.contains("in=\"{w}\"") && c.xml.contains("w = "))
+        .count() as u64;
+    eprintln!(
+        "{with} of the {n} trees have a leaf writing `v`, {reading} one reading `w` and a \
+         script assigning it with `=`"
+    );
     assert!(with >= n / 20, "only {with} of {n} trees write `v`");
+    assert!(
+        reading >= n / 50,
+        "only {reading} of {n} trees assign `w` with `=`"
+    );
 }
 
 /// The same with BT.CPP 4's blackboard nodes (`gen::Options::bb_nodes`: UnsetBlackboard,

@@ -41,6 +41,9 @@ struct G<'r, R: Rng> {
     conds: Conditions,
     /// Writing a SubTree's body (no UnsetBlackboard there).
     in_subtree: bool,
+    /// The main tree has a leaf whose input port names `w` so far
+    /// ([`Options::port_doubles`]): `w = ...` does not throw (the port created `w`).
+    has_in: bool,
 }
 
 /// Which pre/post-condition attributes [`Options::scripts`] writes.
@@ -145,8 +148,11 @@ pub struct Options {
     pub loop_doubles: bool,
     /// With [`Options::bits`]: leaves with an output port `out` of type `float64`
     /// (types `O0`, `O1`, ...: `model::has_out`) writing `model::OUT_VALUES` into `v`,
-    /// one leaf in four, and risky conditions comparing `v` (BT.CPP throws reading it
-    /// before the first write: the port created it empty when the tree was loaded).
+    /// one leaf in eight, leaves with an input port `in` of type `float64` (`I0`, ...:
+    /// `model::has_in`) naming `w`, one in eight, which statements write doubles into
+    /// (`=` too: the port created the entry when the tree was loaded), and risky
+    /// conditions comparing `v` and `w` (BT.CPP throws reading either before its first
+    /// write: the port created it empty).
     /// The real library's harness has no leaves with ports: these trees go to the oracle
     /// and the lowering only. Off, the generator draws what it drew before.
     pub port_doubles: bool,
@@ -191,9 +197,14 @@ impl<R: Rng> G<'_, R> {
     /// A fresh leaf type; `N...` types have no `<bt_halt>` (see `model::plugin`). With
     /// `stop`, its script ends with it or RUNNING, so a count of -1 above it ends.
     fn leaf_with(&mut self, stop: Option<Status>) -> String {
-        let out = self.port_doubles_on() && self.below(4) == 0;
-        let tag = if out {
-            "O"
+        // 0: a leaf writing `v` (`out`), 1: one reading `w` (`in`).
+        let port = if self.port_doubles_on() {
+            self.below(8)
+        } else {
+            8
+        };
+        let tag = if port < 2 {
+            ["O", "I"][port as usize]
         } else if self.below(4) == 0 {
             "N"
         } else {
@@ -210,8 +221,11 @@ impl<R: Rng> G<'_, R> {
             };
         }
         self.scripts.insert(name.clone(), script);
-        if out {
+        if port == 0 {
             format!("<{name} out=\"{{v}}\"/>")
+        } else if port == 1 {
+            self.has_in |= !self.in_subtree;
+            format!("<{name} in=\"{{w}}\"/>")
         } else {
             format!("<{name}/>")
         }
@@ -519,11 +533,14 @@ impl<R: Rng> G<'_, R> {
         }
     }
 
-    /// A condition over `v`, the double the leaves' ports write
-    /// ([`Options::port_doubles`]): it throws before the first write.
+    /// A condition over `v`, the double the leaves' ports write, or `w`, the one scripts
+    /// write for the leaves' input ports ([`Options::port_doubles`]): it throws before
+    /// the first write.
     fn v_cond(&mut self) -> String {
         let op = self.pick(&["==", "!=", "<", "<=", ">", ">="]);
-        let v = self.pick(&["v", "v", "(v * 2)", "(v - r)", "-v", "v / 2"]);
+        let v = self.pick(&[
+            "v", "v", "(v * 2)", "(v - r)", "-v", "v / 2", "w", "(w - v)",
+        ]);
         format!(
             "{v} {op} {}",
             self.pick(&["1.5", "0.5", "0", "r", "x", "-2", "3.25"])
@@ -551,6 +568,17 @@ impl<R: Rng> G<'_, R> {
                         self.text()
                     ),
                     _ => format!("t := {}", self.text()),
+                },
+                // A double into `w`, the entry the leaves' input ports name: every value
+                // a double, so no write throws (an integer first would make it one);
+                // `=` only once a leaf of the main tree created `w` with its port.
+                _ if self.port_doubles_on() && self.below(5) == 0 => match self.below(3) {
+                    0 => format!("w := {} / 2", self.int_expr(1)),
+                    _ if !self.has_in => {
+                        format!("w := {}", self.pick(&["2.5", "-0.5", "r * 0.5", "r / 2"]))
+                    }
+                    1 => format!("w = {} * 0.5", self.pick(&["x", "y", "-1", "3"])),
+                    _ => format!("w = r {} 1", self.pick(&["+", "-", "*"])),
                 },
                 7..=9 => self.bits_statement(),
                 // Depth 2: chains such as `x - 1 + y - 2`, which BT.CPP groups to the right.
@@ -1157,6 +1185,7 @@ pub fn case_with_conds<R: Rng>(rng: &mut R, size: i64, opts: Options, conds: Con
         opts,
         conds,
         in_subtree: true,
+        has_in: false,
     };
     g.v3 = g.below(3) == 0;
     let n_sub = g.below(3);

@@ -22,6 +22,14 @@ pub fn has_out(name: &str) -> bool {
     b.len() > 1 && b[0] == b'O' && b[1].is_ascii_digit()
 }
 
+/// Whether leaf type `name` has an input port `in` of type `float64` (types `I<digit>...`):
+/// it reads nothing the harness observes; the port makes BT.CPP create the entry, empty,
+/// when it loads the tree.
+pub fn has_in(name: &str) -> bool {
+    let b = name.as_bytes();
+    b.len() > 1 && b[0] == b'I' && b[1].is_ascii_digit()
+}
+
 /// The plugin of leaf type `name`: on its k-th tick it answers `script[k % len]` (after
 /// writing `OUT_VALUES[k % 4]` to its port `out`, [`has_out`]); a halt is answered and
 /// does not move it. A type named `N<digit>...` has no `<bt_halt>` ([`has_halt`]), as older
@@ -71,6 +79,11 @@ pub fn plugin(name: &str, script: &[super::tree::Status]) -> String {
         }
         w += &format!("</if><assign location=\"j\" expr=\"(j + 1) % {n}\"/>");
         ("<bt_declare_port_out key=\"out\" type=\"float64\"/>\n", w)
+    } else if has_in(name) {
+        (
+            "<bt_declare_port_in key=\"in\" type=\"float64\"/>\n",
+            String::new(),
+        )
     } else {
         ("", String::new())
     };

@@ -740,10 +740,12 @@ impl<'t> Oracle<'t> {
     }
 
     /// Whether a port of the tree names entry `v` in `{}` (a Loop's `value`, a leaf's
-    /// `out`): BT.CPP creates it, without a value, when it loads the tree.
+    /// `out` or `in`): BT.CPP creates it, without a value, when it loads the tree.
     fn declared(&self, v: &str) -> bool {
         self.tree.nodes.iter().any(|x| {
-            x.out.as_deref() == Some(v) || matches!(&x.kind, Kind::Loop(_, _, Some(e), _) if e == v)
+            x.out.as_deref() == Some(v)
+                || x.input.as_deref() == Some(v)
+                || matches!(&x.kind, Kind::Loop(_, _, Some(e), _) if e == v)
         })
     }
 

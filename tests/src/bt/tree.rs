@@ -227,6 +227,9 @@ pub struct Node {
     /// A leaf's `out` port: the entry (after SubTree remapping) where it writes a double
     /// at every callback ([`super::model::OUT_VALUES`]).
     pub out: Option<String>,
+    /// A leaf's `in` port (a `float64` input, `super::model::has_in`): the entry it
+    /// names, which BT.CPP creates, empty, when it loads the tree.
+    pub input: Option<String>,
 }
 
 /// The scripts of a node's pre/post-condition attributes (BT.CPP 4 `tree_node.h`,
@@ -755,10 +758,11 @@ impl Flat<'_> {
                 }
             }
         }
-        let out = match (&kind, attrs.get("out").and_then(|v| entry(v))) {
+        let port = |key: &str| match (&kind, attrs.get(key).and_then(|v| entry(v))) {
             (Kind::Leaf(_), Some(e)) => Some(e.to_string()),
             _ => None,
         };
+        let (out, input) = (port("out"), port("in"));
         let i = self.tree.nodes.len();
         self.uids += 1;
         self.tree.nodes.push(Node {
@@ -770,6 +774,7 @@ impl Flat<'_> {
             conds,
             subtree_body: false,
             out,
+            input,
         });
         if let Some(p) = parent {
             self.tree.nodes[p].children.push(i);
@@ -859,6 +864,7 @@ impl Flat<'_> {
             conds,
             subtree_body: false,
             out: None,
+            input: None,
         });
         if let Some(p) = parent {
             self.tree.nodes[p].children.push(i);

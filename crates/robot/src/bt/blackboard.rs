@@ -71,7 +71,9 @@ pub(crate) struct Blackboard {
     /// BT.CPP 4 creates them, without a value, when it loads the tree, so `=` on one
     /// does not throw (`btcpp4_script.rs`, `exists`).
     pub declared: Vec<String>,
-    /// Those of them an UnsetBlackboard erases: the machine keeps whether it did
+    /// Entries a plugin's output port names: the plugin writes them (`setOutput`).
+    pub port_outputs: Vec<String>,
+    /// Those of `declared` an UnsetBlackboard erases: the machine keeps whether it did
     /// (`bt_gone__<entry>`).
     pub gone: Vec<String>,
     /// Entries only scripts create that hold a number that need not be whole: the

@@ -530,7 +530,7 @@ fn statement(names: &[Name], bb: &Blackboard, s: &Stmt) -> Result<Lowered, Refus
     };
     if let Some((target, op, at)) = &s.assign {
         if let (g, Ty::Real, false) = tr.entry(target) {
-            return Err((*at, format!("a script writing `{g}`, which a plugin's port types as a double: BT.CPP 4 would store the script's value as it is where the entry holds nothing yet and convert the plugin's later doubles to its type, which is not modelled (read it in scripts; write another entry)")));
+            return Err((*at, format!("a script writing `{g}`, which a plugin's output port types as a double: BT.CPP 4 would store the script's value as it is where the entry holds nothing yet and convert the plugin's later doubles to its type, which is not modelled (read it in scripts; write another entry)")));
         }
         if tr.entry(target).1 == Ty::Real {
             return num::float_statement(tr, target, op, &s.e);

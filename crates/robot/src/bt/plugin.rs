@@ -205,6 +205,9 @@ pub(crate) fn check_ports(
                 if !bb.declared.contains(name) {
                     bb.declared.push(name.clone());
                 }
+                if decl.dir == Dir::Out && !bb.port_outputs.contains(name) {
+                    bb.port_outputs.push(name.clone());
+                }
                 let why = format!("port `{}` of plugin `{}`", p.key, plugin.name);
                 blackboard::register(sm, bb, name, &decl.ty, p.span, &why, errs)
             }

@@ -71,6 +71,18 @@ pub(super) fn resolve(
             out.push((name.clone(), g, Ty::Text, true));
             continue;
         }
+        // A `double` plugins' ports type and only input ports name: scripts write it as
+        // an entry they create (the port created it empty at load; the first value goes
+        // in as it is, `bt_dbl__` keeping its type), and the plugins read the number
+        // (`getInput<double>` converts an integer).
+        let input_double = bb.entry(&g).is_some_and(|e| {
+            e.why != "a script"
+                && Scalar::from_name(e.ty.trim()) == Some(Scalar::F64)
+                && bb.declared.contains(&g)
+                && !bb.port_outputs.contains(&g)
+                && !bb.texts.contains(&g)
+        });
+        let dynamic = dynamic || input_double;
         let t = match bb.entry(&g) {
             None => {
                 let ty = entry_type(bb, &g);
@@ -88,9 +100,9 @@ pub(super) fn resolve(
             }
             Some(e) => match Scalar::from_name(e.ty.trim()) {
                 Some(Scalar::Bool) => Ty::Bool,
-                // A `double` a plugin's port types: the plugin stores doubles there
-                // (`setOutput<double>`), which scripts read; a script writing it is
-                // refused (`statement`).
+                // A `double` a plugin's output port types: the plugin stores doubles
+                // there (`setOutput<double>`), which scripts read; a script writing it
+                // is refused (`statement`).
                 Some(Scalar::F64) => Ty::Real,
                 Some(s) if s.int_range().is_some() => Ty::Int,
                 _ => {
