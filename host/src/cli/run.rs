@@ -16,6 +16,7 @@ use crate::live::wiring::{
     dds_services, describe, node, topic_layouts, topic_qos, Bridges, DdsPlan, Wiring,
 };
 use crate::live::{check_speed, quiet_ipc_log, Clock};
+use crate::verify::load::Loaded;
 use crate::verify::replay::{end_text, play_run};
 
 /// Arguments of `hindsight run`.
@@ -221,17 +222,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         stopped: false,
         on_progress: ProgressReports::new(move |p| draw_line(&p.line(unit_ns), tty)),
     };
-    let outcome = play_run(
-        model,
-        loaded.events,
-        max_time,
-        (args.seed, args.run),
-        &mut live,
-    );
-    live.progress(outcome.time, true);
-    if tty {
-        eprintln!();
-    }
+    let outcome = play_paced(&loaded, max_time, args, (&mut live, Paced::progress), tty);
     let (failed, why) = live.publisher.failed();
     if failed > 0 {
         eprintln!(
@@ -266,12 +257,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     if let Some(e) = &live.inbound_error {
         eprintln!("warning: reading from external components failed: {e}");
     }
-    let how = if live.stopped {
-        "stopped by a signal".to_string()
-    } else {
-        end_text(&outcome.end)
-    };
-    eprintln!("run: ended at model step {}: {how}", outcome.time);
+    say_end(&outcome, live.stopped);
     Ok(())
 }
 
@@ -404,17 +390,13 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
         stopped: false,
         on_progress: ProgressReports::new(move |p| draw_line(&p.line(unit_ns), tty)),
     };
-    let outcome = play_run(
-        model,
-        loaded.events,
+    let outcome = play_paced(
+        &loaded,
         max_time,
-        (args.seed, args.run),
-        &mut live,
+        args,
+        (&mut live, DdsPaced::progress),
+        tty,
     );
-    live.progress(outcome.time, true);
-    if tty {
-        eprintln!();
-    }
     // Reliable delivery of the last messages before the participant goes.
     live.publisher.flush(std::time::Duration::from_secs(2));
     if let Some(s) = &live.services {
@@ -439,11 +421,40 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
             why.unwrap_or("?")
         );
     }
-    let how = if live.stopped {
+    say_end(&outcome, live.stopped);
+    Ok(())
+}
+
+/// Plays run `args.run` of seed `args.seed` into `live`, the iceoryx2 or the DDS side
+/// paced in wall-clock time, and reports its progress once more at the end (the line
+/// closed on a terminal).
+fn play_paced<L: crate::sim::Observer>(
+    loaded: &Loaded,
+    max_time: u64,
+    args: &RunArgs,
+    (live, progress): (&mut L, fn(&mut L, u64, bool)),
+    tty: bool,
+) -> crate::sim::RunOutcome {
+    let outcome = play_run(
+        &loaded.model,
+        loaded.events,
+        max_time,
+        (args.seed, args.run),
+        live,
+    );
+    progress(live, outcome.time, true);
+    if tty {
+        eprintln!();
+    }
+    outcome
+}
+
+/// The last line of `run`: the model step the run ended at and why.
+fn say_end(outcome: &crate::sim::RunOutcome, stopped: bool) {
+    let how = if stopped {
         "stopped by a signal".to_string()
     } else {
         end_text(&outcome.end)
     };
     eprintln!("run: ended at model step {}: {how}", outcome.time);
-    Ok(())
 }
