@@ -430,3 +430,56 @@ fn scripts_and_conditions_lower_under_bt_btcpp_and_are_refused_under_as2fm() {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+/// A leaf whose `string` input port `message` it reads: SUCCESS on `hello`, else FAILURE.
+const SAY: &str = r#"<ascxml name="Say" initial="s">
+  <bt_declare_port_in key="message" type="string"/>
+  <datamodel><data id="m" type="string" expr="''"/></datamodel>
+  <state id="s">
+    <bt_tick target="s">
+      <assign location="m"><expr><bt_get_input key="message"/></expr></assign>
+      <if cond="m == 'hello'"><bt_return_status status="SUCCESS"/>
+      <else/><bt_return_status status="FAILURE"/></if>
+    </bt_tick>
+  </state>
+</ascxml>"#;
+
+#[test]
+fn a_script_sets_the_text_a_plugin_reads_under_btcpp() {
+    // The script sets an action's parameter, the plugin reads it (`getInput<std::string>`);
+    // `=` too, as the port created the entry when the tree was loaded.
+    for (code, p) in [
+        ("msg := 'hello'", 1.0),
+        ("msg := 'bye'", 0.0),
+        ("msg = 'hel'; msg += 'lo'", 1.0),
+        ("n := 2; msg := n &gt; 1 ? 'hello' : 'bye'", 1.0),
+    ] {
+        let tree = v4(&format!(
+            "<Sequence><Script code=\"{code}\"/><Say message=\"{{msg}}\"/></Sequence>"
+        ));
+        let dir = scratch("say", &tree);
+        std::fs::write(dir.join("say.ascxml"), SAY).unwrap();
+        let main = std::fs::read_to_string(dir.join("main.xml"))
+            .unwrap()
+            .replace(
+                "<input type=\"bt-plugin-ascxml\" src=\"./fail_once.ascxml\"/>",
+                "<input type=\"bt-plugin-ascxml\" src=\"./say.ascxml\"/>",
+            );
+        std::fs::write(dir.join("main.xml"), main).unwrap();
+        let (code_, out, err) = hindsight(
+            &dir,
+            &[
+                "verify", "main.xml", "--bt", "btcpp", "--json", "--runs", "20",
+            ],
+        );
+        assert_eq!(code_, 0, "{code}: {err}");
+        let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+        let rows = doc["properties"].as_array().unwrap();
+        let s = rows
+            .iter()
+            .find(|r| r["property"] == "tree_success")
+            .unwrap();
+        assert_eq!(s["probability"].as_f64(), Some(p), "{code}: {s}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -198,3 +198,44 @@ fn scripts_write_a_double_only_plugin_input_ports_name() {
         "{e}"
     );
 }
+
+/// A leaf with a port `k` of direction `dir` and type `ty`.
+fn port_plugin(dir: &str, ty: &str) -> String {
+    format!(
+        r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="P">
+<bt_declare_port_{dir} key="k" type="{ty}"/>
+<state id="s"><bt_tick target="s"><bt_return_status status="SUCCESS"/></bt_tick></state>
+</ascxml>"#
+    )
+}
+
+#[test]
+fn scripts_write_a_text_only_plugin_string_input_ports_name() {
+    let lower = |dir: &str, ty: &str, code: &str| {
+        let body = format!("<Sequence><Script code=\"{code}\"/><P k=\"{{e}}\"/></Sequence>");
+        lower_doc(&body, "", &[("p.ascxml", &port_plugin(dir, ty))], BTCPP)
+    };
+    for code in [
+        "e := 'go'",
+        "e = 'go'",
+        "e := 'a'; e := e == 'a' ? 'b' : 'c'",
+        "e := 'go'; e += 'al'",
+    ] {
+        lower("in", "string", code).unwrap_or_else(|e| panic!("{code}: {e}"));
+    }
+    // A string where a plugin writes (it may write any text) or a port types numbers.
+    for (dir, ty) in [("out", "string"), ("in", "int32"), ("in", "bool")] {
+        let e = lower(dir, ty, "e := 'go'").expect_err("refused");
+        assert!(
+            e.contains(&format!("a script assigns a string to the entry `e`, which is {ty} at tree.xml:3:43 (port `k` of plugin `P`)"))
+                && e.contains("modelled only where `string` input ports alone name it"),
+            "{dir} {ty}: {e}"
+        );
+    }
+    // A number into it: the entry holds strings.
+    let e = lower("in", "string", "e := 'go'; e := 3").expect_err("refused");
+    assert!(
+        e.contains("assigning a number to `e`, which holds strings"),
+        "{e}"
+    );
+}

@@ -844,6 +844,41 @@ fn random_trees_with_port_doubles_lower_to_what_btcpp_does() {
     );
 }
 
+/// The same with leaves whose `string` input port names `t`, which scripts write texts
+/// into (`gen::Options::port_strings`; `btcpp4_strings.rs`, `Strings::port_entries`):
+/// the leaf answers SUCCESS while `t` holds `'a'`, so the text a script stores reaches
+/// the plugin. At least one tree in twenty has such a leaf. The real library's harness
+/// has no leaves with ports.
+#[test]
+fn random_trees_with_port_strings_lower_to_what_btcpp_does() {
+    let opts = gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        strings: true,
+        port_strings: true,
+        ..Default::default()
+    };
+    random_trees(opts);
+    let n = trees(opts);
+    let (mut with, mut changed) = (0u64, 0u64);
+    for c in drawn_again(opts, gen::Conditions::WithoutSkip) {
+        if c.xml.contains("in=\"{t}\"") {
+            with += 1;
+            // A script gives `t` another text than the one it starts with.
+            changed += u64::from(c.xml.contains("t := '") || c.xml.contains("t = ("));
+        }
+    }
+    eprintln!(
+        "{with} of the {n} trees have a leaf reading `t`, {changed} of them with a script \
+         storing another text there"
+    );
+    assert!(
+        with >= n / 20,
+        "only {with} of {n} trees read `t` in a plugin"
+    );
+    assert!(changed >= n / 40, "only {changed} of {n} trees change `t`");
+}
+
 /// The same with BT.CPP 4's blackboard nodes (`gen::Options::bb_nodes`: UnsetBlackboard,
 /// WasEntryUpdated, SkipUnlessUpdated, WaitValueUpdate, and LoopInt, LoopBool,
 /// LoopDouble, LoopString over queues written in the tree) among the scripts, with the
@@ -2419,6 +2454,7 @@ const SUBTREE_CONDS: gen::Options = gen::Options {
     loop_strings: false,
     loop_doubles: false,
     port_doubles: false,
+    port_strings: false,
     joins: false,
 };
 

@@ -156,6 +156,14 @@ pub struct Options {
     /// The real library's harness has no leaves with ports: these trees go to the oracle
     /// and the lowering only. Off, the generator draws what it drew before.
     pub port_doubles: bool,
+    /// With [`Options::strings`]: leaves with an input port `in` of type `string` naming
+    /// `t` (types `T0`, `T1`, ...: `model::has_in_text`), one leaf in six, which answer
+    /// SUCCESS while `t` holds `model::IN_TEXT` (`'a'`, the text the main tree starts `t`
+    /// with) and their script otherwise, so what the scripts store in `t` reaches a
+    /// plugin. Not under a count of -1 (the leaf must be able to stop it). No leaf of the
+    /// real library's harness has ports: oracle and lowering only. Off, the generator
+    /// draws what it drew before.
+    pub port_strings: bool,
     /// Joins, with [`Options::strings`]: the main tree also creates `u` from a string
     /// (`u:=''`, remapped into every SubTree); statements store in `u` joins of `t`,
     /// literals and number literals (`t .. 'a'`, `t .. 3`, `t .. 1.5`, `t + 'b'`,
@@ -203,8 +211,12 @@ impl<R: Rng> G<'_, R> {
         } else {
             8
         };
+        // A leaf reading `t` (`in`, a string).
+        let text_in = port >= 2 && stop.is_none() && self.port_strings_on() && self.below(6) == 0;
         let tag = if port < 2 {
             ["O", "I"][port as usize]
+        } else if text_in {
+            "T"
         } else if self.below(4) == 0 {
             "N"
         } else {
@@ -226,6 +238,8 @@ impl<R: Rng> G<'_, R> {
         } else if port == 1 {
             self.has_in |= !self.in_subtree;
             format!("<{name} in=\"{{w}}\"/>")
+        } else if text_in {
+            format!("<{name} in=\"{{t}}\"/>")
         } else {
             format!("<{name}/>")
         }
@@ -305,6 +319,10 @@ impl<R: Rng> G<'_, R> {
     /// Leaves writing the double `v` through a port ([`Options::port_doubles`]).
     fn port_doubles_on(&self) -> bool {
         self.opts.port_doubles && self.opts.bits && self.scripts_on()
+    }
+
+    fn port_strings_on(&self) -> bool {
+        self.opts.port_strings && self.opts.strings && self.scripts_on()
     }
 
     fn scripts_on(&self) -> bool {

@@ -30,6 +30,17 @@ pub fn has_in(name: &str) -> bool {
     b.len() > 1 && b[0] == b'I' && b[1].is_ascii_digit()
 }
 
+/// Whether leaf type `name` has an input port `in` of type `string` (types
+/// `T<digit>...`): it answers SUCCESS while the text it reads is [`IN_TEXT`], its script
+/// otherwise ([`plugin`]).
+pub fn has_in_text(name: &str) -> bool {
+    let b = name.as_bytes();
+    b.len() > 1 && b[0] == b'T' && b[1].is_ascii_digit()
+}
+
+/// The text that makes a [`has_in_text`] leaf answer SUCCESS.
+pub const IN_TEXT: &str = "a";
+
 /// The plugin of leaf type `name`: on its k-th tick it answers `script[k % len]` (after
 /// writing `OUT_VALUES[k % 4]` to its port `out`, [`has_out`]); a halt is answered and
 /// does not move it. A type named `N<digit>...` has no `<bt_halt>` ([`has_halt`]), as older
@@ -63,6 +74,8 @@ pub fn plugin(name: &str, script: &[super::tree::Status]) -> String {
     };
     let j = if has_out(name) {
         "<data id=\"j\" type=\"int32\" expr=\"0\"/>"
+    } else if has_in_text(name) {
+        "<data id=\"m\" type=\"string\" expr=\"''\"/>"
     } else {
         ""
     };
@@ -82,6 +95,17 @@ pub fn plugin(name: &str, script: &[super::tree::Status]) -> String {
     } else if has_in(name) {
         (
             "<bt_declare_port_in key=\"in\" type=\"float64\"/>\n",
+            String::new(),
+        )
+    } else if has_in_text(name) {
+        // Read the text; IN_TEXT answers SUCCESS (the script still moves on).
+        branches = format!(
+            "<assign location=\"m\"><expr><bt_get_input key=\"in\"/></expr></assign>\
+             <if cond=\"m == '{IN_TEXT}'\"><assign location=\"k\" expr=\"(k + 1) % {len}\"/>\
+             <bt_return_status status=\"SUCCESS\"/><else/>{branches}</if>"
+        );
+        (
+            "<bt_declare_port_in key=\"in\" type=\"string\"/>\n",
             String::new(),
         )
     } else {

@@ -896,8 +896,17 @@ impl<'t> Oracle<'t> {
                     .filter(|s| !s.is_empty())
                     .ok_or(format!("no script for leaf {ty}"))?;
                 let k = self.leaf_ticks[n];
-                let s = script[k % script.len()];
+                let mut s = script[k % script.len()];
                 self.leaf_ticks[n] += 1;
+                // A leaf reading a string (`model::has_in_text`): SUCCESS while its
+                // entry holds IN_TEXT (`getInput<std::string>`).
+                if let Some(key) = &self.tree.nodes[n].input {
+                    if super::model::has_in_text(ty)
+                        && self.strs.get(key).map(String::as_str) == Some(super::model::IN_TEXT)
+                    {
+                        s = Success;
+                    }
+                }
                 // A leaf with an `out` port (`model::plugin`): `setOutput<double>` of
                 // its k-th value, which `Blackboard::set` stores as a LoopDouble's item
                 // is (both write through `setOutput`).

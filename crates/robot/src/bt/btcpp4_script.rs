@@ -514,6 +514,30 @@ impl Tr<'_> {
     }
 }
 
+/// A string statement on entry `g` where a plugin's `string` input port reads it
+/// (`port`, [`super::btcpp4_strings::Strings::port_entries`]): the rank goes to
+/// `bt_sid__g` and the text it stands for to `g`, which the plugins read.
+fn to_port(bb: &Blackboard, g: &str, port: bool, mut l: Lowered) -> Lowered {
+    if !port {
+        return l;
+    }
+    let sid = super::btcpp4_strings::sid(g);
+    let mut assigns = Vec::new();
+    for (var, x) in l.assigns {
+        if var == g {
+            assigns.push((sid.clone(), x));
+            assigns.push((g.to_string(), bb.strings.text_of(&sid)));
+        } else {
+            assigns.push((var, x));
+        }
+    }
+    l.assigns = assigns;
+    if l.value.x == g {
+        l.value.x = sid;
+    }
+    l
+}
+
 /// One statement: what makes it throw, the assignments, its value.
 struct Lowered {
     checks: Vec<String>,
@@ -546,15 +570,19 @@ fn statement(names: &[Name], bb: &Blackboard, s: &Stmt) -> Result<Lowered, Refus
     };
     let (g, et, dynamic) = tr.entry(target);
     let (x, t) = (v.x.as_str(), v.t);
-    if et == Ty::Text && !dynamic {
+    let port_text = bb.strings.port_entries.contains(&g);
+    if et == Ty::Text && !dynamic && !port_text {
         return Err((*at, format!("a script writing `{g}`, which a SetBlackboard writes: BT.CPP 4 holds a string there (4.8.2 refuses to assign it a number), which is not modelled")));
     }
     if et == Ty::Text && t == Ty::Text && *op == "+=" {
-        return tr.plus_assign(&g, v, &s.e, *at);
+        return tr
+            .plus_assign(&g, v, &s.e, *at)
+            .map(|l| to_port(bb, &g, port_text, l));
     }
     if et == Ty::Text || t == Ty::Text {
         let exists = tr.exists(&g);
-        return assign_text(tr.checks, &g, &exists, et == Ty::Text, v, op, *at);
+        return assign_text(tr.checks, &g, &exists, et == Ty::Text, v, op, *at)
+            .map(|l| to_port(bb, &g, port_text, l));
     }
     if t == Ty::Real || *op == "/=" {
         return Err((

@@ -51,6 +51,10 @@ pub(crate) struct Strings {
     pub set_entries: Vec<String>,
     /// Entries scripts create that hold strings.
     pub script_entries: Vec<String>,
+    /// Those of them a plugin's `string` input port types (a script setting an
+    /// action's text parameter, `msg := 'hello'`): the rank in [`sid`], the text in the
+    /// entry for the plugins (`getInput<std::string>`), [`Strings::text_of`].
+    pub port_entries: Vec<String>,
     /// The texts each string entry may hold (the closure over the scripts' joins).
     pub sets: std::collections::BTreeMap<String, std::collections::BTreeSet<String>>,
     /// Why the tree's texts cannot be closed (unbounded, or beyond the cap): every
@@ -101,6 +105,24 @@ impl Strings {
             .binary_search_by(|t| t.as_str().cmp(text))
             .map(|i| i as i64)
             .expect("every text of the tree was interned")
+    }
+
+    /// The text whose rank is model expression `x` as a model expression: a balanced
+    /// `?:` over the ranks of every text of the tree (a rank stands for the same text
+    /// wherever it is stored), so its depth grows with the logarithm of their number.
+    pub fn text_of(&self, x: &str) -> String {
+        fn pick(x: &str, ts: &[String], lo: usize) -> String {
+            match ts {
+                [] => "''".into(),
+                [t] => super::plugin::literal_expr(t, "string"),
+                _ => {
+                    let (a, b) = ts.split_at(ts.len() / 2);
+                    let mid = lo + a.len();
+                    format!("({x} < {mid} ? {} : {})", pick(x, a, lo), pick(x, b, mid))
+                }
+            }
+        }
+        pick(x, &self.texts, 0)
     }
 
     /// Entry `g` holds strings.
@@ -280,6 +302,12 @@ pub(super) fn prepare(tree: &Tree, bb: &mut Blackboard) {
             break;
         }
     }
+    // Those a plugin's `string` input port types and nothing else writes: the text goes
+    // to the plugins too (a LoopString's item into such an entry stays refused).
+    s.port_entries = (s.script_entries.iter())
+        .filter(|g| port_string(bb, g) && !looped.iter().any(|(l, _)| l == *g))
+        .cloned()
+        .collect();
     // The closed set of texts (`btcpp4_script/join.rs`): what each string entry may
     // hold, and what every join may make.
     let mut sets: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
@@ -325,6 +353,19 @@ pub(super) fn prepare(tree: &Tree, bb: &mut Blackboard) {
     s.sets = sets;
     s.overflow = overflow;
     bb.strings = s;
+}
+
+/// Whether entry `g` is one plugins' `string` ports type that only input ports name,
+/// that no SetBlackboard writes or copies and whose type no two ports dispute: a script
+/// may write texts there for the plugins to read ([`Strings::port_entries`]).
+fn port_string(bb: &Blackboard, g: &str) -> bool {
+    bb.entry(g)
+        .is_some_and(|e| e.why.contains("of plugin") && e.ty.trim() == "string")
+        && bb.declared.iter().any(|d| d == g)
+        && !bb.port_outputs.iter().any(|d| d == g)
+        && !bb.texts.iter().any(|d| d == g)
+        && !bb.copies.iter().any(|d| d == g)
+        && !bb.conflicted.iter().any(|d| d == g)
 }
 
 /// A script's names to the string entries they stand for.

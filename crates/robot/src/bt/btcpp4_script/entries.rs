@@ -59,9 +59,18 @@ pub(super) fn resolve(
                     why: "a script".into(),
                 }),
                 Some(e) if e.why == "a script" => {}
+                // A plugin's `string` input port types it: its rank in `bt_sid__`, the
+                // text in the entry for the plugins (`btcpp4_strings.rs`).
+                Some(_) if bb.strings.port_entries.contains(&g) => {
+                    if !bb.script_entries.contains(&g) {
+                        bb.script_entries.push(g.clone());
+                    }
+                    out.push((name.clone(), g, Ty::Text, false));
+                    continue;
+                }
                 Some(e) => {
                     let at = sm.diag(e.span, "");
-                    errs.push(sm.diag(span, format!("a script assigns a string to the entry `{g}`, which is {} at {}:{}:{} ({}): a string in an entry a port types is not modelled", e.ty, at.file, at.line, at.col, e.why)));
+                    errs.push(sm.diag(span, format!("a script assigns a string to the entry `{g}`, which is {} at {}:{}:{} ({}): a string in an entry a port types is modelled only where `string` input ports alone name it and nothing but scripts writes it", e.ty, at.file, at.line, at.col, e.why)));
                     continue;
                 }
             }
