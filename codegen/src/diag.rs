@@ -784,7 +784,7 @@ pub(crate) struct Sink {
 
 impl Sink {
     /// Records an error.
-    pub fn error(&mut self, span: Span, message: impl Into<String>) {
+    pub(crate) fn error(&mut self, span: Span, message: impl Into<String>) {
         self.items.push(Raw {
             severity: Severity::Error,
             span,
@@ -793,7 +793,7 @@ impl Sink {
     }
 
     /// Records a warning.
-    pub fn warn(&mut self, span: Span, message: impl Into<String>) {
+    pub(crate) fn warn(&mut self, span: Span, message: impl Into<String>) {
         self.items.push(Raw {
             severity: Severity::Warning,
             span,
@@ -802,7 +802,7 @@ impl Sink {
     }
 
     /// `true` when an error was recorded.
-    pub fn has_errors(&self) -> bool {
+    pub(crate) fn has_errors(&self) -> bool {
         self.items.iter().any(|r| r.severity == Severity::Error)
     }
 }

@@ -44,6 +44,9 @@
 //!
 //! None: the crate always builds with `std`.
 
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
+
 pub mod ast;
 pub mod bounds;
 mod check;

@@ -60,7 +60,7 @@ pub(crate) enum InfixOp {
 
 impl InfixOp {
     /// Binding strength: higher binds tighter.
-    pub fn precedence(&self) -> u8 {
+    pub(crate) fn precedence(&self) -> u8 {
         match self {
             InfixOp::Iff => 1,
             InfixOp::Implies => 2,
@@ -71,7 +71,7 @@ impl InfixOp {
     }
 
     /// `->` groups to the right, every other operator to the left.
-    pub fn right_assoc(&self) -> bool {
+    pub(crate) fn right_assoc(&self) -> bool {
         matches!(self, InfixOp::Implies)
     }
 }

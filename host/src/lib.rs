@@ -11,6 +11,9 @@
 //! tests reach `expr` and `model` as `hindsight::verify::expr` and
 //! `hindsight::verify::model`, the others as dev-dependencies).
 
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
+
 pub mod cli;
 
 pub use hindsight_live as live;

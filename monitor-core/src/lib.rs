@@ -8,6 +8,9 @@
 //! order. This crate only runs programs:
 //!
 //! 1. **Get a program**: generated Rust source builds one from `static` arrays,
+
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
 #![cfg_attr(
     feature = "postcard",
     doc = "   or [`table::Table::from_bytes`] (feature `postcard`) decodes one from bytes."

@@ -132,7 +132,7 @@ pub(crate) struct Step {
 
 impl Step {
     /// An unused entry.
-    pub const NONE: Step = Step {
+    pub(crate) const NONE: Step = Step {
         lo: 0,
         hi: 0,
         slot: 0,
@@ -259,7 +259,7 @@ pub(crate) struct AtomStep {
 
 impl AtomStep {
     /// An unused entry.
-    pub const NONE: AtomStep = AtomStep {
+    pub(crate) const NONE: AtomStep = AtomStep {
         c: 0,
         var: 0,
         len: 0,
@@ -307,7 +307,7 @@ impl AtomStep {
     /// variable has the type declared; `None` otherwise (a value of another type,
     /// or `General`).
     #[inline(always)]
-    pub fn fast(&self, vals: &[Value]) -> Option<bool> {
+    pub(crate) fn fast(&self, vals: &[Value]) -> Option<bool> {
         // The value's variant first (one compare): a boolean variable, the most
         // common atom, is then one test of the kind away.
         let c = self.c;
@@ -328,7 +328,12 @@ impl AtomStep {
     /// else the atom machine (`General`) or, for a value of another type than
     /// declared (the caller checked, so never), the machine's error.
     #[inline(always)]
-    pub fn eval(&self, instrs: &[Instr], vals: &[Value], atom: usize) -> Result<bool, StepError> {
+    pub(crate) fn eval(
+        &self,
+        instrs: &[Instr],
+        vals: &[Value],
+        atom: usize,
+    ) -> Result<bool, StepError> {
         match self.fast(vals) {
             Some(v) => Ok(v),
             None => self.general(instrs, vals, atom),
@@ -381,41 +386,41 @@ pub(crate) struct Plan {
 
 impl Plan {
     /// The plan arrays hold the program (at most `N` nodes and atoms).
-    pub const PLANNED: u8 = 1;
+    pub(crate) const PLANNED: u8 = 1;
     /// 1 to 64 nodes and 1 to 64 atoms, not `compact`: the
     /// literal nodes (constants, atoms and `Not`s of literals) are not steps but
     /// bits, in each atom's [`AtomStep::pos`]/[`AtomStep::neg`] (a `true`
     /// constant in both masks of atom 0); a `Not` of a step is fused into it
     /// ([`Step::negate`]); the steps are the other nodes, in node order.
     /// Otherwise there is one step per node, in node order, and none is fused.
-    pub const FOLDED: u8 = 2;
+    pub(crate) const FOLDED: u8 = 2;
     /// Every atom has a shape [`AtomStep::fast`] reads, at most 64 atoms and 64
     /// variables, not `compact`: one pass over the variables checks their
     /// types and gathers the boolean ones as bits, then the atoms are read
     /// without a type check.
-    pub const FAST: u8 = 4;
+    pub(crate) const FAST: u8 = 4;
     /// `FAST` and every atom is a boolean variable or its negation
     /// ([`AtomKind::Bool`], [`AtomKind::NotBool`]): a bit of the variables' bits.
-    pub const BOOLS: u8 = 8;
+    pub(crate) const BOOLS: u8 = 8;
     /// At most 64 atoms and 64 nodes (planned or not, see `Monitor::advance`).
-    pub const SMALL: u8 = 16;
+    pub(crate) const SMALL: u8 = 16;
     /// `FOLDED`, every step is `Logic` or a timed `Since` over literals and
     /// other timed steps ([`timed_first`]), with at most [`lookup::TABLE_BITS`] atoms,
     /// timed steps and memory bits together: after the first point, the value
     /// word is the timed steps ([`Plan::timed`] of them) and one lookup in the
     /// monitor's transition table ([`build_table`]).
-    pub const TABLE: u8 = 32;
+    pub(crate) const TABLE: u8 = 32;
     /// `BOOLS`, and atom `k` is boolean variable `shift + k` (not negated): the
     /// atoms are one shift and mask of the variables' bits.
-    pub const RUN: u8 = 64;
+    pub(crate) const RUN: u8 = 64;
     /// `FOLDED`, not `TABLE`, and at most [`lookup::TABLE_BITS`] atoms: the monitor's
     /// table holds the literal nodes' bits of every value of the atoms
     /// ([`build_literals`]), one lookup instead of a loop over the atoms.
-    pub const LITS: u8 = 128;
+    pub(crate) const LITS: u8 = 128;
 
     /// Whether every flag of `f` is set.
     #[inline(always)]
-    pub const fn has(&self, f: u8) -> bool {
+    pub(crate) const fn has(&self, f: u8) -> bool {
         self.flags & f == f
     }
 }

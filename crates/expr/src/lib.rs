@@ -96,6 +96,9 @@
 //! `s.length` of a struct whose first field is (through nested first fields)
 //! an array is that array's length.
 
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
+
 pub mod ast;
 pub mod compile;
 mod parse;

@@ -60,6 +60,9 @@
 //! assert_eq!(engine.verdicts(), &[Some(Verdict::False)]);
 //! ```
 
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
+
 pub mod bench;
 mod clock;
 pub mod config;

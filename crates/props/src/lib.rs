@@ -91,6 +91,9 @@
 //! assert!(errors.to_string().contains("props.xml:4:"), "{errors}");
 //! ```
 
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
+
 // Inside this crate the model layer is `crate::model` / `crate::sim` and the expression
 // language `crate::expr`, as they were inside `hindsight`.
 use hindsight_expr as expr;

@@ -34,6 +34,9 @@
 //! assert!(err.to_string().starts_with("bad.csv:1:1:"), "{err}");
 //! ```
 
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
+
 pub mod data;
 mod html;
 pub mod plot;

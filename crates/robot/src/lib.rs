@@ -65,6 +65,9 @@
 //! assert!(errs.to_string().starts_with("tree.xml:2:15: unknown node `Dock`"), "{errs}");
 //! ```
 
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
+
 pub mod bt;
 pub mod datatypes;
 pub mod interfaces;

@@ -15,6 +15,9 @@
 //! This crate does not depend on `hindsight` (the binary's crate depends on it); it uses
 //! only `codegen`'s source map and scalar names and `monitor-core`'s values.
 
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
+
 pub mod bag;
 pub mod cdr;
 pub mod cdr_write;

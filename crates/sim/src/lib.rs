@@ -47,6 +47,9 @@
 //! assert!(bad.unwrap_err().to_string().contains("bad.scxml:1:"));
 //! ```
 
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
+
 pub mod model;
 pub mod sim;
 

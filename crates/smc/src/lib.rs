@@ -59,6 +59,9 @@
 //! Discarded runs (assumptions violated) and runs cut short (step limit) are counted,
 //! never silently judged: see [`runner`] for the policy.
 
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
+
 pub mod math;
 pub mod progress;
 pub mod runner;

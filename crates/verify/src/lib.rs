@@ -44,6 +44,9 @@
 //! runner.finish().unwrap();
 //! ```
 
+// `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
+#![warn(unreachable_pub)]
+
 pub mod convert;
 pub mod fixed;
 pub mod load;

@@ -38,7 +38,7 @@ pub(super) struct Part {
 impl Part {
     /// This part as a program over the whole program's variables, strings and
     /// instructions (an atom is still a range of the whole `instrs`).
-    pub fn program<'a>(&'a self, whole: &Program<'a>) -> Program<'a> {
+    pub(crate) fn program<'a>(&'a self, whole: &Program<'a>) -> Program<'a> {
         Program {
             nodes: &self.nodes,
             atoms: &self.atoms,
@@ -49,7 +49,7 @@ impl Part {
 
     /// The error a step of this part returned, with its atom numbered as in the whole
     /// program (what `Compiled::describe` reads).
-    pub fn global_error(&self, e: StepError) -> StepError {
+    pub(crate) fn global_error(&self, e: StepError) -> StepError {
         match e {
             StepError::Arithmetic { atom } => StepError::Arithmetic {
                 atom: self.atom_ids.get(atom as usize).copied().unwrap_or(atom),
@@ -59,7 +59,7 @@ impl Part {
     }
 
     /// The number of nodes.
-    pub fn node_count(&self) -> usize {
+    pub(crate) fn node_count(&self) -> usize {
         self.nodes.len()
     }
 }
@@ -84,7 +84,7 @@ impl Split {
     /// properties or when some atom can fail (integer arithmetic: an overflow or a
     /// division by zero stops the run, and a whole-program step is what leaves every
     /// verdict unchanged at the point that fails, as `Monitor::try_step` promises).
-    pub fn new(program: &Program<'_>) -> Split {
+    pub(crate) fn new(program: &Program<'_>) -> Split {
         let can_fail = program.instrs.iter().any(|i| {
             matches!(
                 i,
@@ -132,7 +132,7 @@ impl Split {
     }
 
     /// All parts' bits.
-    pub fn all(&self) -> u64 {
+    pub(crate) fn all(&self) -> u64 {
         match self.parts.len() {
             0 => 0,
             n => u64::MAX >> (64 - n.min(MAX_PARTS)),
@@ -140,7 +140,7 @@ impl Split {
     }
 
     /// The part holding node `node` of the whole program, and the node's index in it.
-    pub fn locate(&self, node: NodeId) -> Option<(usize, NodeId)> {
+    pub(crate) fn locate(&self, node: NodeId) -> Option<(usize, NodeId)> {
         let n = node as usize;
         let p = self.parts.partition_point(|part| part.first_node <= n);
         let part = self.parts.get(p.checked_sub(1)?)?;

@@ -100,7 +100,7 @@ pub(crate) fn as_number(t: &str) -> AsNumber {
 
 impl Strings {
     /// The rank of `text` (interned by [`prepare`]).
-    pub fn id(&self, text: &str) -> i64 {
+    pub(crate) fn id(&self, text: &str) -> i64 {
         self.texts
             .binary_search_by(|t| t.as_str().cmp(text))
             .map(|i| i as i64)
@@ -110,7 +110,7 @@ impl Strings {
     /// The text whose rank is model expression `x` as a model expression: a balanced
     /// `?:` over the ranks of every text of the tree (a rank stands for the same text
     /// wherever it is stored), so its depth grows with the logarithm of their number.
-    pub fn text_of(&self, x: &str) -> String {
+    pub(crate) fn text_of(&self, x: &str) -> String {
         fn pick(x: &str, ts: &[String], lo: usize) -> String {
             match ts {
                 [] => "''".into(),
@@ -126,14 +126,14 @@ impl Strings {
     }
 
     /// Entry `g` holds strings.
-    pub fn holds(&self, g: &str) -> bool {
+    pub(crate) fn holds(&self, g: &str) -> bool {
         self.set_entries.iter().any(|e| e == g) || self.script_entries.iter().any(|e| e == g)
     }
 
     /// The string whose rank is `x` (a model expression) read as a number, when it is
     /// one of `texts`: the condition under which BT.CPP throws and the number; `Err`
     /// with a text whose number the model does not know.
-    pub fn number(
+    pub(crate) fn number(
         &self,
         x: &str,
         texts: &[&str],

@@ -6,7 +6,7 @@ use super::types::{parse_type_comment, TypeAnn, TypeError, TypeExpr};
 use super::xml::{self, Element, Node};
 
 /// Reads the SCXML file `file` (already in `sm`) into a machine.
-pub fn read_machine(sm: &SourceMap, file: FileId) -> Result<Machine, Vec<Diagnostic>> {
+pub(crate) fn read_machine(sm: &SourceMap, file: FileId) -> Result<Machine, Vec<Diagnostic>> {
     let root = xml::parse(sm, file).map_err(|d| vec![d])?;
     read_machine_tree(sm, &root, file)
 }
@@ -15,7 +15,7 @@ pub fn read_machine(sm: &SourceMap, file: FileId) -> Result<Machine, Vec<Diagnos
 ///
 /// `file` names the machine when the root has no `name`; spans in `root` may point into
 /// any file of `sm` (a generated element carries the span of what it was made from).
-pub fn read_machine_tree(
+pub(crate) fn read_machine_tree(
     sm: &SourceMap,
     root: &Element,
     file: FileId,

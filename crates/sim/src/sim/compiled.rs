@@ -123,7 +123,7 @@ pub(crate) struct StateDef {
 impl StateDef {
     /// Transitions on `event`, in document order.
     #[inline]
-    pub fn transitions<'a>(&self, event: u32, dispatch: &'a [u32]) -> &'a [u32] {
+    pub(crate) fn transitions<'a>(&self, event: u32, dispatch: &'a [u32]) -> &'a [u32] {
         // A state handles few events: a scan of a short list costs less than a search.
         let found = if self.on_event.len() <= 8 {
             self.on_event
