@@ -851,13 +851,7 @@ fn random_trees_with_port_doubles_lower_to_what_btcpp_does() {
 /// has no leaves with ports.
 #[test]
 fn random_trees_with_port_strings_lower_to_what_btcpp_does() {
-    let opts = gen::Options {
-        btcpp4_nodes: true,
-        scripts: true,
-        strings: true,
-        port_strings: true,
-        ..Default::default()
-    };
+    let opts = port_strings();
     random_trees(opts);
     let n = trees(opts);
     let (mut with, mut changed) = (0u64, 0u64);
@@ -1841,7 +1835,7 @@ fn harness() -> Option<real::Real> {
     }
 }
 
-/// 2,500 trees: with the eleven tests below (1,000 or 500 each), 10,000 random trees a run
+/// 2,500 trees: with the twelve tests below (1,000 or 500 each), 10,500 random trees a run
 /// go through both the lowering and BehaviorTree.CPP 4.8.2, in both tick modes.
 #[test]
 fn random_trees_with_btcpp4_nodes_lower_to_what_the_real_library_does() {
@@ -1873,6 +1867,29 @@ fn random_trees_with_strings_lower_to_what_the_real_library_does() {
         ..Default::default()
     };
     real_library_opts(opts, 1_000, 1_300_000);
+}
+
+/// The generator's options with leaves reading `t` through a `string` input port
+/// (`gen::Options::port_strings`).
+fn port_strings() -> gen::Options {
+    gen::Options {
+        btcpp4_nodes: true,
+        scripts: true,
+        strings: true,
+        port_strings: true,
+        ..Default::default()
+    }
+}
+
+/// The same with leaves reading `t` through a `string` input port, 500 trees that have
+/// one: the real library's harness (`tests/bt/real/harness.py`) takes the port out of
+/// the XML, as the binding registers no ports, and reads the entry from the leaf's
+/// blackboard, the entry `getInput<std::string>` reads.
+#[test]
+fn random_trees_with_port_strings_lower_to_what_the_real_library_does() {
+    real_library_where(port_strings(), 500, 1_800_000, |t| {
+        t.nodes.iter().any(|x| x.input.as_deref() == Some("t"))
+    });
 }
 
 /// The same with LoopString nodes writing `t`, the string entry the scripts compare

@@ -23,12 +23,19 @@
 # not called at all when ticked again (StatefulActionNode::tick). `uid` is the node's TreeNode::UID
 # (BT.CPP numbers nodes from 1 in the order it creates them: depth-first pre-order with
 # each SubTree node before its body); the test maps it to the oracle's node id.
+# A leaf type `T<digit>...` stands for a leaf with a `string` input port `in` that answers
+# SUCCESS while the text it reads is 'a' (tests/src/bt/model.rs, `has_in_text`): the
+# binding registers no ports, so its `in="{e}"` is taken out of the XML and the callback
+# reads entry `e` from the node's blackboard, the entry getInput<std::string> reads (what
+# the port adds, the entry created empty when the tree loads, is not reproduced: the
+# generated trees create `t` first).
 # A root tick that makes more than `budget` leaf callbacks is a livelock: the leaves
 # then answer RUNNING without logging (so the tick can end), and the case stops there
 # with the log cut at the start of that tick.
 import ctypes
 import json
 import os
+import re
 import sys
 import time
 
@@ -61,7 +68,13 @@ class Case:
         self.live = True
         self.k = {}
         self.log = []
+        # Leaf type -> the entry its `in` port named (`T<digit>...` leaves).
+        self.inputs = {}
 
+
+# A `T<digit>...` leaf's input port, and the text it answers SUCCESS on.
+IN_PORT = re.compile(r'(<(T[0-9]+)\b[^>]*?) in="\{([A-Za-z_][A-Za-z_0-9]*)\}"')
+IN_TEXT = "a"
 
 cur = None
 factory = bt.BehaviorTreeFactory()
@@ -82,6 +95,14 @@ def register(name):
         c.k[uid] = k + 1
         c.log.append(["T", uid, name])
         s = c.scripts[name]
+        entry = c.inputs.get(name)
+        if entry is not None:
+            try:
+                text = node.config().blackboard.get_string(entry)
+            except Exception:  # no such entry, or not a string
+                text = None
+            if text == IN_TEXT:
+                return bt.NodeStatus.SUCCESS
         return STATUS[s[k % len(s)]]
 
     def halted(node):
@@ -104,7 +125,10 @@ def run(req):
         for name in req["scripts"]:
             if name not in registered:
                 register(name)  # a built-in's name is refused ("already registered")
-        tree = factory.create_tree_from_text(req["xml"])
+        xml = req["xml"]
+        for m in IN_PORT.finditer(xml):
+            c.inputs[m.group(2)] = m.group(3)
+        tree = factory.create_tree_from_text(IN_PORT.sub(r"\1", xml))
     except Exception as e:  # BT.CPP refuses the tree
         end = {"kind": "load", "tick": 0, "text": str(e)}
     if tree is not None:
