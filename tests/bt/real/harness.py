@@ -29,6 +29,11 @@
 # reads entry `e` from the node's blackboard, the entry getInput<std::string> reads (what
 # the port adds, the entry created empty when the tree loads, is not reproduced: the
 # generated trees create `t` first).
+# Likewise a leaf type `O<digit>...` stands for a leaf with a `float64` output port `out`
+# writing OUT_VALUES[k % 4] on its k-th callback (`has_out`): its `out="{e}"` is taken out
+# and the callback stores the double in entry `e` of its blackboard, as setOutput<double>
+# does (the port's empty entry at load is not reproduced: reading it before the first
+# write throws either way, "not initialized" or "not found").
 # A root tick that makes more than `budget` leaf callbacks is a livelock: the leaves
 # then answer RUNNING without logging (so the tick can end), and the case stops there
 # with the log cut at the start of that tick.
@@ -68,13 +73,18 @@ class Case:
         self.live = True
         self.k = {}
         self.log = []
-        # Leaf type -> the entry its `in` port named (`T<digit>...` leaves).
+        # Leaf type -> the entry its `in` port named (`T<digit>...` leaves), its `out`
+        # port (`O<digit>...` leaves).
         self.inputs = {}
+        self.outputs = {}
 
 
 # A `T<digit>...` leaf's input port, and the text it answers SUCCESS on.
 IN_PORT = re.compile(r'(<(T[0-9]+)\b[^>]*?) in="\{([A-Za-z_][A-Za-z_0-9]*)\}"')
 IN_TEXT = "a"
+# An `O<digit>...` leaf's output port, and the doubles it writes (`model::OUT_VALUES`).
+OUT_PORT = re.compile(r'(<(O[0-9]+)\b[^>]*?) out="\{([A-Za-z_][A-Za-z_0-9]*)\}"')
+OUT_VALUES = [1.5, 0.5, -2.0, 3.25]
 
 cur = None
 factory = bt.BehaviorTreeFactory()
@@ -95,6 +105,9 @@ def register(name):
         c.k[uid] = k + 1
         c.log.append(["T", uid, name])
         s = c.scripts[name]
+        out = c.outputs.get(name)
+        if out is not None:
+            node.config().blackboard.set_double(out, OUT_VALUES[k % len(OUT_VALUES)])
         entry = c.inputs.get(name)
         if entry is not None:
             try:
@@ -128,7 +141,10 @@ def run(req):
         xml = req["xml"]
         for m in IN_PORT.finditer(xml):
             c.inputs[m.group(2)] = m.group(3)
-        tree = factory.create_tree_from_text(IN_PORT.sub(r"\1", xml))
+        for m in OUT_PORT.finditer(xml):
+            c.outputs[m.group(2)] = m.group(3)
+        xml = OUT_PORT.sub(r"\1", IN_PORT.sub(r"\1", xml))
+        tree = factory.create_tree_from_text(xml)
     except Exception as e:  # BT.CPP refuses the tree
         end = {"kind": "load", "tick": 0, "text": str(e)}
     if tree is not None:
