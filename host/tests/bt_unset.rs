@@ -2,7 +2,9 @@
 //! entry only scripts use; refused with file:line:col under AS2FM's semantics, inside a
 //! SubTree, with `key` in braces, and over an entry a SetBlackboard writes. The queue
 //! nodes BT.CPP does not register are refused, saying why. (What the lowered node does
-//! is held to the oracle by `tests/tests/bt_btcpp_lowering.rs`.)
+//! is held to the oracle by `tests/tests/bt_btcpp_lowering.rs`.) A SetBlackboard copying
+//! an entry is refused under `--bt btcpp` at its `value` (BT.CPP 4 does not copy as
+//! AS2FM's model does) and copies under AS2FM's semantics.
 
 mod common;
 
@@ -59,4 +61,17 @@ fn the_queue_nodes_are_refused_saying_why() {
         e.contains("tree.xml:3:1: ") && e.contains("does not register it"),
         "{node}: {e}"
     );
+}
+
+#[test]
+fn a_set_blackboard_copy_is_refused_under_btcpp_and_copies_under_as2fm() {
+    let body = "<Sequence><SetBlackboard output_key=\"a\" value=\"5\"/><SetBlackboard output_key=\"b\" value=\"{a}\"/><Act/></Sequence>";
+    let e = lower(body, "", BTCPP).expect_err("refused");
+    assert!(
+        e.contains("tree.xml:3:89: SetBlackboard copying `{a}` under `--bt btcpp`")
+            && e.contains("a copy of an entry that holds no value answers FAILURE")
+            && e.contains("a Script `b := a` copies a value"),
+        "{e}"
+    );
+    lower(body, "", BtSemantics::As2fm).unwrap_or_else(|e| panic!("AS2FM's model copies: {e}"));
 }

@@ -570,6 +570,20 @@ pub(crate) fn lower_set(
                 None
             }
         },
+        // BT.CPP 4's copy is not AS2FM's (BT.CPP 4.10 `SetBlackboardNode::tick`, 4.8.2
+        // measured, `tests/bt/real/set_blackboard.toml`): the `value` port creates the
+        // source untyped when the tree loads, so a constant a SetBlackboard writes there
+        // leaves it empty, a second one throws, and a copy of an entry with no value
+        // answers FAILURE. Not modelled: refused rather than copied.
+        PortValue::Blackboard(src) if ctx.btcpp => {
+            errs.push(sm.diag(
+                value.span,
+                format!(
+                    "SetBlackboard copying `{{{src}}}` under `--bt btcpp`: BT.CPP 4 creates `{src}` untyped when it loads the tree, so a constant a SetBlackboard writes there leaves it empty and a second one throws \"Can't convert string [..] to type [BT::Any]\", and a copy of an entry that holds no value answers FAILURE (4.8.2 measured); that is not modelled (a Script `{entry} := {src}` copies a value)"
+                ),
+            ));
+            None
+        }
         PortValue::Blackboard(src) => {
             bb.add_reader(&ctx.machine);
             Some(copy_blackboard(ctx, &entry, src))
