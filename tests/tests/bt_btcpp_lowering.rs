@@ -1454,18 +1454,30 @@ fn random_trees(opts: gen::Options) {
                         let t = tree::read(&c.xml).expect("the oracle reads what it generates");
                         // BT.CPP 4 fails or throws on a SetBlackboard copy of the entries
                         // the harness's untyped ports create (the oracle's
-                        // `set_blackboard`, `tests/bt/real/set_blackboard.toml`); the
-                        // lowering types entries and copies: not compared.
-                        if t.nodes
+                        // `set_blackboard`, `tests/bt/real/set_blackboard.toml`), which
+                        // the lowering refuses; so it does conditions and Loops it does
+                        // not model (`conds_refused`, `loop_refused`). Not compared, but
+                        // the lowering must refuse them: a tree left out is never one it
+                        // lowered.
+                        let copies = t
+                            .nodes
                             .iter()
-                            .any(|x| matches!(x.kind, Kind::SetBlackboard(_, Operand::Entry(_))))
-                        {
-                            counts[4].fetch_add(1, Relaxed);
-                            i += threads;
-                            continue;
-                        }
-                        if conds_refused(&t) || loop_refused(&t) {
-                            counts[6].fetch_add(1, Relaxed);
+                            .any(|x| matches!(x.kind, Kind::SetBlackboard(_, Operand::Entry(_))));
+                        if copies || conds_refused(&t) || loop_refused(&t) {
+                            counts[if copies { 4 } else { 6 }].fetch_add(1, Relaxed);
+                            let low = if timed {
+                                lowered_clocked(&c.xml, &c.scripts, c.ticks, BtTick::Once)
+                            } else {
+                                lowered(&c.xml, &c.scripts, c.ticks, BtTick::Once)
+                            };
+                            if low.is_ok() {
+                                fails.push(format!(
+                                    "seed {seed}: the lowering lowered a tree it must refuse \
+                                     (a SetBlackboard copy, or conditions or a Loop it does \
+                                     not model)\n{}",
+                                    show(&c.xml, &c.scripts, c.ticks)
+                                ));
+                            }
                             i += threads;
                             continue;
                         }
