@@ -483,3 +483,24 @@ fn a_script_sets_the_text_a_plugin_reads_under_btcpp() {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+#[test]
+fn btcpp_warns_where_bt_cpp_4_would_not_load_the_tree() {
+    let tree = "<root BTCPP_format=\"3\" main_tree_to_execute=\"Main\">\n<BehaviorTree ID=\"Main\">\n<SequenceStar><SetBlackboard output_key=\"n\" value=\"1\"/><BlackboardCheckInt value_A=\"{n}\" value_B=\"1\"><FailOnce/></BlackboardCheckInt></SequenceStar>\n</BehaviorTree>\n</root>\n";
+    let dir = scratch("v3warn", tree);
+    let (code, _, err) = hindsight(
+        &dir,
+        &["verify", "main.xml", "--bt", "btcpp", "--runs", "5"],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("warning: tree.xml:1:1: `--bt btcpp` runs this BTCPP_format 3 tree")
+            && err.contains("warning: tree.xml:3:56: BlackboardCheckInt: BehaviorTree.CPP 4 does not register this BehaviorTree.CPP 3 node"),
+        "{err}"
+    );
+    // AS2FM's semantics models the tree as written: nothing to warn about.
+    let (code, _, err) = hindsight(&dir, &["verify", "main.xml", "--runs", "5"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

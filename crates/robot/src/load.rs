@@ -433,6 +433,7 @@ fn load_full(
     // root and plugins): the ROS lowering numbers timers and clients in this order.
     let mut tree_machines = Vec::new();
     let mut bt_notes = Vec::new();
+    let mut bt_warnings = Vec::new();
     if let Some(tree) = &main.behavior_tree {
         let file_of = |sm: &mut SourceMap, input: &Input, errs: &mut Vec<Diagnostic>| {
             match codegen::diag::read_source(&input.path) {
@@ -460,6 +461,7 @@ fn load_full(
                     semantics,
                 };
                 bt_notes = bt::semantics_notes(&sm, &input);
+                bt_warnings = bt::btcpp_warnings(&sm, &input);
                 match bt::lower(&sm, &input) {
                     Ok(ms) => tree_machines = ms,
                     Err(ds) => errs.extend(ds),
@@ -534,7 +536,8 @@ fn load_full(
     }
     let model = CompiledModel::compile(src)?;
     let unit = out.time_unit_ns.max(1);
-    let warnings = main.warnings.clone();
+    let mut warnings = main.warnings.clone();
+    warnings.extend(bt_warnings);
     Ok((
         RobotModel {
             main,

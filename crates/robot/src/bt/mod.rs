@@ -431,6 +431,47 @@ pub(crate) fn semantics_notes(sm: &SourceMap, input: &BtInput) -> Vec<Diagnostic
     }
 }
 
+/// Under `--bt btcpp` ([`BtSemantics::Btcpp`]), where the tree is not one BehaviorTree.CPP 4
+/// runs as written, so the BT.CPP number is for a tree 4.x would not load: a document in
+/// `BTCPP_format="3"` (3.8's format; the lowering applies 4's rules), and each
+/// BlackboardCheck node (3.8's; 4.8.2 refuses it at load, "Node not recognized"), which
+/// is lowered as AS2FM's model of it. Warnings, one per place; empty under AS2FM's
+/// semantics or when the tree cannot be read ([`lower`] reports that).
+pub(crate) fn btcpp_warnings(sm: &SourceMap, input: &BtInput) -> Vec<Diagnostic> {
+    if input.semantics == BtSemantics::As2fm {
+        return Vec::new();
+    }
+    let mut plugins = Vec::new();
+    for &f in &input.plugins {
+        match plugin::read(sm, f) {
+            Ok(p) => plugins.push(p),
+            Err(_) => return Vec::new(),
+        }
+    }
+    let Ok(root) = xml::parse(sm, input.tree) else {
+        return Vec::new();
+    };
+    let mut out: Vec<Diagnostic> = Vec::new();
+    if root.attr_value("BTCPP_format").map(str::trim) == Some("3") {
+        out.push(sm.diag(root.span, "`--bt btcpp` runs this BTCPP_format 3 tree (BehaviorTree.CPP 3.8's format) by BehaviorTree.CPP 4's rules, which differ from 3.8's (3.8's SequenceStar goes back to its first child when halted, its Parallel recounts finished children in child order: README, \"Where AS2FM's models and BehaviorTree.CPP differ\"); 4.x reads 3.8's names such as SequenceStar only when built with USE_BTCPP3_OLD_NAMES").warning());
+    }
+    let Ok(tree) = tree::read(sm, &root, &plugins) else {
+        return out;
+    };
+    for n in &tree.nodes {
+        if let Kind::Control(Control::BlackboardCheck(t)) = n.kind {
+            let d = sm.diag(n.span, format!("{}: BehaviorTree.CPP 4 does not register this BehaviorTree.CPP 3 node (4.8.2 refuses the tree at load, \"Node not recognized\"), so `--bt btcpp` lowers AS2FM's model of it; in a BT.CPP 4 tree, a Precondition or a ScriptCondition compares an entry", t.node_name())).warning();
+            if !out
+                .iter()
+                .any(|o| o.file == d.file && o.line == d.line && o.col == d.col)
+            {
+                out.push(d);
+            }
+        }
+    }
+    out
+}
+
 /// What halting each node (by index) does when it is idle; children come after their
 /// parent in pre-order, so one pass from the end sees every child first.
 fn halt_effects(tree: &tree::Tree, plugins: &[plugin::Plugin]) -> Vec<HaltEffect> {
