@@ -31,6 +31,24 @@ const FAIL_ONCE: &str = r#"<ascxml name="FailOnce" initial="first">
   </state>
 </ascxml>"#;
 
+/// A stateful action (it may answer RUNNING, so BT.CPP 4 runs it as a
+/// `StatefulActionNode`): RUNNING on its first tick, FAILURE on its second, SUCCESS on
+/// every later one.
+const SLOW_FAIL_ONCE: &str = r#"<ascxml name="SlowFailOnce" initial="first">
+  <state id="first">
+    <bt_tick target="second"><bt_return_status status="RUNNING"/></bt_tick>
+    <bt_halt target="first"><bt_return_halted/></bt_halt>
+  </state>
+  <state id="second">
+    <bt_tick target="later"><bt_return_status status="FAILURE"/></bt_tick>
+    <bt_halt target="first"><bt_return_halted/></bt_halt>
+  </state>
+  <state id="later">
+    <bt_tick target="later"><bt_return_status status="SUCCESS"/></bt_tick>
+    <bt_halt target="later"><bt_return_halted/></bt_halt>
+  </state>
+</ascxml>"#;
+
 const PROPS: &str = r#"{"properties": [
   {"name": "tree_success", "expression": {"op": "filter", "fun": "values",
     "values": {"op": "Pmin", "exp": {"op": "F", "exp": {"op": "=",
@@ -40,7 +58,7 @@ const PROPS: &str = r#"{"properties": [
       "left": "bt_1000_response__status", "right": 2}}}, "states": {"op": "initial"}}}
 ]}"#;
 
-/// A scratch model: `tree.xml`, the FailOnce plugin, ticked at 1 Hz for 5 s, again after
+/// A scratch model: `tree.xml`, the FailOnce and SlowFailOnce plugins, ticked at 1 Hz for 5 s, again after
 /// every answer.
 fn scratch(name: &str, tree: &str) -> PathBuf {
     let dir =
@@ -49,6 +67,7 @@ fn scratch(name: &str, tree: &str) -> PathBuf {
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("tree.xml"), tree).unwrap();
     std::fs::write(dir.join("fail_once.ascxml"), FAIL_ONCE).unwrap();
+    std::fs::write(dir.join("slow_fail_once.ascxml"), SLOW_FAIL_ONCE).unwrap();
     std::fs::write(dir.join("properties.jani"), PROPS).unwrap();
     std::fs::write(
         dir.join("main.xml"),
@@ -61,6 +80,7 @@ fn scratch(name: &str, tree: &str) -> PathBuf {
   <behavior_tree>
     <input type="bt.cpp-xml" src="./tree.xml"/>
     <input type="bt-plugin-ascxml" src="./fail_once.ascxml"/>
+    <input type="bt-plugin-ascxml" src="./slow_fail_once.ascxml"/>
   </behavior_tree>
   <properties><input type="jani" src="./properties.jani"/></properties>
 </roaml>"#,
@@ -84,10 +104,12 @@ fn pos(text: &str, needle: &str) -> (usize, usize) {
     (line, col)
 }
 
-/// The two-child IfThenElse over a condition that fails once: AS2FM's model ticks the
-/// condition again and succeeds on the second tick; BT.CPP 4 keeps the failed condition's
-/// status, and a stateful action answers it again, so the tree never succeeds.
-const STALE: &str = "<IfThenElse>\n  <FailOnce/>\n  <AlwaysSuccess/>\n</IfThenElse>";
+/// The two-child IfThenElse over a stateful condition that runs, fails once, then
+/// succeeds: AS2FM's model ticks the condition again and succeeds; BT.CPP 4 keeps the
+/// failed condition's status, and a stateful action answers it again, so the tree never
+/// succeeds. (Over FailOnce, which never answers RUNNING and so is synchronous, the two
+/// agree: BT.CPP runs it again.)
+const STALE: &str = "<IfThenElse>\n  <SlowFailOnce/>\n  <AlwaysSuccess/>\n</IfThenElse>";
 
 #[test]
 fn verify_both_reports_both_probabilities_and_the_sensitive_properties() {
@@ -210,7 +232,7 @@ fn bt_options_are_refused_where_they_mean_nothing() {
 
 #[test]
 fn validate_warns_at_the_nodes_where_the_semantics_differ() {
-    let tree = v4("<ReactiveSequence>\n  <FailOnce/>\n  <SequenceWithMemory>\n    <FailOnce/>\n    <Repeat num_cycles=\"3\">\n      <FailOnce/>\n    </Repeat>\n    <Parallel success_count=\"1\" failure_count=\"1\">\n      <FailOnce/>\n      <AlwaysSuccess/>\n    </Parallel>\n    <IfThenElse>\n      <FailOnce/>\n      <AlwaysSuccess/>\n    </IfThenElse>\n  </SequenceWithMemory>\n</ReactiveSequence>");
+    let tree = v4("<ReactiveSequence>\n  <FailOnce/>\n  <SequenceWithMemory>\n    <FailOnce/>\n    <Repeat num_cycles=\"3\">\n      <FailOnce/>\n    </Repeat>\n    <Parallel success_count=\"1\" failure_count=\"1\">\n      <FailOnce/>\n      <AlwaysSuccess/>\n    </Parallel>\n    <IfThenElse>\n      <SlowFailOnce/>\n      <AlwaysSuccess/>\n    </IfThenElse>\n  </SequenceWithMemory>\n</ReactiveSequence>");
     let dir = scratch("warn", &tree);
     let (code, out, err) = hindsight(&dir, &["validate", "main.xml"]);
     assert_eq!(code, 0, "{out} {err}");

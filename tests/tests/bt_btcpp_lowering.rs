@@ -310,13 +310,31 @@ fn a_wake_up_left_pending_by_a_finished_tick_re_ticks_the_next() {
 #[test]
 fn a_failed_condition_leaf_of_a_two_child_if_then_else_stays_failed() {
     // `IfThenElseNode::tick` returns the condition's FAILURE without resetting it, and a
-    // stateful leaf in a finished status answers it again without running
-    // (`StatefulActionNode::tick`): C is ticked twice, never again.
+    // stateful leaf (one that may answer RUNNING) in a finished status answers it again
+    // without running (`StatefulActionNode::tick`): C is ticked twice, never again.
     let t = v4("<Sequence><IfThenElse><C/><A/></IfThenElse></Sequence>");
-    let sc = scripts(&[("C", &[S, F, S]), ("A", &[S])]);
+    let sc = scripts(&[("C", &[S, F, S, R]), ("A", &[S])]);
     assert_eq!(
         lowered(&t, &sc, 4, BtTick::Once).unwrap(),
         ran(&[S, F, F, F], &[T(1002), T(1003), T(1002)])
+    );
+    // A leaf that never answers RUNNING is synchronous (a condition, a `SyncActionNode`):
+    // ticked again, it runs again (4.8.2 measured: the same statuses and log).
+    let sc = scripts(&[("C", &[S, F, S]), ("A", &[S])]);
+    assert_eq!(
+        lowered(&t, &sc, 4, BtTick::Once).unwrap(),
+        ran(
+            &[S, F, S, S],
+            &[
+                T(1002),
+                T(1003),
+                T(1002),
+                T(1002),
+                T(1003),
+                T(1002),
+                T(1003)
+            ]
+        )
     );
 }
 
@@ -325,13 +343,32 @@ fn while_do_else_keeps_a_leaf_condition_as_it_finished_while_a_branch_runs() {
     // This test and the two below: each run checked against the real library
     // (`tests/bt/real/harness.py`, BT.CPP 4.8.2) while writing them.
     // `WhileDoElseNode::tick` resets its children only when it finishes: while A runs,
-    // the stateful leaf C answers its SUCCESS again without running; once A succeeds,
-    // C runs again (FAILURE) and the else branch B answers.
+    // the stateful leaf C (it may answer RUNNING) answers its SUCCESS again without
+    // running; once A succeeds, C runs again (FAILURE) and the else branch B answers.
     let t = v4("<WhileDoElse><C/><A/><B/></WhileDoElse>");
-    let sc = scripts(&[("C", &[S, F]), ("A", &[R, R, S]), ("B", &[S])]);
+    let sc = scripts(&[("C", &[S, F, R]), ("A", &[R, R, S]), ("B", &[S])]);
     let log = [T(1001), T(1002), T(1002), T(1002), T(1001), T(1003)];
     for tick in [BtTick::Once, BtTick::ExactlyOnce] {
         assert_eq!(lowered(&t, &sc, 4, tick).unwrap(), ran(&[R, R, S, S], &log));
+    }
+    // A synchronous condition (it never answers RUNNING) runs at every tick, as a
+    // robot's battery check under WhileDoElse does: its FAILURE on the second tick
+    // halts the running A and B answers (4.8.2 measured: the same statuses and log).
+    let sc = scripts(&[("C", &[S, F]), ("A", &[R, R, S]), ("B", &[S])]);
+    let log = [
+        T(1001),
+        T(1002),
+        T(1001),
+        H(1002),
+        T(1003),
+        T(1001),
+        T(1002),
+        T(1001),
+        H(1002),
+        T(1003),
+    ];
+    for tick in [BtTick::Once, BtTick::ExactlyOnce] {
+        assert_eq!(lowered(&t, &sc, 4, tick).unwrap(), ran(&[R, S, R, S], &log));
     }
 }
 

@@ -16,8 +16,11 @@
 # case as {"kind": "late"} (the machine was too loaded for the margins the test relies on).
 # `read` (optional) names root blackboard entries to read as integers after the last
 # tick (a boolean reads as 0 or 1; null: missing or not a number).
-# A scripted leaf is a stateful action: on its k-th callback (on_start or on_running)
-# it answers script[k % len]; on_halted logs a halt (BT.CPP halts a child only while it
+# A scripted leaf whose script holds RUNNING is a stateful action, one whose script
+# does not a synchronous action (SyncActionNode: every tick calls it, as a condition's
+# does; a StatefulActionNode ticked in a finished status its parent did not reset
+# answers that status without a callback): on its k-th callback it answers
+# script[k % len]; on_halted logs a halt (BT.CPP halts a child only while it
 # is RUNNING: ControlNode::haltChild, DecoratorNode::resetChild; the differential
 # confirms no other halt reaches a leaf). A finished leaf its parent did not reset is
 # not called at all when ticked again (StatefulActionNode::tick). `uid` is the node's TreeNode::UID
@@ -35,7 +38,7 @@
 # does (the port's empty entry at load is not reproduced: reading it before the first
 # write throws either way, "not initialized" or "not found").
 # A root tick that makes more than `budget` leaf callbacks is a livelock: the leaves
-# then answer RUNNING without logging (so the tick can end), and the case stops there
+# then answer RUNNING (a synchronous one FAILURE) without logging (so the tick can end), and the case stops there
 # with the log cut at the start of that tick.
 import ctypes
 import json
@@ -87,19 +90,39 @@ OUT_PORT = re.compile(r'(<(O[0-9]+)\b[^>]*?) out="\{([A-Za-z_][A-Za-z_0-9]*)\}"'
 OUT_VALUES = [1.5, 0.5, -2.0, 3.25]
 
 cur = None
-factory = bt.BehaviorTreeFactory()
-registered = set()
+# One factory per set of leaf kinds: a type name is registered once per factory, and the
+# same name is stateful in one case and synchronous in another.
+factories = {}
 
 
-def register(name):
+def factory_for(scripts):
+    kinds = tuple(sorted((n, "RUNNING" in s) for n, s in scripts.items()))
+    f = factories.get(kinds)
+    if f is None:
+        if len(factories) > 256:
+            factories.clear()
+        f = bt.BehaviorTreeFactory()
+        for name, stateful in kinds:
+            # A built-in's name is refused ("already registered"): the case ends as a
+            # load error, and the factory is not kept.
+            register(f, name, stateful)
+        factories[kinds] = f
+    return f
+
+
+def register(factory, name, stateful):
+    # What a leaf answers once the case is over: RUNNING ends a tick soonest, but a
+    # synchronous action may not answer it ("SyncActionNode MUST never return RUNNING").
+    idle = bt.NodeStatus.RUNNING if stateful else bt.NodeStatus.FAILURE
+
     def answer(node):
         c = cur
         if c is None or not c.live:
-            return bt.NodeStatus.RUNNING
+            return idle
         c.calls += 1
         if c.calls > c.budget:
             c.over = True
-            return bt.NodeStatus.RUNNING
+            return idle
         uid = node.uid()
         k = c.k.get(uid, 0)
         c.k[uid] = k + 1
@@ -123,8 +146,10 @@ def register(name):
         if c is not None and c.live and not c.over:
             c.log.append(["H", node.uid(), name])
 
-    factory.register_simple_stateful_action(name, answer, answer, halted)
-    registered.add(name)
+    if stateful:
+        factory.register_simple_stateful_action(name, answer, answer, halted)
+    else:
+        factory.register_simple_action(name, answer)
 
 
 def run(req):
@@ -135,9 +160,7 @@ def run(req):
     end = None
     tree = None
     try:
-        for name in req["scripts"]:
-            if name not in registered:
-                register(name)  # a built-in's name is refused ("already registered")
+        factory = factory_for(req["scripts"])
         xml = req["xml"]
         for m in IN_PORT.finditer(xml):
             c.inputs[m.group(2)] = m.group(3)

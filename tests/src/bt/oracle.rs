@@ -875,14 +875,23 @@ impl<'t> Oracle<'t> {
         let kind = &self.tree.nodes[n].kind;
         match kind {
             Kind::Leaf(ty) => {
-                // BT.CPP's scripted leaf is a `StatefulActionNode` (the real-library
-                // harness registers it so): `StatefulActionNode::tick` calls `onStart`
-                // when IDLE, `onRunning` when RUNNING, and otherwise answers its last
-                // status without calling anything (a finished leaf its parent did not
-                // reset, e.g. a 2-child IfThenElse's failed condition).
+                // A scripted leaf that may answer RUNNING is a `StatefulActionNode` (the
+                // real-library harness registers it so): `StatefulActionNode::tick`
+                // calls `onStart` when IDLE, `onRunning` when RUNNING, and otherwise
+                // answers its last status without calling anything (a finished leaf its
+                // parent did not reset, e.g. a 2-child IfThenElse's failed condition).
+                // One that never does is synchronous (the harness registers a
+                // `SyncActionNode`, as a condition is a `ConditionNode`): every tick runs
+                // it (4.10 `action_node.cpp`, `SyncActionNode::executeTick`).
+                let stateful = self
+                    .scripts
+                    .get(ty)
+                    .is_some_and(|s| s.contains(&Status::Running));
                 if self.btcpp() {
                     if let Some(s @ (Success | Failure)) = self.status[n] {
-                        return Ok(s);
+                        if stateful {
+                            return Ok(s);
+                        }
                     }
                     self.calls += 1;
                     if self.calls > self.opts.budget {

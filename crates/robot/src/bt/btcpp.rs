@@ -24,11 +24,14 @@
 //! is taken by the next tick that answers RUNNING.
 //!
 //! # Leaves
-//! A leaf plugin stands for a stateful action (BT.CPP 4 `action_node.cpp`,
-//! `StatefulActionNode::tick`: ticked in a finished status that its parent did not reset,
-//! it answers that status again without running). The only parent that ticks a child it
-//! did not reset is a two-child IfThenElse whose condition failed (`parallel.rs`,
-//! `if_then_else`).
+//! A leaf plugin that may answer RUNNING stands for a stateful action (BT.CPP 4
+//! `action_node.cpp`, `StatefulActionNode::tick`: ticked in a finished status that its
+//! parent did not reset, it answers that status again without running); one that never
+//! does for a synchronous node (a `ConditionNode` or `SyncActionNode`, whose every tick
+//! runs it; `plugin.rs`, `Plugin::may_run`). The parents that tick a child they did not
+//! reset are a two-child IfThenElse whose condition failed (`parallel.rs`,
+//! `if_then_else`) and WhileDoElse, whose condition is ticked while a branch runs
+//! (`btcpp4_skip.rs`, `stale`).
 
 use super::control::{
     index_out_of_range, init_state, n_children, on_child_skipped, skip_to_next, Ctx, FAILURE,

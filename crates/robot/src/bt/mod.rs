@@ -271,9 +271,10 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
     if btcpp {
         errs.extend(btcpp4_skip::refusals(sm, &tree));
     }
-    // A stateful leaf (`btcpp.rs`, "Leaves"): a leaf plugin, or Sleep.
+    // A stateful leaf (`btcpp.rs`, "Leaves"): a leaf plugin that may answer RUNNING, or
+    // Sleep.
     let stateful = |c: usize| match tree.nodes[c].kind {
-        Kind::Plugin(p) => !plugins[p].ticks_children,
+        Kind::Plugin(p) => !plugins[p].ticks_children && plugins[p].may_run,
         Kind::Control(c) => c == Control::Btcpp4(tree::Btcpp4::Sleep),
     };
     // Where BT.CPP may tick a node again without resetting it (`btcpp4_skip.rs`,

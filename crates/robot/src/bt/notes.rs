@@ -111,15 +111,18 @@ pub(super) fn notes(sm: &SourceMap, tree: &Tree, plugins: &[Plugin]) -> Vec<Diag
                     .into(),
             ),
             Control::IfThenElse if kids == 2 => {
+                // Only a condition that may answer RUNNING (a stateful action) keeps its
+                // status; a synchronous one runs again, as AS2FM's model ticks it.
                 if let Kind::Plugin(p) = tree.nodes[n.children[0]].kind {
-                    if !plugins[p].ticks_children {
+                    if !plugins[p].ticks_children && plugins[p].may_run {
                         add(
                             n.span,
                             "IfThenElse with two children: once its condition fails, \
                              BehaviorTree.CPP 4 does not reset it (`IfThenElseNode::tick`), \
-                             and a stateful action in a finished status answers it again \
-                             without running: the node answers FAILURE from then on, where \
-                             AS2FM's model ticks the condition again"
+                             and a stateful action (the condition's plugin may answer \
+                             RUNNING) in a finished status answers it again without \
+                             running: the node answers FAILURE from then on, where AS2FM's \
+                             model ticks the condition again"
                                 .into(),
                         );
                     }

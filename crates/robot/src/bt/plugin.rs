@@ -51,6 +51,11 @@ pub(crate) struct Plugin {
     pub has_halt: bool,
     /// Whether it ticks children (`<bt_tick_child>`): a custom control node.
     pub ticks_children: bool,
+    /// Whether it may answer RUNNING (a `<bt_return_status>` whose status is not SUCCESS
+    /// or FAILURE). One that never does is a synchronous node under BT.CPP's rules (a
+    /// `ConditionNode` or `SyncActionNode`: ticked again, it runs again), one that may
+    /// is a `StatefulActionNode` (`btcpp.rs`, "Leaves").
+    pub may_run: bool,
 }
 
 impl Plugin {
@@ -83,6 +88,19 @@ fn port_type_ok(ty: &str) -> bool {
 
 fn contains_tag(el: &Element, tag: &str) -> bool {
     el.elements().any(|c| c.name == tag || contains_tag(c, tag))
+}
+
+/// Whether a `<bt_return_status>` under `el` may answer RUNNING (its status is not
+/// SUCCESS or FAILURE).
+fn may_answer_running(el: &Element) -> bool {
+    el.elements().any(|c| {
+        (c.name == "bt_return_status"
+            && !matches!(
+                c.attr_value("status").map(str::trim),
+                Some("SUCCESS" | "FAILURE")
+            ))
+            || may_answer_running(c)
+    })
 }
 
 /// Reads the plugin file `file`.
@@ -157,6 +175,7 @@ pub(crate) fn read(sm: &SourceMap, file: FileId) -> Result<Plugin, Vec<Diagnosti
         name,
         has_halt: contains_tag(&root, "bt_halt"),
         ticks_children: contains_tag(&root, "bt_tick_child"),
+        may_run: may_answer_running(&root),
         root,
         ports,
     })
