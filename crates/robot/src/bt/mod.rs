@@ -416,20 +416,22 @@ pub fn lower(sm: &SourceMap, input: &BtInput) -> Result<Vec<Element>, Vec<Diagno
 /// to differ (`notes.rs`): one note per construction, at the node. Empty when the tree
 /// or a plugin cannot be read ([`lower`] reports that).
 pub(crate) fn semantics_notes(sm: &SourceMap, input: &BtInput) -> Vec<Diagnostic> {
-    let mut plugins = Vec::new();
-    for &f in &input.plugins {
-        match plugin::read(sm, f) {
-            Ok(p) => plugins.push(p),
-            Err(_) => return Vec::new(),
-        }
-    }
-    let Ok(root) = xml::parse(sm, input.tree) else {
+    let Some((root, plugins)) = parsed(sm, input) else {
         return Vec::new();
     };
     match tree::read(sm, &root, &plugins) {
         Ok(t) => notes::notes(sm, &t, &plugins),
         Err(_) => Vec::new(),
     }
+}
+
+/// The tree document and the plugins of `input`, read for the notes and warnings
+/// (`None` when one cannot be read: [`lower`] reports that).
+fn parsed(sm: &SourceMap, input: &BtInput) -> Option<(Element, Vec<plugin::Plugin>)> {
+    let plugins = (input.plugins.iter())
+        .map(|&f| plugin::read(sm, f).ok())
+        .collect::<Option<Vec<_>>>()?;
+    Some((xml::parse(sm, input.tree).ok()?, plugins))
 }
 
 /// Under `--bt btcpp` ([`BtSemantics::Btcpp`]), where the tree is not one BehaviorTree.CPP 4
@@ -442,14 +444,7 @@ pub(crate) fn btcpp_warnings(sm: &SourceMap, input: &BtInput) -> Vec<Diagnostic>
     if input.semantics == BtSemantics::As2fm {
         return Vec::new();
     }
-    let mut plugins = Vec::new();
-    for &f in &input.plugins {
-        match plugin::read(sm, f) {
-            Ok(p) => plugins.push(p),
-            Err(_) => return Vec::new(),
-        }
-    }
-    let Ok(root) = xml::parse(sm, input.tree) else {
+    let Some((root, plugins)) = parsed(sm, input) else {
         return Vec::new();
     };
     let mut out: Vec<Diagnostic> = Vec::new();
