@@ -6,7 +6,7 @@
 #   first line out: {"version": "<BT.CPP version>", "binding": "<behaviortreepy version>"}
 #   in:  {"xml": str, "scripts": {type: ["SUCCESS"|"FAILURE"|"RUNNING", ...]},
 #         "ticks": int, "mode": "once"|"exactly_once", "budget": int, "read": [entry],
-#         "period_ms": int (optional)}
+#         "period_ms": int (optional), "out_values": [float], "in_text": str}
 #   out: {"statuses": [str], "log": [["T"|"H", uid, type], ...], "end": null |
 #         {"kind": "load"|"tick"|"livelock", "tick": int, "text": str},
 #         "vars": {entry: int | null}}
@@ -27,13 +27,14 @@
 # (BT.CPP numbers nodes from 1 in the order it creates them: depth-first pre-order with
 # each SubTree node before its body); the test maps it to the oracle's node id.
 # A leaf type `T<digit>...` stands for a leaf with a `string` input port `in` that answers
-# SUCCESS while the text it reads is 'a' (tests/src/bt/model.rs, `has_in_text`): the
+# SUCCESS while the text it reads is `in_text` (tests/src/bt/model.rs, `has_in_text`): the
 # binding registers no ports, so its `in="{e}"` is taken out of the XML and the callback
 # reads entry `e` from the node's blackboard, the entry getInput<std::string> reads (what
 # the port adds, the entry created empty when the tree loads, is not reproduced: the
 # generated trees create `t` first).
 # Likewise a leaf type `O<digit>...` stands for a leaf with a `float64` output port `out`
-# writing OUT_VALUES[k % 4] on its k-th callback (`has_out`): its `out="{e}"` is taken out
+# writing out_values[k % len] on its k-th callback (`has_out`; both values come with the
+# request, from `model::OUT_VALUES` and `model::IN_TEXT`): its `out="{e}"` is taken out
 # and the callback stores the double in entry `e` of its blackboard, as setOutput<double>
 # does (the port's empty entry at load is not reproduced: reading it before the first
 # write throws either way, "not initialized" or "not found").
@@ -80,14 +81,13 @@ class Case:
         # port (`O<digit>...` leaves).
         self.inputs = {}
         self.outputs = {}
+        self.out_values = []
+        self.in_text = None
 
 
-# A `T<digit>...` leaf's input port, and the text it answers SUCCESS on.
+# A `T<digit>...` leaf's input port, and an `O<digit>...` leaf's output port.
 IN_PORT = re.compile(r'(<(T[0-9]+)\b[^>]*?) in="\{([A-Za-z_][A-Za-z_0-9]*)\}"')
-IN_TEXT = "a"
-# An `O<digit>...` leaf's output port, and the doubles it writes (`model::OUT_VALUES`).
 OUT_PORT = re.compile(r'(<(O[0-9]+)\b[^>]*?) out="\{([A-Za-z_][A-Za-z_0-9]*)\}"')
-OUT_VALUES = [1.5, 0.5, -2.0, 3.25]
 
 cur = None
 # One factory per set of leaf kinds: a type name is registered once per factory, and the
@@ -130,14 +130,14 @@ def register(factory, name, stateful):
         s = c.scripts[name]
         out = c.outputs.get(name)
         if out is not None:
-            node.config().blackboard.set_double(out, OUT_VALUES[k % len(OUT_VALUES)])
+            node.config().blackboard.set_double(out, c.out_values[k % len(c.out_values)])
         entry = c.inputs.get(name)
         if entry is not None:
             try:
                 text = node.config().blackboard.get_string(entry)
             except Exception:  # no such entry, or not a string
                 text = None
-            if text == IN_TEXT:
+            if text == c.in_text:
                 return bt.NodeStatus.SUCCESS
         return STATUS[s[k % len(s)]]
 
@@ -162,6 +162,8 @@ def run(req):
     try:
         factory = factory_for(req["scripts"])
         xml = req["xml"]
+        c.out_values = req.get("out_values", [])
+        c.in_text = req.get("in_text")
         for m in IN_PORT.finditer(xml):
             c.inputs[m.group(2)] = m.group(3)
         for m in OUT_PORT.finditer(xml):

@@ -186,6 +186,13 @@ impl Real {
         if let Some(p) = pace {
             v["period_ms"] = p.into();
         }
+        // What the leaves with ports write and read (`model::has_out`, `has_in_text`):
+        // the harness takes them from here, so the two cannot drift apart.
+        let out: Vec<f64> = (super::model::OUT_VALUES.iter())
+            .map(|x| x.parse().expect("OUT_VALUES are numbers"))
+            .collect();
+        v["out_values"] = out.into();
+        v["in_text"] = super::model::IN_TEXT.into();
         format!("{v}\n")
     }
 
