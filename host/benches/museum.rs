@@ -18,7 +18,7 @@
 //! BT nodes never halted their children: 30 % fewer steps per run than the current
 //! translation, so it is not the same model step for step. The `halts when needed` line
 //! is the guide lowered with `Halts::WhenNeeded` (not the default: it changes how races
-//! at one instant come out, see `hindsight::robot::bt::Halts`).
+//! at one instant come out, see `hindsight::verify::robot::bt::Halts`).
 //!
 //! Each configuration runs N seeded runs (stream k of seed 1, as `hindsight verify --seed
 //! 1` does) judged by its properties, exactly as a study runs them; passes of all
@@ -33,11 +33,11 @@ use std::time::Instant;
 #[path = "../tests/common/corpus.rs"]
 mod corpus;
 
-use hindsight::robot::bt::Halts;
-use hindsight::sim::{EventSemantics, RunConfig, Simulator};
-use hindsight::smc::runner::stream;
 use hindsight::verify::load::{load, LoadOptions, Loaded};
 use hindsight::verify::observe::PropertySet;
+use hindsight::verify::robot::bt::Halts;
+use hindsight::verify::sim::{EventSemantics, RunConfig, Simulator};
+use hindsight::verify::smc::runner::stream;
 use hindsight::verify::study::Runner;
 
 fn examples() -> PathBuf {
@@ -121,10 +121,10 @@ impl Case {
             None,
         );
         let plain_dir = root.join("plain/uc3_museum_guide_main");
-        let model = hindsight::sim::CompiledModel::load(&plain_dir)
+        let model = hindsight::verify::sim::CompiledModel::load(&plain_dir)
             .unwrap_or_else(|e| panic!("uc3 plain: {e}"));
         let props_path = root.join("test_data/uc3_museum_guide/Properties/properties.jani");
-        let file = hindsight::props::jani::parse_file(&props_path, &model)
+        let file = hindsight::verify::props::jani::parse_file(&props_path, &model)
             .unwrap_or_else(|e| panic!("uc3 properties: {e}"));
         let set = PropertySet::new(&file, &model).unwrap_or_else(|e| panic!("uc3: {e}"));
         let loaded = Loaded {
@@ -144,10 +144,10 @@ impl Case {
     /// The guide lowered with `halts`, AS2FM's event semantics.
     fn guide_with(name: &'static str, halts: Halts) -> Case {
         let dir = examples().join("museum-guide");
-        let robot = hindsight::robot::load::load_with(&dir.join("main.xml"), halts)
+        let robot = hindsight::verify::robot::load::load_with(&dir.join("main.xml"), halts)
             .unwrap_or_else(|e| panic!("museum-guide: {e}"));
         let props_path = dir.join("properties.xml");
-        let file = hindsight::props::parse_file(&props_path)
+        let file = hindsight::verify::props::parse_file(&props_path)
             .unwrap_or_else(|e| panic!("museum-guide properties: {e}"));
         let set = PropertySet::with_unit(&file, &robot.model, Some(robot.time_unit_ns))
             .unwrap_or_else(|e| panic!("museum-guide properties: {e}"));

@@ -14,11 +14,11 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use hindsight::props;
-use hindsight::sim::{CompiledModel, EndReason, EventSemantics, RunConfig, Simulator};
-use hindsight::smc::runner::stream;
-use hindsight::smc::{RunEnd, Verdict};
 use hindsight::verify::observe::{Judge, PropertySet};
+use hindsight::verify::props;
+use hindsight::verify::sim::{CompiledModel, EndReason, EventSemantics, RunConfig, Simulator};
+use hindsight::verify::smc::runner::stream;
+use hindsight::verify::smc::{RunEnd, Verdict};
 
 /// Runs per case. Every expected value has tolerance 0 (all runs agree): a property whose
 /// true probability were 0.99 (0.01) instead of 1 (0) would still pass 500 runs only with
@@ -243,7 +243,7 @@ fn high_level_models_match_as2fm_expected_probabilities() {
     }
     let skips: Vec<(&str, &'static str)> = SKIPS.iter().chain(HIGH_LEVEL_SKIPS).copied().collect();
     check_corpus(&skips, |_, main| {
-        hindsight::robot::load::load(main)
+        hindsight::verify::robot::load::load(main)
             .map(|r| r.model)
             .map_err(|d| d.to_string())
     });
@@ -257,9 +257,12 @@ fn high_level_models_with_halts_when_needed_match_as2fm_expected_probabilities()
     }
     let skips: Vec<(&str, &'static str)> = SKIPS.iter().chain(HIGH_LEVEL_SKIPS).copied().collect();
     check_corpus(&skips, |_, main| {
-        hindsight::robot::load::load_with(main, hindsight::robot::bt::Halts::WhenNeeded)
-            .map(|r| r.model)
-            .map_err(|d| d.to_string())
+        hindsight::verify::robot::load::load_with(
+            main,
+            hindsight::verify::robot::bt::Halts::WhenNeeded,
+        )
+        .map(|r| r.model)
+        .map_err(|d| d.to_string())
     });
 }
 
@@ -378,7 +381,7 @@ fn receptive_states_match_as2fm_jani_translation_of_the_museum_guide() {
     if common::corpus_or_skip().is_none() {
         return;
     }
-    use hindsight::sim::{as2fm, StateId};
+    use hindsight::verify::sim::{as2fm, StateId};
     let root = corpus();
     let model = CompiledModel::load(&root.join("plain/uc3_museum_guide_main")).unwrap();
     let jani: serde_json::Value = serde_json::from_str(
@@ -399,7 +402,7 @@ fn receptive_states_match_as2fm_jani_translation_of_the_museum_guide() {
             let s = StateId(s as u32);
             let state = model.state_name(m, s);
             for e in 0..model.event_count() {
-                let e = hindsight::sim::EventId(e as u32);
+                let e = hindsight::verify::sim::EventId(e as u32);
                 let event = model.event_name(e);
                 if !model.event_receivers(e).any(|r| r == m) {
                     continue;

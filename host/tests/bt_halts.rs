@@ -10,9 +10,9 @@ mod common;
 use std::convert::Infallible;
 use std::path::{Path, PathBuf};
 
-use hindsight::robot::bt::Halts;
-use hindsight::robot::load::{load_with, RobotModel};
-use hindsight::sim::{EventSemantics, Flow, Observer, RunConfig, SentMessage, Simulator};
+use hindsight::verify::robot::bt::Halts;
+use hindsight::verify::robot::load::{load_with, RobotModel};
+use hindsight::verify::sim::{EventSemantics, Flow, Observer, RunConfig, SentMessage, Simulator};
 
 /// A "random" stream that always gives the same word: the simulator then always picks
 /// the same position among the machines that can move, and every random value is the

@@ -8,8 +8,8 @@
 mod common;
 
 use common::bt::{lower_act as lower, BTCPP};
-use hindsight::robot::bt::BtSemantics;
 use hindsight::verify::model::xml::Element;
+use hindsight::verify::robot::bt::BtSemantics;
 
 /// The `<data>` ids of machine `name`.
 fn data(ms: &[Element], name: &str) -> Vec<String> {

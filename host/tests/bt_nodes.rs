@@ -3,10 +3,10 @@
 //! numbers, and bad trees refused with file:line:col (through the library and the
 //! `hindsight` command, exit code 2).
 
-use hindsight::robot::bt::{self, BtInput, Halts};
-use hindsight::robot::write;
 use hindsight::verify::model::source::SourceMap;
 use hindsight::verify::model::Diagnostics;
+use hindsight::verify::robot::bt::{self, BtInput, Halts};
+use hindsight::verify::robot::write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

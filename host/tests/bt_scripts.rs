@@ -8,7 +8,7 @@
 mod common;
 
 use common::bt::{lower_act, lower_doc, BTCPP};
-use hindsight::robot::bt::{BtSemantics, BtTick};
+use hindsight::verify::robot::bt::{BtSemantics, BtTick};
 
 /// The errors lowering `body` gives under `semantics`.
 fn errors(body: &str, semantics: BtSemantics) -> String {

@@ -9,7 +9,7 @@
 mod common;
 
 use common::bt::{lower_act as lower, BTCPP};
-use hindsight::robot::bt::BtSemantics;
+use hindsight::verify::robot::bt::BtSemantics;
 
 #[test]
 fn unset_lowers_under_btcpp_over_a_script_entry() {

@@ -59,11 +59,11 @@ fn plain_machines(case: &str) -> BTreeMap<String, String> {
 
 /// What `hindsight convert` writes for `main`, read back, by machine name.
 fn converted(main: &std::path::Path) -> Result<BTreeMap<String, String>, String> {
-    let robot = hindsight::robot::load::load(main).map_err(|d| d.to_string())?;
+    let robot = hindsight::verify::robot::load::load(main).map_err(|d| d.to_string())?;
     let mut out = BTreeMap::new();
     for m in &robot.machines {
         let name = m.attr_value("name").unwrap().to_string();
-        let text = hindsight::robot::write::to_xml(m);
+        let text = hindsight::verify::robot::write::to_xml(m);
         out.insert(name.clone(), canon(&parse_text(&name, &text)));
     }
     Ok(out)
@@ -167,7 +167,7 @@ fn the_trees_tick_comes_after_the_node_models_timers() {
         return;
     }
     let main = common::corpus("as2fm/examples/quick_start_battery_monitor/main.xml");
-    let robot = hindsight::robot::load::load(&main).unwrap();
+    let robot = hindsight::verify::robot::load::load(&main).unwrap();
     let timer = robot
         .machines
         .iter()

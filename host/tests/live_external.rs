@@ -401,7 +401,7 @@ fn a_process_calls_a_service_the_model_serves() {
 
 /// The layout `hindsight run` uses for one model event, from the library.
 fn layout_of_event(
-    model: &hindsight::sim::CompiledModel,
+    model: &hindsight::verify::sim::CompiledModel,
     event: &str,
 ) -> hindsight::live::publish::TopicLayout {
     let (all, _) = hindsight::live::publish::layouts(model);
@@ -421,9 +421,9 @@ fn offset(l: &hindsight::live::publish::TopicLayout, field: &str) -> usize {
 /// Plays NavigationComponent for 30 s of the museum at speed 10: accepts every goal, sends
 /// three feedbacks and (with `results`) a success; returns the goals and the run's stderr.
 fn navigation_session(results: bool) -> (Vec<(i64, i64)>, String) {
-    let main = hindsight::robot::load::main_file_of(&museum()).unwrap();
+    let main = hindsight::verify::robot::load::main_file_of(&museum()).unwrap();
     let (robot, ext) =
-        hindsight::robot::load::load_without(&main, &["NavigationComponent".to_string()])
+        hindsight::verify::robot::load::load_without(&main, &["NavigationComponent".to_string()])
             .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(ext[0].serves_actions.len(), 1);
     let goal = layout_of_event(

@@ -5,7 +5,7 @@ mod common;
 
 use std::path::PathBuf;
 
-use hindsight::props::{parse_file, Location, PortKind, PropertyFile};
+use hindsight::verify::props::{parse_file, Location, PortKind, PropertyFile};
 
 fn corpus_root() -> PathBuf {
     common::corpus_root()

@@ -5,7 +5,9 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use hindsight::props::{location, parse_file, parse_str, Location, PropsError, PropsErrorKind};
+use hindsight::verify::props::{
+    location, parse_file, parse_str, Location, PropsError, PropsErrorKind,
+};
 
 fn errors(text: &str) -> Vec<PropsError> {
     match parse_str(text, Path::new("props.xml")) {

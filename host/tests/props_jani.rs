@@ -5,10 +5,10 @@ mod common;
 
 use std::path::Path;
 
-use hindsight::props::{self, PortKind, ANY};
-use hindsight::sim::CompiledModel;
 use hindsight::verify::model::ModelSource;
 use hindsight::verify::observe::PropertySet;
+use hindsight::verify::props::{self, PortKind, ANY};
+use hindsight::verify::sim::CompiledModel;
 
 fn model() -> CompiledModel {
     let s = r#"<scxml name="s" initial="a" version="1.0" xmlns="http://www.w3.org/2005/07/scxml">

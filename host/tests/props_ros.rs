@@ -4,10 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
-use hindsight::props::{parse_file, PortKind, ANY};
-use hindsight::sim::{CompiledModel, RunConfig};
-use hindsight::smc::runner::stream;
 use hindsight::verify::observe::PropertySet;
+use hindsight::verify::props::{parse_file, PortKind, ANY};
+use hindsight::verify::sim::{CompiledModel, RunConfig};
+use hindsight::verify::smc::runner::stream;
 use hindsight::verify::study::Runner;
 
 fn repo(relative: &str) -> PathBuf {

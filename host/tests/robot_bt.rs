@@ -5,12 +5,12 @@
 
 mod common;
 
-use hindsight::robot::bt::{self, BtInput, Halts};
-use hindsight::robot::write;
-use hindsight::sim::{CompiledModel, Flow, Observer, RunConfig, SentMessage, Simulator};
 use hindsight::verify::model::source::{FileId, SourceMap};
 use hindsight::verify::model::xml::{self, Element, Node};
 use hindsight::verify::model::{Diagnostics, ModelSource};
+use hindsight::verify::robot::bt::{self, BtInput, Halts};
+use hindsight::verify::robot::write;
+use hindsight::verify::sim::{CompiledModel, Flow, Observer, RunConfig, SentMessage, Simulator};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::collections::{BTreeMap, BTreeSet};
@@ -622,7 +622,8 @@ fn count_runs(
         assert!(
             !matches!(
                 out.end,
-                hindsight::sim::EndReason::Error(_) | hindsight::sim::EndReason::Spin(_)
+                hindsight::verify::sim::EndReason::Error(_)
+                    | hindsight::verify::sim::EndReason::Spin(_)
             ),
             "{}: {:?}",
             main.display(),
@@ -1306,7 +1307,8 @@ fn run_small_with(body: &str, again: bool, seconds: u64, halts: Halts) -> LastVa
     assert!(
         !matches!(
             out.end,
-            hindsight::sim::EndReason::Error(_) | hindsight::sim::EndReason::Spin(_)
+            hindsight::verify::sim::EndReason::Error(_)
+                | hindsight::verify::sim::EndReason::Spin(_)
         ),
         "{body}: {:?}",
         out.end

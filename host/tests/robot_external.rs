@@ -2,8 +2,8 @@
 
 use std::path::Path;
 
-use hindsight::robot::load::{load_without, main_file_of};
-use hindsight::sim::{
+use hindsight::verify::robot::load::{load_without, main_file_of};
+use hindsight::verify::sim::{
     EventId, EventSemantics, Flow, Inbox, Observer, Quiescence, RunConfig, Scalar, SentMessage,
     Simulator, EXTERNAL,
 };

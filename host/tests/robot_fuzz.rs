@@ -12,8 +12,8 @@ mod common;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
-use hindsight::sim::{EventSemantics, RunConfig, Simulator};
 use hindsight::verify::load::{load, LoadOptions};
+use hindsight::verify::sim::{EventSemantics, RunConfig, Simulator};
 use rand_core::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
@@ -226,7 +226,7 @@ fn fuzz(name: &str, base: &Path, parts: &[&str], main: &str, favourites: &[&str]
         let outcome = catch_unwind(AssertUnwindSafe(|| match load(&args) {
             Ok(loaded) => {
                 let mut sim = Simulator::new(&loaded.model);
-                let mut rng = hindsight::smc::runner::stream(1, k);
+                let mut rng = hindsight::verify::smc::runner::stream(1, k);
                 sim.run(&mut rng, &cfg, &mut ());
                 Ok(())
             }

@@ -4,9 +4,9 @@
 
 mod common;
 
-use hindsight::robot::interfaces::{InterfaceKind, Interfaces};
-use hindsight::robot::types::{FlatField, InterfaceLookup};
 use hindsight::verify::model::source::SourceMap;
+use hindsight::verify::robot::interfaces::{InterfaceKind, Interfaces};
+use hindsight::verify::robot::types::{FlatField, InterfaceLookup};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -402,7 +402,7 @@ fn every_main_file_reads() {
     if common::corpus_or_skip().is_none() {
         return;
     }
-    use hindsight::robot::main_file::{InputKind, MainFile, MainForm};
+    use hindsight::verify::robot::main_file::{InputKind, MainFile, MainForm};
     let mains = main_files();
     let mut inputs = 0;
     for main in &mains {
@@ -488,7 +488,7 @@ fn every_main_file_reads() {
 /// Writes `text` as a main file in a fresh folder and reads it; the errors as text. A
 /// `<parameters>` element with a `max_time` is added on the first line when `text` has none.
 fn main_errors(name: &str, text: &str) -> (PathBuf, Vec<String>) {
-    use hindsight::robot::main_file::MainFile;
+    use hindsight::verify::robot::main_file::MainFile;
     let d = temp_dir(name);
     let p = d.join("main.xml");
     let text = if text.contains("<parameters>") {
@@ -631,9 +631,11 @@ fn data_declarations_read() {
     if common::corpus_or_skip().is_none() {
         return;
     }
-    use hindsight::robot::datatypes::{read_data_declarations, read_main_declarations, DataFormat};
-    use hindsight::robot::main_file::MainFile;
     use hindsight::verify::model::types::{TypeDef, TypeDefs};
+    use hindsight::verify::robot::datatypes::{
+        read_data_declarations, read_main_declarations, DataFormat,
+    };
+    use hindsight::verify::robot::main_file::MainFile;
     let mut read = 0;
     for main in main_files() {
         let mut sm = SourceMap::new();
@@ -689,7 +691,7 @@ fn data_declarations_read() {
 
 #[test]
 fn data_declaration_errors_point_at_the_type() {
-    use hindsight::robot::datatypes::{read_data_declarations, DataFormat};
+    use hindsight::verify::robot::datatypes::{read_data_declarations, DataFormat};
     let d = temp_dir("data");
     let x = d.join("t.xml");
     write(
@@ -795,7 +797,7 @@ fn printed_definitions_read_back() {
     if common::corpus_or_skip().is_none() {
         return;
     }
-    use hindsight::robot::interfaces::{parse_interface, InterfaceDef};
+    use hindsight::verify::robot::interfaces::{parse_interface, InterfaceDef};
     let strip = |d: &InterfaceDef| {
         let mut d = d.clone();
         d.file = None;

@@ -8,9 +8,9 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use hindsight::robot::interfaces::{Interfaces, Search};
-use hindsight::robot::types::InterfaceLookup;
 use hindsight::verify::model::source::SourceMap;
+use hindsight::verify::robot::interfaces::{Interfaces, Search};
+use hindsight::verify::robot::types::InterfaceLookup;
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("hindsight-find-{}-{name}", std::process::id()));
@@ -285,7 +285,7 @@ fn every_builtin_message_lowers_on_a_topic() {
     let ifs = Interfaces::with_builtins();
     let msgs: Vec<String> = ifs
         .iter()
-        .filter(|d| d.kind == hindsight::robot::interfaces::InterfaceKind::Message)
+        .filter(|d| d.kind == hindsight::verify::robot::interfaces::InterfaceKind::Message)
         .map(|d| format!("{}/{}", d.package, d.name))
         .collect();
     assert!(msgs.len() > 130, "{}", msgs.len());
@@ -326,8 +326,8 @@ fn every_builtin_message_lowers_on_a_topic() {
          <input type=\"node-ascxml\" src=\"./pub.ascxml\"/>\n    <input type=\"node-ascxml\" src=\"./sub.ascxml\"/>\n  \
          </node_models>\n</roaml>\n",
     );
-    let robot =
-        hindsight::robot::load::load(&root.join("main.xml")).unwrap_or_else(|e| panic!("{e}"));
+    let robot = hindsight::verify::robot::load::load(&root.join("main.xml"))
+        .unwrap_or_else(|e| panic!("{e}"));
     assert!(robot.machines.len() >= 3);
     let _ = std::fs::remove_dir_all(&root);
 }

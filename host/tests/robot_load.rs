@@ -4,7 +4,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use hindsight::robot::load::{load, main_file_of};
+use hindsight::verify::robot::load::{load, main_file_of};
 
 fn corpus_root() -> PathBuf {
     common::corpus_root()

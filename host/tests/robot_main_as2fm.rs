@@ -5,8 +5,8 @@
 
 use std::path::{Path, PathBuf};
 
-use hindsight::robot::main_file::{InputKind, MainFile};
 use hindsight::verify::model::source::SourceMap;
+use hindsight::verify::robot::main_file::{InputKind, MainFile};
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("hindsight-main-{}-{name}", std::process::id()));

@@ -5,14 +5,14 @@
 mod common;
 
 use common::canon::{canon, parse_file};
-use hindsight::robot::ros::{lower, RosInput, RosOutput};
-use hindsight::robot::types::{
-    ActionFields, FlatField, InterfaceLookup, LookupError, ServiceFields,
-};
-use hindsight::sim::{CompiledModel, Flow, Observer, RunConfig, SentMessage, Simulator};
 use hindsight::verify::model::source::{Diagnostic, SourceMap};
 use hindsight::verify::model::xml::{self, Element};
 use hindsight::verify::model::{Diagnostics, ModelSource};
+use hindsight::verify::robot::ros::{lower, RosInput, RosOutput};
+use hindsight::verify::robot::types::{
+    ActionFields, FlatField, InterfaceLookup, LookupError, ServiceFields,
+};
+use hindsight::verify::sim::{CompiledModel, Flow, Observer, RunConfig, SentMessage, Simulator};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::collections::BTreeMap;
@@ -534,7 +534,7 @@ fn probability(
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
         let outcome = sim.run(&mut rng, &cfg, &mut obs);
         assert!(
-            !matches!(outcome.end, hindsight::sim::EndReason::Error(_)),
+            !matches!(outcome.end, hindsight::verify::sim::EndReason::Error(_)),
             "{main}: {:?}",
             outcome.end
         );
@@ -1117,7 +1117,10 @@ fn written_plain_scxml_runs_like_the_trees() {
             .iter()
             .map(|m| {
                 let n = m.attr_value("name").unwrap();
-                (format!("{n}.scxml"), hindsight::robot::write::to_xml(m))
+                (
+                    format!("{n}.scxml"),
+                    hindsight::verify::robot::write::to_xml(m),
+                )
             })
             .collect();
         let src = ModelSource::from_texts(texts.iter().map(|(a, b)| (a.as_str(), b.as_str())))

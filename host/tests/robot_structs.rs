@@ -5,11 +5,11 @@
 
 mod common;
 
-use hindsight::robot::load::{load, RobotModel};
-use hindsight::sim::{
+use hindsight::verify::expr::{OwnedValue, Strings, Ty, TypeTable};
+use hindsight::verify::robot::load::{load, RobotModel};
+use hindsight::verify::sim::{
     CompiledModel, EndReason, EventSemantics, Flow, Observer, RunConfig, SentMessage, Simulator,
 };
-use hindsight::verify::expr::{OwnedValue, Strings, Ty, TypeTable};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::collections::BTreeMap;
@@ -522,7 +522,7 @@ fn converted_struct_models_read_back_and_run_the_same() {
     if common::corpus_or_skip().is_none() {
         return;
     }
-    use hindsight::robot::write::{to_xml, types_xml};
+    use hindsight::verify::robot::write::{to_xml, types_xml};
     for name in ["data_structs_main_json_def", "array_of_data_structs_main"] {
         let m = load_case(name);
         let dir = std::env::temp_dir().join(format!(
@@ -552,9 +552,9 @@ fn property_ports_read_struct_fields() {
     if common::corpus_or_skip().is_none() {
         return;
     }
-    use hindsight::props::parse_str;
-    use hindsight::smc::runner::stream;
     use hindsight::verify::observe::PropertySet;
+    use hindsight::verify::props::parse_str;
+    use hindsight::verify::smc::runner::stream;
     use hindsight::verify::study::Runner;
     let m = load_case("data_structs_main_xml_def");
     let props = |px: &str| {

@@ -12,11 +12,11 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-use hindsight::sim::{Memory, RunConfig, Scheduler};
-use hindsight::smc::stats::{RuleConfig, RuleKind};
-use hindsight::smc::StudyConfig;
 use hindsight::verify::load::{load, LoadOptions, Loaded};
 use hindsight::verify::schedulers::{bounds, SchedulerBounds, SchedulerOptions};
+use hindsight::verify::sim::{Memory, RunConfig, Scheduler};
+use hindsight::verify::smc::stats::{RuleConfig, RuleKind};
+use hindsight::verify::smc::StudyConfig;
 use hindsight::verify::study::{study, Runner, Unfair};
 
 /// A model's choices as a tree: the explorer's input.
@@ -246,9 +246,13 @@ fn two_machines_racing_for_a_variable_give_half_zero_and_one() {
         };
         let runner = Runner::new(&l.model, &l.set, &cfg);
         for k in 0..20 {
-            let mut rng = hindsight::smc::stream(7, k);
+            let mut rng = hindsight::verify::smc::stream(7, k);
             let out = runner.run(k, &mut rng);
-            assert_eq!(out.verdicts[0], hindsight::smc::Verdict::False, "run {k}");
+            assert_eq!(
+                out.verdicts[0],
+                hindsight::verify::smc::Verdict::False,
+                "run {k}"
+            );
         }
     }
 }

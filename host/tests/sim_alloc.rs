@@ -5,7 +5,7 @@
 
 mod common;
 
-use hindsight::sim::{CompiledModel, EndReason, EventSemantics, RunConfig, Simulator};
+use hindsight::verify::sim::{CompiledModel, EndReason, EventSemantics, RunConfig, Simulator};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::path::{Path, PathBuf};

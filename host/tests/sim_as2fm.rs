@@ -1,10 +1,10 @@
 //! `EventSemantics::As2fm` on small models: targets ignored, all receivers at once,
 //! senders blocked while their event is pending, discards, and deadlocks.
 
-use hindsight::sim::{
+use hindsight::verify::model::ModelSource;
+use hindsight::verify::sim::{
     CompiledModel, EndReason, EventSemantics, Flow, Observer, RunConfig, SentMessage, Simulator,
 };
-use hindsight::verify::model::ModelSource;
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 

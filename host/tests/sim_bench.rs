@@ -4,7 +4,7 @@
 
 mod common;
 
-use hindsight::sim::{CompiledModel, EndReason, RunConfig, Simulator};
+use hindsight::verify::sim::{CompiledModel, EndReason, RunConfig, Simulator};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::path::PathBuf;

@@ -3,7 +3,7 @@
 
 mod common;
 
-use hindsight::sim::{CompiledModel, EndReason, RunConfig, Simulator, TraceRecorder};
+use hindsight::verify::sim::{CompiledModel, EndReason, RunConfig, Simulator, TraceRecorder};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::path::{Path, PathBuf};
@@ -56,7 +56,7 @@ fn as2fm_plain_models_compile_and_run() {
                 EndReason::Spin(s) => {
                     assert_eq!(
                         s.kind,
-                        hindsight::sim::SpinKind::NoTimeProgress,
+                        hindsight::verify::sim::SpinKind::NoTimeProgress,
                         "{name}: {s}"
                     );
                     spinning.insert(name);

@@ -1,7 +1,7 @@
 //! Bad models are errors with file, line and column, never panics (including mutated inputs).
 
-use hindsight::sim::{CompiledModel, RunConfig, Simulator};
 use hindsight::verify::model::{Diagnostics, ModelSource};
+use hindsight::verify::sim::{CompiledModel, RunConfig, Simulator};
 use rand_core::{Rng, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 

@@ -1,10 +1,10 @@
 //! The simulator's semantics on small models with known behaviour (host/tests/data/sim).
 
-use hindsight::sim::{
+use hindsight::verify::expr::{OwnedValue, Value};
+use hindsight::verify::sim::{
     CompiledModel, EndReason, Flow, MachineId, Observer, Quiescence, RunConfig, RunOutcome,
     SentMessage, Simulator, SpinKind, TraceRecorder, TransitionChoice,
 };
-use hindsight::verify::expr::{OwnedValue, Value};
 use rand_core::SeedableRng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::path::Path;
@@ -475,7 +475,7 @@ fn quiescence_can_keep_time_running_like_scan() {
 fn trace_rows_name_event_origin_target_and_params() {
     let m = model("ping_pong");
     let (_, rec) = run(&m, 1, &RunConfig::default());
-    let row = |r: &hindsight::sim::TraceRow| {
+    let row = |r: &hindsight::verify::sim::TraceRow| {
         let target = r.target.map_or("NONE", |t| m.machine_name(t));
         let params: Vec<String> = r.params.iter().map(|v| format!("{v:?}")).collect();
         (

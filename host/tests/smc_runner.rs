@@ -6,7 +6,7 @@ use std::panic::{self, AssertUnwindSafe};
 use std::sync::Mutex;
 use std::time::Duration;
 
-use hindsight::smc::{
+use hindsight::verify::smc::{
     run_range, run_study, stream, Decision, Progress, RuleConfig, RuleKind, RunEnd, RunOutcome,
     StoppingRule, StudyConfig, StudyResult, Verdict,
 };

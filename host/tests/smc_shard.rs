@@ -1,6 +1,6 @@
 //! Tests of sharded fixed-size studies: shard ranges, partial result files, and merging.
 
-use hindsight::smc::{
+use hindsight::verify::smc::{
     merge, run_fixed_study, run_shard, FixedStudy, PartialResult, Progress, PropertySpec,
     RuleConfig, RuleKind, RunEnd, RunOutcome, Shard, ShardError, StudyConfig, Verdict,
 };
@@ -138,7 +138,7 @@ fn sharded_study_equals_the_single_machine_study() {
     assert!(often.interval.contains(0.9), "{:?}", often.interval);
     assert_eq!(
         often.estimate.decision,
-        Some(hindsight::smc::Decision::Accept)
+        Some(hindsight::verify::smc::Decision::Accept)
     );
     assert_eq!(rare.failing_runs.len(), 4);
     assert!(rare.failing_runs.windows(2).all(|w| w[0] < w[1]));
@@ -187,7 +187,7 @@ fn merge_rejects_incomplete_or_foreign_shards() {
     ];
     assert_eq!(merge(&twice, 0), merge(&parts, 0));
     assert_eq!(
-        hindsight::smc::shard::duplicates(&twice),
+        hindsight::verify::smc::shard::duplicates(&twice),
         vec![(Shard { index: 1, count: 3 }, vec![1, 2])]
     );
     // Two different copies of one shard are an error.

@@ -4,10 +4,10 @@
 // Reference values are quoted with all the digits arbitrary-precision arithmetic gave.
 #![allow(clippy::excessive_precision)]
 
-use hindsight::smc::math::{
+use hindsight::verify::smc::math::{
     erfc, inv_reg_inc_beta, ln_gamma, normal_cdf, normal_quantile, reg_inc_beta,
 };
-use hindsight::smc::stats::{
+use hindsight::verify::smc::stats::{
     adaptive_bound, clopper_pearson_interval, okamoto, wilson_interval, Accuracy, AdaptiveBound,
     ClopperPearson, Decision, OkamotoBound, RuleConfig, RuleKind, Sprt, StatsError, StoppingRule,
     WilsonInterval,

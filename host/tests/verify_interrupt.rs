@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::sleep;
 use std::time::{Duration, Instant};
 
-use hindsight::smc::{
+use hindsight::verify::smc::{
     run_study, run_study_until, RuleConfig, RuleKind, RunEnd, RunOutcome, StoppingRule,
     StudyConfig, Verdict,
 };

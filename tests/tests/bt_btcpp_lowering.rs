@@ -19,8 +19,8 @@
 mod bt_common;
 
 use bt_common::{diff, lower_and_run, lower_and_run_clocked, show, Drive, Run};
-use hindsight::robot::bt::{BtSemantics, BtTick, Halts};
-use hindsight::sim::EndReason;
+use hindsight::verify::robot::bt::{BtSemantics, BtTick, Halts};
+use hindsight::verify::sim::EndReason;
 use hindsight_tests::bt::gen;
 use hindsight_tests::bt::oracle::{self, End, LeafEvent, Options, Scripts, TickMode};
 use hindsight_tests::bt::real;

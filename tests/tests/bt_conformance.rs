@@ -8,7 +8,7 @@
 mod bt_common;
 
 use bt_common::{diff, lowered, reference, running_halts_only, Run};
-use hindsight::robot::bt::Halts;
+use hindsight::verify::robot::bt::Halts;
 use hindsight_tests::bt::oracle::{run_with, LeafEvent, Options, Reading, Scripts, TickMode};
 use hindsight_tests::bt::tree::{self, Kind, Status};
 use serde::Deserialize;

@@ -11,7 +11,7 @@
 mod bt_common;
 
 use bt_common::{diff, lowered, reference, show};
-use hindsight::robot::bt::Halts;
+use hindsight::verify::robot::bt::Halts;
 use hindsight_tests::bt::oracle::LeafEvent;
 use hindsight_tests::bt::oracle::Reading;
 use hindsight_tests::bt::tree::{self, Kind};

@@ -15,7 +15,7 @@
 mod bt_common;
 
 use bt_common::lower_and_run_clocked;
-use hindsight::robot::bt::{BtSemantics, BtTick};
+use hindsight::verify::robot::bt::{BtSemantics, BtTick};
 use hindsight_tests::bt::oracle::{self, LeafEvent, Options, Scripts, TickMode};
 use hindsight_tests::bt::tree::{self, Status};
 

@@ -177,6 +177,20 @@ impl Drop for Slot {
 /// a failing `accept` fails again at once, and retrying in a loop would take a core.
 const ACCEPT_PAUSE: Duration = Duration::from_millis(50);
 
+/// Where a sidecar writes a stream of lines (verdicts, the input log).
+pub type Output = Box<dyn Write + Send>;
+
+/// A sidecar's outputs with `server`'s page beside them: the verdict lines go to
+/// `verdicts` and to the page; the page's points are the input records, written to
+/// `record` first when there is one (`--record`), else for the page alone.
+pub fn attach(server: &Server, verdicts: Output, record: Option<Output>) -> (Output, Output) {
+    let log = record.unwrap_or_else(|| Box::new(std::io::sink()));
+    (
+        Box::new(Tee::new(verdicts, server.hub.clone(), Stream::Verdict)),
+        Box::new(Tee::new(log, server.hub.clone(), Stream::Input)),
+    )
+}
+
 /// Binds `addr` and serves `page` at `/`, the event stream at `/events` and every line
 /// held at `/verdicts.jsonl`, each connection on its own thread, within `limits`.
 /// `public`: `addr` may be beyond loopback (`--serve-public`); without it such an address

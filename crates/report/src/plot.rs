@@ -2,7 +2,9 @@
 
 use std::fmt::Write;
 
+use hindsight_verify::codegen::duration::StepsOrDuration;
 use hindsight_verify::model::xml::escape as esc;
+use hindsight_verify::sweep::{axis, bound_text, threshold_index, SweepCurve};
 
 /// One measured point of a curve.
 #[derive(Clone, Debug)]
@@ -28,6 +30,34 @@ pub struct Curve {
     pub threshold: Option<f64>,
     /// The threshold as the legend writes it (`6.2s`); the bare number when `None`.
     pub threshold_text: Option<String>,
+}
+
+/// The curves of a sweep (`hindsight sweep`'s, each bound of `values` a point; a point
+/// with no estimate is left out), each with its threshold.
+pub fn sweep_curves(values: &[StepsOrDuration], curves: &[SweepCurve]) -> Vec<Curve> {
+    curves
+        .iter()
+        .map(|c| {
+            let points = values
+                .iter()
+                .zip(&c.points)
+                .map(|(v, p)| Point {
+                    x: axis(*v),
+                    rate: p.probability.unwrap_or(f64::NAN),
+                    lower: p.lower,
+                    upper: p.upper,
+                })
+                .filter(|p| p.rate.is_finite())
+                .collect();
+            let found = threshold_index(&c.points);
+            Curve {
+                name: c.property.clone(),
+                points,
+                threshold: found.map(|i| axis(values[i])),
+                threshold_text: found.map(|i| bound_text(values[i])),
+            }
+        })
+        .collect()
 }
 
 const W: f64 = 820.0;

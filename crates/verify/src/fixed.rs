@@ -1,6 +1,6 @@
 //! Fixed-size studies (`verify --runs R [--shard I/N]`): what identifies one, so that
 //! `merge` refuses to mix the shards of different studies. The shards themselves run
-//! through [`crate::study::study_shard`], the same runner as every other study.
+//! through `crate::study::study_shard`, the same runner as every other study.
 //!
 //! ```
 //! use hindsight_verify::fixed::fingerprint;
@@ -34,7 +34,7 @@ pub fn fingerprint(parts: &[&[u8]]) -> String {
 /// What identifies the fixed-size study of `runs` runs of `loaded` (read from
 /// `model_path`) with `seed`, `run_cfg` and `rule`: what `merge` compares across shards.
 /// The property file is fingerprinted by its bytes (an unreadable one as empty).
-pub fn fixed_study(
+pub(crate) fn fixed_study(
     loaded: &Loaded,
     model_path: &Path,
     seed: u64,

@@ -1,6 +1,8 @@
 //! Statistical model checking glue: properties observed on simulated runs, judged by monitors.
 //!
-//! The off-line pipeline as a library: [`load`] reads a model (plain SCXML or a robot
+//! The off-line pipeline as a library: [`pipeline`] runs a whole `verify` in its order
+//! (the study, its failing runs, the bounds over schedulers, `merge`), from parts that
+//! are modules of their own: [`load`] reads a model (plain SCXML or a robot
 //! model) and its property file, [`observe`] judges a simulated run with the compiled
 //! monitors, [`options`] holds a study's settings (set once, turned into the
 //! simulator's and the runner's configurations), [`study`] runs studies under stopping
@@ -22,9 +24,11 @@
 //! `hindsight-verify` depends on `monitor-core`, `codegen` and the crates below it in the
 //! pipeline, re-exported here under the paths its modules name them by: [`expr`],
 //! [`model`], [`sim`], [`props`], [`robot`] and [`smc`]; on no other crate of the project.
-//! `hindsight`'s command line drives it, and names the few items of the crates below it
-//! needs (an option's type, a diagnostic) through these re-exports (and [`codegen`]),
-//! never as dependencies of its own.
+//! The types a study's settings are made of come from those crates and are re-exported
+//! where this crate's API takes them ([`options`], [`load`], [`study`], [`replay`],
+//! [`spec`]), so that `hindsight`'s command line names this crate's items (and
+//! [`codegen`]'s, the language of every diagnostic) and no crate below it; the whole
+//! crates are re-exported for the tests.
 //!
 //! One run of the museum example, judged by its five requirements:
 //!
@@ -52,6 +56,7 @@ pub mod fixed;
 pub mod load;
 pub mod observe;
 pub mod options;
+pub mod pipeline;
 pub mod record;
 pub mod replay;
 pub mod result;

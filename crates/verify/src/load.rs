@@ -18,7 +18,8 @@ use codegen::duration::DurationError;
 
 use super::observe::PropertySet;
 use crate::props;
-use crate::robot::load::ExternalComponent;
+// A robot model's components and main file, as callers name them.
+pub use crate::robot::load::{main_file_of, ExternalComponent};
 use crate::sim::{CompiledModel, EventSemantics};
 
 /// What to load: the model, its property file and how to read them.

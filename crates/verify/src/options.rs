@@ -18,10 +18,16 @@
 
 use std::time::Duration;
 
+// The types these settings are made of, from the crates below, named here so that a
+// caller (the command line) sets a study with this crate's API alone.
+pub use crate::robot::bt::{BtSemantics, BtTick};
+pub use crate::sim::{BadScheduler, EventSemantics, Memory, Scheduler};
+pub use crate::smc::shard::Shard;
+pub use crate::smc::stats::{RuleConfig, RuleKind};
+
 use crate::load::{Loaded, MaxTimeError};
 use crate::schedulers::SchedulerOptions;
-use crate::sim::{RunConfig, Scheduler};
-use crate::smc::stats::RuleConfig;
+use crate::sim::RunConfig;
 use crate::smc::StudyConfig;
 
 /// Every setting of one `verify` study.

@@ -2,7 +2,7 @@
 //! [`replay_csv`] for `trace` (run k of a seed is stream k, whatever ran before it), the
 //! failing runs a study kept for `--save-failing` and `--report` ([`failing_runs`],
 //! [`save`]) and, under `--schedulers`, a failing run under each order-sensitive
-//! property's witness ([`witness_runs`]); [`play_run`] plays one run to an observer of
+//! property's witness (`witness_runs`); [`play_run`] plays one run to an observer of
 //! the caller's (`hindsight run` paces it in wall-clock time). Nothing here prints: the files written come
 //! back as values.
 //!
@@ -27,10 +27,12 @@ use std::path::{Path, PathBuf};
 use crate::observe::{Judge, JudgeError, PropertySet};
 use crate::record::{Culprit, Recorder};
 use crate::result::Study;
+// What a played run reports to and how it ends, as callers name them.
 use crate::sim::{
-    BadScheduler, CompiledModel, EndReason, EventSemantics, Observer, Quiescence, RunConfig,
-    RunOutcome, Scheduler, Simulator,
+    BadScheduler, CompiledModel, EndReason, EventSemantics, Quiescence, RunConfig, Scheduler,
+    Simulator,
 };
+pub use crate::sim::{Observer, RunOutcome};
 use crate::smc::StudyResult;
 
 /// One failing run replayed: its property, run index, file name and CSV.
@@ -183,7 +185,7 @@ pub fn save(out: &Path, failing: &[Failing]) -> std::io::Result<Vec<PathBuf>> {
     Ok(written)
 }
 
-/// Runs searched for a failing one under each scheduler ([`witness_runs`]).
+/// Runs searched for a failing one under each scheduler (`witness_runs`).
 pub const SEARCH: u64 = 500;
 
 /// For `--report` with `--schedulers`: per order-sensitive property of `study`, the first
@@ -193,7 +195,7 @@ pub const SEARCH: u64 = 500;
 /// `verify --scheduler ID --save-failing 1` writes the same runs (run k is stream k of
 /// the seed whatever the scheduler). A scheduler with no failing run among the first
 /// [`SEARCH`] adds none.
-pub fn witness_runs(
+pub(crate) fn witness_runs(
     model: &CompiledModel,
     set: &PropertySet,
     run_cfg: &RunConfig,

@@ -4,7 +4,7 @@
 //! Fields only the report fills (settings, formulas) are left out of the JSON when empty,
 //! so the command-line output and the page read the same type.
 //!
-//! A [`Study`] is assembled here from what ran: [`Study::of_result`] from a sequential
+//! A [`Study`] is assembled here from what ran: `Study::of_result` from a sequential
 //! study, [`Study::merged`] from the shards of a fixed-size one; [`Study::add_formulas`]
 //! and [`Study::read_formulas`] add each formula for the page, and
 //! [`Study::scheduler_rows`] is the one list of bounds over schedulers that the table and
@@ -164,7 +164,7 @@ impl Study {
     /// The result of a sequential study of `set` (`result`), run with `rule`, `seed` and
     /// `scheduler` (named in the result when given) on the model at `model` with the
     /// property file `props`.
-    pub fn of_result(
+    pub(crate) fn of_result(
         model: &Path,
         props: &Path,
         set: &PropertySet,
@@ -238,7 +238,7 @@ impl Study {
 
     /// Model time in seconds, for a model whose step is `unit_ns` nanoseconds and whose
     /// runs last `max_time` steps (nothing without a unit).
-    pub fn set_time_unit(&mut self, unit_ns: Option<u64>, max_time: u64) {
+    pub(crate) fn set_time_unit(&mut self, unit_ns: Option<u64>, max_time: u64) {
         if let Some(unit) = unit_ns {
             self.step_seconds = Some(unit as f64 / 1e9);
             self.max_time_seconds = Some(max_time as f64 * unit as f64 / 1e9);

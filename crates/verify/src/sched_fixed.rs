@@ -26,9 +26,9 @@
 //! # Shards
 //!
 //! The jobs of a stage, laid end to end, are `T` runs; shard `I` of `K` runs the runs
-//! `[floor(I T / K), floor((I + 1) T / K))` of that line ([`run_stage`]), each on its job's
+//! `[floor(I T / K), floor((I + 1) T / K))` of that line (`run_stage`), each on its job's
 //! stream (run `k` of a job is stream `k` of the job's seed whatever the shard), and writes
-//! a [`StagePart`] holding the plan it ran. [`merge_stage`] checks the parts are shards of
+//! a [`StagePart`] holding the plan it ran. `merge_stage` checks the parts are shards of
 //! one plan covering it exactly once, sums each job's counts and advances the plan
 //! ([`Plan::advance`]): counts are sums, so the merged plan is the plan of the stage run
 //! on one machine, for any `K` and any thread count. `verify --schedulers N --runs R`
@@ -463,7 +463,7 @@ impl Plan {
 }
 
 /// Runs shard `shard` of the plan's current stage (see the module doc).
-pub fn run_stage(
+pub(crate) fn run_stage(
     model: &CompiledModel,
     set: &PropertySet,
     run_cfg: &RunConfig,
@@ -528,7 +528,7 @@ pub fn run_stage(
 }
 
 /// Merges the shards of one stage and returns the plan of the next (see the module doc).
-pub fn merge_stage(parts: &[StagePart]) -> Result<Plan, StageError> {
+pub(crate) fn merge_stage(parts: &[StagePart]) -> Result<Plan, StageError> {
     let first = parts.first().ok_or(StageError::Empty)?;
     let count = first.shard.count;
     let mut by_index = std::collections::BTreeMap::new();
@@ -629,7 +629,7 @@ pub fn merge_stage(parts: &[StagePart]) -> Result<Plan, StageError> {
 
 /// Runs every stage of `plan` in this process (shard `0/1` each): what a sharded study
 /// merges to.
-pub fn run_all(
+pub(crate) fn run_all(
     model: &CompiledModel,
     set: &PropertySet,
     run_cfg: &RunConfig,

@@ -1,17 +1,19 @@
 //! Properties compiled on their own, without a model: a `.hspec` spec or a property file
 //! over ROS names, for `hindsight compile`, `replay` and `monitor --ros2`, and what
-//! `compile` makes of a spec (a table, the printed IR or Rust source).
+//! `compile` makes of a spec (a table, the printed IR or Rust source); and a model's
+//! guarantees compiled alone for the on-line monitor ([`guarantees`]).
 //!
 //! Nothing here prints: a compiled spec carries its warnings
 //! ([`codegen::Compiled::warnings`]) for the caller to show.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use codegen::diag::Diagnostics;
 use codegen::emit_rust::{emit_rust, EmitError, EmitOptions};
 use codegen::Compiled;
 
-use crate::props::PropertyFile;
+use crate::load::Loaded;
+pub use crate::props::PropertyFile;
 
 /// Reads and compiles a `.hspec` spec with the project's one source reader
 /// ([`codegen::diag::read_source`]); errors name `file:line:col`.
@@ -76,7 +78,7 @@ pub fn emit(compiled: &Compiled, output: &Output) -> Result<Vec<u8>, EmitError> 
 ///
 /// ```
 /// use hindsight_verify::spec::module_name;
-/// use std::path::Path;
+/// use std::path::{Path, PathBuf};
 ///
 /// assert_eq!(module_name(Path::new("specs/Museum-Guide v2.hspec")), "museum_guide_v2");
 /// assert_eq!(module_name(Path::new("2024_run.hspec")), "m_2024_run");
@@ -127,4 +129,57 @@ mod tests {
             assert_eq!(module_name(Path::new(path)), want, "{path}");
         }
     }
+}
+
+/// Why a model's guarantees cannot be monitored on-line.
+#[derive(Debug)]
+pub enum GuaranteesError {
+    /// The model has no time unit, so the monitor's clock has no tick.
+    NoTimeUnit(PathBuf),
+    /// The property file has no guarantee.
+    NoGuarantee(PathBuf),
+    /// The guarantees do not compile alone.
+    Compile(Diagnostics),
+}
+
+impl std::fmt::Display for GuaranteesError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            GuaranteesError::NoTimeUnit(model) => write!(
+                f,
+                "{}: the model has no time unit, so the monitor's clock has no tick; give the \
+                 length of one model step with --time-unit (for example --time-unit 100ms)",
+                model.display()
+            ),
+            GuaranteesError::NoGuarantee(file) => {
+                write!(f, "{}: no guarantee to monitor", file.display())
+            }
+            GuaranteesError::Compile(d) => write!(f, "{d}"),
+        }
+    }
+}
+
+impl std::error::Error for GuaranteesError {}
+
+/// The guarantees of a loaded model's property file compiled into one spec, exactly as
+/// `verify` compiles them: its variables are the ports' ids and its tick is the model's
+/// time unit (`model` names the model in the error when it has none). Assumptions are not
+/// monitored: they are left out, and their count comes back beside the spec (their
+/// warnings are among the whole file's, which the load returned).
+pub fn guarantees(loaded: Loaded, model: &Path) -> Result<(Compiled, usize), GuaranteesError> {
+    let Some(unit_ns) = loaded.unit_ns else {
+        return Err(GuaranteesError::NoTimeUnit(model.into()));
+    };
+    if loaded.file.guarantees.is_empty() {
+        return Err(GuaranteesError::NoGuarantee(loaded.props_path));
+    }
+    let left_out = loaded.file.assumptions.len();
+    if left_out == 0 {
+        return Ok((loaded.set.compiled().clone(), 0));
+    }
+    let mut file = loaded.file;
+    file.assumptions.clear();
+    let set = crate::observe::PropertySet::with_unit(&file, &loaded.model, Some(unit_ns))
+        .map_err(GuaranteesError::Compile)?;
+    Ok((set.compiled().clone(), left_out))
 }

@@ -2,7 +2,7 @@
 //!
 //! [`Runner`] runs one simulation with its [`Judge`] (the function every study
 //! shares: `verify`, `sweep`, shards, the benches); [`study`] hands it to
-//! [`crate::smc::run_study`] with one stopping rule per guarantee, [`study_shard`] to
+//! [`crate::smc::run_study`] with one stopping rule per guarantee, `study_shard` to
 //! [`crate::smc::shard::run_shard`] for one slice of a fixed-size study.
 
 use std::sync::atomic::AtomicBool;
@@ -14,9 +14,10 @@ use super::observe::{Judge, PropertySet};
 use crate::sim::{CompiledModel, EndReason, RunConfig, Scheduler, Simulator, SpinKind};
 use crate::smc::shard::{run_shard, FixedStudy, PartialResult, Shard};
 use crate::smc::stats::{RuleConfig, StatsError};
-use crate::smc::{
-    run_study_until, Progress, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict,
-};
+// A study's progress, as callers draw it.
+pub use crate::smc::progress::{log_line, message, LOG_EVERY};
+pub use crate::smc::Progress;
+use crate::smc::{run_study_until, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict};
 
 /// Runs a study of `set` on `model`: the function `verify` and `sweep` share. `progress`
 /// is told of every run consumed (the binary draws a bar; the library prints nothing).
@@ -41,7 +42,7 @@ pub fn study(
 
 /// [`study`] that stops early, with a partial result, once `stop` is set (see
 /// [`run_study_until`]): `verify` sets it on Ctrl-C.
-pub fn study_until(
+pub(crate) fn study_until(
     model: &CompiledModel,
     set: &PropertySet,
     run_cfg: &RunConfig,
@@ -71,7 +72,7 @@ pub fn study_until(
 /// Shard `shard` of the fixed-size study `fixed` (`verify --runs R [--shard I/N]`):
 /// its runs judged by the same [`Runner`] as every study, counted by
 /// [`crate::smc::shard::run_shard`] (no early stop; `fixed` gives the seed).
-pub fn study_shard(
+pub(crate) fn study_shard(
     model: &CompiledModel,
     set: &PropertySet,
     run_cfg: &RunConfig,

@@ -24,7 +24,11 @@ use std::path::Path;
 
 use codegen::duration::{parse_steps_or_duration, DurationError, StepsOrDuration};
 
+use codegen::diag::Diagnostics;
+
+use crate::load::{Loaded, MaxTimeError};
 use crate::observe::PropertySet;
+use crate::options::VerifyOptions;
 use crate::props::{self, SourceText};
 use crate::sim::{CompiledModel, RunConfig};
 use crate::smc::runner::{widened_interval, PropertyCounts};
@@ -380,6 +384,126 @@ pub fn points_from_counts(
             }
         })
         .collect())
+}
+
+/// What a running sweep reports, in order, for each property.
+pub enum SweepEvent<'a> {
+    /// The property's variants were compiled, with these warnings.
+    Warnings(&'a Diagnostics),
+    /// Runs of its study done so far (simulated sweeps).
+    Runs(&'a Progress<'a>),
+    /// The property's curve.
+    Curve(&'a SweepCurve),
+}
+
+/// Why a sweep stopped once started.
+#[derive(Debug)]
+pub enum SweepFailure {
+    /// The run length (`--max-time`) does not fit the model.
+    MaxTime(MaxTimeError),
+    /// A property's variants do not compile.
+    Variants(Diagnostics),
+    /// The study of a property's variants (the model failed during a run).
+    Study(StudyError),
+    /// The intervals' rule.
+    Stats(StatsError),
+    /// A recorded run could not be judged (`sweep --online`): what the judge said.
+    Recorded(RecordedError),
+}
+
+impl fmt::Display for SweepFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SweepFailure::MaxTime(e) => write!(f, "--max-time: {e}"),
+            SweepFailure::Variants(d) => write!(f, "{d}"),
+            SweepFailure::Study(e) => write!(f, "{e}"),
+            SweepFailure::Stats(e) => write!(f, "statistics: {e}"),
+            SweepFailure::Recorded(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for SweepFailure {}
+
+/// What judging the recorded runs in [`sweep_recorded`] failed on, as its judge says it.
+pub type RecordedError = Box<dyn std::error::Error + Send + Sync>;
+
+/// The judge of [`sweep_recorded`]: given the variants compiled, per recorded run, each
+/// variant's outcome (`Some(true)` satisfied, `Some(false)` not, `None` unknown).
+pub type Recorded<'a> =
+    dyn FnMut(&codegen::Compiled) -> Result<Vec<Vec<Option<bool>>>, RecordedError> + 'a;
+
+/// The sweep `hindsight sweep` runs: per guarantee of `targets`, its [`variants`] over
+/// `values` judged on one study of `opts.max_runs` runs (the same seed for every
+/// guarantee), each curve reported to `event` as it is done.
+pub fn sweep(
+    loaded: &Loaded,
+    targets: &[props::Property],
+    values: &[StepsOrDuration],
+    opts: &VerifyOptions,
+    event: &mut dyn FnMut(SweepEvent<'_>),
+) -> Result<Vec<SweepCurve>, SweepFailure> {
+    let run_cfg = opts.run_config(loaded).map_err(SweepFailure::MaxTime)?;
+    let study_cfg = opts.study_config();
+    let mut curves = Vec::new();
+    for target in targets {
+        let one = variants(&loaded.file, target, values);
+        let set = PropertySet::with_unit(&one, &loaded.model, loaded.unit_ns)
+            .map_err(SweepFailure::Variants)?;
+        event(SweepEvent::Warnings(set.warnings()));
+        let points = sweep_study(
+            &loaded.model,
+            &set,
+            values,
+            &run_cfg,
+            &study_cfg,
+            &opts.rule,
+            &mut |p| event(SweepEvent::Runs(p)),
+        )
+        .map_err(SweepFailure::Study)?;
+        let curve = SweepCurve::new(&target.id, points);
+        event(SweepEvent::Curve(&curve));
+        curves.push(curve);
+    }
+    Ok(curves)
+}
+
+/// `sweep --online`: the same curves from recorded runs instead of simulated ones. Per
+/// guarantee of `targets`, its variants over `values` (guarantees only: the sidecar
+/// monitors no assumption) are compiled and given to `judge`, which returns, per
+/// recorded run, each variant's last verdict (`Some(true)`: the run satisfied it,
+/// `Some(false)`: it did not, `None`: unknown); intervals by `rule`.
+pub fn sweep_recorded(
+    loaded: &Loaded,
+    targets: &[props::Property],
+    values: &[StepsOrDuration],
+    rule: &RuleConfig,
+    judge: &mut Recorded<'_>,
+    event: &mut dyn FnMut(SweepEvent<'_>),
+) -> Result<Vec<SweepCurve>, SweepFailure> {
+    let mut curves = Vec::new();
+    for target in targets {
+        let mut one = variants(&loaded.file, target, values);
+        one.assumptions.clear();
+        let set = PropertySet::with_unit(&one, &loaded.model, loaded.unit_ns)
+            .map_err(SweepFailure::Variants)?;
+        event(SweepEvent::Warnings(set.warnings()));
+        let mut counts = vec![PropertyCounts::default(); values.len()];
+        for finals in judge(set.compiled()).map_err(SweepFailure::Recorded)? {
+            for (c, v) in counts.iter_mut().zip(&finals) {
+                match v {
+                    Some(true) => c.successes += 1,
+                    Some(false) => c.failures += 1,
+                    None => c.unknown += 1,
+                }
+            }
+        }
+        let points = points_from_counts(values, &counts, rule).map_err(SweepFailure::Stats)?;
+        let curve = SweepCurve::new(&target.id, points);
+        event(SweepEvent::Curve(&curve));
+        curves.push(curve);
+    }
+    Ok(curves)
 }
 
 #[cfg(test)]

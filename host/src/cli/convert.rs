@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 
 use super::CliError;
-use crate::robot::load::main_file_of;
 use crate::verify::convert::convert;
+use crate::verify::load::main_file_of;
 
 /// Arguments of `hindsight convert`.
 #[derive(Debug, clap::Args)]

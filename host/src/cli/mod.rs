@@ -17,7 +17,7 @@ use std::fmt;
 use codegen::diag::{Diagnostic, Diagnostics, Severity};
 
 use crate::codegen;
-use crate::robot::load::ExternalComponent;
+use crate::verify::load::ExternalComponent;
 use crate::verify::load::{LoadError, LoadOptions, Loaded};
 
 /// How a subcommand failed, mapped to the documented exit codes.

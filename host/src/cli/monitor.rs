@@ -11,7 +11,6 @@ use codegen::Compiled;
 use super::verify::{load, ModelArgs};
 use super::{compile_spec_file, read_file, CliError};
 use crate::live::{self, config::Config, Options, Sidecar};
-use crate::verify::observe::PropertySet;
 
 /// Arguments of `hindsight monitor`.
 #[derive(Debug, clap::Args)]
@@ -276,33 +275,16 @@ fn spec_of(args: &MonitorArgs) -> Result<Compiled, CliError> {
 /// property file without guarantees, is an input error.
 pub fn guarantees_spec(args: &ModelArgs) -> Result<Compiled, CliError> {
     let loaded = load(args)?;
-    let Some(unit_ns) = loaded.unit_ns else {
-        return Err(CliError::Input(format!(
-            "{}: the model has no time unit, so the monitor's clock has no tick; give the \
-             length of one model step with --time-unit (for example --time-unit 100ms)",
-            args.model.display()
-        )));
-    };
-    if loaded.file.guarantees.is_empty() {
-        return Err(CliError::Input(format!(
-            "{}: no guarantee to monitor",
-            loaded.props_path.display()
-        )));
+    let props_path = loaded.props_path.clone();
+    let (spec, left_out) = crate::verify::spec::guarantees(loaded, &args.model)
+        .map_err(|e| CliError::Input(e.to_string()))?;
+    if left_out > 0 {
+        eprintln!(
+            "monitor: {}: {left_out} assumption(s) not monitored (only guarantees are)",
+            props_path.display()
+        );
     }
-    if loaded.file.assumptions.is_empty() {
-        return Ok(loaded.set.compiled().clone());
-    }
-    eprintln!(
-        "monitor: {}: {} assumption(s) not monitored (only guarantees are)",
-        loaded.props_path.display(),
-        loaded.file.assumptions.len()
-    );
-    let mut file = loaded.file;
-    file.assumptions.clear();
-    // The guarantees' warnings are among the whole file's, which the load printed.
-    Ok(PropertySet::with_unit(&file, &loaded.model, Some(unit_ns))?
-        .compiled()
-        .clone())
+    Ok(spec)
 }
 
 /// Runs `hindsight monitor`.
@@ -376,28 +358,8 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
             .as_ref()
             .or(args.props.as_ref())
             .map_or_else(String::new, |p| p.display().to_string());
-        let server = live::serve::serve(
-            addr,
-            live::serve::page(&title, &spec),
-            args.serve_public,
-            live::http::Limits::default(),
-        )
-        .map_err(|e| CliError::Failed(format!("--serve {addr}: {e}")))?;
-        eprintln!("monitor: live page at http://{}/", server.addr);
-        if !server.addr.ip().is_loopback() {
-            eprintln!(
-                "monitor: warning: the live page is offered to the network at {} (every \
-                 interface for 0.0.0.0 or [::]): whoever reaches it sees every verdict and \
-                 input, without a password",
-                server.addr
-            );
-        }
-        use live::serve::{Stream, Tee};
-        out = Box::new(Tee::new(out, server.hub.clone(), Stream::Verdict));
-        // The page's points are the input records: the log's own lines with `--record`
-        // (written to the file first), else records written for the page alone.
-        let log = record.unwrap_or_else(|| Box::new(std::io::sink()));
-        record = Some(Box::new(Tee::new(log, server.hub, Stream::Input)));
+        let (o, r) = serve_page(addr, args.serve_public, &title, &spec, out, record)?;
+        (out, record) = (o, Some(r));
     }
     let mut opts = options(args, out, record);
     let sidecar =
@@ -407,6 +369,36 @@ pub fn run(args: &MonitorArgs) -> Result<(), CliError> {
         .run(&config, &spec, &mut opts, &stop)
         .map(|_| ())
         .map_err(|e| CliError::Failed(e.to_string()))
+}
+
+/// Serves the live page (`--serve`) titled `title` for `spec`, says where on standard
+/// error (and warns when it is offered beyond this machine), and returns the outputs with
+/// the page beside them ([`live::serve::attach`]).
+pub(super) fn serve_page(
+    addr: std::net::SocketAddr,
+    public: bool,
+    title: &str,
+    spec: &Compiled,
+    verdicts: live::serve::Output,
+    record: Option<live::serve::Output>,
+) -> Result<(live::serve::Output, live::serve::Output), CliError> {
+    let server = live::serve::serve(
+        addr,
+        live::serve::page(title, spec),
+        public,
+        live::http::Limits::default(),
+    )
+    .map_err(|e| CliError::Failed(format!("--serve {addr}: {e}")))?;
+    eprintln!("monitor: live page at http://{}/", server.addr);
+    if !server.addr.ip().is_loopback() {
+        eprintln!(
+            "monitor: warning: the live page is offered to the network at {} (every \
+             interface for 0.0.0.0 or [::]): whoever reaches it sees every verdict and \
+             input, without a password",
+            server.addr
+        );
+    }
+    Ok(live::serve::attach(&server, verdicts, record))
 }
 
 /// The sidecar's outputs: verdict lines to `verdicts`, the input log to `record`, notes on

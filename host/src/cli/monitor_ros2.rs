@@ -108,22 +108,8 @@ pub fn run(
     let mut record: Option<Box<dyn Write + Send>> = None;
     if let Some(addr) = serve {
         let title = props_path.display().to_string();
-        let server = live::serve::serve(
-            addr,
-            live::serve::page(&title, spec),
-            args.serve_public,
-            live::http::Limits::default(),
-        )
-        .map_err(|e| CliError::Failed(format!("--serve {addr}: {e}")))?;
-        eprintln!("monitor: live page at http://{}/", server.addr);
-        use live::serve::{Stream, Tee};
-        out = Box::new(Tee::new(out, server.hub.clone(), Stream::Verdict));
-        // The page's points are the input records, written for the page alone.
-        record = Some(Box::new(Tee::new(
-            Box::new(std::io::sink()),
-            server.hub,
-            Stream::Input,
-        )));
+        let (o, r) = super::monitor::serve_page(addr, args.serve_public, &title, spec, out, None)?;
+        (out, record) = (o, Some(r));
     }
     let mut opts = super::monitor::options(args, out, record);
     live::dds::run(spec, sources, &settings, &mut opts, mcap, stop_flag())

@@ -7,8 +7,8 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::smc::progress::{log_line, message, LOG_EVERY};
-use crate::smc::Progress;
+use crate::verify::study::Progress;
+use crate::verify::study::{log_line, message, LOG_EVERY};
 
 /// Draws a study's [`Progress`] reports on standard error: as a bar when it is a terminal,
 /// else (a log, a CI job) as one plain line every [`LOG_EVERY`] of a study that lasts

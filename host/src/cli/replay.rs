@@ -27,7 +27,7 @@ use std::time::Instant;
 use super::{compile_spec_file, print_spec_warnings, read_file, CliError};
 use crate::codegen::{self, Compiled};
 use crate::live::recording::{self, bind_ports, file_ports, is_recording, MessageTime, Packages};
-use crate::props::PropertyFile;
+use crate::verify::spec::PropertyFile;
 use crate::verify::trace_judge::{Keep, TraceJudge};
 use crate::verify::{spec, tracefile};
 

@@ -167,7 +167,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     for w in &warnings {
         eprintln!("warning: {w}");
     }
-    if !external.is_empty() && loaded.events != crate::sim::EventSemantics::As2fm {
+    if !external.is_empty() && loaded.events != crate::verify::options::EventSemantics::As2fm {
         return Err(CliError::Input(
             "--external needs --events as2fm (messages from processes are posted as AS2FM's \
              translation sends them)"
@@ -278,7 +278,7 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
         ));
     }
     let domain = domain_id().map_err(|e| input(e.to_string()))?;
-    let Some(main_path) = crate::robot::load::main_file_of(&args.input.model) else {
+    let Some(main_path) = crate::verify::load::main_file_of(&args.input.model) else {
         return Err(input(format!(
             "{}: --ros2 needs a robot model (a main file whose node models declare their \
              ROS topics and services with types)",
@@ -428,13 +428,13 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
 /// Plays run `args.run` of seed `args.seed` into `live`, the iceoryx2 or the DDS side
 /// paced in wall-clock time, and reports its progress once more at the end (the line
 /// closed on a terminal).
-fn play_paced<L: crate::sim::Observer>(
+fn play_paced<L: crate::verify::replay::Observer>(
     loaded: &Loaded,
     max_time: u64,
     args: &RunArgs,
     (live, progress): (&mut L, fn(&mut L, u64, bool)),
     tty: bool,
-) -> crate::sim::RunOutcome {
+) -> crate::verify::replay::RunOutcome {
     let outcome = play_run(
         &loaded.model,
         loaded.events,
@@ -450,7 +450,7 @@ fn play_paced<L: crate::sim::Observer>(
 }
 
 /// The last line of `run`: the model step the run ended at and why.
-fn say_end(outcome: &crate::sim::RunOutcome, stopped: bool) {
+fn say_end(outcome: &crate::verify::replay::RunOutcome, stopped: bool) {
     let how = if stopped {
         "stopped by a signal".to_string()
     } else {

@@ -2,19 +2,13 @@
 
 use std::path::PathBuf;
 
-use super::verify::{load, max_time_error, progress_bar};
+use super::verify::{load, progress_bar};
 use super::CliError;
 use crate::codegen::duration::StepsOrDuration;
 use crate::live::{self, engine::Verdict};
-use crate::props;
 use crate::report::plot;
-use crate::smc::runner::PropertyCounts;
-use crate::verify::observe::PropertySet;
 use crate::verify::options::VerifyOptions;
-use crate::verify::sweep::{
-    axis, bound_text, grid, points_from_counts, sweep_study, targets, threshold_index, variants,
-    SweepCurve, SweepPoint,
-};
+use crate::verify::sweep::{grid, sweep, sweep_recorded, targets, SweepCurve, SweepEvent};
 
 /// Arguments of `hindsight sweep`.
 #[derive(Debug, clap::Args)]
@@ -78,7 +72,7 @@ pub struct SweepArgs {
     pub max_time: Option<String>,
     /// Run every run under this scheduler (a witness `verify --schedulers` printed).
     #[arg(long, value_name = "ID", value_parser = super::verify::parse_scheduler)]
-    pub scheduler: Option<crate::sim::Scheduler>,
+    pub scheduler: Option<crate::verify::options::Scheduler>,
     /// Also write an SVG chart of success rate against the bound to this file.
     #[arg(long)]
     pub svg: Option<PathBuf>,
@@ -101,7 +95,9 @@ pub struct SweepArgs {
     pub online: Vec<PathBuf>,
 }
 
-/// Runs `hindsight sweep`.
+/// Runs `hindsight sweep`: the library's [`sweep`] (or [`sweep_recorded`] over the logs
+/// `live` reads and judges), each curve printed as CSV as it is done, then the
+/// thresholds, the chart and the page.
 pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     let values = grid(&args.from, &args.to, args.step.as_deref())
         .map_err(|e| CliError::Input(e.to_string()))?;
@@ -109,99 +105,81 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         return Err(CliError::Input("sweep: --runs must be at least 1".into()));
     }
     let loaded = load(&args.input)?;
-    // Each property is compiled again below: the load printed the file's warnings.
+    // Each property is compiled again: the load printed the file's warnings.
     let mut said: std::collections::BTreeSet<String> = loaded
         .warnings
         .iter()
         .map(crate::cli::warning_text)
         .collect();
-    let (model, file, props_path) = (&loaded.model, &loaded.file, &loaded.props_path);
-    let targets =
-        targets(file, &args.properties, props_path).map_err(|e| CliError::Input(e.to_string()))?;
+    let targets = targets(&loaded.file, &args.properties, &loaded.props_path)
+        .map_err(|e| CliError::Input(e.to_string()))?;
     let rule = crate::verify::sweep::rule(args.confidence);
-    if !args.online.is_empty() {
-        let logs = read_logs(&args.online)?;
-        if !args.json {
-            println!("property,bound,successes,failures,unknown,probability,lower,upper");
-        }
-        let mut curves = Vec::new();
-        for target in &targets {
-            let mut one = variants(file, target, &values);
-            // The sidecar monitors guarantees only.
-            one.assumptions.clear();
-            let set = PropertySet::with_unit(&one, model, loaded.unit_ns)?;
-            crate::cli::print_new_warnings(set.warnings(), &mut said);
-            let mut counts = vec![PropertyCounts::default(); values.len()];
-            for (name, records) in &logs {
-                let finals = live::record::final_verdicts(set.compiled(), records, name)
-                    .map_err(|e| CliError::Input(e.to_string()))?;
-                for (c, v) in counts.iter_mut().zip(&finals) {
-                    match v {
-                        Some(Verdict::True | Verdict::CurrentlyTrue) => c.successes += 1,
-                        Some(Verdict::False | Verdict::CurrentlyFalse) => c.failures += 1,
-                        Some(Verdict::Unknown) | None => c.unknown += 1,
-                    }
-                }
-            }
-            let points = points_from_counts(&values, &counts, &rule)
-                .map_err(|e| CliError::Input(format!("statistics: {e}")))?;
-            curves.push(curve(args, target, points));
-        }
-        return finish(args, &values, curves);
-    }
-    let opts = VerifyOptions {
-        rule,
-        seed: args.seed,
-        threads: args.threads,
-        max_runs: Some(args.runs),
-        max_time: args.max_time.clone(),
-        scheduler: args.scheduler,
-        ..VerifyOptions::default()
+    let logs = if args.online.is_empty() {
+        Vec::new()
+    } else {
+        read_logs(&args.online)?
     };
-    let run_cfg = opts.run_config(&loaded).map_err(max_time_error)?;
-    let study_cfg = opts.study_config();
     if !args.json {
         println!("property,bound,successes,failures,unknown,probability,lower,upper");
     }
-    let mut curves = Vec::new();
-    for target in &targets {
-        let one = variants(file, target, &values);
-        let set = PropertySet::with_unit(&one, model, loaded.unit_ns)?;
-        crate::cli::print_new_warnings(set.warnings(), &mut said);
-        let mut bar = progress_bar(!args.json);
-        let points = sweep_study(
-            model,
-            &set,
-            &values,
-            &run_cfg,
-            &study_cfg,
-            &opts.rule,
-            &mut |p| bar.update(p),
-        )
-        .map_err(|e| CliError::Input(e.to_string()))?;
-        curves.push(curve(args, target, points));
+    let mut bar = progress_bar(!args.json);
+    let mut event = |e: SweepEvent<'_>| match e {
+        SweepEvent::Warnings(w) => crate::cli::print_new_warnings(w, &mut said),
+        SweepEvent::Runs(p) => bar.update(p),
+        SweepEvent::Curve(c) if !args.json => print_rows(c),
+        SweepEvent::Curve(_) => {}
+    };
+    let curves = if args.online.is_empty() {
+        let opts = VerifyOptions {
+            rule,
+            seed: args.seed,
+            threads: args.threads,
+            max_runs: Some(args.runs),
+            max_time: args.max_time.clone(),
+            scheduler: args.scheduler,
+            ..VerifyOptions::default()
+        };
+        sweep(&loaded, &targets, &values, &opts, &mut event)
+    } else {
+        // Each log is one run: the last verdict of each variant over it.
+        let mut judge = |spec: &crate::codegen::Compiled| {
+            let mut runs = Vec::new();
+            for (name, records) in &logs {
+                let finals = live::record::final_verdicts(spec, records, name)?;
+                runs.push(finals.iter().map(|v| passed(*v)).collect());
+            }
+            Ok(runs)
+        };
+        sweep_recorded(&loaded, &targets, &values, &rule, &mut judge, &mut event)
     }
+    .map_err(|e| CliError::Input(e.to_string()))?;
     finish(args, &values, curves)
 }
 
-/// Prints a property's CSV rows (unless --json) and finds its threshold.
-fn curve(args: &SweepArgs, target: &props::Property, points: Vec<SweepPoint>) -> SweepCurve {
-    if !args.json {
-        for p in &points {
-            println!(
-                "{},{},{},{},{},{},{:.4},{:.4}",
-                target.id,
-                p.bound,
-                p.successes,
-                p.failures,
-                p.unknown,
-                p.probability.map_or("".into(), |x| format!("{x:.4}")),
-                p.lower,
-                p.upper
-            );
-        }
+/// Whether a recorded run satisfied a variant, from its last verdict (unknown: `None`).
+fn passed(last: Option<Verdict>) -> Option<bool> {
+    match last? {
+        Verdict::True | Verdict::CurrentlyTrue => Some(true),
+        Verdict::False | Verdict::CurrentlyFalse => Some(false),
+        Verdict::Unknown => None,
     }
-    SweepCurve::new(&target.id, points)
+}
+
+/// A property's CSV rows.
+fn print_rows(c: &SweepCurve) {
+    let name = c.property.as_str();
+    for p in &c.points {
+        println!(
+            "{name},{},{},{},{},{},{:.4},{:.4}",
+            p.bound,
+            p.successes,
+            p.failures,
+            p.unknown,
+            p.probability.map_or("".into(), |x| format!("{x:.4}")),
+            p.lower,
+            p.upper
+        );
+    }
 }
 
 /// A parsed `--online` log: its name and its records with their line numbers.
@@ -269,29 +247,7 @@ fn finish(
         }
     }
     if let Some(path) = &args.svg {
-        let plot_curves: Vec<plot::Curve> = curves
-            .iter()
-            .map(|c| {
-                let points: Vec<plot::Point> = values
-                    .iter()
-                    .zip(&c.points)
-                    .map(|(v, p)| plot::Point {
-                        x: axis(*v),
-                        rate: p.probability.unwrap_or(f64::NAN),
-                        lower: p.lower,
-                        upper: p.upper,
-                    })
-                    .filter(|p| p.rate.is_finite())
-                    .collect();
-                let found = threshold_index(&c.points);
-                plot::Curve {
-                    name: c.property.clone(),
-                    points,
-                    threshold: found.map(|i| axis(values[i])),
-                    threshold_text: found.map(|i| bound_text(values[i])),
-                }
-            })
-            .collect();
+        let plot_curves = plot::sweep_curves(values, &curves);
         let title = if args.online.is_empty() {
             format!(
                 "{}: success rate against the bound ({} runs each)",

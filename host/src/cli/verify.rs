@@ -13,17 +13,17 @@ pub use shard::{merge, MergeArgs};
 
 use super::CliError;
 use crate::codegen;
-use crate::robot::bt::{BtSemantics, BtTick};
-use crate::robot::load::ExternalComponent;
-use crate::sim::{EventSemantics, Scheduler};
-use crate::smc::stats::{RuleConfig, RuleKind};
-use crate::verify::fixed::fixed_study;
+use crate::verify::load::ExternalComponent;
 use crate::verify::load::{LoadOptions, Loaded, MaxTimeError};
 use crate::verify::options::VerifyOptions;
-use crate::verify::replay::{failing_runs, replay_csv, witness_runs};
+use crate::verify::options::{BtSemantics, BtTick};
+use crate::verify::options::{EventSemantics, Scheduler};
+use crate::verify::options::{RuleConfig, RuleKind};
+use crate::verify::pipeline::{verify, Event, Outcome, Request, VerifyError};
+use crate::verify::replay::replay_csv;
 use crate::verify::result::Study;
 use crate::verify::schedulers::SchedulerOptions;
-use crate::verify::study::{study_shard, study_until, Unfair};
+use crate::verify::study::Unfair;
 
 /// The stopping rule, as named on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -151,7 +151,7 @@ pub struct VerifyArgs {
     /// Slices are contiguous run ranges, so any batch scheduler (Slurm arrays,
     /// Kubernetes indexed jobs) can run them anywhere.
     #[arg(long, value_name = "I/N", requires = "runs")]
-    pub shard: Option<crate::smc::shard::Shard>,
+    pub shard: Option<crate::verify::options::Shard>,
     /// Run a fixed-size study of N runs: no early stop, the rule only gives the interval
     /// (the same numbers as its shards merged). With --shard, the size of the study it slices.
     #[arg(
@@ -460,7 +460,8 @@ pub fn max_time_error(e: MaxTimeError) -> CliError {
     CliError::Input(format!("--max-time: {e}"))
 }
 
-/// Runs `hindsight verify`.
+/// Runs `hindsight verify`: the arguments as a [`Request`], the library's [`verify`],
+/// then the table (or JSON), the files written and the report page.
 pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     schedulers::check(args)?;
     let opts = args.options();
@@ -468,42 +469,40 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         return both::run_both(args, &opts);
     }
     let loaded = load(&args.input)?;
-    let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
-    let run_cfg = opts.run_config(&loaded).map_err(max_time_error)?;
-    let study_cfg = opts.study_config();
-    if let (Some(_), Some(runs)) = (opts.schedulers, args.runs) {
-        // A fixed-size scheduler study: one shard of one stage, or every stage here.
-        let Some(mut report) =
-            schedulers::run_fixed(args, &opts, &loaded, &run_cfg, &study_cfg, runs)?
-        else {
-            return Ok(());
-        };
-        report.model = args.input.model.display().to_string();
-        report.properties_file = props_path.display().to_string();
-        if let Some(path) = &args.report {
-            super::report::from_verify(path, &report, &loaded, opts.settings(&run_cfg), &[])?;
-        }
-        return print_report(&report, args.json);
-    }
-    if let Some(runs) = args.runs {
-        // A fixed-size study: one shard of it, or all of it (shard 0/1) reported as
-        // `merge` reports the shards of one, so both give the same numbers.
-        let shard = args.shard.unwrap_or(crate::smc::shard::Shard::WHOLE);
-        let fixed = fixed_study(
-            &loaded,
-            &args.input.model,
-            opts.seed,
-            &run_cfg,
-            &opts.rule,
-            runs,
-        );
-        let mut bar = super::progress::TerminalProgress::stderr();
-        let part = study_shard(model, set, &run_cfg, &study_cfg, &fixed, shard, &mut |p| {
-            bar.update(p)
-        })
-        .map_err(|e| CliError::Input(e.to_string()))?;
-        if args.shard.is_some() {
-            let json = part.to_json();
+    let bt_label = match args.input.semantics()?.as_slice() {
+        [bt] if *bt != BtSemantics::As2fm => Some(bt.label()),
+        _ => None,
+    };
+    let keep = args.save_failing > 0 || args.report.is_some();
+    let request = Request {
+        bt_label,
+        runs: args.runs,
+        shard: args.shard,
+        plan: args.plan.as_deref(),
+        failing_dir: keep.then_some(args.out.as_path()),
+        save_failing: args.save_failing > 0,
+        witnesses: args.report.is_some(),
+        ..Request::new(&loaded, &args.input.model, &opts)
+    };
+    // A fixed-size study draws its bar even with --json (on standard error); a sequential
+    // one does not.
+    let mut bar = progress_bar(args.runs.is_some() || !args.json);
+    let show = !args.json;
+    let outcome = verify(
+        &request,
+        &mut |e| match e {
+            Event::Runs(p) => bar.update(p),
+            Event::Bounds(s) if show => schedulers::say_stage(s),
+            Event::Stage { stage, jobs } if show => {
+                eprintln!("schedulers: stage {stage} ({jobs} run ranges)")
+            }
+            _ => {}
+        },
+        interrupt_flag(),
+    )
+    .map_err(verify_error)?;
+    let done = match outcome {
+        Outcome::Part(json) => {
             return match &args.partial {
                 Some(p) => std::fs::write(p, json)
                     .map_err(|e| CliError::Failed(format!("{}: {e}", p.display()))),
@@ -511,93 +510,43 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
                     println!("{json}");
                     Ok(())
                 }
-            };
-        }
-        let m = crate::smc::shard::merge(&[part], 0)
-            .map_err(|e| CliError::Input(format!("--runs: {e}")))?;
-        let mut report = Study::merged(&m);
-        report.model = args.input.model.display().to_string();
-        report.properties_file = props_path.display().to_string();
-        if let Some(path) = &args.report {
-            // A fixed-size study keeps counts, not runs: the page has no timelines.
-            super::report::from_verify(path, &report, &loaded, opts.settings(&run_cfg), &[])?;
-        }
-        return print_report(&report, args.json);
-    }
-    let mut bar = progress_bar(!args.json);
-    let result = study_until(
-        model,
-        set,
-        &run_cfg,
-        &study_cfg,
-        &opts.rule,
-        &mut |p| bar.update(p),
-        interrupt_flag(),
-    )
-    .map_err(|e| CliError::Input(e.to_string()))?;
-    if result.interrupted && (args.save_failing > 0 || args.report.is_some()) {
-        eprintln!("interrupted: --save-failing and --report are not written for a partial study");
-    }
-    let failing = if !result.interrupted && (args.save_failing > 0 || args.report.is_some()) {
-        let kept = failing_runs(model, set, &run_cfg, opts.seed, &result, &args.out)
-            .map_err(|e| CliError::Failed(e.to_string()))?;
-        if args.save_failing > 0 {
-            let written = crate::verify::replay::save(&args.out, &kept)
-                .map_err(|e| CliError::Failed(format!("{}: {e}", args.out.display())))?;
-            for path in written {
-                eprintln!("wrote {}", path.display());
             }
         }
-        kept
-    } else {
-        Vec::new()
+        Outcome::Study(done) => done,
     };
-    let mut report = Study::of_result(
-        &args.input.model,
-        props_path,
-        set,
-        &opts.rule,
-        opts.seed,
-        opts.scheduler,
-        &result,
-    );
-    if !result.interrupted
-        && !schedulers::add_bounds(
-            &opts,
-            !args.json,
-            &loaded,
-            &run_cfg,
-            &study_cfg,
-            &mut report,
-            interrupt_flag(),
-        )?
-    {
-        eprintln!("interrupted: the bounds over schedulers are left out");
-        report.interrupted = true;
+    for line in &done.left_out {
+        eprintln!("interrupted: {line}");
     }
-    if let [bt] = args.input.semantics()?.as_slice() {
-        if *bt != BtSemantics::As2fm {
-            report.settings.push(("bt".into(), bt.label().into()));
-        }
+    for path in &done.written {
+        eprintln!("wrote {}", path.display());
     }
-    report.set_time_unit(loaded.unit_ns, run_cfg.max_time);
-    if let Some(path) = args.report.as_ref().filter(|_| !result.interrupted) {
+    let run_cfg = opts.run_config(&loaded).map_err(max_time_error)?;
+    if let Some(path) = args.report.as_ref().filter(|_| done.runs_complete) {
         // With --schedulers: a failing run under each order-sensitive property's min
-        // witness beside one under the uniform scheduler.
-        let mut failing = failing;
-        if !report.interrupted {
-            failing.extend(
-                witness_runs(model, set, &run_cfg, opts.seed, &report)
-                    .map_err(|e| CliError::Failed(e.to_string()))?,
-            );
-        }
-        super::report::from_verify(path, &report, &loaded, opts.settings(&run_cfg), &failing)?;
+        // witness beside one under the uniform scheduler. A fixed-size study keeps
+        // counts, not runs: its page has no timelines.
+        super::report::from_verify(
+            path,
+            &done.study,
+            &loaded,
+            opts.settings(&run_cfg),
+            &done.shown_runs(),
+        )?;
     }
-    print_report(&report, args.json)?;
-    if report.interrupted {
-        return Err(interrupted_error(report.runs));
+    print_report(&done.study, args.json)?;
+    if done.study.interrupted {
+        return Err(interrupted_error(done.study.runs));
     }
     Ok(())
+}
+
+/// A library error as the command line's: bad input (exit code 2) or a failure (1).
+fn verify_error(e: VerifyError) -> CliError {
+    if e.is_input() {
+        CliError::Input(e.to_string())
+    } else {
+        CliError::Failed(e.to_string())
+    }
 }
 
 /// Prints a report as JSON or as the table.

@@ -1,10 +1,10 @@
 //! Lowering a small format-4 tree written in a test: the document around a body, one
 //! always-successful leaf `Act`, and the lowering's errors as the CLI prints them.
 
-use hindsight::robot::bt::{self, BtInput, BtSemantics, BtTick, Halts};
 use hindsight::verify::model::source::SourceMap;
 use hindsight::verify::model::xml::Element;
 use hindsight::verify::model::Diagnostics;
+use hindsight::verify::robot::bt::{self, BtInput, BtSemantics, BtTick, Halts};
 
 /// The leaf type `Act`: SUCCESS at every tick.
 pub const ACT: &str = r#"<ascxml xmlns="http://www.w3.org/2005/07/scxml" initial="s" version="1.0" name="Act">

@@ -52,7 +52,7 @@ pub fn corpus(relative: &str) -> PathBuf {
 /// corpus's `museum-simpar2025/model_scxml` with the one-line fix of
 /// `NavigationComponent.scxml` (`_event.thread_id` -> `_event.data.thread_id`) without
 /// which it does not compile. In the repository, so tests using it run on any clone.
-pub fn museum_fixed() -> hindsight::sim::CompiledModel {
+pub fn museum_fixed() -> hindsight::verify::sim::CompiledModel {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-scxml");
     let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
@@ -68,5 +68,5 @@ pub fn museum_fixed() -> hindsight::sim::CompiledModel {
         files.iter().map(|(a, b)| (a.as_str(), b.as_str())),
     )
     .unwrap();
-    hindsight::sim::CompiledModel::compile(src).unwrap()
+    hindsight::verify::sim::CompiledModel::compile(src).unwrap()
 }

@@ -4,11 +4,13 @@
 
 #![allow(dead_code)]
 
-use hindsight::robot::bt::{self, BtInput, BtSemantics, Halts};
-use hindsight::sim::{CompiledModel, EndReason, Flow, Observer, RunConfig, SentMessage, Simulator};
 use hindsight::verify::expr::Value;
 use hindsight::verify::model::source::{FileId, SourceMap};
 use hindsight::verify::model::{xml, Diagnostics, ModelSource};
+use hindsight::verify::robot::bt::{self, BtInput, BtSemantics, Halts};
+use hindsight::verify::sim::{
+    CompiledModel, EndReason, Flow, Observer, RunConfig, SentMessage, Simulator,
+};
 use hindsight_tests::bt::model;
 use hindsight_tests::bt::oracle::{self, LeafEvent, Reading, Scripts};
 use hindsight_tests::bt::tree::{self, Kind, Status, Tree};
@@ -302,9 +304,10 @@ pub fn lower_and_run_clocked(
     let mut timers: Vec<(String, u64)> = Vec::new();
     root.children.retain(|c| match c {
         xml::Node::Element(e) if e.name == "ros_time_rate" => {
-            let p = hindsight::robot::rate::period(e.attr_value("rate_hz").unwrap_or_default())
-                .map(|p| p.period_ns)
-                .unwrap_or(0);
+            let p =
+                hindsight::verify::robot::rate::period(e.attr_value("rate_hz").unwrap_or_default())
+                    .map(|p| p.period_ns)
+                    .unwrap_or(0);
             timers.push((e.attr_value("name").unwrap_or_default().to_string(), p));
             false
         }

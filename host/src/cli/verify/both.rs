@@ -1,12 +1,10 @@
 //! `hindsight verify --bt both`: one study under AS2FM's node models and one under
 //! BehaviorTree.CPP 4, side by side, and which properties are semantics-sensitive.
 
-use super::{
-    interrupt_flag, interrupted_error, interrupted_line, max_time_error, study_until, VerifyArgs,
-};
+use super::{interrupt_flag, interrupted_error, interrupted_line, VerifyArgs};
 use crate::cli::CliError;
 use crate::verify::options::VerifyOptions;
-use crate::verify::result::{PropertyRow, Study};
+use crate::verify::pipeline::{verify_both, Event};
 
 /// `verify --bt both`: the study under AS2FM's node models and under BehaviorTree.CPP 4,
 /// each with the same seed and settings, and per property both probabilities and
@@ -24,74 +22,49 @@ pub(super) fn run_both(args: &VerifyArgs, opts: &VerifyOptions) -> Result<(), Cl
     if args.report.is_some() || args.save_failing > 0 {
         return refuse("--report / --save-failing");
     }
-    let mut studies = Vec::new();
-    let stop = interrupt_flag();
-    for bt in args.input.semantics()? {
-        let loaded = crate::cli::load_model(&args.input.options_with(bt)?)?;
-        let run_cfg = opts.run_config(&loaded).map_err(max_time_error)?;
-        // `--report` and `--save-failing` are refused above: no failing run is kept.
-        let study_cfg = opts.study_config();
-        if !args.json {
-            eprintln!("--bt {}:", bt.label());
-        }
-        // Once interrupted, the next semantics' study starts no run (0 runs, no estimate).
-        let mut bar = super::progress_bar(!args.json);
-        let result = study_until(
-            &loaded.model,
-            &loaded.set,
-            &run_cfg,
-            &study_cfg,
-            &opts.rule,
-            &mut |p| bar.update(p),
-            stop,
-        )
-        .map_err(|e| CliError::Input(e.to_string()))?;
-        let mut r = Study::of_result(
-            &args.input.model,
-            &loaded.props_path,
-            &loaded.set,
-            &opts.rule,
-            opts.seed,
-            opts.scheduler,
-            &result,
-        );
-        r.settings.push(("bt".into(), bt.label().into()));
-        r.set_time_unit(loaded.unit_ns, run_cfg.max_time);
-        // `--schedulers`: the bounds under each semantics, on the same seed.
-        if !result.interrupted
-            && !super::schedulers::add_bounds(
-                opts, !args.json, &loaded, &run_cfg, &study_cfg, &mut r, stop,
-            )?
-        {
-            eprintln!("interrupted: the bounds over schedulers are left out");
-            r.interrupted = true;
-        }
-        studies.push((bt, r));
+    let semantics = args.input.semantics()?;
+    let loads = semantics
+        .iter()
+        .map(|&bt| crate::cli::load_model(&args.input.options_with(bt)?))
+        .collect::<Result<Vec<_>, CliError>>()?;
+    let ([a, b], [bt_a, bt_b]) = (
+        [&loads[0], &loads[1]],
+        [semantics[0].label(), semantics[1].label()],
+    );
+    let show = !args.json;
+    let mut bar = super::progress_bar(show);
+    let both = verify_both(
+        [(bt_a, a), (bt_b, b)],
+        &args.input.model,
+        opts,
+        &mut |label| {
+            if show {
+                eprintln!("--bt {label}:");
+            }
+        },
+        &mut |e| match e {
+            Event::Runs(p) => bar.update(p),
+            Event::Bounds(s) if show => super::schedulers::say_stage(s),
+            _ => {}
+        },
+        interrupt_flag(),
+    )
+    .map_err(super::verify_error)?;
+    for line in &both.left_out {
+        eprintln!("interrupted: {line}");
     }
-    let [(_, a), (bt, b)] = studies.as_slice() else {
+    let rows = &both.rows;
+    let [(_, a), (bt, b)] = both.studies.as_slice() else {
         unreachable!("--bt both names two semantics")
     };
-    let rows: Vec<Sensitivity> = a
-        .properties
-        .iter()
-        .zip(&b.properties)
-        .map(|(x, y)| Sensitivity::of(x, y))
-        .collect();
-    let interrupted = a.interrupted || b.interrupted;
-    let done = a.runs + b.runs;
+    let (interrupted, done) = (both.interrupted(), both.runs());
     if args.json {
         let mut doc = serde_json::json!({
             "bt": "both",
             "as2fm": a,
             "btcpp": b,
-            "btcpp_semantics": bt.label(),
-            "properties": rows.iter().map(|r| serde_json::json!({
-                "property": r.property,
-                "as2fm": r.as2fm,
-                "btcpp": r.btcpp,
-                "difference": r.difference,
-                "semantics_sensitive": r.sensitive,
-            })).collect::<Vec<_>>(),
+            "btcpp_semantics": bt,
+            "properties": rows,
         });
         if interrupted {
             doc["interrupted"] = true.into();
@@ -119,7 +92,7 @@ pub(super) fn run_both(args: &VerifyArgs, opts: &VerifyOptions) -> Result<(), Cl
         "{:<w$}  {:>8}  {:>8}  {:>10}  semantics-sensitive",
         "property", "as2fm", "btcpp", "difference"
     );
-    for r in &rows {
+    for r in rows {
         println!(
             "{:<w$}  {:>8}  {:>8}  {:>10}  {}",
             r.property,
@@ -132,17 +105,12 @@ pub(super) fn run_both(args: &VerifyArgs, opts: &VerifyOptions) -> Result<(), Cl
     println!(
         "as2fm: {} runs; {}: {} runs; seed {}, confidence {}, precision {}; \
          semantics-sensitive: the two intervals (±precision) are disjoint",
-        a.runs,
-        bt.label(),
-        b.runs,
-        opts.seed,
-        opts.rule.confidence,
-        opts.rule.precision
+        a.runs, bt, b.runs, opts.seed, opts.rule.confidence, opts.rule.precision
     );
-    for (bt, s) in &studies {
+    for (bt, s) in &both.studies {
         if s.properties.iter().any(|p| p.schedulers.is_some()) {
             println!();
-            println!("--bt {}:", bt.label());
+            println!("--bt {bt}:");
             super::schedulers::print_bounds(s);
         }
     }
@@ -150,29 +118,4 @@ pub(super) fn run_both(args: &VerifyArgs, opts: &VerifyOptions) -> Result<(), Cl
         return Err(interrupted_error(done));
     }
     Ok(())
-}
-
-/// One property under both semantics.
-struct Sensitivity {
-    property: String,
-    as2fm: Option<f64>,
-    btcpp: Option<f64>,
-    /// BT.CPP's estimate minus AS2FM's.
-    difference: Option<f64>,
-    /// The two intervals are disjoint: the difference is beyond the precision.
-    sensitive: bool,
-}
-
-impl Sensitivity {
-    fn of(a: &PropertyRow, b: &PropertyRow) -> Self {
-        let difference = a.probability.zip(b.probability).map(|(x, y)| y - x);
-        let sensitive = difference.is_some() && (a.upper < b.lower || b.upper < a.lower);
-        Sensitivity {
-            property: a.property.clone(),
-            as2fm: a.probability,
-            btcpp: b.probability,
-            difference,
-            sensitive,
-        }
-    }
 }

@@ -3,29 +3,9 @@
 //! schedulers, and which properties are order-sensitive.
 
 use super::{CliError, VerifyArgs};
-use crate::sim::{Memory, Scheduler};
-use crate::smc::stats::RuleKind;
-use crate::verify::fixed::fixed_study;
-use crate::verify::load::Loaded;
-use crate::verify::options::VerifyOptions;
+use crate::verify::options::{Memory, Scheduler};
 use crate::verify::result::Study;
-use crate::verify::sched_fixed::{run_all, run_stage, Plan, StageError};
-use crate::verify::schedulers::{bounds, explain, BoundsError, Stage};
-
-impl From<BoundsError> for CliError {
-    fn from(e: BoundsError) -> Self {
-        match e {
-            BoundsError::Rule(_) => CliError::Input(format!("--schedulers: {e}")),
-            _ => CliError::Input(e.to_string()),
-        }
-    }
-}
-
-impl From<StageError> for CliError {
-    fn from(e: StageError) -> Self {
-        CliError::Input(format!("--schedulers: {e}"))
-    }
-}
+use crate::verify::schedulers::{explain, Stage};
 
 /// What a sampled scheduler's choices depend on, as named on the command line.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
@@ -47,7 +27,7 @@ impl From<MemoryArg> for Memory {
 }
 
 /// A `--scheduler` value that names no scheduler: the text and what is wrong with it.
-pub use crate::sim::BadScheduler;
+pub use crate::verify::options::BadScheduler;
 
 /// Parses `--scheduler`: `uniform`, `memoryless:ID` or `history:ID` (with `+...`
 /// put-backs, as `--json` names them).
@@ -95,57 +75,22 @@ pub(super) fn check(args: &VerifyArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Runs the bounds of `--schedulers` and adds them to `report`'s rows, their progress on
-/// standard error when `show`; `Ok(false)` when interrupted.
-pub(super) fn add_bounds(
-    opts: &VerifyOptions,
-    show: bool,
-    loaded: &Loaded,
-    run_cfg: &crate::sim::RunConfig,
-    study_cfg: &crate::smc::StudyConfig,
-    report: &mut Study,
-    stop: &std::sync::atomic::AtomicBool,
-) -> Result<bool, CliError> {
-    let Some(sched) = &opts.schedulers else {
-        return Ok(true);
-    };
-    debug_assert!(!matches!(opts.rule.kind, RuleKind::Sprt { .. }));
-    let mut progress = |s: Stage<'_>| {
-        if !show {
-            return;
+/// A step of the bounds over schedulers, on standard error.
+pub(super) fn say_stage(s: Stage<'_>) {
+    match s {
+        Stage::Round { alive, runs } => {
+            eprintln!("schedulers: selecting among {alive}, {runs} runs each")
         }
-        match s {
-            Stage::Round { alive, runs } => {
-                eprintln!("schedulers: selecting among {alive}, {runs} runs each")
-            }
-            Stage::Estimate {
-                index,
-                of,
-                scheduler,
-            } => eprintln!("schedulers: fresh estimate {index}/{of} ({scheduler})"),
-            Stage::Sources { property } => eprintln!(
-                "schedulers: where the order of {property} comes from (choices put back to \
-                 uniform one kind at a time)"
-            ),
-        }
-    };
-    let found = bounds(
-        &loaded.model,
-        &loaded.set,
-        run_cfg,
-        study_cfg,
-        &opts.rule,
-        sched,
-        stop,
-        &mut progress,
-    )?;
-    let Some(found) = found else {
-        return Ok(false);
-    };
-    for (row, b) in report.properties.iter_mut().zip(found) {
-        row.schedulers = Some(b);
+        Stage::Estimate {
+            index,
+            of,
+            scheduler,
+        } => eprintln!("schedulers: fresh estimate {index}/{of} ({scheduler})"),
+        Stage::Sources { property } => eprintln!(
+            "schedulers: where the order of {property} comes from (choices put back to \
+             uniform one kind at a time)"
+        ),
     }
-    Ok(true)
 }
 
 /// The table of bounds under the study's table (nothing without `--schedulers`).
@@ -255,73 +200,4 @@ pub(super) fn print_bounds(r: &Study) {
         rows.len(),
         r.precision
     );
-}
-
-/// `verify --schedulers N --runs R [--shard I/K [--plan FILE]]`: the fixed-size scheduler
-/// study ([`crate::verify::sched_fixed`]). With `--shard`, runs that shard of the plan's
-/// current stage (stage 0 without `--plan`) and writes its part (`Ok(None)`); without,
-/// runs every stage here and returns the report `merge` gives for the shards.
-pub(super) fn run_fixed(
-    args: &VerifyArgs,
-    opts: &VerifyOptions,
-    loaded: &Loaded,
-    run_cfg: &crate::sim::RunConfig,
-    study_cfg: &crate::smc::StudyConfig,
-    runs: u64,
-) -> Result<Option<Study>, CliError> {
-    let Some(sched) = &opts.schedulers else {
-        return Ok(None);
-    };
-    let fixed = fixed_study(
-        loaded,
-        &args.input.model,
-        opts.seed,
-        run_cfg,
-        &opts.rule,
-        runs,
-    );
-    let plan = match &args.plan {
-        Some(p) => {
-            let text = crate::cli::read_file(p)?;
-            let plan: Plan = serde_json::from_str(&text).map_err(|e| {
-                CliError::Input(format!(
-                    "{}: not a scheduler study's plan: {e}",
-                    p.display()
-                ))
-            })?;
-            plan.check(&fixed, sched)
-                .map_err(|e| CliError::Input(format!("{}: {e}", p.display())))?;
-            plan
-        }
-        None => Plan::new(fixed, sched),
-    };
-    if let Some(shard) = args.shard {
-        let part = run_stage(&loaded.model, &loaded.set, run_cfg, study_cfg, &plan, shard)?;
-        let json =
-            serde_json::to_string(&part).map_err(|e| CliError::Failed(format!("json: {e}")))?;
-        match &args.partial {
-            Some(p) => std::fs::write(p, json)
-                .map_err(|e| CliError::Failed(format!("{}: {e}", p.display())))?,
-            None => println!("{json}"),
-        }
-        return Ok(None);
-    }
-    let show = !args.json;
-    let plan = run_all(
-        &loaded.model,
-        &loaded.set,
-        run_cfg,
-        study_cfg,
-        plan,
-        &mut |p: &Plan| {
-            if show {
-                eprintln!(
-                    "schedulers: stage {} ({} run ranges)",
-                    p.stage,
-                    p.jobs.len()
-                );
-            }
-        },
-    )?;
-    Ok(Some(plan.study()?))
 }
