@@ -433,7 +433,7 @@ pub struct Snippet {
 
 impl Snippet {
     /// The line of `text` holding byte `lo`, with carets under `lo..hi` (cut at the
-    /// line's end). A line longer than [`SNIPPET_WIDTH`] characters is cut to that
+    /// line's end). A line longer than `SNIPPET_WIDTH` characters is cut to that
     /// many around `lo`, `...` marking each cut: the work and the text are bounded
     /// whatever the line's length.
     pub fn of(text: &str, lo: usize, hi: usize) -> Snippet {
@@ -489,7 +489,7 @@ impl Snippet {
 
 /// The most characters of a source line a diagnostic shows: a longer line is cut
 /// around the problem.
-pub const SNIPPET_WIDTH: usize = 200;
+pub(crate) const SNIPPET_WIDTH: usize = 200;
 
 /// The most characters of a message a diagnostic prints: a longer one (a message
 /// quoting a huge attribute) is cut in the middle.

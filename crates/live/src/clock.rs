@@ -72,7 +72,7 @@ impl Clock {
     /// nearest tick instead of truncated: it starts half a tick of wall-clock time ago.
     /// A system that steps on whole ticks from now on is stamped on whole ticks despite
     /// up to half a tick of scheduling jitter either way.
-    pub fn anchor_now(&mut self) {
+    pub(crate) fn anchor_now(&mut self) {
         let half_tick_wall_ns =
             (self.tick_ns as u128 * 1_000_000 / (2 * self.speed_micros.max(1) as u128)) as u64;
         let now = Instant::now();
@@ -99,7 +99,7 @@ impl Clock {
 
     /// The tick the clock read `age` of wall-clock time ago, or `None` when that was
     /// before the clock started (see [`Clock::now`]).
-    pub fn ticks_ago(&self, age: Duration) -> Option<u64> {
+    pub(crate) fn ticks_ago(&self, age: Duration) -> Option<u64> {
         self.start.elapsed().checked_sub(age).map(|e| self.ticks(e))
     }
 

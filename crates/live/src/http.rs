@@ -74,7 +74,7 @@ pub struct Refusal(pub &'static str, pub &'static str);
 /// (or failed) before a whole head came, a [`Refusal`] for a head too long, too slow or
 /// malformed. Reads in pieces into one buffer never larger than `limits.head` plus one
 /// piece, against one deadline for the whole head (a byte now and then does not extend it).
-pub fn read_request(s: &TcpStream, limits: &Limits) -> Result<Option<Request>, Refusal> {
+pub(crate) fn read_request(s: &TcpStream, limits: &Limits) -> Result<Option<Request>, Refusal> {
     let deadline = Instant::now() + limits.request_time;
     let mut buf: Vec<u8> = Vec::with_capacity(1024);
     let mut piece = [0u8; 4096];
@@ -259,7 +259,7 @@ fn is_port(s: &str) -> bool {
 
 /// Writes all of `buf` to `s` by `deadline` (not per call: a reader that takes a byte now
 /// and then does not extend it); `TimedOut` when it passes.
-pub fn write_by(s: &TcpStream, mut buf: &[u8], deadline: Instant) -> std::io::Result<()> {
+pub(crate) fn write_by(s: &TcpStream, mut buf: &[u8], deadline: Instant) -> std::io::Result<()> {
     while !buf.is_empty() {
         let left = deadline.saturating_duration_since(Instant::now());
         if left.is_zero() {
@@ -281,7 +281,7 @@ pub fn write_by(s: &TcpStream, mut buf: &[u8], deadline: Instant) -> std::io::Re
 
 /// Writes `buf` in pieces of at most `limits.chunk` bytes, each by its own deadline of
 /// `limits.stall`: a connection makes progress or is closed.
-pub fn write_chunks(s: &TcpStream, buf: &[u8], limits: &Limits) -> std::io::Result<()> {
+pub(crate) fn write_chunks(s: &TcpStream, buf: &[u8], limits: &Limits) -> std::io::Result<()> {
     for piece in buf.chunks(limits.chunk.max(1)) {
         write_by(s, piece, Instant::now() + limits.stall)?;
     }

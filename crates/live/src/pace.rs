@@ -41,7 +41,7 @@ pub struct Paced<'n> {
 }
 
 impl Paced<'_> {
-    /// Reports the progress at model time `time` (at most every [`PROGRESS_EVERY`]
+    /// Reports the progress at model time `time` (at most every `PROGRESS_EVERY`
     /// unless `force`).
     pub fn progress(&mut self, time: u64, force: bool) {
         let (publisher, inbound) = (&self.publisher, &self.inbound);
@@ -59,7 +59,7 @@ impl Paced<'_> {
 }
 
 /// How often a paced run reports its progress.
-pub const PROGRESS_EVERY: Duration = Duration::from_millis(500);
+pub(crate) const PROGRESS_EVERY: Duration = Duration::from_millis(500);
 
 /// Where a paced run is, for the binary to draw as one line ([`RunProgress::line`]: `run:
 /// model time 1.5 s (1500 steps), 12 samples published, 3 received`).
@@ -93,7 +93,7 @@ impl RunProgress {
     }
 }
 
-/// Hands a paced run's [`RunProgress`] to a callback, at most every [`PROGRESS_EVERY`]
+/// Hands a paced run's [`RunProgress`] to a callback, at most every `PROGRESS_EVERY`
 /// unless forced: the observer's side of the progress line.
 pub struct ProgressReports<'p> {
     last: Instant,
@@ -101,7 +101,7 @@ pub struct ProgressReports<'p> {
 }
 
 impl<'p> ProgressReports<'p> {
-    /// Reports to `sink`, the first time [`PROGRESS_EVERY`] from now.
+    /// Reports to `sink`, the first time `PROGRESS_EVERY` from now.
     pub fn new(sink: impl FnMut(&RunProgress) + 'p) -> Self {
         ProgressReports {
             last: Instant::now(),

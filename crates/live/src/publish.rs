@@ -61,7 +61,7 @@ impl WireTy {
     }
 
     /// The sidecar's field type of the same bytes.
-    pub fn field_ty(self) -> super::config::FieldTy {
+    pub(crate) fn field_ty(self) -> super::config::FieldTy {
         match self {
             WireTy::Bool => super::config::FieldTy::Bool,
             WireTy::I64 => super::config::FieldTy::I64,
@@ -128,7 +128,7 @@ impl WireKind {
 
 /// The ROS name and kind of a model event that carries a ROS message, `None` for others:
 /// `topic_a__b_msg` -> (`a/b`, topic), `srv_s_request` -> (`s/request`, request), ...
-pub fn wire_name(event: &str) -> Option<(String, WireKind)> {
+pub(crate) fn wire_name(event: &str) -> Option<(String, WireKind)> {
     let table: [(&str, &str, &str, WireKind); 6] = [
         ("topic_", "_msg", "", WireKind::Topic),
         ("srv_", "_request", "/request", WireKind::Request),
@@ -219,7 +219,7 @@ impl TopicLayout {
     }
 }
 
-/// The layouts of every ROS message of `model` ([`wire_name`]), in event order, and a
+/// The layouts of every ROS message of `model` (`wire_name`), in event order, and a
 /// warning per field that cannot be laid out (strings, arrays, structs).
 pub fn layouts(model: &CompiledModel) -> (Vec<TopicLayout>, Vec<String>) {
     let mut out = Vec::new();
@@ -236,7 +236,7 @@ pub fn layouts(model: &CompiledModel) -> (Vec<TopicLayout>, Vec<String>) {
 
 /// The layout of any event's parameters, published under `topic` as a `kind`; a warning
 /// per field that cannot be laid out.
-pub fn layout_of(
+pub(crate) fn layout_of(
     model: &CompiledModel,
     event: EventId,
     topic: String,
@@ -284,7 +284,7 @@ pub fn layout_of(
 /// Names the spec variables of each layout after the property file's ports on the
 /// same event: a `<state_var>` on a field names that field's `var`, an `<event_var>`
 /// the topic's `event` (the first one wins).
-pub fn name_from_ports(layouts: &mut [TopicLayout], model: &CompiledModel, ports: &[Port]) {
+pub(crate) fn name_from_ports(layouts: &mut [TopicLayout], model: &CompiledModel, ports: &[Port]) {
     for l in layouts {
         for p in ports.iter().filter(|p| p.event == l.event_name) {
             match &p.kind {
@@ -312,7 +312,7 @@ fn field_name(param: &str) -> String {
 }
 
 /// A spec variable name for a field: `pose.x` → `pose_x`.
-pub fn default_var(field: &str) -> String {
+pub(crate) fn default_var(field: &str) -> String {
     field.replace('.', "_")
 }
 
@@ -335,8 +335,8 @@ fn toml_str(s: &str) -> String {
 /// The layouts as `[[topic]]` tables of the sidecar's config.
 ///
 /// A topic's `event` and a field's `var` are the property file's names when
-/// [`name_from_ports`] found them; otherwise the line (for a field, its whole
-/// table) is written commented out, with a suggested name ([`default_var`]), to
+/// `name_from_ports` found them; otherwise the line (for a field, its whole
+/// table) is written commented out, with a suggested name (`default_var`), to
 /// be named after the spec's variables and uncommented. A message the property file
 /// names nothing of is written commented out as a whole: tapping it would only cost.
 pub fn layout_toml(layouts: &[TopicLayout], prefix: &str) -> String {

@@ -89,7 +89,7 @@ impl RosTypes for BTreeMap<String, String> {
 /// subscribers, service servers and clients) in its node models and behavior-tree
 /// plugins, keyed `topic /a/b` and `service /s` (see [`RosTypes`]). A file that does not
 /// read is skipped: loading the model already reported it.
-pub fn declared_types(main: &crate::robot::main_file::MainFile) -> BTreeMap<String, String> {
+pub(crate) fn declared_types(main: &crate::robot::main_file::MainFile) -> BTreeMap<String, String> {
     fn walk(el: &crate::model::xml::Element, out: &mut BTreeMap<String, String>) {
         let key = match el.name.as_str() {
             "ros_topic_publisher" | "ros_topic_subscriber" => el
@@ -441,7 +441,7 @@ pub struct DdsPaced<'m> {
 
 impl DdsPaced<'_> {
     /// Reports the progress at model time `time` (at most every
-    /// [`super::pace::PROGRESS_EVERY`] unless `force`).
+    /// `super::pace::PROGRESS_EVERY` unless `force`).
     pub fn progress(&mut self, time: u64, force: bool) {
         let published = self.publisher.published();
         self.on_progress.report(force, || RunProgress {

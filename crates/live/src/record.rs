@@ -178,7 +178,7 @@ pub enum Input {
 }
 
 /// Value to JSON.
-pub fn value_json(spec: &Compiled, v: Value) -> serde_json::Value {
+pub(crate) fn value_json(spec: &Compiled, v: Value) -> serde_json::Value {
     match v {
         Value::Bool(b) => b.into(),
         Value::Int(i) => i.into(),
@@ -195,7 +195,10 @@ pub fn value_json(spec: &Compiled, v: Value) -> serde_json::Value {
 }
 
 /// Variable sets to a JSON object keyed by variable name.
-pub fn sets_json(spec: &Compiled, sets: &[(usize, Value)]) -> BTreeMap<String, serde_json::Value> {
+pub(crate) fn sets_json(
+    spec: &Compiled,
+    sets: &[(usize, Value)],
+) -> BTreeMap<String, serde_json::Value> {
     sets.iter()
         .map(|&(v, x)| (spec.vars()[v].name.clone(), value_json(spec, x)))
         .collect()
@@ -345,7 +348,7 @@ fn loss_event(reason: &str, source: &str) -> String {
 }
 
 /// The reason of a [`Input::Loss`] for a late sample.
-pub const LATE: &str = "late";
+pub(crate) const LATE: &str = "late";
 
 /// Parses an input log: every record with its line number (1-based); blank lines are
 /// skipped. Errors name `file:line:col`.

@@ -298,7 +298,7 @@ impl Packages {
     }
 
     /// [`Packages::discover`] with the files read kept in `sm`.
-    pub fn discover_in(
+    pub(crate) fn discover_in(
         sm: &mut SourceMap,
         path: &Path,
         interfaces: Vec<PathBuf>,

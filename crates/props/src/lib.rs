@@ -220,7 +220,8 @@ impl PropertyFile {
 pub const MAX_ID_LEN: usize = 200;
 
 /// What an id may hold, as the error at a bad one says it.
-pub const ID_RULE: &str = "an id of ASCII letters, digits, `_`, `-` and `.`, starting with a \
+pub(crate) const ID_RULE: &str =
+    "an id of ASCII letters, digits, `_`, `-` and `.`, starting with a \
      letter, digit or `_`, at most 200 characters (ids name CSV columns and the files of \
      `verify --save-failing`)";
 

@@ -47,7 +47,7 @@ pub struct Sweep {
 }
 
 /// The bound on a chart's x axis: model units, or seconds for a duration.
-pub fn bound_axis(bound: &str) -> Option<(f64, bool)> {
+pub(crate) fn bound_axis(bound: &str) -> Option<(f64, bool)> {
     use codegen::duration::StepsOrDuration;
     match codegen::duration::parse_steps_or_duration(bound).ok()? {
         StepsOrDuration::Steps(v) => Some((v as f64, false)),

@@ -113,7 +113,7 @@ pub fn svg(title: &str, x_label: &str, curves: &[Curve]) -> String {
 
 /// The same chart as an element to put inside an HTML page (no namespace attribute: the
 /// HTML parser gives `<svg>` its namespace, and the page names no URL).
-pub fn svg_element(title: &str, x_label: &str, curves: &[Curve]) -> String {
+pub(crate) fn svg_element(title: &str, x_label: &str, curves: &[Curve]) -> String {
     chart(title, x_label, curves, "")
 }
 

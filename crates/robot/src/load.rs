@@ -388,22 +388,8 @@ pub fn load_without(
 }
 
 /// [`load_without`] with the interface search given (`--interfaces` folders and the
-/// workspace prefixes; [`Search::from_env`] reads `AMENT_PREFIX_PATH`).
-pub fn load_searching(
-    main_path: &Path,
-    external: &[String],
-    search: &Search,
-) -> Result<(RobotModel, Vec<ExternalComponent>), Diagnostics> {
-    load_full(
-        main_path,
-        external,
-        Halts::default(),
-        BtSemantics::default(),
-        search,
-    )
-}
-
-/// [`load_searching`] with the behavior tree lowered under `semantics`.
+/// workspace prefixes; [`Search::from_env`] reads `AMENT_PREFIX_PATH`) and the behavior
+/// tree lowered under `semantics`.
 pub fn load_searching_bt(
     main_path: &Path,
     external: &[String],

@@ -52,10 +52,10 @@ use codegen::duration;
 use super::main_ignored::{close_to, Notes, PARAMETERS, SECTIONS};
 
 /// The BT tick rate AS2FM uses when `bt_tick_rate` is absent, in Hz.
-pub const DEFAULT_BT_TICK_RATE_HZ: f64 = 1.0;
+pub(crate) const DEFAULT_BT_TICK_RATE_HZ: f64 = 1.0;
 
 /// Whether AS2FM ticks a finished tree again when `bt_tick_if_not_running` is absent.
-pub const DEFAULT_BT_TICK_IF_NOT_RUNNING: bool = false;
+pub(crate) const DEFAULT_BT_TICK_IF_NOT_RUNNING: bool = false;
 
 /// The length bound of unbounded arrays AS2FM uses when `max_array_size` is absent.
 pub(crate) const DEFAULT_MAX_ARRAY_SIZE: u32 = 100;
@@ -155,9 +155,9 @@ pub struct Parameters {
     pub max_time_ns: Param<u64>,
     /// `max_array_size`: the length bound of unbounded arrays.
     pub max_array_size: Option<Param<u32>>,
-    /// `bt_tick_rate` (default [`DEFAULT_BT_TICK_RATE_HZ`]).
+    /// `bt_tick_rate` (default `DEFAULT_BT_TICK_RATE_HZ`).
     pub bt_tick_rate: Option<Param<TickRate>>,
-    /// `bt_tick_if_not_running` (default [`DEFAULT_BT_TICK_IF_NOT_RUNNING`]).
+    /// `bt_tick_if_not_running` (default `DEFAULT_BT_TICK_IF_NOT_RUNNING`).
     pub bt_tick_if_not_running: Option<Param<bool>>,
     /// Where the parameters element starts.
     pub span: Span,

@@ -495,7 +495,7 @@ fn read_mcap<E: From<BagError>>(
 /// The `mcap` crate's sans-I/O reader does the container (chunks, compression, the end
 /// magic) with a record length limit (a chunk may be 4096 times the file): its convenience iterators set
 /// none, and then reserve whatever length a corrupt record inside a chunk claims.
-pub fn mcap_bytes<E: From<BagError>>(
+pub(crate) fn mcap_bytes<E: From<BagError>>(
     bytes: &[u8],
     shown: &str,
     conns: &mut Vec<Connection>,

@@ -227,7 +227,7 @@ pub struct PathStep {
 }
 
 /// Parses a field path: `data`, `header.stamp.sec`, `cell_voltage[0]`, `a[2].b`.
-pub fn parse_path(path: &str) -> Result<Vec<PathStep>, FieldError> {
+pub(crate) fn parse_path(path: &str) -> Result<Vec<PathStep>, FieldError> {
     let bad = |why: &'static str| FieldError::Syntax {
         path: path.to_string(),
         why,
@@ -578,7 +578,7 @@ impl Decoder {
     }
 
     /// The field path slot `slot` reads.
-    pub fn slot_path(&self, slot: usize) -> &str {
+    pub(crate) fn slot_path(&self, slot: usize) -> &str {
         &self.slot_path[slot]
     }
 

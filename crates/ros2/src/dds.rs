@@ -198,7 +198,7 @@ pub fn service_topics(ros_service: &str) -> (String, String) {
 }
 
 /// The highest domain ROS 2 allows on Linux (its port mapping leaves room for 232).
-pub const MAX_DOMAIN_ID: u16 = 232;
+pub(crate) const MAX_DOMAIN_ID: u16 = 232;
 
 /// The domain: `ROS_DOMAIN_ID` (a number from 0 to 232), 0 when unset or empty.
 pub fn domain_id() -> Result<u16, DdsError> {
@@ -345,7 +345,7 @@ impl Qos {
 }
 
 /// The pause between two writers of one participant (see [`Participant::writer`]).
-pub const WRITER_PACE: std::time::Duration = std::time::Duration::from_millis(50);
+pub(crate) const WRITER_PACE: std::time::Duration = std::time::Duration::from_millis(50);
 
 /// A DDS participant on one domain, with one subscriber and one publisher.
 pub struct Participant {
@@ -460,7 +460,7 @@ impl Participant {
 
     /// A writer of ROS topic `ros_topic` of type `ros_type`.
     ///
-    /// Writers are created at most one per [`WRITER_PACE`]: rustdds 0.13's
+    /// Writers are created at most one per `WRITER_PACE`: rustdds 0.13's
     /// `create_datawriter` holds its discovery database's write lock while it hands the
     /// writer to the participant's event loop over a channel of 10, and that loop takes
     /// the same lock to drain it; creating writers faster than the loop drains them

@@ -5,7 +5,7 @@
 //!
 //! A [`Port`] binds a monitor variable to a topic: an event variable is true at each
 //! message of the topic, a state variable takes a field's value (a field path,
-//! [`crate::cdr::parse_path`]). A port of a service (`<ros_service service_name="/s"
+//! `crate::cdr::parse_path`). A port of a service (`<ros_service service_name="/s"
 //! event="request">`) reads the service's introspection topic `/s/_service_event` and
 //! only its events of one kind ([`ServiceSide`]): the request as the server received it
 //! (`REQUEST_RECEIVED`) or the response as the server sent it (`RESPONSE_SENT`), the

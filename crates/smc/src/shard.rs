@@ -64,7 +64,7 @@ use super::runner::{
 use super::stats::{Estimate, Interval, RuleConfig, StatsError};
 
 /// The `format` tag of partial result files.
-pub const PARTIAL_FORMAT: &str = "hindsight-partial-1";
+pub(crate) const PARTIAL_FORMAT: &str = "hindsight-partial-1";
 
 /// Slice `index` of `count` (`--shard index/count`, `index < count`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -251,7 +251,7 @@ pub struct PartialProperty {
 /// The result of one shard, as written to a JSON file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PartialResult {
-    /// Always [`PARTIAL_FORMAT`].
+    /// Always `PARTIAL_FORMAT`.
     pub format: String,
     /// The study this shard belongs to.
     pub study: FixedStudy,

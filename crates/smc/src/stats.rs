@@ -38,7 +38,7 @@ pub struct Interval {
 
 impl Interval {
     /// The whole `[0, 1]`: nothing is known.
-    pub const UNIT: Interval = Interval {
+    pub(crate) const UNIT: Interval = Interval {
         lower: 0.0,
         upper: 1.0,
     };
@@ -113,7 +113,7 @@ pub trait StoppingRule: fmt::Debug + Send + Sync {
     fn done(&self, successes: u64, runs: u64) -> bool;
 
     /// The confidence interval to report after `runs` judged runs
-    /// ([`Interval::UNIT`] when `runs == 0`).
+    /// (`Interval::UNIT` when `runs == 0`).
     fn interval(&self, successes: u64, runs: u64) -> Interval;
 
     /// The test's answer, for rules that answer a question ([`Sprt`]).

@@ -111,7 +111,7 @@ fn widened(
 /// declared)` makes of it), one formula per guarantee and then per assumption, and the
 /// time unit `unit_ns` (`None`: untimed). Used by [`PropertySet::with_unit`] and by
 /// `hindsight replay` over a recording, so a property file means the same to both.
-pub fn spec_input(
+pub(crate) fn spec_input(
     props: &PropertyFile,
     unit_ns: Option<u64>,
     mut state_type: impl FnMut(&crate::props::Port, &str, &str, &'static str) -> &'static str,

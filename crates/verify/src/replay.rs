@@ -186,7 +186,7 @@ pub fn save(out: &Path, failing: &[Failing]) -> std::io::Result<Vec<PathBuf>> {
 }
 
 /// Runs searched for a failing one under each scheduler (`witness_runs`).
-pub const SEARCH: u64 = 500;
+pub(crate) const SEARCH: u64 = 500;
 
 /// For `--report` with `--schedulers`: per order-sensitive property of `study`, the first
 /// failing run of `seed` under its minimising witness and the first under the uniform

@@ -51,9 +51,9 @@ use crate::smc::shard::{FixedStudy, MergedProperty, MergedResult, Shard};
 use crate::smc::{run_range, PropertyCounts, RangeCounts, StudyConfig};
 
 /// The `format` tag of a plan file.
-pub const PLAN_FORMAT: &str = "hindsight-scheduler-plan-1";
+pub(crate) const PLAN_FORMAT: &str = "hindsight-scheduler-plan-1";
 /// The `format` tag of a stage's partial result.
-pub const PART_FORMAT: &str = "hindsight-scheduler-partial-1";
+pub(crate) const PART_FORMAT: &str = "hindsight-scheduler-partial-1";
 
 /// Whose streams a job's runs use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -89,7 +89,7 @@ impl Job {
 /// The study's state between stages (see the module doc).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Plan {
-    /// Always [`PLAN_FORMAT`].
+    /// Always `PLAN_FORMAT`.
     pub format: String,
     /// The fixed-size study's identity (seed, `R`, fingerprints, properties and rules).
     pub study: FixedStudy,
@@ -117,7 +117,7 @@ pub struct Plan {
     /// Schedulers left out as unfair so far, in the order met.
     pub left_out: Vec<LeftOut>,
     /// The intervals each property's confidence is split over, fixed when the
-    /// confirmation starts ([`split_count`]).
+    /// confirmation starts (`split_count`).
     pub split_over: usize,
 }
 
@@ -188,7 +188,7 @@ impl std::error::Error for StageError {}
 /// One shard of one stage, as written to a JSON file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StagePart {
-    /// Always [`PART_FORMAT`].
+    /// Always `PART_FORMAT`.
     pub format: String,
     /// The plan the shard ran.
     pub plan: Plan,

@@ -15,7 +15,7 @@
 //!    property, the half of the survivors with the lowest estimate is kept as min
 //!    candidates and the half with the highest as max candidates, and the survivors get
 //!    more runs so that every round costs about the same (`N * R` runs), until
-//!    [`CANDIDATES`] remain per property and side. Runs of the selection use the streams
+//!    `CANDIDATES` remain per property and side. Runs of the selection use the streams
 //!    of a seed of their own (`mix(s, SELECT)`), the same run indices for every scheduler.
 //! 3. **Estimate.** Each remaining candidate is estimated afresh, by the study's stopping
 //!    rule on the streams of another seed (`mix(s, ESTIMATE)`), none of which the
@@ -61,7 +61,7 @@ use crate::smc::stats::RuleConfig;
 use crate::smc::{run_range, run_study_until, PropertyCounts, StudyConfig};
 
 /// Candidates kept per property and side (min, max) for the fresh estimate.
-pub const CANDIDATES: usize = 2;
+pub(crate) const CANDIDATES: usize = 2;
 
 /// Salts of the seeds derived from the study seed.
 const IDS: u64 = 0x5c4e_d01e_0000_0001;
@@ -128,7 +128,7 @@ pub struct SchedulerBounds {
     /// for every property: the bounds are over the others.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub left_out: u64,
-    /// The first of them (up to [`LEFT_OUT_SHOWN`]), in the order they were met.
+    /// The first of them (up to `LEFT_OUT_SHOWN`), in the order they were met.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub left_out_first: Vec<LeftOut>,
 }
@@ -138,7 +138,7 @@ fn is_zero(n: &u64) -> bool {
 }
 
 /// Left-out schedulers listed by name in the report.
-pub const LEFT_OUT_SHOWN: usize = 5;
+pub(crate) const LEFT_OUT_SHOWN: usize = 5;
 
 /// A sampled scheduler left out of the bounds as unfair.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -279,7 +279,7 @@ pub enum Stage<'a> {
 /// state advanced one round at a time, so that a round's runs can be run in one process
 /// ([`bounds`]) or as the shards of a stage ([`super::sched_fixed`]).
 ///
-/// Rounds run only while some side holds more than [`CANDIDATES`] schedulers: the
+/// Rounds run only while some side holds more than `CANDIDATES` schedulers: the
 /// counts of a round after which nothing is ranked would choose nothing.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Selection {
@@ -317,7 +317,7 @@ impl Selection {
         }
     }
 
-    /// Whether every side is down to [`CANDIDATES`] (no round left to run).
+    /// Whether every side is down to `CANDIDATES` (no round left to run).
     pub fn finished(&self) -> bool {
         self.sides
             .iter()
@@ -427,7 +427,7 @@ pub fn witnesses(
 /// The intervals each property's confidence is split over: the most candidates on a
 /// property's two sides (`2 K`; with schedulers left out a property's sides may hold
 /// fewer, and the most keeps the split valid for each).
-pub fn split_count(sides: &[[Vec<usize>; 2]]) -> usize {
+pub(crate) fn split_count(sides: &[[Vec<usize>; 2]]) -> usize {
     sides
         .iter()
         .map(|[low, high]| low.len() + high.len())

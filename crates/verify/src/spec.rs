@@ -34,7 +34,7 @@ pub struct PropertyMonitors {
 /// Reads a property file and compiles its guarantees and assumptions with time unit
 /// `unit_ns`: bounds with a unit (`within="1" time_unit="s"`, `[6.2s:]`) are converted
 /// exactly to it, as `verify` converts them to a model's unit
-/// ([`crate::observe::spec_input`]).
+/// (`crate::observe::spec_input`).
 pub fn compile_property_file(path: &Path, unit_ns: u64) -> Result<PropertyMonitors, Diagnostics> {
     let file = crate::props::parse_file(path).map_err(crate::load::props_diagnostics)?;
     let input = crate::observe::spec_input(&file, Some(unit_ns), |_, _, _, t| t)?;

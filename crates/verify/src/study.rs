@@ -167,7 +167,7 @@ pub enum Unfair {
     /// A model failure, as under the uniform scheduler (the study stops).
     #[default]
     Fail,
-    /// The run ends as failed without a failure message; [`Runner::unfair_run`] names
+    /// The run ends as failed without a failure message; `Runner::unfair_run` names
     /// it, so that the study leaves its scheduler out.
     LeaveOut,
     /// The run is kept: judged as it stands, as if the time horizon were the instant it
@@ -197,7 +197,7 @@ impl<'m> Runner<'m> {
 
     /// The first run (lowest index) of `scheduler` that blocked time and was left out
     /// ([`Unfair::LeaveOut`]), and why.
-    pub fn unfair_run(&self, scheduler: &Scheduler) -> Option<(u64, String)> {
+    pub(crate) fn unfair_run(&self, scheduler: &Scheduler) -> Option<(u64, String)> {
         let runs = self.unfair_runs.lock().ok()?;
         runs.get(&scheduler.to_string()).cloned()
     }

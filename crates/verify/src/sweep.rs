@@ -4,9 +4,9 @@
 //!
 //! A bound value is codegen's [`StepsOrDuration`] (model steps, or an exact duration):
 //! [`grid`] reads the range, [`variants`] writes one guarantee per value with every bound
-//! end of its formula replaced ([`set_bounds`]), [`sweep_study`] judges them on one
-//! study's runs (or [`points_from_counts`] on counts found elsewhere, the recorded logs
-//! of `sweep --online`), and [`threshold_index`] finds the threshold.
+//! end of its formula replaced ([`set_bounds`]), [`sweep`] judges each guarantee's
+//! variants on one study's runs (or [`sweep_recorded`] on recorded runs, the logs of
+//! `sweep --online`), and [`threshold_index`] finds each curve's threshold.
 //!
 //! ```
 //! use hindsight_verify::codegen::duration::StepsOrDuration;
@@ -45,7 +45,7 @@ pub enum SweepError {
     Mixed,
     /// `--from` above `--to`, or a step of zero.
     Empty,
-    /// More values than [`MAX_VALUES`].
+    /// More values than `MAX_VALUES`.
     TooMany(u64),
     /// No guarantee of that name in the property file.
     NoGuarantee {
@@ -102,11 +102,11 @@ impl fmt::Display for SweepError {
 impl std::error::Error for SweepError {}
 
 /// The most values one sweep takes.
-pub const MAX_VALUES: u64 = 1000;
+pub(crate) const MAX_VALUES: u64 = 1000;
 
 /// Parses a bound value: `62` (steps), `6.2s`, `100ms`, `1.5min`, `250us`, `10ns`
 /// ([`parse_steps_or_duration`]).
-pub fn parse_bound(text: &str) -> Result<StepsOrDuration, SweepError> {
+pub(crate) fn parse_bound(text: &str) -> Result<StepsOrDuration, SweepError> {
     parse_steps_or_duration(text).map_err(SweepError::Bound)
 }
 
@@ -119,7 +119,7 @@ pub fn bound_text(v: StepsOrDuration) -> String {
 }
 
 /// The text put into the formula (exact: nanoseconds for durations).
-pub fn formula_text(v: StepsOrDuration) -> String {
+pub(crate) fn formula_text(v: StepsOrDuration) -> String {
     match v {
         StepsOrDuration::Steps(v) => v.to_string(),
         StepsOrDuration::Nanos(v) => format!("{v}ns"),
@@ -170,7 +170,7 @@ fn default_step(text: &str) -> Result<StepsOrDuration, SweepError> {
 }
 
 /// The values from `from` to `to` (inclusive) in steps of `step` (default: one unit of
-/// `from`'s last digit); all three of one kind, at most [`MAX_VALUES`].
+/// `from`'s last digit); all three of one kind, at most `MAX_VALUES`.
 pub fn grid(from: &str, to: &str, step: Option<&str>) -> Result<Vec<StepsOrDuration>, SweepError> {
     let a = parse_bound(from)?;
     let b = parse_bound(to)?;
@@ -335,7 +335,7 @@ pub fn variants(
 /// Judges `set` (the [`variants`] of one guarantee, compiled) on one study of
 /// `study_cfg.max_runs` runs: one point per value of `values`.
 #[allow(clippy::too_many_arguments)]
-pub fn sweep_study(
+pub(crate) fn sweep_study(
     model: &CompiledModel,
     set: &PropertySet,
     values: &[StepsOrDuration],
@@ -362,7 +362,7 @@ pub fn sweep_study(
 
 /// One point per value from counts found without a study (`sweep --online`: one run per
 /// recorded log), with `rule`'s estimate and interval (widened over unknown runs).
-pub fn points_from_counts(
+pub(crate) fn points_from_counts(
     values: &[StepsOrDuration],
     counts: &[PropertyCounts],
     rule: &RuleConfig,

@@ -149,7 +149,7 @@ impl Primitive {
     }
 
     /// Whether it is `string` or `wstring`.
-    pub fn is_string(self) -> bool {
+    pub(crate) fn is_string(self) -> bool {
         matches!(self, Primitive::String | Primitive::WString)
     }
 
@@ -261,7 +261,7 @@ impl InterfaceDef {
 
 impl Primitive {
     /// The name as written in a `.msg` file.
-    pub fn msg_name(self) -> &'static str {
+    pub(crate) fn msg_name(self) -> &'static str {
         match self {
             Primitive::Byte => "byte",
             Primitive::Char => "char",

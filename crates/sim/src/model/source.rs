@@ -53,7 +53,7 @@ pub fn unescaped_offset(sm: &SourceMap, span: Span, k: u32) -> Span {
 /// when `rest` does not start with `&`. The one scanner of references, used by the
 /// XML tree (`model::xml`, attribute values of every XML file read), by the property
 /// reader's position-keeping unescaping (formulas, element text) and by
-/// [`unescaped_offset`]; names are decoded by [`resolve_entity`].
+/// [`unescaped_offset`]; names are decoded by `resolve_entity`.
 pub fn reference(rest: &str) -> Option<Result<(char, usize), BadReference>> {
     let after = rest.strip_prefix('&')?;
     // A name longer than any entity or reasonable character reference is taken as a
@@ -93,7 +93,7 @@ impl std::error::Error for BadReference {}
 /// The character an XML entity name (without `&` and `;`) stands for: the five
 /// predefined entities and character references (`&#65;`, `&#x41;`). `&#0;` is `None`:
 /// U+0000 is not an XML character (XML 1.0, production `Char`). The one entity decoder.
-pub fn resolve_entity(name: &str) -> Option<char> {
+pub(crate) fn resolve_entity(name: &str) -> Option<char> {
     match name {
         "lt" => Some('<'),
         "gt" => Some('>'),
