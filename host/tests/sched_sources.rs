@@ -139,6 +139,48 @@ fn a_race_of_deliveries_is_put_down_to_the_delivery_order_not_the_machine_order(
     );
 }
 
+/// A fixed-size study (`--runs R`, which also runs as shards) estimates where the order
+/// comes from in two more stages, `R` runs per witness and choice: the same hand-derived
+/// answers as the sequential study's.
+#[test]
+fn a_fixed_size_study_finds_where_the_order_comes_from_too() {
+    let (r, table) = verify(&["verify", RACE, "--schedulers", "16", "--runs", "600"]);
+    let s = &prop(&r, "a_wins")["schedulers"];
+    assert_eq!(s["order_sensitive"], true, "{s}");
+    for (w, base) in [("min", 0.0), ("max", 1.0)] {
+        let kind = source(s, w, "machine", None).expect("machine order");
+        assert!((p(kind) - 0.5).abs() < 0.07, "{w}: {kind}");
+        assert!((kind["shift"].as_f64().unwrap() - (0.5 - base)).abs() < 0.07);
+        assert!(source(s, w, "delivery", None).is_none());
+    }
+    let a = source(s, "min", "machine", Some("a")).expect("a on the min witness");
+    assert!(a["shift"].as_f64().unwrap() > 0.3, "{a}");
+    let b = source(s, "max", "machine", Some("b")).expect("b on the max witness");
+    assert!(b["shift"].as_f64().unwrap() < -0.3, "{b}");
+    assert!(prop(&r, "someone_wins")["schedulers"]
+        .get("sources")
+        .is_none());
+    assert!(table.contains("moves first"), "{table}");
+
+    let (r, _) = verify(&[
+        "verify",
+        DELIVERY,
+        "--events",
+        "as2fm",
+        "--schedulers",
+        "16",
+        "--runs",
+        "600",
+    ]);
+    let s = &prop(&r, "a_wins")["schedulers"];
+    let kind = source(s, "min", "delivery", None).expect("delivery order");
+    assert!((p(kind) - 0.5).abs() < 0.07, "{kind}");
+    for e in ["ea", "eb"] {
+        let one = source(s, "min", "delivery", Some(e)).expect("an event");
+        assert!((p(one) - 0.5).abs() < 0.07, "{e}: {one}");
+    }
+}
+
 #[test]
 fn a_bad_override_in_a_scheduler_id_is_refused_with_the_forms_it_takes() {
     let (code, _, err) = hindsight(&["verify", RACE, "--scheduler", "memoryless:12+sideways"]);

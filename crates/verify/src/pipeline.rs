@@ -36,7 +36,7 @@ use crate::observe::JudgeError;
 use crate::options::VerifyOptions;
 use crate::replay::{failing_runs, save, witness_runs, Failing, ReplayError};
 use crate::result::{PropertyRow, Study};
-use crate::sched_fixed::{run_all, run_stage, Plan, StageError};
+use crate::sched_fixed::{run_all, run_stage, Choices, Plan, StageError};
 use crate::schedulers::{bounds, BoundsError, Stage};
 use crate::sim::RunConfig;
 use crate::smc::shard::{merge, Shard, ShardError};
@@ -254,7 +254,7 @@ pub fn verify(
                     .map_err(|e| VerifyError::Plan(path.into(), e.to_string()))?;
                 plan
             }
-            None => Plan::new(fixed, sched),
+            None => Plan::new(fixed, sched, Choices::of(&loaded.model, &run_cfg)),
         };
         if let Some(shard) = request.shard {
             let part = run_stage(

@@ -19,9 +19,15 @@
 //!    instead of the rule's stopping point (a stopping point is a sequential decision that
 //!    one shard cannot take alone).
 //!
-//! After the last stage the plan holds everything the report needs. Where the order comes
-//! from (the sequential study's `sources`) is not estimated: it needs runs chosen after the
-//! bounds, one more stage per level.
+//! 4. where the order comes from, for the order-sensitive properties only: runs `0..R` of
+//!    each witness on the estimate seed with one kind of choice put back to uniform
+//!    (which machine moves; which pending event is delivered, under AS2FM's semantics;
+//!    which enabled transition fires, with random transitions), as the sequential study's
+//!    `sources` but with `R` runs each;
+//! 5. for a kind that moved a witness's probability by more than twice the precision,
+//!    each machine's (event's) position alone put back, `R` runs each.
+//!
+//! After the last stage the plan holds everything the report needs.
 //!
 //! # Shards
 //!
@@ -42,18 +48,24 @@ use serde::{Deserialize, Serialize};
 use super::observe::PropertySet;
 use super::schedulers::{
     sampled, split_count, split_rule, witnesses, Bound, BoundsError, LeftOut, SchedulerBounds,
-    SchedulerOptions, Selection, ESTIMATE, LEFT_OUT_SHOWN, SELECT,
+    SchedulerOptions, Selection, Source, ESTIMATE, LEFT_OUT_SHOWN, SELECT,
 };
 use super::study::{Runner, Unfair};
-use crate::sim::{mix, CompiledModel, Memory, RunConfig, Scheduler};
+use crate::sim::{
+    mix, CompiledModel, EventId, EventSemantics, MachineId, Memory, PutBack, RunConfig, Scheduler,
+    TransitionChoice,
+};
+
+/// An estimate and its interval.
+type Estimated = (Option<f64>, [f64; 2]);
 use crate::smc::runner::widened_interval;
 use crate::smc::shard::{FixedStudy, MergedProperty, MergedResult, Shard};
 use crate::smc::{run_range, PropertyCounts, RangeCounts, StudyConfig};
 
 /// The `format` tag of a plan file.
-pub(crate) const PLAN_FORMAT: &str = "hindsight-scheduler-plan-1";
+pub(crate) const PLAN_FORMAT: &str = "hindsight-scheduler-plan-2";
 /// The `format` tag of a stage's partial result.
-pub(crate) const PART_FORMAT: &str = "hindsight-scheduler-partial-1";
+pub(crate) const PART_FORMAT: &str = "hindsight-scheduler-partial-2";
 
 /// Whose streams a job's runs use.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -78,6 +90,145 @@ pub struct Job {
     pub start: u64,
     /// End of the run indices (exclusive).
     pub end: u64,
+    /// The choices put back to uniform in the scheduler (the sources' stages).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub put_back: Option<Uniform>,
+}
+
+/// [`PutBack`] as a plan file holds it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Uniform {
+    /// Which runnable machine moves.
+    #[serde(default)]
+    pub machines: bool,
+    /// Which deliverable event is delivered.
+    #[serde(default)]
+    pub events: bool,
+    /// Which enabled transition fires.
+    #[serde(default)]
+    pub transitions: bool,
+    /// This machine's position.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub machine: Option<u32>,
+    /// This event's position.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub event: Option<u32>,
+}
+
+impl From<Uniform> for PutBack {
+    fn from(u: Uniform) -> PutBack {
+        PutBack {
+            machines: u.machines,
+            events: u.events,
+            transitions: u.transitions,
+            machine: u.machine,
+            event: u.event,
+        }
+    }
+}
+
+/// What the sources of an order-sensitive property may put back, read from the model
+/// and the run's semantics when the study starts (a plan is merged without the model).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Choices {
+    /// Every machine's name, by id.
+    pub machines: Vec<String>,
+    /// The events some machine receives: id and name.
+    pub events: Vec<(u32, String)>,
+    /// Which pending event is delivered is a choice (AS2FM's semantics).
+    pub deliveries: bool,
+    /// Which enabled transition fires is a choice (random transitions).
+    pub transitions: bool,
+}
+
+impl Choices {
+    /// The choices of `model` run with `run_cfg`.
+    pub fn of(model: &CompiledModel, run_cfg: &RunConfig) -> Choices {
+        Choices {
+            machines: (0..model.machine_count() as u32)
+                .map(|m| model.machine_name(MachineId(m)).to_string())
+                .collect(),
+            events: (0..model.event_count() as u32)
+                .filter(|&e| model.event_receivers(EventId(e)).next().is_some())
+                .map(|e| (e, model.event_name(EventId(e)).to_string()))
+                .collect(),
+            deliveries: run_cfg.events == EventSemantics::As2fm,
+            transitions: run_cfg.transitions == TransitionChoice::Random,
+        }
+    }
+
+    /// The kinds of choice put back one at a time, with their names in a [`Source`].
+    fn kinds(&self) -> Vec<(&'static str, Uniform)> {
+        let none = Uniform::default();
+        [
+            (
+                "machine",
+                true,
+                Uniform {
+                    machines: true,
+                    ..none
+                },
+            ),
+            (
+                "delivery",
+                self.deliveries,
+                Uniform {
+                    events: true,
+                    ..none
+                },
+            ),
+            (
+                "transition",
+                self.transitions,
+                Uniform {
+                    transitions: true,
+                    ..none
+                },
+            ),
+        ]
+        .into_iter()
+        .filter_map(|(choice, made, u)| made.then_some((choice, u)))
+        .collect()
+    }
+
+    /// Each machine's (`machine`) or event's (`delivery`) position alone, with its name.
+    fn items(&self, choice: &str) -> Vec<(Uniform, Option<String>, Option<String>)> {
+        match choice {
+            "machine" => (0..self.machines.len() as u32)
+                .map(|m| {
+                    let u = Uniform {
+                        machine: Some(m),
+                        ..Uniform::default()
+                    };
+                    (u, Some(self.machines[m as usize].clone()), None)
+                })
+                .collect(),
+            "delivery" => self
+                .events
+                .iter()
+                .map(|(e, name)| {
+                    let u = Uniform {
+                        event: Some(*e),
+                        ..Uniform::default()
+                    };
+                    (u, None, Some(name.clone()))
+                })
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+}
+
+/// The counts of one witness with choices put back (`None`: a run blocked time, so the
+/// source is left out, as the sequential study leaves it out).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SourceCounts {
+    /// The witness's index in the study.
+    pub scheduler: usize,
+    /// What was put back.
+    pub put_back: Uniform,
+    /// Per property, its counts.
+    pub counts: Option<Vec<PropertyCounts>>,
 }
 
 impl Job {
@@ -119,6 +270,12 @@ pub struct Plan {
     /// The intervals each property's confidence is split over, fixed when the
     /// confirmation starts (`split_count`).
     pub split_over: usize,
+    /// What the sources may put back.
+    pub choices: Choices,
+    /// The sources' stages run so far: 0, 1 (the kinds) or 2 (the positions).
+    pub sources_level: u8,
+    /// The sources' counts, in job order.
+    pub sources: Vec<SourceCounts>,
 }
 
 /// A job's first run (lowest index) that blocked time, and why.
@@ -200,8 +357,9 @@ pub struct StagePart {
 }
 
 impl Plan {
-    /// Stage 0 of the study `study` with the options of `--schedulers`.
-    pub fn new(study: FixedStudy, opts: &SchedulerOptions) -> Plan {
+    /// Stage 0 of the study `study` with the options of `--schedulers`, on a model whose
+    /// choices are `choices`.
+    pub fn new(study: FixedStudy, opts: &SchedulerOptions, choices: Choices) -> Plan {
         let props = study.properties.len();
         let n = opts.count.max(1) as usize;
         let mut plan = Plan {
@@ -216,6 +374,7 @@ impl Plan {
                 streams: Streams::Study,
                 start: 0,
                 end: study.study_runs,
+                put_back: None,
             }],
             selecting: false,
             uniform: None,
@@ -223,6 +382,9 @@ impl Plan {
             fresh: Vec::new(),
             left_out: Vec::new(),
             split_over: 2,
+            choices,
+            sources_level: 0,
+            sources: Vec::new(),
             study,
         };
         plan.next_jobs();
@@ -246,8 +408,15 @@ impl Plan {
     fn scheduler(&self, job: &Job) -> Scheduler {
         match job.scheduler {
             None => Scheduler::Uniform,
-            Some(i) => Scheduler::Sampled(sampled(self.study.seed, i as u64, self.memory())),
+            Some(i) => self.witness(i, job.put_back.unwrap_or_default()),
         }
+    }
+
+    /// Sampled scheduler `i` with `put_back` put back to uniform.
+    fn witness(&self, i: usize, put_back: Uniform) -> Scheduler {
+        let mut w = sampled(self.study.seed, i as u64, self.memory());
+        w.uniform = put_back.into();
+        Scheduler::Sampled(w)
     }
 
     /// The seed of a job's streams.
@@ -275,6 +444,7 @@ impl Plan {
                 streams: Streams::Selection,
                 start: range.start,
                 end: range.end,
+                put_back: None,
             }));
             return;
         }
@@ -286,6 +456,7 @@ impl Plan {
                 streams: Streams::Estimate,
                 start: 0,
                 end: r,
+                put_back: None,
             }));
         }
     }
@@ -295,8 +466,17 @@ impl Plan {
     pub fn advance(&mut self, results: Vec<(RangeCounts, UnfairRun)>) {
         let jobs = std::mem::take(&mut self.jobs);
         let selecting = self.selecting;
+        let sourcing = jobs.iter().any(|j| j.put_back.is_some());
         let mut confirmed = false;
         for (job, (got, unfair)) in jobs.iter().zip(results) {
+            if let (Some(put_back), Some(i)) = (job.put_back, job.scheduler) {
+                self.sources.push(SourceCounts {
+                    scheduler: i,
+                    put_back,
+                    counts: unfair.is_none().then_some(got.properties),
+                });
+                continue;
+            }
             if let (Some(i), Some((run, reason))) = (job.scheduler, unfair) {
                 self.left_out.push(LeftOut {
                     scheduler: self.scheduler(job).to_string(),
@@ -326,9 +506,142 @@ impl Plan {
             self.selection.halve();
         }
         self.stage += 1;
-        if !confirmed {
+        if sourcing {
+            if self.sources_level == 1 {
+                self.sources_level = 2;
+                self.position_jobs();
+            }
+        } else if confirmed {
+            self.sources_level = 1;
+            self.kind_jobs();
+        } else {
             self.next_jobs();
         }
+    }
+
+    /// The jobs of the sources' first stage: each order-sensitive property's witnesses
+    /// with each kind of choice put back (none when no property is order-sensitive).
+    fn kind_jobs(&mut self) {
+        let Ok(bounds) = self.bounds() else {
+            return;
+        };
+        let kinds = self.choices.kinds();
+        let mut jobs: Vec<Job> = Vec::new();
+        for (b, witnesses) in &bounds {
+            if !b.order_sensitive {
+                continue;
+            }
+            for &i in witnesses {
+                for (_, u) in &kinds {
+                    self.push_source_job(&mut jobs, i, *u);
+                }
+            }
+        }
+        self.jobs = jobs;
+    }
+
+    /// The jobs of the sources' second stage: for each kind that moved a witness's
+    /// probability by more than twice the precision, each machine's (event's) position.
+    fn position_jobs(&mut self) {
+        let Ok(bounds) = self.bounds() else {
+            return;
+        };
+        let mut jobs: Vec<Job> = Vec::new();
+        for (p, (b, witnesses)) in bounds.iter().enumerate() {
+            if !b.order_sensitive {
+                continue;
+            }
+            for (&i, base) in witnesses.iter().zip([&b.min, &b.max]) {
+                for (choice, u) in self.choices.kinds() {
+                    if self.source_matters(p, i, u, base.probability) {
+                        for (item, _, _) in self.choices.items(choice) {
+                            self.push_source_job(&mut jobs, i, item);
+                        }
+                    }
+                }
+            }
+        }
+        self.jobs = jobs;
+    }
+
+    /// Adds the job of witness `i` with `put_back` (runs `0..R` on the estimate seed)
+    /// unless another property asked for it already.
+    fn push_source_job(&self, jobs: &mut Vec<Job>, i: usize, put_back: Uniform) {
+        let job = Job {
+            scheduler: Some(i),
+            streams: Streams::Estimate,
+            start: 0,
+            end: self.study.study_runs,
+            put_back: Some(put_back),
+        };
+        if !jobs.contains(&job) {
+            jobs.push(job);
+        }
+    }
+
+    /// Property `p`'s estimate and interval (at the study's confidence, on its own) under
+    /// witness `i` with `put_back`: `None` when not run or left out (a run blocked time).
+    fn source_estimate(&self, p: usize, i: usize, put_back: Uniform) -> Option<Estimated> {
+        let found = self
+            .sources
+            .iter()
+            .find(|s| s.scheduler == i && s.put_back == put_back)?;
+        let c = found.counts.as_ref()?.get(p)?;
+        let rule = self.study.properties.get(p)?.rule.build().ok()?;
+        let iv = widened_interval(rule.as_ref(), c);
+        Some((
+            rule.estimate(c.successes, c.judged()).estimate,
+            [iv.lower, iv.upper],
+        ))
+    }
+
+    /// Whether putting `put_back` back moved property `p`'s probability under witness `i`
+    /// (`base`) by more than twice the precision (a kind whose positions are run next).
+    fn source_matters(&self, p: usize, i: usize, put_back: Uniform, base: Option<f64>) -> bool {
+        let precision = self.study.properties[p].rule.precision;
+        self.source_estimate(p, i, put_back)
+            .is_some_and(|(probability, _)| {
+                (probability.unwrap_or(0.0) - base.unwrap_or(0.0)).abs() > 2.0 * precision
+            })
+    }
+
+    /// Property `p`'s sources, as the sequential study lists them: per witness (min, then
+    /// max), each kind, then, for a kind that matters, each position, in id order.
+    fn sources_of(&self, p: usize, b: &SchedulerBounds, witnesses: [usize; 2]) -> Vec<Source> {
+        let mut out = Vec::new();
+        for ((side, &i), base) in ["min", "max"].iter().zip(&witnesses).zip([&b.min, &b.max]) {
+            let source = |u: Uniform, machine, event, (probability, interval): Estimated| Source {
+                witness: side.to_string(),
+                choice: String::new(),
+                machine,
+                event,
+                probability,
+                interval,
+                shift: probability.unwrap_or(0.0) - base.probability.unwrap_or(0.0),
+                scheduler: self.witness(i, u).to_string(),
+            };
+            for (choice, u) in self.choices.kinds() {
+                let Some(est) = self.source_estimate(p, i, u) else {
+                    continue;
+                };
+                out.push(Source {
+                    choice: choice.to_string(),
+                    ..source(u, None, None, est)
+                });
+                if choice == "transition" || !self.source_matters(p, i, u, base.probability) {
+                    continue;
+                }
+                for (item, machine, event) in self.choices.items(choice) {
+                    if let Some(est) = self.source_estimate(p, i, item) {
+                        out.push(Source {
+                            choice: choice.to_string(),
+                            ..source(item, machine, event, est)
+                        });
+                    }
+                }
+            }
+        }
+        out
     }
 
     /// The result of a finished study: the uniform study as `merge` reports a
@@ -349,18 +662,6 @@ impl Plan {
         if !self.done() {
             return Err(unfinished);
         }
-        if self
-            .selection
-            .sides
-            .iter()
-            .flatten()
-            .any(|side| side.is_empty())
-        {
-            return Err(BoundsError::AllUnfair {
-                left_out: self.left_out.len() as u64,
-                sampled: self.schedulers,
-            });
-        }
         let uniform = self.uniform.as_ref().ok_or(BoundsError::Unfinished(0))?;
         let mut properties = Vec::new();
         for (spec, counts) in self.study.properties.iter().zip(&uniform.properties) {
@@ -380,6 +681,35 @@ impl Plan {
             properties,
             runs: uniform.runs,
         };
+        let bounds = self
+            .bounds()?
+            .into_iter()
+            .enumerate()
+            .map(|(p, (mut b, witnesses))| {
+                if b.order_sensitive {
+                    b.sources = self.sources_of(p, &b, witnesses);
+                }
+                b
+            })
+            .collect();
+        Ok((merged, bounds))
+    }
+
+    /// Each property's bounds after the confirmation (no sources yet) and its witnesses
+    /// (scheduler indices, min then max): an error with a side emptied by unfair ones.
+    fn bounds(&self) -> Result<Vec<(SchedulerBounds, [usize; 2])>, BoundsError> {
+        if self
+            .selection
+            .sides
+            .iter()
+            .flatten()
+            .any(|side| side.is_empty())
+        {
+            return Err(BoundsError::AllUnfair {
+                left_out: self.left_out.len() as u64,
+                sampled: self.schedulers,
+            });
+        }
         let sides = &self.selection.sides;
         let fresh = |i: usize| self.fresh.iter().find(|(j, _)| *j == i).map(|(_, c)| c);
         let mut bounds = Vec::new();
@@ -398,14 +728,7 @@ impl Plan {
                 Some(Bound {
                     probability: estimate(i),
                     interval: [iv.lower, iv.upper],
-                    scheduler: self
-                        .scheduler(&Job {
-                            scheduler: Some(i),
-                            streams: Streams::Estimate,
-                            start: 0,
-                            end: 0,
-                        })
-                        .to_string(),
+                    scheduler: self.witness(i, Uniform::default()).to_string(),
                     runs: c.judged(),
                     successes: c.successes,
                 })
@@ -417,18 +740,21 @@ impl Plan {
                 (Some(a), Some(b)) => b - a > 2.0 * spec.rule.precision,
                 _ => false,
             };
-            bounds.push(SchedulerBounds {
-                sampled: self.schedulers,
-                memory: self.memory.clone(),
-                min,
-                max,
-                order_sensitive,
-                sources: Vec::new(),
-                left_out: self.left_out.len() as u64,
-                left_out_first: self.left_out.iter().take(LEFT_OUT_SHOWN).cloned().collect(),
-            });
+            bounds.push((
+                SchedulerBounds {
+                    sampled: self.schedulers,
+                    memory: self.memory.clone(),
+                    min,
+                    max,
+                    order_sensitive,
+                    sources: Vec::new(),
+                    left_out: self.left_out.len() as u64,
+                    left_out_first: self.left_out.iter().take(LEFT_OUT_SHOWN).cloned().collect(),
+                },
+                [lo, hi],
+            ));
         }
-        Ok((merged, bounds))
+        Ok(bounds)
     }
 
     /// Checks that this plan is the study `study` with options `opts` (the paths may
