@@ -99,6 +99,8 @@ pub enum Event<'a> {
     Stage {
         /// The stage.
         stage: u32,
+        /// What it runs ([`Plan::stage_kind`]).
+        kind: &'static str,
         /// Its run ranges.
         jobs: usize,
     },
@@ -278,6 +280,7 @@ pub fn verify(
             &mut |p: &Plan| {
                 event(Event::Stage {
                     stage: p.stage,
+                    kind: p.stage_kind(),
                     jobs: p.jobs.len(),
                 })
             },

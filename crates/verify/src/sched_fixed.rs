@@ -391,6 +391,22 @@ impl Plan {
         plan
     }
 
+    /// What the current stage runs: `selection`, `confirmation` or `sources` (where the
+    /// order comes from); `done` after the last.
+    pub fn stage_kind(&self) -> &'static str {
+        if self.done() {
+            "done"
+        } else if self.jobs.iter().any(|j| j.streams == Streams::Study) {
+            "uniform study and selection"
+        } else if self.selecting {
+            "selection"
+        } else if self.jobs.iter().any(|j| j.put_back.is_some()) {
+            "sources"
+        } else {
+            "confirmation"
+        }
+    }
+
     /// Whether every stage was run.
     pub fn done(&self) -> bool {
         self.jobs.is_empty()

@@ -493,8 +493,8 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         &mut |e| match e {
             Event::Runs(p) => bar.update(p),
             Event::Bounds(s) if show => schedulers::say_stage(s),
-            Event::Stage { stage, jobs } if show => {
-                eprintln!("schedulers: stage {stage} ({jobs} run ranges)")
+            Event::Stage { stage, kind, jobs } if show => {
+                eprintln!("schedulers: stage {stage}, {kind} ({jobs} run ranges)")
             }
             _ => {}
         },

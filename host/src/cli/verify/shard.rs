@@ -55,10 +55,11 @@ pub fn merge(args: &MergeArgs) -> Result<(), CliError> {
             std::fs::write(next, json)
                 .map_err(|e| CliError::Failed(format!("{}: {e}", next.display())))?;
             eprintln!(
-                "merge: stage {} merged; stage {} has {} run ranges: run every shard with \
-                 --plan {}, then merge their parts",
+                "merge: stage {} merged; stage {} ({}) has {} run ranges: run every shard \
+                 with --plan {}, then merge their parts",
                 plan.stage - 1,
                 plan.stage,
+                plan.stage_kind(),
                 plan.jobs.len(),
                 next.display()
             );
