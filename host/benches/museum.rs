@@ -137,6 +137,7 @@ impl Case {
             events: EventSemantics::As2fm,
             bt_notes: Vec::new(),
             warnings: Default::default(),
+            options: Default::default(),
         };
         Some([high, Case::of("uc3 AS2FM plain (corpus)", loaded, None)])
     }
@@ -161,6 +162,7 @@ impl Case {
             events: EventSemantics::As2fm,
             bt_notes: Vec::new(),
             warnings: Default::default(),
+            options: Default::default(),
         };
         Case::of(name, loaded, None)
     }

@@ -1,6 +1,6 @@
 //! `hindsight verify --schedulers N` and `--scheduler ID` end to end: the JSON shape, the
-//! witness replayed by `verify`, `trace` and `sweep`, the same numbers on any thread
-//! count, and the combinations refused with a reason.
+//! witness replayed by `verify`, `trace`, `sweep` and `report`, the same numbers on any
+//! thread count, and the combinations refused with a reason.
 
 mod common;
 
@@ -133,6 +133,120 @@ fn a_witness_replays_its_bound_in_verify_trace_and_sweep() {
         !uniform.contains(",0,40,0,0,") && !uniform.contains(",0,0,40,0,"),
         "{uniform}"
     );
+}
+
+/// The index of the first run of seed 3 (among the first 50) whose last `verdict_a_wins`
+/// is false under `scheduler`, found by `trace`: another command than `report`.
+fn first_failing_by_trace(scheduler: &str) -> u64 {
+    (0..50u64)
+        .find(|k| {
+            let run = k.to_string();
+            let (code, csv, err) = hindsight(&[
+                "trace",
+                RACE,
+                "--seed",
+                "3",
+                "--scheduler",
+                scheduler,
+                "--run",
+                &run,
+            ]);
+            assert_eq!(code, 0, "{err}");
+            let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+            let col = header.iter().position(|h| *h == "verdict_a_wins").unwrap();
+            let last = csv.lines().last().unwrap();
+            last.split(',').nth(col) == Some("false")
+        })
+        .expect("a failing run among the first 50")
+}
+
+#[test]
+fn report_replays_a_study_under_a_witness_from_its_json_alone() {
+    let dir = std::env::temp_dir().join(format!("hindsight-sched-report-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (code, out, err) =
+        hindsight(&["verify", RACE, "--schedulers", "8", "--seed", "3", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let study = dir.join("study.json");
+    std::fs::write(&study, &out).unwrap();
+    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    // The study records how its model ran.
+    assert_eq!(r["replay"]["model"], RACE, "{r}");
+    assert_eq!(r["replay"]["events"], "queues");
+    let min = prop(&r, "a_wins")["schedulers"]["min"]["scheduler"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let page = dir.join("page.html");
+    let (study_arg, page_arg) = (study.to_str().unwrap(), page.to_str().unwrap());
+    let (code, _, err) = hindsight(&[
+        "report",
+        "--study",
+        study_arg,
+        "--scheduler",
+        &min,
+        "-o",
+        page_arg,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let html = std::fs::read_to_string(&page).unwrap();
+    // Per property, the first failing run under the witness and under the uniform
+    // scheduler, as `trace` finds them run by run.
+    let under_min = first_failing_by_trace(&min);
+    let under_uniform = first_failing_by_trace("uniform");
+    assert!(
+        html.contains(&format!(
+            "a_wins under the scheduler {min}, run {under_min}"
+        )),
+        "{min}: run {under_min}"
+    );
+    assert!(
+        html.contains(&format!(
+            "a_wins under the uniform scheduler, run {under_uniform}"
+        )),
+        "uniform: run {under_uniform}"
+    );
+    // `someone_wins` holds in every run: nothing shown for it.
+    assert!(!html.contains("someone_wins under the"));
+    // Refused with a reason: a study that does not record how it ran, and one whose model
+    // is not there from where `report` runs.
+    for (key, value, says) in [
+        (
+            "replay",
+            serde_json::Value::Null,
+            "does not record how its model was run",
+        ),
+        (
+            "model",
+            serde_json::json!("no/such/model"),
+            "is not found from here",
+        ),
+    ] {
+        let mut edited = r.clone();
+        if key == "replay" {
+            edited.as_object_mut().unwrap().remove("replay");
+        } else {
+            edited["replay"][key] = value;
+        }
+        let bad = dir.join(format!("bad-{key}.json"));
+        std::fs::write(&bad, edited.to_string()).unwrap();
+        let (code, _, err) = hindsight(&[
+            "report",
+            "--study",
+            bad.to_str().unwrap(),
+            "--scheduler",
+            &min,
+            "-o",
+            page_arg,
+        ]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(says) && err.contains("bad-"), "{err}");
+    }
+    // --scheduler without --study has nothing to replay.
+    let (code, _, err) = hindsight(&["report", "--scheduler", &min, "-o", page_arg]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--study"), "{err}");
+    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]

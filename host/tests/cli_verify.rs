@@ -383,14 +383,15 @@ fn shards_merged_equal_the_whole_study_and_gaps_are_refused() {
     assert_eq!(merged["properties"], single["properties"]);
     assert_eq!(merged["runs"], 300);
     // `merge --json` prints the fields `verify --json` prints, and no page-only ones
-    // (settings, formulas), which `hindsight report --study` reads back.
+    // (settings, formulas), which `hindsight report --study` reads back; `replay` (how
+    // the model ran, for `report --scheduler`) comes through the shards.
     let keys = |v: &serde_json::Value| {
         let mut k: Vec<String> = v.as_object().unwrap().keys().cloned().collect();
         k.sort();
         k
     };
     let study_keys = "confidence decided discarded model precision properties properties_file \
-                      quiescent runs seconds seed step_limit time_horizon";
+                      quiescent replay runs seconds seed step_limit time_horizon";
     let row_keys = "cut_short decision lower probability property runs successes upper";
     for report in [&merged, &json(&["verify", COIN, "--precision", "0.1"])] {
         assert_eq!(keys(report).join(" "), study_keys);

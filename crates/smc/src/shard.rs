@@ -235,6 +235,10 @@ pub struct StudyPaths {
     pub model: String,
     /// The property file's path.
     pub properties: String,
+    /// The caller's record of how to replay a run of the study (opaque here: the
+    /// options its model was loaded and run with), carried into the merged result.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replay: Option<serde_json::Value>,
 }
 
 /// One property's counts in a partial result.

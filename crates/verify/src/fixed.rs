@@ -73,6 +73,8 @@ pub(crate) fn fixed_study(
         paths: Some(StudyPaths {
             model: model_path.display().to_string(),
             properties: loaded.props_path.display().to_string(),
+            replay: serde_json::to_value(crate::replay::Replay::of(loaded, model_path, run_cfg))
+                .ok(),
         }),
     }
 }

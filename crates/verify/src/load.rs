@@ -226,6 +226,9 @@ pub struct Loaded {
     /// ignores, an integer port read as a float, ...), in the order found: the command
     /// prints them.
     pub warnings: Diagnostics,
+    /// The options it was loaded with: a study records them so that its runs can be
+    /// replayed from its JSON ([`crate::replay::Replay`]).
+    pub options: LoadOptions,
 }
 
 impl Loaded {
@@ -319,6 +322,7 @@ pub fn load_without(
             events,
             bt_notes: Vec::new(),
             warnings,
+            options: opts.clone(),
         },
         Vec::new(),
     ))
@@ -534,6 +538,7 @@ fn load_robot(
             // The lowering is AS2FM's translation; its sends mean what AS2FM's JANI means.
             events: opts.events.unwrap_or(EventSemantics::As2fm),
             warnings,
+            options: opts.clone(),
         },
         external,
     ))

@@ -34,7 +34,7 @@ use crate::fixed::fixed_study;
 use crate::load::{Loaded, MaxTimeError};
 use crate::observe::JudgeError;
 use crate::options::VerifyOptions;
-use crate::replay::{failing_runs, save, witness_runs, Failing, ReplayError};
+use crate::replay::{failing_runs, save, witness_runs, Failing, Replay, ReplayError};
 use crate::result::{PropertyRow, Study};
 use crate::sched_fixed::{run_all, run_stage, Choices, Plan, StageError};
 use crate::schedulers::{bounds, BoundsError, Stage};
@@ -387,6 +387,7 @@ fn sequential(
         study.settings.push(("bt".into(), label.into()));
     }
     study.set_time_unit(loaded.unit_ns, run_cfg.max_time);
+    study.replay = Some(Replay::of(loaded, request.model, run_cfg));
     if request.witnesses && !study.interrupted {
         done.witnesses = witness_runs(model, set, run_cfg, opts.seed, &study)?;
     }

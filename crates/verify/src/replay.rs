@@ -2,7 +2,9 @@
 //! [`replay_csv`] for `trace` (run k of a seed is stream k, whatever ran before it), the
 //! failing runs a study kept for `--save-failing` and `--report` ([`failing_runs`],
 //! [`save`]) and, under `--schedulers`, a failing run under each order-sensitive
-//! property's witness (`witness_runs`); [`play_run`] plays one run to an observer of
+//! property's witness (`witness_runs`); [`Replay`] is what a study's JSON records of how
+//! its model ran, from which [`scheduler_runs`] replays it under any scheduler (`report
+//! --study FILE --scheduler ID`); [`play_run`] plays one run to an observer of
 //! the caller's (`hindsight run` paces it in wall-clock time). Nothing here prints: the files written come
 //! back as values.
 //!
@@ -216,20 +218,321 @@ pub(crate) fn witness_runs(
                 scheduler,
                 ..run_cfg.clone()
             };
-            for k in 0..SEARCH {
-                let (csv, culprits) = replay_csv(model, set, &cfg, seed, k)?;
-                if culprits.iter().any(|c| c.property == row.property) {
-                    out.push(Failing {
-                        property: row.property.clone(),
-                        run: k,
-                        file: format!("{} under the {label}, run {k}", row.property),
-                        csv,
-                        culprits,
-                    });
-                    break;
-                }
-            }
+            out.extend(first_failing(
+                model,
+                set,
+                &cfg,
+                seed,
+                &row.property,
+                &label,
+            )?);
         }
     }
     Ok(out)
+}
+
+/// The first failing run of `property` among the first [`SEARCH`] runs of `seed` under
+/// `run_cfg`, named "PROPERTY under the LABEL, run K" (`None`: none fails). A run fails it
+/// as the study judges runs ([`run_fails`]), not where its verdict was false at some point.
+fn first_failing(
+    model: &CompiledModel,
+    set: &PropertySet,
+    run_cfg: &RunConfig,
+    seed: u64,
+    property: &str,
+    label: &str,
+) -> Result<Option<Failing>, ReplayError> {
+    let Some(p) = set.guarantee_names().iter().position(|n| n == property) else {
+        return Ok(None);
+    };
+    for k in 0..SEARCH {
+        let mut judge = Judge::new(set)?;
+        let (csv, culprits, out) = {
+            let mut rec = Recorder::new(&mut judge, model);
+            rec.start();
+            let mut rng = crate::smc::runner::stream(seed, k);
+            let out = Simulator::new(model).run(&mut rng, run_cfg, &mut rec);
+            (rec.csv, rec.culprits, out)
+        };
+        if run_fails(&judge, &out, p) {
+            return Ok(Some(Failing {
+                property: property.to_string(),
+                run: k,
+                file: format!("{property} under the {label}, run {k}"),
+                csv,
+                culprits,
+            }));
+        }
+    }
+    Ok(None)
+}
+
+/// Whether a run that ended as `out`, judged by `judge`, fails guarantee `p` as a study
+/// counts it (`study.rs`, `Runner::run_under`): its verdict false at the last point (or
+/// final before), its assumptions not false. A run that ended in an error, a spin or with
+/// the judge failing is not judged, so it fails nothing.
+fn run_fails(judge: &Judge<'_>, out: &RunOutcome, p: usize) -> bool {
+    use crate::smc::{RunEnd, Verdict};
+    let end = match out.end {
+        EndReason::Quiescent => RunEnd::Quiescent,
+        EndReason::MaxTime => RunEnd::TimeHorizon,
+        EndReason::MaxSteps => RunEnd::StepLimit,
+        EndReason::Stopped => RunEnd::Decided,
+        EndReason::Spin(_) | EndReason::Error(_) => return false,
+    };
+    if judge.error.is_some() {
+        return false;
+    }
+    let judged = judge.outcome(end, out.steps, out.time);
+    judged.verdicts.get(p) == Some(&Verdict::False) && judged.assumptions != Verdict::False
+}
+
+/// How a study's model was loaded and run, recorded in its JSON (`"replay"`) so that its
+/// runs can be replayed from the file alone (`hindsight report --study FILE --scheduler
+/// ID`): the model and property file as the study named them (relative to where it ran)
+/// and every option that changes a run. A run replayed from it is the run the study made
+/// (run k is stream k of the seed), the scheduler aside.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Replay {
+    /// The model, as named.
+    pub model: String,
+    /// The property file read.
+    pub properties: String,
+    /// `--time-unit` in nanoseconds, when given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_unit_ns: Option<u64>,
+    /// How sends were delivered: `queues` or `as2fm`.
+    pub events: String,
+    /// The behavior tree's semantics (`--bt`): `as2fm`, `btcpp` or `btcpp-exactly-once`.
+    pub bt: String,
+    /// `--only`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub only: Vec<String>,
+    /// `--skip`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub skip: Vec<String>,
+    /// `--interfaces`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub interfaces: Vec<String>,
+    /// The run length in model steps.
+    pub max_time: u64,
+    /// The step limit of a run.
+    pub max_steps: u64,
+    /// The step limit of one instant.
+    pub max_instant_steps: u64,
+}
+
+/// Why a study's runs cannot be replayed from its JSON.
+#[derive(Debug)]
+pub enum RerunError {
+    /// The study records no `"replay"` (written by an older version).
+    NotRecorded,
+    /// The recorded settings name an option value this version does not know.
+    Setting(String),
+    /// The model the study names is not there (paths are relative to where it ran).
+    Missing(String),
+    /// The model or its properties no longer load.
+    Load(crate::load::LoadError),
+    /// A run could not be replayed.
+    Replay(ReplayError),
+}
+
+impl std::fmt::Display for RerunError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RerunError::NotRecorded => write!(
+                f,
+                "the study does not record how its model was run (it has no \"replay\": it \
+                 was written by an older version); replay with `verify MODEL --scheduler ID \
+                 --report FILE` instead"
+            ),
+            RerunError::Setting(m) => write!(f, "the study's \"replay\": {m}"),
+            RerunError::Missing(m) => write!(
+                f,
+                "the study's model `{m}` is not found from here: the study names it as \
+                 `verify` was given it, so run `report` in the folder `verify` ran in"
+            ),
+            RerunError::Load(e) => write!(f, "{e}"),
+            RerunError::Replay(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for RerunError {}
+
+impl Replay {
+    /// The settings of a study of `loaded` run with `run_cfg`, its model named `model`.
+    pub fn of(loaded: &crate::load::Loaded, model: &Path, run_cfg: &RunConfig) -> Replay {
+        let o = &loaded.options;
+        let names = |v: &[PathBuf]| v.iter().map(|p| p.display().to_string()).collect();
+        Replay {
+            model: model.display().to_string(),
+            properties: loaded.props_path.display().to_string(),
+            time_unit_ns: o.time_unit_ns,
+            events: events_name(loaded.events).to_string(),
+            bt: o.bt.label().to_string(),
+            only: o.only.clone(),
+            skip: o.skip.clone(),
+            interfaces: names(&o.interfaces),
+            max_time: run_cfg.max_time,
+            max_steps: run_cfg.max_steps,
+            max_instant_steps: run_cfg.max_steps_per_instant,
+        }
+    }
+
+    /// The load options these settings name.
+    pub fn load_options(&self) -> Result<crate::load::LoadOptions, RerunError> {
+        use crate::robot::bt::{BtSemantics, BtTick};
+        let events = match self.events.as_str() {
+            "queues" => EventSemantics::Queues,
+            "as2fm" => EventSemantics::As2fm,
+            other => return Err(RerunError::Setting(format!("unknown events `{other}`"))),
+        };
+        let bt = match self.bt.as_str() {
+            "as2fm" => BtSemantics::As2fm,
+            "btcpp" => BtSemantics::Btcpp { tick: BtTick::Once },
+            "btcpp-exactly-once" => BtSemantics::Btcpp {
+                tick: BtTick::ExactlyOnce,
+            },
+            other => return Err(RerunError::Setting(format!("unknown bt `{other}`"))),
+        };
+        Ok(crate::load::LoadOptions {
+            model: PathBuf::from(&self.model),
+            props: Some(PathBuf::from(&self.properties)),
+            time_unit_ns: self.time_unit_ns,
+            events: Some(events),
+            only: self.only.clone(),
+            skip: self.skip.clone(),
+            interfaces: self.interfaces.iter().map(PathBuf::from).collect(),
+            bt,
+        })
+    }
+
+    /// The run configuration these settings name, under `scheduler`.
+    pub fn run_config(&self, events: EventSemantics, scheduler: Scheduler) -> RunConfig {
+        RunConfig {
+            max_time: self.max_time,
+            max_steps: self.max_steps,
+            max_steps_per_instant: self.max_instant_steps,
+            events,
+            scheduler,
+            ..RunConfig::default()
+        }
+    }
+}
+
+/// The name `--events` gives `e`.
+fn events_name(e: EventSemantics) -> &'static str {
+    match e {
+        EventSemantics::Queues => "queues",
+        EventSemantics::As2fm => "as2fm",
+    }
+}
+
+/// What `hindsight report --study FILE --scheduler ID` shows: the study's model loaded
+/// again from its recorded settings, and per guarantee of the study the first failing run
+/// (among the first 500 of its seed) under `scheduler` and, when that is not the
+/// uniform scheduler, the first under the uniform one beside it. A property that no run
+/// fails under either adds nothing. Returns the model as loaded (its warnings are the
+/// caller's to print) and the runs.
+pub fn scheduler_runs(
+    study: &Study,
+    scheduler: Scheduler,
+) -> Result<(crate::load::Loaded, Vec<Failing>), RerunError> {
+    let settings = study.replay.as_ref().ok_or(RerunError::NotRecorded)?;
+    if !Path::new(&settings.model).exists() {
+        return Err(RerunError::Missing(settings.model.clone()));
+    }
+    let loaded = crate::load::load(&settings.load_options()?).map_err(RerunError::Load)?;
+    let mut runs = Vec::new();
+    let mut schedulers = vec![(format!("scheduler {scheduler}"), scheduler)];
+    if scheduler != Scheduler::Uniform {
+        schedulers.push(("uniform scheduler".to_string(), Scheduler::Uniform));
+    }
+    for row in &study.properties {
+        for (label, s) in &schedulers {
+            let cfg = settings.run_config(loaded.events, *s);
+            let found = first_failing(
+                &loaded.model,
+                &loaded.set,
+                &cfg,
+                study.seed,
+                &row.property,
+                label,
+            )
+            .map_err(RerunError::Replay)?;
+            runs.extend(found);
+        }
+    }
+    Ok((loaded, runs))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::load::{load, LoadOptions};
+
+    fn museum() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/museum-scxml")
+    }
+
+    #[test]
+    fn recorded_settings_load_the_same_model_and_run_the_same_runs() {
+        let opts = LoadOptions {
+            model: museum(),
+            time_unit_ns: Some(100_000_000),
+            events: Some(EventSemantics::As2fm),
+            skip: vec!["absence".into()],
+            ..LoadOptions::default()
+        };
+        let loaded = load(&opts).unwrap();
+        let run_cfg = RunConfig {
+            max_time: 300,
+            max_steps: 50_000,
+            max_steps_per_instant: 4_000,
+            events: loaded.events,
+            ..RunConfig::default()
+        };
+        let recorded = Replay::of(&loaded, &opts.model, &run_cfg);
+        let text = serde_json::to_string(&recorded).unwrap();
+        let back: Replay = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, recorded);
+        let again = load(&back.load_options().unwrap()).unwrap();
+        assert_eq!(again.events, EventSemantics::As2fm);
+        assert_eq!(again.unit_ns, Some(100_000_000));
+        assert_eq!(again.set.guarantee_names(), loaded.set.guarantee_names());
+        let cfg = back.run_config(again.events, Scheduler::Uniform);
+        assert_eq!(
+            (cfg.max_time, cfg.max_steps, cfg.max_steps_per_instant),
+            (300, 50_000, 4_000)
+        );
+        // The same run, to the byte.
+        let before = replay_csv(&loaded.model, &loaded.set, &run_cfg, 7, 2).unwrap();
+        let after = replay_csv(&again.model, &again.set, &cfg, 7, 2).unwrap();
+        assert_eq!(before.0, after.0);
+    }
+
+    #[test]
+    fn unknown_recorded_values_are_refused_by_name() {
+        let base = Replay {
+            model: museum().display().to_string(),
+            properties: "p.xml".into(),
+            events: "queues".into(),
+            bt: "as2fm".into(),
+            ..Replay::default()
+        };
+        for (events, bt, says) in [
+            ("fifo", "as2fm", "events `fifo`"),
+            ("queues", "bt4", "bt `bt4`"),
+        ] {
+            let r = Replay {
+                events: events.into(),
+                bt: bt.into(),
+                ..base.clone()
+            };
+            let e = r.load_options().unwrap_err().to_string();
+            assert!(e.contains(says), "{e}");
+        }
+        assert!(base.load_options().is_ok());
+    }
 }

@@ -99,6 +99,11 @@ pub struct Study {
     /// for the report page only.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub settings: Vec<(String, String)>,
+    /// How the model was loaded and run, so that its runs can be replayed from this file
+    /// (`report --study FILE --scheduler ID`); a merged study has its shards' (they
+    /// carry it in their paths).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replay: Option<crate::replay::Replay>,
     /// One row per guarantee.
     pub properties: Vec<PropertyRow>,
 }
@@ -191,6 +196,7 @@ impl Study {
             scheduler: scheduler.map(|s| s.to_string()),
             seconds: r.elapsed.as_secs_f64(),
             settings: Vec::new(),
+            replay: None,
             properties: set
                 .guarantee_names()
                 .iter()
@@ -228,6 +234,12 @@ impl Study {
             step_seconds: None,
             max_time_seconds: None,
             settings: Vec::new(),
+            replay: m
+                .study
+                .paths
+                .as_ref()
+                .and_then(|p| p.replay.clone())
+                .and_then(|v| serde_json::from_value(v).ok()),
             properties: m
                 .properties
                 .iter()

@@ -7,7 +7,8 @@ use super::CliError;
 use crate::codegen;
 use crate::report::{self, ReportData, Run, Study, Sweep};
 use crate::verify::load::Loaded;
-use crate::verify::replay::Failing;
+use crate::verify::options::Scheduler;
+use crate::verify::replay::{scheduler_runs, Failing};
 
 /// Arguments of `hindsight report`.
 #[derive(Debug, clap::Args)]
@@ -25,9 +26,17 @@ script, charts and data inline; nothing is fetched when it is opened):
 `verify --report FILE` and `sweep --report FILE` write the same page straight from the
 study in memory, with each formula as written and as compiled.
 
+--scheduler ID (with --study) replays the study's model under a scheduler, typically a
+witness `verify --schedulers N` printed: per property, the first failing run under it
+beside the first under the uniform scheduler (among each one's first 500 runs of the
+study's seed). The model is loaded again from the study's \"replay\" settings (paths
+as the study named them: run `report` where `verify` or its shards ran).
+
 Examples:
   hindsight verify examples/museum-guide --json --save-failing 2 --out runs > study.json
-  hindsight report --study study.json runs -o report.html")]
+  hindsight report --study study.json runs -o report.html
+  hindsight verify MODEL --schedulers 100 --json > study.json
+  hindsight report --study study.json --scheduler memoryless:29656f316841437b -o order.html")]
 pub struct ReportArgs {
     /// Failing runs: CSV files written by `verify --save-failing` or `trace`, or folders of them.
     pub runs: Vec<PathBuf>,
@@ -47,6 +56,11 @@ pub struct ReportArgs {
     /// no study gives it.
     #[arg(long, value_name = "DURATION")]
     pub time_unit: Option<String>,
+    /// Replay the study's model under this scheduler (`memoryless:ID`, `history:ID`,
+    /// `uniform`) and show each property's first failing run under it beside one under
+    /// the uniform scheduler; needs --study.
+    #[arg(long, value_name = "ID", value_parser = super::verify::parse_scheduler, requires = "study")]
+    pub scheduler: Option<Scheduler>,
 }
 
 fn read_json<T: serde::de::DeserializeOwned>(path: &Path, what: &str) -> Result<T, CliError> {
@@ -88,10 +102,24 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         ));
     }
     let mut data = ReportData::default();
+    let mut replayed = Vec::new();
     if let Some(path) = &args.study {
         let mut study: Study = read_json(path, "`verify --json`")?;
         if let Err(e) = study.read_formulas() {
             eprintln!("warning: formulas not shown: {e}");
+        }
+        if let Some(scheduler) = args.scheduler {
+            let (loaded, runs) = scheduler_runs(&study, scheduler)
+                .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
+            super::print_warnings(&loaded.warnings);
+            if runs.is_empty() {
+                eprintln!(
+                    "no property fails in the first runs of seed {} under {scheduler} or the \
+                     uniform scheduler: no run to show",
+                    study.seed
+                );
+            }
+            replayed = runs;
         }
         data.study = Some(study);
     }
@@ -108,6 +136,9 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
         ),
         None => data.study.as_ref().and_then(|s| s.step_seconds),
     };
+    for f in &replayed {
+        data.runs.push(shown_run(f, step_seconds)?);
+    }
     for path in run_files(&args.runs)? {
         let text = super::read_file(&path)?;
         let mut run = Run::from_csv(&path.display().to_string(), &text)?;
@@ -146,13 +177,7 @@ pub fn from_verify(
         ..ReportData::default()
     };
     for f in failing {
-        let mut run =
-            Run::from_csv(&f.file, &f.csv).map_err(|d| CliError::Failed(d.to_string()))?;
-        run.property = Some(f.property.clone());
-        run.run = Some(f.run);
-        run.step_seconds = study.step_seconds;
-        run.culprits = f.culprits.clone();
-        data.runs.push(run);
+        data.runs.push(shown_run(f, study.step_seconds)?);
     }
     data.study = Some(study);
     write(path, &data)
@@ -169,4 +194,14 @@ pub fn from_sweep(path: &Path, model: &Path, doc: &serde_json::Value) -> Result<
         ..ReportData::default()
     };
     write(path, &data)
+}
+
+/// A replayed run as the page draws it: linked to its property, with its culprits.
+fn shown_run(f: &Failing, step_seconds: Option<f64>) -> Result<Run, CliError> {
+    let mut run = Run::from_csv(&f.file, &f.csv).map_err(|d| CliError::Failed(d.to_string()))?;
+    run.property = Some(f.property.clone());
+    run.run = Some(f.run);
+    run.step_seconds = step_seconds;
+    run.culprits = f.culprits.clone();
+    Ok(run)
 }
