@@ -429,11 +429,22 @@ fn events_name(e: EventSemantics) -> &'static str {
     }
 }
 
+/// Whether the study saw `row`'s property fail: in a judged run, or under the witness of
+/// its smallest probability over schedulers. [`scheduler_runs`] searches only those: a
+/// search that finds nothing replays 500 runs per scheduler.
+fn seen_failing(row: &crate::result::PropertyRow) -> bool {
+    let min_fails = row
+        .schedulers
+        .as_ref()
+        .is_some_and(|b| b.min.successes < b.min.runs);
+    row.successes < row.runs || min_fails
+}
+
 /// What `hindsight report --study FILE --scheduler ID` shows: the study's model loaded
-/// again from its recorded settings, and per guarantee of the study the first failing run
-/// (among the first 500 of its seed) under `scheduler` and, when that is not the
-/// uniform scheduler, the first under the uniform one beside it. A property that no run
-/// fails under either adds nothing. Returns the model as loaded (its warnings are the
+/// again from its recorded settings, and per guarantee the study saw fail (in a judged run
+/// or under its minimising witness) the first failing run (among the first 500 of its
+/// seed) under `scheduler` and, when that is not the uniform scheduler, the first under
+/// the uniform one beside it. A property that no run fails under either adds nothing. Returns the model as loaded (its warnings are the
 /// caller's to print) and the runs.
 pub fn scheduler_runs(
     study: &Study,
@@ -449,7 +460,7 @@ pub fn scheduler_runs(
     if scheduler != Scheduler::Uniform {
         schedulers.push(("uniform scheduler".to_string(), Scheduler::Uniform));
     }
-    for row in &study.properties {
+    for row in study.properties.iter().filter(|r| seen_failing(r)) {
         for (label, s) in &schedulers {
             let cfg = settings.run_config(loaded.events, *s);
             let found = first_failing(

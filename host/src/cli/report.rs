@@ -27,9 +27,9 @@ script, charts and data inline; nothing is fetched when it is opened):
 study in memory, with each formula as written and as compiled.
 
 --scheduler ID (with --study) replays the study's model under a scheduler, typically a
-witness `verify --schedulers N` printed: per property, the first failing run under it
-beside the first under the uniform scheduler (among each one's first 500 runs of the
-study's seed). The model is loaded again from the study's \"replay\" settings (paths
+witness `verify --schedulers N` printed: per property the study saw fail (in a run, or
+under its minimising witness), the first failing run under it beside the first under the
+uniform scheduler (among each one's first 500 runs of the study's seed). The model is loaded again from the study's \"replay\" settings (paths
 as the study named them: run `report` where `verify` or its shards ran).
 
 Examples:
@@ -114,8 +114,9 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
             super::print_warnings(&loaded.warnings);
             if runs.is_empty() {
                 eprintln!(
-                    "no property fails in the first runs of seed {} under {scheduler} or the \
-                     uniform scheduler: no run to show",
+                    "no run to show: no property the study saw fail (in a run or under its \
+                     minimising witness) fails in the first 500 runs of seed {} under \
+                     {scheduler} or the uniform scheduler",
                     study.seed
                 );
             }
