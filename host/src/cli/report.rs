@@ -113,10 +113,14 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
                 .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
             super::print_warnings(&loaded.warnings);
             if runs.is_empty() {
+                let under = match scheduler {
+                    Scheduler::Uniform => "the uniform scheduler".to_string(),
+                    s => format!("{s} or the uniform scheduler"),
+                };
                 eprintln!(
-                    "no run to show: no property the study saw fail (in a run or under its \
-                     minimising witness) fails in the first 500 runs of seed {} under \
-                     {scheduler} or the uniform scheduler",
+                    "no run to show: the study saw no property fail (in a run or under its \
+                     minimising witness), or none of those fails in the first 500 runs of \
+                     seed {} under {under}",
                     study.seed
                 );
             }
