@@ -270,7 +270,8 @@ fn first_failing(
 /// Whether a run that ended as `out`, judged by `judge`, fails guarantee `p` as a study
 /// counts it (`study.rs`, `Runner::run_under`): its verdict false at the last point (or
 /// final before), its assumptions not false. A run that ended in an error, a spin or with
-/// the judge failing is not judged, so it fails nothing.
+/// the judge failing is not judged, so it fails nothing (a sampled scheduler's run that
+/// blocks time is left out, as a study leaves it out without `--keep-unfair`).
 fn run_fails(judge: &Judge<'_>, out: &RunOutcome, p: usize) -> bool {
     use crate::smc::{RunEnd, Verdict};
     let end = match out.end {
@@ -444,8 +445,8 @@ fn seen_failing(row: &crate::result::PropertyRow) -> bool {
 /// again from its recorded settings, and per guarantee the study saw fail (in a judged run
 /// or under its minimising witness) the first failing run (among the first 500 of its
 /// seed) under `scheduler` and, when that is not the uniform scheduler, the first under
-/// the uniform one beside it. A property that no run fails under either adds nothing. Returns the model as loaded (its warnings are the
-/// caller's to print) and the runs.
+/// the uniform one beside it. A property that no run fails under either adds nothing.
+/// Returns the model as loaded (its warnings are the caller's to print) and the runs.
 pub fn scheduler_runs(
     study: &Study,
     scheduler: Scheduler,
