@@ -189,6 +189,13 @@ fn report_replays_a_study_under_a_witness_from_its_json_alone() {
         page_arg,
     ]);
     assert_eq!(code, 0, "{err}");
+    // Each search says so first (it may replay up to 500 runs); a property the study never
+    // saw fail is not searched.
+    assert!(
+        err.contains("the first run of seed 3 that fails a_wins under the uniform"),
+        "{err}"
+    );
+    assert!(!err.contains("fails someone_wins"), "{err}");
     let html = std::fs::read_to_string(&page).unwrap();
     // Per property, the first failing run under the witness and under the uniform
     // scheduler, as `trace` finds them run by run.

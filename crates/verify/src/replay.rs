@@ -446,10 +446,13 @@ fn seen_failing(row: &crate::result::PropertyRow) -> bool {
 /// or under its minimising witness) the first failing run (among the first 500 of its
 /// seed) under `scheduler` and, when that is not the uniform scheduler, the first under
 /// the uniform one beside it. A property that no run fails under either adds nothing.
-/// Returns the model as loaded (its warnings are the caller's to print) and the runs.
+/// Returns the model as loaded (its warnings are the caller's to print) and the runs;
+/// `searching` is told each property and scheduler label before its search starts (a
+/// search replays up to 500 runs: a progress line for the caller).
 pub fn scheduler_runs(
     study: &Study,
     scheduler: Scheduler,
+    searching: &mut dyn FnMut(&str, &str),
 ) -> Result<(crate::load::Loaded, Vec<Failing>), RerunError> {
     let settings = study.replay.as_ref().ok_or(RerunError::NotRecorded)?;
     if !Path::new(&settings.model).exists() {
@@ -463,6 +466,7 @@ pub fn scheduler_runs(
     }
     for row in study.properties.iter().filter(|r| seen_failing(r)) {
         for (label, s) in &schedulers {
+            searching(&row.property, label);
             let cfg = settings.run_config(loaded.events, *s);
             let found = first_failing(
                 &loaded.model,

@@ -109,7 +109,14 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
             eprintln!("warning: formulas not shown: {e}");
         }
         if let Some(scheduler) = args.scheduler {
-            let (loaded, runs) = scheduler_runs(&study, scheduler)
+            let seed = study.seed;
+            let mut searching = |property: &str, label: &str| {
+                eprintln!(
+                    "replaying: the first run of seed {seed} that fails {property} under the \
+                     {label} (up to 500 runs)"
+                )
+            };
+            let (loaded, runs) = scheduler_runs(&study, scheduler, &mut searching)
                 .map_err(|e| CliError::Input(format!("{}: {e}", path.display())))?;
             super::print_warnings(&loaded.warnings);
             if runs.is_empty() {
