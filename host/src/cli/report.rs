@@ -28,9 +28,10 @@ study in memory, with each formula as written and as compiled.
 
 --scheduler ID (with --study) replays the study's model under a scheduler, typically a
 witness `verify --schedulers N` printed: per property the study saw fail (in a run, or
-under its minimising witness), the first failing run under it beside the first under the
-uniform scheduler (among each one's first 500 runs of the study's seed). The model is loaded again from the study's \"replay\" settings (paths
-as the study named them: run `report` where `verify` or its shards ran).
+under its minimising witness), the first failing run under it beside the first under
+the uniform scheduler (among each one's first 500 runs of the study's seed). The model
+is loaded again from the study's \"replay\" settings (paths as the study named them:
+run `report` where `verify` or its shards ran).
 
 Examples:
   hindsight verify examples/museum-guide --json --save-failing 2 --out runs > study.json
