@@ -44,8 +44,11 @@ const TREE: &str = "<root BTCPP_format=\"4\" main_tree_to_execute=\"Main\">\n<Be
                     ID=\"Main\">\n<IfThenElse>\n  <FailOnce/>\n  <AlwaysSuccess/>\n</IfThenElse>\
                     \n</BehaviorTree>\n</root>\n";
 
-fn scratch() -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("hindsight-sched-bt-both-{}", std::process::id()));
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "hindsight-sched-bt-both-{name}-{}",
+        std::process::id()
+    ));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("tree.xml"), TREE).unwrap();
@@ -72,7 +75,7 @@ fn scratch() -> PathBuf {
 
 #[test]
 fn bt_both_bounds_each_semantics_over_the_same_schedulers() {
-    let dir = scratch();
+    let dir = scratch("bounds");
     let args = [
         "verify",
         "main.xml",
@@ -108,4 +111,59 @@ fn bt_both_bounds_each_semantics_over_the_same_schedulers() {
     assert!(table.contains("--bt as2fm:"), "{table}");
     assert!(table.contains("--bt btcpp:"), "{table}");
     assert_eq!(table.matches("bounds over 4 sampled").count(), 2, "{table}");
+}
+
+#[test]
+fn report_shows_one_study_of_bt_both_and_replays_it_under_its_semantics() {
+    let dir = scratch("report");
+    let (code, out, err) = hindsight(
+        &dir,
+        &[
+            "verify",
+            "main.xml",
+            "--bt",
+            "both",
+            "--schedulers",
+            "4",
+            "--selection-runs",
+            "2",
+            "--precision",
+            "0.05",
+            "--json",
+        ],
+    );
+    assert_eq!(code, 0, "{err}");
+    std::fs::write(dir.join("both.json"), &out).unwrap();
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(doc["btcpp"]["replay"]["bt"], "btcpp", "{doc}");
+    let witness = doc["btcpp"]["properties"][0]["schedulers"]["min"]["scheduler"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let report = |extra: &[&str]| {
+        let mut args = vec!["report", "--study", "both.json", "-o", "page.html"];
+        args.extend_from_slice(extra);
+        hindsight(&dir, &args)
+    };
+    // Two studies: one must be named.
+    let (code, _, err) = report(&[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("give --bt as2fm or --bt btcpp"), "{err}");
+    // The BT.CPP study fails in every run, and its replay runs under BT.CPP's rules: under
+    // AS2FM's the same tree succeeds at the third tick, so a failing run shows only if
+    // the recorded semantics were used.
+    let (code, _, err) = report(&["--bt", "btcpp", "--scheduler", &witness]);
+    assert_eq!(code, 0, "{err}");
+    let html = std::fs::read_to_string(dir.join("page.html")).unwrap();
+    let property = doc["btcpp"]["properties"][0]["property"].as_str().unwrap();
+    assert!(
+        html.contains(&format!("{property} under the scheduler {witness}, run 0")),
+        "{err}"
+    );
+    assert!(html.contains(&format!("{property} under the uniform scheduler, run 0")));
+    // The AS2FM study saw no failure: nothing to replay, and it says so.
+    let (code, _, err) = report(&["--bt", "as2fm", "--scheduler", &witness]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("no run to show"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
 }

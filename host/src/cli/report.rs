@@ -18,6 +18,7 @@ script, charts and data inline; nothing is fetched when it is opened):
   --study FILE   the JSON of `verify --json` or `merge --json`: settings, how runs ended,
                  each property's probability, interval and runs; formulas are read from
                  the property file it names when that file is an XML file found here
+                 (of `verify --bt both --json`, the study --bt as2fm or btcpp names)
   --sweep FILE   the JSON of `sweep --json` (repeatable): success rate against the bound,
                  with intervals and thresholds
   RUNS           CSV files of `verify --save-failing` or `trace`, or folders of them: each
@@ -57,11 +58,63 @@ pub struct ReportArgs {
     /// no study gives it.
     #[arg(long, value_name = "DURATION")]
     pub time_unit: Option<String>,
+    /// With a study that `verify --bt both --json` printed (two studies): which one to
+    /// show, `as2fm` or `btcpp`.
+    #[arg(long = "bt", value_enum, value_name = "SEMANTICS", requires = "study")]
+    pub bt: Option<BtPick>,
     /// Replay the study's model under this scheduler (`memoryless:ID`, `history:ID`,
     /// `uniform`) and show each property's first failing run under it beside one under
     /// the uniform scheduler; needs --study.
     #[arg(long, value_name = "ID", value_parser = super::verify::parse_scheduler, requires = "study")]
     pub scheduler: Option<Scheduler>,
+}
+
+/// Which study of `verify --bt both --json` a page shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BtPick {
+    /// The study under AS2FM's node models (`"as2fm"`).
+    As2fm,
+    /// The study under BehaviorTree.CPP 4 (`"btcpp"`).
+    Btcpp,
+}
+
+/// The study in `path`: the JSON of `verify --json` or `merge --json`, or one of the two
+/// of `verify --bt both --json`, picked by `bt` (refused without it, naming the choice).
+fn read_study(path: &Path, bt: Option<BtPick>) -> Result<Study, CliError> {
+    let doc: serde_json::Value = read_json(path, "`verify --json`")?;
+    let both = doc.get("bt").and_then(|b| b.as_str()) == Some("both");
+    match (both, bt) {
+        (true, Some(pick)) => {
+            let key = match pick {
+                BtPick::As2fm => "as2fm",
+                BtPick::Btcpp => "btcpp",
+            };
+            let Some(one) = doc.get(key) else {
+                return Err(CliError::Input(format!(
+                    "{}: `verify --bt both` output without its `{key}` study",
+                    path.display()
+                )));
+            };
+            serde_json::from_value(one.clone()).map_err(|e| {
+                CliError::Input(format!(
+                    "{}: its `{key}` study is not the JSON of `verify --json`: {e}",
+                    path.display()
+                ))
+            })
+        }
+        (true, None) => Err(CliError::Input(format!(
+            "{}: this is `verify --bt both` output, two studies: give --bt as2fm or --bt \
+             btcpp to show one",
+            path.display()
+        ))),
+        (false, Some(_)) => Err(CliError::Input(format!(
+            "{}: --bt picks one study of `verify --bt both` output; this file is a single \
+             study",
+            path.display()
+        ))),
+        // Read again as a study, for an error with its line and column.
+        (false, None) => read_json(path, "`verify --json`"),
+    }
 }
 
 fn read_json<T: serde::de::DeserializeOwned>(path: &Path, what: &str) -> Result<T, CliError> {
@@ -105,7 +158,7 @@ pub fn run(args: &ReportArgs) -> Result<(), CliError> {
     let mut data = ReportData::default();
     let mut replayed = Vec::new();
     if let Some(path) = &args.study {
-        let mut study: Study = read_json(path, "`verify --json`")?;
+        let mut study = read_study(path, args.bt)?;
         if let Err(e) = study.read_formulas() {
             eprintln!("warning: formulas not shown: {e}");
         }
