@@ -17,7 +17,9 @@
 #       ["/topic", "TYPE", QOS] (QOS as for publish's "qos" step), ...],
 #       "count": N, "seconds": S}: reads the topics (TYPE: a key of ros_types()) with ROS
 #       2's default QoS, prints "ready" once its readers exist, then one JSON line per
-#       sample {"topic", "data": the sample's fields} until N samples or S seconds.
+#       sample {"topic", "data": the sample's fields} until N samples or S seconds, or
+#       until SIGINT; it then leaves at once (os._exit), without tearing the participant
+#       down: once, a SIGINT raised as KeyboardInterrupt left it hanging past 30 s.
 #   cyclone.py call DOMAIN SPEC_JSON       SPEC: {"service": "/s", "calls": [[a, b], ...],
 #       "seconds": S}: a ROS 2 client of example_interfaces/srv/AddTwoInts as
 #       rmw_cyclonedds makes one: requests on rq/<s>Request, replies on rr/<s>Reply, each
@@ -27,6 +29,8 @@
 #       {"topic", "schema", "encoding", "message_encoding", "log_time", and "data"
 #       decoded with mcap-ros2-support, or "error" when it does not decode}.
 import json
+import os
+import signal
 import sys
 import time
 from dataclasses import dataclass
@@ -237,10 +241,13 @@ def subscribe(domain, spec):
         q = ros_qos(entry[2]) if len(entry) > 2 else qos
         t = Topic(dp, "rt" + topic, types[kind], qos=q)
         readers.append((topic, DataReader(dp, t, qos=q)))
+    # SIGINT ends the loop between takes instead of raising inside the binding.
+    stop = []
+    signal.signal(signal.SIGINT, lambda *_: stop.append(True))
     print("ready", flush=True)
     end = time.time() + spec["seconds"]
     got = 0
-    while got < spec["count"] and time.time() < end:
+    while not stop and got < spec["count"] and time.time() < end:
         idle = True
         for topic, r in readers:
             for sample in r.take(N=64):
@@ -254,6 +261,8 @@ def subscribe(domain, spec):
                 print(json.dumps(line, default=list), flush=True)
         if idle:
             time.sleep(0.005)
+    # Every line was flushed as it was printed; nothing is left to write.
+    os._exit(0)
 
 
 def call(domain, spec):
