@@ -73,24 +73,26 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// The study both tests run: `verify --bt both` over 4 sampled schedulers.
+const STUDY: [&str; 10] = [
+    "verify",
+    "main.xml",
+    "--bt",
+    "both",
+    "--schedulers",
+    "4",
+    "--selection-runs",
+    "2",
+    "--precision",
+    "0.05",
+];
+
 #[test]
 fn bt_both_bounds_each_semantics_over_the_same_schedulers() {
     let dir = scratch("bounds");
-    let args = [
-        "verify",
-        "main.xml",
-        "--bt",
-        "both",
-        "--schedulers",
-        "4",
-        "--selection-runs",
-        "2",
-        "--precision",
-        "0.05",
-        "--threads",
-        "2",
-    ];
-    let mut json = args.to_vec();
+    let mut args = STUDY.to_vec();
+    args.extend(["--threads", "2"]);
+    let mut json = args.clone();
     json.push("--json");
     let (code, out, err) = hindsight(&dir, &json);
     assert_eq!(code, 0, "{err}");
@@ -116,22 +118,9 @@ fn bt_both_bounds_each_semantics_over_the_same_schedulers() {
 #[test]
 fn report_shows_one_study_of_bt_both_and_replays_it_under_its_semantics() {
     let dir = scratch("report");
-    let (code, out, err) = hindsight(
-        &dir,
-        &[
-            "verify",
-            "main.xml",
-            "--bt",
-            "both",
-            "--schedulers",
-            "4",
-            "--selection-runs",
-            "2",
-            "--precision",
-            "0.05",
-            "--json",
-        ],
-    );
+    let mut json = STUDY.to_vec();
+    json.push("--json");
+    let (code, out, err) = hindsight(&dir, &json);
     assert_eq!(code, 0, "{err}");
     std::fs::write(dir.join("both.json"), &out).unwrap();
     let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
