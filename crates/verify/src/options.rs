@@ -107,7 +107,7 @@ impl VerifyOptions {
             ("rule", format!("{:?}", self.rule.kind).to_lowercase()),
             ("run length in steps", run_cfg.max_time.to_string()),
             ("step limit", self.max_steps.to_string()),
-            ("events", format!("{:?}", run_cfg.events).to_lowercase()),
+            ("events", run_cfg.events.label().to_string()),
         ]
         .map(|(k, v)| (k.to_string(), v))
         .into_iter()

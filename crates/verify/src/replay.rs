@@ -88,12 +88,40 @@ pub fn replay_csv(
     seed: u64,
     k: u64,
 ) -> Result<(String, Vec<Culprit>), JudgeError> {
+    replayed(model, set, run_cfg, seed, k).map(|r| (r.csv, r.culprits))
+}
+
+/// Run `k` of `seed` replayed: its CSV and culprits, and the judge and outcome it ended
+/// with (whether it fails a property: [`run_fails`]).
+struct Replayed<'s> {
+    csv: String,
+    culprits: Vec<Culprit>,
+    judge: Judge<'s>,
+    out: RunOutcome,
+}
+
+/// The one replay of a run behind [`replay_csv`] and the failing-run searches.
+fn replayed<'s>(
+    model: &'s CompiledModel,
+    set: &'s PropertySet,
+    run_cfg: &RunConfig,
+    seed: u64,
+    k: u64,
+) -> Result<Replayed<'s>, JudgeError> {
     let mut judge = Judge::new(set)?;
-    let mut rec = Recorder::new(&mut judge, model);
-    rec.start();
-    let mut rng = crate::smc::runner::stream(seed, k);
-    Simulator::new(model).run(&mut rng, run_cfg, &mut rec);
-    Ok((rec.csv, rec.culprits))
+    let (csv, culprits, out) = {
+        let mut rec = Recorder::new(&mut judge, model);
+        rec.start();
+        let mut rng = crate::smc::runner::stream(seed, k);
+        let out = Simulator::new(model).run(&mut rng, run_cfg, &mut rec);
+        (rec.csv, rec.culprits, out)
+    };
+    Ok(Replayed {
+        csv,
+        culprits,
+        judge,
+        out,
+    })
 }
 
 /// Plays run `k` of a study with `seed` (the run `verify --seed` numbers `k`: the same
@@ -246,21 +274,14 @@ fn first_failing(
         return Ok(None);
     };
     for k in 0..SEARCH {
-        let mut judge = Judge::new(set)?;
-        let (csv, culprits, out) = {
-            let mut rec = Recorder::new(&mut judge, model);
-            rec.start();
-            let mut rng = crate::smc::runner::stream(seed, k);
-            let out = Simulator::new(model).run(&mut rng, run_cfg, &mut rec);
-            (rec.csv, rec.culprits, out)
-        };
-        if run_fails(&judge, &out, p) {
+        let r = replayed(model, set, run_cfg, seed, k)?;
+        if run_fails(&r.judge, &r.out, p) {
             return Ok(Some(Failing {
                 property: property.to_string(),
                 run: k,
                 file: format!("{property} under the {label}, run {k}"),
-                csv,
-                culprits,
+                csv: r.csv,
+                culprits: r.culprits,
             }));
         }
     }
@@ -273,13 +294,9 @@ fn first_failing(
 /// the judge failing is not judged, so it fails nothing (a sampled scheduler's run that
 /// blocks time is left out, as a study leaves it out without `--keep-unfair`).
 fn run_fails(judge: &Judge<'_>, out: &RunOutcome, p: usize) -> bool {
-    use crate::smc::{RunEnd, Verdict};
-    let end = match out.end {
-        EndReason::Quiescent => RunEnd::Quiescent,
-        EndReason::MaxTime => RunEnd::TimeHorizon,
-        EndReason::MaxSteps => RunEnd::StepLimit,
-        EndReason::Stopped => RunEnd::Decided,
-        EndReason::Spin(_) | EndReason::Error(_) => return false,
+    use crate::smc::Verdict;
+    let Some(end) = crate::study::judged_end(&out.end) else {
+        return false;
     };
     if judge.error.is_some() {
         return false;
@@ -370,7 +387,7 @@ impl Replay {
             model: model.display().to_string(),
             properties: loaded.props_path.display().to_string(),
             time_unit_ns: o.time_unit_ns,
-            events: events_name(loaded.events).to_string(),
+            events: loaded.events.label().to_string(),
             bt: o.bt.label().to_string(),
             only: o.only.clone(),
             skip: o.skip.clone(),
@@ -383,20 +400,10 @@ impl Replay {
 
     /// The load options these settings name.
     pub fn load_options(&self) -> Result<crate::load::LoadOptions, RerunError> {
-        use crate::robot::bt::{BtSemantics, BtTick};
-        let events = match self.events.as_str() {
-            "queues" => EventSemantics::Queues,
-            "as2fm" => EventSemantics::As2fm,
-            other => return Err(RerunError::Setting(format!("unknown events `{other}`"))),
-        };
-        let bt = match self.bt.as_str() {
-            "as2fm" => BtSemantics::As2fm,
-            "btcpp" => BtSemantics::Btcpp { tick: BtTick::Once },
-            "btcpp-exactly-once" => BtSemantics::Btcpp {
-                tick: BtTick::ExactlyOnce,
-            },
-            other => return Err(RerunError::Setting(format!("unknown bt `{other}`"))),
-        };
+        let events = EventSemantics::from_label(&self.events)
+            .ok_or_else(|| RerunError::Setting(format!("unknown events `{}`", self.events)))?;
+        let bt = crate::robot::bt::BtSemantics::from_label(&self.bt)
+            .ok_or_else(|| RerunError::Setting(format!("unknown bt `{}`", self.bt)))?;
         Ok(crate::load::LoadOptions {
             model: PathBuf::from(&self.model),
             props: Some(PathBuf::from(&self.properties)),
@@ -419,14 +426,6 @@ impl Replay {
             scheduler,
             ..RunConfig::default()
         }
-    }
-}
-
-/// The name `--events` gives `e`.
-fn events_name(e: EventSemantics) -> &'static str {
-    match e {
-        EventSemantics::Queues => "queues",
-        EventSemantics::As2fm => "as2fm",
     }
 }
 
@@ -526,6 +525,20 @@ mod tests {
         let before = replay_csv(&loaded.model, &loaded.set, &run_cfg, 7, 2).unwrap();
         let after = replay_csv(&again.model, &again.set, &cfg, 7, 2).unwrap();
         assert_eq!(before.0, after.0);
+    }
+
+    #[test]
+    fn every_semantics_reads_back_from_its_label() {
+        use crate::robot::bt::{BtSemantics, BtTick};
+        for e in [EventSemantics::Queues, EventSemantics::As2fm] {
+            assert_eq!(EventSemantics::from_label(e.label()), Some(e));
+        }
+        for tick in [BtTick::Once, BtTick::ExactlyOnce] {
+            let b = BtSemantics::Btcpp { tick };
+            assert_eq!(BtSemantics::from_label(b.label()), Some(b));
+        }
+        assert_eq!(BtSemantics::from_label("as2fm"), Some(BtSemantics::As2fm));
+        assert_eq!(BtSemantics::from_label("btcpp4"), None);
     }
 
     #[test]

@@ -247,10 +247,10 @@ impl<'m> Runner<'m> {
                 what,
             };
             let end = match &out.end {
-                EndReason::Quiescent => Some(RunEnd::Quiescent),
-                EndReason::MaxTime => Some(RunEnd::TimeHorizon),
-                EndReason::MaxSteps => Some(RunEnd::StepLimit),
-                EndReason::Stopped => Some(RunEnd::Decided),
+                e @ (EndReason::Quiescent
+                | EndReason::MaxTime
+                | EndReason::MaxSteps
+                | EndReason::Stopped) => judged_end(e),
                 EndReason::Spin(s)
                     if s.kind == SpinKind::NoTimeProgress
                         && scheduler != Scheduler::Uniform
@@ -308,5 +308,18 @@ impl<'m> Runner<'m> {
 fn record(slot: &Mutex<Option<ModelFailure>>, failure: ModelFailure) {
     if let Ok(mut s) = slot.lock() {
         s.get_or_insert(failure);
+    }
+}
+
+/// How a run that ended as `end` is judged: at the time horizon, quiescent, cut at the
+/// step limit or decided. `None` for a spin or an error, which a study does not judge
+/// as it stands (`Runner::run_under` decides what becomes of them).
+pub(crate) fn judged_end(end: &EndReason) -> Option<RunEnd> {
+    match end {
+        EndReason::Quiescent => Some(RunEnd::Quiescent),
+        EndReason::MaxTime => Some(RunEnd::TimeHorizon),
+        EndReason::MaxSteps => Some(RunEnd::StepLimit),
+        EndReason::Stopped => Some(RunEnd::Decided),
+        EndReason::Spin(_) | EndReason::Error(_) => None,
     }
 }

@@ -126,6 +126,19 @@ impl BtSemantics {
             } => "btcpp-exactly-once",
         }
     }
+
+    /// The semantics [`BtSemantics::label`] names (`None`: no such label).
+    pub fn from_label(label: &str) -> Option<Self> {
+        [
+            BtSemantics::As2fm,
+            BtSemantics::Btcpp { tick: BtTick::Once },
+            BtSemantics::Btcpp {
+                tick: BtTick::ExactlyOnce,
+            },
+        ]
+        .into_iter()
+        .find(|b| b.label() == label)
+    }
 }
 
 /// Which children a built-in control node halts when it finishes or is halted.

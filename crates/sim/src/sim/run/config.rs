@@ -63,6 +63,23 @@ pub enum EventSemantics {
     As2fm,
 }
 
+impl EventSemantics {
+    /// The name on the command line (`--events`): `queues` or `as2fm`.
+    pub fn label(self) -> &'static str {
+        match self {
+            EventSemantics::Queues => "queues",
+            EventSemantics::As2fm => "as2fm",
+        }
+    }
+
+    /// The semantics [`EventSemantics::label`] names (`None`: no such label).
+    pub fn from_label(label: &str) -> Option<Self> {
+        [EventSemantics::Queues, EventSemantics::As2fm]
+            .into_iter()
+            .find(|e| e.label() == label)
+    }
+}
+
 /// Limits and choices for one run.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RunConfig {
