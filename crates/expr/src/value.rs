@@ -191,6 +191,26 @@ impl Clone for Cell {
     }
 }
 
+/// Copies `src` into `dst` as `Vec::clone_from` does (the result is equal to `src`, and
+/// lists reuse their buffers), with scalars of the same kind copied in place: a message's
+/// parameters are mostly numbers, and this is the copy each receiver of an AS2FM message
+/// makes (the generic path dropped and rebuilt every cell).
+#[inline]
+pub fn assign_cells(dst: &mut Vec<Cell>, src: &[Cell]) {
+    dst.truncate(src.len());
+    let kept = dst.len();
+    for (d, s) in dst.iter_mut().zip(src) {
+        match (d, s) {
+            (Cell::Int(a), Cell::Int(b)) => *a = *b,
+            (Cell::Float(a), Cell::Float(b)) => *a = *b,
+            (Cell::Bool(a), Cell::Bool(b)) => *a = *b,
+            (Cell::Str(a), Cell::Str(b)) => *a = *b,
+            (d, s) => d.clone_from(s),
+        }
+    }
+    dst.extend_from_slice(&src[kept..]);
+}
+
 /// The elements of an array or the fields of a struct.
 ///
 /// Elements removed by shrinking stay in the buffer past the live length, buffers and all,
@@ -446,6 +466,42 @@ impl OwnedValue {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn assign_cells_copies_every_kind_and_length() {
+        let list = |n: i64| Cell::list((0..n).map(Cell::Int).collect());
+        let src = vec![
+            Cell::Int(-4),
+            Cell::Float(2.5),
+            Cell::Bool(true),
+            Cell::Str(StrId(3)),
+            list(3),
+        ];
+        // Same kinds, other kinds in every position, shorter and longer destinations.
+        let dsts = [
+            vec![
+                Cell::Int(0),
+                Cell::Float(0.0),
+                Cell::Bool(false),
+                Cell::Str(StrId(0)),
+                list(1),
+            ],
+            vec![
+                list(2),
+                Cell::Int(1),
+                Cell::Str(StrId(9)),
+                Cell::Float(1.0),
+                Cell::Bool(true),
+            ],
+            vec![Cell::Int(7)],
+            vec![Cell::Int(7); 8],
+            Vec::new(),
+        ];
+        for mut dst in dsts {
+            assign_cells(&mut dst, &src);
+            assert_eq!(dst, src);
+        }
+    }
 
     #[test]
     fn lists_reuse_the_elements_they_shrink_away() {

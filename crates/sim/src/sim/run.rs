@@ -5,7 +5,7 @@ use super::compiled::{CompiledModel, DelayDef, Instr, MachineDef, SendDef, SendT
 use super::ids::{EventId, MachineId, StateId};
 use super::observer::{Flow, Inbox, Observer, Scalar, SentMessage, EXTERNAL};
 use crate::expr::compile::{Code, Entropy, Env, EvalError, EvalErrorKind, MAX_PATH};
-use crate::expr::value::{Cell, StrId, Strings};
+use crate::expr::value::{assign_cells, Cell, StrId, Strings};
 use crate::expr::Value;
 use crate::model::Diagnostic;
 use std::collections::VecDeque;
@@ -35,6 +35,8 @@ struct Slot {
     origin: u32,
     /// `u32::MAX`: the `NONE` sink.
     target: u32,
+    /// The next message in its target's external queue (`NO_MSG`: the last).
+    next: u32,
     params: Vec<Cell>,
 }
 
@@ -59,7 +61,11 @@ struct MachineRt {
     cur_event: StrId,
     cur_origin: StrId,
     intq: VecDeque<u32>,
-    extq: VecDeque<u32>,
+    /// The external queue: a list of pool slots linked through [`Slot::next`], oldest
+    /// first (`NO_MSG`: empty). A queue costs two words and no buffer of its own.
+    qhead: u32,
+    qtail: u32,
+    qlen: u32,
     vars: Vec<Cell>,
     /// Position in [`Simulator::runnable`] (`NOT_RUNNABLE`: not there).
     rpos: u32,
@@ -227,8 +233,7 @@ fn scratch_cell(scratch: &mut [Vec<Cell>], m: usize, sc: u32) -> Option<&mut Cel
 #[inline(always)]
 fn refresh_in(ms: &mut [MachineRt], runnable: &mut Vec<u32>, m: usize) {
     let r = &ms[m];
-    let can =
-        !r.waiting && !r.blocked && (r.pc != IDLE || !r.intq.is_empty() || !r.extq.is_empty());
+    let can = !r.waiting && !r.blocked && (r.pc != IDLE || !r.intq.is_empty() || r.qhead != NO_MSG);
     let pos = r.rpos;
     if can && pos == NOT_RUNNABLE {
         ms[m].rpos = runnable.len() as u32;

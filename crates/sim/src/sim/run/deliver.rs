@@ -36,12 +36,19 @@ impl Simulator<'_> {
             }
             return Ok(None);
         }
-        if let Some(slot) = self.ms[m].extq.pop_front() {
-            self.release(m);
-            let (event, origin, target) = {
+        let slot = self.ms[m].qhead;
+        if slot != NO_MSG {
+            let (event, origin, target, next) = {
                 let s = &self.pool[slot as usize];
-                (s.event, s.origin, s.target)
+                (s.event, s.origin, s.target, s.next)
             };
+            let q = &mut self.ms[m];
+            q.qhead = next;
+            q.qlen -= 1;
+            if next == NO_MSG {
+                q.qtail = NO_MSG;
+            }
+            self.release(m);
             self.take_current(m, slot, event, origin);
             self.steps += 1;
             self.instant_steps += 1;
@@ -235,7 +242,7 @@ impl Simulator<'_> {
             // The receiver keeps its own copy: JANI assigns it with the receive itself.
             let rx = self.rx_base[e as usize] as usize + k;
             let (global, copy) = self.pool.split_at_mut(rx);
-            copy[0].params.clone_from(&global[e as usize].params);
+            assign_cells(&mut copy[0].params, &global[e as usize].params);
             copy[0].origin = origin;
             self.ms[m].cur = rx as u32;
             self.steps += 1;

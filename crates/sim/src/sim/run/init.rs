@@ -25,7 +25,9 @@ impl<'m> Simulator<'m> {
                     cur_event: StrId(0),
                     cur_origin: StrId(0),
                     intq: VecDeque::new(),
-                    extq: VecDeque::new(),
+                    qhead: NO_MSG,
+                    qtail: NO_MSG,
+                    qlen: 0,
                     vars: d.defaults.clone(),
                     rpos: NOT_RUNNABLE,
                     moves: 0,
@@ -43,6 +45,7 @@ impl<'m> Simulator<'m> {
                     event: e as u32,
                     origin: 0,
                     target: u32::MAX,
+                    next: NO_MSG,
                     params: d.defaults.clone(),
                 })
                 .chain(model.events.iter().enumerate().flat_map(|(e, d)| {
@@ -50,6 +53,7 @@ impl<'m> Simulator<'m> {
                         event: e as u32,
                         origin: 0,
                         target: r,
+                        next: NO_MSG,
                         params: d.defaults.clone(),
                     })
                 }))
@@ -170,7 +174,9 @@ impl Simulator<'_> {
             r.cur_event = StrId(0);
             r.cur_origin = StrId(0);
             r.intq.clear();
-            r.extq.clear();
+            r.qhead = NO_MSG;
+            r.qtail = NO_MSG;
+            r.qlen = 0;
             // Variables with an initial value are overwritten below; resetting them to the
             // default first would throw their buffers away.
             for (i, (v, d)) in r.vars.iter_mut().zip(&def.defaults).enumerate() {

@@ -512,14 +512,16 @@ impl Simulator<'_> {
             h = mix(h, r.cur_event.0 as u64 | (r.cur_origin.0 as u64) << 32);
             h = self.hash_message(h, r.cur);
         }
-        h = mix(h, r.intq.len() as u64 | (r.extq.len() as u64) << 32);
+        h = mix(h, r.intq.len() as u64 | (r.qlen as u64) << 32);
         // The internal queue holds raised events (no parameters), the external one pool
         // slots.
         for &ev in &r.intq {
             h = mix(h, ev as u64);
         }
-        for &slot in &r.extq {
+        let mut slot = r.qhead;
+        while slot != NO_MSG {
             h = self.hash_message(h, slot);
+            slot = self.pool.get(slot as usize).map_or(NO_MSG, |s| s.next);
         }
         for c in &r.vars {
             h = hash_cell(h, c);

@@ -134,6 +134,7 @@ impl Simulator<'_> {
                     event: sd.event,
                     origin: 0,
                     target: 0,
+                    next: NO_MSG,
                     params: evdef.defaults.clone(),
                 });
                 pool.len() as u32 - 1
@@ -173,7 +174,16 @@ impl Simulator<'_> {
         match target {
             Some(t) => {
                 let t = t as usize;
-                ms[t].extq.push_back(slot);
+                s.next = NO_MSG;
+                let q = &mut ms[t];
+                let tail = q.qtail;
+                q.qtail = slot;
+                q.qlen += 1;
+                if tail == NO_MSG {
+                    q.qhead = slot;
+                } else if let Some(prev) = pool.get_mut(tail as usize) {
+                    prev.next = slot;
+                }
                 touch_in(ms, dirty, t);
                 refresh_in(ms, runnable, t);
             }
