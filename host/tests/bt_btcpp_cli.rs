@@ -211,8 +211,10 @@ fn bt_options_are_refused_where_they_mean_nothing() {
             "--bt-tick: only BehaviorTree.CPP's executor",
         ),
         (
-            &["verify", "main.xml", "--bt", "both", "--runs", "10"][..],
-            "--bt both: not with --runs",
+            &[
+                "verify", "main.xml", "--bt", "both", "--runs", "10", "--shard", "0/2",
+            ][..],
+            "--bt both: not with --shard",
         ),
         (
             &["convert", "main.xml", "--out", "out", "--bt", "both"][..],

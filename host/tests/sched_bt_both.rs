@@ -156,3 +156,40 @@ fn report_shows_one_study_of_bt_both_and_replays_it_under_its_semantics() {
     assert!(err.contains("no run to show"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `--bt both --runs N`: a fixed-size study under each semantics, each the study `--bt
+/// as2fm --runs N` / `--bt btcpp --runs N` makes alone, and the property flagged
+/// semantics-sensitive (AS2FM's IfThenElse succeeds, BT.CPP 4's never does).
+#[test]
+fn bt_both_takes_a_fixed_number_of_runs() {
+    let dir = scratch("runs");
+    let base = [
+        "verify", "main.xml", "--runs", "30", "--seed", "4", "--json",
+    ];
+    let (code, out, err) = hindsight(&dir, &[&base[..], &["--bt", "both"]].concat());
+    assert_eq!(code, 0, "{err}");
+    let both: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let strip = |mut v: serde_json::Value| {
+        v["seconds"] = serde_json::Value::Null;
+        v
+    };
+    for semantics in ["as2fm", "btcpp"] {
+        let (code, out, err) = hindsight(&dir, &[&base[..], &["--bt", semantics]].concat());
+        assert_eq!(code, 0, "{err}");
+        let alone: serde_json::Value = serde_json::from_str(&out).unwrap();
+        assert_eq!(alone["runs"], 30, "{alone}");
+        assert_eq!(strip(both[semantics].clone()), strip(alone), "{semantics}");
+    }
+    let row = &both["properties"][0];
+    assert_eq!(row["as2fm"], 1.0, "{row}");
+    assert_eq!(row["btcpp"], 0.0, "{row}");
+    assert_eq!(row["semantics_sensitive"], true, "{row}");
+    // A shard of it is refused: `merge` would not know which semantics a part was.
+    let (code, _, err) = hindsight(
+        &dir,
+        &[&base[..], &["--bt", "both", "--shard", "0/2"]].concat(),
+    );
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("--bt both: not with --shard"), "{err}");
+}

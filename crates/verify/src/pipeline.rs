@@ -450,14 +450,16 @@ impl Sensitivity {
     }
 }
 
-/// [`verify`]'s sequential study of each of `loads` (the same model under AS2FM's
-/// semantics, then BT.CPP's, each with its label) with the same settings and seed, and
-/// the comparison. `started(label)` is called as each begins. Once `stop` is set, the
-/// next study starts no run (0 runs, no estimate).
+/// [`verify`]'s study of each of `loads` (the same model under AS2FM's semantics, then
+/// BT.CPP's, each with its label) with the same settings and seed, and the comparison:
+/// sequential, or of `runs` runs each (`--runs`). `started(label)` is called as each
+/// begins. Once `stop` is set, the next sequential study starts no run (0 runs, no
+/// estimate).
 pub fn verify_both(
     loads: [(&'static str, &Loaded); 2],
     model: &Path,
     opts: &VerifyOptions,
+    runs: Option<u64>,
     started: &mut dyn FnMut(&'static str),
     event: &mut dyn FnMut(Event<'_>),
     stop: &AtomicBool,
@@ -467,10 +469,14 @@ pub fn verify_both(
         started(label);
         let request = Request {
             bt_label: Some(label),
+            runs,
             ..Request::new(loaded, model, opts)
         };
-        let run_cfg = opts.run_config(loaded).map_err(VerifyError::MaxTime)?;
-        let done = sequential(&request, &run_cfg, &opts.study_config(), event, stop)?;
+        let done = match verify(&request, event, stop)? {
+            Outcome::Study(done) => *done,
+            // No shard was asked for.
+            Outcome::Part(_) => return Err(VerifyError::Json("--bt both: a shard".into())),
+        };
         left_out.extend(done.left_out);
         studies.push((label, done.study));
     }

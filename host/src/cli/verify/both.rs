@@ -16,8 +16,9 @@ pub(super) fn run_both(args: &VerifyArgs, opts: &VerifyOptions) -> Result<(), Cl
             "--bt both: not with {what} (run each semantics with --bt as2fm / --bt btcpp)"
         )))
     };
-    if args.shard.is_some() || args.runs.is_some() {
-        return refuse("--runs / --shard");
+    if args.shard.is_some() {
+        // A shard's part is one study's; `merge` would not know which semantics it was.
+        return refuse("--shard");
     }
     if args.report.is_some() || args.save_failing > 0 {
         return refuse("--report / --save-failing");
@@ -37,6 +38,7 @@ pub(super) fn run_both(args: &VerifyArgs, opts: &VerifyOptions) -> Result<(), Cl
         [(bt_a, a), (bt_b, b)],
         &args.input.model,
         opts,
+        args.runs,
         &mut |label| {
             if show {
                 eprintln!("--bt {label}:");
