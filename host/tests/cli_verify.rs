@@ -89,6 +89,58 @@ fn museum() -> PathBuf {
     PathBuf::from("examples/museum-scxml")
 }
 
+/// A study that can judge no run (every run cut at a step limit set too low, or every
+/// run discarded by an assumption that never holds) stops and says why; it ran forever.
+#[test]
+fn a_study_that_can_judge_no_run_stops_and_says_why() {
+    let museum = museum();
+    let museum = museum.to_str().unwrap();
+    let (code, out, err) = hindsight(&["verify", museum, "--max-steps", "10", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(r["unjudged"], true, "{r}");
+    assert_eq!(r["runs"], 1000);
+    assert_eq!(r["step_limit"], 1000);
+    assert!(r["properties"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .all(|p| p["probability"].is_null()));
+    assert!(
+        err.contains(
+            "stopped after 1000 runs: not one could be judged for absence, alarm_response"
+        ) && err.contains("cut at the step limit (--max-steps 10)"),
+        "{err}"
+    );
+    // An assumption no run satisfies: every run discarded.
+    let dir = std::env::temp_dir().join(format!("hindsight-unjudged-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let never = dir.join("never.xml");
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/verify/coin/assume-tails.xml"
+    ))
+    .unwrap()
+    .replace(
+        "once {tails}",
+        "once {tails} &amp;&amp; historically !{tails}",
+    );
+    std::fs::write(&never, text).unwrap();
+    let (code, out, err) = hindsight(&["verify", COIN, never.to_str().unwrap()]);
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("1000 discarded by assumptions"), "{out}");
+    assert!(
+        err.contains("not one could be judged for no_heads")
+            && err.contains("discarded because an assumption was violated"),
+        "{err}"
+    );
+    // A study that judges runs says nothing of the kind.
+    let (code, _, err) = hindsight(&["verify", COIN, "--max-runs", "50"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!err.contains("could be judged"), "{err}");
+}
+
 #[test]
 fn the_museum_requirements_hold_at_the_papers_bounds_and_fail_one_step_below() {
     let m = museum();

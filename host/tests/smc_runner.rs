@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use hindsight::verify::smc::{
     run_range, run_study, stream, Decision, Progress, RuleConfig, RuleKind, RunEnd, RunOutcome,
-    StoppingRule, StudyConfig, StudyResult, Verdict,
+    StoppingRule, StudyConfig, StudyResult, Verdict, UNJUDGED_LIMIT,
 };
 use rand_core::Rng;
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -351,6 +351,71 @@ fn sprt_answers_far_from_the_threshold() {
             Some(Decision::Accept)
         );
     }
+}
+
+/// A study none of whose runs can be judged for a property still going stops after
+/// `UNJUDGED_LIMIT` runs (it ran forever before: no run brought the rule closer to done),
+/// whether the runs are cut short or discarded; a property with rare judged runs goes on.
+#[test]
+fn a_study_that_can_judge_no_run_stops() {
+    // Property 0 is judged on every run (a coin); property 1 on none: cut short, or (with
+    // the assumption false) every run discarded.
+    for discard in [false, true] {
+        let run = move |_: u64, rng: &mut Xoshiro256PlusPlus| RunOutcome {
+            verdicts: vec![Verdict::from(uniform(rng) < 0.5), Verdict::Unknown],
+            assumptions: if discard {
+                Verdict::False
+            } else {
+                Verdict::True
+            },
+            end: RunEnd::StepLimit,
+            steps: 1,
+            time: 0,
+        };
+        for threads in [1, 3] {
+            let rules = rules(RuleKind::Okamoto, 0.95, 0.1, 2);
+            let result = run_study(&config(5, threads), &rules, run, &mut quiet);
+            // Okamoto at 0.1 needs 185 judged runs: property 0 is done long before, and
+            // the study stops at the limit, not at a cap (there is none) nor never.
+            assert!(result.unjudged && result.capped, "discard {discard}");
+            assert_eq!(result.runs.runs, UNJUDGED_LIMIT, "discard {discard}");
+            assert_eq!(result.properties[1].counts.judged(), 0);
+            assert_eq!(result.properties[1].stopped_at, None);
+            if discard {
+                assert_eq!(result.runs.discarded, UNJUDGED_LIMIT);
+                assert_eq!(result.properties[0].counts.judged(), 0);
+            } else {
+                assert_eq!(result.properties[1].counts.unknown, UNJUDGED_LIMIT);
+                assert!(result.properties[0].stopped_at.is_some());
+            }
+        }
+    }
+    // One judged run in 500 (the first at run 499) keeps the property going past the
+    // limit until its rule is done.
+    let rare = |k: u64, rng: &mut Xoshiro256PlusPlus| RunOutcome {
+        verdicts: vec![if k % 500 == 499 {
+            Verdict::from(uniform(rng) < 0.5)
+        } else {
+            Verdict::Unknown
+        }],
+        assumptions: Verdict::True,
+        end: RunEnd::StepLimit,
+        steps: 1,
+        time: 0,
+    };
+    let study = StudyConfig {
+        max_runs: Some(5 * UNJUDGED_LIMIT),
+        ..config(5, 2)
+    };
+    let result = run_study(
+        &study,
+        &rules(RuleKind::Okamoto, 0.95, 0.1, 1),
+        rare,
+        &mut quiet,
+    );
+    assert!(!result.unjudged);
+    assert_eq!(result.runs.runs, 5 * UNJUDGED_LIMIT);
+    assert_eq!(result.properties[0].counts.judged(), 10);
 }
 
 #[test]

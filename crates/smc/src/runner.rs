@@ -43,6 +43,14 @@
 //! rule becomes done (that run's index is [`PropertyResult::stopped_at`]); the study
 //! goes on until every rule is done or [`StudyConfig::max_runs`] runs were consumed.
 //!
+//! A property none of whose runs can be judged (every one cut short before its verdict
+//! was final, or discarded by the assumptions) would keep a study going forever: no run
+//! brings its rule closer to done. So once [`UNJUDGED_LIMIT`] runs were consumed and no
+//! property that is not done has a single judged run, the study stops there
+//! ([`StudyResult::unjudged`]): those properties have no estimate, and the runs say why
+//! (their counts of unknown and discarded runs). A property with some judged runs goes
+//! on, however rare they are.
+//!
 //! # Interruption
 //!
 //! [`run_study_until`] also takes a stop flag (set by `verify`'s Ctrl-C handler). Once it
@@ -340,9 +348,17 @@ pub struct StudyResult {
     /// done: the counts are those of the runs consumed, a partial study.
     #[serde(default)]
     pub interrupted: bool,
+    /// Whether the study stopped after [`UNJUDGED_LIMIT`] runs because no property that
+    /// was not done had a judged run (see the module doc).
+    #[serde(default)]
+    pub unjudged: bool,
     /// Wall-clock time (not deterministic, unlike everything else).
     pub elapsed: Duration,
 }
+
+/// Runs after which a sequential study stops when no property still going has a judged
+/// run (every run cut short or discarded): the module doc, "Per-property stopping".
+pub const UNJUDGED_LIMIT: u64 = 1000;
 
 /// Where one property stands during a study.
 struct Tracker {
@@ -431,6 +447,7 @@ where
     let mut runs = RunCounts::default();
     let mut last_report = start;
     let mut remaining_hint = u64::MAX;
+    let mut unjudged = false;
     let all_done = |trackers: &[Tracker]| trackers.iter().all(|t| t.stopped_at.is_some());
     let end = config.max_runs;
     let mut report = |trackers: &[Tracker], consumed: u64, finished: bool| {
@@ -492,6 +509,14 @@ where
                 if all_done(&trackers) {
                     return ControlFlow::Break(());
                 }
+                if runs.runs >= UNJUDGED_LIMIT
+                    && trackers
+                        .iter()
+                        .all(|t| t.stopped_at.is_some() || t.counts.judged() == 0)
+                {
+                    unjudged = true;
+                    return ControlFlow::Break(());
+                }
                 let now = Instant::now();
                 if now.duration_since(last_report) >= config.progress_every {
                     last_report = now;
@@ -524,6 +549,7 @@ where
         runs,
         capped,
         interrupted,
+        unjudged,
         elapsed: start.elapsed(),
     }
 }

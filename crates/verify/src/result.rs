@@ -82,6 +82,11 @@ pub struct Study {
     /// numbers are those of the runs done (left out of the JSON when false).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub interrupted: bool,
+    /// Whether the study stopped because no run could be judged for the properties it
+    /// still needed runs for (all cut short or discarded; see [`Study::unjudged_line`]);
+    /// left out of the JSON when false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub unjudged: bool,
     /// The scheduler every run was under, when `--scheduler` named one (left out of the
     /// JSON otherwise: the uniform scheduler).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -193,6 +198,7 @@ impl Study {
             decided: r.runs.decided,
             quiescent: r.runs.quiescent,
             interrupted: r.interrupted,
+            unjudged: r.unjudged,
             scheduler: scheduler.map(|s| s.to_string()),
             seconds: r.elapsed.as_secs_f64(),
             settings: Vec::new(),
@@ -204,6 +210,43 @@ impl Study {
                 .map(|(name, p)| PropertyRow::new(name, &p.estimate, &p.interval, &p.counts))
                 .collect(),
         }
+    }
+
+    /// Why a study that stopped with [`Study::unjudged`] has no estimate for some
+    /// properties: which ones, and what became of their runs. `None` for any other study.
+    pub fn unjudged_line(&self) -> Option<String> {
+        if !self.unjudged {
+            return None;
+        }
+        let names: Vec<&str> = self
+            .properties
+            .iter()
+            .filter(|p| p.runs == 0)
+            .map(|p| p.property.as_str())
+            .collect();
+        let mut why = Vec::new();
+        if self
+            .properties
+            .iter()
+            .any(|p| p.runs == 0 && p.cut_short > 0)
+        {
+            let limit = match &self.replay {
+                Some(r) => format!(" (--max-steps {})", r.max_steps),
+                None => String::new(),
+            };
+            why.push(format!(
+                "cut at the step limit{limit} before the verdict was final: raise --max-steps"
+            ));
+        }
+        if self.discarded > 0 {
+            why.push("discarded because an assumption was violated: check the assumptions".into());
+        }
+        Some(format!(
+            "stopped after {} runs: not one could be judged for {} (each was {})",
+            self.runs,
+            names.join(", "),
+            why.join("; or ")
+        ))
     }
 
     /// The report of a merged fixed-size study (`merge`, and `verify --runs R` alone):
@@ -229,6 +272,7 @@ impl Study {
             decided: m.runs.decided,
             quiescent: m.runs.quiescent,
             interrupted: false,
+            unjudged: false,
             scheduler: None,
             seconds: 0.0,
             step_seconds: None,

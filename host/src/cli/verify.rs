@@ -534,6 +534,9 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
         )?;
     }
     print_report(&done.study, args.json)?;
+    if let Some(line) = done.study.unjudged_line() {
+        eprintln!("{line}");
+    }
     if done.study.interrupted {
         return Err(interrupted_error(done.study.runs));
     }

@@ -55,6 +55,11 @@ pub(super) fn run_both(args: &VerifyArgs, opts: &VerifyOptions) -> Result<(), Cl
     for line in &both.left_out {
         eprintln!("interrupted: {line}");
     }
+    for (label, study) in &both.studies {
+        if let Some(line) = study.unjudged_line() {
+            eprintln!("--bt {label}: {line}");
+        }
+    }
     let rows = &both.rows;
     let [(_, a), (bt, b)] = both.studies.as_slice() else {
         unreachable!("--bt both names two semantics")
