@@ -62,6 +62,7 @@
 // `pub` only where another crate can reach it: internals are `pub(crate)` (issue 27).
 #![warn(unreachable_pub)]
 
+mod jump;
 pub mod math;
 pub mod progress;
 pub mod runner;

@@ -133,9 +133,14 @@ pub struct RunOutcome {
 }
 
 /// The generator of stream `k` for a study seed: seeded from `seed`, then jumped `k`
-/// times. Costs `k` jumps; the runner itself derives streams incrementally.
+/// times. Beyond a few thousand jumps it applies the jump's powers instead (`jump.rs`):
+/// the same generator, at a cost that does not grow with `k`. The runner itself derives
+/// the streams after the first one incrementally.
 pub fn stream(seed: u64, k: u64) -> Xoshiro256PlusPlus {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    if k >= crate::jump::FEW_JUMPS {
+        return crate::jump::jumped(&rng, k);
+    }
     for _ in 0..k {
         rng.jump();
     }
