@@ -828,6 +828,7 @@ impl Judge<'_> {
 }
 
 impl Observer for Judge<'_> {
+    #[inline]
     fn on_send(&mut self, time: u64, msg: &SentMessage<'_>) -> Flow {
         self.begin();
         let set = self.set;
@@ -841,6 +842,7 @@ impl Observer for Judge<'_> {
         self.step(time)
     }
 
+    #[inline]
     fn on_receive(&mut self, time: u64, _msg: &SentMessage<'_>) -> Flow {
         self.begin();
         self.step(time)
