@@ -130,7 +130,8 @@ pub struct VerifyArgs {
     /// the model has a time unit [default: 10000 steps].
     #[arg(long, value_name = "T")]
     pub max_time: Option<String>,
-    /// A run reaching this many steps is cut short: its open verdicts are unknown.
+    /// A run reaching this many steps is cut short: its open verdicts are unknown (not
+    /// judged). A study that judges no run in its first 1000 stops and says why.
     #[arg(long, default_value_t = 100_000_000)]
     pub max_steps: u64,
     /// Stop the study after this many runs even if the rule wants more (at least 1).
