@@ -244,6 +244,46 @@ fn bad_properties_and_arguments_exit_2() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+/// A sweep in durations on a model whose step is 200 ms: the default step (one unit of
+/// `--from`'s last digit, 0.1 s) is rounded up to whole steps, and a step given that makes
+/// values between steps is refused once, naming the first, instead of failing each.
+#[test]
+fn a_sweeps_default_step_is_whole_model_steps() {
+    let args = |extra: &[&'static str]| {
+        let mut a = vec![
+            "sweep",
+            "examples/museum-scxml",
+            "--time-unit",
+            "200ms",
+            "--property",
+            "visitors_recurrence",
+            "--from",
+            "0.2s",
+            "--to",
+            "1s",
+            "--runs",
+            "3",
+        ];
+        a.extend_from_slice(extra);
+        a
+    };
+    let (code, out, err) = hindsight(&args(&[]));
+    assert_eq!(code, 0, "{err}");
+    let bounds: Vec<&str> = out
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').nth(1))
+        .collect();
+    assert_eq!(bounds, ["0.2s", "0.4s", "0.6s", "0.8s", "1s"], "{out}");
+    let (code, out, err) = hindsight(&args(&["--step", "0.1s"]));
+    assert_eq!(code, 2, "{out}");
+    assert!(
+        err.contains("0.3s is not a whole number of the model's time steps (200ms)"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+}
+
 #[test]
 fn sweep_shows_the_step_at_the_recurrence_threshold() {
     let (code, out, err) = hindsight(&[

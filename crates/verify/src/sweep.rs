@@ -47,6 +47,13 @@ pub enum SweepError {
     Empty,
     /// More values than `MAX_VALUES`.
     TooMany(u64),
+    /// A duration of the range that is no whole number of the model's time steps.
+    NotWholeSteps {
+        /// The value, as the table writes it.
+        value: String,
+        /// The model's time step.
+        unit: String,
+    },
     /// No guarantee of that name in the property file.
     NoGuarantee {
         /// The property file.
@@ -78,6 +85,11 @@ impl fmt::Display for SweepError {
                 f.write_str("--from, --to and --step must all be plain numbers or all durations")
             }
             SweepError::Empty => f.write_str("need --from <= --to and a step above zero"),
+            SweepError::NotWholeSteps { value, unit } => write!(
+                f,
+                "{value} is not a whole number of the model's time steps ({unit}): give --from, \
+                 --to and --step in multiples of {unit}"
+            ),
             SweepError::TooMany(n) => {
                 write!(
                     f,
@@ -118,12 +130,11 @@ pub fn bound_text(v: StepsOrDuration) -> String {
     }
 }
 
-/// The text put into the formula (exact: nanoseconds for durations).
+/// The text put into the formula: the value as [`bound_text`] writes it (exact: seconds
+/// with up to nine decimals), so that an error in a variant names the bound as the
+/// command line and the table do.
 pub(crate) fn formula_text(v: StepsOrDuration) -> String {
-    match v {
-        StepsOrDuration::Steps(v) => v.to_string(),
-        StepsOrDuration::Nanos(v) => format!("{v}ns"),
-    }
+    bound_text(v)
 }
 
 /// The value on a chart's x axis: steps, or seconds.
@@ -172,11 +183,29 @@ fn default_step(text: &str) -> Result<StepsOrDuration, SweepError> {
 /// The values from `from` to `to` (inclusive) in steps of `step` (default: one unit of
 /// `from`'s last digit); all three of one kind, at most `MAX_VALUES`.
 pub fn grid(from: &str, to: &str, step: Option<&str>) -> Result<Vec<StepsOrDuration>, SweepError> {
+    grid_in(from, to, step, None)
+}
+
+/// [`grid`] for a model whose time step is `unit_ns` nanoseconds (`None`: no time unit):
+/// a default step of durations that is not a whole number of model steps is rounded up
+/// to one (`--from 0.2s` on a 200 ms model steps by 0.2 s, not 0.1 s, whose odd values
+/// no bound can take). A step given is kept as given.
+pub fn grid_in(
+    from: &str,
+    to: &str,
+    step: Option<&str>,
+    unit_ns: Option<u64>,
+) -> Result<Vec<StepsOrDuration>, SweepError> {
     let a = parse_bound(from)?;
     let b = parse_bound(to)?;
     let s = match step {
         Some(s) => parse_bound(s)?,
-        None => default_step(from)?,
+        None => match (default_step(from)?, unit_ns) {
+            (StepsOrDuration::Nanos(s), Some(unit)) if unit > 0 && s % unit != 0 => {
+                StepsOrDuration::Nanos(s.div_ceil(unit).saturating_mul(unit))
+            }
+            (s, _) => s,
+        },
     };
     let same = |x: StepsOrDuration, y: StepsOrDuration| {
         std::mem::discriminant(&x) == std::mem::discriminant(&y)
@@ -191,9 +220,21 @@ pub fn grid(from: &str, to: &str, step: Option<&str>) -> Result<Vec<StepsOrDurat
     if count > MAX_VALUES {
         return Err(SweepError::TooMany(count));
     }
-    Ok((0..count)
+    let values: Vec<StepsOrDuration> = (0..count)
         .map(|i| with_raw(a, raw(a) + i * raw(s)))
-        .collect())
+        .collect();
+    if let Some(unit) = unit_ns.filter(|&u| u > 0) {
+        let odd = values
+            .iter()
+            .find(|v| matches!(v, StepsOrDuration::Nanos(n) if n % unit != 0));
+        if let Some(&v) = odd {
+            return Err(SweepError::NotWholeSteps {
+                value: bound_text(v),
+                unit: codegen::duration::format(unit),
+            });
+        }
+    }
+    Ok(values)
 }
 
 /// Replaces every bound end of `formula` (with its unit, if any: `62`, `2.5s`) by `value`
@@ -562,6 +603,32 @@ mod tests {
 
     #[test]
     fn grids_step_exactly_and_default_to_the_last_digit() {
+        // A default step that is no whole number of model steps is rounded up to one.
+        let g = grid_in("0.2s", "1s", None, Some(200_000_000)).unwrap();
+        let texts: Vec<String> = g.iter().map(|v| bound_text(*v)).collect();
+        assert_eq!(texts, ["0.2s", "0.4s", "0.6s", "0.8s", "1s"]);
+        // A range off the model's steps is refused at its first value, and a step given
+        // that is no whole number of steps at the first value it makes so.
+        assert!(matches!(
+            grid_in("0.25s", "0.5s", None, Some(100_000_000)),
+            Err(SweepError::NotWholeSteps { value, .. }) if value == "0.25s"
+        ));
+        assert_eq!(
+            grid_in("0.2s", "1s", Some("0.1s"), Some(200_000_000)),
+            Err(SweepError::NotWholeSteps {
+                value: "0.3s".into(),
+                unit: "200ms".into()
+            })
+        );
+        // A whole step, and steps, stay as they are.
+        let five = |g: Result<Vec<StepsOrDuration>, SweepError>| g.map(|g| g.len());
+        assert_eq!(
+            five(grid_in("0.1s", "0.5s", None, Some(100_000_000))),
+            Ok(5)
+        );
+        assert_eq!(five(grid_in("1", "5", None, Some(200_000_000))), Ok(5));
+        assert_eq!(formula_text(StepsOrDuration::Nanos(300_000_000)), "0.3s");
+        assert_eq!(formula_text(StepsOrDuration::Nanos(1)), "0.000000001s");
         let g = grid("0.1s", "0.5s", None).unwrap();
         assert_eq!(g.len(), 5);
         assert_eq!(g[4], StepsOrDuration::Nanos(500_000_000));

@@ -8,7 +8,7 @@ use crate::codegen::duration::StepsOrDuration;
 use crate::live::{self, engine::Verdict};
 use crate::report::plot;
 use crate::verify::options::VerifyOptions;
-use crate::verify::sweep::{grid, sweep, sweep_recorded, targets, SweepCurve, SweepEvent};
+use crate::verify::sweep::{grid, grid_in, sweep, sweep_recorded, targets, SweepCurve, SweepEvent};
 
 /// Arguments of `hindsight sweep`.
 #[derive(Debug, clap::Args)]
@@ -52,7 +52,8 @@ pub struct SweepArgs {
     /// Last bound value, inclusive.
     #[arg(long)]
     pub to: String,
-    /// Step between values; default: one unit of `--from`'s last digit (`1`, `0.1s`).
+    /// Step between values; default: one unit of `--from`'s last digit (`1`, `0.1s`),
+    /// rounded up to a whole number of the model's time steps.
     #[arg(long)]
     pub step: Option<String>,
     /// Runs per property (every bound of a property is judged on the same runs; at least 1).
@@ -99,12 +100,15 @@ pub struct SweepArgs {
 /// `live` reads and judges), each curve printed as CSV as it is done, then the
 /// thresholds, the chart and the page.
 pub fn run(args: &SweepArgs) -> Result<(), CliError> {
-    let values = grid(&args.from, &args.to, args.step.as_deref())
-        .map_err(|e| CliError::Input(e.to_string()))?;
+    // The range is read before the model loads, so that a bad one is said at once; the
+    // model's time step then rounds a default step up to whole steps.
+    grid(&args.from, &args.to, args.step.as_deref()).map_err(|e| CliError::Input(e.to_string()))?;
     if args.runs == 0 {
         return Err(CliError::Input("sweep: --runs must be at least 1".into()));
     }
     let loaded = load(&args.input)?;
+    let values = grid_in(&args.from, &args.to, args.step.as_deref(), loaded.unit_ns)
+        .map_err(|e| CliError::Input(e.to_string()))?;
     // Each property is compiled again: the load printed the file's warnings.
     let mut said: std::collections::BTreeSet<String> = loaded
         .warnings
