@@ -214,7 +214,7 @@ fn bt_options_are_refused_where_they_mean_nothing() {
             &[
                 "verify", "main.xml", "--bt", "both", "--runs", "10", "--shard", "0/2",
             ][..],
-            "--bt both: not with --shard",
+            "--bt both: not with --shard / --plan",
         ),
         (
             &["convert", "main.xml", "--out", "out", "--bt", "both"][..],

@@ -191,5 +191,8 @@ fn bt_both_takes_a_fixed_number_of_runs() {
     );
     std::fs::remove_dir_all(&dir).ok();
     assert_eq!(code, 2, "{err}");
-    assert!(err.contains("--bt both: not with --shard"), "{err}");
+    assert!(
+        err.contains("--bt both: not with --shard / --plan"),
+        "{err}"
+    );
 }

@@ -16,9 +16,10 @@ pub(super) fn run_both(args: &VerifyArgs, opts: &VerifyOptions) -> Result<(), Cl
             "--bt both: not with {what} (run each semantics with --bt as2fm / --bt btcpp)"
         )))
     };
-    if args.shard.is_some() {
-        // A shard's part is one study's; `merge` would not know which semantics it was.
-        return refuse("--shard");
+    if args.shard.is_some() || args.plan.is_some() {
+        // A shard's part, or a stage's plan, is one study's: `merge` would not know which
+        // semantics it was.
+        return refuse("--shard / --plan");
     }
     if args.report.is_some() || args.save_failing > 0 {
         return refuse("--report / --save-failing");
