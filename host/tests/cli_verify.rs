@@ -284,6 +284,33 @@ fn a_sweeps_default_step_is_whole_model_steps() {
     assert_eq!(err.lines().count(), 1, "{err}");
 }
 
+/// `verify --runs N` in one process: its table says the time it took and the model's time
+/// unit, as a sequential study's does, while its JSON stays the document `merge` makes of
+/// its shards (no wall-clock seconds, no time unit).
+#[test]
+fn a_fixed_size_study_table_says_its_time_and_its_json_stays_mergeable() {
+    let args = [
+        "verify",
+        "examples/museum-scxml",
+        "--time-unit",
+        "100ms",
+        "--runs",
+        "4",
+        "--seed",
+        "3",
+    ];
+    let (code, out, err) = hindsight(&args);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("4 runs in "), "{out}");
+    assert!(
+        out.contains("model time: steps of 0.1 s, runs of at most"),
+        "{out}"
+    );
+    let r = json(&args);
+    assert_eq!(r["seconds"], 0.0, "{r}");
+    assert!(r.get("step_seconds").is_none(), "{r}");
+}
+
 #[test]
 fn sweep_shows_the_step_at_the_recurrence_threshold() {
     let (code, out, err) = hindsight(&[

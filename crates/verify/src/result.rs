@@ -294,7 +294,7 @@ impl Study {
 
     /// Model time in seconds, for a model whose step is `unit_ns` nanoseconds and whose
     /// runs last `max_time` steps (nothing without a unit).
-    pub(crate) fn set_time_unit(&mut self, unit_ns: Option<u64>, max_time: u64) {
+    pub fn set_time_unit(&mut self, unit_ns: Option<u64>, max_time: u64) {
         if let Some(unit) = unit_ns {
             self.step_seconds = Some(unit as f64 / 1e9);
             self.max_time_seconds = Some(max_time as f64 * unit as f64 / 1e9);

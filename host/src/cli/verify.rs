@@ -489,6 +489,7 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     // one does not.
     let mut bar = progress_bar(args.runs.is_some() || !args.json);
     let show = !args.json;
+    let started = std::time::Instant::now();
     let outcome = verify(
         &request,
         &mut |e| match e {
@@ -534,7 +535,17 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
             &done.shown_runs(),
         )?;
     }
-    print_report(&done.study, args.json)?;
+    if args.runs.is_some() && !args.json {
+        // A fixed-size study's result is the document `merge` makes of its shards, which
+        // knows neither the time it took nor the model's time unit: the table of one made
+        // here says both, as a sequential study's does.
+        let mut shown = done.study.clone();
+        shown.seconds = started.elapsed().as_secs_f64();
+        shown.set_time_unit(loaded.unit_ns, run_cfg.max_time);
+        print_report(&shown, false)?;
+    } else {
+        print_report(&done.study, args.json)?;
+    }
     if let Some(line) = done.study.unjudged_line() {
         eprintln!("{line}");
     }
