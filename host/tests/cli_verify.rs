@@ -241,6 +241,24 @@ fn bad_properties_and_arguments_exit_2() {
         assert!(out.is_empty(), "{args:?}: {out}");
         assert!(err.contains("must be at least 1"), "{args:?}: {err}");
     }
+    // A thread count past 1024 is refused at once (it tried to start as many threads).
+    for args in [
+        &["verify", COIN, "--threads", "100000000", "--max-runs", "5"][..],
+        &[
+            "sweep",
+            COIN,
+            "--from",
+            "1",
+            "--to",
+            "2",
+            "--threads",
+            "5000",
+        ],
+    ] {
+        let (code, out, err) = hindsight(args);
+        assert_eq!(code, 2, "{args:?}: {out}{err}");
+        assert!(err.contains("at most 1024"), "{args:?}: {err}");
+    }
     let _ = std::fs::remove_dir_all(dir);
 }
 

@@ -418,6 +418,26 @@ fn a_study_that_can_judge_no_run_stops() {
     assert_eq!(result.properties[0].counts.judged(), 10);
 }
 
+/// A thread count past MAX_THREADS (a library caller's, the CLI refuses it) is taken as
+/// MAX_THREADS: the study runs, with the numbers of one thread.
+#[test]
+fn a_huge_thread_count_is_capped() {
+    let probabilities = [0.5];
+    let rules = rules(RuleKind::Okamoto, 0.95, 0.1, 1);
+    let huge = StudyConfig {
+        max_runs: Some(50),
+        ..config(3, usize::MAX)
+    };
+    let one = StudyConfig {
+        max_runs: Some(50),
+        ..config(3, 1)
+    };
+    let a = run_study(&huge, &rules, bernoulli(&probabilities), &mut quiet);
+    let b = run_study(&one, &rules, bernoulli(&probabilities), &mut quiet);
+    assert_eq!(a.runs.runs, 50);
+    assert_eq!(deterministic_part(&a), deterministic_part(&b));
+}
+
 #[test]
 fn a_rule_that_cannot_finish_is_capped() {
     let run = |_: u64, _: &mut Xoshiro256PlusPlus| RunOutcome {

@@ -71,7 +71,8 @@ pub mod stats;
 
 pub use runner::{
     run_range, run_study, run_study_until, stream, Progress, PropertyCounts, PropertyResult,
-    RangeCounts, RunCounts, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict, UNJUDGED_LIMIT,
+    RangeCounts, RunCounts, RunEnd, RunOutcome, StudyConfig, StudyResult, Verdict, MAX_THREADS,
+    UNJUDGED_LIMIT,
 };
 pub use shard::{
     merge, run_fixed_study, run_shard, FixedStudy, MergedProperty, MergedResult, PartialProperty,

@@ -297,7 +297,7 @@ impl StudyConfig {
     /// The number of worker threads this configuration asks for.
     pub(crate) fn thread_count(&self) -> usize {
         if self.threads > 0 {
-            self.threads
+            self.threads.min(MAX_THREADS)
         } else {
             thread::available_parallelism().map_or(1, |n| n.get())
         }
@@ -360,6 +360,10 @@ pub struct StudyResult {
     /// Wall-clock time (not deterministic, unlike everything else).
     pub elapsed: Duration,
 }
+
+/// The most worker threads a study starts: each is an OS thread, and the results do not
+/// depend on the count, so [`StudyConfig::threads`] above it is taken as this.
+pub const MAX_THREADS: usize = 1024;
 
 /// Runs after which a sequential study stops when no property still going has a judged
 /// run (every run cut short or discarded): the module doc, "Per-property stopping".

@@ -145,6 +145,20 @@ pub fn run_count(s: &str) -> Result<u64, String> {
     }
 }
 
+/// `--threads`: 0 (every core) up to [`crate::verify::smc::MAX_THREADS`]. A study's numbers
+/// do not depend on the count, and each worker is an OS thread: a count past that is a
+/// typo, not a wish (`--threads 100000000` tried to start as many).
+pub fn thread_count(s: &str) -> Result<usize, String> {
+    let max = crate::verify::smc::MAX_THREADS;
+    match s.trim().parse::<usize>() {
+        Ok(n) if n <= max => Ok(n),
+        Ok(n) => Err(format!(
+            "{n} worker threads: at most {max} (0 uses every core; the numbers do not depend on it)"
+        )),
+        Err(e) => Err(format!("not a whole number of threads ({e})")),
+    }
+}
+
 /// Reads a whole text file (a spec, trace, study, log or config) with the project's one
 /// source reader, `codegen::diag::read_source`: a folder, FIFO or device is refused
 /// without being opened, a UTF-8 byte order mark is dropped, and a byte that is not

@@ -65,8 +65,8 @@ pub struct SweepArgs {
     /// Study seed (the same for every property).
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Worker threads (0: all cores).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads (0: all cores; at most 1024). The numbers do not depend on it.
+    #[arg(long, default_value_t = 0, value_parser = crate::cli::thread_count)]
     pub threads: usize,
     /// A run ends when model time reaches this, as for `verify`.
     #[arg(long, value_name = "T")]

@@ -123,8 +123,8 @@ pub struct VerifyArgs {
     /// Study seed: run k uses stream k of xoshiro256++, so results do not depend on --threads.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Worker threads (0: all cores).
-    #[arg(long, default_value_t = 0)]
+    /// Worker threads (0: all cores; at most 1024). The numbers do not depend on it.
+    #[arg(long, default_value_t = 0, value_parser = crate::cli::thread_count)]
     pub threads: usize,
     /// A run ends when model time reaches this: model steps, or a duration (`100s`) when
     /// the model has a time unit [default: 10000 steps].
