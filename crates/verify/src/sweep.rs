@@ -130,13 +130,6 @@ pub fn bound_text(v: StepsOrDuration) -> String {
     }
 }
 
-/// The text put into the formula: the value as [`bound_text`] writes it (exact: seconds
-/// with up to nine decimals), so that an error in a variant names the bound as the
-/// command line and the table do.
-pub(crate) fn formula_text(v: StepsOrDuration) -> String {
-    bound_text(v)
-}
-
 /// The value on a chart's x axis: steps, or seconds.
 pub fn axis(v: StepsOrDuration) -> f64 {
     match v {
@@ -364,7 +357,9 @@ pub fn variants(
             let mut g = target.clone();
             g.id = format!("{}@{}", target.id, bound_text(*v));
             g.formula = SourceText::generated(
-                set_bounds(target.formula.as_str(), &formula_text(*v)).0,
+                // The bound as the table writes it (exact: seconds with up to nine
+                // decimals), so an error in a variant names it as the user did.
+                set_bounds(target.formula.as_str(), &bound_text(*v)).0,
                 target.at,
             );
             g
@@ -627,8 +622,8 @@ mod tests {
             Ok(5)
         );
         assert_eq!(five(grid_in("1", "5", None, Some(200_000_000))), Ok(5));
-        assert_eq!(formula_text(StepsOrDuration::Nanos(300_000_000)), "0.3s");
-        assert_eq!(formula_text(StepsOrDuration::Nanos(1)), "0.000000001s");
+        assert_eq!(bound_text(StepsOrDuration::Nanos(300_000_000)), "0.3s");
+        assert_eq!(bound_text(StepsOrDuration::Nanos(1)), "0.000000001s");
         let g = grid("0.1s", "0.5s", None).unwrap();
         assert_eq!(g.len(), 5);
         assert_eq!(g[4], StepsOrDuration::Nanos(500_000_000));
