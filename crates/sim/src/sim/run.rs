@@ -248,10 +248,13 @@ fn refresh_in(ms: &mut [MachineRt], runnable: &mut Vec<u32>, m: usize) {
     }
 }
 
-/// Marks machine `m`'s cached state hash stale, as [`Simulator::touch`] does, over the two
-/// fields it needs.
+/// Marks machine `m`'s cached state hash stale, as [`Simulator::touch`] does, over the
+/// fields it needs (`sampled`: [`Simulator::sampled`]).
 #[inline(always)]
-fn touch_in(ms: &mut [MachineRt], dirty: &mut Vec<u32>, m: usize) {
+fn touch_in(ms: &mut [MachineRt], dirty: &mut Vec<u32>, sampled: bool, m: usize) {
+    if !sampled {
+        return;
+    }
     let r = &mut ms[m];
     if !r.dirty {
         r.dirty = true;

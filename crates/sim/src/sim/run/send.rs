@@ -86,6 +86,7 @@ impl Simulator<'_> {
             steps,
             instant_steps,
             reserved,
+            sampled,
             ..
         } = self;
         let r = &ms[m];
@@ -184,7 +185,7 @@ impl Simulator<'_> {
                 } else if let Some(prev) = pool.get_mut(tail as usize) {
                     prev.next = slot;
                 }
-                touch_in(ms, dirty, t);
+                touch_in(ms, dirty, *sampled, t);
                 refresh_in(ms, runnable, t);
             }
             None => {
