@@ -220,3 +220,36 @@ fn per_target_copies_of_one_broadcast_are_sent_once() {
     let (_, log) = run(&m, EventSemantics::As2fm, 0);
     assert_eq!(log, ["send e a->b", "recv e a->b", "recv e a->c"]);
 }
+
+#[test]
+fn a_deadlock_before_the_horizon_is_quiescence_at_it_the_horizon() {
+    // `a` waits 5 units, then sends a BT tick twice: `b` cannot take it (no transition on
+    // it in `s0`, and nobody may drop a tick), so the run deadlocks at time 5.
+    let b = scxml(
+        "b",
+        r#"<state id="s0"><transition event="never" target="s1"/></state>
+           <state id="s1"><transition event="bt_1_tick" target="s1"/></state>"#,
+    );
+    let a = scxml(
+        "a",
+        r#"<state id="s0"><onentry><send event="go" target="a" delay="5"/></onentry>
+             <transition event="go" target="s1"/></state>
+           <state id="s1"><onentry><send event="bt_1_tick" target="b"/><send event="bt_1_tick" target="b"/></onentry></state>"#,
+    );
+    let never = scxml(
+        "n",
+        r#"<state id="s0"><transition event="x" target="s0"><send event="never" target="b"/></transition></state>"#,
+    );
+    let m = model(&[("a.scxml", &a), ("b.scxml", &b), ("n.scxml", &never)]);
+    let end_at = |max_time| {
+        let cfg = RunConfig {
+            events: EventSemantics::As2fm,
+            max_time,
+            ..RunConfig::default()
+        };
+        let out = Simulator::new(&m).run(&mut Xoshiro256PlusPlus::seed_from_u64(0), &cfg, &mut ());
+        (out.end, out.time)
+    };
+    assert_eq!(end_at(6), (EndReason::Quiescent, 5));
+    assert_eq!(end_at(5), (EndReason::MaxTime, 5));
+}

@@ -127,6 +127,26 @@ fn delayed_sends_block_the_sender_for_the_delay() {
 }
 
 #[test]
+fn going_quiet_at_the_horizon_ends_at_the_horizon() {
+    // The delay model's last send is at 16, after which nothing can ever happen: before
+    // the horizon that is quiescence; at it, the run simply lasted its length (a robot
+    // model's global timer stops at `max_time`, and its runs must not all read as
+    // quiescent, which would hide a real deadlock).
+    let m = model("delay");
+    let at = |max_time| {
+        let cfg = RunConfig {
+            max_time,
+            ..RunConfig::default()
+        };
+        let (out, rec) = run(&m, 3, &cfg);
+        (out.end, out.time, rec.rows.len())
+    };
+    assert_eq!(at(17), (EndReason::Quiescent, 16, 5));
+    assert_eq!(at(16), (EndReason::MaxTime, 16, 5));
+    assert_eq!(at(15), (EndReason::MaxTime, 15, 4));
+}
+
+#[test]
 fn send_without_target_reaches_every_receiver() {
     let m = model("broadcast");
     let (out, rec) = run(&m, 5, &RunConfig::default());

@@ -395,8 +395,13 @@ impl<'m> Simulator<'m> {
                 {
                     // An event nobody can ever take blocks time: JANI's deadlock. A live
                     // run (`Quiescence::AdvanceTime`) goes on: a process playing a node may
-                    // still answer and unblock it, as any external message may.
-                    return Ok(EndReason::Quiescent);
+                    // still answer and unblock it, as any external message may. At the
+                    // horizon the run is over anyway: it ends there.
+                    return Ok(if self.time >= cfg.max_time {
+                        EndReason::MaxTime
+                    } else {
+                        EndReason::Quiescent
+                    });
                 }
             }
             if self.runnable.is_empty() && self.deliverable.is_empty() {
@@ -412,11 +417,14 @@ impl<'m> Simulator<'m> {
                         continue;
                     }
                 }
-                if self.delayed.is_empty() && cfg.quiescence == Quiescence::Stop {
-                    return Ok(EndReason::Quiescent);
-                }
+                // The horizon first: a run that went quiet at its last instant lasted its
+                // whole length (a robot model's global timer stops at `max_time`, so every
+                // run of one would otherwise end "quiescent" and hide a real deadlock).
                 if self.time >= cfg.max_time {
                     return Ok(EndReason::MaxTime);
+                }
+                if self.delayed.is_empty() && cfg.quiescence == Quiescence::Stop {
+                    return Ok(EndReason::Quiescent);
                 }
                 self.time += 1;
                 self.instant_steps = 0;

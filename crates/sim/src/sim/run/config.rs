@@ -15,7 +15,7 @@ pub enum TransitionChoice {
 /// What happens when nothing can move and no delayed send is pending.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Quiescence {
-    /// End the run ([`EndReason::Quiescent`]).
+    /// End the run ([`EndReason::Quiescent`]; [`EndReason::MaxTime`] at the horizon).
     #[default]
     Stop,
     /// Keep advancing time (one [`Observer::on_time`] per unit) until `max_time`,
@@ -186,10 +186,11 @@ impl std::fmt::Display for RunError {
 /// Why a run ended.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum EndReason {
-    /// Nothing can ever happen again: every machine waits for an event that no
-    /// one will send and no delayed send is pending.
+    /// Nothing can ever happen again, before the horizon: every machine waits for an
+    /// event that no one will send and no delayed send is pending.
     Quiescent,
-    /// The clock reached [`RunConfig::max_time`] and everything due then was done.
+    /// The clock reached [`RunConfig::max_time`] and everything due then was done
+    /// (whether or not anything could still happen later).
     MaxTime,
     /// [`RunConfig::max_steps`] steps were taken.
     MaxSteps,
