@@ -367,6 +367,37 @@ fn sweep_shows_the_step_at_the_recurrence_threshold() {
         err.contains("visitors_recurrence: every run succeeds from bound 10 on"),
         "{err}"
     );
+    // The same deadline written as a window from now, `once[0:10]`: the sweep moves the
+    // deadline and keeps the window's start (it once swept both ends, `once[X:X]`, and
+    // every run failed at every bound).
+    let dir = std::env::temp_dir().join(format!("hs_sweep_zero_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let props = dir.join("properties.xml");
+    let museum = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../examples/museum-scxml/properties.xml");
+    let text = std::fs::read_to_string(museum)
+        .unwrap()
+        .replace("once[:10]", "once[0:10]");
+    assert!(text.contains("once[0:10]"));
+    std::fs::write(&props, text).unwrap();
+    let (code, windowed, err) = hindsight(&[
+        "sweep",
+        "examples/museum-scxml",
+        props.to_str().unwrap(),
+        "--property",
+        "visitors_recurrence",
+        "--from",
+        "9",
+        "--to",
+        "10",
+        "--runs",
+        "10",
+        "--seed",
+        "2",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(windowed, out);
+    std::fs::remove_dir_all(&dir).ok();
     let (code, _, err) = hindsight(&[
         "sweep",
         "examples/museum-scxml",
@@ -768,6 +799,25 @@ fn replay_refuses_a_bad_trace_naming_file_line_and_column() {
         "{err}"
     );
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn robot_model_runs_end_at_the_time_horizon() {
+    // The museum guide's global timer stops at `max_time`: its runs lasted their whole
+    // length and are counted at the horizon, not as quiescent (which names a deadlock).
+    let r = json(&[
+        "verify",
+        "examples/museum-guide",
+        "--runs",
+        "5",
+        "--seed",
+        "4",
+    ]);
+    assert_eq!(
+        (r["time_horizon"].as_u64(), r["quiescent"].as_u64()),
+        (Some(5), Some(0)),
+        "{r}"
+    );
 }
 
 #[test]

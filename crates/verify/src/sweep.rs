@@ -4,7 +4,7 @@
 //!
 //! A bound value is codegen's [`StepsOrDuration`] (model steps, or an exact duration):
 //! [`grid`] reads the range, [`variants`] writes one guarantee per value with every bound
-//! end of its formula replaced ([`set_bounds`]), [`sweep`] judges each guarantee's
+//! end of its formula but zero ones replaced ([`set_bounds`]), [`sweep`] judges each guarantee's
 //! variants on one study's runs (or [`sweep_recorded`] on recorded runs, the logs of
 //! `sweep --online`), and [`threshold_index`] finds each curve's threshold.
 //!
@@ -17,6 +17,9 @@
 //! assert_eq!(grid("58", "62", Some("2")).unwrap()[2], StepsOrDuration::Steps(62));
 //! assert!(grid("1", "2s", None).is_err());
 //! assert_eq!(set_bounds("once[2:5] {a}", "7"), ("once[7:7] {a}".to_string(), 2));
+//! // A window that starts now keeps its start: only the deadline moves.
+//! assert_eq!(set_bounds("once[0:5] {a}", "7"), ("once[0:7] {a}".to_string(), 1));
+//! assert_eq!(set_bounds("once[0s:5s] {a}", "7s").1, 1);
 //! ```
 
 use std::fmt;
@@ -231,10 +234,27 @@ pub fn grid_in(
 }
 
 /// Replaces every bound end of `formula` (with its unit, if any: `62`, `2.5s`) by `value`
-/// ([`codegen::bounds::map_bounds`]: an edit of the parsed tree, atoms are left alone).
-/// Returns the new formula and how many ends were replaced.
+/// ([`codegen::bounds::map_bounds`]: an edit of the parsed tree, atoms are left alone),
+/// except an end that is zero: the `0` of `once[0:2s]` says the window starts now, it
+/// is not a bound (sweeping it too turned the deadline `once[0:2s]` into `once[2s:2s]`,
+/// "exactly 2 s ago"). Returns the new formula and how many ends were replaced.
 pub fn set_bounds(formula: &str, value: &str) -> (String, usize) {
-    codegen::bounds::map_bounds(formula, |_| Ok::<_, ()>(value.to_string())).unwrap_or_default()
+    let mut replaced = 0;
+    let out = codegen::bounds::map_bounds(formula, |end| {
+        let zero = matches!(
+            parse_steps_or_duration(end),
+            Ok(StepsOrDuration::Steps(0) | StepsOrDuration::Nanos(0))
+        );
+        if zero {
+            return Ok::<_, ()>(end.to_string());
+        }
+        replaced += 1;
+        Ok(value.to_string())
+    });
+    match out {
+        Ok((text, _)) => (text, replaced),
+        Err(()) => (formula.to_string(), 0),
+    }
 }
 
 /// The guarantees to sweep: those named in `ids` (each must have a time bound), or, with
