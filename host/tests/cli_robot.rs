@@ -82,6 +82,11 @@ fn converted_plain_scxml_runs_exactly_like_the_robot_model() {
     let model = out_dir.join("model.xml");
     let (code, high, err) = hindsight(&["trace", GUIDE, "--run", "1", "--seed", "9"]);
     assert_eq!(code, 0, "{err}");
+    // The guide's global timer runs to `max_time` (100 s): the run lasts its whole length.
+    assert!(
+        err.contains("run 1 of seed 9: reached the time horizon, time 1001 (100.1s), after "),
+        "{err}"
+    );
     let (code, plain, err) = hindsight(&[
         "trace",
         model.to_str().unwrap(),

@@ -635,6 +635,12 @@ fn trace_replays_one_run_as_csv() {
     assert!(out.contains("\n2,send,a_done,a,judge,"), "{out}");
     assert!(out.contains("\n2,send,b_done,b,judge,"), "{out}");
     assert!(out.contains("\n3,send,c_done,c,judge,"), "{out}");
+    // How the run ended goes to standard error: the race's machines stop after their
+    // sends, so it goes quiet at time 3.
+    assert!(
+        err.contains("run 3 of seed 1: went quiet at time 3 after "),
+        "{err}"
+    );
     // The same run twice gives the same text.
     let (_, again, _) = hindsight(&[
         "trace",

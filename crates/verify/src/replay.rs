@@ -79,6 +79,46 @@ impl From<JudgeError> for ReplayError {
     }
 }
 
+/// Replays run `k` like [`replay_csv`] and returns its CSV with how the run ended
+/// ([`how_it_ended`] words it): `trace`'s two outputs.
+pub fn trace_run(
+    model: &CompiledModel,
+    set: &PropertySet,
+    run_cfg: &RunConfig,
+    seed: u64,
+    k: u64,
+) -> Result<(String, RunOutcome), JudgeError> {
+    replayed(model, set, run_cfg, seed, k).map(|r| (r.csv, r.out))
+}
+
+/// How a run ended, in words, its time also in seconds when the model's step is known
+/// (`unit_ns`). A robot model's run that went quiet before the horizon is a deadlock (its
+/// global timer runs until `max_time`); a plain model's may have stopped its own timer.
+pub fn how_it_ended(out: &RunOutcome, unit_ns: Option<u64>) -> String {
+    let at = match unit_ns {
+        Some(u) => format!(
+            "time {} ({})",
+            out.time,
+            codegen::duration::seconds(out.time.saturating_mul(u))
+        ),
+        None => format!("time {}", out.time),
+    };
+    let steps = out.steps;
+    match &out.end {
+        EndReason::Quiescent => format!(
+            "went quiet at {at} after {steps} steps, before the time horizon: nothing could \
+             move and no timer was pending"
+        ),
+        EndReason::MaxTime => format!("reached the time horizon, {at}, after {steps} steps"),
+        EndReason::MaxSteps => {
+            format!("was cut at the step limit, {steps} steps, at {at} (raise --max-steps)")
+        }
+        EndReason::Stopped => format!("stopped at {at} after {steps} steps"),
+        EndReason::Spin(s) => format!("stopped at {at} after {steps} steps: {s}"),
+        EndReason::Error(e) => format!("failed at {at} after {steps} steps: {e}"),
+    }
+}
+
 /// Replays run `k` of a study with `seed` and returns its CSV (see [`crate::record`])
 /// and, per property that turned false, the subformula that explains it.
 pub fn replay_csv(
@@ -150,7 +190,11 @@ pub fn play_run<O: Observer + ?Sized>(
 pub fn end_text(end: &EndReason) -> String {
     match end {
         EndReason::MaxTime => "reached the duration".to_string(),
-        other => format!("{other:?}"),
+        EndReason::Quiescent => "went quiet: nothing could move and no timer was pending".into(),
+        EndReason::MaxSteps => "was cut at the step limit".to_string(),
+        EndReason::Stopped => "was stopped".to_string(),
+        EndReason::Spin(s) => s.to_string(),
+        EndReason::Error(e) => e.to_string(),
     }
 }
 

@@ -20,7 +20,7 @@ use crate::verify::options::{BtSemantics, BtTick};
 use crate::verify::options::{EventSemantics, Scheduler};
 use crate::verify::options::{RuleConfig, RuleKind};
 use crate::verify::pipeline::{verify, Event, Outcome, Request, VerifyError};
-use crate::verify::replay::replay_csv;
+use crate::verify::replay::{how_it_ended, trace_run};
 use crate::verify::result::Study;
 use crate::verify::schedulers::SchedulerOptions;
 use crate::verify::study::Unfair;
@@ -445,7 +445,7 @@ pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
         ..VerifyOptions::default()
     };
     let run_cfg = opts.run_config(&loaded).map_err(max_time_error)?;
-    let (csv, _) = replay_csv(&loaded.model, &loaded.set, &run_cfg, opts.seed, args.run)
+    let (csv, out) = trace_run(&loaded.model, &loaded.set, &run_cfg, opts.seed, args.run)
         .map_err(|e| CliError::Failed(e.to_string()))?;
     match &args.output {
         Some(p) => {
@@ -453,6 +453,12 @@ pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
         }
         None => print!("{csv}"),
     }
+    eprintln!(
+        "run {} of seed {}: {}",
+        args.run,
+        opts.seed,
+        how_it_ended(&out, loaded.unit_ns)
+    );
     Ok(())
 }
 
