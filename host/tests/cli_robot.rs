@@ -29,6 +29,79 @@ fn copy_dir(from: &Path, to: &Path) {
 const GUIDE: &str = "examples/museum-guide";
 
 #[test]
+fn a_robot_that_deadlocks_is_told_so() {
+    // The client calls `/svc` after 1 s; the server waits for a topic nobody publishes
+    // and never handles the request, which nobody may drop: time stops at 1 s of 10.
+    let dir = scratch("deadlock");
+    let files = [
+        (
+            "main.xml",
+            r#"<roaml><parameters><max_time value="10" unit="s"/></parameters>
+  <node_models><input type="ros-scxml" src="./client.scxml"/><input type="ros-scxml" src="./server.scxml"/></node_models>
+  <properties><input type="xml" src="./properties.xml"/></properties></roaml>"#,
+        ),
+        (
+            "client.scxml",
+            r#"<scxml version="1.0" datamodel="ecmascript" name="client" initial="wait">
+  <ros_service_client service_name="/svc" type="std_srvs/Trigger"/>
+  <ros_time_rate name="t" rate_hz="1"/>
+  <state id="wait"><ros_rate_callback name="t" target="call"/></state>
+  <state id="call"><onentry><ros_service_send_request name="/svc"/></onentry>
+    <ros_service_handle_response name="/svc" target="wait"/></state>
+</scxml>"#,
+        ),
+        (
+            "server.scxml",
+            r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="off">
+  <ros_service_server service_name="/svc" type="std_srvs/Trigger"/>
+  <ros_topic_subscriber topic="/never" type="std_msgs/Bool"/>
+  <state id="off"><ros_topic_callback name="/never" target="on"/></state>
+  <state id="on"><ros_service_handle_request name="/svc" target="on">
+    <ros_service_send_response name="/svc"><field name="success" expr="true"/></ros_service_send_response>
+  </ros_service_handle_request></state>
+</scxml>"#,
+        ),
+        (
+            "properties.xml",
+            r#"<properties><ports>
+  <ros_service service_name="/svc" type="std_srvs/Trigger" event="request"><event_var id="asked"/></ros_service>
+</ports><guarantees>
+  <property id="answered" logic="pmtl" expr="once[0:3s] {asked} || !once {asked}"/>
+</guarantees></properties>"#,
+        ),
+    ];
+    for (name, text) in files {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let model = dir.to_str().unwrap();
+    let (code, out, err) = hindsight(&["verify", model, "--runs", "5", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(
+        (r["quiescent"].as_u64(), r["time_horizon"].as_u64()),
+        (Some(5), Some(0))
+    );
+    assert!(
+        err.contains("note: 5 of 5 runs went quiet before the time horizon"),
+        "{err}"
+    );
+    let (code, _, err) = hindsight(&["trace", model, "--run", "2"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("run 2 of seed 0: went quiet at time 1 (1s) after "),
+        "{err}"
+    );
+    // Run past the model's own length, quiet runs are not called deadlocks: a plain
+    // timer may have stopped there.
+    let (_, _, err) = hindsight(&["verify", model, "--runs", "5", "--max-time", "20s"]);
+    assert!(!err.contains("went quiet"), "{err}");
+    // A healthy robot gets no such note.
+    let (_, _, err) = hindsight(&["verify", GUIDE, "--runs", "3"]);
+    assert!(!err.contains("went quiet"), "{err}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
 fn the_museum_guide_verifies_from_its_main_file() {
     let (code, out, err) =
         hindsight(&["verify", GUIDE, "--seed", "4", "--max-runs", "8", "--json"]);
