@@ -331,20 +331,25 @@ fn a_fixed_size_study_table_says_its_time_and_its_json_stays_mergeable() {
 
 #[test]
 fn sweep_shows_the_step_at_the_recurrence_threshold() {
-    let (code, out, err) = hindsight(&[
-        "sweep",
-        "examples/museum-scxml",
-        "--property",
-        "visitors_recurrence",
-        "--from",
-        "9",
-        "--to",
-        "10",
-        "--runs",
-        "10",
-        "--seed",
-        "2",
-    ]);
+    // visitors_recurrence swept over 9 and 10 steps, with the example's properties or others.
+    let sweep = |props: &[&str]| {
+        let mut args = vec!["sweep", "examples/museum-scxml"];
+        args.extend_from_slice(props);
+        args.extend_from_slice(&[
+            "--property",
+            "visitors_recurrence",
+            "--from",
+            "9",
+            "--to",
+            "10",
+            "--runs",
+            "10",
+            "--seed",
+            "2",
+        ]);
+        hindsight(&args)
+    };
+    let (code, out, err) = sweep(&[]);
     assert_eq!(code, 0, "{err}");
     let rows: Vec<Vec<&str>> = out
         .lines()
@@ -380,21 +385,7 @@ fn sweep_shows_the_step_at_the_recurrence_threshold() {
         .replace("once[:10]", "once[0:10]");
     assert!(text.contains("once[0:10]"));
     std::fs::write(&props, text).unwrap();
-    let (code, windowed, err) = hindsight(&[
-        "sweep",
-        "examples/museum-scxml",
-        props.to_str().unwrap(),
-        "--property",
-        "visitors_recurrence",
-        "--from",
-        "9",
-        "--to",
-        "10",
-        "--runs",
-        "10",
-        "--seed",
-        "2",
-    ]);
+    let (code, windowed, err) = sweep(&[props.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     assert_eq!(windowed, out);
     std::fs::remove_dir_all(&dir).ok();
