@@ -3,10 +3,10 @@
 //! threshold from which every run succeeds.
 //!
 //! A bound value is codegen's [`StepsOrDuration`] (model steps, or an exact duration):
-//! [`grid`] reads the range, [`variants`] writes one guarantee per value with every bound
-//! end of its formula but zero ones replaced ([`set_bounds`]), [`sweep`] judges each guarantee's
-//! variants on one study's runs (or [`sweep_recorded`] on recorded runs, the logs of
-//! `sweep --online`), and [`threshold_index`] finds each curve's threshold.
+//! [`grid`] reads the range, [`variants`] writes one guarantee per value with every
+//! nonzero bound end of its formula replaced ([`set_bounds`]), [`sweep`] judges each
+//! guarantee's variants on one study's runs (or [`sweep_recorded`] on recorded runs, the
+//! logs of `sweep --online`), and [`threshold_index`] finds each curve's threshold.
 //!
 //! ```
 //! use hindsight_verify::codegen::duration::StepsOrDuration;
