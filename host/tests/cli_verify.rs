@@ -372,6 +372,24 @@ fn sweep_shows_the_step_at_the_recurrence_threshold() {
         err.contains("visitors_recurrence: every run succeeds from bound 10 on"),
         "{err}"
     );
+    // Below 10 steps not one run succeeds at any bound: the sweep says so.
+    let (code, _, low) = hindsight(&[
+        "sweep",
+        "examples/museum-scxml",
+        "--property",
+        "visitors_recurrence",
+        "--from",
+        "8",
+        "--to",
+        "9",
+        "--runs",
+        "5",
+    ]);
+    assert_eq!(code, 0, "{low}");
+    assert!(
+        low.contains("visitors_recurrence: no run succeeds at any bound in the range"),
+        "{low}"
+    );
     // The same deadline written as a window from now, `once[0:10]`: the sweep moves the
     // deadline and keeps the window's start (it once swept both ends, `once[X:X]`, and
     // every run failed at every bound).

@@ -243,6 +243,14 @@ fn finish(
         for c in &curves {
             match &c.threshold {
                 Some(t) => eprintln!("{}: every run succeeds from bound {t} on", c.property),
+                // Not one run succeeding anywhere: the range is too low, or the property
+                // fails for a reason its bounds do not move.
+                None if c.points.iter().all(|p| p.successes == 0 && p.failures > 0) => {
+                    eprintln!(
+                        "{}: no run succeeds at any bound in the range: the threshold is above it (raise --to), or what fails does not depend on the bound (`hindsight trace MODEL --run K` shows a run)",
+                        c.property
+                    )
+                }
                 None => eprintln!(
                     "{}: no bound in the range makes every run succeed",
                     c.property
