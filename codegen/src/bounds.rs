@@ -35,28 +35,61 @@ pub fn map_bounds<E>(
     Ok((out, ends.len()))
 }
 
+/// The windows of `formula` whose two ends are both written and neither is zero, as
+/// written (`[1s:3s]`): an edit that gives every nonzero end one value (a sweep) makes
+/// each of them `[X:X]`. Empty for a formula that does not parse.
+pub fn two_sided_windows(formula: &str) -> Vec<String> {
+    let mut sink = Sink::default();
+    let Some(tree) = parse::parse_formula(formula, 0, &mut sink) else {
+        return Vec::new();
+    };
+    let zero = |t: &TimeLit| t.int.chars().chain(t.frac.chars()).all(|c| c == '0');
+    let mut out = Vec::new();
+    each_bound(&tree, &mut |b| {
+        if let (Some(lo), Some(hi)) = (&b.lo, &b.hi) {
+            if !zero(lo) && !zero(hi) {
+                let text = formula.get(b.span.lo as usize..b.span.hi as usize);
+                out.push(text.unwrap_or_default().to_string());
+            }
+        }
+    });
+    out
+}
+
 /// The byte ranges of every bound end in `formula`, in any order.
 fn collect(formula: &Formula, out: &mut Vec<(usize, usize)>) {
-    let mut bound = |b: &Option<Bound>| {
-        let ends = b.iter().flat_map(|b| [&b.lo, &b.hi]).flatten();
+    each_bound(formula, &mut |b| {
+        let ends = [&b.lo, &b.hi].into_iter().flatten();
         out.extend(ends.map(|t: &TimeLit| (t.span.lo as usize, t.span.hi as usize)));
-    };
+    });
+}
+
+/// Calls `f` on every written bound of `formula`'s temporal operators.
+fn each_bound(formula: &Formula, f: &mut impl FnMut(&Bound)) {
     match &formula.kind {
         FormulaKind::Const(_) | FormulaKind::Atom(_) => {}
         FormulaKind::Prefix(op, sub) => {
             match op {
-                PrefixOp::Once(b) | PrefixOp::Historically(b) => bound(b),
-                PrefixOp::Not | PrefixOp::Yesterday | PrefixOp::WeakYesterday => {}
+                PrefixOp::Once(Some(b)) | PrefixOp::Historically(Some(b)) => f(b),
+                PrefixOp::Once(None)
+                | PrefixOp::Historically(None)
+                | PrefixOp::Not
+                | PrefixOp::Yesterday
+                | PrefixOp::WeakYesterday => {}
             }
-            collect(sub, out);
+            each_bound(sub, f);
         }
         FormulaKind::Infix(op, l, r) => {
             match op {
-                InfixOp::Since(b) => bound(b),
-                InfixOp::And | InfixOp::Or | InfixOp::Implies | InfixOp::Iff => {}
+                InfixOp::Since(Some(b)) => f(b),
+                InfixOp::Since(None)
+                | InfixOp::And
+                | InfixOp::Or
+                | InfixOp::Implies
+                | InfixOp::Iff => {}
             }
-            collect(l, out);
-            collect(r, out);
+            each_bound(l, f);
+            each_bound(r, f);
         }
     }
 }
@@ -87,6 +120,14 @@ mod tests {
         );
         // Not a formula: unchanged.
         assert_eq!(set("P[0:5 {a}", "7"), ("P[0:5 {a}".into(), 0));
+    }
+
+    #[test]
+    fn two_sided_windows_are_those_with_two_nonzero_ends() {
+        assert_eq!(two_sided_windows("P[1s:3s] {a} && H[0:2] {b}"), ["[1s:3s]"]);
+        assert!(two_sided_windows("P[0:5s] {a} && {b} S[6.2s:] {c} && H[:3] {d}").is_empty());
+        assert!(two_sided_windows("P[0.0s:5s] {a}").is_empty());
+        assert!(two_sided_windows("P[1:2 {a}").is_empty());
     }
 
     #[test]

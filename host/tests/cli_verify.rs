@@ -406,6 +406,19 @@ fn sweep_shows_the_step_at_the_recurrence_threshold() {
     let (code, windowed, err) = sweep(&[props.to_str().unwrap()]);
     assert_eq!(code, 0, "{err}");
     assert_eq!(windowed, out);
+    // A window with two nonzero ends has both swept: the sweep warns before it starts.
+    let text = std::fs::read_to_string(&props)
+        .unwrap()
+        .replace("once[0:10]", "once[1:10]");
+    std::fs::write(&props, text).unwrap();
+    let (code, _, err) = sweep(&[props.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains(
+            "guarantee `visitors_recurrence`: both ends of the window [1:10] take each swept value"
+        ),
+        "{err}"
+    );
     std::fs::remove_dir_all(&dir).ok();
     let (code, _, err) = hindsight(&[
         "sweep",

@@ -117,6 +117,15 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         .collect();
     let targets = targets(&loaded.file, &args.properties, &loaded.props_path)
         .map_err(|e| CliError::Input(e.to_string()))?;
+    for t in &targets {
+        for w in crate::codegen::bounds::two_sided_windows(t.formula.as_str()) {
+            eprintln!(
+                "warning: {}: guarantee `{}`: both ends of the window {w} take each swept value (it becomes [X:X]); a sweep moves a deadline written as [0:X], [:X] or [X:]",
+                loaded.props_path.display(),
+                t.id
+            );
+        }
+    }
     let rule = crate::verify::sweep::rule(args.confidence);
     let logs = if args.online.is_empty() {
         Vec::new()
