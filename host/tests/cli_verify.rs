@@ -331,17 +331,18 @@ fn a_fixed_size_study_table_says_its_time_and_its_json_stays_mergeable() {
 
 #[test]
 fn sweep_shows_the_step_at_the_recurrence_threshold() {
-    // visitors_recurrence swept over 9 and 10 steps, with the example's properties or others.
-    let sweep = |props: &[&str]| {
+    // visitors_recurrence swept over a range of steps, with the example's properties or
+    // others.
+    let sweep_over = |props: &[&str], from: &str, to: &str| {
         let mut args = vec!["sweep", "examples/museum-scxml"];
         args.extend_from_slice(props);
         args.extend_from_slice(&[
             "--property",
             "visitors_recurrence",
             "--from",
-            "9",
+            from,
             "--to",
-            "10",
+            to,
             "--runs",
             "10",
             "--seed",
@@ -349,6 +350,7 @@ fn sweep_shows_the_step_at_the_recurrence_threshold() {
         ]);
         hindsight(&args)
     };
+    let sweep = |props: &[&str]| sweep_over(props, "9", "10");
     let (code, out, err) = sweep(&[]);
     assert_eq!(code, 0, "{err}");
     let rows: Vec<Vec<&str>> = out
@@ -373,18 +375,7 @@ fn sweep_shows_the_step_at_the_recurrence_threshold() {
         "{err}"
     );
     // Below 10 steps not one run succeeds at any bound: the sweep says so.
-    let (code, _, low) = hindsight(&[
-        "sweep",
-        "examples/museum-scxml",
-        "--property",
-        "visitors_recurrence",
-        "--from",
-        "8",
-        "--to",
-        "9",
-        "--runs",
-        "5",
-    ]);
+    let (code, _, low) = sweep_over(&[], "8", "9");
     assert_eq!(code, 0, "{low}");
     assert!(
         low.contains("visitors_recurrence: no run succeeds at any bound in the range"),
