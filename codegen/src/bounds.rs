@@ -43,7 +43,8 @@ pub fn two_sided_windows(formula: &str) -> Vec<String> {
     let Some(tree) = parse::parse_formula(formula, 0, &mut sink) else {
         return Vec::new();
     };
-    let zero = |t: &TimeLit| t.int.chars().chain(t.frac.chars()).all(|c| c == '0');
+    let text = |t: &TimeLit| formula.get(t.span.lo as usize..t.span.hi as usize);
+    let zero = |t: &TimeLit| text(t).is_some_and(is_zero_end);
     let mut out = Vec::new();
     each_bound(&tree, &mut |b| {
         if let (Some(lo), Some(hi)) = (&b.lo, &b.hi) {
@@ -54,6 +55,15 @@ pub fn two_sided_windows(formula: &str) -> Vec<String> {
         }
     });
     out
+}
+
+/// Whether a bound end as written (`0`, `0s`, `0.0ms`, `62`) is zero: the start of a
+/// window that starts now, not a bound a sweep moves.
+pub fn is_zero_end(end: &str) -> bool {
+    matches!(
+        crate::duration::parse_steps_or_duration(end),
+        Ok(crate::duration::StepsOrDuration::Steps(0) | crate::duration::StepsOrDuration::Nanos(0))
+    )
 }
 
 /// The byte ranges of every bound end in `formula`, in any order.

@@ -240,21 +240,14 @@ pub fn grid_in(
 /// "exactly 2 s ago"). Returns the new formula and how many ends were replaced.
 pub fn set_bounds(formula: &str, value: &str) -> (String, usize) {
     let mut replaced = 0;
-    let out = codegen::bounds::map_bounds(formula, |end| {
-        let zero = matches!(
-            parse_steps_or_duration(end),
-            Ok(StepsOrDuration::Steps(0) | StepsOrDuration::Nanos(0))
-        );
-        if zero {
-            return Ok::<_, ()>(end.to_string());
+    let Ok((text, _)) = codegen::bounds::map_bounds(formula, |end| {
+        if codegen::bounds::is_zero_end(end) {
+            return Ok::<_, std::convert::Infallible>(end.to_string());
         }
         replaced += 1;
         Ok(value.to_string())
     });
-    match out {
-        Ok((text, _)) => (text, replaced),
-        Err(()) => (formula.to_string(), 0),
-    }
+    (text, replaced)
 }
 
 /// The guarantees to sweep: those named in `ids` (each must have a time bound), or, with

@@ -322,6 +322,18 @@ impl<'m> Simulator<'m> {
         refresh_in(&mut self.ms, &mut self.runnable, m);
     }
 
+    /// How a run that can no longer move ends: at the horizon if the clock is there (a
+    /// run that went quiet at its last instant lasted its whole length; a robot model's
+    /// global timer stops at `max_time`, so every run of one would otherwise end quiescent
+    /// and hide a real deadlock), else quiescent.
+    fn quiet_end(&self, cfg: &RunConfig) -> EndReason {
+        if self.time >= cfg.max_time {
+            EndReason::MaxTime
+        } else {
+            EndReason::Quiescent
+        }
+    }
+
     fn free_slot(&mut self, slot: u32) {
         // The first slots are the events' global buffers and receiver copies: never free.
         if (slot as usize) < self.reserved {
@@ -395,13 +407,8 @@ impl<'m> Simulator<'m> {
                 {
                     // An event nobody can ever take blocks time: JANI's deadlock. A live
                     // run (`Quiescence::AdvanceTime`) goes on: a process playing a node may
-                    // still answer and unblock it, as any external message may. At the
-                    // horizon the run is over anyway: it ends there.
-                    return Ok(if self.time >= cfg.max_time {
-                        EndReason::MaxTime
-                    } else {
-                        EndReason::Quiescent
-                    });
+                    // still answer and unblock it, as any external message may.
+                    return Ok(self.quiet_end(cfg));
                 }
             }
             if self.runnable.is_empty() && self.deliverable.is_empty() {
@@ -417,14 +424,11 @@ impl<'m> Simulator<'m> {
                         continue;
                     }
                 }
-                // The horizon first: a run that went quiet at its last instant lasted its
-                // whole length (a robot model's global timer stops at `max_time`, so every
-                // run of one would otherwise end "quiescent" and hide a real deadlock).
+                if self.delayed.is_empty() && cfg.quiescence == Quiescence::Stop {
+                    return Ok(self.quiet_end(cfg));
+                }
                 if self.time >= cfg.max_time {
                     return Ok(EndReason::MaxTime);
-                }
-                if self.delayed.is_empty() && cfg.quiescence == Quiescence::Stop {
-                    return Ok(EndReason::Quiescent);
                 }
                 self.time += 1;
                 self.instant_steps = 0;
