@@ -91,6 +91,35 @@ fn a_robot_that_deadlocks_is_told_so() {
         err.contains("run 2 of seed 0: went quiet at time 1 (1s) after "),
         "{err}"
     );
+    // A shorter run says its length in the command, which replays the same run.
+    let (code, _, err) = hindsight(&["verify", model, "--runs", "5", "--max-time", "5s"]);
+    assert_eq!(code, 0, "{err}");
+    let command = err
+        .split('`')
+        .nth(1)
+        .unwrap_or_else(|| panic!("no command in {err}"));
+    assert!(command.ends_with("--seed 0 --max-time 5"), "{command}");
+    let args: Vec<&str> = command
+        .split(' ')
+        .skip(1)
+        .map(|a| if a == "K" { "3" } else { a })
+        .collect();
+    let (code, _, err) = hindsight(&args);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("run 3 of seed 0: went quiet at time 1 (1s)"),
+        "{err}"
+    );
+    // `sweep` runs the same runs, and says so once.
+    let (code, _, err) = hindsight(&[
+        "sweep", model, "--from", "1s", "--to", "3s", "--runs", "5", "--json",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        err.matches("note: 5 of 5 runs went quiet").count(),
+        1,
+        "{err}"
+    );
     // Run past the model's own length, quiet runs are not called deadlocks: a plain
     // timer may have stopped there.
     let (_, _, err) = hindsight(&["verify", model, "--runs", "5", "--max-time", "20s"]);

@@ -892,10 +892,19 @@ fn with_a_time_unit_bounds_and_sweeps_are_in_seconds() {
     assert_eq!(code, 2);
     assert!(err.contains("properties.xml"), "{err}");
     // The units are codegen's everywhere: `sec` is rejected with the list of units.
-    let cases: [(&[&str], &str); 3] = [
+    let cases: [(&[&str], &str); 5] = [
         (
             &["--time-unit", "100ms", "--max-time", "150ms"],
             "--max-time: 150ms is not a whole number of model steps of 100ms",
+        ),
+        // A zero length would judge every property on the first instant alone.
+        (
+            &["--max-time", "0"],
+            "--max-time: 0 would end every run before model time moves",
+        ),
+        (
+            &["--time-unit", "100ms", "--max-time", "0s"],
+            "--max-time: 0s would end every run before model time moves",
         ),
         (
             &["--time-unit", "1sec"],

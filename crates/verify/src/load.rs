@@ -147,6 +147,9 @@ pub enum MaxTimeError {
     },
     /// A duration for a model without a time unit.
     NoTimeUnit(String),
+    /// Zero (as written): every run would end before model time moves, and each
+    /// property would be judged on the first instant alone.
+    Zero(String),
 }
 
 impl fmt::Display for MaxTimeError {
@@ -162,6 +165,11 @@ impl fmt::Display for MaxTimeError {
                 f,
                 "{text} is a duration but the model has no time unit (give --time-unit, \
                  or the length in steps)"
+            ),
+            MaxTimeError::Zero(text) => write!(
+                f,
+                "{text} would end every run before model time moves, and judge each \
+                 property on the first instant alone: give a positive length"
             ),
         }
     }
@@ -232,6 +240,49 @@ pub struct Loaded {
 }
 
 impl Loaded {
+    /// The note for runs of `max_time` steps of which `quiescent` of `runs` (seed `seed`)
+    /// went quiet before the time horizon, when that means a deadlock: `None` when none
+    /// did or it does not.
+    ///
+    /// A robot model's global timer runs until its main file's `max_time`, so a run no
+    /// longer than that which went quiet is stuck (the simulator ends a run that went
+    /// quiet at its horizon as `MaxTime`, see `docs/SEMANTICS.md` section 2). A plain
+    /// model may simply stop its timer, as AS2FM's translations do, and a run longer than
+    /// the model's own length outlives its timer: neither gets the note.
+    pub fn deadlock_note(
+        &self,
+        max_time: u64,
+        quiescent: u64,
+        runs: u64,
+        seed: u64,
+    ) -> Option<String> {
+        let own_length = self.default_max_time.is_some_and(|d| max_time <= d);
+        if !own_length || quiescent == 0 {
+            return None;
+        }
+        let mut replay = format!(
+            "hindsight trace {} --run K --seed {seed}",
+            self.options.model.display()
+        );
+        match self.options.bt {
+            crate::robot::bt::BtSemantics::As2fm => {}
+            crate::robot::bt::BtSemantics::Btcpp { tick } => {
+                replay.push_str(" --bt btcpp");
+                if tick == crate::robot::bt::BtTick::ExactlyOnce {
+                    replay.push_str(" --bt-tick exactly-once");
+                }
+            }
+        }
+        if Some(max_time) != self.default_max_time {
+            replay.push_str(&format!(" --max-time {max_time}"));
+        }
+        Some(format!(
+            "note: {quiescent} of {runs} runs went quiet before the time horizon (nothing \
+             could move and no timer was pending: a deadlock); `{replay}` says how run K \
+             ended"
+        ))
+    }
+
     /// The run length in model steps: `arg` is model steps (`500`), or a duration
     /// (`100s`) when the model has a time unit; by default the main file's `max_time`,
     /// else 10,000 steps. The caller names its flag in front of an error.
@@ -240,17 +291,25 @@ impl Loaded {
         let Some(text) = arg else {
             return Ok(self.default_max_time.unwrap_or(10_000));
         };
-        match codegen::duration::parse_steps_or_duration(text).map_err(MaxTimeError::Unreadable)? {
-            StepsOrDuration::Steps(v) => Ok(v),
+        let steps = match codegen::duration::parse_steps_or_duration(text)
+            .map_err(MaxTimeError::Unreadable)?
+        {
+            StepsOrDuration::Steps(v) => v,
             StepsOrDuration::Nanos(ns) => match self.unit_ns {
-                Some(unit) if ns % unit == 0 => Ok(ns / unit),
-                Some(unit_ns) => Err(MaxTimeError::NotWholeSteps {
-                    text: text.trim().to_owned(),
-                    unit_ns,
-                }),
-                None => Err(MaxTimeError::NoTimeUnit(text.trim().to_owned())),
+                Some(unit) if ns % unit == 0 => ns / unit,
+                Some(unit_ns) => {
+                    return Err(MaxTimeError::NotWholeSteps {
+                        text: text.trim().to_owned(),
+                        unit_ns,
+                    })
+                }
+                None => return Err(MaxTimeError::NoTimeUnit(text.trim().to_owned())),
             },
+        };
+        if steps == 0 {
+            return Err(MaxTimeError::Zero(text.trim().to_owned()));
         }
+        Ok(steps)
     }
 }
 

@@ -34,7 +34,7 @@ use crate::observe::PropertySet;
 use crate::options::VerifyOptions;
 use crate::props::{self, SourceText};
 use crate::sim::{CompiledModel, RunConfig};
-use crate::smc::runner::{widened_interval, PropertyCounts};
+use crate::smc::runner::{widened_interval, PropertyCounts, RunCounts};
 use crate::smc::stats::{RuleConfig, RuleKind, StatsError};
 use crate::smc::{Progress, StudyConfig};
 use crate::study::{study, StudyError};
@@ -392,9 +392,9 @@ pub(crate) fn sweep_study(
     study_cfg: &StudyConfig,
     rule: &RuleConfig,
     progress: &mut dyn FnMut(&Progress<'_>),
-) -> Result<Vec<SweepPoint>, StudyError> {
+) -> Result<(Vec<SweepPoint>, RunCounts), StudyError> {
     let r = study(model, set, run_cfg, study_cfg, rule, progress)?;
-    Ok(values
+    let points = values
         .iter()
         .zip(&r.properties)
         .map(|(v, p)| SweepPoint {
@@ -406,7 +406,8 @@ pub(crate) fn sweep_study(
             lower: p.interval.lower,
             upper: p.interval.upper,
         })
-        .collect())
+        .collect();
+    Ok((points, r.runs))
 }
 
 /// One point per value from counts found without a study (`sweep --online`: one run per
@@ -443,6 +444,9 @@ pub enum SweepEvent<'a> {
     Runs(&'a Progress<'a>),
     /// The property's curve.
     Curve(&'a SweepCurve),
+    /// How the runs of its study (simulated sweeps) ended, when some of them show a
+    /// deadlock: [`Loaded::deadlock_note`]'s note.
+    Deadlock(&'a str),
 }
 
 /// Why a sweep stopped once started.
@@ -500,7 +504,7 @@ pub fn sweep(
         let set = PropertySet::with_unit(&one, &loaded.model, loaded.unit_ns)
             .map_err(SweepFailure::Variants)?;
         event(SweepEvent::Warnings(set.warnings()));
-        let points = sweep_study(
+        let (points, ends) = sweep_study(
             &loaded.model,
             &set,
             values,
@@ -510,6 +514,11 @@ pub fn sweep(
             &mut |p| event(SweepEvent::Runs(p)),
         )
         .map_err(SweepFailure::Study)?;
+        if let Some(note) =
+            loaded.deadlock_note(run_cfg.max_time, ends.quiescent, ends.runs, opts.seed)
+        {
+            event(SweepEvent::Deadlock(&note));
+        }
         let curve = SweepCurve::new(&target.id, points);
         event(SweepEvent::Curve(&curve));
         curves.push(curve);

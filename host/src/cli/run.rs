@@ -420,6 +420,15 @@ fn run_ros2(args: &RunArgs) -> Result<(), CliError> {
             "warning: {failed} samples could not be published (last: {})",
             why.unwrap_or("?")
         );
+        if args.wait_match.is_empty() {
+            // Seen here: at --speed 10 without it, writes blocked while a monitor started
+            // beside the run was still being discovered; with it nothing was lost.
+            eprintln!(
+                "hint: a subscriber that DDS is still discovering when the run starts can \
+                 make writes block; start it first and pass --wait-match TOPIC for the \
+                 topics it reads, so that the first step waits for it"
+            );
+        }
     }
     say_end(&outcome, live.stopped);
     Ok(())

@@ -136,11 +136,18 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
         println!("property,bound,successes,failures,unknown,probability,lower,upper");
     }
     let mut bar = progress_bar(!args.json);
+    let mut deadlock_said = false;
     let mut event = |e: SweepEvent<'_>| match e {
         SweepEvent::Warnings(w) => crate::cli::print_new_warnings(w, &mut said),
         SweepEvent::Runs(p) => bar.update(p),
         SweepEvent::Curve(c) if !args.json => print_rows(c),
         SweepEvent::Curve(_) => {}
+        // Every guarantee is swept on the same seed's runs: one note says it.
+        SweepEvent::Deadlock(note) if !deadlock_said => {
+            deadlock_said = true;
+            eprintln!("{note}");
+        }
+        SweepEvent::Deadlock(_) => {}
     };
     let curves = if args.online.is_empty() {
         let opts = VerifyOptions {

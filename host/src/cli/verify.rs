@@ -555,20 +555,13 @@ pub fn run(args: &VerifyArgs) -> Result<(), CliError> {
     if let Some(line) = done.study.unjudged_line() {
         eprintln!("{line}");
     }
-    // A robot model's global timer runs until `max_time`: a run of one that went quiet
-    // before it is stuck (a plain model without a length of its own may simply stop its
-    // timer, as AS2FM's translations do).
-    let own_length = loaded
-        .default_max_time
-        .is_some_and(|d| run_cfg.max_time <= d);
-    if own_length && done.study.quiescent > 0 {
-        eprintln!(
-            "note: {} of {} runs went quiet before the time horizon (nothing could move and no timer was pending: a deadlock); `hindsight trace {} --run K --seed {}` says how run K ended",
-            done.study.quiescent,
-            done.study.runs,
-            args.input.model.display(),
-            opts.seed
-        );
+    if let Some(note) = loaded.deadlock_note(
+        run_cfg.max_time,
+        done.study.quiescent,
+        done.study.runs,
+        opts.seed,
+    ) {
+        eprintln!("{note}");
     }
     if done.study.interrupted {
         return Err(interrupted_error(done.study.runs));

@@ -56,9 +56,15 @@ pub(super) fn run_both(args: &VerifyArgs, opts: &VerifyOptions) -> Result<(), Cl
     for line in &both.left_out {
         eprintln!("interrupted: {line}");
     }
-    for (label, study) in &both.studies {
+    for ((label, study), loaded) in both.studies.iter().zip(&loads) {
         if let Some(line) = study.unjudged_line() {
             eprintln!("--bt {label}: {line}");
+        }
+        let note = opts.run_config(loaded).ok().and_then(|cfg| {
+            loaded.deadlock_note(cfg.max_time, study.quiescent, study.runs, opts.seed)
+        });
+        if let Some(note) = note {
+            eprintln!("--bt {label}: {note}");
         }
     }
     let rows = &both.rows;
