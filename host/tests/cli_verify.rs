@@ -235,12 +235,32 @@ fn bad_properties_and_arguments_exit_2() {
         &["verify", COIN, "--runs", "0"][..],
         &["verify", COIN, "--max-runs", "0"],
         &["sweep", COIN, "--from", "1", "--to", "2", "--runs", "0"],
+        // Runs cut before their first step judge nothing: 1,000 of them were run first.
+        &["verify", COIN, "--max-steps", "0"],
+        &["trace", COIN, "--max-steps", "0"],
     ] {
         let (code, out, err) = hindsight(args);
         assert_eq!(code, 2, "{args:?}: {out}{err}");
         assert!(out.is_empty(), "{args:?}: {out}");
         assert!(err.contains("must be at least 1"), "{args:?}: {err}");
     }
+    // A bad rule is refused before the sweep's CSV header goes out.
+    let (code, out, err) = hindsight(&[
+        "sweep",
+        COIN,
+        "--from",
+        "1",
+        "--to",
+        "2",
+        "--confidence",
+        "1",
+    ]);
+    assert_eq!((code, out.as_str()), (2, ""), "{err}");
+    assert!(err.contains("confidence 1 is not in (0, 1)"), "{err}");
+    // --max-runs does nothing beside a fixed --runs: refused, not ignored.
+    let (code, _, err) = hindsight(&["verify", COIN, "--runs", "4", "--max-runs", "3"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("cannot be used with"), "{err}");
     // A thread count past 1024 is refused at once (it tried to start as many threads).
     for args in [
         &["verify", COIN, "--threads", "100000000", "--max-runs", "5"][..],

@@ -145,6 +145,16 @@ pub fn run_count(s: &str) -> Result<u64, String> {
     }
 }
 
+/// `--max-steps`: a whole number, at least 1 (a run cut before its first step judges
+/// nothing, and a study of such runs would stop after 1,000 of them saying so).
+pub fn step_limit(s: &str) -> Result<u64, String> {
+    match s.trim().parse::<u64>() {
+        Ok(0) => Err("must be at least 1 (a run cut before its first step judges nothing)".into()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("not a whole number of steps ({e})")),
+    }
+}
+
 /// `--threads`: 0 (every core) up to [`crate::verify::smc::MAX_THREADS`]. A study's numbers
 /// do not depend on the count, and each worker is an OS thread: a count past that is a
 /// typo, not a wish (`--threads 100000000` tried to start as many).

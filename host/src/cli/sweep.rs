@@ -106,6 +106,11 @@ pub fn run(args: &SweepArgs) -> Result<(), CliError> {
     if args.runs == 0 {
         return Err(CliError::Input("sweep: --runs must be at least 1".into()));
     }
+    // So is the rule, and before the CSV header goes out: a script reading standard
+    // output sees no table of a sweep that never started.
+    crate::verify::sweep::rule(args.confidence)
+        .build()
+        .map_err(|e| CliError::Input(format!("statistics: {e}")))?;
     let loaded = load(&args.input)?;
     let values = grid_in(&args.from, &args.to, args.step.as_deref(), loaded.unit_ns)
         .map_err(|e| CliError::Input(e.to_string()))?;

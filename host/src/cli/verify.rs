@@ -132,7 +132,7 @@ pub struct VerifyArgs {
     pub max_time: Option<String>,
     /// A run reaching this many steps is cut short: its open verdicts are unknown (not
     /// judged). A study that judges no run in its first 1000 stops and says why.
-    #[arg(long, default_value_t = 100_000_000)]
+    #[arg(long, default_value_t = 100_000_000, value_parser = crate::cli::step_limit)]
     pub max_steps: u64,
     /// Stop the study after this many runs even if the rule wants more (at least 1).
     #[arg(long, value_parser = super::run_count)]
@@ -158,7 +158,7 @@ pub struct VerifyArgs {
     #[arg(
         long,
         value_name = "N",
-        conflicts_with = "save_failing",
+        conflicts_with_all = ["save_failing", "max_runs"],
         value_parser = super::run_count
     )]
     pub runs: Option<u64>,
@@ -424,7 +424,7 @@ pub struct TraceArgs {
     #[arg(long, value_name = "T")]
     pub max_time: Option<String>,
     /// A run is cut at this many steps.
-    #[arg(long, default_value_t = 100_000_000)]
+    #[arg(long, default_value_t = 100_000_000, value_parser = crate::cli::step_limit)]
     pub max_steps: u64,
     /// Replay the run under this scheduler (a witness `verify --schedulers` printed).
     #[arg(long, value_name = "ID", value_parser = parse_scheduler)]
