@@ -54,6 +54,11 @@ pub struct Env<'a> {
 pub enum EvalErrorKind {
     /// Integer `%` by zero.
     DivByZero,
+    /// An integer result outside the 64-bit range (`+ - *`, negation, `Math.abs`).
+    Overflow,
+    /// A float with no 64-bit integer value (`Math.floor` and its kin of NaN, an
+    /// infinity or a value out of range): the bits of the float.
+    NoInteger(u64),
     /// Array index out of range (reads), or negative (writes).
     Index {
         /// The index used.
@@ -84,6 +89,17 @@ impl EvalError {
     pub fn message(&self) -> String {
         match self.kind {
             EvalErrorKind::DivByZero => "integer remainder by zero".into(),
+            EvalErrorKind::Overflow => {
+                "integer overflow: the result is outside the 64-bit range".into()
+            }
+            EvalErrorKind::NoInteger(bits) => {
+                let v = f64::from_bits(bits);
+                if v.is_finite() {
+                    format!("{v:e} has no 64-bit integer value")
+                } else {
+                    format!("{v} has no 64-bit integer value")
+                }
+            }
             EvalErrorKind::Index { index, len } => {
                 format!("array index {index} out of bounds (length {len})")
             }

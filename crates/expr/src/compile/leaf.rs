@@ -212,7 +212,8 @@ pub(super) fn compare(op: BinOp, ty: &Ty, a: Leaf, b: Leaf) -> Option<BoolFn> {
     }
 }
 
-/// Integer arithmetic on two keys; `at` is where a remainder by zero is reported.
+/// Integer arithmetic on two keys; `at` is where an overflow or a remainder by zero is
+/// reported.
 trait Arith: 'static {
     fn apply(a: i64, b: i64, at: u32) -> Res<i64>;
 }
@@ -224,22 +225,31 @@ struct RemA;
 
 impl Arith for AddA {
     #[inline(always)]
-    fn apply(a: i64, b: i64, _: u32) -> Res<i64> {
-        Ok(a.wrapping_add(b))
+    fn apply(a: i64, b: i64, at: u32) -> Res<i64> {
+        a.checked_add(b).ok_or(EvalError {
+            at,
+            kind: EvalErrorKind::Overflow,
+        })
     }
 }
 
 impl Arith for SubA {
     #[inline(always)]
-    fn apply(a: i64, b: i64, _: u32) -> Res<i64> {
-        Ok(a.wrapping_sub(b))
+    fn apply(a: i64, b: i64, at: u32) -> Res<i64> {
+        a.checked_sub(b).ok_or(EvalError {
+            at,
+            kind: EvalErrorKind::Overflow,
+        })
     }
 }
 
 impl Arith for MulA {
     #[inline(always)]
-    fn apply(a: i64, b: i64, _: u32) -> Res<i64> {
-        Ok(a.wrapping_mul(b))
+    fn apply(a: i64, b: i64, at: u32) -> Res<i64> {
+        a.checked_mul(b).ok_or(EvalError {
+            at,
+            kind: EvalErrorKind::Overflow,
+        })
     }
 }
 
@@ -274,8 +284,8 @@ fn arith_k<A: Arith>(a: Leaf, b: Leaf, at: u32) -> IntFn {
     }
 }
 
-/// `a op b` for two integer leaves and `op` one of `+ - * %` (`at`: where `%` by zero is
-/// reported): one closure for `i + 1`, where the tree of closures made three. Both leaves
+/// `a op b` for two integer leaves and `op` one of `+ - * %` (`at`: where an overflow or
+/// `%` by zero is reported): one closure for `i + 1`, where the tree of closures made three. Both leaves
 /// are read, in order, before the operation, as the tree reads them.
 pub(super) fn arith(op: BinOp, a: Leaf, b: Leaf, at: u32) -> Option<IntFn> {
     Some(match op {

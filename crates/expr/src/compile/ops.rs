@@ -238,9 +238,10 @@ impl Compiler<'_, '_> {
                     "round" => |v: f64| (v + 0.5).floor(),
                     _ => f64::trunc,
                 };
+                let at = self.abs(at);
                 Ok(Typed {
                     ty: Ty::Int,
-                    code: Code::Int(Box::new(move |e| Ok(g(x(e)?) as i64))),
+                    code: Code::Int(Box::new(move |e| whole(g(x(e)?), at))),
                 })
             }
             "abs" | "sign" => {
@@ -249,10 +250,15 @@ impl Compiler<'_, '_> {
                 let abs = fname == "abs";
                 match a.code {
                     Code::Int(f) => {
-                        let int: fn(i64) -> i64 = if abs { i64::wrapping_abs } else { i64::signum };
+                        let int: fn(i64) -> Option<i64> = if abs {
+                            i64::checked_abs
+                        } else {
+                            |v| Some(v.signum())
+                        };
+                        let at = self.abs(at);
                         Ok(Typed {
                             ty: Ty::Int,
-                            code: Code::Int(Box::new(move |e| Ok(int(f(e)?)))),
+                            code: Code::Int(Box::new(move |e| int(f(e)?).ok_or(overflow(at)))),
                         })
                     }
                     _ => {
@@ -384,10 +390,13 @@ impl Compiler<'_, '_> {
                 ty: Ty::Bool,
                 code: Code::Bool(Box::new(move |e| Ok(!f(e)?))),
             }),
-            (UnOp::Neg, Code::Int(f)) => Ok(Typed {
-                ty: Ty::Int,
-                code: Code::Int(Box::new(move |e| Ok(f(e)?.wrapping_neg()))),
-            }),
+            (UnOp::Neg, Code::Int(f)) => {
+                let at = self.abs(at);
+                Ok(Typed {
+                    ty: Ty::Int,
+                    code: Code::Int(Box::new(move |e| f(e)?.checked_neg().ok_or(overflow(at)))),
+                })
+            }
             (UnOp::Neg, Code::Float(f)) => Ok(Typed {
                 ty: Ty::Float,
                 code: Code::Float(Box::new(move |e| Ok(-f(e)?))),
@@ -481,7 +490,13 @@ impl Compiler<'_, '_> {
                     let (Code::Int(x), Code::Int(y)) = (ta.code, tb.code) else {
                         return Err(cerr(at, "internal error"));
                     };
-                    let bat = self.abs(b.start);
+                    // A remainder by zero is said at the divisor, an overflow at the
+                    // expression.
+                    let bat = if op == BinOp::Rem {
+                        self.abs(b.start)
+                    } else {
+                        self.abs(at)
+                    };
                     // Two leaves: one closure reads both (see `leaf.rs`).
                     if let (Some(la), Some(lb)) = (self.leaf(a, &Ty::Int), self.leaf(b, &Ty::Int)) {
                         if let Some(f) = leaf::arith(op, la, lb, bat) {
@@ -492,9 +507,15 @@ impl Compiler<'_, '_> {
                         }
                     }
                     let f: IntFn = match op {
-                        BinOp::Add => Box::new(move |e| Ok(x(e)?.wrapping_add(y(e)?))),
-                        BinOp::Sub => Box::new(move |e| Ok(x(e)?.wrapping_sub(y(e)?))),
-                        BinOp::Mul => Box::new(move |e| Ok(x(e)?.wrapping_mul(y(e)?))),
+                        BinOp::Add => {
+                            Box::new(move |e| x(e)?.checked_add(y(e)?).ok_or(overflow(bat)))
+                        }
+                        BinOp::Sub => {
+                            Box::new(move |e| x(e)?.checked_sub(y(e)?).ok_or(overflow(bat)))
+                        }
+                        BinOp::Mul => {
+                            Box::new(move |e| x(e)?.checked_mul(y(e)?).ok_or(overflow(bat)))
+                        }
                         _ => Box::new(move |e| {
                             let l = x(e)?;
                             let r = y(e)?;
@@ -654,5 +675,30 @@ impl Compiler<'_, '_> {
             _ => return Err(cerr(e.start, "internal error: branch code")),
         };
         Ok(Typed { ty, code })
+    }
+}
+
+/// The error of an integer result outside the 64-bit range, at `at`.
+#[inline]
+fn overflow(at: u32) -> EvalError {
+    EvalError {
+        at,
+        kind: EvalErrorKind::Overflow,
+    }
+}
+
+/// A whole float (`Math.floor` and its kin) as an integer: NaN, the infinities and values
+/// outside the 64-bit range have none (a cast would make them 0 or the nearest end).
+#[inline]
+fn whole(v: f64, at: u32) -> Res<i64> {
+    // -2^63 is exact as a float and fits; 2^63 is the first value that does not.
+    const LIMIT: f64 = 9_223_372_036_854_775_808.0;
+    if (-LIMIT..LIMIT).contains(&v) {
+        Ok(v as i64)
+    } else {
+        Err(EvalError {
+            at,
+            kind: EvalErrorKind::NoInteger(v.to_bits()),
+        })
     }
 }

@@ -86,8 +86,47 @@ fn arithmetic_and_typing() {
     assert_eq!(eval("Math.min(i, f)"), Ok(Cell::Float(2.5)));
     assert_eq!(eval("Math.abs(-3)"), Ok(Cell::Int(3)));
     assert_eq!(eval("Math.random()"), Ok(Cell::Float(0.5)));
-    assert_eq!(eval("9223372036854775807 + 1"), Ok(Cell::Int(i64::MIN)));
     assert!(eval("i % 0").unwrap_err().contains("by zero"));
+    // An integer result outside 64 bits is an error, not a wrapped value: neither
+    // ECMAScript (doubles) nor arithmetic gives a negative sum of positive numbers.
+    for text in [
+        "9223372036854775807 + 1",
+        "-9223372036854775807 - i",
+        "4611686018427387904 * 2",
+        "-(-9223372036854775807 - 1)",
+        "Math.abs(-9223372036854775807 - 1)",
+        "9223372036854775807 + i - i",
+    ] {
+        assert_eq!(
+            eval(text),
+            Err("integer overflow: the result is outside the 64-bit range".into()),
+            "{text}"
+        );
+    }
+    assert_eq!(eval("-9223372036854775807 - 1"), Ok(Cell::Int(i64::MIN)));
+    assert_eq!(eval("(-9223372036854775807 - 1) % -1"), Ok(Cell::Int(0)));
+    // A float without an integer value has no floor: a cast made NaN 0 and 1e300 the
+    // largest integer.
+    assert_eq!(
+        eval("Math.floor(f / 0 - f / 0)"),
+        Err("NaN has no 64-bit integer value".into())
+    );
+    assert_eq!(
+        eval("Math.trunc(1e300)"),
+        Err("1e300 has no 64-bit integer value".into())
+    );
+    assert_eq!(
+        eval("Math.ceil(-f / 0)").unwrap_err(),
+        "-inf has no 64-bit integer value"
+    );
+    assert_eq!(
+        eval("Math.floor(-9223372036854775808.0)"),
+        Ok(Cell::Int(i64::MIN))
+    );
+    assert_eq!(
+        eval("Math.floor(9223372036854775808.0)").unwrap_err(),
+        "9.223372036854776e18 has no 64-bit integer value"
+    );
 }
 
 #[test]
@@ -569,9 +608,17 @@ fn fused_leaf_arithmetic_and_negation_agree_with_the_operators() {
         ("-7 % i", 0),
         ("i + i", 14),
         ("(i + 1) * 2", 16),
-        ("9223372036854775807 + i", i64::MIN + 6),
+        ("9223372036854775800 + i", i64::MAX),
     ] {
         assert_eq!(eval(text), Ok(Cell::Int(want)), "{text}");
+    }
+    // The fused forms overflow as the operators do.
+    for text in [
+        "9223372036854775807 + i",
+        "i * 4611686018427387904",
+        "-9223372036854775807 - i",
+    ] {
+        assert!(eval(text).unwrap_err().contains("overflow"), "{text}");
     }
     // A remainder by zero is reported at the divisor, as the unfused code reports it.
     let zero = "i % 0";
