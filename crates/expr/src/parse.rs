@@ -241,6 +241,12 @@ impl P {
                 self.depth = depth;
                 return Ok((rest, lhs));
             };
+            // ECMAScript reads `x ++ 1` as `x++` then `1`, a syntax error; `x + +1` is
+            // a sum. Read as the sum it gave a number where JavaScript gives none.
+            if matches!(op, BinOp::Add | BinOp::Sub) && (r.starts_with("++") || r.starts_with("--"))
+            {
+                return Err(self.err(r, "`++`/`--` are not supported"));
+            }
             let after = self.ws(after);
             self.enter(after)?;
             let (r2, rhs) = next(self, after)?;
@@ -647,6 +653,18 @@ mod tests {
         assert_eq!(p("-x * 2"), "((Neg x) * 2)");
         assert_eq!(p("a === b && c !== d"), "((a == b) && (c != d))");
         assert_eq!(p("(1 + 2) * 3"), "((1 + 2) * 3)");
+        // A sign after a binary `+`/`-` needs a space, as in ECMAScript, where `x ++ 1`
+        // and `x--1` are syntax errors (increments).
+        assert_eq!(p("x + +1 - -y"), "((x + (Plus 1)) - (Neg y))");
+        assert_eq!(p("x+-1"), "(x + (Neg 1))");
+        for (bad, at) in [("x ++ 1", 2), ("x--1", 1), ("(a)++", 3)] {
+            let e = parse_expr(bad).unwrap_err();
+            assert_eq!(
+                (e.message.contains("`++`/`--` are not supported"), e.offset),
+                (true, at),
+                "{bad}: {e}"
+            );
+        }
     }
 
     #[test]
