@@ -1028,3 +1028,41 @@ fn the_uc3_scale_model_holds_every_guarantee() {
         assert_eq!(p["successes"], 12, "{p}");
     }
 }
+
+/// A plain SCXML model that writes its delays as durations (`delay="1s"`,
+/// `delayexpr="ms + 'ms'"`) runs with `--time-unit`, which converts them, and without it
+/// is refused with the way out.
+#[test]
+fn durations_in_delays_take_the_time_unit() {
+    let dir = std::env::temp_dir().join(format!("hindsight-delays-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("a.scxml"),
+        r#"<scxml name="a" initial="s" version="1.0" datamodel="ecmascript"><datamodel><data id="ms" expr="1500"/></datamodel>
+  <state id="s"><onentry><send event="tick" target="NONE" delay="1s"/><send event="tock" target="NONE" delayexpr="ms + 'ms'"/></onentry></state></scxml>"#,
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("properties.xml"),
+        r#"<properties><ports><scxml_event_send event="tock" origin="a" target="NONE"><event_var id="tock"/></scxml_event_send></ports>
+<guarantees><property id="tocked" logic="pmtl" expr="once {tock}"/></guarantees></properties>"#,
+    )
+    .unwrap();
+    let model = dir.to_str().unwrap();
+    let (code, out, err) = hindsight(&["trace", model, "--time-unit", "100ms"]);
+    assert_eq!(code, 0, "{err}");
+    let sends: Vec<String> = out
+        .lines()
+        .filter(|l| l.contains(",send,"))
+        .map(|l| l.split(',').take(3).collect::<Vec<_>>().join(","))
+        .collect();
+    // 1 s is 10 steps of 100 ms; the second send waits its 1.5 s after the first.
+    assert_eq!(sends, ["10,send,tick", "25,send,tock"], "{out}");
+    let (code, _, err) = hindsight(&["verify", model, "--runs", "2"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains("a.scxml:2:66: delay 1s is a duration: it needs the model's time unit: give --time-unit"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -56,6 +56,16 @@ pub enum EvalErrorKind {
     DivByZero,
     /// An integer result outside the 64-bit range (`+ - *`, negation, `Math.abs`).
     Overflow,
+    /// A `<send>`'s `delayexpr` gave a negative delay.
+    NegativeDelay(i64),
+    /// A `<send>`'s `delayexpr` gave a duration (nanoseconds) that is not a whole number
+    /// of model time units (nanoseconds).
+    DelaySteps {
+        /// The delay.
+        ns: u64,
+        /// The model's time unit.
+        unit: u64,
+    },
     /// A float with no 64-bit integer value (`Math.floor` and its kin of NaN, an
     /// infinity or a value out of range): the bits of the float.
     NoInteger(u64),
@@ -91,6 +101,10 @@ impl EvalError {
             EvalErrorKind::DivByZero => "integer remainder by zero".into(),
             EvalErrorKind::Overflow => {
                 "integer overflow: the result is outside the 64-bit range".into()
+            }
+            EvalErrorKind::NegativeDelay(v) => format!("the delay is negative ({v})"),
+            EvalErrorKind::DelaySteps { ns, unit } => {
+                format!("a delay of {ns} ns is not a whole number of model time units of {unit} ns")
             }
             EvalErrorKind::NoInteger(bits) => {
                 let v = f64::from_bits(bits);

@@ -520,8 +520,9 @@ fn load_full(
     if !errs.is_empty() {
         return Err(errs);
     }
-    let model = CompiledModel::compile(src)?;
     let unit = out.time_unit_ns.max(1);
+    src.time_unit_ns = Some(unit);
+    let model = CompiledModel::compile(src)?;
     let mut warnings = main.warnings.clone();
     warnings.extend(bt_warnings);
     Ok((

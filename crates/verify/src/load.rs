@@ -360,7 +360,10 @@ pub fn load_without(
     }
     let model = &opts.model;
     let unit_ns = opts.time_unit_ns;
-    let compiled = CompiledModel::load(model)?;
+    // The time unit converts the durations of `<send delay>` into steps.
+    let mut source = crate::model::load(model)?;
+    source.time_unit_ns = unit_ns;
+    let compiled = CompiledModel::compile(source)?;
     let mut warnings = as_warnings(compiled.warnings());
     let props_path = match &opts.props {
         Some(p) => p.to_path_buf(),

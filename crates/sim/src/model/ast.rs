@@ -137,13 +137,19 @@ pub enum SendTarget {
     Expr(SrcExpr),
 }
 
-/// A `<send>` delay in model time units.
+/// A `<send>` delay: in model time units, or a duration that the model's time unit
+/// converts ([`crate::model::ModelSource::time_unit_ns`]).
 #[derive(Clone, Debug)]
 pub enum Delay {
     /// `delay="n"`.
     Const(u64, Span),
+    /// `delay="1.5s"`: a duration in nanoseconds (the attribute value's span).
+    Duration(u64, Span),
     /// `delayexpr="..."`: an integer expression.
     Expr(SrcExpr),
+    /// `delayexpr="e + 'ms'"`, SCXML's way of writing a duration an expression computes:
+    /// the integer expression `e` counts units of the given nanoseconds.
+    ExprIn(SrcExpr, u64),
 }
 
 /// A `<send>`.

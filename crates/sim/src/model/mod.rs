@@ -40,6 +40,10 @@ pub struct ModelSource {
     pub types: TypeDefs,
     /// The properties file named by `model.xml`, or `properties.xml` in a model folder.
     pub properties: Option<PathBuf>,
+    /// The length of one model time unit in nanoseconds, when known (`--time-unit`, a
+    /// robot model's timers): it converts the durations of `<send delay="1.5s">` and
+    /// `delayexpr="e + 'ms'"` into units. Without it, such a delay is an error.
+    pub time_unit_ns: Option<u64>,
 }
 
 impl ModelSource {

@@ -615,15 +615,31 @@ impl Reader<'_> {
         let delay = match (el.attr("delay"), el.attr("delayexpr")) {
             (Some(a), None) => match a.value.trim().parse::<u64>() {
                 Ok(n) => Some(Delay::Const(n, a.value_span)),
-                Err(_) => {
-                    self.err(
-                        a.value_span,
-                        format!("delay `{}` is not a whole number of time units", a.value),
-                    );
-                    None
-                }
+                Err(_) => match codegen::duration::parse(&a.value) {
+                    Ok(ns) => Some(Delay::Duration(ns, a.value_span)),
+                    Err(e) => {
+                        self.err(
+                            a.value_span,
+                            format!(
+                                "delay `{}` is neither a whole number of model time units \
+                                 nor a duration (`500ms`, `1.5s`): {e}",
+                                a.value
+                            ),
+                        );
+                        None
+                    }
+                },
             },
-            (None, Some(a)) => Some(Delay::Expr(self.src(a))),
+            (None, Some(a)) => Some(match unit_suffix(&a.value) {
+                Some((len, ns)) => Delay::ExprIn(
+                    SrcExpr {
+                        text: a.value[..len].to_string(),
+                        span: a.value_span,
+                    },
+                    ns,
+                ),
+                None => Delay::Expr(self.src(a)),
+            }),
             (None, None) => None,
             (Some(_), Some(b)) => {
                 self.err(b.name_span, "<send> has both `delay` and `delayexpr`");
@@ -690,6 +706,24 @@ impl Reader<'_> {
             span: el.span,
         }))
     }
+}
+
+/// `e + 'ms'` (or `"ms"`, any unit of `codegen::duration`): the length of `e`'s text and
+/// the unit in nanoseconds. SCXML writes a computed delay as a CSS2 duration string, and
+/// this is how a model builds one; the expression language has no string concatenation
+/// otherwise, so `e` (an integer) counts units of the suffix.
+fn unit_suffix(text: &str) -> Option<(usize, u64)> {
+    let t = text.trim_end();
+    let quote = t.chars().last().filter(|&c| c == '\'' || c == '"')?;
+    let body = &t[..t.len() - 1];
+    let open = body.rfind(quote)?;
+    let unit = codegen::duration::TimeUnit::from_suffix(&body[open + 1..])?;
+    let before = body[..open].trim_end();
+    let plus = before.strip_suffix('+')?;
+    if plus.trim().is_empty() {
+        return None;
+    }
+    Some((plus.len(), unit.nanos()))
 }
 
 #[cfg(test)]

@@ -44,7 +44,19 @@ pub(crate) enum SendTo {
 
 pub(crate) enum DelayDef {
     Const(u64),
-    Expr(IntFn),
+    /// `delayexpr="f"`, `at` the file offset of its text (where a negative delay is told).
+    Expr {
+        f: IntFn,
+        at: u32,
+    },
+    /// `delayexpr="f + 'ms'"`: `f` counts `ns` nanoseconds, in a model whose unit is
+    /// `unit` nanoseconds.
+    Scaled {
+        f: IntFn,
+        ns: u64,
+        unit: u64,
+        at: u32,
+    },
 }
 
 pub(crate) struct SendDef {

@@ -291,15 +291,67 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                             .collect(),
                     ),
                 };
+                let unit = self.b.src.time_unit_ns;
                 let delay = match &s.delay {
                     None | Some(Delay::Const(0, _)) => None,
                     Some(Delay::Const(n, _)) => Some(DelayDef::Const(*n)),
+                    Some(Delay::Duration(ns, span)) => match unit {
+                        Some(u) if ns % u == 0 => match ns / u {
+                            0 => None,
+                            n => Some(DelayDef::Const(n)),
+                        },
+                        Some(u) => {
+                            self.b.err(
+                                *span,
+                                format!(
+                                    "delay {} is not a whole number of model time units of {}",
+                                    codegen::duration::format(*ns),
+                                    codegen::duration::format(u)
+                                ),
+                            );
+                            return;
+                        }
+                        None => {
+                            self.b.err(
+                                *span,
+                                format!(
+                                    "delay {} is a duration: {NO_UNIT}",
+                                    codegen::duration::format(*ns)
+                                ),
+                            );
+                            return;
+                        }
+                    },
                     Some(Delay::Expr(e)) => match self.typed(e, event, Some(&Ty::Int)) {
                         Some(Typed {
                             code: Code::Int(f), ..
-                        }) => Some(DelayDef::Expr(f)),
+                        }) => Some(DelayDef::Expr { f, at: e.span.lo }),
                         _ => return,
                     },
+                    Some(Delay::ExprIn(e, ns)) => {
+                        let Some(u) = unit else {
+                            let suffix = codegen::duration::format(*ns);
+                            self.b.err(
+                                e.span,
+                                format!(
+                                    "a delay in `{}` is a duration: {NO_UNIT}",
+                                    suffix.trim_start_matches('1')
+                                ),
+                            );
+                            return;
+                        };
+                        match self.typed(e, event, Some(&Ty::Int)) {
+                            Some(Typed {
+                                code: Code::Int(f), ..
+                            }) => Some(DelayDef::Scaled {
+                                f,
+                                ns: *ns,
+                                unit: u,
+                                at: e.span.lo,
+                            }),
+                            _ => return,
+                        }
+                    }
                 };
                 let pdefs = &self.events[ev as usize].1;
                 let mut params = Vec::new();
@@ -590,3 +642,7 @@ impl CompiledModel {
         out
     }
 }
+
+/// Why a delay written as a duration cannot be read without the model's time unit.
+const NO_UNIT: &str = "it needs the model's time unit: give --time-unit (e.g. 100ms), or \
+                       write the delay in model time units";

@@ -69,3 +69,99 @@ fn errors_are_collected_with_positions() {
         "{msgs:#?}"
     );
 }
+
+/// The times at which `a.scxml` (one machine sending `e` to itself, then `f` after its
+/// delay) sends, compiled with a time unit of `unit` ns; or the errors, as text.
+fn delayed_sends(send: &str, unit: Option<u64>) -> Result<Vec<u64>, String> {
+    use crate::sim::{RunConfig, Simulator, TraceRecorder};
+    use rand_core::SeedableRng;
+    let text = format!(
+        r#"<scxml name="A" initial="s"><datamodel><data id="d" expr="300"/><data id="neg" expr="-2"/></datamodel>
+        <state id="s"><onentry><send event="e" target="NONE"/>{send}</onentry></state></scxml>"#
+    );
+    let mut src =
+        ModelSource::from_texts([("a.scxml", text.as_str())]).map_err(|d| d.to_string())?;
+    src.time_unit_ns = unit;
+    let model = CompiledModel::compile(src).map_err(|d| d.to_string())?;
+    let mut trace = TraceRecorder::new();
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(1);
+    let out = Simulator::new(&model).run(&mut rng, &RunConfig::default(), &mut trace);
+    if let crate::sim::EndReason::Error(e) = out.end {
+        return Err(e.diagnostic.to_string());
+    }
+    Ok(trace.rows.iter().map(|r| r.time).collect())
+}
+
+/// SCXML writes delays as CSS2 durations (`delay="1s"`, `delayexpr="d + 'ms'"`): with the
+/// model's time unit they become whole units, without one they are an error, and a
+/// delay between two units, or a negative one, is an error at the send, not rounded.
+#[test]
+fn durations_in_delays_become_model_time_units() {
+    const MS100: Option<u64> = Some(100_000_000);
+    let send = |attr: &str| format!(r#"<send event="f" target="NONE" {attr}/>"#);
+    for (attr, unit, times) in [
+        (r#"delay="1s""#, MS100, vec![0, 10]),
+        (r#"delay="4""#, None, vec![0, 4]),
+        (r#"delay="0ms""#, MS100, vec![0, 0]),
+        (r#"delayexpr="d + 'ms'""#, MS100, vec![0, 3]),
+        (
+            r#"delayexpr="d*2 + &quot;ms&quot;""#,
+            Some(1_000_000),
+            vec![0, 600],
+        ),
+        (
+            r#"delayexpr="(d + 1) * 10 + 'us'""#,
+            Some(10_000),
+            vec![0, 301],
+        ),
+        (r#"delayexpr="d""#, None, vec![0, 300]),
+    ] {
+        assert_eq!(delayed_sends(&send(attr), unit), Ok(times), "{attr}");
+    }
+    for (attr, unit, want) in [
+        (
+            r#"delay="1s""#,
+            None,
+            "a.scxml:2:100: delay 1s is a duration: it needs the model's time unit",
+        ),
+        (
+            r#"delayexpr="d + 'ms'""#,
+            None,
+            "a.scxml:2:104: a delay in `ms` is a duration: it needs the model's time unit",
+        ),
+        (
+            r#"delay="150ms""#,
+            MS100,
+            "a.scxml:2:100: delay 150ms is not a whole number of model time units of 100ms",
+        ),
+        (
+            r#"delay="1sec""#,
+            MS100,
+            "delay `1sec` is neither a whole number of model time units nor a duration",
+        ),
+        (
+            r#"delayexpr="(d + 1) + 'ms'""#,
+            MS100,
+            "a.scxml:2:104: a delay of 301ms is not a whole number of model time units of 100ms",
+        ),
+        (
+            r#"delayexpr="neg""#,
+            None,
+            "a.scxml:2:104: the delay is negative (-2)",
+        ),
+        (
+            r#"delayexpr="neg + 'ms'""#,
+            MS100,
+            "the delay is negative (-2)",
+        ),
+        // Only a unit ends the sum: anything else stays a (refused) string concatenation.
+        (
+            r#"delayexpr="d + 'sec'""#,
+            MS100,
+            "string concatenation is not supported",
+        ),
+    ] {
+        let err = delayed_sends(&send(attr), unit).unwrap_err();
+        assert!(err.contains(want), "{attr}: {err}");
+    }
+}

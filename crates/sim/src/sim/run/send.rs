@@ -35,13 +35,13 @@ impl Simulator<'_> {
             if !self.ms[m].delay_done {
                 let n = match d {
                     DelayDef::Const(n) => *n,
-                    DelayDef::Expr(f) => {
+                    DelayDef::Expr { f, .. } | DelayDef::Scaled { f, .. } => {
                         let res = {
                             let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
-                            f(&mut env)
+                            f(&mut env).and_then(|v| delay_units(v, d))
                         };
                         match res {
-                            Ok(v) => v.max(0) as u64,
+                            Ok(n) => n,
                             Err(e) => return Err(self.diag_error(m, Some(pc as usize), e)),
                         }
                     }
@@ -230,5 +230,30 @@ impl Simulator<'_> {
                 ),
             ),
         })))
+    }
+}
+
+/// The units a `delayexpr` that gave `v` waits: `v` itself, or for `e + 'ms'` the
+/// duration `v` ms in the model's units. A negative delay, or a duration between two
+/// units, is an error at the `delayexpr`.
+fn delay_units(v: i64, d: &DelayDef) -> Result<u64, EvalError> {
+    let at = match d {
+        DelayDef::Expr { at, .. } | DelayDef::Scaled { at, .. } => *at,
+        DelayDef::Const(_) => 0,
+    };
+    let err = |kind| EvalError { at, kind };
+    let n = u64::try_from(v).map_err(|_| err(EvalErrorKind::NegativeDelay(v)))?;
+    match d {
+        DelayDef::Scaled { ns, unit, .. } => {
+            let total = n.checked_mul(*ns).ok_or(err(EvalErrorKind::Overflow))?;
+            if total % unit != 0 {
+                return Err(err(EvalErrorKind::DelaySteps {
+                    ns: total,
+                    unit: *unit,
+                }));
+            }
+            Ok(total / unit)
+        }
+        _ => Ok(n),
     }
 }

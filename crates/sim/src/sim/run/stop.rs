@@ -14,7 +14,7 @@ impl Simulator<'_> {
         Stop::End(Box::new(EndReason::Error(RunError {
             machine: MachineId(m as u32),
             time: self.time,
-            diagnostic: self.model.sources.diag(span, e.message()),
+            diagnostic: self.model.sources.diag(span, message(&e)),
         })))
     }
 
@@ -52,5 +52,18 @@ impl Simulator<'_> {
                 kind: EvalErrorKind::Internal,
             },
         )
+    }
+}
+
+/// What a run-time error says: a delay between two time units in durations as the model
+/// wrote them (`150ms`, `100ms`; the expression language knows no units).
+fn message(e: &EvalError) -> String {
+    match e.kind {
+        EvalErrorKind::DelaySteps { ns, unit } => format!(
+            "a delay of {} is not a whole number of model time units of {}",
+            codegen::duration::format(ns),
+            codegen::duration::format(unit)
+        ),
+        _ => e.message(),
     }
 }
