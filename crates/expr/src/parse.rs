@@ -247,6 +247,14 @@ impl P {
             {
                 return Err(self.err(r, "`++`/`--` are not supported"));
             }
+            // Operators of ECMAScript this language does not have, said by name rather
+            // than as an unexpected second character.
+            if op == BinOp::Mul && r.starts_with("**") {
+                return Err(self.err(r, "`**` is not supported (use Math.pow(a, b))"));
+            }
+            if matches!(op, BinOp::Lt | BinOp::Gt) && (r.starts_with("<<") || r.starts_with(">>")) {
+                return Err(self.err(r, "the shift operators `<<`, `>>`, `>>>` are not supported"));
+            }
             let after = self.ws(after);
             self.enter(after)?;
             let (r2, rhs) = next(self, after)?;
@@ -657,6 +665,19 @@ mod tests {
         // and `x--1` are syntax errors (increments).
         assert_eq!(p("x + +1 - -y"), "((x + (Plus 1)) - (Neg y))");
         assert_eq!(p("x+-1"), "(x + (Neg 1))");
+        for (bad, want, at) in [
+            ("x ** 2", "`**` is not supported (use Math.pow(a, b))", 2),
+            ("x >> 1", "the shift operators", 2),
+            ("1 + x << 2", "the shift operators", 6),
+            ("x >>> 1", "the shift operators", 2),
+        ] {
+            let e = parse_expr(bad).unwrap_err();
+            assert_eq!(
+                (e.message.contains(want), e.offset),
+                (true, at),
+                "{bad}: {e}"
+            );
+        }
         for (bad, at) in [("x ++ 1", 2), ("x--1", 1), ("(a)++", 3)] {
             let e = parse_expr(bad).unwrap_err();
             assert_eq!(

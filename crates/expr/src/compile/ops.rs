@@ -183,6 +183,19 @@ impl Compiler<'_, '_> {
             ExprKind::Member(obj, f, _) if matches!(&obj.kind, ExprKind::Ident(n) if n == "Math") => {
                 f.as_str()
             }
+            ExprKind::Ident(n) if n == "In" => {
+                return Err(cerr(
+                    callee.start,
+                    "`In()` is not supported: a machine here has one active state at a \
+                     time (no nesting, no <parallel>); keep the state in a variable",
+                ))
+            }
+            ExprKind::Ident(n) => {
+                return Err(cerr(
+                    callee.start,
+                    format!("`{n}()` is not supported: only `Math` functions can be called"),
+                ))
+            }
             _ => return Err(cerr(callee.start, "only `Math` functions can be called")),
         };
         let arity = |n: usize| -> Result<(), CompileError> {
