@@ -244,6 +244,16 @@ fn bad_properties_and_arguments_exit_2() {
         assert!(out.is_empty(), "{args:?}: {out}");
         assert!(err.contains("must be at least 1"), "{args:?}: {err}");
     }
+    // A file without guarantees estimates nothing: refused, not an empty table of 0 runs.
+    let none = dir.join("none.xml");
+    std::fs::write(&none, "<properties><guarantees/></properties>").unwrap();
+    for runs in [&[][..], &["--runs", "3"]] {
+        let mut args = vec!["verify", COIN, none.to_str().unwrap()];
+        args.extend_from_slice(runs);
+        let (code, out, err) = hindsight(&args);
+        assert_eq!((code, out.as_str()), (2, ""), "{err}");
+        assert!(err.contains("none.xml: no guarantee to verify"), "{err}");
+    }
     // A bad rule is refused before the sweep's CSV header goes out.
     let (code, out, err) = hindsight(&[
         "sweep",

@@ -149,6 +149,8 @@ impl Verified {
 pub enum VerifyError {
     /// The run length (`--max-time`) does not fit the model.
     MaxTime(MaxTimeError),
+    /// The property file has no guarantee: nothing to estimate (bad input).
+    NoGuarantee(PathBuf),
     /// The stopping rule, or the model during a run (bad input).
     Study(StudyError),
     /// The bounds over schedulers (bad input: their rule, or too few fair schedulers).
@@ -183,6 +185,12 @@ impl std::fmt::Display for VerifyError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             VerifyError::MaxTime(e) => write!(f, "--max-time: {e}"),
+            VerifyError::NoGuarantee(p) => write!(
+                f,
+                "{}: no guarantee to verify (a <property> under <guarantees>); \
+                 assumptions alone estimate nothing",
+                p.display()
+            ),
             VerifyError::Study(e) => write!(f, "{e}"),
             VerifyError::Bounds(e @ BoundsError::Rule(_)) => write!(f, "--schedulers: {e}"),
             VerifyError::Bounds(e) => write!(f, "{e}"),
@@ -238,6 +246,11 @@ pub fn verify(
 ) -> Result<Outcome, VerifyError> {
     let (loaded, opts) = (request.loaded, request.opts);
     let run_cfg = opts.run_config(loaded).map_err(VerifyError::MaxTime)?;
+    if loaded.set.guarantee_names().is_empty() {
+        // A study would run and print an empty table (a fixed-size one with
+        // "confidence 0", since no property carries the rule).
+        return Err(VerifyError::NoGuarantee(loaded.props_path.clone()));
+    }
     let study_cfg = opts.study_config();
     let Some(runs) = request.runs else {
         return sequential(request, &run_cfg, &study_cfg, event, stop)
