@@ -529,6 +529,11 @@ fn main_file_errors_point_at_the_input() {
             ":2:3: <max_time> needs a `unit`",
         ),
         (
+            "zero",
+            "<roaml><parameters>\n  <max_time value=\"0.0\" unit=\"s\"/></parameters></roaml>",
+            ":2:20: max_time must be positive",
+        ),
+        (
             "missing",
             "<roaml>\n<node_models>\n  <input type=\"node-ascxml\" src=\"./nope.ascxml\" />\n</node_models>\n</roaml>",
             ":3:34: node-ascxml file `",

@@ -534,6 +534,13 @@ impl<'a> Reader<'a> {
                             ),
                         )),
                         Some(unit) => match duration::decimal_times(v, unit.nanos()) {
+                            // As `--max-time 0` is: a run would end before its timers
+                            // fire, every property judged on the first instant alone.
+                            Ok(0) => self.errs.push(sm.diag(
+                                span,
+                                "max_time must be positive: a run of length 0 ends before \
+                                 any timer fires",
+                            )),
                             Ok(ns) => p.max_time_ns = Some(Param { value: ns, span }),
                             Err(m) => self.errs.push(sm.diag(span, m.to_string())),
                         },

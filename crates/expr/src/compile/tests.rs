@@ -88,8 +88,12 @@ fn arithmetic_and_typing() {
     assert_eq!(eval("Math.random()"), Ok(Cell::Float(0.5)));
     assert!(eval("i % 0").unwrap_err().contains("by zero"));
     // Functions outside `Math` are named in the refusal; `In()` says why.
-    assert!(eval("parseInt(s)").unwrap_err().starts_with("`parseInt()` is not supported"));
-    assert!(eval("In('a')").unwrap_err().contains("one active state at a time"));
+    assert!(eval("parseInt(s)")
+        .unwrap_err()
+        .starts_with("`parseInt()` is not supported"));
+    assert!(eval("In('a')")
+        .unwrap_err()
+        .contains("one active state at a time"));
     // An integer result outside 64 bits is an error, not a wrapped value: neither
     // ECMAScript (doubles) nor arithmetic gives a negative sum of positive numbers.
     for text in [
