@@ -130,6 +130,67 @@ fn a_robot_that_deadlocks_is_told_so() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+/// A `<send delay>` in a node model: AS2FM drops it, hindsight waits for it, and a
+/// request that reaches the machine meanwhile blocks time under AS2FM's events. Each of
+/// the three is said: the warning at the attribute, then the deadlock note.
+#[test]
+fn a_delayed_send_in_a_node_model_is_warned_about() {
+    let dir = scratch("delayed-send");
+    let files = [
+        (
+            "main.xml",
+            r#"<roaml><parameters><max_time value="10" unit="s"/></parameters>
+  <node_models><input type="ros-scxml" src="./client.scxml"/><input type="ros-scxml" src="./server.scxml"/></node_models>
+  <properties><input type="xml" src="./properties.xml"/></properties></roaml>"#,
+        ),
+        (
+            "client.scxml",
+            r#"<scxml version="1.0" datamodel="ecmascript" name="client" initial="wait">
+  <ros_service_client service_name="/svc" type="std_srvs/Trigger"/>
+  <ros_time_rate name="t" rate_hz="1"/>
+  <state id="wait"><ros_rate_callback name="t" target="call"/></state>
+  <state id="call"><onentry><ros_service_send_request name="/svc"/></onentry>
+    <ros_service_handle_response name="/svc" target="wait"/></state>
+</scxml>"#,
+        ),
+        (
+            "server.scxml",
+            r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="on">
+  <ros_service_server service_name="/svc" type="std_srvs/Trigger"/>
+  <state id="on"><ros_service_handle_request name="/svc" target="cool">
+    <ros_service_send_response name="/svc"><field name="success" expr="true"/></ros_service_send_response>
+  </ros_service_handle_request></state>
+  <state id="cool"><onentry><send event="cooled" target="server" delay="2s"/></onentry>
+    <transition event="cooled" target="on"/></state>
+</scxml>"#,
+        ),
+        (
+            "properties.xml",
+            r#"<properties><ports>
+  <ros_service service_name="/svc" type="std_srvs/Trigger" event="request"><event_var id="asked"/></ros_service>
+</ports><guarantees>
+  <property id="asked" logic="pmtl" expr="once[0:2s] {asked} || !once {asked}"/>
+</guarantees></properties>"#,
+        ),
+    ];
+    for (name, text) in files {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let model = dir.to_str().unwrap();
+    let (code, _, err) = hindsight(&["verify", model, "--runs", "3"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("server.scxml:6:66: `delay` on <send>: AS2FM drops it"),
+        "{err}"
+    );
+    // The second request (at 2 s) finds the server waiting until 3 s: time stops.
+    assert!(
+        err.contains("note: 3 of 3 runs went quiet before the time horizon"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 #[test]
 fn the_museum_guide_verifies_from_its_main_file() {
     let (code, out, err) =

@@ -458,8 +458,10 @@ fn load_full(
     }
     let mut left_out = Vec::new();
     let mut machines = Vec::new();
+    let mut delay_warnings = Vec::new();
     for input in &main.node_models {
         if let Some(e) = read_xml(&mut sm, input, &mut errs) {
+            delayed_sends(&sm, &e, &mut delay_warnings);
             let name = e.attr_value("name").unwrap_or("").trim().to_string();
             if external.contains(&name) {
                 match external_component(&sm, &e, &name) {
@@ -525,6 +527,7 @@ fn load_full(
     let model = CompiledModel::compile(src)?;
     let mut warnings = main.warnings.clone();
     warnings.extend(bt_warnings);
+    warnings.extend(delay_warnings);
     Ok((
         RobotModel {
             main,
@@ -538,4 +541,30 @@ fn load_full(
         },
         left_out,
     ))
+}
+
+/// Warns at each `<send>` of a node model with a `delay` or `delayexpr`: AS2FM's reader
+/// keeps a send's event, target and parameters only (`scxml_converter/scxml_entries/
+/// scxml_send.py`, `ScxmlSend::from_xml_tree`), so AS2FM's numbers ignore the delay,
+/// while hindsight waits for it; and under AS2FM's events time stops while an event is
+/// pending (`docs/SEMANTICS.md` section 3), so a request to a machine that waits there
+/// ends the run as a deadlock.
+fn delayed_sends(sm: &SourceMap, e: &Element, out: &mut Vec<Diagnostic>) {
+    if e.name == "send" {
+        if let Some(a) = e.attr("delay").or_else(|| e.attr("delayexpr")) {
+            out.push(sm.diag(
+                a.name_span,
+                format!(
+                    "`{}` on <send>: AS2FM drops it (its reader keeps a send's event, \
+                     target and parameters), hindsight waits for it; a request to this \
+                     machine while it waits is a deadlock under --events as2fm, where time \
+                     stops while an event is pending: wait with a <ros_time_rate> timer",
+                    a.name
+                ),
+            ));
+        }
+    }
+    for c in e.elements() {
+        delayed_sends(sm, c, out);
+    }
 }
