@@ -107,7 +107,9 @@ pub fn convert(
     let mut names = Vec::new();
     for m in &robot.machines {
         let name = m.attr_value("name").unwrap_or("machine").to_string();
-        write(&format!("{name}.scxml"), &to_xml(m))?;
+        let mut m = m.clone();
+        delays_in_steps(&mut m, robot.time_unit_ns);
+        write(&format!("{name}.scxml"), &to_xml(&m))?;
         names.push(name);
     }
 
@@ -167,6 +169,27 @@ pub fn convert(
         unit: seconds(robot.time_unit_ns),
         max_time_steps: robot.max_time_steps,
     })
+}
+
+/// Writes each `<send delay="1.5s">` in steps of `unit_ns`, as SCAN reads a delay (the
+/// model compiled, so each is a whole number of steps; one that is not is left as it is).
+/// A `delayexpr` with a unit (`e + 'ms'`) is left too: the steps it gives are known only
+/// when it runs.
+fn delays_in_steps(e: &mut Element, unit_ns: u64) {
+    if e.name == "send" {
+        if let Some(a) = e.attrs.iter_mut().find(|a| a.name == "delay") {
+            let whole = a.value.trim().parse::<u64>().is_ok();
+            match codegen::duration::parse(&a.value) {
+                Ok(ns) if !whole && unit_ns > 0 && ns % unit_ns == 0 => {
+                    a.value = (ns / unit_ns).to_string();
+                }
+                _ => {}
+            }
+        }
+    }
+    for c in e.elements_mut() {
+        delays_in_steps(c, unit_ns);
+    }
 }
 
 /// Every `(sender, receiver)` machine pair of `<send event="...">` in the plain machines.
@@ -336,7 +359,42 @@ fn to_steps(bound: &str, unit_ns: u64) -> Result<String, BadBound> {
 
 #[cfg(test)]
 mod tests {
-    use super::to_steps;
+    use super::{delays_in_steps, to_steps};
+    use crate::model::xml::Element;
+    use crate::model::{xml, SourceMap};
+
+    /// SCAN reads a delay as whole steps: a duration becomes them, steps stay, and what
+    /// is not whole (refused by the compile before) or a `delayexpr` is left alone.
+    #[test]
+    fn durations_of_delays_become_steps() {
+        let mut sm = SourceMap::new();
+        let text = r#"<scxml name="m"><state id="s"><onentry>
+            <send event="a" delay="1.5s"/><send event="b" delay="7"/><send event="c" delay="150ms"/>
+            <if cond="true"><send event="d" delay="200ms"/></if>
+            <send event="e" delayexpr="x + 'ms'"/></onentry></state></scxml>"#;
+        let file = sm.add("m.scxml", text.to_string());
+        let mut m = xml::parse(&sm, file).unwrap();
+        delays_in_steps(&mut m, 100_000_000);
+        fn sends(e: &Element, out: &mut Vec<String>) {
+            if e.name == "send" {
+                let d = e.attr("delay").or(e.attr("delayexpr")).unwrap();
+                out.push(format!("{}={}", d.name, d.value));
+            }
+            e.elements().for_each(|c| sends(c, out));
+        }
+        let mut got = Vec::new();
+        sends(&m, &mut got);
+        assert_eq!(
+            got,
+            [
+                "delay=15",
+                "delay=7",
+                "delay=150ms",
+                "delay=2",
+                "delayexpr=x + 'ms'"
+            ]
+        );
+    }
 
     #[test]
     fn a_bound_becomes_whole_steps_or_says_why_not() {
