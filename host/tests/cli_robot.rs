@@ -127,6 +127,21 @@ fn a_robot_that_deadlocks_is_told_so() {
     // A healthy robot gets no such note.
     let (_, _, err) = hindsight(&["verify", GUIDE, "--runs", "3"]);
     assert!(!err.contains("went quiet"), "{err}");
+    // Nor does one without timers: with no global timer, a run ends when its machines
+    // are done (here: one message, taken).
+    std::fs::write(
+        dir.join("client.scxml"),
+        r#"<scxml version="1.0" datamodel="ecmascript" name="client" initial="s">
+  <ros_topic_publisher topic="/never" type="std_msgs/Bool"/>
+  <state id="s"><onentry><ros_topic_publish name="/never"><field name="data" expr="true"/></ros_topic_publish></onentry></state>
+</scxml>"#,
+    )
+    .unwrap();
+    let (code, out, err) = hindsight(&["verify", model, "--runs", "3", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(r["quiescent"].as_u64(), Some(3), "{out}");
+    assert!(!err.contains("went quiet"), "{err}");
     let _ = std::fs::remove_dir_all(dir);
 }
 

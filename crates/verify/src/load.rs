@@ -247,8 +247,9 @@ impl Loaded {
     /// A robot model's global timer runs until its main file's `max_time`, so a run no
     /// longer than that which went quiet is stuck (the simulator ends a run that went
     /// quiet at its horizon as `MaxTime`, see `docs/SEMANTICS.md` section 2). A plain
-    /// model may simply stop its timer, as AS2FM's translations do, and a run longer than
-    /// the model's own length outlives its timer: neither gets the note.
+    /// model may simply stop its timer, as AS2FM's translations do, a run longer than
+    /// the model's own length outlives its timer, and a robot model without timers has
+    /// no global timer and ends when its machines are done: none gets the note.
     pub fn deadlock_note(
         &self,
         max_time: u64,
@@ -257,7 +258,11 @@ impl Loaded {
         seed: u64,
     ) -> Option<String> {
         let own_length = self.default_max_time.is_some_and(|d| max_time <= d);
-        if !own_length || quiescent == 0 {
+        let clock = self
+            .model
+            .machine_id(crate::robot::ros::GLOBAL_TIMER)
+            .is_some();
+        if !own_length || !clock || quiescent == 0 {
             return None;
         }
         let mut replay = format!(
