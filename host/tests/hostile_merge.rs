@@ -125,3 +125,43 @@ fn forged_counts_are_refused_naming_the_shard_file() {
     assert!(err.contains("64 bits"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A file cut short beside a scheduler study's stage part is said to be cut short (its
+/// JSON error), not "not a part of a stage".
+#[test]
+fn a_truncated_part_beside_a_stage_part_is_named_as_not_json() {
+    let dir = scratch("merge-truncated");
+    let part = |i: u64| {
+        let file = dir.join(format!("s0-{i}.json"));
+        let out = hindsight()
+            .arg("verify")
+            .arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-scxml"))
+            .args(["--schedulers", "2", "--runs", "4", "--threads", "1"])
+            .args(["--shard", &format!("{i}/2")])
+            .arg("--partial")
+            .arg(&file)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        std::fs::read_to_string(file).unwrap()
+    };
+    let (first, second) = (part(0), part(1));
+    let cut = dir.join("cut.json");
+    std::fs::write(&cut, &first[..first.len() / 2]).unwrap();
+    let whole = dir.join("whole.json");
+    std::fs::write(&whole, second).unwrap();
+    let out = hindsight()
+        .arg("merge")
+        .arg(&cut)
+        .arg(&whole)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("cut.json: EOF while parsing"), "{err}");
+    let _ = std::fs::remove_dir_all(dir);
+}

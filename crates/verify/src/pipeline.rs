@@ -579,6 +579,13 @@ pub fn merge_parts(parts: &[(String, String)]) -> Result<Merged, MergeError> {
     if let Some(first) = staged.iter().position(|&s| s) {
         let mut stage_parts = Vec::new();
         for ((file, text), &is) in parts.iter().zip(&staged) {
+            // A file that is not JSON at all (cut short, or another file) is said as such.
+            if let Err(e) = serde_json::from_str::<serde_json::Value>(text) {
+                return Err(MergeError::Part {
+                    file: file.clone(),
+                    error: e.to_string(),
+                });
+            }
             if !is {
                 return Err(MergeError::Mixed {
                     file: file.clone(),
