@@ -28,11 +28,12 @@ fn copy_dir(from: &Path, to: &Path) {
 
 const GUIDE: &str = "examples/museum-guide";
 
-#[test]
-fn a_robot_that_deadlocks_is_told_so() {
-    // The client calls `/svc` after 1 s; the server waits for a topic nobody publishes
-    // and never handles the request, which nobody may drop: time stops at 1 s of 10.
-    let dir = scratch("deadlock");
+/// A robot in `scratch(name)`: a client that calls `/svc` every second and `server`
+/// (the machine that serves it), judged on whether `/svc` was asked within 2 s of the
+/// first request (`once[0:2s] {asked} || !once {asked}`, never final, so a run goes
+/// on until it ends). Returns the folder.
+fn service_robot(name: &str, server: &str) -> PathBuf {
+    let dir = scratch(name);
     let files = [
         (
             "main.xml",
@@ -50,9 +51,29 @@ fn a_robot_that_deadlocks_is_told_so() {
     <ros_service_handle_response name="/svc" target="wait"/></state>
 </scxml>"#,
         ),
+        ("server.scxml", server),
         (
-            "server.scxml",
-            r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="off">
+            "properties.xml",
+            r#"<properties><ports>
+  <ros_service service_name="/svc" type="std_srvs/Trigger" event="request"><event_var id="asked"/></ros_service>
+</ports><guarantees>
+  <property id="answered" logic="pmtl" expr="once[0:2s] {asked} || !once {asked}"/>
+</guarantees></properties>"#,
+        ),
+    ];
+    for (file, text) in files {
+        std::fs::write(dir.join(file), text).unwrap();
+    }
+    dir
+}
+
+#[test]
+fn a_robot_that_deadlocks_is_told_so() {
+    // The client calls `/svc` after 1 s; the server waits for a topic nobody publishes
+    // and never handles the request, which nobody may drop: time stops at 1 s of 10.
+    let dir = service_robot(
+        "deadlock",
+        r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="off">
   <ros_service_server service_name="/svc" type="std_srvs/Trigger"/>
   <ros_topic_subscriber topic="/never" type="std_msgs/Bool"/>
   <state id="off"><ros_topic_callback name="/never" target="on"/></state>
@@ -60,19 +81,7 @@ fn a_robot_that_deadlocks_is_told_so() {
     <ros_service_send_response name="/svc"><field name="success" expr="true"/></ros_service_send_response>
   </ros_service_handle_request></state>
 </scxml>"#,
-        ),
-        (
-            "properties.xml",
-            r#"<properties><ports>
-  <ros_service service_name="/svc" type="std_srvs/Trigger" event="request"><event_var id="asked"/></ros_service>
-</ports><guarantees>
-  <property id="answered" logic="pmtl" expr="once[0:3s] {asked} || !once {asked}"/>
-</guarantees></properties>"#,
-        ),
-    ];
-    for (name, text) in files {
-        std::fs::write(dir.join(name), text).unwrap();
-    }
+    );
     let model = dir.to_str().unwrap();
     let (code, out, err) = hindsight(&["verify", model, "--runs", "5", "--json"]);
     assert_eq!(code, 0, "{err}");
@@ -150,27 +159,9 @@ fn a_robot_that_deadlocks_is_told_so() {
 /// the three is said: the warning at the attribute, then the deadlock note.
 #[test]
 fn a_delayed_send_in_a_node_model_is_warned_about() {
-    let dir = scratch("delayed-send");
-    let files = [
-        (
-            "main.xml",
-            r#"<roaml><parameters><max_time value="10" unit="s"/></parameters>
-  <node_models><input type="ros-scxml" src="./client.scxml"/><input type="ros-scxml" src="./server.scxml"/></node_models>
-  <properties><input type="xml" src="./properties.xml"/></properties></roaml>"#,
-        ),
-        (
-            "client.scxml",
-            r#"<scxml version="1.0" datamodel="ecmascript" name="client" initial="wait">
-  <ros_service_client service_name="/svc" type="std_srvs/Trigger"/>
-  <ros_time_rate name="t" rate_hz="1"/>
-  <state id="wait"><ros_rate_callback name="t" target="call"/></state>
-  <state id="call"><onentry><ros_service_send_request name="/svc"/></onentry>
-    <ros_service_handle_response name="/svc" target="wait"/></state>
-</scxml>"#,
-        ),
-        (
-            "server.scxml",
-            r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="on">
+    let dir = service_robot(
+        "delayed-send",
+        r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="on">
   <ros_service_server service_name="/svc" type="std_srvs/Trigger"/>
   <state id="on"><ros_service_handle_request name="/svc" target="cool">
     <ros_service_send_response name="/svc"><field name="success" expr="true"/></ros_service_send_response>
@@ -178,19 +169,7 @@ fn a_delayed_send_in_a_node_model_is_warned_about() {
   <state id="cool"><onentry><send event="cooled" target="server" delay="2s"/></onentry>
     <transition event="cooled" target="on"/></state>
 </scxml>"#,
-        ),
-        (
-            "properties.xml",
-            r#"<properties><ports>
-  <ros_service service_name="/svc" type="std_srvs/Trigger" event="request"><event_var id="asked"/></ros_service>
-</ports><guarantees>
-  <property id="asked" logic="pmtl" expr="once[0:2s] {asked} || !once {asked}"/>
-</guarantees></properties>"#,
-        ),
-    ];
-    for (name, text) in files {
-        std::fs::write(dir.join(name), text).unwrap();
-    }
+    );
     let model = dir.to_str().unwrap();
     let (code, _, err) = hindsight(&["verify", model, "--runs", "3"]);
     assert_eq!(code, 0, "{err}");

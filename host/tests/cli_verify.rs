@@ -254,40 +254,32 @@ fn bad_properties_and_arguments_exit_2() {
         assert_eq!((code, out.as_str()), (2, ""), "{err}");
         assert!(err.contains("none.xml: no guarantee to verify"), "{err}");
     }
-    // A bad rule is refused before the sweep's CSV header goes out.
-    let (code, out, err) = hindsight(&[
-        "sweep",
-        COIN,
-        "--from",
-        "1",
-        "--to",
-        "2",
-        "--confidence",
-        "1",
-    ]);
-    assert_eq!((code, out.as_str()), (2, ""), "{err}");
-    assert!(err.contains("confidence 1 is not in (0, 1)"), "{err}");
-    // --max-runs does nothing beside a fixed --runs: refused, not ignored.
-    let (code, _, err) = hindsight(&["verify", COIN, "--runs", "4", "--max-runs", "3"]);
-    assert_eq!(code, 2, "{err}");
-    assert!(err.contains("cannot be used with"), "{err}");
-    // A thread count past 1024 is refused at once (it tried to start as many threads).
-    for args in [
-        &["verify", COIN, "--threads", "100000000", "--max-runs", "5"][..],
-        &[
-            "sweep",
-            COIN,
-            "--from",
-            "1",
-            "--to",
-            "2",
-            "--threads",
-            "5000",
-        ],
-    ] {
-        let (code, out, err) = hindsight(args);
-        assert_eq!(code, 2, "{args:?}: {out}{err}");
-        assert!(err.contains("at most 1024"), "{args:?}: {err}");
+    // Arguments refused at once, with nothing on standard output: a bad rule before the
+    // sweep's CSV header goes out, --max-runs beside a fixed --runs (it did nothing), and
+    // a thread count past 1024 (it tried to start as many threads).
+    let sweep = ["sweep", COIN, "--from", "1", "--to", "2"];
+    let cases: [(Vec<&str>, &str); 4] = [
+        (
+            [&sweep[..], &["--confidence", "1"]].concat(),
+            "confidence 1 is not in (0, 1)",
+        ),
+        (
+            vec!["verify", COIN, "--runs", "4", "--max-runs", "3"],
+            "cannot be used with",
+        ),
+        (
+            vec!["verify", COIN, "--threads", "100000000", "--max-runs", "5"],
+            "at most 1024",
+        ),
+        (
+            [&sweep[..], &["--threads", "5000"]].concat(),
+            "at most 1024",
+        ),
+    ];
+    for (args, want) in cases {
+        let (code, out, err) = hindsight(&args);
+        assert_eq!((code, out.as_str()), (2, ""), "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: {err}");
     }
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -17,14 +17,15 @@ fn scratch(tag: &str) -> PathBuf {
     dir
 }
 
-/// Runs shard `i` of 2 of a 10-run study of the museum model and returns its JSON.
-fn shard(dir: &Path, i: u64) -> Value {
+/// Runs shard `i` of 2 of a study of the museum model with `study` (its size, ...) and
+/// returns the part as written.
+fn part(dir: &Path, i: u64, study: &[&str]) -> String {
     let file = dir.join(format!("real-{i}.json"));
     let out = hindsight()
         .arg("verify")
         .arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-scxml"))
-        .args(["--seed", "3", "--runs", "10", "--threads", "1"])
-        .args(["--shard", &format!("{i}/2")])
+        .args(study)
+        .args(["--threads", "1", "--shard", &format!("{i}/2")])
         .arg("--partial")
         .arg(&file)
         .output()
@@ -34,7 +35,12 @@ fn shard(dir: &Path, i: u64) -> Value {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    serde_json::from_str(&std::fs::read_to_string(file).unwrap()).unwrap()
+    std::fs::read_to_string(file).unwrap()
+}
+
+/// Shard `i` of 2 of a 10-run study of the museum model, as JSON.
+fn shard(dir: &Path, i: u64) -> Value {
+    serde_json::from_str(&part(dir, i, &["--seed", "3", "--runs", "10"])).unwrap()
 }
 
 fn merge(dir: &Path, parts: &[(&str, &Value)]) -> Output {
@@ -131,25 +137,8 @@ fn forged_counts_are_refused_naming_the_shard_file() {
 #[test]
 fn a_truncated_part_beside_a_stage_part_is_named_as_not_json() {
     let dir = scratch("merge-truncated");
-    let part = |i: u64| {
-        let file = dir.join(format!("s0-{i}.json"));
-        let out = hindsight()
-            .arg("verify")
-            .arg(PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/museum-scxml"))
-            .args(["--schedulers", "2", "--runs", "4", "--threads", "1"])
-            .args(["--shard", &format!("{i}/2")])
-            .arg("--partial")
-            .arg(&file)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        std::fs::read_to_string(file).unwrap()
-    };
-    let (first, second) = (part(0), part(1));
+    let stage = ["--schedulers", "2", "--runs", "4"];
+    let (first, second) = (part(&dir, 0, &stage), part(&dir, 1, &stage));
     let cut = dir.join("cut.json");
     std::fs::write(&cut, &first[..first.len() / 2]).unwrap();
     let whole = dir.join("whole.json");
