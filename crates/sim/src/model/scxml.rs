@@ -851,7 +851,7 @@ mod tests {
     #[test]
     fn bad_delay_and_missing_attrs() {
         let errs = read(
-            r#"<scxml name="M"><state id="a"><onentry><send target="M" delay="1s"/><assign location="x"/></onentry></state></scxml>"#,
+            r#"<scxml name="M"><state id="a"><onentry><send target="M" delay="soon"/><assign location="x"/></onentry></state></scxml>"#,
         )
         .unwrap_err();
         assert_eq!(errs.len(), 3, "{errs:?}");
