@@ -56,8 +56,8 @@ pub enum EvalErrorKind {
     DivByZero,
     /// An integer result outside the 64-bit range (`+ - *`, negation, `Math.abs`).
     Overflow,
-    /// A `<send>`'s `delayexpr` gave a negative delay.
-    NegativeDelay(i64),
+    /// A `<send>`'s `delayexpr` gave a negative delay (the bits of its value as a float).
+    NegativeDelay(u64),
     /// A `<send>`'s `delayexpr` gave a duration (nanoseconds) that is not a whole number
     /// of model time units (nanoseconds).
     DelaySteps {
@@ -102,7 +102,9 @@ impl EvalError {
             EvalErrorKind::Overflow => {
                 "integer overflow: the result is outside the 64-bit range".into()
             }
-            EvalErrorKind::NegativeDelay(v) => format!("the delay is negative ({v})"),
+            EvalErrorKind::NegativeDelay(bits) => {
+                format!("the delay is negative ({})", f64::from_bits(bits))
+            }
             EvalErrorKind::DelaySteps { ns, unit } => {
                 format!("a delay of {ns} ns is not a whole number of model time units of {unit} ns")
             }

@@ -12,7 +12,7 @@
 use super::ids::{EventId, MachineId, StateId};
 use crate::expr::compile::{
     compile, compile_as, compile_cell, compile_place, unknown_param_type, BoolFn, CellFn, Code,
-    CompileError, EventScope, IntFn, Place, Scope, StrFn, Typed,
+    CompileError, EventScope, FloatFn, IntFn, Place, Scope, StrFn, Typed,
 };
 use crate::expr::parse_expr;
 use crate::expr::value::{Cell, StrId, Strings, StructDef, Ty, TypeTable};
@@ -53,6 +53,13 @@ pub(crate) enum DelayDef {
     /// `unit` nanoseconds.
     Scaled {
         f: IntFn,
+        ns: u64,
+        unit: u64,
+        at: u32,
+    },
+    /// `delayexpr="f + 's'"` with a float `f` (`0.5 + 's'`): as [`DelayDef::Scaled`].
+    ScaledFloat {
+        f: FloatFn,
         ns: u64,
         unit: u64,
         at: u32,

@@ -340,16 +340,26 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                             );
                             return;
                         };
-                        match self.typed(e, event, Some(&Ty::Int)) {
+                        let (ns, at) = (*ns, e.span.lo);
+                        match self.typed(e, event, None) {
                             Some(Typed {
                                 code: Code::Int(f), ..
-                            }) => Some(DelayDef::Scaled {
-                                f,
-                                ns: *ns,
-                                unit: u,
-                                at: e.span.lo,
-                            }),
-                            _ => return,
+                            }) => Some(DelayDef::Scaled { f, ns, unit: u, at }),
+                            Some(Typed {
+                                code: Code::Float(f),
+                                ..
+                            }) => Some(DelayDef::ScaledFloat { f, ns, unit: u, at }),
+                            Some(_) => {
+                                self.b.err(
+                                    e.span,
+                                    format!(
+                                        "a delay in `{}` needs a number before its unit",
+                                        codegen::duration::format(ns).trim_start_matches('1')
+                                    ),
+                                );
+                                return;
+                            }
+                            None => return,
                         }
                     }
                 };

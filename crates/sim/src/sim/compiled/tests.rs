@@ -76,7 +76,7 @@ fn delayed_sends(send: &str, unit: Option<u64>) -> Result<Vec<u64>, String> {
     use crate::sim::{RunConfig, Simulator, TraceRecorder};
     use rand_core::SeedableRng;
     let text = format!(
-        r#"<scxml name="A" initial="s"><datamodel><data id="d" expr="300"/><data id="neg" expr="-2"/></datamodel>
+        r#"<scxml name="A" initial="s"><datamodel><data id="d" expr="300"/><data id="neg" expr="-2"/><data id="q" expr="0.25"/></datamodel>
         <state id="s"><onentry><send event="e" target="NONE"/>{send}</onentry></state></scxml>"#
     );
     let mut src =
@@ -115,6 +115,9 @@ fn durations_in_delays_become_model_time_units() {
             vec![0, 301],
         ),
         (r#"delayexpr="d""#, None, vec![0, 300]),
+        // A float counts its unit too, rounded to the nanosecond (0.1 s is not exact).
+        (r#"delayexpr="q * 2 + 's'""#, MS100, vec![0, 5]),
+        (r#"delayexpr="0.1 + 's'""#, MS100, vec![0, 1]),
     ] {
         assert_eq!(delayed_sends(&send(attr), unit), Ok(times), "{attr}");
     }
@@ -153,6 +156,21 @@ fn durations_in_delays_become_model_time_units() {
             r#"delayexpr="neg + 'ms'""#,
             MS100,
             "the delay is negative (-2)",
+        ),
+        (
+            r#"delayexpr="-q + 's'""#,
+            MS100,
+            "the delay is negative (-0.25)",
+        ),
+        (
+            r#"delayexpr="q + 's'""#,
+            MS100,
+            "a delay of 250ms is not a whole number",
+        ),
+        (
+            r#"delayexpr="(q > 0) + 's'""#,
+            MS100,
+            "a delay in `s` needs a number before its unit",
         ),
         // Only a unit ends the sum: anything else stays a (refused) string concatenation.
         (

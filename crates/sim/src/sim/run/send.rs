@@ -45,6 +45,16 @@ impl Simulator<'_> {
                             Err(e) => return Err(self.diag_error(m, Some(pc as usize), e)),
                         }
                     }
+                    DelayDef::ScaledFloat { f, ns, unit, at } => {
+                        let res = {
+                            let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
+                            f(&mut env).and_then(|v| float_delay_units(v, *ns, *unit, *at))
+                        };
+                        match res {
+                            Ok(n) => n,
+                            Err(e) => return Err(self.diag_error(m, Some(pc as usize), e)),
+                        }
+                    }
                 };
                 if n > 0 {
                     let r = &mut self.ms[m];
@@ -238,11 +248,14 @@ impl Simulator<'_> {
 /// units, is an error at the `delayexpr`.
 fn delay_units(v: i64, d: &DelayDef) -> Result<u64, EvalError> {
     let at = match d {
-        DelayDef::Expr { at, .. } | DelayDef::Scaled { at, .. } => *at,
+        DelayDef::Expr { at, .. }
+        | DelayDef::Scaled { at, .. }
+        | DelayDef::ScaledFloat { at, .. } => *at,
         DelayDef::Const(_) => 0,
     };
     let err = |kind| EvalError { at, kind };
-    let n = u64::try_from(v).map_err(|_| err(EvalErrorKind::NegativeDelay(v)))?;
+    let n =
+        u64::try_from(v).map_err(|_| err(EvalErrorKind::NegativeDelay((v as f64).to_bits())))?;
     match d {
         DelayDef::Scaled { ns, unit, .. } => {
             let total = n.checked_mul(*ns).ok_or(err(EvalErrorKind::Overflow))?;
@@ -256,4 +269,24 @@ fn delay_units(v: i64, d: &DelayDef) -> Result<u64, EvalError> {
         }
         _ => Ok(n),
     }
+}
+
+/// The units `v` of `ns` nanoseconds make in a model whose unit is `unit` ns (a float
+/// `delayexpr`: `0.5 + 's'`). The product is rounded to the nanosecond (`0.1 * 1e9` is
+/// not exactly 10^8 in floats); a negative or non-finite delay, or one between two units,
+/// is an error at `at`.
+fn float_delay_units(v: f64, ns: u64, unit: u64, at: u32) -> Result<u64, EvalError> {
+    let err = |kind| EvalError { at, kind };
+    if v < 0.0 {
+        return Err(err(EvalErrorKind::NegativeDelay(v.to_bits())));
+    }
+    let total = (v * ns as f64).round();
+    if !total.is_finite() || total >= u64::MAX as f64 {
+        return Err(err(EvalErrorKind::NoInteger(v.to_bits())));
+    }
+    let total = total as u64;
+    if total % unit != 0 {
+        return Err(err(EvalErrorKind::DelaySteps { ns: total, unit }));
+    }
+    Ok(total / unit)
 }
