@@ -148,7 +148,7 @@ pub enum Delay {
     /// `delayexpr="..."`: an integer expression.
     Expr(SrcExpr),
     /// `delayexpr="e + 'ms'"`, SCXML's way of writing a duration an expression computes:
-    /// the integer expression `e` counts units of the given nanoseconds.
+    /// the number `e` (an integer or a float) counts units of the given nanoseconds.
     ExprIn(SrcExpr, u64),
 }
 

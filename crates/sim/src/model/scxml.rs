@@ -711,7 +711,7 @@ impl Reader<'_> {
 /// `e + 'ms'` (or `"ms"`, any unit of `codegen::duration`): the length of `e`'s text and
 /// the unit in nanoseconds. SCXML writes a computed delay as a CSS2 duration string, and
 /// this is how a model builds one; the expression language has no string concatenation
-/// otherwise, so `e` (an integer) counts units of the suffix.
+/// otherwise, so `e` (a number) counts units of the suffix.
 fn unit_suffix(text: &str) -> Option<(usize, u64)> {
     let t = text.trim_end();
     let quote = t.chars().last().filter(|&c| c == '\'' || c == '"')?;

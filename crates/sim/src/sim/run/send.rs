@@ -243,9 +243,10 @@ impl Simulator<'_> {
     }
 }
 
-/// The units a `delayexpr` that gave `v` waits: `v` itself, or for `e + 'ms'` the
-/// duration `v` ms in the model's units. A negative delay, or a duration between two
-/// units, is an error at the `delayexpr`.
+/// The units an integer `delayexpr` (`d`, a [`DelayDef::Expr`], or `d + 'ms'`, a
+/// [`DelayDef::Scaled`]) that gave `v` waits: `v` itself, or the duration `v` ms in the
+/// model's units. A negative delay, or a duration between two units, is an error at the
+/// `delayexpr`.
 fn delay_units(v: i64, d: &DelayDef) -> Result<u64, EvalError> {
     let at = match d {
         DelayDef::Expr { at, .. }
