@@ -79,6 +79,24 @@ impl Reader<'_> {
         }
     }
 
+    /// The `event` a `<send>` or `<raise>` names: one name, no blanks. A transition's
+    /// `event="a b"` lists two events, so a sent `a b` could never be taken.
+    fn sent_event(&mut self, el: &Element) -> Option<Ident> {
+        let ev = self.required_ident(el, "event")?;
+        if ev.name.contains(char::is_whitespace) {
+            self.err(
+                ev.span,
+                format!(
+                    "event `{}` has blanks: an event name is one word (a transition's \
+                     `event=\"a b\"` lists two events)",
+                    ev.name
+                ),
+            );
+            return None;
+        }
+        Some(ev)
+    }
+
     fn required_src(&mut self, el: &Element, name: &str) -> Option<SrcExpr> {
         match el.required(self.sm, name) {
             Ok(a) => Some(self.src(a)),
@@ -484,7 +502,7 @@ impl Reader<'_> {
             }
             "raise" => {
                 self.check(el, &["event"]);
-                let event = self.required_ident(el, "event")?;
+                let event = self.sent_event(el)?;
                 Some(Exec::Raise {
                     event,
                     span: el.span,
@@ -602,7 +620,7 @@ impl Reader<'_> {
                 self.err(t.value_span, format!("unsupported send type `{v}`"));
             }
         }
-        let event = self.required_ident(el, "event");
+        let event = self.sent_event(el);
         let target = match (el.attr("target"), el.attr("targetexpr")) {
             (Some(a), None) => Some(SendTarget::Id(self.ident(a))),
             (None, Some(a)) => Some(SendTarget::Expr(self.src(a))),
@@ -846,6 +864,24 @@ mod tests {
         assert!(msgs[1].contains("more than 1"), "{msgs:?}");
         assert!(msgs[2].contains("between 0 and 1"), "{msgs:?}");
         assert!(msgs[3].contains("beside <target>"), "{msgs:?}");
+    }
+
+    /// A sent or raised event is one word: a transition reads `event="a b"` as two.
+    #[test]
+    fn a_sent_event_with_blanks_is_refused() {
+        let errs = read(
+            r#"<scxml name="M"><state id="a"><onentry><send event="a b" target="M"/><raise event=" c	d "/></onentry>
+            <transition event="a b" target="a"/></state></scxml>"#,
+        )
+        .unwrap_err();
+        let msgs: Vec<String> = errs.iter().map(|d| d.to_string()).collect();
+        assert_eq!(msgs.len(), 2, "{msgs:#?}");
+        assert!(
+            msgs[0].starts_with("m.scxml:1:53: event `a b` has blanks"),
+            "{msgs:#?}"
+        );
+        // XML normalises the tab of an attribute value to a space.
+        assert!(msgs[1].contains("event `c d` has blanks"), "{msgs:#?}");
     }
 
     #[test]
