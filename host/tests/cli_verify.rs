@@ -403,6 +403,13 @@ fn sweep_shows_the_step_at_the_recurrence_threshold() {
         low.contains("visitors_recurrence: no run succeeds at any bound in the range"),
         "{low}"
     );
+    // From 10 on every run succeeds at the range's first bound: the threshold may be lower.
+    let (code, _, high) = sweep_over(&[], "10", "11");
+    assert_eq!(code, 0, "{high}");
+    assert!(
+        high.contains("visitors_recurrence: every run succeeds at every bound of the range, from 10 on: the threshold is 10 or lower"),
+        "{high}"
+    );
     // The same deadline written as a window from now, `once[0:10]`: the sweep moves the
     // deadline and keeps the window's start (it once swept both ends, `once[X:X]`, and
     // every run failed at every bound).

@@ -263,6 +263,12 @@ fn finish(
     if !args.json {
         for c in &curves {
             match &c.threshold {
+                // At the range's first bound already: the threshold may lie below it.
+                Some(t) if c.points.first().is_some_and(|p| &p.bound == t) => eprintln!(
+                    "{}: every run succeeds at every bound of the range, from {t} on: the \
+                     threshold is {t} or lower (lower --from to find it)",
+                    c.property
+                ),
                 Some(t) => eprintln!("{}: every run succeeds from bound {t} on", c.property),
                 // Not one run succeeding anywhere: the range is too low, or the property
                 // fails for a reason its bounds do not move.
