@@ -182,6 +182,27 @@ fn a_delayed_send_in_a_node_model_is_warned_about() {
         err.contains("note: 3 of 3 runs went quiet before the time horizon"),
         "{err}"
     );
+    // A delay the 1 s timer does not divide makes the model's step finer (0.5 s), not an
+    // error: the client still calls each second, and the server still waits.
+    let server = std::fs::read_to_string(dir.join("server.scxml")).unwrap();
+    std::fs::write(
+        dir.join("server.scxml"),
+        server.replace("delay=\"2s\"", "delay=\"1500ms\""),
+    )
+    .unwrap();
+    let (code, out, err) = hindsight(&["verify", model, "--runs", "3"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("model time: steps of 0.5 s, runs of at most 10.5 s"),
+        "{out}"
+    );
+    assert!(
+        err.contains("note: 3 of 3 runs went quiet before the time horizon"),
+        "{err}"
+    );
+    let (code, _, err) = hindsight(&["trace", model, "--run", "0"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("went quiet at time 4 (2s)"), "{err}");
     let _ = std::fs::remove_dir_all(dir);
 }
 

@@ -259,14 +259,23 @@ impl Cx<'_> {
     /// top_level_interpreter.py) converts them: the node models in main-file order, then
     /// the behavior tree's root and plugins. So the tree's tick comes after every node
     /// model's timer of the same instant.
-    pub(super) fn global_timer(&mut self, max_time_ns: u64) -> (Option<Element>, u64) {
+    ///
+    /// `delays_ns` are the node models' `<send delay>`s written as durations (AS2FM drops
+    /// them; hindsight waits for them, `crates/robot/src/load.rs`): they count as periods
+    /// for the unit, so that each is a whole number of steps, but start no timer.
+    pub(super) fn global_timer(
+        &mut self,
+        max_time_ns: u64,
+        delays_ns: &[u64],
+    ) -> (Option<Element>, u64) {
         let periods: Vec<u64> = self.timers.iter().map(|t| t.period_ns).collect();
-        // The coarsest of s, ms, us, ns in which every period and max_time are whole.
+        let lengths = || periods.iter().chain(delays_ns.iter().filter(|&&d| d > 0));
+        // The coarsest of s, ms, us, ns in which every period, delay and max_time are whole.
         let unit = [1_000_000_000u64, 1_000_000, 1_000, 1]
             .into_iter()
-            .find(|u| periods.iter().chain([&max_time_ns]).all(|p| p % u == 0))
+            .find(|u| lengths().chain([&max_time_ns]).all(|p| p % u == 0))
             .unwrap_or(1);
-        let step = periods.iter().fold(0, |g, p| gcd(g, *p / unit));
+        let step = lengths().fold(0, |g, p| gcd(g, *p / unit));
         let Some(first) = self.timers.first() else {
             return (None, unit);
         };
