@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use codegen::bounds::map_bounds;
 use codegen::diag::{Diagnostic, Diagnostics};
-use codegen::duration::{seconds, StepsOrDuration};
+use codegen::duration::{parse_steps_or_duration, seconds, StepsOrDuration};
 
 use crate::model::xml::Element;
 use crate::props::{self, PortKind, PropertyFile, ANY};
@@ -178,12 +178,10 @@ pub fn convert(
 fn delays_in_steps(e: &mut Element, unit_ns: u64) {
     if e.name == "send" {
         if let Some(a) = e.attrs.iter_mut().find(|a| a.name == "delay") {
-            let whole = a.value.trim().parse::<u64>().is_ok();
-            match codegen::duration::parse(&a.value) {
-                Ok(ns) if !whole && unit_ns > 0 && ns % unit_ns == 0 => {
+            if let Ok(StepsOrDuration::Nanos(ns)) = parse_steps_or_duration(&a.value) {
+                if unit_ns > 0 && ns % unit_ns == 0 {
                     a.value = (ns / unit_ns).to_string();
                 }
-                _ => {}
             }
         }
     }

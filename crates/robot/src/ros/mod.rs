@@ -62,12 +62,11 @@ use crate::types::{ActionFields, FlatField, InterfaceLookup, LookupError, Servic
 /// says nothing of their length).
 fn duration_delays(e: &Element, out: &mut Vec<u64>) {
     if e.name == "send" {
-        if let Some(v) = e.attr_value("delay") {
-            if v.trim().parse::<u64>().is_err() {
-                if let Ok(ns) = codegen::duration::parse(v) {
-                    out.push(ns);
-                }
-            }
+        let delay = e
+            .attr_value("delay")
+            .map(codegen::duration::parse_steps_or_duration);
+        if let Some(Ok(codegen::duration::StepsOrDuration::Nanos(ns))) = delay {
+            out.push(ns);
         }
     }
     for c in e.elements() {

@@ -4,6 +4,7 @@ use super::ast::*;
 use super::source::{unescaped_offset, Diagnostic, FileId, SourceMap, Span};
 use super::types::{parse_type_comment, TypeAnn, TypeError, TypeExpr};
 use super::xml::{self, Element, Node};
+use codegen::duration::StepsOrDuration;
 
 /// Reads the SCXML file `file` (already in `sm`) into a machine.
 pub(crate) fn read_machine(sm: &SourceMap, file: FileId) -> Result<Machine, Vec<Diagnostic>> {
@@ -631,22 +632,21 @@ impl Reader<'_> {
             }
         };
         let delay = match (el.attr("delay"), el.attr("delayexpr")) {
-            (Some(a), None) => match a.value.trim().parse::<u64>() {
-                Ok(n) => Some(Delay::Const(n, a.value_span)),
-                Err(_) => match codegen::duration::parse(&a.value) {
-                    Ok(ns) => Some(Delay::Duration(ns, a.value_span)),
-                    Err(e) => {
-                        self.err(
-                            a.value_span,
-                            format!(
-                                "delay `{}` is neither a whole number of model time units \
-                                 nor a duration (`500ms`, `1.5s`): {e}",
-                                a.value
-                            ),
-                        );
-                        None
-                    }
-                },
+            // Whole steps, or a duration (`codegen::duration`, the one reader of both).
+            (Some(a), None) => match codegen::duration::parse_steps_or_duration(&a.value) {
+                Ok(StepsOrDuration::Steps(n)) => Some(Delay::Const(n, a.value_span)),
+                Ok(StepsOrDuration::Nanos(ns)) => Some(Delay::Duration(ns, a.value_span)),
+                Err(e) => {
+                    self.err(
+                        a.value_span,
+                        format!(
+                            "delay `{}` is neither a whole number of model time units \
+                             nor a duration (`500ms`, `1.5s`): {e}",
+                            a.value
+                        ),
+                    );
+                    None
+                }
             },
             (None, Some(a)) => Some(match unit_suffix(&a.value) {
                 Some((len, ns)) => Delay::ExprIn(
