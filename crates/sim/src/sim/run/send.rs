@@ -35,20 +35,12 @@ impl Simulator<'_> {
             if !self.ms[m].delay_done {
                 let n = match d {
                     DelayDef::Const(n) => *n,
-                    DelayDef::Expr { f, .. } | DelayDef::Scaled { f, .. } => {
+                    // An environment only for a delay that evaluates (the global timer's
+                    // `delay="1"` is a constant, and it waits every unit).
+                    _ => {
                         let res = {
                             let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
-                            f(&mut env).and_then(|v| delay_units(v, d))
-                        };
-                        match res {
-                            Ok(n) => n,
-                            Err(e) => return Err(self.diag_error(m, Some(pc as usize), e)),
-                        }
-                    }
-                    DelayDef::ScaledFloat { f, ns, unit, at } => {
-                        let res = {
-                            let mut env = env(&self.ms, &self.pool, m, &mut *rng, &model.strings);
-                            f(&mut env).and_then(|v| float_delay_units(v, *ns, *unit, *at))
+                            d.units(&mut env)
                         };
                         match res {
                             Ok(n) => n,
@@ -243,33 +235,37 @@ impl Simulator<'_> {
     }
 }
 
-/// The units an integer `delayexpr` (`d`, a [`DelayDef::Expr`], or `d + 'ms'`, a
-/// [`DelayDef::Scaled`]) that gave `v` waits: `v` itself, or the duration `v` ms in the
-/// model's units. A negative delay, or a duration between two units, is an error at the
-/// `delayexpr`.
-fn delay_units(v: i64, d: &DelayDef) -> Result<u64, EvalError> {
-    let at = match d {
-        DelayDef::Expr { at, .. }
-        | DelayDef::Scaled { at, .. }
-        | DelayDef::ScaledFloat { at, .. } => *at,
-        DelayDef::Const(_) => 0,
-    };
+impl DelayDef {
+    /// The model time units this delay waits, its expression evaluated in `env`.
+    fn units(&self, env: &mut Env<'_>) -> Result<u64, EvalError> {
+        match self {
+            DelayDef::Const(n) => Ok(*n),
+            DelayDef::Expr { f, at } => f(env).and_then(|v| delay_units(v, None, *at)),
+            DelayDef::Scaled { f, ns, unit, at } => {
+                f(env).and_then(|v| delay_units(v, Some((*ns, *unit)), *at))
+            }
+            DelayDef::ScaledFloat { f, ns, unit, at } => {
+                f(env).and_then(|v| float_delay_units(v, *ns, *unit, *at))
+            }
+        }
+    }
+}
+
+/// The units an integer `delayexpr` that gave `v` waits: `v` itself, or with `scale`
+/// `(ns, unit)` (`d + 'ms'`) the duration `v` times `ns` in units of `unit` ns. A
+/// negative delay, or a duration between two units, is an error at `at`.
+fn delay_units(v: i64, scale: Option<(u64, u64)>, at: u32) -> Result<u64, EvalError> {
     let err = |kind| EvalError { at, kind };
     let n =
         u64::try_from(v).map_err(|_| err(EvalErrorKind::NegativeDelay((v as f64).to_bits())))?;
-    match d {
-        DelayDef::Scaled { ns, unit, .. } => {
-            let total = n.checked_mul(*ns).ok_or(err(EvalErrorKind::Overflow))?;
-            if total % unit != 0 {
-                return Err(err(EvalErrorKind::DelaySteps {
-                    ns: total,
-                    unit: *unit,
-                }));
-            }
-            Ok(total / unit)
-        }
-        _ => Ok(n),
+    let Some((ns, unit)) = scale else {
+        return Ok(n);
+    };
+    let total = n.checked_mul(ns).ok_or(err(EvalErrorKind::Overflow))?;
+    if total % unit != 0 {
+        return Err(err(EvalErrorKind::DelaySteps { ns: total, unit }));
     }
+    Ok(total / unit)
 }
 
 /// The units `v` of `ns` nanoseconds make in a model whose unit is `unit` ns (a float
