@@ -568,36 +568,36 @@ impl std::error::Error for MergeError {}
 pub fn merge_parts(parts: &[(String, String)]) -> Result<Merged, MergeError> {
     use crate::sched_fixed::{merge_stage, StagePart, PART_FORMAT};
     use crate::smc::shard::{duplicates, PartialResult};
-    let format = |t: &str| -> Option<String> {
-        let v: serde_json::Value = serde_json::from_str(t).ok()?;
-        Some(v.get("format")?.as_str()?.to_string())
-    };
-    let staged: Vec<bool> = parts
+    // Each part's JSON, read once: its `format` says whether it is a stage's part.
+    let json: Vec<Result<serde_json::Value, String>> = parts
         .iter()
-        .map(|(_, t)| format(t).as_deref() == Some(PART_FORMAT))
+        .map(|(_, t)| serde_json::from_str(t).map_err(|e: serde_json::Error| e.to_string()))
+        .collect();
+    let staged: Vec<bool> = json
+        .iter()
+        .map(|v| {
+            v.as_ref()
+                .is_ok_and(|v| v.get("format").and_then(|f| f.as_str()) == Some(PART_FORMAT))
+        })
         .collect();
     if let Some(first) = staged.iter().position(|&s| s) {
         let mut stage_parts = Vec::new();
-        for ((file, text), &is) in parts.iter().zip(&staged) {
+        for (((file, _), v), &is) in parts.iter().zip(json).zip(&staged) {
+            let part_error = |error: String| MergeError::Part {
+                file: file.clone(),
+                error,
+            };
             // A file that is not JSON at all (cut short, or another file) is said as such.
-            if let Err(e) = serde_json::from_str::<serde_json::Value>(text) {
-                return Err(MergeError::Part {
-                    file: file.clone(),
-                    error: e.to_string(),
-                });
-            }
+            let v = v.map_err(part_error)?;
             if !is {
                 return Err(MergeError::Mixed {
                     file: file.clone(),
                     staged: parts[first].0.clone(),
                 });
             }
-            stage_parts.push(serde_json::from_str::<StagePart>(text).map_err(|e| {
-                MergeError::Part {
-                    file: file.clone(),
-                    error: e.to_string(),
-                }
-            })?);
+            stage_parts.push(
+                serde_json::from_value::<StagePart>(v).map_err(|e| part_error(e.to_string()))?,
+            );
         }
         let plan = merge_stage(&stage_parts).map_err(MergeError::Stage)?;
         if !plan.done() {
