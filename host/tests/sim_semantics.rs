@@ -595,3 +595,43 @@ fn attribute_line_breaks_are_spaces_in_expressions() {
         assert_eq!(sim.var(a, var), Some(Value::Bool(true)), "{var}");
     }
 }
+
+#[test]
+fn a_transition_without_target_exits_and_enters_no_state() {
+    // SCXML 1.0, section 3.13: a targetless transition's exit set is empty, so neither the
+    // state's <onexit> nor its <onentry> runs; its own content does. (SCAN and AS2FM
+    // require a target, so the W3C rule is the only one.) The same transition with a
+    // target runs both. Found with the W3C test suite's test503.
+    let text = |target: &str| {
+        format!(
+            "<scxml xmlns=\"http://www.w3.org/2005/07/scxml\" version=\"1.0\" name=\"M\" \
+             initial=\"s0\" datamodel=\"ecmascript\"><datamodel>\
+             <data id=\"exits\" expr=\"0\"/><data id=\"entries\" expr=\"0\"/>\
+             <data id=\"body\" expr=\"0\"/></datamodel>\
+             <state id=\"s0\"><onentry><assign location=\"entries\" expr=\"entries + 1\"/>\
+             <if cond=\"entries == 1\"><raise event=\"foo\"/></if></onentry>\
+             <onexit><assign location=\"exits\" expr=\"exits + 1\"/></onexit>\
+             <transition event=\"foo\" {target}><assign location=\"body\" expr=\"body + 1\"/>\
+             </transition></state></scxml>"
+        )
+    };
+    for (target, want) in [("", (0, 1, 1)), ("target=\"s0\"", (1, 2, 1))] {
+        let t = text(target);
+        let src =
+            hindsight::verify::model::ModelSource::from_texts([("m.scxml", t.as_str())]).unwrap();
+        let m = CompiledModel::compile(src).unwrap();
+        let mut sim = Simulator::new(&m);
+        let out = sim.run(
+            &mut rng(0),
+            &RunConfig::default(),
+            &mut TraceRecorder::new(),
+        );
+        assert_eq!(out.end, EndReason::Quiescent, "{target}");
+        let id = m.machine_id("M").unwrap();
+        let got = ["exits", "entries", "body"].map(|v| match sim.var(id, v) {
+            Some(Value::Int(n)) => n,
+            other => panic!("{v}: {other:?}"),
+        });
+        assert_eq!((got[0], got[1], got[2]), want, "{target}");
+    }
+}

@@ -64,7 +64,7 @@ pub fn parse_expr(text: &str) -> Result<Expr, ParseError> {
         } else {
             format!("unexpected `{c}`")
         };
-        return Err(p.err(rest, msg));
+        return Err(p.stray(rest, msg));
     }
     Ok(e)
 }
@@ -85,24 +85,71 @@ fn ident_char(c: char) -> bool {
 }
 
 /// Whether `word` is reserved by the expression language, so that it cannot name a
-/// variable: the literals `true` and `false`, and the ECMAScript words it refuses
-/// (`null`, `NaN`, `var`, ...). A lowering that names model variables after names of
-/// another language (behavior tree entries) renames these.
+/// variable: the literals `true` and `false`, the ECMAScript words it refuses (`null`,
+/// `NaN`, `var`, ...) and ECMAScript's other reserved words (`return`, `default`, `in`,
+/// ...). A lowering that names model variables after names of another language
+/// (behavior tree entries) renames these.
 pub fn is_reserved(word: &str) -> bool {
+    is_keyword(word)
+        || matches!(
+            word,
+            "true"
+                | "false"
+                | "null"
+                | "undefined"
+                | "NaN"
+                | "Infinity"
+                | "new"
+                | "function"
+                | "this"
+                | "typeof"
+                | "var"
+                | "let"
+        )
+}
+
+/// The other reserved words of ECMAScript (ES2015, strict mode): no expression may use
+/// one as a name. SCAN parses expressions with an ECMAScript parser, which refuses them.
+fn is_keyword(word: &str) -> bool {
     matches!(
         word,
-        "true"
-            | "false"
-            | "null"
-            | "undefined"
-            | "NaN"
-            | "Infinity"
-            | "new"
-            | "function"
-            | "this"
-            | "typeof"
-            | "var"
-            | "let"
+        "break"
+            | "delete"
+            | "void"
+            | "case"
+            | "catch"
+            | "class"
+            | "const"
+            | "continue"
+            | "debugger"
+            | "default"
+            | "do"
+            | "else"
+            | "enum"
+            | "export"
+            | "extends"
+            | "finally"
+            | "for"
+            | "if"
+            | "import"
+            | "in"
+            | "instanceof"
+            | "return"
+            | "super"
+            | "switch"
+            | "throw"
+            | "try"
+            | "while"
+            | "with"
+            | "yield"
+            | "await"
+            | "static"
+            | "implements"
+            | "interface"
+            | "package"
+            | "private"
+            | "protected"
+            | "public"
     )
 }
 
@@ -159,6 +206,19 @@ impl P {
         }
     }
 
+    /// The error where a complete operand is followed by `rest` that continues none of
+    /// the grammar: `message`, unless `rest` is an ECMAScript operator this language does
+    /// not have (`'a' in _event`), which is named.
+    fn stray(&self, rest: &str, message: impl Into<String>) -> ParseError {
+        let word = name(rest).map_or("", |(_, n)| n);
+        match word {
+            "in" | "instanceof" => {
+                self.err(rest, format!("the `{word}` operator is not supported"))
+            }
+            _ => self.err(rest, message),
+        }
+    }
+
     fn ws<'a>(&self, i: &'a str) -> &'a str {
         i.trim_start_matches(|c: char| c.is_whitespace())
     }
@@ -190,7 +250,7 @@ impl P {
             let (r, a) = self.cond(r)?;
             let r = self.ws(r);
             let Some(r) = r.strip_prefix(':') else {
-                return Err(self.err(r, "expected `:` in conditional expression"));
+                return Err(self.stray(r, "expected `:` in conditional expression"));
             };
             let r = self.ws(r);
             let (r, b) = self.cond(r)?;
@@ -394,7 +454,7 @@ impl P {
                 let (r, idx) = self.cond(r)?;
                 let r = self.ws(r);
                 let Some(r) = r.strip_prefix(']') else {
-                    return Err(self.err(r, "expected `]`"));
+                    return Err(self.stray(r, "expected `]`"));
                 };
                 e = self.node(ExprKind::Index(Box::new(e), Box::new(idx)), start, r);
                 rest = r;
@@ -425,7 +485,7 @@ impl P {
                 return Ok((after, items));
             }
             let Some(after) = r2.strip_prefix(',') else {
-                return Err(self.err(r2, format!("expected `,` or `{close}`")));
+                return Err(self.stray(r2, format!("expected `,` or `{close}`")));
             };
             r = self.ws(after);
             if trailing {
@@ -489,7 +549,7 @@ impl P {
                 return Ok((after, fields));
             }
             let Some(after) = r2.strip_prefix(',') else {
-                return Err(self.err(r2, "expected `,` or `}`"));
+                return Err(self.stray(r2, "expected `,` or `}`"));
             };
             r = self.ws(after);
         }
@@ -506,7 +566,7 @@ impl P {
             let (r, e) = self.cond(r)?;
             let r = self.ws(r);
             let Some(r) = r.strip_prefix(')') else {
-                return Err(self.err(r, "expected `)`"));
+                return Err(self.stray(r, "expected `)`"));
             };
             self.depth -= 1;
             // Keep the inner node; widen its range to the parentheses.
@@ -544,6 +604,15 @@ impl P {
             let kind = match n {
                 "true" => ExprKind::Bool(true),
                 "false" => ExprKind::Bool(false),
+                n if is_keyword(n) && !matches!(n, "delete" | "void") => {
+                    return Err(self.err(
+                        i,
+                        format!(
+                            "`{n}` is a reserved word of ECMAScript, not a value: an attribute \
+                             holds one expression (`x > 0`, not `return x > 0`)"
+                        ),
+                    ));
+                }
                 n if is_reserved(n) => {
                     return Err(self.err(i, format!("`{n}` is not supported")));
                 }
@@ -670,6 +739,19 @@ mod tests {
             ("x >> 1", "the shift operators", 2),
             ("1 + x << 2", "the shift operators", 6),
             ("x >>> 1", "the shift operators", 2),
+            // ECMAScript words this language has no use for: named, not "unexpected".
+            ("'name' in _event", "the `in` operator is not supported", 7),
+            ("('a' in o) && b", "the `in` operator is not supported", 5),
+            ("x instanceof y", "the `instanceof` operator", 2),
+            ("c ? a in b : 1", "the `in` operator", 6),
+            (
+                "return x > 0",
+                "`return` is a reserved word of ECMAScript",
+                0,
+            ),
+            ("x == default", "`default` is a reserved word", 5),
+            ("void 0", "`void` is not supported", 0),
+            ("delete x", "`delete` is not supported", 0),
         ] {
             let e = parse_expr(bad).unwrap_err();
             assert_eq!(

@@ -269,8 +269,38 @@ impl Reader<'_> {
         self.type_ann(t, a.value_span)
     }
 
+    /// A constant delay `text` written in attribute `a`: whole model time units, or a
+    /// duration (`codegen::duration`, the one reader of both).
+    fn delay_text(&mut self, text: &str, a: &crate::model::xml::Attr) -> Option<Delay> {
+        match codegen::duration::parse_steps_or_duration(text) {
+            Ok(StepsOrDuration::Steps(n)) => Some(Delay::Const(n, a.value_span)),
+            Ok(StepsOrDuration::Nanos(ns)) => Some(Delay::Duration(ns, a.value_span)),
+            Err(e) => {
+                self.err(
+                    a.value_span,
+                    format!(
+                        "delay `{text}` is neither a whole number of model time units nor a \
+                         duration (`500ms`, `1.5s`): {e}"
+                    ),
+                );
+                None
+            }
+        }
+    }
+
     fn state(&mut self, el: &Element) -> Option<State> {
-        self.check(el, &["id"]);
+        match el.attr("initial") {
+            // A compound state's: say so once, not as a stray attribute.
+            Some(a) => {
+                self.check(el, &["id", "initial"]);
+                self.err(
+                    a.name_span,
+                    "nested states are not supported: machines must be flat (`initial` on a \
+                     <state> names one of its child states)",
+                );
+            }
+            None => self.check(el, &["id"]),
+        }
         self.text_not_allowed(el);
         let id = self.required_ident(el, "id")?;
         let mut s = State {
@@ -631,23 +661,16 @@ impl Reader<'_> {
                 None
             }
         };
+        // `delayexpr="'50ms'"`, a constant CSS2 duration (the W3C tests write them so),
+        // reads as `delay="50ms"`.
+        let constant = el
+            .attr("delayexpr")
+            .filter(|_| el.attr("delay").is_none())
+            .and_then(|a| string_literal(&a.value).map(|text| (text, a)));
         let delay = match (el.attr("delay"), el.attr("delayexpr")) {
+            _ if constant.is_some() => constant.and_then(|(text, a)| self.delay_text(text, a)),
             // Whole steps, or a duration (`codegen::duration`, the one reader of both).
-            (Some(a), None) => match codegen::duration::parse_steps_or_duration(&a.value) {
-                Ok(StepsOrDuration::Steps(n)) => Some(Delay::Const(n, a.value_span)),
-                Ok(StepsOrDuration::Nanos(ns)) => Some(Delay::Duration(ns, a.value_span)),
-                Err(e) => {
-                    self.err(
-                        a.value_span,
-                        format!(
-                            "delay `{}` is neither a whole number of model time units \
-                             nor a duration (`500ms`, `1.5s`): {e}",
-                            a.value
-                        ),
-                    );
-                    None
-                }
-            },
+            (Some(a), None) => self.delay_text(&a.value, a),
             (None, Some(a)) => Some(match unit_suffix(&a.value) {
                 Some((len, ns)) => Delay::ExprIn(
                     SrcExpr {
@@ -724,6 +747,14 @@ impl Reader<'_> {
             span: el.span,
         }))
     }
+}
+
+/// The text of `text` when it is one string literal (`'50ms'`, `"2s"`), else `None`.
+fn string_literal(text: &str) -> Option<&str> {
+    let t = text.trim();
+    let quote = t.chars().next().filter(|&c| c == '\'' || c == '"')?;
+    let body = t[1..].strip_suffix(quote)?;
+    (!body.contains(quote)).then_some(body)
 }
 
 /// `e + 'ms'` (or `"ms"`, any unit of `codegen::duration`): the length of `e`'s text and
@@ -891,5 +922,57 @@ mod tests {
         )
         .unwrap_err();
         assert_eq!(errs.len(), 3, "{errs:?}");
+    }
+
+    #[test]
+    fn a_constant_delayexpr_reads_as_a_delay() {
+        // W3C's `delayexpr="'50ms'"` (a string literal) is `delay="50ms"`; a bad one is
+        // the same error as a bad `delay`, at the attribute's value.
+        let m = read(
+            r#"<scxml name="M" initial="a"><state id="a"><onentry>
+            <send event="e" target="M" delayexpr="'50ms'"/><send event="f" target="M" delayexpr=" &quot;3&quot; "/>
+            </onentry></state></scxml>"#,
+        )
+        .unwrap();
+        let delays: Vec<String> = m.states[0]
+            .onentry
+            .iter()
+            .map(|x| match x {
+                Exec::Send(s) => format!("{:?}", s.delay),
+                other => panic!("{other:?}"),
+            })
+            .collect();
+        assert!(
+            delays[0].starts_with("Some(Duration(50000000,"),
+            "{delays:?}"
+        );
+        assert!(delays[1].starts_with("Some(Const(3,"), "{delays:?}");
+        let errs = read(
+            r#"<scxml name="M" initial="a"><state id="a"><onentry><send event="e" target="M" delayexpr="'soon'"/></onentry></state></scxml>"#,
+        )
+        .unwrap_err();
+        assert!(
+            errs[0]
+                .to_string()
+                .starts_with("m.scxml:1:90: delay `soon` is neither"),
+            "{errs:?}"
+        );
+    }
+
+    #[test]
+    fn a_compound_state_is_refused_at_its_initial_attribute() {
+        let errs = read(
+            r#"<scxml name="M" initial="a"><state id="a" initial="b"><state id="b"/></state></scxml>"#,
+        )
+        .unwrap_err();
+        let msgs: Vec<String> = errs.iter().map(|d| d.to_string()).collect();
+        assert!(
+            msgs[0].starts_with("m.scxml:1:43: nested states are not supported"),
+            "{msgs:#?}"
+        );
+        assert!(
+            !msgs.iter().any(|m| m.contains("unknown attribute")),
+            "{msgs:#?}"
+        );
     }
 }

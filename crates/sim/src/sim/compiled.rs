@@ -470,6 +470,7 @@ impl<'s> Builder<'s> {
             self.vars.push(vars);
         }
         self.collect_events();
+        self.prefix_warnings();
         self.infer_params();
         let events: EventParams = self
             .events

@@ -61,6 +61,88 @@ impl<'s> Builder<'s> {
         }
     }
 
+    /// A warning at each transition event `a` of a model that sends `a.b` to the same
+    /// machine without the transition naming it: W3C SCXML's descriptor `a` matches every
+    /// event `a.*` (SCXML 1.0, section 3.12.1), hindsight matches names exactly, as SCAN
+    /// does (`scan_scxml` builder, `ModelBuilder::event_index`: one channel index per
+    /// name) and AS2FM does (one JANI action per name). Models from other SCXML tools may
+    /// count on the prefix rule; nothing else would show that those events are dropped.
+    pub(super) fn prefix_warnings(&mut self) {
+        let src = self.src;
+        // Only dotted events can be missed so: most models have none.
+        if !self.events.iter().any(|e| e.name.contains('.')) {
+            return;
+        }
+        // Per machine, the dotted events that reach it: its own raises and sends to
+        // itself, sends that name it, and sends whose target is an expression.
+        let names: Vec<&str> = src.machines.iter().map(|m| m.name.name.as_str()).collect();
+        let mut reach: Vec<BTreeSet<&str>> = vec![BTreeSet::new(); src.machines.len()];
+        for (mi, m) in src.machines.iter().enumerate() {
+            let mut visit = |x: &'s Exec| match x {
+                Exec::Raise { event, .. } if event.name.contains('.') => {
+                    reach[mi].insert(event.name.as_str());
+                }
+                Exec::Send(send) if send.event.name.contains('.') => {
+                    let to: Vec<usize> = match &send.target {
+                        Some(SendTarget::Id(id)) => names
+                            .iter()
+                            .position(|n| *n == id.name)
+                            .into_iter()
+                            .collect(),
+                        Some(SendTarget::Expr(_)) => (0..names.len()).collect(),
+                        // Without a target: to the machines with a transition on it.
+                        None => Vec::new(),
+                    };
+                    for t in to {
+                        reach[t].insert(send.event.name.as_str());
+                    }
+                }
+                _ => {}
+            };
+            for s in &m.states {
+                walk(&s.onentry, &mut visit);
+                walk(&s.onexit, &mut visit);
+                for t in &s.transitions {
+                    walk(&t.body, &mut visit);
+                }
+            }
+        }
+        for (mi, m) in src.machines.iter().enumerate() {
+            for s in &m.states {
+                for t in &s.transitions {
+                    for d in &t.events {
+                        let missed: Vec<&str> = reach[mi]
+                            .iter()
+                            .copied()
+                            .filter(|e| {
+                                e.strip_prefix(d.name.as_str())
+                                    .is_some_and(|rest| rest.starts_with('.'))
+                                    && !t.events.iter().any(|n| n.name == *e)
+                            })
+                            .collect();
+                        let Some(first) = missed.first() else {
+                            continue;
+                        };
+                        let more = match missed.len() {
+                            1 => String::new(),
+                            n => format!(" (and {} more)", n - 1),
+                        };
+                        self.warnings.push(src.sources.diag(
+                            d.span,
+                            format!(
+                                "event `{first}`{more}, sent to `{}`, is not taken by this \
+                                 `{}` transition: hindsight matches event names exactly, as SCAN \
+                                 and AS2FM do (W3C SCXML would take it: a descriptor matches the \
+                                 events it is a prefix of); add it to `event` to take it",
+                                m.name.name, d.name
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+
     /// Every `<send>` with the event in scope where it is compiled.
     pub(super) fn sites(&self) -> Vec<Site<'s>> {
         let src = self.src;

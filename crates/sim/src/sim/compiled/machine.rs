@@ -266,6 +266,20 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                     Some(SendTarget::Id(t)) => match self.b.machine_index.get(t.name.as_str()) {
                         Some(&m) => SendTo::Machine(m),
                         None if t.name == "NONE" => SendTo::Sink,
+                        None if t.name.starts_with("#_") => {
+                            // W3C's special targets (`#_internal`, `#_parent`,
+                            // `#_scxml_<id>`, `#_<invokeid>`): SCAN's sends name a machine.
+                            self.b.err(
+                                t.span,
+                                format!(
+                                    "W3C SCXML's special target `{}` is not supported: a send \
+                                     names a machine (this machine's own name sends to its \
+                                     external queue; <raise> queues an internal event)",
+                                    t.name
+                                ),
+                            );
+                            return;
+                        }
                         None => {
                             self.b.err(
                                 t.span,
@@ -488,7 +502,12 @@ impl<'b, 's> MachineCompiler<'b, 's> {
                         None => None,
                     };
                     let pc = self.code.len() as u32;
-                    self.block(&s.onexit, ev);
+                    // A transition without a target exits no state, so the state's
+                    // <onexit> does not run (SCXML 1.0, section 3.13: a targetless
+                    // transition's exit set is empty). SCAN and AS2FM require a target.
+                    if target.is_some() {
+                        self.block(&s.onexit, ev);
+                    }
                     self.block(&t.body, ev);
                     match target {
                         Some(tg) => self.emit(Instr::Goto(tg), t.span),

@@ -183,3 +183,58 @@ fn durations_in_delays_become_model_time_units() {
         assert!(err.contains(want), "{attr}: {err}");
     }
 }
+
+#[test]
+fn a_transition_on_a_prefix_of_a_dotted_event_is_warned_about() {
+    // W3C SCXML's `foo` would take `foo.bar`; hindsight (as SCAN and AS2FM) does not.
+    // Warned where `foo.bar` reaches the machine (its own raise, a send naming it), not
+    // where it goes elsewhere, nor where the transition lists it too.
+    let m = compile_texts(&[
+        (
+            "a.scxml",
+            r#"<scxml name="A" initial="s"><state id="s">
+            <onentry><raise event="foo.bar"/><send event="err.io" target="B"/><send event="foo" target="A"/></onentry>
+            <transition event="foo" target="s"/><transition event="err" target="s"/>
+            <transition event="foo foo.bar" target="s"/></state></scxml>"#,
+        ),
+        (
+            "b.scxml",
+            r#"<scxml name="B" initial="w"><state id="w"><transition event="err" target="w"/>
+            <transition event="err.io" target="w"/></state></scxml>"#,
+        ),
+    ])
+    .unwrap();
+    let warned: Vec<(String, u32, u32)> = m
+        .warnings()
+        .iter()
+        .filter(|d| d.message.contains("matches event names exactly"))
+        .map(|d| (d.file.clone(), d.line, d.col))
+        .collect();
+    assert_eq!(
+        warned,
+        vec![
+            ("a.scxml".to_string(), 3, 32),
+            ("b.scxml".to_string(), 1, 62)
+        ],
+        "{:?}",
+        m.warnings()
+    );
+    assert!(m.warnings()[0]
+        .message
+        .starts_with("event `foo.bar`, sent to `A`, is not taken by this `foo` transition"));
+}
+
+#[test]
+fn a_w3c_special_target_is_named_as_such() {
+    let errs = compile_texts(&[(
+        "a.scxml",
+        r##"<scxml name="A" initial="s"><state id="s"><onentry><send event="e" target="#_internal"/></onentry>
+        <transition event="e" target="s"/></state></scxml>"##,
+    )])
+    .unwrap_err();
+    assert!(
+        errs.to_string()
+            .contains("a.scxml:1:76: W3C SCXML's special target `#_internal` is not supported"),
+        "{errs}"
+    );
+}
