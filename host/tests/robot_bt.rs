@@ -967,6 +967,31 @@ fn unknown_nodes_and_plugins_are_errors_at_their_position() {
     );
     let t = wrap("<Action ID=\"Nope\" n=\"1\"/>");
     one_error(&t, &[COUNT], "t.xml", &t, "Nope", "plugins: Count");
+    // Under an unknown node, every unknown node is named at once (a tree written for
+    // another executor lacks many), the known ones (Sequence, Count, a SubTree) are not.
+    let t = wrap(
+        "<Recovery>\n<Pipeline>\n<Sequence><Count n=\"1\"/><Rate><Spin/></Rate></Sequence>\n\
+         <Action ID=\"Wait\"/><SubTree ID=\"Gone\"/></Pipeline>\n</Recovery>",
+    );
+    let errs = lower_texts(&t, &[COUNT]).expect_err("errors");
+    let got: Vec<(u32, u32, &str)> = errs
+        .iter()
+        .map(|e| (e.line, e.col, e.message.split(':').next().unwrap_or("")))
+        .collect();
+    let at = |needle| pos(&t, needle);
+    assert_eq!(
+        got,
+        [
+            ("<Recovery", "unknown node `Recovery`"),
+            ("<Pipeline", "unknown node `Pipeline`"),
+            ("<Rate", "unknown node `Rate`"),
+            ("<Spin", "unknown node `Spin`"),
+            ("Wait", "unknown node `Wait`"),
+        ]
+        .map(|(n, m)| (at(n).0, at(n).1, m))
+        .to_vec(),
+        "{errs:?}"
+    );
 }
 
 #[test]

@@ -676,6 +676,47 @@ impl Reader<'_> {
         }
     }
 
+    fn unknown_node(&mut self, type_name: &str, at: Span) {
+        let mut known: Vec<&str> = self.plugins.iter().map(|p| p.name.as_str()).collect();
+        known.sort_unstable();
+        self.err(
+            at,
+            format!(
+                "unknown node `{type_name}`: not a built-in node and no plugin is called so \
+                 (plugins: {})",
+                if known.is_empty() {
+                    "none".to_string()
+                } else {
+                    known.join(", ")
+                }
+            ),
+        );
+    }
+
+    /// Reports every node of an unknown type below `el` (whose own type is unknown), as
+    /// [`Reader::node`] would have if it could read `el`.
+    fn unknown_below(&mut self, el: &Element) {
+        for c in el.elements() {
+            let (type_name, at) = match c.name.as_str() {
+                "SubTree" | "SubTreePlus" => continue,
+                "Action" | "Condition" | "Control" | "Decorator" => match c.attr("ID") {
+                    Some(a) => (a.value.trim().to_string(), a.value_span),
+                    None => (String::new(), c.span),
+                },
+                _ => (c.name.clone(), c.span),
+            };
+            let known = type_name.is_empty()
+                || self.plugins.iter().any(|p| p.name == type_name)
+                || Control::from_name(&type_name).is_some()
+                || UNSUPPORTED.iter().any(|(n, _)| *n == type_name)
+                || format_name_error(&type_name, self.format).is_some();
+            if !known {
+                self.unknown_node(&type_name, at);
+            }
+            self.unknown_below(c);
+        }
+    }
+
     fn node(&mut self, el: &Element, parent: Option<usize>, depth: usize) {
         if el.name == "SubTree" || el.name == "SubTreePlus" {
             self.subtree(el, parent, depth);
@@ -726,16 +767,11 @@ impl Reader<'_> {
                     return;
                 }
                 None => {
-                    let mut known: Vec<&str> =
-                        self.plugins.iter().map(|p| p.name.as_str()).collect();
-                    known.sort_unstable();
-                    self.err(
-                        type_span,
-                        format!(
-                            "unknown node `{type_name}`: not a built-in node and no plugin is called so (plugins: {})",
-                            if known.is_empty() { "none".to_string() } else { known.join(", ") }
-                        ),
-                    );
+                    self.unknown_node(&type_name, type_span);
+                    // The nodes below it are not read, but a tree written for another
+                    // executor (Nav2's RecoveryNode, PipelineSequence, RateController)
+                    // lacks many: name them all at once.
+                    self.unknown_below(el);
                     return;
                 }
             },
