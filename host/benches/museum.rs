@@ -138,6 +138,7 @@ impl Case {
             bt_notes: Vec::new(),
             warnings: Default::default(),
             options: Default::default(),
+            no_props: None,
         };
         Some([high, Case::of("uc3 AS2FM plain (corpus)", loaded, None)])
     }
@@ -163,6 +164,7 @@ impl Case {
             bt_notes: Vec::new(),
             warnings: Default::default(),
             options: Default::default(),
+            no_props: None,
         };
         Case::of(name, loaded, None)
     }

@@ -42,6 +42,8 @@ enum Command {
     Verify(cli::verify::VerifyArgs),
     /// Check that a model and its properties load and compile, without simulating.
     ///
+    /// A model with no property file (none given, none found) is checked alone.
+    ///
     /// Example: `hindsight validate examples/museum-scxml`
     Validate(cli::verify::ValidateArgs),
     /// Success rate of each bounded guarantee as its time bounds sweep a range: CSV, the
@@ -63,6 +65,8 @@ enum Command {
     Merge(cli::verify::MergeArgs),
     /// Replay one run of a study (run k of --seed) and print every point as CSV: time,
     /// step, event, origin, target, parameters, every property variable and verdict.
+    ///
+    /// A model with no property file has a trace too: its messages alone.
     ///
     /// Example: `hindsight trace examples/museum-scxml --run 3 --seed 1 -o run3.csv`
     Trace(cli::verify::TraceArgs),

@@ -428,3 +428,59 @@ fn verify_checks_the_properties_named() {
         "{err}"
     );
 }
+
+#[test]
+fn a_model_without_properties_validates_and_traces_but_does_not_verify() {
+    // A model alone: validate checks it, trace shows its messages (no property
+    // columns); verify, sweep and report have nothing to estimate and refuse.
+    let robot = service_robot(
+        "noprops",
+        r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="on">
+  <ros_service_server service_name="/svc" type="std_srvs/Trigger"/>
+  <state id="on"><ros_service_handle_request name="/svc" target="on">
+    <ros_service_send_response name="/svc"><field name="success" expr="true"/></ros_service_send_response>
+  </ros_service_handle_request></state>
+</scxml>"#,
+    );
+    let main = robot.join("main.xml");
+    let text = std::fs::read_to_string(&main).unwrap();
+    std::fs::write(
+        &main,
+        text.replace(
+            r#"<properties><input type="xml" src="./properties.xml"/></properties>"#,
+            "",
+        ),
+    )
+    .unwrap();
+    let plain = scratch("noprops-plain");
+    std::fs::write(
+        plain.join("m.scxml"),
+        r#"<scxml xmlns="http://www.w3.org/2005/07/scxml" name="M" initial="a" datamodel="ecmascript">
+  <state id="a"><onentry><send event="e" target="M" delay="1"/></onentry><transition event="e" target="a"/></state>
+</scxml>"#,
+    )
+    .unwrap();
+    for (dir, why) in [
+        (&robot, "main.xml: the main file names no property file"),
+        (&plain, "no property file given and none found"),
+    ] {
+        let model = dir.to_str().unwrap();
+        let (code, out, err) = hindsight(&["validate", model]);
+        assert_eq!(code, 0, "{err}");
+        assert!(
+            out.contains(why) && out.ends_with("the model alone is ok\n"),
+            "{out}"
+        );
+        let (code, out, err) = hindsight(&["trace", model, "--max-time", "3"]);
+        assert_eq!(code, 0, "{err}");
+        assert!(err.contains("the trace has no property columns"), "{err}");
+        assert!(
+            out.starts_with("time,step,event,origin,target,params\n"),
+            "{out}"
+        );
+        assert!(out.lines().count() > 2, "{out}");
+        let (code, _, err) = hindsight(&["verify", model]);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains("property file"), "{err}");
+    }
+}

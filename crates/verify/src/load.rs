@@ -48,6 +48,10 @@ pub struct LoadOptions {
     /// Whose rules a robot model's behavior tree follows (`--bt`); anything but AS2FM's
     /// needs a robot model with a behavior tree.
     pub bt: crate::robot::bt::BtSemantics,
+    /// A plain model without a property file (none given, none found) loads with no
+    /// properties instead of failing ([`Loaded::no_props`] says why): for `validate` and
+    /// `trace`, which are of use on a model alone.
+    pub props_optional: bool,
 }
 
 /// The event semantics for a property file when none is asked for: AS2FM's for a JANI
@@ -237,6 +241,9 @@ pub struct Loaded {
     /// The options it was loaded with: a study records them so that its runs can be
     /// replayed from its JSON ([`crate::replay::Replay`]).
     pub options: LoadOptions,
+    /// Why the model was loaded with no properties ([`LoadOptions::props_optional`]):
+    /// where a property file was looked for. `props_path` is then empty.
+    pub no_props: Option<String>,
 }
 
 impl Loaded {
@@ -370,11 +377,21 @@ pub fn load_without(
     source.time_unit_ns = unit_ns;
     let compiled = CompiledModel::compile(source)?;
     let mut warnings = as_warnings(compiled.warnings());
-    let props_path = match &opts.props {
-        Some(p) => p.to_path_buf(),
-        None => default_props(model, &compiled)?,
+    let (props_path, no_props) = match &opts.props {
+        Some(p) => (p.to_path_buf(), None),
+        None => match default_props(model, &compiled) {
+            Ok(p) => (p, None),
+            Err(LoadError::Files { diagnostics, .. }) if opts.props_optional => {
+                let why = diagnostics.iter().map(|d| d.message.clone()).collect();
+                (PathBuf::new(), Some(why))
+            }
+            Err(e) => return Err(e),
+        },
     };
-    let file = read_properties(&props_path, &compiled, opts)?;
+    let file = match no_props {
+        None => read_properties(&props_path, &compiled, opts)?,
+        Some(_) => no_properties(),
+    };
     let set = compile_properties(&file, &compiled, unit_ns)?;
     warnings.extend(set.warnings().clone());
     let events = opts.events.unwrap_or_else(|| default_events(&props_path));
@@ -390,6 +407,7 @@ pub fn load_without(
             bt_notes: Vec::new(),
             warnings,
             options: opts.clone(),
+            no_props,
         },
         Vec::new(),
     ))
@@ -582,6 +600,7 @@ fn load_robot(
             }
             input.path.clone()
         }
+        (None, None) if opts.props_optional => PathBuf::new(),
         (None, None) => {
             return Err(LoadError::about_file(
                 main,
@@ -589,7 +608,14 @@ fn load_robot(
             ))
         }
     };
-    let file = read_properties(&props_path, &robot.model, opts)?;
+    let no_props = props_path
+        .as_os_str()
+        .is_empty()
+        .then(|| format!("{}: the main file names no property file", main.display()));
+    let file = match no_props {
+        None => read_properties(&props_path, &robot.model, opts)?,
+        Some(_) => no_properties(),
+    };
     check_ros_types(&file, main, &search)?;
     let set = compile_properties(&file, &robot.model, Some(robot.time_unit_ns))?;
     warnings.extend(set.warnings().clone());
@@ -606,7 +632,19 @@ fn load_robot(
             events: opts.events.unwrap_or(EventSemantics::As2fm),
             warnings,
             options: opts.clone(),
+            no_props,
         },
         external,
     ))
+}
+
+/// The property file of a model loaded without one ([`LoadOptions::props_optional`]).
+fn no_properties() -> props::PropertyFile {
+    props::PropertyFile {
+        path: PathBuf::new(),
+        ports: Vec::new(),
+        guarantees: Vec::new(),
+        assumptions: Vec::new(),
+        ros_types: Vec::new(),
+    }
 }

@@ -457,6 +457,7 @@ impl Replay {
             skip: self.skip.clone(),
             interfaces: self.interfaces.iter().map(PathBuf::from).collect(),
             bt,
+            props_optional: false,
         })
     }
 

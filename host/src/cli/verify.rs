@@ -327,6 +327,7 @@ impl ModelArgs {
             only: self.only.clone(),
             skip: self.skip.clone(),
             interfaces: self.interfaces.clone(),
+            props_optional: false,
         })
     }
 }
@@ -436,7 +437,14 @@ pub struct TraceArgs {
 
 /// Runs `hindsight trace`: one run of the study, every point as CSV.
 pub fn trace(args: &TraceArgs) -> Result<(), CliError> {
-    let loaded = load(&args.input)?;
+    // A model alone has a trace too: its messages, without property columns.
+    let loaded = super::load_model(&LoadOptions {
+        props_optional: true,
+        ..args.input.options()?
+    })?;
+    if let Some(why) = &loaded.no_props {
+        eprintln!("note: {why}; the trace has no property columns");
+    }
     let opts = VerifyOptions {
         seed: args.seed,
         max_time: args.max_time.clone(),
@@ -657,21 +665,31 @@ pub struct ValidateArgs {
 pub fn validate(args: &ValidateArgs) -> Result<(), CliError> {
     let semantics = args.input.semantics()?;
     for (k, &bt) in semantics.iter().enumerate() {
-        let loaded = super::load_model(&args.input.options_with(bt)?)?;
+        // A model alone can be checked too: it loads, compiles and has no properties.
+        let loaded = super::load_model(&LoadOptions {
+            props_optional: true,
+            ..args.input.options_with(bt)?
+        })?;
         let (model, set, props_path) = (&loaded.model, &loaded.set, &loaded.props_path);
         let under = if bt == BtSemantics::As2fm && semantics.len() == 1 {
             String::new()
         } else {
             format!(" (--bt {})", bt.label())
         };
+        let props = match &loaded.no_props {
+            Some(why) => format!("{why}: the model alone is ok"),
+            None => format!(
+                "{}: {} guarantees, monitor state {} bytes: ok",
+                props_path.display(),
+                set.guarantee_names().len(),
+                set.compiled().state_bytes()
+            ),
+        };
         println!(
-            "{}{under}: {} machines, {} events; {}: {} guarantees, monitor state {} bytes: ok",
+            "{}{under}: {} machines, {} events; {props}",
             args.input.model.display(),
             model.machine_count(),
             model.event_count(),
-            props_path.display(),
-            set.guarantee_names().len(),
-            set.compiled().state_bytes()
         );
         if k == 0 {
             for n in &loaded.bt_notes {
