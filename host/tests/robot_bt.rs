@@ -967,6 +967,15 @@ fn unknown_nodes_and_plugins_are_errors_at_their_position() {
     );
     let t = wrap("<Action ID=\"Nope\" n=\"1\"/>");
     one_error(&t, &[COUNT], "t.xml", &t, "Nope", "plugins: Count");
+    let t = wrap("<RateController hz=\"1\"><Count n=\"1\"/></RateController>");
+    one_error(
+        &t,
+        &[COUNT],
+        "t.xml",
+        &t,
+        "<RateController",
+        "`RateController` is a control or decorator node of Nav2",
+    );
     // Under an unknown node, every unknown node is named at once (a tree written for
     // another executor lacks many), the known ones (Sequence, Count, a SubTree) are not.
     let t = wrap(

@@ -317,6 +317,25 @@ const SUPPORTED: &[&str] = &[
     "AsyncSequence, AsyncFallback, ParallelAll, WhileDoElse, KeepRunningUntilFailure, RunOnce, Switch2 ... Switch6, Timeout, Delay, Sleep, TryCatch, Script, ScriptCondition, Precondition, UnsetBlackboard, WasEntryUpdated, SkipUnlessUpdated, WaitValueUpdate, LoopInt, LoopBool, LoopDouble, LoopString (with `--bt btcpp`)",
 ];
 
+/// Nav2's control and decorator nodes (the `<Control>` and `<Decorator>` entries of
+/// `nav2_behavior_tree/nav2_tree_nodes.xml`), which a tree written for Nav2's navigator
+/// uses: named as such when no plugin is called so.
+const NAV2_INNER: &[&str] = &[
+    "PipelineSequence",
+    "RecoveryNode",
+    "RoundRobin",
+    "NonblockingSequence",
+    "PersistentSequence",
+    "PauseResumeController",
+    "RateController",
+    "DistanceController",
+    "SpeedController",
+    "GoalUpdater",
+    "PathLongerOnApproach",
+    "SingleTrigger",
+    "GoalUpdatedController",
+];
+
 /// BehaviorTree.CPP's other built-in nodes (the ones its `BehaviorTreeFactory`
 /// registers in 4.10 or 3.8, and the queue nodes its headers ship), each with why
 /// hindsight refuses it. README lists the same.
@@ -677,6 +696,18 @@ impl Reader<'_> {
     }
 
     fn unknown_node(&mut self, type_name: &str, at: Span) {
+        if NAV2_INNER.contains(&type_name) {
+            self.err(
+                at,
+                format!(
+                    "`{type_name}` is a control or decorator node of Nav2 (nav2_behavior_tree), \
+                     not of BehaviorTree.CPP: hindsight lowers BT.CPP's built-in nodes, and \
+                     plugins model leaves only, so a tree with Nav2's inner nodes cannot be \
+                     modelled yet"
+                ),
+            );
+            return;
+        }
         let mut known: Vec<&str> = self.plugins.iter().map(|p| p.name.as_str()).collect();
         known.sort_unstable();
         self.err(
