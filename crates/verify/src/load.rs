@@ -588,6 +588,7 @@ fn load_robot(
             ));
         }
     }
+    let mut no_props = None;
     let props_path = match (&opts.props, robot.main.properties.first()) {
         (Some(p), _) => p.clone(),
         (None, Some(input)) => {
@@ -600,7 +601,13 @@ fn load_robot(
             }
             input.path.clone()
         }
-        (None, None) if opts.props_optional => PathBuf::new(),
+        (None, None) if opts.props_optional => {
+            no_props = Some(format!(
+                "{}: the main file names no property file",
+                main.display()
+            ));
+            PathBuf::new()
+        }
         (None, None) => {
             return Err(LoadError::about_file(
                 main,
@@ -608,11 +615,7 @@ fn load_robot(
             ))
         }
     };
-    let no_props = props_path
-        .as_os_str()
-        .is_empty()
-        .then(|| format!("{}: the main file names no property file", main.display()));
-    let file = match no_props {
+    let file = match &no_props {
         None => read_properties(&props_path, &robot.model, opts)?,
         Some(_) => no_properties(),
     };
