@@ -987,6 +987,14 @@ fn bad_models_give_positioned_errors() {
 </ascxml>"#,
             "s.ascxml:2:36: `rate_hz` must be a positive number of hertz, not `0`",
         ),
+        // A period that is no whole number of nanoseconds: the step would be 1 ns.
+        (
+            r#"<ascxml name="S" initial="a">
+  <ros_time_rate name="r" rate_hz="3"/>
+  <state id="a"/>
+</ascxml>"#,
+            "s.ascxml:2:36: `rate_hz` `3` ticks every 333333333.333 ns, not a whole number",
+        ),
         // Probabilities that add up to more than one.
         (
             r#"<ascxml name="S" initial="a">

@@ -434,9 +434,23 @@ impl Cx<'_> {
                             self.err(el.span, msg);
                             continue;
                         }
-                        // The one rate rule (`robot::rate`): exact when the period is whole;
-                        // otherwise rounded to the nanosecond, as before.
+                        // The one rate rule (`robot::rate`). The model's step is the
+                        // greatest common divisor of the periods: one that is not a whole
+                        // number of nanoseconds (3 Hz) would shrink it to 1 ns, and every
+                        // run would stop at the step limit without a verdict. Refused, as
+                        // such a `bt_tick_rate` is.
                         match crate::rate::period(rate.trim()) {
+                            Ok(p) if !p.exact => self.err(
+                                rspan,
+                                format!(
+                                    "`rate_hz` `{}` ticks every {:.3} ns, not a whole number of \
+                                     nanoseconds: the model's time step would shrink to 1 ns \
+                                     and every run would stop at the step limit; use a rate \
+                                     whose period is whole, such as 2, 4, 5, 10 or 0.5 Hz",
+                                    rate.trim(),
+                                    1e9 / p.hz
+                                ),
+                            ),
                             Ok(p) => {
                                 self.timers.push(Timer {
                                     name: tname.clone(),
