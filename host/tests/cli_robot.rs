@@ -270,6 +270,8 @@ fn converted_plain_scxml_runs_exactly_like_the_robot_model() {
         model.to_str().unwrap(),
         "--events",
         "as2fm",
+        "--time-unit",
+        "100ms",
         "--max-time",
         "1001",
         "--run",
@@ -279,6 +281,8 @@ fn converted_plain_scxml_runs_exactly_like_the_robot_model() {
     ]);
     assert_eq!(code, 0, "{err}");
     assert!(high.lines().count() > 1000);
+    // Both name their unit first, for `replay`.
+    assert!(high.starts_with("# time unit: 100ms\n"), "{}", &high[..80]);
     assert!(high == plain, "the converted model runs differently");
     let _ = std::fs::remove_dir_all(dir);
 }
@@ -475,7 +479,8 @@ fn a_model_without_properties_validates_and_traces_but_does_not_verify() {
         assert_eq!(code, 0, "{err}");
         assert!(err.contains("the trace has no property columns"), "{err}");
         assert!(
-            out.starts_with("time,step,event,origin,target,params\n"),
+            out.lines().find(|l| !l.starts_with('#'))
+                == Some("time,step,event,origin,target,params"),
             "{out}"
         );
         assert!(out.lines().count() > 2, "{out}");
@@ -483,4 +488,89 @@ fn a_model_without_properties_validates_and_traces_but_does_not_verify() {
         assert_eq!(code, 2, "{err}");
         assert!(err.contains("property file"), "{err}");
     }
+}
+
+#[test]
+fn a_robot_trace_replays_in_its_own_time_unit() {
+    // `trace` writes the model's unit first (`# time unit: 1s`), and `replay` of a
+    // property file with bounds in seconds reads the trace's times in it: `young` turns
+    // false at 3 s there. Read as nanoseconds (replay's default) it would stay true.
+    let dir = service_robot(
+        "replay-unit",
+        r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="on">
+  <ros_service_server service_name="/svc" type="std_srvs/Trigger"/>
+  <state id="on"><ros_service_handle_request name="/svc" target="on">
+    <ros_service_send_response name="/svc"><field name="success" expr="true"/></ros_service_send_response>
+  </ros_service_handle_request></state>
+</scxml>"#,
+    );
+    let props = dir.join("properties.xml");
+    std::fs::write(
+        &props,
+        r#"<properties><ports>
+  <ros_service service_name="/svc" type="std_srvs/Trigger" event="request"><event_var id="asked"/></ros_service>
+</ports><guarantees>
+  <property id="young" logic="pmtl" expr="historically(!(once[3s:] true))"/>
+</guarantees></properties>"#,
+    )
+    .unwrap();
+    let (code, csv, err) = hindsight(&["trace", dir.to_str().unwrap(), "--max-time", "5s"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(csv.starts_with("# time unit: 1s\n"), "{csv}");
+    let trace = dir.join("run.csv");
+    std::fs::write(&trace, &csv).unwrap();
+    let last = |text: &str| {
+        text.lines()
+            .last()
+            .unwrap()
+            .rsplit(',')
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    assert_eq!(last(&csv), "false", "{csv}");
+    let (p, t) = (props.to_str().unwrap(), trace.to_str().unwrap());
+    let (code, out, err) = hindsight(&["replay", p, t, "--changes"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out.lines().last(), Some("3,false"), "{out}");
+    // The same unit given is fine; another is refused rather than misread.
+    let (code, out, _) = hindsight(&["replay", p, t, "--changes", "--time-unit", "1000ms"]);
+    assert_eq!((code, out.lines().last()), (0, Some("3,false")));
+    let (code, _, err) = hindsight(&["replay", p, t, "--time-unit", "100ms"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("says its times are in units of 1s"), "{err}");
+}
+
+#[test]
+fn a_bound_without_unit_on_a_robot_model_is_warned_about() {
+    // A robot model's step is its timers' common period (1 s here): `[0:2]` is 2 s now
+    // and would be 1 s if a 2 Hz timer were added. Said at the bound; durations and an
+    // index inside an atom are not bounds.
+    let dir = service_robot(
+        "unitless",
+        r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="on">
+  <ros_service_server service_name="/svc" type="std_srvs/Trigger"/>
+  <state id="on"><ros_service_handle_request name="/svc" target="on">
+    <ros_service_send_response name="/svc"><field name="success" expr="true"/></ros_service_send_response>
+  </ros_service_handle_request></state>
+</scxml>"#,
+    );
+    std::fs::write(
+        dir.join("properties.xml"),
+        r#"<properties><ports>
+  <ros_service service_name="/svc" type="std_srvs/Trigger" event="request"><event_var id="asked"/></ros_service>
+</ports><guarantees>
+  <property id="steps" logic="pmtl" expr="historically(once[0:2] {asked} || !once[1s:] true)"/>
+</guarantees></properties>"#,
+    )
+    .unwrap();
+    let (code, _, err) = hindsight(&["validate", dir.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let warned: Vec<&str> = err.lines().filter(|l| l.contains("has no unit")).collect();
+    assert_eq!(warned.len(), 1, "{err}");
+    assert!(
+        warned[0].contains("properties.xml:4:63: property `steps`: the bound `2` has no unit, so it counts model steps, here of 1s"),
+        "{err}"
+    );
+    assert!(warned[0].contains("2 steps = 2s"), "{err}");
 }

@@ -71,7 +71,7 @@ fn the_museum_report_renders_in_chromium_without_errors_or_fetches() {
         return;
     };
     let m = report_common::museum("browser");
-    let csv = std::fs::read_to_string(&m.failing_csv).unwrap();
+    let csv = report_common::read_run(&m.failing_csv);
     let (due_time, due_point) = expected_first_false(&csv);
     let opened = open(&mut browser, &m.verify_page, "", "museum-report");
     let dom = &opened.dom;

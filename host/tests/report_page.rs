@@ -34,7 +34,7 @@ fn attr(tag: &str, name: &str) -> String {
 #[test]
 fn a_museum_study_page_shows_every_property_and_where_the_failing_run_turned_false() {
     let m = museum("page");
-    let csv = std::fs::read_to_string(&m.failing_csv).unwrap();
+    let csv = report_common::read_run(&m.failing_csv);
     let (due_time, due_point) = expected_first_false(&csv);
     for (page, from_memory) in [(&m.verify_page, true), (&m.files_page, false)] {
         let html = std::fs::read_to_string(page).unwrap();

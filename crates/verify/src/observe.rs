@@ -224,7 +224,7 @@ impl PropertySet {
                 )
             };
             let Some(event) = model.event_id(&p.event) else {
-                errors.push(here(format!("the model sends no event `{}`", p.event)));
+                errors.push(here(no_such_event(model, &p.event)));
                 continue;
             };
             let origin = match model.machine_id(&p.origin) {
@@ -851,6 +851,32 @@ impl Observer for Judge<'_> {
     fn on_time(&mut self, time: u64) -> Flow {
         self.begin();
         self.step(time)
+    }
+}
+
+/// A port's event the model does not send, said as the user wrote it (a ROS port's
+/// `topic_a__b_msg` is topic `/a/b`) with the closest name the model does send.
+fn no_such_event(model: &CompiledModel, event: &str) -> String {
+    let shown = |name: &str| match name
+        .strip_prefix("topic_")
+        .and_then(|n| n.strip_suffix("_msg"))
+    {
+        Some(t) => format!("topic `/{}`", t.replace("__", "/")),
+        None => format!("event `{name}`"),
+    };
+    let closest = (0..model.event_count())
+        .map(|e| model.event_name(EventId(e as u32)))
+        .map(|n| (crate::robot::interfaces::edit_distance(event, n), n))
+        .min();
+    let hint = match closest {
+        Some((d, n)) if d <= (event.len() / 4).max(2) => format!(" (did you mean {}?)", shown(n)),
+        _ => String::new(),
+    };
+    let what = shown(event);
+    if what.starts_with("topic") {
+        format!("no node model publishes {what}{hint}")
+    } else {
+        format!("the model sends no {what}{hint}")
     }
 }
 

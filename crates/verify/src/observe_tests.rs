@@ -233,3 +233,44 @@ fn floats_compare_bit_for_bit() {
     assert!(!same_value(Value::Int(1), Value::Float(1.0)));
     assert!(!same_value(Value::Bool(false), Value::Int(0)));
 }
+
+#[test]
+fn a_port_on_an_event_the_model_lacks_names_it_as_written_with_the_closest() {
+    use crate::sim::CompiledModel;
+    let machine = "<scxml name=\"a\" initial=\"s0\" version=\"1.0\" \
+        xmlns=\"http://www.w3.org/2005/07/scxml\"><state id=\"s0\"><onentry>\
+        <send event=\"topic_robot__result_msg\" target=\"a\"/><send event=\"done\" target=\"a\"/>\
+        </onentry></state></scxml>";
+    let model = CompiledModel::compile(
+        crate::model::ModelSource::from_texts([("a.scxml", machine)]).unwrap(),
+    )
+    .unwrap();
+    let errors = |event: &str| {
+        let props = format!(
+            "<properties><ports><scxml_event_send event=\"{event}\" origin=\"a\" target=\"a\">\
+             <event_var id=\"p\"/></scxml_event_send></ports><guarantees>\
+             <property id=\"g\" logic=\"pmtl\" expr=\"historically(true)\"/></guarantees></properties>"
+        );
+        let file = crate::props::parse_str(&props, std::path::Path::new("p.xml")).unwrap();
+        match PropertySet::new(&file, &model) {
+            Ok(_) => panic!("{event}: no error"),
+            Err(d) => d.to_string(),
+        }
+    };
+    // A ROS port's event is its topic: said so, with the topic the model does publish.
+    let e = errors("topic_robot__reslt_msg");
+    assert!(
+        e.contains("port `p`: no node model publishes topic `/robot/reslt` (did you mean topic `/robot/result`?)"),
+        "{e}"
+    );
+    let e = errors("dome");
+    assert!(
+        e.contains("the model sends no event `dome` (did you mean event `done`?)"),
+        "{e}"
+    );
+    let e = errors("something_else_entirely");
+    assert!(
+        e.ends_with("the model sends no event `something_else_entirely`"),
+        "{e}"
+    );
+}

@@ -38,7 +38,13 @@ pub struct Culprit {
 impl<'j, 'a> Recorder<'j, 'a> {
     /// A recorder writing the header; call [`Recorder::start`] next.
     pub fn new(judge: &'j mut Judge<'a>, model: &'a CompiledModel) -> Self {
-        let mut csv = String::from("time,step,event,origin,target,params");
+        // A model with a time unit says it first (a comment the CSV readers skip), so
+        // that `replay` reads bounds in seconds over the times of this trace rightly.
+        let mut csv = match model.time_unit_ns() {
+            Some(ns) => format!("# time unit: {}\n", codegen::duration::format(ns)),
+            None => String::new(),
+        };
+        csv.push_str("time,step,event,origin,target,params");
         let compiled = judge.set().compiled();
         // Names are quoted like every other field (ids are checked where declared and
         // never need it; a spec's own names are identifiers): one grammar for the file.

@@ -16,9 +16,10 @@
 //! A CSV row's `time` is in the spec's unit. A recording's message is at its log time
 //! (or `--time header`: its `header.stamp`), in nanoseconds since the first message,
 //! divided (rounding down) by the spec's unit: the `unit` line of a `.hspec`, or
-//! `--time-unit` for a property file (default `1ns`: no rounding), whose bounds with a
-//! unit (`within="1" time_unit="s"`, `[6.2s:]`) are converted exactly to it, as `verify`
-//! converts them to a model's unit.
+//! `--time-unit` for a property file (default: the unit a CSV trace names on a leading
+//! `# time unit:` line, as `trace` writes it for a model with a unit, else `1ns`: no
+//! rounding), whose bounds with a unit (`within="1" time_unit="s"`, `[6.2s:]`) are
+//! converted exactly to it, as `verify` converts them to a model's unit.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -52,7 +53,8 @@ pub struct ReplayArgs {
     #[arg(long, value_enum, default_value = "log")]
     pub time: TimeArg,
     /// The time unit of a property file's monitors (`1ns`, `1ms`, `100ms`): CSV times are
-    /// in it, a recording's times are rounded down to it. Default `1ns`.
+    /// in it, a recording's times are rounded down to it. Default: the unit a CSV trace
+    /// names on a `# time unit:` line (`hindsight trace` writes it), else `1ns`.
     #[arg(long, value_name = "DURATION")]
     pub time_unit: Option<String>,
     /// For a `.hspec` over a recording: bind variable VAR to `/topic.field.path`,
@@ -81,13 +83,38 @@ pub(crate) struct Props {
     pub(crate) file: Option<PropertyFile>,
 }
 
-fn load_props(args: &ReplayArgs) -> Result<Props, CliError> {
-    load_props_at(
-        &args.spec,
-        args.time_unit.as_deref(),
-        1,
-        !args.bind.is_empty(),
-    )
+fn load_props(args: &ReplayArgs, csv_unit: Option<&str>) -> Result<Props, CliError> {
+    let hspec = args.spec.extension().is_some_and(|e| e == "hspec");
+    // A trace `hindsight trace` wrote says its unit; a property file's bounds in seconds
+    // read it in that unit, unless --time-unit says another (then the times would mean
+    // something else: refused).
+    let time_unit = match (args.time_unit.as_deref(), csv_unit) {
+        (Some(given), Some(written)) if !hspec => {
+            let same =
+                codegen::duration::parse(given).ok() == codegen::duration::parse(written).ok();
+            if !same {
+                return Err(CliError::Input(format!(
+                    "--time-unit {given}: {} says its times are in units of {written} (its \
+                     `# time unit` line); drop --time-unit",
+                    args.trace.display()
+                )));
+            }
+            Some(given)
+        }
+        (None, Some(written)) if !hspec => Some(written),
+        (given, _) => given,
+    };
+    load_props_at(&args.spec, time_unit, 1, !args.bind.is_empty())
+}
+
+/// The unit a CSV trace names in a leading `# time unit: 200ms` comment (what `hindsight
+/// trace` and `--save-failing` write for a model with a time unit).
+fn csv_time_unit(text: &str) -> Option<&str> {
+    text.trim_start_matches('\u{feff}')
+        .lines()
+        .take_while(|l| l.trim_start().starts_with('#') || l.trim().is_empty())
+        .find_map(|l| l.trim_start().strip_prefix("# time unit:"))
+        .map(str::trim)
 }
 
 /// Loads `PROPS` (a `.hspec` or a property file over ROS names). A property file's unit
@@ -139,7 +166,13 @@ pub(crate) fn load_props_at(
 
 /// Runs `hindsight replay`: output is CSV `time,PROP,...` with `true`/`false`.
 pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
-    let props = load_props(args)?;
+    let recording = is_recording(&args.trace);
+    let csv_text = if recording {
+        None
+    } else {
+        Some(read_file(&args.trace)?)
+    };
+    let props = load_props(args, csv_text.as_deref().and_then(csv_time_unit))?;
     let compiled = &props.compiled;
     let keep = if args.quiet {
         Keep::Nothing
@@ -151,7 +184,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
     let mut judge = TraceJudge::new(compiled, keep)
         .map_err(|e| CliError::Failed(format!("internal: compiled program rejected: {e}")))?;
     let start;
-    if is_recording(&args.trace) {
+    if recording {
         let ports = match &props.file {
             Some(f) => file_ports(f, compiled).map_err(|e| {
                 if e.is_internal() {
@@ -197,7 +230,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
                 "--time, --bind and --interfaces are for a ROS 2 recording, not a CSV trace".into(),
             ));
         }
-        let text = read_file(&args.trace)?;
+        let text = csv_text.unwrap_or_default();
         let name = args.trace.display().to_string();
         let trace = tracefile::parse_csv(&text, &name, compiled)?;
         start = Instant::now();

@@ -132,3 +132,19 @@ pub fn external_refs(html: &str) -> Vec<String> {
     }
     found
 }
+
+/// A saved run's CSV without its leading `# time unit` comment (a robot model's runs
+/// name their unit there): the header first, then one line per point, as the page
+/// counts them.
+pub fn read_run(path: &std::path::Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(
+        text.starts_with("# time unit: "),
+        "{}",
+        &text[..40.min(text.len())]
+    );
+    text.lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| format!("{l}\n"))
+        .collect()
+}

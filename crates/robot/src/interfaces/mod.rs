@@ -453,7 +453,9 @@ fn array_default(dims: &[ArraySize], leaf: &str) -> String {
     }
 }
 
-pub(crate) fn edit_distance(a: &str, b: &str) -> usize {
+/// The Levenshtein distance between `a` and `b` (in characters): how close a misspelt
+/// name is to a known one, for "did you mean".
+pub fn edit_distance(a: &str, b: &str) -> usize {
     let b: Vec<char> = b.chars().collect();
     let mut prev: Vec<usize> = (0..=b.len()).collect();
     for (i, ca) in a.chars().enumerate() {

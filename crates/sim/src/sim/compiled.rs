@@ -205,6 +205,9 @@ pub struct CompiledModel {
     pub(crate) none_str: StrId,
     pub(crate) warnings: Vec<Diagnostic>,
     pub(crate) properties: Option<PathBuf>,
+    /// The length of one model time unit in nanoseconds, when the model has one
+    /// ([`crate::model::ModelSource::time_unit_ns`]).
+    pub(crate) time_unit_ns: Option<u64>,
 }
 
 impl std::fmt::Debug for CompiledModel {
@@ -373,6 +376,12 @@ impl CompiledModel {
         self.properties.as_deref()
     }
 
+    /// The length of one model time unit in nanoseconds, when the model has one (a robot
+    /// model's, or a plain model's `--time-unit`).
+    pub fn time_unit_ns(&self) -> Option<u64> {
+        self.time_unit_ns
+    }
+
     /// Total number of instructions, states and transitions (a size measure for reports).
     pub fn size(&self) -> (usize, usize, usize) {
         self.machines.iter().fold((0, 0, 0), |(c, s, t), m| {
@@ -525,7 +534,9 @@ impl<'s> Builder<'s> {
                 *slot = i as u32;
             }
         }
+        let time_unit_ns = self.src.time_unit_ns;
         Ok(CompiledModel {
+            time_unit_ns,
             sources,
             strings: self.strings,
             types: self.types,
