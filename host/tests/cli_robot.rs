@@ -574,3 +574,37 @@ fn a_bound_without_unit_on_a_robot_model_is_warned_about() {
     );
     assert!(warned[0].contains("2 steps = 2s"), "{err}");
 }
+
+#[test]
+fn a_tree_or_property_file_given_as_the_model_says_what_to_give() {
+    let dir = scratch("wrong-model");
+    let tree = dir.join("tree.xml");
+    std::fs::write(
+        &tree,
+        r#"<root BTCPP_format="4"><BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></root>"#,
+    )
+    .unwrap();
+    let props = dir.join("props.xml");
+    std::fs::write(&props, "<properties><ports/><guarantees/></properties>").unwrap();
+    for (file, want) in [
+        (
+            &tree,
+            "found <root>: this is a BehaviorTree.CPP tree; give the robot model's main file",
+        ),
+        (
+            &props,
+            "found <properties>: this is a property file; give the model first",
+        ),
+    ] {
+        let (code, _, err) = hindsight(&["validate", file.to_str().unwrap()]);
+        assert_eq!(code, 2, "{err}");
+        assert!(
+            err.contains(":1:1: expected <specification>, ") && err.contains(want),
+            "{err}"
+        );
+    }
+    // `convert --out` a file: bad input, said as such.
+    let (code, _, err) = hindsight(&["convert", GUIDE, "--out", props.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("props.xml: not a folder"), "{err}");
+}

@@ -47,6 +47,13 @@ pub fn run(args: &ConvertArgs) -> Result<(), CliError> {
         }
     };
     let out = &args.out;
+    if out.exists() && !out.is_dir() {
+        return Err(CliError::Input(format!(
+            "--out {}: not a folder (the plain machines, model.xml and the properties are \
+             written into a folder, created if missing)",
+            out.display()
+        )));
+    }
     let done = convert(&main, args.interfaces.clone(), bt, out, &mut |w| {
         eprintln!("warning: {w}")
     })

@@ -194,10 +194,22 @@ pub(crate) fn load_spec(path: &Path) -> Result<ModelSource, Diagnostics> {
     let base = path.parent().unwrap_or(Path::new("."));
     let sm = m.sources.clone();
     if root.name != "specification" {
+        // Another file of a model given as the model: say which and what to give.
+        let what = match root.name.as_str() {
+            "root" => {
+                ": this is a BehaviorTree.CPP tree; give the robot model's main file \
+                       (main.xml), which names it"
+            }
+            "properties" => ": this is a property file; give the model first, then it",
+            _ => {
+                " (a SCAN model.xml; or give a folder of .scxml files, one .scxml file, \
+                  or a robot model's main.xml)"
+            }
+        };
         return Err(sm
             .diag(
                 root.span,
-                format!("expected <specification>, found <{}>", root.name),
+                format!("expected <specification>, found <{}>{what}", root.name),
             )
             .into());
     }
