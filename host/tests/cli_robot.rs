@@ -28,6 +28,14 @@ fn copy_dir(from: &Path, to: &Path) {
 
 const GUIDE: &str = "examples/museum-guide";
 
+/// A server that answers every request to `/svc` at once (for [`service_robot`]).
+const ANSWERING: &str = r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="on">
+  <ros_service_server service_name="/svc" type="std_srvs/Trigger"/>
+  <state id="on"><ros_service_handle_request name="/svc" target="on">
+    <ros_service_send_response name="/svc"><field name="success" expr="true"/></ros_service_send_response>
+  </ros_service_handle_request></state>
+</scxml>"#;
+
 /// A robot in `scratch(name)`: a client that calls `/svc` every second and `server`
 /// (the machine that serves it), judged on whether `/svc` was asked within 2 s of the
 /// first request (`once[0:2s] {asked} || !once {asked}`, never final, so a run goes
@@ -437,15 +445,7 @@ fn verify_checks_the_properties_named() {
 fn a_model_without_properties_validates_and_traces_but_does_not_verify() {
     // A model alone: validate checks it, trace shows its messages (no property
     // columns); verify, sweep and report have nothing to estimate and refuse.
-    let robot = service_robot(
-        "noprops",
-        r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="on">
-  <ros_service_server service_name="/svc" type="std_srvs/Trigger"/>
-  <state id="on"><ros_service_handle_request name="/svc" target="on">
-    <ros_service_send_response name="/svc"><field name="success" expr="true"/></ros_service_send_response>
-  </ros_service_handle_request></state>
-</scxml>"#,
-    );
+    let robot = service_robot("noprops", ANSWERING);
     let main = robot.join("main.xml");
     let text = std::fs::read_to_string(&main).unwrap();
     std::fs::write(
@@ -495,15 +495,7 @@ fn a_robot_trace_replays_in_its_own_time_unit() {
     // `trace` writes the model's unit first (`# time unit: 1s`), and `replay` of a
     // property file with bounds in seconds reads the trace's times in it: `young` turns
     // false at 3 s there. Read as nanoseconds (replay's default) it would stay true.
-    let dir = service_robot(
-        "replay-unit",
-        r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="on">
-  <ros_service_server service_name="/svc" type="std_srvs/Trigger"/>
-  <state id="on"><ros_service_handle_request name="/svc" target="on">
-    <ros_service_send_response name="/svc"><field name="success" expr="true"/></ros_service_send_response>
-  </ros_service_handle_request></state>
-</scxml>"#,
-    );
+    let dir = service_robot("replay-unit", ANSWERING);
     let props = dir.join("properties.xml");
     std::fs::write(
         &props,
@@ -546,15 +538,7 @@ fn a_bound_without_unit_on_a_robot_model_is_warned_about() {
     // A robot model's step is its timers' common period (1 s here): `[0:2]` is 2 s now
     // and would be 1 s if a 2 Hz timer were added. Said at the bound; durations and an
     // index inside an atom are not bounds.
-    let dir = service_robot(
-        "unitless",
-        r#"<scxml version="1.0" datamodel="ecmascript" name="server" initial="on">
-  <ros_service_server service_name="/svc" type="std_srvs/Trigger"/>
-  <state id="on"><ros_service_handle_request name="/svc" target="on">
-    <ros_service_send_response name="/svc"><field name="success" expr="true"/></ros_service_send_response>
-  </ros_service_handle_request></state>
-</scxml>"#,
-    );
+    let dir = service_robot("unitless", ANSWERING);
     std::fs::write(
         dir.join("properties.xml"),
         r#"<properties><ports>
