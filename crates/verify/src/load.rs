@@ -48,9 +48,10 @@ pub struct LoadOptions {
     /// Whose rules a robot model's behavior tree follows (`--bt`); anything but AS2FM's
     /// needs a robot model with a behavior tree.
     pub bt: crate::robot::bt::BtSemantics,
-    /// A plain model without a property file (none given, none found) loads with no
-    /// properties instead of failing ([`Loaded::no_props`] says why): for `validate` and
-    /// `trace`, which are of use on a model alone.
+    /// A model without a property file (none given, and none found beside a plain model
+    /// or named by a robot model's main file) loads with no properties instead of
+    /// failing ([`Loaded::no_props`] says why): for `validate` and `trace`, which are of
+    /// use on a model alone.
     pub props_optional: bool,
 }
 
