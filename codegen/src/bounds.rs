@@ -57,6 +57,31 @@ pub fn two_sided_windows(formula: &str) -> Vec<String> {
     out
 }
 
+/// The bound ends of `formula` written without a unit and not zero (`8` in `P[8:]`), with
+/// their byte offsets, in text order: on a model whose step no one wrote down (a robot
+/// model's), each counts steps of a length the timers set. Empty for a formula that does
+/// not parse.
+pub fn unitless_ends(formula: &str) -> Vec<(usize, String)> {
+    let mut sink = Sink::default();
+    let Some(tree) = parse::parse_formula(formula, 0, &mut sink) else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    each_bound(&tree, &mut |b| {
+        for t in [&b.lo, &b.hi].into_iter().flatten() {
+            let (lo, hi) = (t.span.lo as usize, t.span.hi as usize);
+            match formula.get(lo..hi) {
+                Some(text) if t.unit.is_none() && !is_zero_end(text) => {
+                    out.push((lo, text.to_string()))
+                }
+                _ => {}
+            }
+        }
+    });
+    out.sort_unstable();
+    out
+}
+
 /// Whether a bound end as written (`0`, `0s`, `0.0ms`, `62`) is zero: the start of a
 /// window that starts now, not a bound a sweep moves.
 pub fn is_zero_end(end: &str) -> bool {
@@ -138,6 +163,23 @@ mod tests {
         assert!(two_sided_windows("P[0:5s] {a} && {b} S[6.2s:] {c} && H[:3] {d}").is_empty());
         assert!(two_sided_windows("P[0.0s:5s] {a}").is_empty());
         assert!(two_sided_windows("P[1:2 {a}").is_empty());
+    }
+
+    #[test]
+    fn unitless_ends_are_the_bare_nonzero_ones_in_text_order() {
+        let f = "H[0:2] {x > 1} && {b} S[62:] {c} && P[1s:5] {d} && P {e}";
+        let got = unitless_ends(f);
+        let at = |n: &str| f.find(n).unwrap();
+        assert_eq!(
+            got,
+            [
+                (at("2]"), "2".to_string()),
+                (at("62"), "62".to_string()),
+                (at("5]"), "5".to_string()),
+            ]
+        );
+        assert!(unitless_ends("P[0:0.0ms] {a}").is_empty());
+        assert!(unitless_ends("P[1:2 {a}").is_empty());
     }
 
     #[test]

@@ -650,8 +650,7 @@ fn load_robot(
 fn unitless_bounds(file: &props::PropertyFile, unit_ns: u64) -> Diagnostics {
     let mut out = Vec::new();
     for p in file.guarantees.iter().chain(&file.assumptions) {
-        let text = p.formula.as_str();
-        for (at, bound) in bare_bounds(text) {
+        for (at, bound) in codegen::bounds::unitless_ends(p.formula.as_str()) {
             let here = p.formula.location(at);
             let steps: u64 = bound.parse().unwrap_or(0);
             out.push(Diagnostic::warning(Diagnostic::error(
@@ -669,44 +668,6 @@ fn unitless_bounds(file: &props::PropertyFile, unit_ns: u64) -> Diagnostics {
         }
     }
     out.into()
-}
-
-/// The time bounds of formula `text` written as bare numbers (`[8:]`, `[0:10]`), with
-/// their byte offsets; bounds inside `{...}` atoms (array indices) are not bounds.
-fn bare_bounds(text: &str) -> Vec<(usize, &str)> {
-    let mut out = Vec::new();
-    let mut depth = 0usize;
-    let b = text.as_bytes();
-    let mut i = 0;
-    while i < b.len() {
-        match b[i] {
-            b'{' => depth += 1,
-            b'}' => depth = depth.saturating_sub(1),
-            b'[' if depth == 0 => {
-                let Some(len) = text[i + 1..].find(']') else {
-                    break;
-                };
-                let inner = &text[i + 1..i + 1 + len];
-                if inner.contains(':') {
-                    let mut start = i + 1;
-                    for part in inner.split(':') {
-                        let t = part.trim();
-                        // Zero is zero in any unit.
-                        let zero = t.bytes().all(|c| c == b'0');
-                        if !t.is_empty() && !zero && t.bytes().all(|c| c.is_ascii_digit()) {
-                            let lead = part.len() - part.trim_start().len();
-                            out.push((start + lead, t));
-                        }
-                        start += part.len() + 1;
-                    }
-                }
-                i += len + 1;
-            }
-            _ => {}
-        }
-        i += 1;
-    }
-    out
 }
 
 /// The property file of a model loaded without one ([`LoadOptions::props_optional`]).
