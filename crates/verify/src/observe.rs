@@ -15,10 +15,13 @@ use monitor_core::{analysis, layout, valuation, Monitor, Ty, Value, VarKind};
 
 use crate::expr::Value as SimValue;
 use crate::props::{PortKind, PropertyFile, ANY};
-use crate::sim::{CompiledModel, EventId, Flow, MachineId, Observer, SentMessage};
+use crate::sim::{CompiledModel, Flow, MachineId, Observer, SentMessage};
 use crate::smc::{RunEnd, RunOutcome, Verdict};
 
 use super::split::Split;
+use ports::{missing_param, no_such_event};
+
+mod ports;
 
 /// One port resolved to model ids.
 #[derive(Clone, Debug)]
@@ -851,68 +854,6 @@ impl Observer for Judge<'_> {
     fn on_time(&mut self, time: u64) -> Flow {
         self.begin();
         self.step(time)
-    }
-}
-
-/// A port's event the model does not send, said as the user wrote it (a ROS port's
-/// `topic_a__b_msg` is topic `/a/b`) with the closest name the model does send.
-fn no_such_event(model: &CompiledModel, event: &str) -> String {
-    let shown = |name: &str| match name
-        .strip_prefix("topic_")
-        .and_then(|n| n.strip_suffix("_msg"))
-    {
-        Some(t) => format!("topic `/{}`", t.replace("__", "/")),
-        None => format!("event `{name}`"),
-    };
-    let closest = (0..model.event_count())
-        .map(|e| model.event_name(EventId(e as u32)))
-        .map(|n| (crate::robot::interfaces::edit_distance(event, n), n))
-        .min();
-    let hint = match closest {
-        Some((d, n)) if d <= (event.len() / 4).max(2) => format!(" (did you mean {}?)", shown(n)),
-        _ => String::new(),
-    };
-    let what = shown(event);
-    if what.starts_with("topic") {
-        format!("no node model publishes {what}{hint}")
-    } else {
-        format!("the model sends no {what}{hint}")
-    }
-}
-
-/// Why `param` cannot be read from `event`: a ROS message field (`ros_fields__a__b`, a
-/// port over a topic or service) is named as the user wrote it, with the fields there are.
-fn missing_param(model: &CompiledModel, event: EventId, param: &str) -> String {
-    let params = model.event_params(event);
-    match param.strip_prefix("ros_fields__") {
-        Some(field) => {
-            let fields: Vec<String> = params
-                .iter()
-                .filter_map(|(n, _)| n.strip_prefix("ros_fields__"))
-                .map(|f| f.replace("__", "."))
-                .collect();
-            format!(
-                "the message has no field `{}` (fields: {})",
-                field.replace("__", "."),
-                if fields.is_empty() {
-                    "none".to_string()
-                } else {
-                    fields.join(", ")
-                }
-            )
-        }
-        None => {
-            let names: Vec<&str> = params.iter().map(|(n, _)| n.as_str()).collect();
-            format!(
-                "event `{}` has no parameter `{param}` (parameters: {})",
-                model.event_name(event),
-                if names.is_empty() {
-                    "none".to_string()
-                } else {
-                    names.join(", ")
-                }
-            )
-        }
     }
 }
 
